@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <memory>
+#include <string>
+
+namespace asyncfem {
+
+/// Which factorization backs a SparseSolver.
+enum class SolverKind {
+  cholmod,     ///< CHOLMOD supernodal Cholesky, METIS ordering (SPD matrices; reads the upper triangle)
+  umfpack,     ///< UMFPACK LU (any square non-singular matrix)
+  eigenLDLT,   ///< Eigen SimplicialLDLT (SPD fallback, no SuiteSparse needed at run time)
+  eigenLU,     ///< Eigen SparseLU (unsymmetric fallback)
+};
+/// "cholmod", "umfpack", "eigen-ldlt", "eigen-lu".
+std::string toString(SolverKind kind);
+/// Inverse of toString; throws asyncfem::Error listing the valid names.
+SolverKind parseSolverKind(const std::string& name);
+
+/// Counters a solver keeps; the machine-independent cost figures come from the
+/// factorization libraries themselves (CHOLMOD's Common->fl and lnz, UMFPACK's Info).
+struct SolverStats {
+  long long factorNonZeros = 0;      ///< non-zeros of L (Cholesky) or L+U (LU)
+  double factorFlops = 0.0;          ///< flops of the last numeric factorization
+  double solveFlopsPerRhs = 0.0;     ///< flops of one forward+back substitution (estimate 4*nnz(L) for Cholesky)
+  int analyses = 0;
+  int factorizations = 0;
+  long long solvedRightHandSides = 0;
+  double analyzeSeconds = 0.0, factorSeconds = 0.0, solveSeconds = 0.0;  ///< cumulative wall time
+};
+
+/// A sparse direct solver: symbolic analysis once per pattern, numeric factorization
+/// whenever values change, then any number of solves. Matrices are Eigen column-major
+/// with int indices and full storage (both triangles) even for symmetric ones.
+/// CHOLMOD/UMFPACK types never appear here (pimpl).
+class SparseSolver {
+public:
+  virtual ~SparseSolver() = default;
+
+  /// Symbolic analysis (ordering, elimination tree) of A's pattern.
+  virtual void analyzePattern(const Eigen::SparseMatrix<double>& matrix) = 0;
+  /// Numeric factorization of A, which must have the analysed pattern. Throws
+  /// asyncfem::NumericalError when A is not positive definite (Cholesky) or singular.
+  virtual void factorize(const Eigen::SparseMatrix<double>& matrix) = 0;
+  /// analyzePattern + factorize.
+  void compute(const Eigen::SparseMatrix<double>& matrix) {
+    analyzePattern(matrix);
+    factorize(matrix);
+  }
+  /// Solves A X = B for every column of B (n x k). X is resized.
+  virtual void solve(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) = 0;
+  /// Convenience for one right-hand side.
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) {
+    Eigen::MatrixXd x;
+    solve(rhs, x);
+    return x.col(0);
+  }
+
+  virtual SolverKind kind() const = 0;
+  const SolverStats& stats() const { return stats_; }
+  void resetStats() { stats_ = SolverStats{}; }
+
+protected:
+  SolverStats stats_;
+};
+
+/// Creates a solver of the given kind.
+std::unique_ptr<SparseSolver> makeSparseSolver(SolverKind kind);
+
+}  // namespace asyncfem

@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <vector>
+
+namespace asyncfem {
+
+/// Splits the 3n DOFs into fixed and free ones and moves vectors between the full
+/// (3n) and free (numFree) numbering. Fixed DOFs are removed from systems, never
+/// penalised.
+class FreeDofs {
+public:
+  FreeDofs() = default;
+  /// fixedDofs: global DOF ids (any order, duplicates allowed), each in [0, numDofs).
+  FreeDofs(int numDofs, const std::vector<int>& fixedDofs);
+  /// All three DOFs of each listed vertex are fixed.
+  static FreeDofs fromFixedVertices(int numVertices, const std::vector<int>& fixedVertices);
+
+  int numDofs() const { return static_cast<int>(fullToFree_.size()); }
+  int numFree() const { return static_cast<int>(freeToFull_.size()); }
+  int numFixed() const { return numDofs() - numFree(); }
+  /// free index -> global DOF (ascending).
+  const std::vector<int>& freeToFull() const { return freeToFull_; }
+  /// global DOF -> free index, -1 if fixed.
+  const std::vector<int>& fullToFree() const { return fullToFree_; }
+  bool isFixed(int dof) const { return fullToFree_[static_cast<std::size_t>(dof)] < 0; }
+
+  /// The free entries of a full vector (size numDofs -> numFree).
+  Eigen::VectorXd restrict(const Eigen::VectorXd& full) const;
+  /// A full vector with the free entries from free and the fixed entries zero.
+  Eigen::VectorXd expand(const Eigen::VectorXd& free) const;
+
+private:
+  std::vector<int> freeToFull_;
+  std::vector<int> fullToFree_;
+};
+
+/// Extracts the submatrix A(rows, cols) of a sparse matrix, building its pattern and a
+/// value map once, so that later calls to update() with a matrix of the same pattern
+/// copy values only (one pass, no search). rows and cols are ascending index lists.
+/// Used to remove fixed DOFs (rows = cols = free DOFs) and to cut the asynchronous
+/// integrator's blocks (K^{SS}, K^{SL}, ...).
+class SubmatrixExtractor {
+public:
+  SubmatrixExtractor() = default;
+  SubmatrixExtractor(const Eigen::SparseMatrix<double>& full, const std::vector<int>& rows,
+                     const std::vector<int>& cols);
+
+  /// A new submatrix with values from full.
+  Eigen::SparseMatrix<double> extract(const Eigen::SparseMatrix<double>& full) const;
+  /// Overwrites sub's values (sub from extract()) with those of full.
+  void update(const Eigen::SparseMatrix<double>& full, Eigen::SparseMatrix<double>& sub) const;
+
+private:
+  Eigen::SparseMatrix<double> pattern_;
+  std::vector<int> sourceSlots_;  // for every stored entry of pattern_, its index in full.valuePtr()
+};
+
+}  // namespace asyncfem

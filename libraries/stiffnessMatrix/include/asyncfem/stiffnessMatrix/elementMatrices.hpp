@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+
+namespace asyncfem {
+
+/// Element-local DOF order everywhere: local index 3*a + c for vertex a (0..3) of the
+/// element and coordinate c (x, y, z); global DOF 3*v + c.
+using ElementMatrix = Eigen::Matrix<double, 12, 12>;
+using ElementVector = Eigen::Matrix<double, 12, 1>;
+using ElementPositions = Eigen::Matrix<double, 3, 4>;  ///< columns = the element's vertices
+
+/// Lame parameters from Young's modulus E and Poisson's ratio nu:
+/// lambda = E nu / ((1+nu)(1-2nu)), mu = E / (2(1+nu)).
+Eigen::Vector2d lameParameters(double youngsModulus, double poissonRatio);
+
+/// Gradients of the four linear shape functions (3 x 4, column a = grad N_a) and the
+/// signed volume of a tetrahedron with vertex positions X. Throws nothing; the caller
+/// checks the volume.
+Eigen::Matrix<double, 3, 4> shapeFunctionGradients(const ElementPositions& restPositions, double* signedVolume);
+
+/// Linear (constant-strain) element stiffness K_e = V B^T C B for isotropic material.
+/// Symmetric positive semi-definite, six rigid-body modes in its null space.
+ElementMatrix linearElementStiffness(const ElementPositions& restPositions, double youngsModulus,
+                                     double poissonRatio);
+
+/// Consistent mass of a linear tetrahedron: rho V / 20 * (1 + delta_ab) per coordinate.
+ElementMatrix consistentElementMass(double volume, double density);
+/// Lumped (row-sum) mass: rho V / 4 on each diagonal entry.
+ElementMatrix lumpedElementMass(double volume, double density);
+
+}  // namespace asyncfem

@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <vector>
+
+namespace asyncfem {
+
+/// Signed volume of element e at rest: det([x1-x0, x2-x0, x3-x0]) / 6.
+/// Positive for the orientation the toolkit uses.
+double signedElementVolume(const TetMesh& mesh, int e);
+/// |signed volume| of every element.
+Eigen::VectorXd elementVolumes(const TetMesh& mesh);
+double totalVolume(const TetMesh& mesh);
+/// Sum of rho * V over elements.
+double totalMass(const TetMesh& mesh);
+
+/// Boundary triangles: faces that belong to exactly one element, oriented so that
+/// their normal (b-a)x(c-a) points out of the mesh. Deterministic order.
+std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh);
+
+/// Vertex -> incident elements in compressed form: the elements of vertex v are
+/// elements[offsets[v] .. offsets[v+1]), ascending.
+struct VertexElementAdjacency {
+  std::vector<int> offsets;
+  std::vector<int> elements;
+};
+VertexElementAdjacency vertexElementAdjacency(const TetMesh& mesh);
+
+struct BoundingBox {
+  Eigen::Vector3d min;
+  Eigen::Vector3d max;
+};
+/// Box of the rest positions (of positions + displacement if given, size 3n).
+BoundingBox boundingBox(const TetMesh& mesh, const Eigen::VectorXd& displacement = {});
+
+/// Shape quality of one element.
+struct ElementQuality {
+  double minDihedralAngle = 0.0;  ///< radians
+  double maxDihedralAngle = 0.0;  ///< radians
+  /// Longest edge / (2 * sqrt(6) * inradius): 1 for the regular tetrahedron, grows as
+  /// the element degenerates.
+  double aspectRatio = 0.0;
+};
+ElementQuality elementQuality(const TetMesh& mesh, int e);
+std::vector<ElementQuality> elementQualities(const TetMesh& mesh);
+
+/// Vertices referenced by no element.
+std::vector<int> unusedVertices(const TetMesh& mesh);
+
+}  // namespace asyncfem

@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+/// Isotropic linear-elastic material. SI units are conventional but not required;
+/// the toolkit only needs them consistent.
+struct Material {
+  std::string name;
+  double density = 1000.0;     ///< rho, mass per volume (kg/m^3)
+  double youngsModulus = 1e6;  ///< E (Pa)
+  double poissonRatio = 0.45;  ///< nu, in (-1, 0.5)
+
+  bool operator==(const Material&) const = default;
+};
+
+/// Linear (4-node) tetrahedral mesh with a material per element and named vertex and
+/// element sets. Indices are 0-based everywhere in the API; readers and writers convert.
+///
+/// Invariants (checked by the constructor and the mutators, which throw
+/// asyncfem::ValidationError naming the offending element, vertex, set or material):
+/// - every element index is in [0, numVertices), the four indices of an element differ;
+/// - every element has a material index in [0, materials().size());
+/// - every material has E > 0, rho > 0, -1 < nu < 0.5, all finite;
+/// - all rest positions are finite;
+/// - set members are in range; set names are non-empty.
+/// Element orientation (positive signed volume) is the readers' business (see
+/// readers.hpp), not an invariant of this class, so algorithms that need it check.
+class TetMesh {
+public:
+  TetMesh() = default;
+  /// restPositions: 3 x numVertices; elements: 4 x numElements (0-based vertex ids);
+  /// elementMaterials: numElements entries, each an index into materials.
+  TetMesh(Eigen::Matrix3Xd restPositions, Eigen::Matrix4Xi elements, std::vector<Material> materials,
+          std::vector<int> elementMaterials);
+
+  int numVertices() const { return static_cast<int>(restPositions_.cols()); }
+  int numElements() const { return static_cast<int>(elements_.cols()); }
+  /// Number of degrees of freedom, 3 * numVertices.
+  int numDofs() const { return 3 * numVertices(); }
+
+  const Eigen::Matrix3Xd& restPositions() const { return restPositions_; }
+  Eigen::Vector3d restPosition(int vertex) const { return restPositions_.col(vertex); }
+  const Eigen::Matrix4Xi& elements() const { return elements_; }
+  Eigen::Vector4i element(int e) const { return elements_.col(e); }
+  /// 3 x 4 matrix of the rest positions of element e's vertices (columns in element order).
+  Eigen::Matrix<double, 3, 4> elementRestPositions(int e) const;
+
+  const std::vector<Material>& materials() const { return materials_; }
+  const std::vector<int>& elementMaterials() const { return elementMaterials_; }
+  int elementMaterialIndex(int e) const { return elementMaterials_[static_cast<std::size_t>(e)]; }
+  const Material& elementMaterial(int e) const { return materials_[static_cast<std::size_t>(elementMaterialIndex(e))]; }
+  /// Index of the material called name, or -1.
+  int findMaterial(const std::string& name) const;
+  /// Adds a material (or replaces the one with the same name) and returns its index.
+  int addMaterial(const Material& material);
+  /// Assigns material index to every element of the element set called setName.
+  void assignMaterial(const std::string& setName, int materialIndex);
+
+  /// Named element sets (sorted, unique, 0-based element ids).
+  const std::map<std::string, std::vector<int>>& elementSets() const { return elementSets_; }
+  /// Named vertex sets (sorted, unique, 0-based vertex ids).
+  const std::map<std::string, std::vector<int>>& vertexSets() const { return vertexSets_; }
+  /// The element set called name; "allElements" always exists implicitly.
+  /// Throws ValidationError naming the set (and listing the known ones) if absent.
+  std::vector<int> elementSet(const std::string& name) const;
+  /// The vertex set called name; throws ValidationError naming it if absent.
+  const std::vector<int>& vertexSet(const std::string& name) const;
+  /// Adds or replaces a set; members are sorted and de-duplicated, range-checked.
+  void setElementSet(const std::string& name, std::vector<int> elements);
+  void setVertexSet(const std::string& name, std::vector<int> vertices);
+
+  /// Replaces the vertex order of element e (used by readers to fix orientation).
+  void setElement(int e, const Eigen::Vector4i& vertices);
+
+private:
+  void validate() const;
+
+  Eigen::Matrix3Xd restPositions_;
+  Eigen::Matrix4Xi elements_;
+  std::vector<Material> materials_;
+  std::vector<int> elementMaterials_;
+  std::map<std::string, std::vector<int>> elementSets_;
+  std::map<std::string, std::vector<int>> vertexSets_;
+};
+
+}  // namespace asyncfem
