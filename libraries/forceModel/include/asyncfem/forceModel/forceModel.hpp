@@ -1,0 +1,42 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+namespace asyncfem {
+
+/// Internal elastic forces of a body as a function of its displacement.
+///
+/// Sign convention (as in Vega FEM): f_int(u) is the force the material exerts
+/// *against* the deformation, so the equations of motion read
+///     M a + D v + f_int(u) = f_ext.
+/// For linear FEM f_int(u) = K u. All vectors are stacked 3n (x0 y0 z0 x1 ...), all
+/// matrices 3n x 3n in the pattern of the force model's assembler (full storage).
+/// Implementations are called once per (large) step, so one virtual call per step is
+/// fine; element loops inside are non-virtual and parallel.
+class ForceModel {
+public:
+  virtual ~ForceModel() = default;
+
+  virtual int numDofs() const = 0;
+  /// True when f_int(u) = K u with a constant K: integrators may then factor once.
+  virtual bool isLinear() const = 0;
+
+  /// A matrix with the pattern tangentStiffness() fills (all values zero).
+  virtual Eigen::SparseMatrix<double> createStiffnessMatrix() const = 0;
+  /// f_int(u), size 3n.
+  virtual void internalForces(const Eigen::VectorXd& displacement, Eigen::VectorXd& forces) = 0;
+  /// K(u) = d f_int / d u into stiffness (pattern from createStiffnessMatrix()).
+  virtual void tangentStiffness(const Eigen::VectorXd& displacement, Eigen::SparseMatrix<double>& stiffness) = 0;
+  /// Both at once; implementations that share work (rotations) override it.
+  virtual void forcesAndTangent(const Eigen::VectorXd& displacement, Eigen::VectorXd& forces,
+                                Eigen::SparseMatrix<double>& stiffness) {
+    internalForces(displacement, forces);
+    tangentStiffness(displacement, stiffness);
+  }
+  /// Elastic potential energy at u (0 at rest).
+  virtual double elasticEnergy(const Eigen::VectorXd& displacement) = 0;
+};
+
+}  // namespace asyncfem

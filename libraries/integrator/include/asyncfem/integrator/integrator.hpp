@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <asyncfem/forceModel/forceModel.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+/// External force as a function of time and state: adds its contribution to forces
+/// (size 3n, zeroed by the caller). The state arguments let explicit force terms
+/// (penalty contact, springs) depend on it; time-only loads ignore them.
+using ExternalForceFunction = std::function<void(double time, const Eigen::VectorXd& displacement,
+                                                 const Eigen::VectorXd& velocity, Eigen::VectorXd& forces)>;
+
+/// The body an integrator advances: M a + D v + f_int(u) = f_ext(t), with
+/// D = alpha M + beta K (K the tangent stiffness at the start of a step) and the DOFs in
+/// freeDofs' fixed list held at zero displacement and velocity.
+struct DynamicSystem {
+  std::shared_ptr<ForceModel> forceModel;
+  Eigen::SparseMatrix<double> mass;  ///< 3n x 3n, in the force model's stiffness pattern
+  FreeDofs freeDofs;
+  double rayleighMass = 0.0;       ///< alpha
+  double rayleighStiffness = 0.0;  ///< beta
+  ExternalForceFunction externalForce;  ///< may be empty: no external force
+
+  int numDofs() const { return static_cast<int>(mass.rows()); }
+  bool damped() const { return rayleighMass != 0.0 || rayleighStiffness != 0.0; }
+  /// Throws asyncfem::ValidationError if sizes disagree or alpha, beta < 0.
+  void validate() const;
+};
+
+/// Where the time of a run went, and machine-independent counts.
+struct IntegratorStats {
+  double forceSeconds = 0.0;          ///< f_int and tangent element loops
+  double assemblySeconds = 0.0;       ///< building system matrices / blocks from K, M
+  double factorizationSeconds = 0.0;  ///< numeric factorizations (symbolic included)
+  double solveSeconds = 0.0;          ///< back-substitutions and dense block products
+  long long steps = 0;                ///< calls to step()
+  long long factorizations = 0;
+  long long solvedRightHandSides = 0;
+  double factorFlops = 0.0;           ///< sum over factorizations, as the solver library reports
+  double solveFlops = 0.0;            ///< sum over back-substitutions (estimate from factor non-zeros)
+  std::vector<std::string> skipped;   ///< work the configuration made unnecessary, for the run summary
+};
+
+/// One time integrator: owns the state (u, v, t) of a DynamicSystem and advances it by
+/// step(). The linear solves are done by a SparseSolver the integrator owns, so
+/// integrators and solvers can be swapped independently.
+///
+/// State vectors are full (3n); fixed DOFs are kept at exactly zero.
+class Integrator {
+public:
+  Integrator(DynamicSystem system, double timestep);
+  virtual ~Integrator() = default;
+  Integrator(const Integrator&) = delete;
+  Integrator& operator=(const Integrator&) = delete;
+
+  /// Short name used in scenes and utilities ("backward-euler", "async", ...).
+  virtual std::string name() const = 0;
+  /// Advances the state by timestep() (for multirate integrators: one large step).
+  virtual void step() = 0;
+  /// Largest timestep this integrator is stable for on this system, or +inf when
+  /// unconditionally stable (implicit methods).
+  virtual double stableTimestepEstimate() const;
+
+  /// Sets u and v (size 3n; fixed entries are zeroed) and the time.
+  void setState(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, double time = 0.0);
+  const Eigen::VectorXd& displacement() const { return displacement_; }
+  const Eigen::VectorXd& velocity() const { return velocity_; }
+  double time() const { return time_; }
+  double timestep() const { return timestep_; }
+  /// Changes h; implicit integrators refactor lazily at the next step.
+  virtual void setTimestep(double timestep);
+
+  const DynamicSystem& system() const { return system_; }
+  /// Kinetic energy v^T M v / 2 plus the force model's elastic energy.
+  double mechanicalEnergy() const;
+  const IntegratorStats& stats() const { return stats_; }
+
+protected:
+  /// The external force at time t and the current state (size 3n; zero if none).
+  void evaluateExternalForce(double time, Eigen::VectorXd& forces) const;
+  /// Zeroes the fixed entries of a full vector.
+  void zeroFixed(Eigen::VectorXd& full) const;
+
+  DynamicSystem system_;
+  Eigen::VectorXd displacement_;
+  Eigen::VectorXd velocity_;
+  double time_ = 0.0;
+  double timestep_ = 0.0;
+  IntegratorStats stats_;
+};
+
+}  // namespace asyncfem
