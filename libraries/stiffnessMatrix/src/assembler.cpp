@@ -1,2 +1,468 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// placeholder: implementation pending
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
+
+#include "detail/linearStiffness.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <numeric>
+#include <string>
+
+namespace asyncfem {
+
+namespace {
+
+using Index = std::size_t;
+
+Index toIndex(int i) { return static_cast<Index>(i); }
+
+// Prefix sum of counts in place: counts[i] becomes the start of segment i; returns the
+// total. counts has one trailing entry that receives the total.
+long long exclusiveScan(std::vector<int>& counts) {
+  long long running = 0;
+  for (int& c : counts) {
+    const long long count = c;
+    if (running > INT_MAX) throw Error("MatrixAssembler: index overflow while building the pattern");
+    c = static_cast<int>(running);
+    running += count;
+  }
+  return running;
+}
+
+// Chunk colouring: chunks of chunkSize consecutive elements; greedy, smallest colour not
+// used by an earlier chunk sharing a vertex. Returns the colour of every chunk.
+std::vector<int> colorChunks(const Eigen::Matrix4Xi& elements, int numVertices, int chunkSize, int* numColors) {
+  const int numElements = static_cast<int>(elements.cols());
+  const int numChunks = (numElements + chunkSize - 1) / chunkSize;
+  // Distinct vertices of every chunk (CSR).
+  std::vector<int> chunkVertexOffsets(toIndex(numChunks) + 1, 0);
+  std::vector<int> chunkVertices(toIndex(numElements) * 4);
+  {
+    std::vector<int> scratch;
+    int written = 0;
+    for (int chunk = 0; chunk < numChunks; ++chunk) {
+      const int first = chunk * chunkSize;
+      const int last = std::min(numElements, first + chunkSize);
+      scratch.assign(elements.data() + (toIndex(first) * 4), elements.data() + (toIndex(last) * 4));
+      std::sort(scratch.begin(), scratch.end());
+      scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+      chunkVertexOffsets[toIndex(chunk)] = written;
+      std::copy(scratch.begin(), scratch.end(), chunkVertices.begin() + written);
+      written += static_cast<int>(scratch.size());
+    }
+    chunkVertexOffsets[toIndex(numChunks)] = written;
+    chunkVertices.resize(toIndex(written));
+  }
+  // Transpose: the chunks touching every vertex, ascending.
+  std::vector<int> vertexChunkOffsets(toIndex(numVertices) + 1, 0);
+  for (int v : chunkVertices) ++vertexChunkOffsets[toIndex(v)];
+  exclusiveScan(vertexChunkOffsets);
+  std::vector<int> vertexChunks(chunkVertices.size());
+  {
+    std::vector<int> fill(vertexChunkOffsets.begin(), vertexChunkOffsets.end() - 1);
+    for (int chunk = 0; chunk < numChunks; ++chunk) {
+      for (int p = chunkVertexOffsets[toIndex(chunk)]; p < chunkVertexOffsets[toIndex(chunk) + 1]; ++p) {
+        const int v = chunkVertices[toIndex(p)];
+        vertexChunks[toIndex(fill[toIndex(v)]++)] = chunk;
+      }
+    }
+  }
+  std::vector<int> colors(toIndex(numChunks), -1);
+  std::vector<int> forbiddenBy;  // forbiddenBy[c] == chunk: colour c is taken by a neighbour of chunk
+  int colorCount = 0;
+  for (int chunk = 0; chunk < numChunks; ++chunk) {
+    for (int p = chunkVertexOffsets[toIndex(chunk)]; p < chunkVertexOffsets[toIndex(chunk) + 1]; ++p) {
+      const int v = chunkVertices[toIndex(p)];
+      for (int q = vertexChunkOffsets[toIndex(v)]; q < vertexChunkOffsets[toIndex(v) + 1]; ++q) {
+        const int other = vertexChunks[toIndex(q)];
+        if (other >= chunk) break;  // ascending: the rest are not coloured yet
+        forbiddenBy[toIndex(colors[toIndex(other)])] = chunk;
+      }
+    }
+    int color = 0;
+    while (color < colorCount && forbiddenBy[toIndex(color)] == chunk) ++color;
+    if (color == colorCount) {
+      ++colorCount;
+      forbiddenBy.push_back(-1);
+    }
+    colors[toIndex(chunk)] = color;
+  }
+  *numColors = colorCount;
+  return colors;
+}
+
+}  // namespace
+
+MatrixAssembler::MatrixAssembler(const TetMesh& mesh)
+    : numDofs_(mesh.numDofs()), numElements_(mesh.numElements()), elements_(mesh.elements()) {
+  const int numVertices = mesh.numVertices();
+  const Index vertexCount = toIndex(numVertices);
+
+  // Candidate row vertices of every column vertex: the four vertices of each incident
+  // element, plus the vertex itself so that every diagonal block is in the pattern even
+  // for vertices no element uses. Two counting passes, then one sort per (short) list.
+  std::vector<int> candidateOffsets(vertexCount + 1, 0);
+  for (Index v = 0; v < vertexCount; ++v) candidateOffsets[v] = 1;
+  for (Index k = 0; k < toIndex(numElements_) * 4; ++k) candidateOffsets[toIndex(elements_.data()[k])] += 4;
+  const long long candidateCount = exclusiveScan(candidateOffsets);
+  std::vector<int> candidates(static_cast<Index>(candidateCount));
+  {
+    std::vector<int> fill(candidateOffsets.begin(), candidateOffsets.end() - 1);
+    for (int v = 0; v < numVertices; ++v) candidates[toIndex(fill[toIndex(v)]++)] = v;
+    for (int e = 0; e < numElements_; ++e) {
+      for (int b = 0; b < 4; ++b) {
+        const int column = elements_(b, e);
+        int& position = fill[toIndex(column)];
+        for (int a = 0; a < 4; ++a) candidates[toIndex(position++)] = elements_(a, e);
+      }
+    }
+  }
+  std::vector<int> neighbourCounts(vertexCount + 1, 0);
+#pragma omp parallel for schedule(dynamic, 1024)
+  for (int v = 0; v < numVertices; ++v) {
+    int* first = candidates.data() + candidateOffsets[toIndex(v)];
+    int* last = candidates.data() + candidateOffsets[toIndex(v) + 1];
+    std::sort(first, last);
+    neighbourCounts[toIndex(v)] = static_cast<int>(std::unique(first, last) - first);
+  }
+  const long long blockCount = exclusiveScan(neighbourCounts);
+  if (9 * blockCount > INT_MAX) {
+    throw Error("MatrixAssembler: the pattern has " + std::to_string(9 * blockCount) +
+                " entries, more than int indices can address");
+  }
+  blockOuter_ = std::move(neighbourCounts);
+  blockRows_.resize(static_cast<Index>(blockCount));
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < numVertices; ++v) {
+    const int count = blockOuter_[toIndex(v) + 1] - blockOuter_[toIndex(v)];
+    std::copy_n(candidates.begin() + candidateOffsets[toIndex(v)], count, blockRows_.begin() + blockOuter_[toIndex(v)]);
+  }
+  candidates = std::vector<int>();
+  candidateOffsets = std::vector<int>();
+
+  // Block slots by binary search in the (short, sorted) row list of the column vertex.
+  blockSlots_.resize(toIndex(numElements_) * 16);
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < numElements_; ++e) {
+    for (int b = 0; b < 4; ++b) {
+      const Index column = toIndex(elements_(b, e));
+      const int* first = blockRows_.data() + blockOuter_[column];
+      const int* last = blockRows_.data() + blockOuter_[column + 1];
+      for (int a = 0; a < 4; ++a) {
+        const int position = static_cast<int>(std::lower_bound(first, last, elements_(a, e)) - blockRows_.data());
+        // Scalar column 3 vb starts at 9 * blockOuter_[vb]; block row p starts 3 p below.
+        blockSlots_[(toIndex(e) * 16) + toIndex((b * 4) + a)] =
+            (9 * blockOuter_[column]) + (3 * (position - blockOuter_[column]));
+      }
+    }
+  }
+
+  // Scheduling: colour chunks of consecutive elements (good locality within a chunk);
+  // shrink the chunks until every colour has enough of them to keep threads busy. The
+  // result depends on the mesh only, never on the thread count.
+  int chunkSize = std::max(1, std::min(256, numElements_ / 64));
+  std::vector<int> colors;
+  int numColors = 0;
+  while (true) {
+    colors = colorChunks(elements_, numVertices, chunkSize, &numColors);
+    const int numChunks = static_cast<int>(colors.size());
+    if (chunkSize == 1 || numChunks >= 16 * numColors) break;
+    chunkSize = std::max(1, chunkSize / 4);
+  }
+  chunkSize_ = chunkSize;
+  colorOffsets_.assign(toIndex(numColors) + 1, 0);
+  for (int c : colors) ++colorOffsets_[toIndex(c)];
+  exclusiveScan(colorOffsets_);
+  coloredChunks_.resize(colors.size());
+  std::vector<int> fill(colorOffsets_.begin(), colorOffsets_.end() - 1);
+  for (int chunk = 0; chunk < static_cast<int>(colors.size()); ++chunk) {
+    coloredChunks_[toIndex(fill[toIndex(colors[toIndex(chunk)])]++)] = chunk;
+  }
+}
+
+Eigen::Index MatrixAssembler::nonZeros() const {
+  return blockOuter_.empty() ? 0 : 9 * static_cast<Eigen::Index>(blockOuter_.back());
+}
+
+Eigen::SparseMatrix<double> MatrixAssembler::createMatrix() const {
+  Eigen::SparseMatrix<double> matrix(numDofs_, numDofs_);
+  const Eigen::Index nnz = nonZeros();
+  matrix.resizeNonZeros(nnz);
+  int* outer = matrix.outerIndexPtr();
+  int* inner = matrix.innerIndexPtr();
+  double* values = matrix.valuePtr();
+  const int numVertices = numDofs_ / 3;
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < numVertices; ++v) {
+    const int begin = blockOuter_[toIndex(v)];
+    const int count = blockOuter_[toIndex(v) + 1] - begin;
+    for (int cj = 0; cj < 3; ++cj) {
+      const int start = (9 * begin) + (cj * 3 * count);
+      outer[(3 * v) + cj] = start;
+      for (int p = 0; p < count; ++p) {
+        const int row = 3 * blockRows_[toIndex(begin + p)];
+        for (int ci = 0; ci < 3; ++ci) {
+          inner[start + (3 * p) + ci] = row + ci;
+          values[start + (3 * p) + ci] = 0.0;
+        }
+      }
+    }
+  }
+  outer[numDofs_] = static_cast<int>(nnz);
+  return matrix;
+}
+
+void MatrixAssembler::checkPattern(const Eigen::SparseMatrix<double>& matrix, const char* caller) const {
+  // Sizes and column starts are cheap to compare and catch every matrix not made by
+  // createMatrix() of an assembler of the same mesh connectivity.
+  const bool same = matrix.rows() == numDofs_ && matrix.cols() == numDofs_ && matrix.isCompressed() &&
+                    matrix.nonZeros() == nonZeros() && [&] {
+                      const int* outer = matrix.outerIndexPtr();
+                      for (int v = 0; v < numDofs_ / 3; ++v) {
+                        if (outer[3 * v] != 9 * blockOuter_[toIndex(v)]) return false;
+                      }
+                      return true;
+                    }();
+  if (!same) {
+    throw Error(std::string("MatrixAssembler::") + caller + ": the " + std::to_string(matrix.rows()) + " x " +
+                std::to_string(matrix.cols()) + " matrix with " + std::to_string(matrix.nonZeros()) +
+                " stored entries does not have the assembler's pattern (" + std::to_string(numDofs_) + " x " +
+                std::to_string(numDofs_) + ", " + std::to_string(nonZeros()) + " entries); create it with createMatrix()");
+  }
+}
+
+template <class ElementFunction>
+void MatrixAssembler::assembleWith(const ElementFunction& elementMatrix, Eigen::SparseMatrix<double>& matrix) const {
+  checkPattern(matrix, "assemble");
+  double* values = matrix.valuePtr();
+  const Eigen::Index nnz = matrix.nonZeros();
+  const int numColors = this->numColors();
+  // Exceptions may not leave a parallel region: keep the one of the lowest failing
+  // element (all elements are still visited) so that the error reported does not depend
+  // on the thread count or the schedule.
+  std::exception_ptr firstError;
+  int firstErrorElement = INT_MAX;
+#pragma omp parallel
+  {
+#pragma omp for schedule(static)
+    for (Eigen::Index k = 0; k < nnz; ++k) values[k] = 0.0;
+    // Colours in order, the chunks of one colour in parallel; chunks of one colour share
+    // no vertex, so no two threads write the same value and every entry receives its
+    // contributions in the same order whatever the thread count.
+    for (int color = 0; color < numColors; ++color) {
+#pragma omp for schedule(dynamic, 1)
+      for (int k = colorOffsets_[toIndex(color)]; k < colorOffsets_[toIndex(color) + 1]; ++k) {
+        const int chunk = coloredChunks_[toIndex(k)];
+        const int first = chunk * chunkSize_;
+        const int last = std::min(numElements_, first + chunkSize_);
+        ElementMatrix local;
+        for (int e = first; e < last; ++e) {
+          try {
+            elementMatrix(e, local);
+          } catch (...) {
+#pragma omp critical(asyncfem_assembler_error)
+            {
+              if (e < firstErrorElement) {
+                firstErrorElement = e;
+                firstError = std::current_exception();
+              }
+            }
+            continue;
+          }
+          const int* slots = blockSlots_.data() + (toIndex(e) * 16);
+          for (int b = 0; b < 4; ++b) {
+            const Index columnVertex = toIndex(elements_(b, e));
+            const int columnLength = 3 * (blockOuter_[columnVertex + 1] - blockOuter_[columnVertex]);
+            for (int a = 0; a < 4; ++a) {
+              double* block = values + slots[(b * 4) + a];
+              for (int cj = 0; cj < 3; ++cj) {
+                double* column = block + (cj * columnLength);
+                for (int ci = 0; ci < 3; ++ci) column[ci] += local((3 * a) + ci, (3 * b) + cj);
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  if (firstError) std::rethrow_exception(firstError);
+}
+
+void MatrixAssembler::assemble(const ElementMatrixFunction& elementMatrix, Eigen::SparseMatrix<double>& matrix) const {
+  assembleWith(elementMatrix, matrix);
+}
+
+void MatrixAssembler::assemble(const std::vector<ElementMatrix>& elementMatrices,
+                               Eigen::SparseMatrix<double>& matrix) const {
+  if (elementMatrices.size() != toIndex(numElements_)) {
+    throw Error("MatrixAssembler::assemble: got " + std::to_string(elementMatrices.size()) +
+                " element matrices for a mesh of " + std::to_string(numElements_) + " elements");
+  }
+  assembleWith([&](int e, ElementMatrix& out) { out = elementMatrices[toIndex(e)]; }, matrix);
+}
+
+Eigen::VectorXd MatrixAssembler::assembleVector(const ElementVectorFunction& elementVector) const {
+  Eigen::VectorXd result = Eigen::VectorXd::Zero(numDofs_);
+  double* values = result.data();
+  const int numColors = this->numColors();
+  std::exception_ptr firstError;
+  int firstErrorElement = INT_MAX;
+#pragma omp parallel
+  {
+    for (int color = 0; color < numColors; ++color) {
+#pragma omp for schedule(dynamic, 1)
+      for (int k = colorOffsets_[toIndex(color)]; k < colorOffsets_[toIndex(color) + 1]; ++k) {
+        const int chunk = coloredChunks_[toIndex(k)];
+        const int first = chunk * chunkSize_;
+        const int last = std::min(numElements_, first + chunkSize_);
+        ElementVector local;
+        for (int e = first; e < last; ++e) {
+          try {
+            elementVector(e, local);
+          } catch (...) {
+#pragma omp critical(asyncfem_assembler_error)
+            {
+              if (e < firstErrorElement) {
+                firstErrorElement = e;
+                firstError = std::current_exception();
+              }
+            }
+            continue;
+          }
+          for (int a = 0; a < 4; ++a) {
+            double* vertexValues = values + (3 * toIndex(elements_(a, e)));
+            for (int c = 0; c < 3; ++c) vertexValues[c] += local((3 * a) + c);
+          }
+        }
+      }
+    }
+  }
+  if (firstError) std::rethrow_exception(firstError);
+  return result;
+}
+
+namespace {
+
+// Throws ValidationError when element e is degenerate: |V| tiny against its longest edge
+// cubed (a regular tetrahedron has V = 0.118 L^3), or not finite.
+void checkVolume(int e, double signedVolume, const ElementPositions& x) {
+  double longestEdge = 0.0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) longestEdge = std::max(longestEdge, (x.col(a) - x.col(b)).norm());
+  if (!(std::abs(signedVolume) > 1e-14 * longestEdge * longestEdge * longestEdge)) {
+    throw ValidationError("element " + std::to_string(e) + " is degenerate (signed volume " +
+                          std::to_string(signedVolume) + ", longest edge " + std::to_string(longestEdge) + ")");
+  }
+}
+
+}  // namespace
+
+Eigen::SparseMatrix<double> linearStiffnessMatrix(const TetMesh& mesh, const MatrixAssembler& assembler) {
+  if (mesh.numElements() != assembler.numElements() || mesh.numDofs() != assembler.numDofs()) {
+    throw Error("linearStiffnessMatrix: the assembler was built for another mesh");
+  }
+  // Lame parameters once per material instead of once per element.
+  std::vector<Eigen::Vector2d> lame;
+  for (const Material& m : mesh.materials()) lame.push_back(lameParameters(m.youngsModulus, m.poissonRatio));
+  Eigen::SparseMatrix<double> stiffness = assembler.createMatrix();
+  assembler.assembleWith(
+      [&](int e, ElementMatrix& out) {
+        const ElementPositions x = mesh.elementRestPositions(e);
+        double signedVolume = 0.0;
+        const Eigen::Matrix<double, 3, 4> g = shapeFunctionGradients(x, &signedVolume);
+        checkVolume(e, signedVolume, x);
+        const Eigen::Vector2d& parameters = lame[toIndex(mesh.elementMaterialIndex(e))];
+        const double volume = std::abs(signedVolume);
+        detail::linearStiffnessFromGradients(g, parameters[0] * volume, parameters[1] * volume, out);
+      },
+      stiffness);
+  return stiffness;
+}
+
+Eigen::SparseMatrix<double> massMatrix(const TetMesh& mesh, const MatrixAssembler& assembler, MassType type) {
+  if (mesh.numElements() != assembler.numElements() || mesh.numDofs() != assembler.numDofs()) {
+    throw Error("massMatrix: the assembler was built for another mesh");
+  }
+  Eigen::SparseMatrix<double> mass = assembler.createMatrix();
+  assembler.assembleWith(
+      [&](int e, ElementMatrix& out) {
+        const ElementPositions x = mesh.elementRestPositions(e);
+        double signedVolume = 0.0;
+        shapeFunctionGradients(x, &signedVolume);
+        checkVolume(e, signedVolume, x);
+        const double density = mesh.elementMaterial(e).density;
+        out = type == MassType::consistent ? consistentElementMass(signedVolume, density)
+                                           : lumpedElementMass(signedVolume, density);
+      },
+      mass);
+  return mass;
+}
+
+Eigen::SparseMatrix<double> rayleighDamping(const Eigen::SparseMatrix<double>& mass,
+                                            const Eigen::SparseMatrix<double>& stiffness, double alpha,
+                                            double beta) {
+  Eigen::SparseMatrix<double> damping;
+  combine({alpha, beta}, {&mass, &stiffness}, damping);
+  return damping;
+}
+
+namespace {
+
+bool samePattern(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix<double>& b) {
+  if (&a == &b) return true;
+  if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros()) return false;
+  if (!a.isCompressed() || !b.isCompressed()) return false;
+  const Index outerBytes = (toIndex(static_cast<int>(a.cols())) + 1) * sizeof(int);
+  const Index innerBytes = static_cast<Index>(a.nonZeros()) * sizeof(int);
+  return std::memcmp(a.outerIndexPtr(), b.outerIndexPtr(), outerBytes) == 0 &&
+         (a.innerIndexPtr() == b.innerIndexPtr() ||
+          std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), innerBytes) == 0);
+}
+
+}  // namespace
+
+void combine(const std::vector<double>& coefficients, const std::vector<const Eigen::SparseMatrix<double>*>& matrices,
+             Eigen::SparseMatrix<double>& out) {
+  if (coefficients.size() != matrices.size() || matrices.empty()) {
+    throw Error("combine: need as many coefficients as matrices, at least one (got " +
+                std::to_string(coefficients.size()) + " coefficients, " + std::to_string(matrices.size()) +
+                " matrices)");
+  }
+  for (std::size_t i = 0; i < matrices.size(); ++i) {
+    if (matrices[i] == nullptr) throw Error("combine: matrix " + std::to_string(i) + " is null");
+    if (!matrices[i]->isCompressed()) throw Error("combine: matrix " + std::to_string(i) + " is not compressed");
+    if (!samePattern(*matrices[0], *matrices[i])) {
+      throw Error("combine: matrix " + std::to_string(i) + " (" + std::to_string(matrices[i]->rows()) + " x " +
+                  std::to_string(matrices[i]->cols()) + ", " + std::to_string(matrices[i]->nonZeros()) +
+                  " entries) does not have the pattern of matrix 0 (" + std::to_string(matrices[0]->rows()) + " x " +
+                  std::to_string(matrices[0]->cols()) + ", " + std::to_string(matrices[0]->nonZeros()) + " entries)");
+    }
+  }
+  const Eigen::SparseMatrix<double>& reference = *matrices[0];
+  // out may alias one of the inputs: keep its values until all reads of an entry are done
+  // (each entry is read and written by the same iteration, so in-place is safe).
+  bool aliased = false;
+  for (const auto* m : matrices) aliased = aliased || m == &out;
+  if (!aliased && !samePattern(reference, out)) {
+    out = reference;  // copies the pattern (values are overwritten below)
+  }
+  const Eigen::Index nnz = reference.nonZeros();
+  const std::size_t count = matrices.size();
+  std::vector<const double*> sources(count);
+  for (std::size_t i = 0; i < count; ++i) sources[i] = matrices[i]->valuePtr();
+  double* target = out.valuePtr();
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index k = 0; k < nnz; ++k) {
+    double sum = coefficients[0] * sources[0][k];
+    for (std::size_t i = 1; i < count; ++i) sum += coefficients[i] * sources[i][k];
+    target[k] = sum;
+  }
+}
+
+}  // namespace asyncfem

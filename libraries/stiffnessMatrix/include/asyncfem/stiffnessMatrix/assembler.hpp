@@ -12,6 +12,9 @@
 
 namespace asyncfem {
 
+/// Consistent (rho V / 20 (1 + delta_ab)) or row-sum lumped (rho V / 4) element mass.
+enum class MassType { consistent, lumped };
+
 /// Sparsity pattern of the 3n x 3n matrices of a tet mesh (full storage, both triangles,
 /// column-major, int indices, sorted row indices) computed once, plus an element -> value
 /// slot map: slot(e, i, j) is the index into valuePtr() where entry (i, j) of element e's
@@ -32,7 +35,25 @@ public:
   /// Number of stored entries (both triangles).
   Eigen::Index nonZeros() const;
   /// Index into valuePtr() of local entry (i, j) of element e, i, j in [0, 12).
-  int slot(int e, int i, int j) const { return slots_[(static_cast<std::size_t>(e) * 144) + (i * 12) + j]; }
+  ///
+  /// Only one slot per vertex pair is stored (16 per element): the three columns of a
+  /// vertex share one row pattern and the three rows of a vertex are consecutive, so
+  /// entry (3a + ci, 3b + cj) lies ci entries below the stored block slot of (a, b) and
+  /// cj times the length of vertex b's columns further on.
+  int slot(int e, int i, int j) const {
+    const int a = i / 3;
+    const int b = j / 3;
+    const int columnVertex = elements_(b, e);
+    const auto v = static_cast<std::size_t>(columnVertex);
+    const int columnLength = 3 * (blockOuter_[v + 1] - blockOuter_[v]);
+    return blockSlots_[(static_cast<std::size_t>(e) * 16) + static_cast<std::size_t>((b * 4) + a)] + (i - (3 * a)) +
+           ((j - (3 * b)) * columnLength);
+  }
+  /// Number of element groups processed one after another during assembly (elements of
+  /// one group share no vertex with each other group of the same colour).
+  int numColors() const { return static_cast<int>(colorOffsets_.size()) - 1; }
+  /// Elements per group (consecutive element ids) used by the scheduling.
+  int elementsPerChunk() const { return chunkSize_; }
 
   /// Computes one element's 12x12 matrix; called concurrently for different elements.
   using ElementMatrixFunction = std::function<void(int element, ElementMatrix& out)>;
@@ -48,20 +69,37 @@ public:
   Eigen::VectorXd assembleVector(const ElementVectorFunction& elementVector) const;
 
 private:
+  friend Eigen::SparseMatrix<double> linearStiffnessMatrix(const TetMesh& mesh, const MatrixAssembler& assembler);
+  friend Eigen::SparseMatrix<double> massMatrix(const TetMesh& mesh, const MatrixAssembler& assembler,
+                                                MassType type);
+  // Scatter-adds callback(e, Ke) for every element in the deterministic colour order;
+  // defined (and instantiated) in assembler.cpp only, so callers need no OpenMP flags.
+  template <class ElementFunction>
+  void assembleWith(const ElementFunction& elementMatrix, Eigen::SparseMatrix<double>& matrix) const;
+  void checkPattern(const Eigen::SparseMatrix<double>& matrix, const char* caller) const;
+
   int numDofs_ = 0;
   int numElements_ = 0;
+  int chunkSize_ = 1;
   Eigen::Matrix4Xi elements_;
-  Eigen::SparseMatrix<double> pattern_;
-  std::vector<int> slots_;  // numElements * 144
-  // Private scheduling data (e.g. element colouring) lives here.
+  // Vertex-block pattern, CSR by column vertex: the row vertices of column vertex v are
+  // blockRows_[blockOuter_[v] .. blockOuter_[v+1]), ascending. The scalar pattern
+  // (3x3 dense blocks) follows from it, so it is not stored here.
+  std::vector<int> blockOuter_;
+  std::vector<int> blockRows_;
+  // numElements * 16: valuePtr() index of entry (3 va, 3 vb) for the element's vertex
+  // pair (a, b), at e * 16 + b * 4 + a.
+  std::vector<int> blockSlots_;
+  // Elements are grouped in chunks of chunkSize_ consecutive ids; chunks are coloured so
+  // that chunks of one colour share no vertex. Colour c holds the chunks
+  // coloredChunks_[colorOffsets_[c] .. colorOffsets_[c+1]).
   std::vector<int> colorOffsets_;
-  std::vector<int> coloredElements_;
+  std::vector<int> coloredChunks_;
 };
 
 /// Linear FEM stiffness K (3n x 3n) of the mesh with its per-element materials.
 Eigen::SparseMatrix<double> linearStiffnessMatrix(const TetMesh& mesh, const MatrixAssembler& assembler);
 
-enum class MassType { consistent, lumped };
 /// Mass matrix M (3n x 3n) in the assembler's pattern (lumped: only diagonal values
 /// non-zero, pattern unchanged). Sums to rho V per coordinate.
 Eigen::SparseMatrix<double> massMatrix(const TetMesh& mesh, const MatrixAssembler& assembler, MassType type);

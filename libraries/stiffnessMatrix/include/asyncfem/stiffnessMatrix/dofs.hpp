@@ -57,6 +57,10 @@ public:
 private:
   Eigen::SparseMatrix<double> pattern_;
   std::vector<int> sourceSlots_;  // for every stored entry of pattern_, its index in full.valuePtr()
+  // Shape and entry count of the matrix the map was built from (cheap pattern check).
+  Eigen::Index sourceRows_ = 0;
+  Eigen::Index sourceCols_ = 0;
+  Eigen::Index sourceNonZeros_ = 0;
 };
 
 }  // namespace asyncfem
