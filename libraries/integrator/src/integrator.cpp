@@ -52,6 +52,7 @@ void Integrator::setState(const Eigen::VectorXd& displacement, const Eigen::Vect
   zeroFixed(displacement_);
   zeroFixed(velocity_);
   time_ = time;
+  stateChanged();
 }
 
 double Integrator::mechanicalEnergy() const {

@@ -90,6 +90,10 @@ protected:
   void evaluateExternalForce(double time, Eigen::VectorXd& forces) const;
   /// Zeroes the fixed entries of a full vector.
   void zeroFixed(Eigen::VectorXd& full) const;
+  /// Called by setState() after the state changed, so that integrators that carry
+  /// derived quantities (the acceleration of trapezoidal and central differences)
+  /// recompute them before the next step. Default: nothing.
+  virtual void stateChanged() {}
 
   DynamicSystem system_;
   Eigen::VectorXd displacement_;

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <asyncfem/integrator/integrator.hpp>
+#include <asyncfem/integrator/integratorOptions.hpp>
+
+#include <memory>
+#include <string>
+
+namespace asyncfem {
+
+namespace detail {
+class FreeSystem;
+}
+
+/// Implicit backward Euler on the free DOFs (paper Eq. 5; shared design note, section
+/// "Single-rate implicit backward Euler"). One step of size h from (u_k, v_k):
+///
+///     (M + h D + h^2 K) dv = h ( f_ext(t_{k+1}) - f_int(u_k) - D v_k - h K v_k )
+///     v_{k+1} = v_k + dv,   u_{k+1} = u_k + h v_{k+1}
+///
+/// with D = alpha M + beta K. Since D is a combination of M and K, the system matrix is
+/// assembled as (1 + h alpha) M + (h beta + h^2) K and D v as alpha M v + beta K v: no
+/// damping matrix is ever formed (with alpha = beta = 0 the damping products are skipped
+/// too; stats().skipped says so).
+///
+/// Linear force model (isLinear()): K is constant, the free system matrix is assembled
+/// and factored once (symbolic + numeric) and each step is one back-substitution plus
+/// one sparse product with K (and one with M when alpha > 0). setTimestep() triggers one
+/// numeric refactorization at the next step.
+///
+/// Nonlinear force model: each step evaluates f_int(u_k) and K(u_k) once
+/// (forcesAndTangent), updates the free matrix values in place and refactors
+/// numerically; the symbolic analysis is done once per integrator. With
+/// options.maxIterations > 1 the step continues with Newton iterations on the nonlinear
+/// backward Euler equations, written for dv with D = alpha M + beta K(u_k) fixed over the
+/// step:
+///
+///     R(dv) = M dv - h ( f_ext(t_{k+1}) - f_int(u_k + h (v_k + dv)) - D (v_k + dv) )
+///     J(dv) = M + h D + h^2 K(u_k + h (v_k + dv))
+///
+/// The first iteration is the linearized step above; iteration i > 1 solves
+/// J dv_delta = -R and stops once |R|_2 <= tolerance * |b_0|_2, b_0 the right-hand side
+/// of the linearized step (the residual of the linearized equations at dv = 0).
+class BackwardEuler final : public Integrator {
+public:
+  /// system: validated; h > 0. Factors at once for linear force models.
+  BackwardEuler(DynamicSystem system, double timestep, const IntegratorOptions& options = {});
+  ~BackwardEuler() override;
+
+  std::string name() const override { return "backward-euler"; }
+  void step() override;
+  void setTimestep(double timestep) override;
+
+  const IntegratorOptions& options() const { return options_; }
+  /// Newton iterations (factorizations) used by the last step: 1 for the linearized step.
+  int lastIterations() const { return lastIterations_; }
+  /// |R|_2 / |b_0|_2 after the last step's final iteration, or -1 when it was not
+  /// evaluated (linear models and maxIterations = 1 never evaluate it: the linearized
+  /// step is taken as is).
+  double lastRelativeResidual() const { return lastRelativeResidual_; }
+
+private:
+  void stepLinear();
+  void stepNonlinear();
+  void assembleAndFactor();
+
+  IntegratorOptions options_;
+  std::unique_ptr<detail::FreeSystem> free_;
+  bool linear_ = false;
+  bool factorizationStale_ = true;
+  int lastIterations_ = 0;
+  double lastRelativeResidual_ = -1.0;
+  // Scratch on the free DOFs, kept to avoid per-step allocation.
+  Eigen::VectorXd u_, v_, force_, rhs_, dv_, work_;
+  Eigen::VectorXd fullForce_, fullU_, fullV_;
+};
+
+}  // namespace asyncfem

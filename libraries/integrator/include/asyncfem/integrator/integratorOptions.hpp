@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <asyncfem/sparseSolver/sparseSolver.hpp>
+
+namespace asyncfem {
+
+/// Settings shared by the single-rate integrators; each integrator reads the fields that
+/// concern it and ignores the others.
+struct IntegratorOptions {
+  /// Factorization used for the implicit system matrices and for a consistent mass
+  /// matrix (explicit methods). The matrices are SPD once fixed DOFs are removed.
+  SolverKind solver = SolverKind::cholmod;
+
+  /// Implicit methods, nonlinear force models only: iterations per step. 1 is the
+  /// linearized step (tangent at the start of the step, as Vega FEM does); more
+  /// iterations run Newton on the nonlinear step equations until the residual norm falls
+  /// below tolerance times the norm of the linearized right-hand side. Linear force
+  /// models solve the step equations exactly with one iteration and ignore this.
+  int maxIterations = 1;
+  /// Relative Newton tolerance (see maxIterations).
+  double tolerance = 1e-8;
+
+  /// Explicit methods: an upper bound of the highest angular frequency omega_max
+  /// (rad / time unit) of the free system, e.g. from estimateMaxFrequency(mesh, massType).
+  /// <= 0: the integrator estimates it from the matrices (see stableTimestep.hpp).
+  double maxFrequency = 0.0;
+  /// Explicit methods: run even when the timestep exceeds the stable estimate.
+  bool force = false;
+};
+
+}  // namespace asyncfem

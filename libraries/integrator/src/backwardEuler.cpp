@@ -1,0 +1,186 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/integrator/backwardEuler.hpp>
+
+#include "detail/freeSystem.hpp"
+
+#include <algorithm>
+#include <string>
+
+namespace asyncfem {
+
+using detail::TimeInto;
+
+BackwardEuler::BackwardEuler(DynamicSystem system, double timestep, const IntegratorOptions& options)
+    : Integrator(std::move(system), timestep), options_(options) {
+  if (options_.maxIterations < 1) {
+    throw ValidationError("backward Euler needs maxIterations >= 1 (got " + std::to_string(options_.maxIterations) +
+                          ")");
+  }
+  if (!(options_.tolerance >= 0.0)) {
+    throw ValidationError("backward Euler needs a Newton tolerance >= 0 (got " + std::to_string(options_.tolerance) +
+                          ")");
+  }
+  linear_ = system_.forceModel->isLinear();
+  {
+    TimeInto timer(stats_.assemblySeconds);
+    free_ = std::make_unique<detail::FreeSystem>(system_, options_.solver);
+  }
+  if (!system_.damped()) stats_.skipped.emplace_back("damping matrix (alpha = beta = 0)");
+  if (linear_) {
+    // f_int(u) = K u with K constant: evaluate K once (at rest) and keep it.
+    Eigen::VectorXd rest = Eigen::VectorXd::Zero(system_.numDofs());
+    free_->evaluateForcesAndTangent(system_, rest, free_->stiffness, stats_);
+    stats_.skipped.emplace_back("refactorization (constant system matrix)");
+    if (options_.maxIterations > 1) {
+      stats_.skipped.emplace_back("Newton iterations (linear force model: the linearized step is exact)");
+    }
+    assembleAndFactor();
+  }
+}
+
+BackwardEuler::~BackwardEuler() = default;
+
+void BackwardEuler::setTimestep(double timestep) {
+  const double previous = timestep_;
+  Integrator::setTimestep(timestep);
+  if (timestep != previous) factorizationStale_ = true;
+}
+
+void BackwardEuler::assembleAndFactor() {
+  const double h = timestep_;
+  // M + h D + h^2 K = (1 + h alpha) M + (h beta + h^2) K
+  free_->assemble({1.0 + (h * system_.rayleighMass), (h * system_.rayleighStiffness) + (h * h)},
+                  {&free_->mass, &free_->stiffness}, stats_);
+  free_->factorize(stats_);
+  factorizationStale_ = false;
+}
+
+void BackwardEuler::step() {
+  if (linear_) {
+    stepLinear();
+  } else {
+    stepNonlinear();
+  }
+}
+
+void BackwardEuler::stepLinear() {
+  const double h = timestep_;
+  const double alpha = system_.rayleighMass;
+  const double beta = system_.rayleighStiffness;
+  const FreeDofs& dofs = system_.freeDofs;
+  if (factorizationStale_) assembleAndFactor();
+
+  detail::restrictTo(dofs, displacement_, u_);
+  detail::restrictTo(dofs, velocity_, v_);
+  if (system_.externalForce) {
+    evaluateExternalForce(time_ + h, fullForce_);
+    detail::restrictTo(dofs, fullForce_, rhs_);
+  } else {
+    rhs_.setZero(u_.size());
+  }
+  {
+    // Fixed DOFs are zero, so the free rows of K u are K_ff u_f:
+    // b = h ( f_ext - K (u + (beta + h) v) - alpha M v ).
+    TimeInto timer(stats_.forceSeconds);
+    work_ = u_ + (beta + h) * v_;
+    rhs_.noalias() -= free_->stiffness * work_;
+    if (alpha != 0.0) rhs_.noalias() -= alpha * (free_->mass * v_);
+    rhs_ *= h;
+  }
+  free_->solve(rhs_, dv_, stats_);
+  v_ += dv_;
+  u_ += h * v_;
+  lastIterations_ = 1;
+  lastRelativeResidual_ = -1.0;
+
+  detail::expandTo(dofs, u_, fullU_);
+  detail::expandTo(dofs, v_, fullV_);
+  detail::checkFiniteState(fullU_, fullV_, time_ + h, name());
+  displacement_.swap(fullU_);
+  velocity_.swap(fullV_);
+  time_ += h;
+  ++stats_.steps;
+}
+
+void BackwardEuler::stepNonlinear() {
+  const double h = timestep_;
+  const double alpha = system_.rayleighMass;
+  const double beta = system_.rayleighStiffness;
+  const FreeDofs& dofs = system_.freeDofs;
+  detail::FreeSystem& free = *free_;
+
+  detail::restrictTo(dofs, displacement_, u_);
+  detail::restrictTo(dofs, velocity_, v_);
+  if (system_.externalForce) {
+    evaluateExternalForce(time_ + h, fullForce_);
+    detail::restrictTo(dofs, fullForce_, force_);
+  } else {
+    force_.setZero(u_.size());
+  }
+
+  // Linearized step: tangent and forces at u_k.
+  free.evaluateForcesAndTangent(system_, displacement_, free.stiffness, stats_);
+  Eigen::VectorXd internal;
+  detail::restrictTo(dofs, free.fullForces(), internal);
+  assembleAndFactor();
+  {
+    TimeInto timer(stats_.forceSeconds);
+    rhs_ = force_ - internal;
+    work_ = (beta + h) * v_;
+    rhs_.noalias() -= free.stiffness * work_;
+    if (alpha != 0.0) rhs_.noalias() -= alpha * (free.mass * v_);
+    rhs_ *= h;
+  }
+  const double rhsNorm = rhs_.norm();
+  free.solve(rhs_, dv_, stats_);
+  int iterations = 1;
+  lastRelativeResidual_ = -1.0;
+
+  if (options_.maxIterations > 1) {
+    const double scale = rhsNorm > 0.0 ? rhsNorm : 1.0;
+    Eigen::VectorXd newVelocity, newDisplacement, residual, correction;
+    while (true) {
+      newVelocity = v_ + dv_;
+      newDisplacement = u_ + h * newVelocity;
+      detail::expandTo(dofs, newDisplacement, fullU_);
+      const bool mayIterate = iterations < options_.maxIterations;
+      if (mayIterate) {
+        free.evaluateForcesAndTangent(system_, fullU_, free.iterateStiffness, stats_);
+      } else {
+        free.evaluateForces(system_, fullU_, stats_);
+      }
+      detail::restrictTo(dofs, free.fullForces(), internal);
+      {
+        // R = M dv - h ( f_ext - f_int(u_{k+1}) - D v_{k+1} ),  D = alpha M + beta K(u_k)
+        TimeInto timer(stats_.forceSeconds);
+        residual = free.mass * dv_;
+        residual.noalias() -= h * (force_ - internal);
+        if (alpha != 0.0) residual.noalias() += (h * alpha) * (free.mass * newVelocity);
+        if (beta != 0.0) residual.noalias() += (h * beta) * (free.stiffness * newVelocity);
+      }
+      lastRelativeResidual_ = residual.norm() / scale;
+      if (lastRelativeResidual_ <= options_.tolerance || !mayIterate) break;
+      // J = (1 + h alpha) M + h beta K(u_k) + h^2 K(u_{k+1}^{(i)})
+      free.assemble({1.0 + (h * alpha), h * beta, h * h}, {&free.mass, &free.stiffness, &free.iterateStiffness},
+                    stats_);
+      free.factorize(stats_);
+      free.solve(-residual, correction, stats_);
+      dv_ += correction;
+      ++iterations;
+    }
+  }
+  lastIterations_ = iterations;
+
+  v_ += dv_;
+  u_ += h * v_;
+  detail::expandTo(dofs, u_, fullU_);
+  detail::expandTo(dofs, v_, fullV_);
+  detail::checkFiniteState(fullU_, fullV_, time_ + h, name());
+  displacement_.swap(fullU_);
+  velocity_.swap(fullV_);
+  time_ += h;
+  ++stats_.steps;
+}
+
+}  // namespace asyncfem

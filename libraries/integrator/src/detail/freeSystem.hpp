@@ -1,0 +1,109 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/integrator/integrator.hpp>
+#include <asyncfem/sparseSolver/sparseSolver.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+// Internals shared by the single-rate integrators: the free-DOF matrices, their
+// factorization with timing and counters, the mass solve and the state checks.
+namespace asyncfem::detail {
+
+/// The values of matrix re-expressed in the sparsity pattern of pattern (zeros where
+/// matrix has no entry). Throws asyncfem::ValidationError naming the entry if matrix has
+/// a non-zero value outside pattern. what names matrix in that message.
+Eigen::SparseMatrix<double> embedInPattern(const Eigen::SparseMatrix<double>& matrix,
+                                           const Eigen::SparseMatrix<double>& pattern, const std::string& what);
+
+/// True when every stored off-diagonal value of matrix is zero.
+bool isDiagonal(const Eigen::SparseMatrix<double>& matrix);
+
+/// free = the free entries of full (resized), without allocating when sizes already match.
+void restrictTo(const FreeDofs& dofs, const Eigen::VectorXd& full, Eigen::VectorXd& free);
+/// full = free scattered to the full numbering, fixed entries exactly zero.
+void expandTo(const FreeDofs& dofs, const Eigen::VectorXd& free, Eigen::VectorXd& full);
+
+/// Throws asyncfem::NumericalError if displacement or velocity (full, 3n) has a
+/// non-finite entry, naming the integrator, the time the step was heading to, and the
+/// first bad DOF as vertex and coordinate.
+void checkFiniteState(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, double time,
+                      const std::string& integratorName);
+
+/// Adds the wall time of its lifetime to a stats field (one of IntegratorStats' seconds).
+class TimeInto {
+public:
+  explicit TimeInto(double& seconds) : seconds_(seconds) { watch_.start(); }
+  ~TimeInto() { seconds_ += watch_.stop(); }
+  TimeInto(const TimeInto&) = delete;
+  TimeInto& operator=(const TimeInto&) = delete;
+
+private:
+  double& seconds_;
+  Stopwatch watch_;
+};
+
+/// Free-DOF matrices of a DynamicSystem and one factorization of a linear combination of
+/// them. Every free matrix shares the pattern of the force model's stiffness restricted
+/// to the free DOFs, so combinations are value-wise sums (combine()).
+class FreeSystem {
+public:
+  FreeSystem(const DynamicSystem& system, SolverKind solverKind);
+
+  /// Evaluates f_int(u) and K(u) (u full) with the force model, then copies the free
+  /// values of K into `into` (a free matrix from this object). Adds to stats.
+  void evaluateForcesAndTangent(const DynamicSystem& system, const Eigen::VectorXd& displacement,
+                                Eigen::SparseMatrix<double>& into, IntegratorStats& stats);
+  /// f_int(u) only (full), into fullForces().
+  void evaluateForces(const DynamicSystem& system, const Eigen::VectorXd& displacement, IntegratorStats& stats);
+
+  /// systemMatrix = sum_i coefficients[i] * matrices[i] (free matrices of this object).
+  void assemble(const std::vector<double>& coefficients, const std::vector<const Eigen::SparseMatrix<double>*>& matrices,
+                IntegratorStats& stats);
+  /// Numeric factorization of systemMatrix (symbolic analysis the first time only).
+  void factorize(IntegratorStats& stats);
+  /// x = systemMatrix^{-1} rhs with the last factorization.
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, IntegratorStats& stats);
+
+  const Eigen::VectorXd& fullForces() const { return fullForces_; }
+  SparseSolver& solver() { return *solver_; }
+
+  Eigen::SparseMatrix<double> mass;             ///< M on the free DOFs
+  Eigen::SparseMatrix<double> stiffness;        ///< K on the free DOFs (constant, or tangent at step start)
+  Eigen::SparseMatrix<double> iterateStiffness; ///< K at a Newton iterate (free)
+  Eigen::SparseMatrix<double> systemMatrix;     ///< the combination last assembled
+
+private:
+  SubmatrixExtractor extractor_;
+  Eigen::SparseMatrix<double> fullStiffness_;
+  Eigen::VectorXd fullForces_;
+  std::unique_ptr<SparseSolver> solver_;
+  bool analyzed_ = false;
+  Eigen::MatrixXd solution_;
+};
+
+/// Solves M x = b on the free DOFs: a division for a diagonal (lumped) M, otherwise a
+/// sparse Cholesky factored once.
+class FreeMassSolver {
+public:
+  FreeMassSolver() = default;
+  /// Factors (or inverts the diagonal of) the free mass matrix; adds to stats.
+  void setup(const Eigen::SparseMatrix<double>& freeMass, SolverKind kind, IntegratorStats& stats);
+  bool diagonal() const { return diagonal_; }
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, IntegratorStats& stats);
+
+private:
+  bool diagonal_ = false;
+  Eigen::VectorXd inverseDiagonal_;
+  std::unique_ptr<SparseSolver> solver_;
+  Eigen::MatrixXd solution_;
+};
+
+}  // namespace asyncfem::detail
