@@ -44,17 +44,18 @@ std::vector<int> colorChunks(const Eigen::Matrix4Xi& elements, int numVertices, 
   std::vector<int> chunkVertexOffsets(toIndex(numChunks) + 1, 0);
   std::vector<int> chunkVertices(toIndex(numElements) * 4);
   {
-    std::vector<int> scratch;
+    std::vector<int> stamp(toIndex(numVertices), -1);
     int written = 0;
     for (int chunk = 0; chunk < numChunks; ++chunk) {
-      const int first = chunk * chunkSize;
-      const int last = std::min(numElements, first + chunkSize);
-      scratch.assign(elements.data() + (toIndex(first) * 4), elements.data() + (toIndex(last) * 4));
-      std::sort(scratch.begin(), scratch.end());
-      scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
       chunkVertexOffsets[toIndex(chunk)] = written;
-      std::copy(scratch.begin(), scratch.end(), chunkVertices.begin() + written);
-      written += static_cast<int>(scratch.size());
+      const Index first = toIndex(chunk * chunkSize) * 4;
+      const Index last = toIndex(std::min(numElements, (chunk + 1) * chunkSize)) * 4;
+      for (Index k = first; k < last; ++k) {
+        const int v = elements.data()[k];
+        if (stamp[toIndex(v)] == chunk) continue;
+        stamp[toIndex(v)] = chunk;
+        chunkVertices[toIndex(written++)] = v;
+      }
     }
     chunkVertexOffsets[toIndex(numChunks)] = written;
     chunkVertices.resize(toIndex(written));
@@ -104,64 +105,85 @@ MatrixAssembler::MatrixAssembler(const TetMesh& mesh)
   const int numVertices = mesh.numVertices();
   const Index vertexCount = toIndex(numVertices);
 
-  // Candidate row vertices of every column vertex: the four vertices of each incident
-  // element, plus the vertex itself so that every diagonal block is in the pattern even
-  // for vertices no element uses. Two counting passes, then one sort per (short) list.
-  std::vector<int> candidateOffsets(vertexCount + 1, 0);
-  for (Index v = 0; v < vertexCount; ++v) candidateOffsets[v] = 1;
-  for (Index k = 0; k < toIndex(numElements_) * 4; ++k) candidateOffsets[toIndex(elements_.data()[k])] += 4;
-  const long long candidateCount = exclusiveScan(candidateOffsets);
-  std::vector<int> candidates(static_cast<Index>(candidateCount));
+  // Incident (element, local vertex) pairs of every vertex, encoded 4 e + b, ascending
+  // in e: counting sort, two passes.
+  std::vector<int> incidenceOffsets(vertexCount + 1, 0);
+  for (Index k = 0; k < toIndex(numElements_) * 4; ++k) ++incidenceOffsets[toIndex(elements_.data()[k])];
+  exclusiveScan(incidenceOffsets);
+  std::vector<int> incidences(toIndex(numElements_) * 4);
   {
-    std::vector<int> fill(candidateOffsets.begin(), candidateOffsets.end() - 1);
-    for (int v = 0; v < numVertices; ++v) candidates[toIndex(fill[toIndex(v)]++)] = v;
-    for (int e = 0; e < numElements_; ++e) {
-      for (int b = 0; b < 4; ++b) {
-        const int column = elements_(b, e);
-        int& position = fill[toIndex(column)];
-        for (int a = 0; a < 4; ++a) candidates[toIndex(position++)] = elements_(a, e);
+    std::vector<int> fill(incidenceOffsets.begin(), incidenceOffsets.end() - 1);
+    for (int k = 0; k < numElements_ * 4; ++k) incidences[toIndex(fill[toIndex(elements_.data()[k])]++)] = k;
+  }
+
+  // Row vertices of column vertex v: v itself (so that every diagonal block is in the
+  // pattern, even for a vertex no element uses) and the vertices of its elements. Pass 1
+  // counts them, pass 2 writes them sorted and, through a vertex -> position map, the
+  // block slots of every incident element. Per-thread stamp and position arrays replace
+  // sets and searches.
+  const int* elementVertices = elements_.data();
+  // Appends the row vertices of column vertex v to rows (cleared first), unsorted;
+  // stamp[u] == v marks u as seen.
+  const auto collectRows = [&](int v, std::vector<int>& stamp, std::vector<int>& rows) {
+    rows.clear();
+    stamp[toIndex(v)] = v;
+    rows.push_back(v);
+    for (int p = incidenceOffsets[toIndex(v)]; p < incidenceOffsets[toIndex(v) + 1]; ++p) {
+      const Index e = toIndex(incidences[toIndex(p)] / 4);
+      for (Index a = 0; a < 4; ++a) {
+        const int u = elementVertices[(4 * e) + a];
+        if (stamp[toIndex(u)] != v) {
+          stamp[toIndex(u)] = v;
+          rows.push_back(u);
+        }
       }
     }
+  };
+  blockOuter_.assign(vertexCount + 1, 0);
+#pragma omp parallel
+  {
+    std::vector<int> stamp(vertexCount, -1);
+    std::vector<int> rows;
+#pragma omp for schedule(static)
+    for (int v = 0; v < numVertices; ++v) {
+      collectRows(v, stamp, rows);
+      blockOuter_[toIndex(v)] = static_cast<int>(rows.size());
+    }
   }
-  std::vector<int> neighbourCounts(vertexCount + 1, 0);
-#pragma omp parallel for schedule(dynamic, 1024)
-  for (int v = 0; v < numVertices; ++v) {
-    int* first = candidates.data() + candidateOffsets[toIndex(v)];
-    int* last = candidates.data() + candidateOffsets[toIndex(v) + 1];
-    std::sort(first, last);
-    neighbourCounts[toIndex(v)] = static_cast<int>(std::unique(first, last) - first);
-  }
-  const long long blockCount = exclusiveScan(neighbourCounts);
+  const long long blockCount = exclusiveScan(blockOuter_);
   if (9 * blockCount > INT_MAX) {
     throw Error("MatrixAssembler: the pattern has " + std::to_string(9 * blockCount) +
                 " entries, more than int indices can address");
   }
-  blockOuter_ = std::move(neighbourCounts);
   blockRows_.resize(static_cast<Index>(blockCount));
-#pragma omp parallel for schedule(static)
-  for (int v = 0; v < numVertices; ++v) {
-    const int count = blockOuter_[toIndex(v) + 1] - blockOuter_[toIndex(v)];
-    std::copy_n(candidates.begin() + candidateOffsets[toIndex(v)], count, blockRows_.begin() + blockOuter_[toIndex(v)]);
-  }
-  candidates = std::vector<int>();
-  candidateOffsets = std::vector<int>();
-
-  // Block slots by binary search in the (short, sorted) row list of the column vertex.
   blockSlots_.resize(toIndex(numElements_) * 16);
-#pragma omp parallel for schedule(static)
-  for (int e = 0; e < numElements_; ++e) {
-    for (int b = 0; b < 4; ++b) {
-      const Index column = toIndex(elements_(b, e));
-      const int* first = blockRows_.data() + blockOuter_[column];
-      const int* last = blockRows_.data() + blockOuter_[column + 1];
-      for (int a = 0; a < 4; ++a) {
-        const int position = static_cast<int>(std::lower_bound(first, last, elements_(a, e)) - blockRows_.data());
-        // Scalar column 3 vb starts at 9 * blockOuter_[vb]; block row p starts 3 p below.
-        blockSlots_[(toIndex(e) * 16) + toIndex((b * 4) + a)] =
-            (9 * blockOuter_[column]) + (3 * (position - blockOuter_[column]));
+#pragma omp parallel
+  {
+    std::vector<int> stamp(vertexCount, -1);
+    std::vector<int> position(vertexCount, 0);
+    std::vector<int> rows;
+#pragma omp for schedule(static)
+    for (int v = 0; v < numVertices; ++v) {
+      collectRows(v, stamp, rows);
+      std::sort(rows.begin(), rows.end());
+      const int begin = blockOuter_[toIndex(v)];
+      for (std::size_t p = 0; p < rows.size(); ++p) {
+        blockRows_[toIndex(begin) + p] = rows[p];
+        position[toIndex(rows[p])] = static_cast<int>(p);
+      }
+      // Scalar column 3 v starts at 9 * blockOuter_[v]; block row p starts 3 p below.
+      for (int p = incidenceOffsets[toIndex(v)]; p < incidenceOffsets[toIndex(v) + 1]; ++p) {
+        const Index e = toIndex(incidences[toIndex(p)] / 4);
+        const Index b = toIndex(incidences[toIndex(p)] % 4);
+        for (Index a = 0; a < 4; ++a) {
+          const int u = elementVertices[(4 * e) + a];
+          blockSlots_[(e * 16) + (b * 4) + a] = (9 * begin) + (3 * position[toIndex(u)]);
+        }
       }
     }
   }
+  incidences = std::vector<int>();
+  incidenceOffsets = std::vector<int>();
 
   // Scheduling: colour chunks of consecutive elements (good locality within a chunk);
   // shrink the chunks until every colour has enough of them to keep threads busy. The
@@ -352,25 +374,33 @@ namespace {
 // Throws ValidationError when element e is degenerate: |V| tiny against its longest edge
 // cubed (a regular tetrahedron has V = 0.118 L^3), or not finite.
 void checkVolume(int e, double signedVolume, const ElementPositions& x) {
-  double longestEdge = 0.0;
+  double longestSquared = 0.0;
   for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) longestEdge = std::max(longestEdge, (x.col(a) - x.col(b)).norm());
-  if (!(std::abs(signedVolume) > 1e-14 * longestEdge * longestEdge * longestEdge)) {
+    for (int b = a + 1; b < 4; ++b) longestSquared = std::max(longestSquared, (x.col(a) - x.col(b)).squaredNorm());
+  // V^2 > (1e-14 L^3)^2, squared to avoid a square root per element.
+  if (!(signedVolume * signedVolume > 1e-28 * longestSquared * longestSquared * longestSquared)) {
     throw ValidationError("element " + std::to_string(e) + " is degenerate (signed volume " +
-                          std::to_string(signedVolume) + ", longest edge " + std::to_string(longestEdge) + ")");
+                          std::to_string(signedVolume) + ", longest edge " + std::to_string(std::sqrt(longestSquared)) +
+                          ")");
   }
 }
 
 }  // namespace
 
 Eigen::SparseMatrix<double> linearStiffnessMatrix(const TetMesh& mesh, const MatrixAssembler& assembler) {
+  Eigen::SparseMatrix<double> stiffness = assembler.createMatrix();
+  assembleLinearStiffness(mesh, assembler, stiffness);
+  return stiffness;
+}
+
+void assembleLinearStiffness(const TetMesh& mesh, const MatrixAssembler& assembler,
+                             Eigen::SparseMatrix<double>& stiffness) {
   if (mesh.numElements() != assembler.numElements() || mesh.numDofs() != assembler.numDofs()) {
-    throw Error("linearStiffnessMatrix: the assembler was built for another mesh");
+    throw Error("assembleLinearStiffness: the assembler was built for another mesh");
   }
   // Lame parameters once per material instead of once per element.
   std::vector<Eigen::Vector2d> lame;
   for (const Material& m : mesh.materials()) lame.push_back(lameParameters(m.youngsModulus, m.poissonRatio));
-  Eigen::SparseMatrix<double> stiffness = assembler.createMatrix();
   assembler.assembleWith(
       [&](int e, ElementMatrix& out) {
         const ElementPositions x = mesh.elementRestPositions(e);
@@ -382,7 +412,6 @@ Eigen::SparseMatrix<double> linearStiffnessMatrix(const TetMesh& mesh, const Mat
         detail::linearStiffnessFromGradients(g, parameters[0] * volume, parameters[1] * volume, out);
       },
       stiffness);
-  return stiffness;
 }
 
 Eigen::SparseMatrix<double> massMatrix(const TetMesh& mesh, const MatrixAssembler& assembler, MassType type) {

@@ -69,7 +69,8 @@ public:
   Eigen::VectorXd assembleVector(const ElementVectorFunction& elementVector) const;
 
 private:
-  friend Eigen::SparseMatrix<double> linearStiffnessMatrix(const TetMesh& mesh, const MatrixAssembler& assembler);
+  friend void assembleLinearStiffness(const TetMesh& mesh, const MatrixAssembler& assembler,
+                                      Eigen::SparseMatrix<double>& stiffness);
   friend Eigen::SparseMatrix<double> massMatrix(const TetMesh& mesh, const MatrixAssembler& assembler,
                                                 MassType type);
   // Scatter-adds callback(e, Ke) for every element in the deterministic colour order;
@@ -97,8 +98,15 @@ private:
   std::vector<int> coloredChunks_;
 };
 
-/// Linear FEM stiffness K (3n x 3n) of the mesh with its per-element materials.
+/// Linear FEM stiffness K (3n x 3n, units of E times length, e.g. N/m) of the mesh with
+/// its per-element materials: K = sum_e V_e B_e^T C_e B_e. Throws ValidationError naming
+/// the lowest degenerate element (|V| <= 1e-14 L^3, L its longest edge); inverted
+/// elements are accepted (|V| is used).
 Eigen::SparseMatrix<double> linearStiffnessMatrix(const TetMesh& mesh, const MatrixAssembler& assembler);
+/// Same as linearStiffnessMatrix, re-assembling into stiffness (from createMatrix()), so
+/// that new materials cost one value pass and no allocation.
+void assembleLinearStiffness(const TetMesh& mesh, const MatrixAssembler& assembler,
+                             Eigen::SparseMatrix<double>& stiffness);
 
 /// Mass matrix M (3n x 3n) in the assembler's pattern (lumped: only diagonal values
 /// non-zero, pattern unchanged). Sums to rho V per coordinate.
