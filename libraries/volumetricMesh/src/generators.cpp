@@ -2,6 +2,8 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <cmath>

@@ -1,2 +1,158 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// placeholder: implementation pending
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace asyncfem {
+
+double signedElementVolume(const TetMesh& mesh, int e) {
+  const Eigen::Matrix<double, 3, 4> x = mesh.elementRestPositions(e);
+  Eigen::Matrix3d edges;
+  edges << x.col(1) - x.col(0), x.col(2) - x.col(0), x.col(3) - x.col(0);
+  return edges.determinant() / 6.0;
+}
+
+Eigen::VectorXd elementVolumes(const TetMesh& mesh) {
+  Eigen::VectorXd volumes(mesh.numElements());
+  for (int e = 0; e < mesh.numElements(); ++e) volumes[e] = std::abs(signedElementVolume(mesh, e));
+  return volumes;
+}
+
+double totalVolume(const TetMesh& mesh) { return elementVolumes(mesh).sum(); }
+
+double totalMass(const TetMesh& mesh) {
+  double mass = 0.0;
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    mass += mesh.elementMaterial(e).density * std::abs(signedElementVolume(mesh, e));
+  }
+  return mass;
+}
+
+std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh) {
+  // Faces of a positively oriented tet (v0..v3) with outward normals (b-a)x(c-a).
+  static constexpr std::array<std::array<int, 3>, 4> kFaces{{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+  struct Face {
+    std::array<int, 3> key;  // sorted vertex ids
+    int element;
+    int local;
+  };
+  std::vector<Face> faces;
+  faces.reserve(4 * static_cast<std::size_t>(mesh.numElements()));
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const Eigen::Vector4i t = mesh.element(e);
+    for (int f = 0; f < 4; ++f) {
+      std::array<int, 3> key{};
+      for (int a = 0; a < 3; ++a) key[static_cast<std::size_t>(a)] = t[kFaces[static_cast<std::size_t>(f)][static_cast<std::size_t>(a)]];
+      std::sort(key.begin(), key.end());
+      faces.push_back({key, e, f});
+    }
+  }
+  std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) {
+    return a.key != b.key ? a.key < b.key : (a.element != b.element ? a.element < b.element : a.local < b.local);
+  });
+  std::vector<std::pair<int, int>> boundary;  // (element, local face), kept in element order below
+  for (std::size_t i = 0; i < faces.size();) {
+    std::size_t j = i + 1;
+    while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+    if (j - i == 1) boundary.emplace_back(faces[i].element, faces[i].local);
+    i = j;
+  }
+  std::sort(boundary.begin(), boundary.end());
+  std::vector<std::array<int, 3>> triangles;
+  triangles.reserve(boundary.size());
+  for (const auto& [e, f] : boundary) {
+    const Eigen::Vector4i t = mesh.element(e);
+    const auto& local = kFaces[static_cast<std::size_t>(f)];
+    std::array<int, 3> tri{t[local[0]], t[local[1]], t[local[2]]};
+    // An element stored with negative orientation has every face turned inward.
+    if (signedElementVolume(mesh, e) < 0.0) std::swap(tri[1], tri[2]);
+    triangles.push_back(tri);
+  }
+  return triangles;
+}
+
+VertexElementAdjacency vertexElementAdjacency(const TetMesh& mesh) {
+  VertexElementAdjacency adjacency;
+  adjacency.offsets.assign(static_cast<std::size_t>(mesh.numVertices()) + 1, 0);
+  const Eigen::Matrix4Xi& elements = mesh.elements();
+  for (int e = 0; e < mesh.numElements(); ++e)
+    for (int a = 0; a < 4; ++a) ++adjacency.offsets[static_cast<std::size_t>(elements(a, e)) + 1];
+  for (std::size_t v = 1; v < adjacency.offsets.size(); ++v) adjacency.offsets[v] += adjacency.offsets[v - 1];
+  adjacency.elements.resize(static_cast<std::size_t>(adjacency.offsets.back()));
+  std::vector<int> fill(adjacency.offsets.begin(), adjacency.offsets.end() - 1);
+  // Visiting elements in increasing order leaves each vertex's list ascending.
+  for (int e = 0; e < mesh.numElements(); ++e)
+    for (int a = 0; a < 4; ++a) adjacency.elements[static_cast<std::size_t>(fill[static_cast<std::size_t>(elements(a, e))]++)] = e;
+  return adjacency;
+}
+
+BoundingBox boundingBox(const TetMesh& mesh, const Eigen::VectorXd& displacement) {
+  if (displacement.size() != 0 && displacement.size() != mesh.numDofs()) {
+    throw ValidationError("boundingBox: displacement has " + std::to_string(displacement.size()) +
+                          " entries, expected 0 or " + std::to_string(mesh.numDofs()));
+  }
+  if (mesh.numVertices() == 0) return {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  Eigen::Matrix3Xd x = mesh.restPositions();
+  if (displacement.size() != 0) x += Eigen::Map<const Eigen::Matrix3Xd>(displacement.data(), 3, mesh.numVertices());
+  return {x.rowwise().minCoeff(), x.rowwise().maxCoeff()};
+}
+
+ElementQuality elementQuality(const TetMesh& mesh, int e) {
+  if (e < 0 || e >= mesh.numElements()) throw ValidationError("elementQuality: element " + std::to_string(e) + " out of range");
+  const Eigen::Matrix<double, 3, 4> x = mesh.elementRestPositions(e);
+  static constexpr std::array<std::array<int, 4>, 6> kEdges{
+      {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2}, {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}}};
+  ElementQuality q;
+  q.minDihedralAngle = std::numeric_limits<double>::infinity();
+  q.maxDihedralAngle = 0.0;
+  double longestEdge = 0.0;
+  for (const auto& edge : kEdges) {
+    // Interior angle between the two faces at edge (i, j): project the two other
+    // vertices onto the plane normal to the edge and measure the angle between them.
+    const Eigen::Vector3d xi = x.col(edge[0]);
+    const Eigen::Vector3d along = x.col(edge[1]) - xi;
+    longestEdge = std::max(longestEdge, along.norm());
+    const Eigen::Vector3d direction = along.normalized();
+    Eigen::Vector3d u = x.col(edge[2]) - xi;
+    Eigen::Vector3d w = x.col(edge[3]) - xi;
+    u -= u.dot(direction) * direction;
+    w -= w.dot(direction) * direction;
+    const double angle = std::atan2(u.cross(w).norm(), u.dot(w));
+    q.minDihedralAngle = std::min(q.minDihedralAngle, angle);
+    q.maxDihedralAngle = std::max(q.maxDihedralAngle, angle);
+  }
+  // Inradius r = 3V / (total face area); the regular tetrahedron of edge a has r = a / (2 sqrt 6).
+  double area = 0.0;
+  static constexpr std::array<std::array<int, 3>, 4> kFaces{{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+  for (const auto& f : kFaces) area += 0.5 * (x.col(f[1]) - x.col(f[0])).cross(x.col(f[2]) - x.col(f[0])).norm();
+  const double volume = std::abs(signedElementVolume(mesh, e));
+  const double inradius = area > 0.0 ? 3.0 * volume / area : 0.0;
+  q.aspectRatio = inradius > 0.0 ? longestEdge / (2.0 * std::sqrt(6.0) * inradius) : std::numeric_limits<double>::infinity();
+  return q;
+}
+
+std::vector<ElementQuality> elementQualities(const TetMesh& mesh) {
+  std::vector<ElementQuality> qualities;
+  qualities.reserve(static_cast<std::size_t>(mesh.numElements()));
+  for (int e = 0; e < mesh.numElements(); ++e) qualities.push_back(elementQuality(mesh, e));
+  return qualities;
+}
+
+std::vector<int> unusedVertices(const TetMesh& mesh) {
+  std::vector<char> used(static_cast<std::size_t>(mesh.numVertices()), 0);
+  const Eigen::Matrix4Xi& elements = mesh.elements();
+  for (int e = 0; e < mesh.numElements(); ++e)
+    for (int a = 0; a < 4; ++a) used[static_cast<std::size_t>(elements(a, e))] = 1;
+  std::vector<int> unused;
+  for (std::size_t v = 0; v < used.size(); ++v)
+    if (!used[v]) unused.push_back(static_cast<int>(v));
+  return unused;
+}
+
+}  // namespace asyncfem

@@ -1,2 +1,44 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// placeholder: implementation pending
+// Format dispatch and the .bou reader; the mesh readers live in detail/*Reader.cpp.
+#include "detail/textInput.hpp"
+
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+TetMesh readMesh(const std::filesystem::path& path, const MeshReadOptions& options, MeshReadReport* report) {
+  const std::string extension = path.extension().string();
+  if (detail::equalsIgnoreCase(extension, ".veg")) return readVeg(path, options, report);
+  if (detail::equalsIgnoreCase(extension, ".node") || detail::equalsIgnoreCase(extension, ".ele")) {
+    return readTetGen(path, options, report);
+  }
+  if (detail::equalsIgnoreCase(extension, ".msh")) return readGmsh(path, options, report);
+  throw Error("cannot read mesh '" + path.string() + "': unknown extension '" + extension +
+              "' (expected .veg, .node, .ele or .msh)");
+}
+
+std::vector<int> readBou(const std::filesystem::path& path, int numVertices) {
+  if (numVertices < 0) throw Error("readBou: negative vertex count for '" + path.string() + "'");
+  const detail::FlatText flat = detail::loadFlatText(path, false);
+  detail::LineCursor cursor(flat, true);
+  std::vector<int> vertices;
+  while (cursor.next()) {
+    for (const std::string_view token : detail::splitTokens(cursor.line(), true)) {
+      const long long id = detail::integerAt(cursor, token, "fixed vertex");
+      if (id < 1 || id > numVertices) {
+        cursor.fail("fixed vertex " + std::to_string(id) + " is outside [1, " + std::to_string(numVertices) + "]");
+      }
+      vertices.push_back(static_cast<int>(id - 1));
+    }
+  }
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  return vertices;
+}
+
+}  // namespace asyncfem

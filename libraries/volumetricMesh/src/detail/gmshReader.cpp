@@ -1,0 +1,379 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Gmsh .msh reader, ASCII versions 2.2 and 4.1; see docs/file-formats.md.
+#include "detail/rawMesh.hpp"
+#include "detail/textInput.hpp"
+
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
+
+#include <array>
+#include <map>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+namespace asyncfem {
+
+namespace {
+
+using detail::LineCursor;
+
+constexpr long long kTetrahedron = 4;       // 4-node tetrahedron
+constexpr long long kQuadraticTet = 11;     // 10-node tetrahedron
+
+class GmshParser {
+public:
+  explicit GmshParser(const detail::FlatText& flat) : cursor_(flat, false) {}
+
+  TetMesh parse(const MeshReadOptions& options, MeshReadReport& report) {
+    if (!cursor_.next()) cursor_.failAtEnd("empty file: not a Gmsh mesh");
+    if (cursor_.line() != "$MeshFormat") {
+      cursor_.fail("not a Gmsh ASCII file: expected $MeshFormat, got '" + std::string(cursor_.line().substr(0, 40)) + "'");
+    }
+    readMeshFormat();
+    report.format = version41_ ? "gmsh 4.1" : "gmsh 2.2";
+    bool haveNodes = false;
+    bool haveElements = false;
+    while (cursor_.next()) {
+      const std::string_view line = cursor_.line();
+      if (line.front() != '$') cursor_.fail("expected a section such as $Nodes, got '" + std::string(line.substr(0, 40)) + "'");
+      const std::string section(line.substr(1));
+      if (section == "PhysicalNames") {
+        readPhysicalNames();
+      } else if (section == "Entities" && version41_) {
+        readEntities();
+      } else if (section == "Nodes") {
+        if (haveNodes) cursor_.fail("second $Nodes section");
+        haveNodes = true;
+        version41_ ? readNodes41() : readNodes22();
+      } else if (section == "Elements") {
+        if (haveElements) cursor_.fail("second $Elements section");
+        if (!haveNodes) cursor_.fail("$Elements before $Nodes");
+        haveElements = true;
+        version41_ ? readElements41() : readElements22();
+      } else if (section.rfind("End", 0) == 0) {
+        cursor_.fail("'" + std::string(line) + "' without its opening section");
+      } else {
+        skipSection(section);
+      }
+    }
+    if (!haveNodes) cursor_.failAtEnd("no $Nodes section");
+    if (!haveElements) cursor_.failAtEnd("no $Elements section");
+
+    report.ignoredElements = ignoredTotal_;
+    if (ignoredTotal_ > 0) {
+      std::string types;
+      for (const auto& [type, count] : ignoredByType_) {
+        types += (types.empty() ? "" : ", ") + std::to_string(count) + " of type " + std::to_string(type);
+      }
+      report.warnings.push_back("ignored " + std::to_string(ignoredTotal_) +
+                                " element(s) that are not 4-node tetrahedra (" + types + ")");
+    }
+    if (raw_.elements.empty() && ignoredByType_.count(kQuadraticTet)) {
+      cursor_.failAtEnd("only 10-node tetrahedra (type 11) found: export a first-order mesh (Mesh.ElementOrder = 1)");
+    }
+    for (const auto& [tag, members] : physicalElements_) {
+      auto it = physicalNames_.find(tag);
+      const std::string name = it != physicalNames_.end() ? it->second : "physical_" + std::to_string(tag);
+      auto& set = raw_.elementSets[name];
+      set.insert(set.end(), members.begin(), members.end());
+    }
+    return detail::finishMesh(std::move(raw_), cursor_, options, report, detail::MissingMaterialPolicy::FormatDefault);
+  }
+
+private:
+  std::vector<std::string_view> nextRecord(const std::string& what) {
+    if (!cursor_.next()) cursor_.failAtEnd("file ends inside " + what);
+    if (cursor_.line().front() == '$') cursor_.fail("section ends early: expected " + what + ", got '" + std::string(cursor_.line()) + "'");
+    return detail::splitTokens(cursor_.line(), false);
+  }
+
+  void expectEnd(const std::string& section, const std::string& overflowMessage) {
+    if (!cursor_.next()) cursor_.failAtEnd("missing $End" + section);
+    if (cursor_.line() != "$End" + section) {
+      if (cursor_.line().front() != '$') cursor_.fail(overflowMessage);
+      cursor_.fail("expected $End" + section + ", got '" + std::string(cursor_.line()) + "'");
+    }
+  }
+
+  void skipSection(const std::string& section) {
+    const auto start = cursor_.location();
+    const std::string end = "$End" + section;
+    while (cursor_.next()) {
+      if (cursor_.line() == end) return;
+    }
+    cursor_.failAt(start, "section $" + section + " has no " + end);
+  }
+
+  void readMeshFormat() {
+    const auto tokens = nextRecord("the $MeshFormat line 'version fileType dataSize'");
+    if (tokens.size() != 3) cursor_.fail("$MeshFormat needs 'version fileType dataSize', got " + std::to_string(tokens.size()) + " fields");
+    if (tokens[1] == "1") {
+      cursor_.fail("binary .msh files are not supported: save the mesh as ASCII (Gmsh: Mesh.Binary = 0, "
+                   "or File > Export without 'Save in binary format')");
+    }
+    if (tokens[1] != "0") cursor_.fail("$MeshFormat file type must be 0 (ASCII), got '" + std::string(tokens[1]) + "'");
+    if (tokens[0] == "4.1") {
+      version41_ = true;
+    } else if (tokens[0] != "2.2") {
+      cursor_.fail("unsupported Gmsh format version '" + std::string(tokens[0]) +
+                   "': this reader reads ASCII versions 2.2 and 4.1 (export as 'Version 4 ASCII' or 'Version 2 ASCII')");
+    }
+    expectEnd("MeshFormat", "$MeshFormat has more than one line");
+  }
+
+  void readPhysicalNames() {
+    const auto header = nextRecord("the physical name count");
+    if (header.size() != 1) cursor_.fail("$PhysicalNames needs a count line");
+    const long long count = detail::integerAt(cursor_, header[0], "physical name count");
+    cursor_.checkCountFits(count, 7, "physical names");
+    for (long long i = 0; i < count; ++i) {
+      const auto tokens = nextRecord("'dim tag \"name\"'");
+      if (tokens.size() < 3) cursor_.fail("physical name line needs 'dim tag \"name\"'");
+      const long long dim = detail::integerAt(cursor_, tokens[0], "physical name dimension");
+      const long long tag = detail::integerAt(cursor_, tokens[1], "physical tag");
+      // The name is the rest of the line, in quotes, and may contain spaces.
+      std::string_view rest = cursor_.line().substr(static_cast<std::size_t>(tokens[2].data() - cursor_.line().data()));
+      rest = detail::trim(rest);
+      if (rest.size() >= 2 && rest.front() == '"' && rest.back() == '"') rest = rest.substr(1, rest.size() - 2);
+      if (rest.empty()) cursor_.fail("physical group " + std::to_string(tag) + " has an empty name");
+      if (dim == 3) physicalNames_[tag] = std::string(rest);
+    }
+    expectEnd("PhysicalNames", "$PhysicalNames has more lines than its count " + std::to_string(count));
+  }
+
+  void readEntities() {
+    const auto header = nextRecord("'numPoints numCurves numSurfaces numVolumes'");
+    if (header.size() != 4) cursor_.fail("$Entities header needs 4 counts, got " + std::to_string(header.size()));
+    long long lower = 0;
+    long long counts[4];
+    for (std::size_t i = 0; i < 4; ++i) {
+      counts[i] = detail::integerAt(cursor_, header[i], "$Entities count");
+      cursor_.checkCountFits(counts[i], 7, "entities");
+      lower += counts[i];
+    }
+    cursor_.checkCountFits(lower, 7, "entities");
+    for (long long i = 0; i < counts[0] + counts[1] + counts[2]; ++i) nextRecord("an entity line");
+    for (long long i = 0; i < counts[3]; ++i) {
+      const auto tokens = nextRecord("a volume entity line");
+      if (tokens.size() < 8) cursor_.fail("volume entity line needs 'tag minX minY minZ maxX maxY maxZ numPhysicalTags ...'");
+      const long long tag = detail::integerAt(cursor_, tokens[0], "volume entity tag");
+      for (std::size_t c = 1; c < 7; ++c) detail::doubleAt(cursor_, tokens[c], "volume entity bounding box");
+      const long long numPhysicals = detail::integerAt(cursor_, tokens[7], "volume entity physical tag count");
+      if (numPhysicals < 0 || static_cast<std::size_t>(numPhysicals) > tokens.size() - 8) {
+        cursor_.fail("volume entity " + std::to_string(tag) + " claims " + std::to_string(numPhysicals) +
+                     " physical tags but the line has fewer");
+      }
+      auto& physicals = volumePhysicals_[tag];
+      for (std::size_t p = 0; p < static_cast<std::size_t>(numPhysicals); ++p) {
+        physicals.push_back(detail::integerAt(cursor_, tokens[8 + p], "physical tag"));
+      }
+    }
+    expectEnd("Entities", "$Entities has more lines than its counts");
+  }
+
+  void addNode(long long tag, const std::string_view* coordinates) {
+    if (tag < 1) cursor_.fail("node tag " + std::to_string(tag) + " must be a positive integer");
+    const int index = static_cast<int>(raw_.vertexFileIds.size());
+    if (!nodeIndex_.emplace(tag, index).second) cursor_.fail("duplicate node tag " + std::to_string(tag));
+    raw_.vertexFileIds.push_back(tag);
+    for (int c = 0; c < 3; ++c) {
+      raw_.positions.push_back(detail::finiteDoubleAt(cursor_, coordinates[c], "node " + std::to_string(tag) + " coordinate"));
+    }
+  }
+
+  void readNodes22() {
+    const auto header = nextRecord("the node count");
+    const auto headerAt = cursor_.location();
+    if (header.size() != 1) cursor_.fail("$Nodes needs a count line");
+    const long long count = detail::integerAt(cursor_, header[0], "node count");
+    cursor_.checkCountFits(count, 7, "nodes");
+    reserveNodes(count);
+    for (long long i = 0; i < count; ++i) {
+      if (!cursor_.next() || cursor_.line().front() == '$') {
+        cursor_.failAt(headerAt, "$Nodes says " + std::to_string(count) + " nodes, but the section has only " + std::to_string(i));
+      }
+      const auto tokens = detail::splitTokens(cursor_.line(), false);
+      if (tokens.size() != 4) cursor_.fail("node line needs 'tag x y z', got " + std::to_string(tokens.size()) + " fields");
+      addNode(detail::integerAt(cursor_, tokens[0], "node tag"), &tokens[1]);
+    }
+    expectEnd("Nodes", "$Nodes says " + std::to_string(count) + " nodes, but there are more node lines");
+  }
+
+  void reserveNodes(long long count) {
+    raw_.vertexFileIds.reserve(static_cast<std::size_t>(count));
+    raw_.positions.reserve(3 * static_cast<std::size_t>(count));
+  }
+
+  void readNodes41() {
+    const auto header = nextRecord("'numEntityBlocks numNodes minNodeTag maxNodeTag'");
+    const auto headerAt = cursor_.location();
+    if (header.size() != 4) cursor_.fail("$Nodes header needs 'numEntityBlocks numNodes minNodeTag maxNodeTag'");
+    const long long blocks = detail::integerAt(cursor_, header[0], "node block count");
+    const long long count = detail::integerAt(cursor_, header[1], "node count");
+    cursor_.checkCountFits(blocks, 7, "node blocks");
+    cursor_.checkCountFits(count, 7, "nodes");
+    reserveNodes(count);
+    long long read = 0;
+    for (long long b = 0; b < blocks; ++b) {
+      const auto block = nextRecord("a node block header 'entityDim entityTag parametric numNodesInBlock'");
+      if (block.size() != 4) cursor_.fail("node block header needs 'entityDim entityTag parametric numNodesInBlock'");
+      const long long dim = detail::integerAt(cursor_, block[0], "node block entity dimension");
+      const long long parametric = detail::integerAt(cursor_, block[2], "node block parametric flag");
+      const long long inBlock = detail::integerAt(cursor_, block[3], "node block size");
+      if (dim < 0 || dim > 3) cursor_.fail("node block entity dimension must be 0..3, got " + std::to_string(dim));
+      if (parametric != 0 && parametric != 1) cursor_.fail("node block parametric flag must be 0 or 1");
+      cursor_.checkCountFits(inBlock, 7, "nodes in the block");
+      if (read + inBlock > count) cursor_.failAt(headerAt, "$Nodes says " + std::to_string(count) + " nodes, but its blocks hold more");
+      std::vector<long long> tags(static_cast<std::size_t>(inBlock));
+      for (auto& tag : tags) {
+        const auto tokens = nextRecord("a node tag");
+        if (tokens.size() != 1) cursor_.fail("node block: expected one node tag per line, got " + std::to_string(tokens.size()) + " fields");
+        tag = detail::integerAt(cursor_, tokens[0], "node tag");
+      }
+      const std::size_t fields = 3 + static_cast<std::size_t>(parametric ? dim : 0);
+      for (long long tag : tags) {
+        const auto tokens = nextRecord("node coordinates");
+        if (tokens.size() != fields) {
+          cursor_.fail("node " + std::to_string(tag) + ": expected " + std::to_string(fields) + " coordinates, got " +
+                       std::to_string(tokens.size()));
+        }
+        addNode(tag, tokens.data());
+      }
+      read += inBlock;
+    }
+    if (read != count) {
+      cursor_.failAt(headerAt, "$Nodes says " + std::to_string(count) + " nodes, but its blocks hold " + std::to_string(read));
+    }
+    expectEnd("Nodes", "$Nodes has more lines than its blocks describe");
+  }
+
+  /// Appends one tetrahedron given its Gmsh element tag and four node tags.
+  void addTet(long long tag, const std::string_view* nodeTokens) {
+    const std::string name = "element " + std::to_string(tag);
+    std::array<int, 4> t{};
+    for (std::size_t a = 0; a < 4; ++a) {
+      const long long nodeTag = detail::integerAt(cursor_, nodeTokens[a], name + " node");
+      auto it = nodeIndex_.find(nodeTag);
+      if (it == nodeIndex_.end()) cursor_.fail(name + " references node " + std::to_string(nodeTag) + ", which $Nodes does not define");
+      for (std::size_t b = 0; b < a; ++b) {
+        if (t[b] == it->second) cursor_.fail(name + " uses node " + std::to_string(nodeTag) + " twice");
+      }
+      t[a] = it->second;
+    }
+    if (!elementTags_.insert(tag).second) cursor_.fail("duplicate element tag " + std::to_string(tag));
+    raw_.elements.push_back(t);
+    raw_.elementLocations.push_back(cursor_.location());
+    raw_.elementFileIds.push_back(tag);
+    raw_.elementMaterials.push_back(-1);
+  }
+
+  void ignore(long long type) {
+    ++ignoredTotal_;
+    ++ignoredByType_[type];
+  }
+
+  void readElements22() {
+    const auto header = nextRecord("the element count");
+    const auto headerAt = cursor_.location();
+    if (header.size() != 1) cursor_.fail("$Elements needs a count line");
+    const long long count = detail::integerAt(cursor_, header[0], "element count");
+    cursor_.checkCountFits(count, 7, "elements");
+    for (long long i = 0; i < count; ++i) {
+      if (!cursor_.next() || cursor_.line().front() == '$') {
+        cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but the section has only " + std::to_string(i));
+      }
+      const auto tokens = detail::splitTokens(cursor_.line(), false);
+      if (tokens.size() < 3) cursor_.fail("element line needs 'tag type numTags tags... nodes...'");
+      const long long tag = detail::integerAt(cursor_, tokens[0], "element tag");
+      const long long type = detail::integerAt(cursor_, tokens[1], "element " + std::to_string(tag) + " type");
+      const long long numTags = detail::integerAt(cursor_, tokens[2], "element " + std::to_string(tag) + " tag count");
+      if (numTags < 0 || static_cast<std::size_t>(numTags) > tokens.size() - 3) {
+        cursor_.fail("element " + std::to_string(tag) + " claims " + std::to_string(numTags) + " tags but the line has fewer fields");
+      }
+      if (type != kTetrahedron) {
+        ignore(type);
+        continue;
+      }
+      const std::size_t expected = 3 + static_cast<std::size_t>(numTags) + 4;
+      if (tokens.size() != expected) {
+        cursor_.fail("element " + std::to_string(tag) + " (4-node tetrahedron) needs " + std::to_string(expected) +
+                     " fields, got " + std::to_string(tokens.size()));
+      }
+      addTet(tag, &tokens[3 + static_cast<std::size_t>(numTags)]);
+      if (numTags >= 1) {
+        const long long physical = detail::integerAt(cursor_, tokens[3], "element " + std::to_string(tag) + " physical tag");
+        if (physical != 0) physicalElements_[physical].push_back(static_cast<int>(raw_.elements.size()) - 1);
+      }
+    }
+    expectEnd("Elements", "$Elements says " + std::to_string(count) + " elements, but there are more element lines");
+  }
+
+  void readElements41() {
+    const auto header = nextRecord("'numEntityBlocks numElements minElementTag maxElementTag'");
+    const auto headerAt = cursor_.location();
+    if (header.size() != 4) cursor_.fail("$Elements header needs 'numEntityBlocks numElements minElementTag maxElementTag'");
+    const long long blocks = detail::integerAt(cursor_, header[0], "element block count");
+    const long long count = detail::integerAt(cursor_, header[1], "element count");
+    cursor_.checkCountFits(blocks, 7, "element blocks");
+    cursor_.checkCountFits(count, 3, "elements");
+    long long read = 0;
+    for (long long b = 0; b < blocks; ++b) {
+      const auto block = nextRecord("an element block header 'entityDim entityTag elementType numElementsInBlock'");
+      if (block.size() != 4) cursor_.fail("element block header needs 'entityDim entityTag elementType numElementsInBlock'");
+      const long long dim = detail::integerAt(cursor_, block[0], "element block entity dimension");
+      const long long entity = detail::integerAt(cursor_, block[1], "element block entity tag");
+      const long long type = detail::integerAt(cursor_, block[2], "element block type");
+      const long long inBlock = detail::integerAt(cursor_, block[3], "element block size");
+      cursor_.checkCountFits(inBlock, 3, "elements in the block");
+      if (read + inBlock > count) cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but its blocks hold more");
+      const std::vector<long long>* physicals = nullptr;
+      if (dim == 3) {
+        if (auto it = volumePhysicals_.find(entity); it != volumePhysicals_.end()) physicals = &it->second;
+      }
+      for (long long i = 0; i < inBlock; ++i) {
+        const auto tokens = nextRecord("an element line");
+        if (type != kTetrahedron) {
+          ignore(type);
+          continue;
+        }
+        if (tokens.size() != 5) cursor_.fail("4-node tetrahedron line needs 'tag n1 n2 n3 n4', got " + std::to_string(tokens.size()) + " fields");
+        addTet(detail::integerAt(cursor_, tokens[0], "element tag"), &tokens[1]);
+        if (physicals) {
+          for (long long p : *physicals) physicalElements_[p].push_back(static_cast<int>(raw_.elements.size()) - 1);
+        }
+      }
+      read += inBlock;
+    }
+    if (read != count) {
+      cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but its blocks hold " + std::to_string(read));
+    }
+    expectEnd("Elements", "$Elements has more lines than its blocks describe");
+  }
+
+  LineCursor cursor_;
+  detail::RawMesh raw_;
+  bool version41_ = false;
+  std::unordered_map<long long, int> nodeIndex_;
+  std::unordered_set<long long> elementTags_;
+  std::map<long long, std::string> physicalNames_;
+  std::map<long long, std::vector<long long>> volumePhysicals_;
+  std::map<long long, std::vector<int>> physicalElements_;
+  std::map<long long, long long> ignoredByType_;
+  int ignoredTotal_ = 0;
+};
+
+}  // namespace
+
+TetMesh readGmsh(const std::filesystem::path& path, const MeshReadOptions& options, MeshReadReport* report) {
+  MeshReadReport local;
+  MeshReadReport& out = report ? *report : local;
+  out = MeshReadReport{};
+  out.format = "gmsh";
+  const detail::FlatText flat = detail::loadFlatText(path, false);
+  GmshParser parser(flat);
+  return parser.parse(options, out);
+}
+
+}  // namespace asyncfem

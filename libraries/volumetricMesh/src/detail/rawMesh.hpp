@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include "detail/textInput.hpp"
+
+#include <asyncfem/volumetricMesh/readers.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace asyncfem::detail {
+
+/// What a reader has parsed before the checks that need the whole mesh (orientation,
+/// degeneracy, materials, unused vertices). Ids in the file's own numbering are kept so
+/// messages name elements and vertices as the user sees them.
+struct RawMesh {
+  std::vector<double> positions;              ///< x y z per vertex
+  std::vector<long long> vertexFileIds;       ///< id of each vertex in the file
+  std::vector<std::array<int, 4>> elements;   ///< 0-based vertex ids
+  std::vector<Location> elementLocations;     ///< where each element was read
+  std::vector<long long> elementFileIds;      ///< id of each element in the file
+  std::vector<Material> materials;
+  std::vector<int> elementMaterials;          ///< index into materials, -1 for none yet
+  std::map<std::string, std::vector<int>> elementSets;
+  std::map<std::string, std::vector<int>> vertexSets;
+};
+
+/// What to do with elements that have no material after reading.
+enum class MissingMaterialPolicy {
+  Error,          ///< .veg: an element outside every *REGION is an error
+  FormatDefault,  ///< TetGen, Gmsh: no materials in the format, use the documented default
+};
+
+/// The default material of formats that carry none (documented in docs/file-formats.md).
+Material formatDefaultMaterial();
+
+/// Throws a ParseError at the cursor's line unless density > 0, E > 0, -1 < nu < 0.5.
+void checkMaterialAt(const LineCursor& cursor, const Material& material);
+
+/// Applies the material policy, checks every element for degeneracy and orientation
+/// (reorienting when options allow), reports unused vertices, and builds the TetMesh.
+TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions& options, MeshReadReport& report,
+                   MissingMaterialPolicy policy);
+
+}  // namespace asyncfem::detail

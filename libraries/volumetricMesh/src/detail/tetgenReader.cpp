@@ -1,0 +1,204 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// TetGen .node/.ele reader; see docs/file-formats.md.
+#include "detail/rawMesh.hpp"
+#include "detail/textInput.hpp"
+
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
+
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+namespace {
+
+using detail::LineCursor;
+
+/// Attributes per vertex beyond this are surely a corrupt header.
+constexpr long long kMaxAttributes = 1000;
+
+std::vector<std::string_view> headerTokens(LineCursor& cursor, const std::string& expected) {
+  if (!cursor.next()) cursor.failAtEnd("missing header line '" + expected + "'");
+  return detail::splitTokens(cursor.line(), false);
+}
+
+long long headerField(const LineCursor& cursor, const std::vector<std::string_view>& tokens, std::size_t i,
+                      long long fallback, const std::string& what) {
+  return i < tokens.size() ? detail::integerAt(cursor, tokens[i], what) : fallback;
+}
+
+/// Reads the .node file into raw; returns the numbering base (0 or 1).
+long long readNodes(LineCursor& cursor, detail::RawMesh& raw) {
+  const auto header = headerTokens(cursor, "<count> 3 <attributes> <boundaryMarker>");
+  const auto headerAt = cursor.location();
+  if (header.size() > 4) cursor.fail(".node header needs '<count> 3 <attributes> <boundaryMarker>', got " + std::to_string(header.size()) + " fields");
+  const long long count = headerField(cursor, header, 0, 0, ".node vertex count");
+  const long long dimension = headerField(cursor, header, 1, 3, ".node dimension");
+  const long long attributes = headerField(cursor, header, 2, 0, ".node attribute count");
+  const long long markers = headerField(cursor, header, 3, 0, ".node boundary marker flag");
+  if (dimension != 3) cursor.fail(".node dimension must be 3, got " + std::to_string(dimension));
+  if (attributes < 0 || attributes > kMaxAttributes) cursor.fail(".node attribute count " + std::to_string(attributes) + " is out of range");
+  if (markers != 0 && markers != 1) cursor.fail(".node boundary marker flag must be 0 or 1, got " + std::to_string(markers));
+  cursor.checkCountFits(count, 7, "vertices");
+  const auto n = static_cast<std::size_t>(count);
+  const std::size_t fields = 4 + static_cast<std::size_t>(attributes + markers);
+  raw.positions.assign(3 * n, 0.0);
+  raw.vertexFileIds.resize(n);
+  std::vector<char> seen(n, 0);
+  long long base = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!cursor.next()) {
+      cursor.failAt(headerAt, ".node header says " + std::to_string(count) + " vertices, but the file has only " +
+                                  std::to_string(i));
+    }
+    const auto tokens = detail::splitTokens(cursor.line(), false);
+    if (tokens.size() != fields) {
+      cursor.fail("vertex line needs " + std::to_string(fields) + " fields (index x y z, " + std::to_string(attributes) +
+                  " attributes, " + std::to_string(markers) + " marker), got " + std::to_string(tokens.size()));
+    }
+    const long long id = detail::integerAt(cursor, tokens[0], "vertex index");
+    if (i == 0) {
+      if (id != 0 && id != 1) cursor.fail("the first vertex index must be 0 or 1 (it sets the numbering base), got " + std::to_string(id));
+      base = id;
+    }
+    if (id < base || id >= base + count) {
+      cursor.fail("vertex index " + std::to_string(id) + " is outside [" + std::to_string(base) + ", " +
+                  std::to_string(base + count - 1) + "]");
+    }
+    const auto v = static_cast<std::size_t>(id - base);
+    if (seen[v]) cursor.fail("duplicate vertex index " + std::to_string(id));
+    seen[v] = 1;
+    raw.vertexFileIds[v] = id;
+    for (std::size_t c = 0; c < 3; ++c) {
+      raw.positions[3 * v + c] = detail::finiteDoubleAt(cursor, tokens[c + 1], "vertex " + std::to_string(id) + " coordinate");
+    }
+    for (std::size_t a = 4; a < 4 + static_cast<std::size_t>(attributes); ++a) {
+      detail::doubleAt(cursor, tokens[a], "vertex " + std::to_string(id) + " attribute");
+    }
+    if (markers) detail::integerAt(cursor, tokens.back(), "vertex " + std::to_string(id) + " boundary marker");
+  }
+  if (cursor.next()) {
+    cursor.fail(".node header says " + std::to_string(count) + " vertices, but there are more vertex lines");
+  }
+  return base;
+}
+
+void readTets(LineCursor& cursor, detail::RawMesh& raw, long long base, MeshReadReport& report) {
+  const auto header = headerTokens(cursor, "<count> <4|10> <regionAttribute 0|1>");
+  const auto headerAt = cursor.location();
+  if (header.size() > 3) cursor.fail(".ele header needs '<count> <4|10> <0|1>', got " + std::to_string(header.size()) + " fields");
+  const long long count = headerField(cursor, header, 0, 0, ".ele element count");
+  const long long nodesPerTet = headerField(cursor, header, 1, 4, ".ele nodes per tetrahedron");
+  const long long region = headerField(cursor, header, 2, 0, ".ele region attribute flag");
+  if (nodesPerTet != 4 && nodesPerTet != 10) {
+    cursor.fail(".ele nodes per tetrahedron must be 4 or 10, got " + std::to_string(nodesPerTet));
+  }
+  if (region != 0 && region != 1) cursor.fail(".ele region attribute flag must be 0 or 1, got " + std::to_string(region));
+  cursor.checkCountFits(count, 9, "elements");
+  const auto n = static_cast<std::size_t>(count);
+  const auto numVertices = static_cast<long long>(raw.vertexFileIds.size());
+  const std::size_t fields = 1 + static_cast<std::size_t>(nodesPerTet + region);
+  raw.elements.resize(n);
+  raw.elementLocations.resize(n);
+  raw.elementFileIds.resize(n);
+  raw.elementMaterials.assign(n, -1);
+  std::vector<char> seen(n, 0);
+  std::vector<char> cornerVertex(static_cast<std::size_t>(numVertices), 0);
+  std::vector<char> edgeVertex(static_cast<std::size_t>(numVertices), 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!cursor.next()) {
+      cursor.failAt(headerAt, ".ele header says " + std::to_string(count) + " elements, but the file has only " +
+                                  std::to_string(i));
+    }
+    const auto tokens = detail::splitTokens(cursor.line(), false);
+    if (tokens.size() != fields) {
+      cursor.fail("element line needs " + std::to_string(fields) + " fields (index, " + std::to_string(nodesPerTet) +
+                  " vertices" + (region ? ", region" : "") + "), got " + std::to_string(tokens.size()));
+    }
+    const long long id = detail::integerAt(cursor, tokens[0], "element index");
+    if (id < base || id >= base + count) {
+      cursor.fail("element index " + std::to_string(id) + " is outside [" + std::to_string(base) + ", " +
+                  std::to_string(base + count - 1) + "]");
+    }
+    const auto e = static_cast<std::size_t>(id - base);
+    if (seen[e]) cursor.fail("duplicate element index " + std::to_string(id));
+    seen[e] = 1;
+    const std::string name = "element " + std::to_string(id);
+    for (std::size_t a = 0; a < static_cast<std::size_t>(nodesPerTet); ++a) {
+      const long long v = detail::integerAt(cursor, tokens[a + 1], name + " vertex");
+      if (v < base || v >= base + numVertices) {
+        cursor.fail(name + " references vertex " + std::to_string(v) + ", outside [" + std::to_string(base) + ", " +
+                    std::to_string(base + numVertices - 1) + "]");
+      }
+      const int local = static_cast<int>(v - base);
+      if (a < 4) {
+        for (std::size_t b = 0; b < a; ++b) {
+          if (raw.elements[e][b] == local) cursor.fail(name + " uses vertex " + std::to_string(v) + " twice");
+        }
+        raw.elements[e][a] = local;
+        cornerVertex[static_cast<std::size_t>(local)] = 1;
+      } else {
+        edgeVertex[static_cast<std::size_t>(local)] = 1;
+      }
+    }
+    if (region) {
+      const double value = detail::finiteDoubleAt(cursor, tokens.back(), name + " region attribute");
+      raw.elementSets["region_" + detail::formatDouble(value)].push_back(static_cast<int>(e));
+    }
+    raw.elementLocations[e] = cursor.location();
+    raw.elementFileIds[e] = id;
+  }
+  if (cursor.next()) cursor.fail(".ele header says " + std::to_string(count) + " elements, but there are more element lines");
+
+  if (nodesPerTet == 10) {
+    // Linear elements use only the corners; vertices that only ever were edge nodes
+    // would carry no mass or stiffness, so drop them and renumber the rest.
+    std::vector<int> newIndex(static_cast<std::size_t>(numVertices), -1);
+    int kept = 0;
+    int dropped = 0;
+    for (std::size_t v = 0; v < newIndex.size(); ++v) {
+      if (edgeVertex[v] && !cornerVertex[v]) {
+        ++dropped;
+        continue;
+      }
+      newIndex[v] = kept;
+      raw.vertexFileIds[static_cast<std::size_t>(kept)] = raw.vertexFileIds[v];
+      for (std::size_t c = 0; c < 3; ++c) raw.positions[3 * static_cast<std::size_t>(kept) + c] = raw.positions[3 * v + c];
+      ++kept;
+    }
+    raw.vertexFileIds.resize(static_cast<std::size_t>(kept));
+    raw.positions.resize(3 * static_cast<std::size_t>(kept));
+    for (auto& t : raw.elements)
+      for (int& v : t) v = newIndex[static_cast<std::size_t>(v)];
+    report.warnings.push_back("10-node (quadratic) tetrahedra: using the 4 corner vertices of each element and "
+                              "dropping the " + std::to_string(dropped) + " edge-only nodes (vertices are renumbered)");
+  }
+}
+
+}  // namespace
+
+TetMesh readTetGen(const std::filesystem::path& path, const MeshReadOptions& options, MeshReadReport* report) {
+  MeshReadReport local;
+  MeshReadReport& out = report ? *report : local;
+  out = MeshReadReport{};
+  out.format = "tetgen";
+  std::filesystem::path base = path;
+  const std::string extension = path.extension().string();
+  if (detail::equalsIgnoreCase(extension, ".node") || detail::equalsIgnoreCase(extension, ".ele")) {
+    base.replace_extension();
+  }
+  const std::filesystem::path nodePath = base.string() + ".node";
+  const std::filesystem::path elePath = base.string() + ".ele";
+
+  detail::RawMesh raw;
+  const detail::FlatText nodeText = detail::loadFlatText(nodePath, false);
+  LineCursor nodeCursor(nodeText, true);
+  const long long numberingBase = readNodes(nodeCursor, raw);
+  const detail::FlatText eleText = detail::loadFlatText(elePath, false);
+  LineCursor eleCursor(eleText, true);
+  readTets(eleCursor, raw, numberingBase, out);
+  return detail::finishMesh(std::move(raw), eleCursor, options, out, detail::MissingMaterialPolicy::FormatDefault);
+}
+
+}  // namespace asyncfem
