@@ -1,0 +1,155 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Mesh queries: volumes, mass, boundary orientation, adjacency, bounding box, quality.
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace asyncfem {
+namespace {
+
+BoxMeshSpec oddBox() {
+  BoxMeshSpec spec;
+  spec.origin = Eigen::Vector3d(0.1, -0.2, 0.3);
+  spec.size = Eigen::Vector3d(1.5, 0.7, 2.0);
+  spec.cells = Eigen::Vector3i(3, 4, 5);
+  return spec;
+}
+
+TetMesh regularTet() {
+  Eigen::Matrix3Xd x(3, 4);
+  x << 1, 1, -1, -1,  //
+      1, -1, 1, -1,   //
+      1, -1, -1, 1;
+  Eigen::Matrix4Xi t(4, 1);
+  t << 0, 1, 2, 3;
+  return TetMesh(x, t, {Material{"m", 1000, 1e6, 0.3}}, {0});
+}
+
+// Every element volume is a 3x3 determinant with relative rounding error of a few ulps;
+// summing 360 of them adds at most ~360 ulps, about 1e-13 relative, so 1e-12 is a bound
+// with margin that still catches any missing or double-counted element.
+constexpr double kSumTolerance = 1e-12;
+
+TEST(MeshQueries, BoxVolumesSumToTheBoxVolume) {
+  const BoxMeshSpec spec = oddBox();
+  const TetMesh mesh = makeBoxMesh(spec);
+  const double expected = spec.size.prod();
+  EXPECT_NEAR(totalVolume(mesh), expected, kSumTolerance * expected);
+  EXPECT_NEAR(elementVolumes(mesh).sum(), expected, kSumTolerance * expected);
+  for (int e = 0; e < mesh.numElements(); ++e) EXPECT_GT(signedElementVolume(mesh, e), 0.0);
+}
+
+TEST(MeshQueries, MassIsDensityTimesVolume) {
+  BeamSpec spec;
+  spec.cellsAlongLength = 10;
+  const TetMesh beam = makeBeamMesh(spec);
+  // The tip is the last 20% of the 1 x 0.2 x 0.2 beam.
+  const double tipVolume = 0.2 * 0.2 * 0.2, bodyVolume = 0.8 * 0.2 * 0.2;
+  const double expected = spec.body.density * bodyVolume + spec.tip.density * tipVolume;
+  EXPECT_NEAR(totalMass(beam), expected, kSumTolerance * expected);
+}
+
+TEST(MeshQueries, BoundaryTrianglesCountAndOutwardOrientation) {
+  const BoxMeshSpec spec = oddBox();
+  const TetMesh mesh = makeBoxMesh(spec);
+  const auto triangles = boundaryTriangles(mesh);
+  const Eigen::Vector3i c = spec.cells;
+  EXPECT_EQ(triangles.size(), static_cast<std::size_t>(4 * (c.x() * c.y() + c.y() * c.z() + c.z() * c.x())));
+  // Divergence theorem with F(x) = x / 3: V = sum over boundary of (centroid . n) area / 3,
+  // exact for flat triangles. Inward-facing triangles would flip the sign.
+  double volume = 0.0;
+  for (const auto& t : triangles) {
+    const Eigen::Vector3d a = mesh.restPosition(t[0]), b = mesh.restPosition(t[1]), cc = mesh.restPosition(t[2]);
+    const Eigen::Vector3d areaNormal = 0.5 * (b - a).cross(cc - a);
+    volume += ((a + b + cc) / 3.0).dot(areaNormal) / 3.0;
+  }
+  const double expected = spec.size.prod();
+  EXPECT_NEAR(volume, expected, kSumTolerance * expected);
+}
+
+TEST(MeshQueries, BoundaryOfNegativelyStoredElementStillFacesOut) {
+  Eigen::Matrix3Xd x(3, 4);
+  x << 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1;
+  Eigen::Matrix4Xi t(4, 1);
+  t << 0, 2, 1, 3;  // negative orientation
+  const TetMesh mesh(x, t, {Material{"m", 1, 1, 0}}, {0});
+  ASSERT_LT(signedElementVolume(mesh, 0), 0.0);
+  const auto triangles = boundaryTriangles(mesh);
+  ASSERT_EQ(triangles.size(), 4u);
+  const Eigen::Vector3d centroid(0.25, 0.25, 0.25);
+  for (const auto& f : triangles) {
+    const Eigen::Vector3d a = x.col(f[0]), b = x.col(f[1]), c = x.col(f[2]);
+    EXPECT_GT((b - a).cross(c - a).dot((a + b + c) / 3.0 - centroid), 0.0);
+  }
+}
+
+TEST(MeshQueries, VertexElementAdjacency) {
+  BoxMeshSpec spec;
+  spec.cells = Eigen::Vector3i(2, 1, 1);
+  const TetMesh mesh = makeBoxMesh(spec);
+  const VertexElementAdjacency adjacency = vertexElementAdjacency(mesh);
+  ASSERT_EQ(adjacency.offsets.size(), static_cast<std::size_t>(mesh.numVertices()) + 1);
+  EXPECT_EQ(adjacency.offsets.back(), 4 * mesh.numElements());
+  for (int v = 0; v < mesh.numVertices(); ++v) {
+    const auto begin = adjacency.elements.begin() + adjacency.offsets[static_cast<std::size_t>(v)];
+    const auto end = adjacency.elements.begin() + adjacency.offsets[static_cast<std::size_t>(v) + 1];
+    EXPECT_TRUE(std::is_sorted(begin, end));
+    for (int e = 0; e < mesh.numElements(); ++e) {
+      const bool incident = (mesh.element(e).array() == v).any();
+      EXPECT_EQ(std::find(begin, end, e) != end, incident) << "vertex " << v << " element " << e;
+    }
+  }
+  // Vertex 0 (the low corner of the first cube) lies on the shared diagonal of all six tets.
+  EXPECT_EQ(adjacency.offsets[1] - adjacency.offsets[0], 6);
+}
+
+TEST(MeshQueries, BoundingBoxWithAndWithoutDisplacement) {
+  const BoxMeshSpec spec = oddBox();
+  const TetMesh mesh = makeBoxMesh(spec);
+  const BoundingBox rest = boundingBox(mesh);
+  EXPECT_TRUE(rest.min.isApprox(spec.origin));
+  EXPECT_TRUE(rest.max.isApprox(spec.origin + spec.size));
+  Eigen::VectorXd shift(mesh.numDofs());
+  for (int v = 0; v < mesh.numVertices(); ++v) shift.segment<3>(3 * v) = Eigen::Vector3d(1, 2, 3);
+  const BoundingBox moved = boundingBox(mesh, shift);
+  EXPECT_TRUE(moved.min.isApprox(spec.origin + Eigen::Vector3d(1, 2, 3)));
+  EXPECT_THROW(boundingBox(mesh, Eigen::VectorXd::Zero(5)), ValidationError);
+}
+
+TEST(MeshQueries, RegularTetQuality) {
+  const ElementQuality q = elementQuality(regularTet(), 0);
+  const double dihedral = std::acos(1.0 / 3.0);
+  EXPECT_NEAR(q.minDihedralAngle, dihedral, 1e-14);
+  EXPECT_NEAR(q.maxDihedralAngle, dihedral, 1e-14);
+  EXPECT_NEAR(q.aspectRatio, 1.0, 1e-14);
+}
+
+TEST(MeshQueries, FlattenedTetHasWorseQuality) {
+  Eigen::Matrix3Xd x(3, 4);
+  x << 0, 1, 0, 0.3, 0, 0, 1, 0.3, 0, 0, 0, 0.01;
+  Eigen::Matrix4Xi t(4, 1);
+  t << 0, 1, 2, 3;
+  const TetMesh mesh(x, t, {Material{"m", 1, 1, 0}}, {0});
+  const ElementQuality q = elementQualities(mesh).front();
+  EXPECT_GT(q.aspectRatio, 10.0);
+  EXPECT_LT(q.minDihedralAngle, 0.1);
+  EXPECT_GT(q.maxDihedralAngle, 3.0);
+}
+
+TEST(MeshQueries, UnusedVertices) {
+  Eigen::Matrix3Xd x(3, 5);
+  x << 0, 1, 0, 0, 5, 0, 0, 1, 0, 5, 0, 0, 0, 1, 5;
+  Eigen::Matrix4Xi t(4, 1);
+  t << 0, 1, 2, 3;
+  const TetMesh mesh(x, t, {Material{"m", 1, 1, 0}}, {0});
+  EXPECT_EQ(unusedVertices(mesh), std::vector<int>{4});
+}
+
+}  // namespace
+}  // namespace asyncfem
