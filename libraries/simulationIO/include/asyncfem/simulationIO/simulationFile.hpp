@@ -1,0 +1,153 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+namespace asyncfem {
+
+/// What the 64-byte header of a simulation output file (.afsim) says. The byte layout
+/// (little-endian) is documented in docs/simulation-output.md:
+///
+///     offset  size  field
+///          0     8  magic "AFEMSIM\0"
+///          8     4  format version (u32, currently 1)
+///         12     4  header size in bytes (u32, 64)
+///         16     8  numVertices n (u64)
+///         24     8  frame interval (f64, time between frames)
+///         32     8  integrator timestep (f64, informational; 0 if unknown)
+///         40     8  flags (u64): bit 0 = records carry velocities; other bits 0
+///         48     8  record size in bytes (u64, derived from n and flags; checked)
+///         56     4  reserved (0)
+///         60     4  CRC-32 of bytes 0..59
+struct SimulationFileHeader {
+  std::int64_t numVertices = 0;
+  double frameInterval = 0.0;
+  double timestep = 0.0;
+  bool hasVelocities = false;
+
+  /// Bytes of one frame record: index (8) + time (8) + 3n doubles of displacement
+  /// (+ 3n of velocity) + CRC-32 (4) + 4 reserved bytes.
+  std::int64_t recordBytes() const;
+};
+
+/// Current format version, and the size of the header in bytes.
+inline constexpr std::uint32_t simulationFileVersion = 1;
+inline constexpr std::int64_t simulationHeaderBytes = 64;
+/// Largest vertex count a header may claim: 3n must fit in an int (Eigen index), so a
+/// corrupt header can never trigger a giant allocation.
+inline constexpr std::int64_t maxSimulationFileVertices = 715827882;  // floor((2^31 - 1) / 3)
+
+/// One frame as stored: record index (0-based, consecutive), simulated time, and the
+/// stacked 3n displacement (and velocity when the file carries them, else empty).
+struct SimulationFrame {
+  std::int64_t index = 0;
+  double time = 0.0;
+  Eigen::VectorXd displacement;
+  Eigen::VectorXd velocity;
+};
+
+/// Writes a simulation output file. The constructor creates (or truncates) the file and
+/// writes the header, so a run always starts from a fresh file; appendFrame() appends one
+/// checksummed record and flushes it to the operating system before returning, so a
+/// process killed at any point leaves every previously appended frame readable.
+///
+/// Errors (cannot create, write failure, wrong vector size, non-finite values) throw
+/// asyncfem::Error naming the file.
+class SimulationWriter {
+public:
+  struct Options {
+    /// Also fsync() after every frame, so frames survive a machine crash, not only a
+    /// killed process (slower).
+    bool syncEachFrame = false;
+  };
+
+  SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header);
+  SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header, Options options);
+  ~SimulationWriter();
+  SimulationWriter(const SimulationWriter&) = delete;
+  SimulationWriter& operator=(const SimulationWriter&) = delete;
+
+  /// Appends the next frame (index = numFrames()). displacement: size 3n. Use the
+  /// overload with velocity when the header says hasVelocities.
+  void appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement);
+  void appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
+                   const Eigen::Ref<const Eigen::VectorXd>& velocity);
+
+  /// Frames appended so far.
+  std::int64_t numFrames() const { return numFrames_; }
+  const SimulationFileHeader& header() const { return header_; }
+  const std::filesystem::path& path() const { return path_; }
+  /// Flushes and closes; further appends throw. The destructor closes too (silently).
+  void close();
+
+private:
+  struct FileCloser {
+    void operator()(std::FILE* file) const;
+  };
+  void appendRecord(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
+                    const Eigen::Ref<const Eigen::VectorXd>* velocity);
+
+  std::filesystem::path path_;
+  SimulationFileHeader header_;
+  Options options_;
+  std::unique_ptr<std::FILE, FileCloser> file_;
+  std::int64_t numFrames_ = 0;
+  std::vector<unsigned char> buffer_;
+};
+
+/// Reads a simulation output file, possibly one still being written or left behind by an
+/// interrupted run.
+///
+/// The constructor validates the header and throws asyncfem::ParseError naming the file
+/// for a missing or truncated header, bad magic, an unsupported version, a header
+/// checksum mismatch, unknown flags, or absurd sizes (n = 0, n > maxSimulationFileVertices,
+/// a non-finite or negative frame interval, a record size that disagrees with n). A
+/// trailing partial record (an interrupted append) is not an error: it is ignored and
+/// reported by truncatedTrailingBytes(). readFrame() verifies the record's checksum and
+/// index and throws a ParseError naming the frame if they do not match.
+class SimulationReader {
+public:
+  explicit SimulationReader(const std::filesystem::path& path);
+  ~SimulationReader();
+  SimulationReader(const SimulationReader&) = delete;
+  SimulationReader& operator=(const SimulationReader&) = delete;
+
+  const SimulationFileHeader& header() const { return header_; }
+  const std::filesystem::path& path() const { return path_; }
+  int numVertices() const { return static_cast<int>(header_.numVertices); }
+  /// Complete frame records in the file (as of construction or the last refresh()).
+  std::int64_t numFrames() const { return numFrames_; }
+  /// Bytes after the last complete record: > 0 when the last append was interrupted.
+  std::int64_t truncatedTrailingBytes() const { return trailingBytes_; }
+  bool hasTruncatedFrame() const { return trailingBytes_ > 0; }
+
+  /// Re-reads the file size (for a file another process is still appending to).
+  void refresh();
+
+  /// Frame k in [0, numFrames()).
+  SimulationFrame readFrame(std::int64_t k);
+  /// Same, reusing out's storage.
+  void readFrame(std::int64_t k, SimulationFrame& out);
+  /// Reads and checks every complete frame; throws at the first bad one.
+  void verifyAll();
+
+private:
+  struct FileCloser {
+    void operator()(std::FILE* file) const;
+  };
+
+  std::filesystem::path path_;
+  std::unique_ptr<std::FILE, FileCloser> file_;
+  SimulationFileHeader header_;
+  std::int64_t numFrames_ = 0;
+  std::int64_t trailingBytes_ = 0;
+  std::vector<unsigned char> buffer_;
+};
+
+}  // namespace asyncfem

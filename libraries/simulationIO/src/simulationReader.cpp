@@ -1,0 +1,168 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/simulationIO/crc32.hpp>
+#include <asyncfem/simulationIO/simulationFile.hpp>
+
+#include "detail/byteOrder.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include <sys/types.h>
+
+namespace asyncfem {
+
+void SimulationReader::FileCloser::operator()(std::FILE* file) const { std::fclose(file); }
+
+namespace {
+
+std::string hex32(std::uint32_t value) {
+  static constexpr char digits[] = "0123456789abcdef";
+  std::string text = "0x00000000";
+  for (int i = 0; i < 8; ++i) {
+    text[static_cast<std::size_t>(9 - i)] = digits[(value >> (4 * i)) & 0xFU];
+  }
+  return text;
+}
+
+}  // namespace
+
+SimulationReader::SimulationReader(const std::filesystem::path& path) : path_(path) {
+  const std::string name = path.string();
+  file_.reset(std::fopen(name.c_str(), "rb"));
+  if (!file_) {
+    throw Error(name + ": cannot open: " + std::strerror(errno));
+  }
+  unsigned char bytes[simulationHeaderBytes] = {};
+  const std::size_t got = std::fread(bytes, 1, sizeof(bytes), file_.get());
+  if (got < sizeof(detail::simulationMagic) ||
+      std::memcmp(bytes, detail::simulationMagic, sizeof(detail::simulationMagic)) != 0) {
+    if (got < sizeof(detail::simulationMagic)) {
+      throw ParseError(name, 0, "truncated header: " + std::to_string(got) + " bytes, expected " +
+                                    std::to_string(simulationHeaderBytes));
+    }
+    throw ParseError(name, 0, "not an AsyncFEM simulation file (bad magic)");
+  }
+  if (got < sizeof(bytes)) {
+    throw ParseError(name, 0, "truncated header: " + std::to_string(got) + " bytes, expected " +
+                                  std::to_string(simulationHeaderBytes));
+  }
+  const std::uint32_t version = detail::getU32(bytes + detail::offsetVersion);
+  if (version != simulationFileVersion) {
+    throw ParseError(name, 0, "unsupported format version " + std::to_string(version) + " (this build reads " +
+                                  std::to_string(simulationFileVersion) + ")");
+  }
+  const std::uint32_t headerBytes = detail::getU32(bytes + detail::offsetHeaderBytes);
+  if (headerBytes != simulationHeaderBytes) {
+    throw ParseError(name, 0, "header size " + std::to_string(headerBytes) + ", expected " +
+                                  std::to_string(simulationHeaderBytes));
+  }
+  const std::uint32_t storedCrc = detail::getU32(bytes + detail::offsetHeaderCrc);
+  const std::uint32_t actualCrc = crc32(bytes, detail::offsetHeaderCrc);
+  if (storedCrc != actualCrc) {
+    throw ParseError(name, 0, "header checksum mismatch (stored " + hex32(storedCrc) + ", computed " +
+                                  hex32(actualCrc) + "): the header is corrupted");
+  }
+
+  // Sizes are checked before anything is allocated from them.
+  const std::uint64_t numVertices = detail::getU64(bytes + detail::offsetNumVertices);
+  if (numVertices == 0 || numVertices > static_cast<std::uint64_t>(maxSimulationFileVertices)) {
+    throw ParseError(name, 0, "header claims " + std::to_string(numVertices) + " vertices (expected 1 to " +
+                                  std::to_string(maxSimulationFileVertices) + ")");
+  }
+  header_.numVertices = static_cast<std::int64_t>(numVertices);
+  header_.frameInterval = detail::getF64(bytes + detail::offsetFrameInterval);
+  header_.timestep = detail::getF64(bytes + detail::offsetTimestep);
+  if (!std::isfinite(header_.frameInterval) || header_.frameInterval < 0.0 || !std::isfinite(header_.timestep) ||
+      header_.timestep < 0.0) {
+    throw ParseError(name, 0, "header has a non-finite or negative frame interval or timestep");
+  }
+  const std::uint64_t flags = detail::getU64(bytes + detail::offsetFlags);
+  if ((flags & ~detail::flagVelocities) != 0) {
+    throw ParseError(name, 0, "header has unknown flags " + std::to_string(flags));
+  }
+  header_.hasVelocities = (flags & detail::flagVelocities) != 0;
+  const std::uint64_t recordBytes = detail::getU64(bytes + detail::offsetRecordBytes);
+  if (recordBytes != static_cast<std::uint64_t>(header_.recordBytes())) {
+    throw ParseError(name, 0, "header record size " + std::to_string(recordBytes) + " disagrees with " +
+                                  std::to_string(numVertices) + " vertices (expected " +
+                                  std::to_string(header_.recordBytes()) + ")");
+  }
+  refresh();
+}
+
+SimulationReader::~SimulationReader() = default;
+
+void SimulationReader::refresh() {
+  if (::fseeko(file_.get(), 0, SEEK_END) != 0) {
+    throw Error(path_.string() + ": cannot seek: " + std::strerror(errno));
+  }
+  const auto size = static_cast<std::int64_t>(::ftello(file_.get()));
+  if (size < simulationHeaderBytes) {
+    throw ParseError(path_.string(), 0, "the file shrank below its header while being read");
+  }
+  const std::int64_t payload = size - simulationHeaderBytes;
+  numFrames_ = payload / header_.recordBytes();
+  trailingBytes_ = payload % header_.recordBytes();
+}
+
+SimulationFrame SimulationReader::readFrame(std::int64_t k) {
+  SimulationFrame frame;
+  readFrame(k, frame);
+  return frame;
+}
+
+void SimulationReader::readFrame(std::int64_t k, SimulationFrame& out) {
+  const std::string where = path_.string() + ": frame " + std::to_string(k);
+  if (k < 0 || k >= numFrames_) {
+    throw Error(where + ": out of range (the file has " + std::to_string(numFrames_) + " complete frames)");
+  }
+  const auto recordBytes = static_cast<std::size_t>(header_.recordBytes());
+  buffer_.resize(recordBytes);
+  const std::int64_t offset = simulationHeaderBytes + (k * header_.recordBytes());
+  if (::fseeko(file_.get(), static_cast<off_t>(offset), SEEK_SET) != 0 ||
+      std::fread(buffer_.data(), 1, recordBytes, file_.get()) != recordBytes) {
+    throw ParseError(path_.string(), 0, "frame " + std::to_string(k) + ": cannot read the record");
+  }
+  const unsigned char* in = buffer_.data();
+  const std::size_t crcOffset = recordBytes - detail::recordSuffixBytes;
+  const std::uint32_t storedCrc = detail::getU32(in + crcOffset);
+  const std::uint32_t actualCrc = crc32(in, crcOffset);
+  if (storedCrc != actualCrc) {
+    throw ParseError(path_.string(), 0, "frame " + std::to_string(k) + ": checksum mismatch (stored " +
+                                            hex32(storedCrc) + ", computed " + hex32(actualCrc) +
+                                            "): the record is corrupted");
+  }
+  const auto index = static_cast<std::int64_t>(detail::getU64(in));
+  if (index != k) {
+    throw ParseError(path_.string(), 0, "frame " + std::to_string(k) + ": record says it is frame " +
+                                            std::to_string(index));
+  }
+  out.index = index;
+  out.time = detail::getF64(in + 8);
+  const auto size = static_cast<Eigen::Index>(3 * header_.numVertices);
+  std::size_t position = detail::recordPrefixBytes;
+  out.displacement.resize(size);
+  for (Eigen::Index i = 0; i < size; ++i, position += 8) {
+    out.displacement[i] = detail::getF64(in + position);
+  }
+  if (header_.hasVelocities) {
+    out.velocity.resize(size);
+    for (Eigen::Index i = 0; i < size; ++i, position += 8) {
+      out.velocity[i] = detail::getF64(in + position);
+    }
+  } else {
+    out.velocity.resize(0);
+  }
+}
+
+void SimulationReader::verifyAll() {
+  SimulationFrame frame;
+  for (std::int64_t k = 0; k < numFrames_; ++k) {
+    readFrame(k, frame);
+  }
+}
+
+}  // namespace asyncfem

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/simulationIO/crc32.hpp>
+#include <asyncfem/simulationIO/simulationFile.hpp>
+
+#include "detail/byteOrder.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include <unistd.h>
+
+namespace asyncfem {
+
+std::int64_t SimulationFileHeader::recordBytes() const {
+  const std::int64_t arrays = hasVelocities ? 2 : 1;
+  return static_cast<std::int64_t>(detail::recordPrefixBytes + detail::recordSuffixBytes) +
+         (arrays * 3 * numVertices * static_cast<std::int64_t>(sizeof(double)));
+}
+
+void SimulationWriter::FileCloser::operator()(std::FILE* file) const { std::fclose(file); }
+
+namespace {
+
+std::string systemMessage() { return std::strerror(errno); }
+
+}  // namespace
+
+SimulationWriter::SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header)
+    : SimulationWriter(path, header, Options{}) {}
+
+SimulationWriter::SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header,
+                                   Options options)
+    : path_(path), header_(header), options_(options) {
+  const std::string name = path.string();
+  if (header.numVertices <= 0 || header.numVertices > maxSimulationFileVertices) {
+    throw Error(name + ": cannot write a simulation file with " + std::to_string(header.numVertices) + " vertices");
+  }
+  if (!std::isfinite(header.frameInterval) || header.frameInterval < 0.0 || !std::isfinite(header.timestep) ||
+      header.timestep < 0.0) {
+    throw Error(name + ": frame interval and timestep must be finite and >= 0");
+  }
+  file_.reset(std::fopen(name.c_str(), "wb"));
+  if (!file_) {
+    throw Error(name + ": cannot create: " + systemMessage());
+  }
+
+  unsigned char bytes[simulationHeaderBytes] = {};
+  std::memcpy(bytes, detail::simulationMagic, sizeof(detail::simulationMagic));
+  detail::putU32(bytes + detail::offsetVersion, simulationFileVersion);
+  detail::putU32(bytes + detail::offsetHeaderBytes, static_cast<std::uint32_t>(simulationHeaderBytes));
+  detail::putU64(bytes + detail::offsetNumVertices, static_cast<std::uint64_t>(header.numVertices));
+  detail::putF64(bytes + detail::offsetFrameInterval, header.frameInterval);
+  detail::putF64(bytes + detail::offsetTimestep, header.timestep);
+  detail::putU64(bytes + detail::offsetFlags, header.hasVelocities ? detail::flagVelocities : 0);
+  detail::putU64(bytes + detail::offsetRecordBytes, static_cast<std::uint64_t>(header.recordBytes()));
+  detail::putU32(bytes + detail::offsetHeaderCrc, crc32(bytes, detail::offsetHeaderCrc));
+  if (std::fwrite(bytes, 1, sizeof(bytes), file_.get()) != sizeof(bytes) || std::fflush(file_.get()) != 0) {
+    throw Error(name + ": cannot write the header: " + systemMessage());
+  }
+  buffer_.resize(static_cast<std::size_t>(header.recordBytes()));
+}
+
+SimulationWriter::~SimulationWriter() = default;
+
+void SimulationWriter::close() {
+  if (!file_) {
+    return;
+  }
+  std::FILE* file = file_.release();
+  const bool flushed = std::fflush(file) == 0;
+  const bool closed = std::fclose(file) == 0;
+  if (!flushed || !closed) {
+    throw Error(path_.string() + ": cannot close: " + systemMessage());
+  }
+}
+
+void SimulationWriter::appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement) {
+  if (header_.hasVelocities) {
+    throw Error(path_.string() + ": frame " + std::to_string(numFrames_) +
+                ": the file stores velocities, but none were given");
+  }
+  appendRecord(time, displacement, nullptr);
+}
+
+void SimulationWriter::appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
+                                   const Eigen::Ref<const Eigen::VectorXd>& velocity) {
+  if (!header_.hasVelocities) {
+    throw Error(path_.string() + ": frame " + std::to_string(numFrames_) +
+                ": velocities given, but the file was created without them");
+  }
+  appendRecord(time, displacement, &velocity);
+}
+
+void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
+                                    const Eigen::Ref<const Eigen::VectorXd>* velocity) {
+  const std::string where = path_.string() + ": frame " + std::to_string(numFrames_);
+  if (!file_) {
+    throw Error(where + ": the file is closed");
+  }
+  const Eigen::Index size = 3 * header_.numVertices;
+  if (displacement.size() != size || (velocity != nullptr && velocity->size() != size)) {
+    throw Error(where + ": expected vectors of size " + std::to_string(size) + ", got " +
+                std::to_string(displacement.size()));
+  }
+  // A reader must be able to trust every frame it finds, so nothing non-finite is stored.
+  if (!std::isfinite(time) || !displacement.allFinite() || (velocity != nullptr && !velocity->allFinite())) {
+    throw Error(where + ": refusing to store non-finite values");
+  }
+
+  unsigned char* out = buffer_.data();
+  detail::putU64(out, static_cast<std::uint64_t>(numFrames_));
+  detail::putF64(out + 8, time);
+  std::size_t offset = detail::recordPrefixBytes;
+  for (Eigen::Index i = 0; i < size; ++i, offset += 8) {
+    detail::putF64(out + offset, displacement[i]);
+  }
+  if (velocity != nullptr) {
+    for (Eigen::Index i = 0; i < size; ++i, offset += 8) {
+      detail::putF64(out + offset, (*velocity)[i]);
+    }
+  }
+  detail::putU32(out + offset, crc32(out, offset));
+  detail::putU32(out + offset + 4, 0);
+
+  if (std::fwrite(out, 1, buffer_.size(), file_.get()) != buffer_.size() || std::fflush(file_.get()) != 0) {
+    throw Error(where + ": write failed: " + systemMessage());
+  }
+  if (options_.syncEachFrame && ::fsync(::fileno(file_.get())) != 0) {
+    throw Error(where + ": fsync failed: " + systemMessage());
+  }
+  ++numFrames_;
+}
+
+}  // namespace asyncfem
