@@ -14,9 +14,11 @@ namespace asyncfem {
 class FreeDofs {
 public:
   FreeDofs() = default;
-  /// fixedDofs: global DOF ids (any order, duplicates allowed), each in [0, numDofs).
+  /// fixedDofs: global DOF ids (any order, duplicates allowed), each in [0, numDofs);
+  /// throws ValidationError naming the first DOF out of range.
   FreeDofs(int numDofs, const std::vector<int>& fixedDofs);
-  /// All three DOFs of each listed vertex are fixed.
+  /// All three DOFs of each listed vertex are fixed; throws ValidationError naming a
+  /// vertex out of [0, numVertices).
   static FreeDofs fromFixedVertices(int numVertices, const std::vector<int>& fixedVertices);
 
   int numDofs() const { return static_cast<int>(fullToFree_.size()); }
@@ -28,9 +30,11 @@ public:
   const std::vector<int>& fullToFree() const { return fullToFree_; }
   bool isFixed(int dof) const { return fullToFree_[static_cast<std::size_t>(dof)] < 0; }
 
-  /// The free entries of a full vector (size numDofs -> numFree).
+  /// The free entries of a full vector (size numDofs -> numFree); asyncfem::Error on a
+  /// size mismatch.
   Eigen::VectorXd restrict(const Eigen::VectorXd& full) const;
-  /// A full vector with the free entries from free and the fixed entries zero.
+  /// A full vector with the free entries from free and the fixed entries zero
+  /// (numFree -> numDofs); asyncfem::Error on a size mismatch.
   Eigen::VectorXd expand(const Eigen::VectorXd& free) const;
 
 private:
@@ -46,12 +50,17 @@ private:
 class SubmatrixExtractor {
 public:
   SubmatrixExtractor() = default;
+  /// Builds the pattern of full(rows, cols) (rows.size() x cols.size()) and the value
+  /// map. Throws ValidationError if an index list is not strictly ascending or leaves
+  /// [0, full.rows()) resp. [0, full.cols()). full may be uncompressed.
   SubmatrixExtractor(const Eigen::SparseMatrix<double>& full, const std::vector<int>& rows,
                      const std::vector<int>& cols);
 
   /// A new submatrix with values from full.
   Eigen::SparseMatrix<double> extract(const Eigen::SparseMatrix<double>& full) const;
-  /// Overwrites sub's values (sub from extract()) with those of full.
+  /// Overwrites sub's values (sub from extract()) with those of full, which must have
+  /// the pattern the extractor was built from (size and entry count are checked:
+  /// asyncfem::Error otherwise). Parallel, one copy per stored entry.
   void update(const Eigen::SparseMatrix<double>& full, Eigen::SparseMatrix<double>& sub) const;
 
 private:
