@@ -73,6 +73,12 @@ TEST(VegErrors, ElementUsesVertexTwice) {
   expectVegError("1 1 2 3 4", "1 1 2 1 4", 11, {"element 1", "vertex 1 twice"});
 }
 
+TEST(VegErrors, LinesOfOnlySeparators) {
+  expectVegError("5 3 0 0", ",", 2, {"*VERTICES needs a header line"});
+  expectVegError("TET", ", ,", 9, {"unsupported element type"});
+  expectVegError("ENU, 7800, 2e11, 0.3", ",,", 14, {"steel", "ENU, density, E, nu"});
+}
+
 TEST(VegErrors, FewerVerticesThanHeader) {
   expectVegError("5 3 0 0", "7 3 0 0", 2, {"7 vertices", "only 5"});
 }

@@ -88,7 +88,9 @@ private:
     if (!cursor_.next() || isKeywordLine(cursor_.line())) {
       cursor_.fail(keyword + " needs a header line '" + expected + "'");
     }
-    return detail::splitTokens(cursor_.line(), true);
+    auto tokens = detail::splitTokens(cursor_.line(), true);
+    if (tokens.empty()) cursor_.fail(keyword + " needs a header line '" + expected + "'");
+    return tokens;
   }
 
   void readVertices() {
@@ -143,7 +145,8 @@ private:
       cursor_.fail("element type CUBIC (hexahedra) is not supported: only TET meshes can be read");
     }
     if (!detail::equalsIgnoreCase(type, "TET")) {
-      if (detail::parseInteger(detail::splitTokens(type, true).front(), ignored)) {
+      const auto typeTokens = detail::splitTokens(type, true);
+      if (!typeTokens.empty() && detail::parseInteger(typeTokens.front(), ignored)) {
         cursor_.fail("*ELEMENTS needs the element type (TET) on its own line before the count");
       }
       cursor_.fail("unsupported element type '" + std::string(type) + "': only TET is supported");
@@ -218,6 +221,7 @@ private:
       cursor_.fail("*MATERIAL " + name + " needs a line 'ENU, density, E, nu'");
     }
     const auto tokens = detail::splitTokens(cursor_.line(), true);
+    if (tokens.empty()) cursor_.fail("*MATERIAL " + name + " needs a line 'ENU, density, E, nu'");
     if (!detail::equalsIgnoreCase(tokens.front(), "ENU")) {
       cursor_.fail("material '" + name + "': unsupported material keyword '" + std::string(tokens.front()) +
                    "' (only isotropic 'ENU, density, E, nu' is supported)");
