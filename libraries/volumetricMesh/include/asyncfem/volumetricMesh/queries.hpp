@@ -13,8 +13,9 @@ namespace asyncfem {
 /// Signed volume of element e at rest: det([x1-x0, x2-x0, x3-x0]) / 6.
 /// Positive for the orientation the toolkit uses.
 double signedElementVolume(const TetMesh& mesh, int e);
-/// |signed volume| of every element.
+/// |signed volume| of every element (size numElements).
 Eigen::VectorXd elementVolumes(const TetMesh& mesh);
+/// Sum of the element volumes.
 double totalVolume(const TetMesh& mesh);
 /// Sum of rho * V over elements.
 double totalMass(const TetMesh& mesh);
@@ -23,19 +24,22 @@ double totalMass(const TetMesh& mesh);
 /// their normal (b-a)x(c-a) points out of the mesh. Deterministic order.
 std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh);
 
-/// Vertex -> incident elements in compressed form: the elements of vertex v are
+/// Vertex -> incident elements in compressed form (offsets has numVertices + 1 entries): the elements of vertex v are
 /// elements[offsets[v] .. offsets[v+1]), ascending.
 struct VertexElementAdjacency {
   std::vector<int> offsets;
   std::vector<int> elements;
 };
+/// Builds the vertex -> element adjacency in O(numElements).
 VertexElementAdjacency vertexElementAdjacency(const TetMesh& mesh);
 
+/// Axis-aligned box, min and max corner.
 struct BoundingBox {
   Eigen::Vector3d min;
   Eigen::Vector3d max;
 };
-/// Box of the rest positions (of positions + displacement if given, size 3n).
+/// Box of the rest positions (of positions + displacement if given, size 3n; other sizes
+/// throw ValidationError). Zero box for a mesh without vertices.
 BoundingBox boundingBox(const TetMesh& mesh, const Eigen::VectorXd& displacement = {});
 
 /// Shape quality of one element.
@@ -46,7 +50,11 @@ struct ElementQuality {
   /// the element degenerates.
   double aspectRatio = 0.0;
 };
+/// Quality of element e. Dihedral angle at an edge = angle between the two faces that
+/// share it (acos(1/3) for all six edges of the regular tetrahedron); a zero-volume
+/// element has aspect ratio +infinity.
 ElementQuality elementQuality(const TetMesh& mesh, int e);
+/// elementQuality for every element, in element order.
 std::vector<ElementQuality> elementQualities(const TetMesh& mesh);
 
 /// Vertices referenced by no element.
