@@ -61,6 +61,9 @@ public:
   }
 
   virtual SolverKind kind() const = 0;
+  /// Fill-reducing ordering in effect after analyzePattern(): "metis", "amd", "colamd",
+  /// "natural", ... as the backend reports it ("default" when the backend does not say).
+  virtual std::string ordering() const { return "default"; }
   const SolverStats& stats() const { return stats_; }
   void resetStats() { stats_ = SolverStats{}; }
 
