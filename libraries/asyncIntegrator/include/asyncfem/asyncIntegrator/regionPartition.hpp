@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+/// One fast region S_i: a set of vertices advanced with the small timestep
+/// hS_i = hL / ratio. Everything not in any fast region is the large-step region L.
+struct AsyncRegion {
+  std::string name;
+  std::vector<int> vertices;  ///< 0-based vertex ids (any order; duplicates ignored)
+  int ratio = 1;              ///< m_i = hL / hS_i, a positive integer
+};
+
+/// Ways to name the vertices of a region in a scene (resolved by regionVertices()).
+struct RegionSelector {
+  std::vector<std::string> vertexSets;   ///< named vertex sets of the mesh
+  std::vector<std::string> elementSets;  ///< every vertex of every element of these sets
+  std::vector<Eigen::Vector3d> boxMin;   ///< axis-aligned boxes (rest positions inside, inclusive)
+  std::vector<Eigen::Vector3d> boxMax;
+  std::vector<int> vertices;             ///< explicit 0-based ids
+};
+/// Union of everything the selector names, sorted and unique. Unknown set names and
+/// out-of-range ids throw asyncfem::ValidationError naming them.
+std::vector<int> regionVertices(const TetMesh& mesh, const RegionSelector& selector);
+
+/// A validated partition of the free DOFs into fast regions S_1..S_n and the rest L,
+/// with the interface data the asynchronous solve needs.
+///
+/// Rejected with asyncfem::ValidationError (message names the culprit):
+/// - a ratio < 1;
+/// - a vertex listed in two regions (names the vertex and both regions);
+/// - an element with vertices in two different fast regions (names the element): the
+///   method couples each S_i only to L;
+/// - a region with no free DOF (all its vertices fixed, or empty);
+/// - a vertex id out of range.
+class RegionPartition {
+public:
+  RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, std::vector<AsyncRegion> regions);
+
+  int numRegions() const { return static_cast<int>(regions_.size()); }
+  const AsyncRegion& region(int i) const { return regions_[static_cast<std::size_t>(i)]; }
+  int ratio(int i) const { return region(i).ratio; }
+
+  /// Free DOFs of S_i as global DOF ids (ascending).
+  const std::vector<int>& regionDofs(int i) const { return regionDofs_[static_cast<std::size_t>(i)]; }
+  /// Free DOFs of L as global DOF ids (ascending).
+  const std::vector<int>& largeDofs() const { return largeDofs_; }
+  /// Free DOFs of L that share an element with S_i (global ids, ascending): the only
+  /// columns of H^{S_i L} and rows of H^{L S_i} that are non-zero.
+  const std::vector<int>& interfaceDofs(int i) const { return interfaceDofs_[static_cast<std::size_t>(i)]; }
+  /// Positions of interfaceDofs(i) inside largeDofs().
+  const std::vector<int>& interfacePositions(int i) const { return interfacePositions_[static_cast<std::size_t>(i)]; }
+  /// Elements with vertices in more than one region (L counts as a region).
+  const std::vector<int>& interfaceElements() const { return interfaceElements_; }
+  /// Region of every vertex: i for S_i, -1 for L.
+  const std::vector<int>& vertexRegion() const { return vertexRegion_; }
+
+private:
+  std::vector<AsyncRegion> regions_;
+  std::vector<std::vector<int>> regionDofs_;
+  std::vector<int> largeDofs_;
+  std::vector<std::vector<int>> interfaceDofs_;
+  std::vector<std::vector<int>> interfacePositions_;
+  std::vector<int> interfaceElements_;
+  std::vector<int> vertexRegion_;
+};
+
+}  // namespace asyncfem

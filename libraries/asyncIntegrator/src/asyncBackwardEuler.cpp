@@ -1,0 +1,468 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Asynchronous implicit backward Euler. Every equation number refers to the design note
+// shared/design/async-backward-euler.md ("row r", "last row", "Solving it in O(m)").
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
+
+#include <Eigen/SparseCore>
+
+#include <cmath>
+#include <string>
+
+namespace asyncfem {
+
+namespace {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// Entries of a full vector at the listed global DOFs.
+Eigen::VectorXd gather(const Eigen::VectorXd& full, const std::vector<int>& dofs) {
+  Eigen::VectorXd out(static_cast<Eigen::Index>(dofs.size()));
+  for (std::size_t k = 0; k < dofs.size(); ++k) out[static_cast<Eigen::Index>(k)] = full[dofs[k]];
+  return out;
+}
+
+/// Appends the entries of block, shifted by (rowOffset, colOffset), to triplets; with a
+/// column map, block column c goes to colOffset + columnMap[c] (and likewise rows).
+void appendTriplets(const SparseMatrix& block, double scale, int rowOffset, int colOffset,
+                    std::vector<Eigen::Triplet<double>>& triplets, const std::vector<int>* rowMap = nullptr,
+                    const std::vector<int>* columnMap = nullptr) {
+  for (int c = 0; c < block.outerSize(); ++c) {
+    for (SparseMatrix::InnerIterator it(block, c); it; ++it) {
+      const int row = rowMap ? (*rowMap)[static_cast<std::size_t>(it.row())] : static_cast<int>(it.row());
+      const int col = columnMap ? (*columnMap)[static_cast<std::size_t>(c)] : c;
+      triplets.emplace_back(rowOffset + row, colOffset + col, scale * it.value());
+    }
+  }
+}
+
+/// A dense q x q block scattered into a |L| x |L| sparse matrix at the listed positions,
+/// every entry stored (so the pattern never depends on values).
+SparseMatrix scatterDense(const Eigen::MatrixXd& block, const std::vector<int>& positions, int size) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(block.size()));
+  for (Eigen::Index c = 0; c < block.cols(); ++c)
+    for (Eigen::Index r = 0; r < block.rows(); ++r)
+      triplets.emplace_back(positions[static_cast<std::size_t>(r)], positions[static_cast<std::size_t>(c)], block(r, c));
+  SparseMatrix out(size, size);
+  out.setFromTriplets(triplets.begin(), triplets.end());
+  return out;
+}
+
+/// Blocks of one fast region S_i (rows/columns named as in the design note; "I" is the
+/// interface subset of L, the only L DOFs the coupling blocks touch).
+struct RegionBlocks {
+  int ratio = 1;
+  double smallStep = 0.0;  // hS
+  SubmatrixExtractor massSS, massSI, massIS, stiffSS, stiffSI, stiffIS;
+  SparseMatrix Mss, Kss, Dss, Msi, Ksi, Dsi, Mis, Kis, Dis;
+  SparseMatrix systemMatrix;   // A^S = M + hS D + hS^2 K
+  SparseMatrix G;              // hS^2 K^{SS}
+  SparseMatrix E;              // hL hS K^{IS}
+  SparseMatrix P;              // M^{IS} + hL D^{IS}  (F - E)
+  std::unique_ptr<SparseSolver> solver;
+  bool analyzed = false;
+  std::vector<Eigen::MatrixXd> z;  // Z_r blocks (denseZ recovery only)
+  Eigen::MatrixXd correction;      // C_i = H^{IS} Z, q x q
+};
+
+}  // namespace
+
+struct AsyncBackwardEuler::Impl {
+  double largeStep = 0.0;
+  bool linear = true;
+  bool built = false;  // blocks and factors valid for the current timestep (linear models)
+  SparseMatrix stiffness;  // full 3n x 3n tangent K(u_0)
+  Eigen::VectorXd internalForce;
+  std::vector<RegionBlocks> regions;
+  SubmatrixExtractor massLL, stiffLL;
+  SparseMatrix largeSystem;  // A^L
+  SparseMatrix schur;        // H^{LL*} (or its symmetric part)
+  std::unique_ptr<SparseSolver> schurSolver;
+  bool schurAnalyzed = false;
+  // Naive method.
+  SparseMatrix naiveSystem;
+  std::unique_ptr<SparseSolver> naiveSolver;
+  bool naiveAnalyzed = false;
+  std::vector<int> naiveOffsets;  // first row of region i's X_1; last entry = first row of Y
+};
+
+AsyncBackwardEuler::AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system, double largeTimestep,
+                                       std::vector<AsyncRegion> regions, AsyncOptions options)
+    : Integrator(std::move(system), largeTimestep),
+      partition_(mesh, system_.freeDofs, std::move(regions)),
+      options_(options),
+      impl_(std::make_unique<Impl>()) {
+  if (mesh.numDofs() != system_.numDofs()) {
+    throw ValidationError("async integrator: mesh has " + std::to_string(mesh.numDofs()) +
+                          " DOFs but the dynamic system has " + std::to_string(system_.numDofs()));
+  }
+  Impl& d = *impl_;
+  d.linear = system_.forceModel->isLinear();
+  d.stiffness = system_.forceModel->createStiffnessMatrix();
+  d.stiffness.makeCompressed();
+  const SparseMatrix& mass = system_.mass;
+  const std::vector<int>& large = partition_.largeDofs();
+  d.massLL = SubmatrixExtractor(mass, large, large);
+  d.stiffLL = SubmatrixExtractor(d.stiffness, large, large);
+  d.regions.resize(static_cast<std::size_t>(partition_.numRegions()));
+  for (int i = 0; i < partition_.numRegions(); ++i) {
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    const std::vector<int>& s = partition_.regionDofs(i);
+    const std::vector<int>& iface = partition_.interfaceDofs(i);
+    rb.ratio = partition_.ratio(i);
+    rb.massSS = SubmatrixExtractor(mass, s, s);
+    rb.massSI = SubmatrixExtractor(mass, s, iface);
+    rb.massIS = SubmatrixExtractor(mass, iface, s);
+    rb.stiffSS = SubmatrixExtractor(d.stiffness, s, s);
+    rb.stiffSI = SubmatrixExtractor(d.stiffness, s, iface);
+    rb.stiffIS = SubmatrixExtractor(d.stiffness, iface, s);
+    rb.Mss = rb.massSS.extract(mass);
+    rb.Msi = rb.massSI.extract(mass);
+    rb.Mis = rb.massIS.extract(mass);
+    rb.solver = makeSparseSolver(options_.regionSolver);
+  }
+  d.schurSolver = makeSparseSolver(options_.schur == SchurMode::exact ? SolverKind::umfpack : SolverKind::cholmod);
+  d.naiveSolver = makeSparseSolver(SolverKind::umfpack);
+  if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
+  if (d.linear) stats_.skipped.push_back("per-step refactorization (linear forces: blocks, Z and H^{LL*} factored once)");
+  if (options_.method == AsyncSolveMethod::naive) stats_.skipped.push_back("Schur complement (naive full-system solve)");
+}
+
+AsyncBackwardEuler::~AsyncBackwardEuler() = default;
+
+void AsyncBackwardEuler::setTimestep(double timestep) {
+  Integrator::setTimestep(timestep);
+  if (impl_) impl_->built = false;
+}
+
+// Rebuilds every block from the current K (impl_->stiffness) and M, refactors, and
+// recomputes the Schur complement. Called once for linear forces, every large step
+// otherwise.
+void AsyncBackwardEuler::rebuildBlocks() {
+  Impl& d = *impl_;
+  const DynamicSystem& system = system_;
+  const RegionPartition& partition = partition_;
+  const AsyncOptions& options = options_;
+  const double largeStep = timestep();
+  IntegratorStats& stats = stats_;
+  double& schurAsymmetry = schurAsymmetry_;
+  const double alpha = system.rayleighMass, beta = system.rayleighStiffness;
+  const bool damped = system.damped();
+  const double hL = largeStep;
+  Stopwatch assembly, factor;
+
+  assembly.start();
+  const SparseMatrix Mll = d.massLL.extract(system.mass);
+  const SparseMatrix Kll = d.stiffLL.extract(d.stiffness);
+  // A^L = M^{LL} + hL D^{LL} + hL^2 K^{LL}, D = alpha M + beta K.
+  d.largeSystem = (1.0 + hL * alpha) * Mll + (hL * hL + hL * beta) * Kll;
+  d.largeSystem.makeCompressed();
+  for (RegionBlocks& rb : d.regions) {
+    const double hS = hL / rb.ratio;
+    rb.smallStep = hS;
+    rb.Kss = rb.stiffSS.extract(d.stiffness);
+    rb.Ksi = rb.stiffSI.extract(d.stiffness);
+    rb.Kis = rb.stiffIS.extract(d.stiffness);
+    if (damped) {
+      rb.Dss = alpha * rb.Mss + beta * rb.Kss;
+      rb.Dsi = alpha * rb.Msi + beta * rb.Ksi;
+      rb.Dis = alpha * rb.Mis + beta * rb.Kis;
+    }
+    // A^S = M^{SS} + hS D^{SS} + hS^2 K^{SS}
+    rb.systemMatrix = (1.0 + hS * alpha) * rb.Mss + (hS * hS + hS * beta) * rb.Kss;
+    rb.systemMatrix.makeCompressed();
+    rb.G = (hS * hS) * rb.Kss;
+    rb.E = (hL * hS) * rb.Kis;
+    rb.P = damped ? SparseMatrix(rb.Mis + hL * rb.Dis) : rb.Mis;
+  }
+  stats.assemblySeconds += assembly.stop();
+
+  if (options.method == AsyncSolveMethod::naive) {
+    // The whole block lower-Hessenberg system (design note, rows r = 1..m and last row).
+    assembly.start();
+    const int numLarge = static_cast<int>(partition.largeDofs().size());
+    d.naiveOffsets.assign(d.regions.size() + 1, 0);
+    int offset = 0;
+    for (std::size_t i = 0; i < d.regions.size(); ++i) {
+      d.naiveOffsets[i] = offset;
+      offset += d.regions[i].ratio * static_cast<int>(d.regions[i].Mss.rows());
+    }
+    d.naiveOffsets.back() = offset;
+    const int size = offset + numLarge;
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (std::size_t i = 0; i < d.regions.size(); ++i) {
+      const RegionBlocks& rb = d.regions[i];
+      const int m = rb.ratio;
+      const int s = static_cast<int>(rb.Mss.rows());
+      const double hS = rb.smallStep;
+      const std::vector<int>& ifacePos = partition.interfacePositions(static_cast<int>(i));
+      const SparseMatrix C = rb.G - rb.Mss;
+      for (int r = 1; r <= m; ++r) {
+        const int row = d.naiveOffsets[i] + (r - 1) * s;
+        appendTriplets(rb.systemMatrix, 1.0, row, row, triplets);
+        if (r >= 2) appendTriplets(C, 1.0, row, row - s, triplets);
+        for (int j = 1; j <= r - 2; ++j) appendTriplets(rb.G, 1.0, row, d.naiveOffsets[i] + (j - 1) * s, triplets);
+        // B_r = (M^{SL} + r hS D^{SL} + r^2 hS^2 K^{SL}) / m, columns at the interface.
+        SparseMatrix B = rb.Msi + (double(r) * r * hS * hS) * rb.Ksi;
+        if (damped) B += (double(r) * hS) * rb.Dsi;
+        appendTriplets(B, 1.0 / m, row, offset, triplets, nullptr, &ifacePos);
+      }
+      // Last row: E on X_1..X_{m-1}, F = P + E on X_m (rows at the interface of L).
+      for (int j = 1; j <= m; ++j) {
+        const int col = d.naiveOffsets[i] + (j - 1) * s;
+        appendTriplets(rb.E, 1.0, offset, col, triplets, &ifacePos, nullptr);
+        if (j == m) appendTriplets(rb.P, 1.0, offset, col, triplets, &ifacePos, nullptr);
+      }
+    }
+    appendTriplets(d.largeSystem, 1.0, offset, offset, triplets);
+    d.naiveSystem.resize(size, size);
+    d.naiveSystem.setFromTriplets(triplets.begin(), triplets.end());
+    d.naiveSystem.makeCompressed();
+    stats.assemblySeconds += assembly.stop();
+    factor.start();
+    if (!d.naiveAnalyzed) {
+      d.naiveSolver->analyzePattern(d.naiveSystem);
+      d.naiveAnalyzed = true;
+    }
+    d.naiveSolver->factorize(d.naiveSystem);
+    stats.factorizationSeconds += factor.stop();
+    ++stats.factorizations;
+    return;
+  }
+
+  // Structured: factor every A^S, compute Z = (H^{SS})^{-1} H^{SI} by forward
+  // substitution with |I| right-hand sides, and the Schur corrections C_i = H^{IS} Z.
+  factor.start();
+  schurAsymmetry = 0.0;
+  d.schur = d.largeSystem;
+  const int numLarge = static_cast<int>(d.largeSystem.rows());
+  for (std::size_t i = 0; i < d.regions.size(); ++i) {
+    RegionBlocks& rb = d.regions[i];
+    if (!rb.analyzed) {
+      rb.solver->analyzePattern(rb.systemMatrix);
+      rb.analyzed = true;
+    }
+    rb.solver->factorize(rb.systemMatrix);
+    ++stats.factorizations;
+    const int m = rb.ratio;
+    const double hS = rb.smallStep;
+    const Eigen::Index q = rb.Msi.cols();
+    rb.z.clear();
+    if (q == 0) {
+      rb.correction.resize(0, 0);
+      continue;
+    }
+    const Eigen::MatrixXd Msi = Eigen::MatrixXd(rb.Msi), Ksi = Eigen::MatrixXd(rb.Ksi);
+    const Eigen::MatrixXd Dsi = damped ? Eigen::MatrixXd(rb.Dsi) : Eigen::MatrixXd();
+    Eigen::MatrixXd sum, prev, rhs, x;
+    for (int r = 1; r <= m; ++r) {
+      rhs = (1.0 / m) * Msi + (double(r) * r * hS * hS / m) * Ksi;
+      if (damped) rhs += (double(r) * hS / m) * Dsi;
+      if (r >= 2) {
+        rhs -= rb.G * sum;
+        rhs += rb.Mss * prev;
+      }
+      rb.solver->solve(rhs, x);
+      if (r == 1) {
+        sum = x;
+      } else {
+        sum += x;
+      }
+      prev = x;
+      if (options.recovery == RecoveryMode::denseZ) rb.z.push_back(x);
+    }
+    // H^{IS} Z = E sum_r Z_r + (F - E) Z_m.
+    rb.correction = rb.E * sum + rb.P * prev;
+    const double norm = rb.correction.norm();
+    if (norm > 0.0) {
+      schurAsymmetry = std::max(schurAsymmetry, (rb.correction - rb.correction.transpose()).norm() / norm);
+    }
+    const Eigen::MatrixXd applied = options.schur == SchurMode::exact
+                                        ? rb.correction
+                                        : Eigen::MatrixXd(0.5 * (rb.correction + rb.correction.transpose()));
+    d.schur -= scatterDense(applied, partition.interfacePositions(static_cast<int>(i)), numLarge);
+  }
+  d.schur.makeCompressed();
+  if (numLarge > 0) {
+    if (!d.schurAnalyzed) {
+      d.schurSolver->analyzePattern(d.schur);
+      d.schurAnalyzed = true;
+    }
+    d.schurSolver->factorize(d.schur);
+    ++stats.factorizations;
+  }
+  stats.factorizationSeconds += factor.stop();
+}
+
+void AsyncBackwardEuler::step() {
+  Impl& d = *impl_;
+  const double hL = timestep();
+  const double t0 = time();
+  const Eigen::VectorXd& u0 = displacement_;
+  const Eigen::VectorXd& v0 = velocity_;
+  const bool damped = system_.damped();
+  const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
+
+  Stopwatch forces, solve;
+  forces.start();
+  if (d.linear) {
+    if (!d.built) {
+      system_.forceModel->tangentStiffness(u0, d.stiffness);
+    }
+    system_.forceModel->internalForces(u0, d.internalForce);
+  } else {
+    system_.forceModel->forcesAndTangent(u0, d.internalForce, d.stiffness);
+  }
+  stats_.forceSeconds += forces.stop();
+  if (!d.linear || !d.built) {
+    rebuildBlocks();
+    d.built = true;
+  }
+
+  solve.start();
+  // Right-hand sides (design note): b_r = h (f_ext(t) - f_int(u_0) - (D + t K) v_0), t = r hS.
+  const Eigen::VectorXd stiffVelocity = d.stiffness * v0;
+  Eigen::VectorXd dampVelocity;
+  if (damped) dampVelocity = alpha * (system_.mass * v0) + beta * stiffVelocity;
+  Eigen::VectorXd externalForce;
+  auto residualAt = [&](double t, double tau) {
+    // f_ext(t0 + tau) - f_int(u_0) - D v_0 - tau K v_0 as a full vector.
+    evaluateExternalForce(t, externalForce);
+    Eigen::VectorXd r = externalForce - d.internalForce - tau * stiffVelocity;
+    if (damped) r -= dampVelocity;
+    return r;
+  };
+
+  const std::vector<int>& large = partition_.largeDofs();
+  const int numRegions = partition_.numRegions();
+  std::vector<Eigen::MatrixXd> rhsS(static_cast<std::size_t>(numRegions));  // |S| x m, column r-1 = b_r
+  for (int i = 0; i < numRegions; ++i) {
+    const RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    const std::vector<int>& s = partition_.regionDofs(i);
+    Eigen::MatrixXd& b = rhsS[static_cast<std::size_t>(i)];
+    b.resize(static_cast<Eigen::Index>(s.size()), rb.ratio);
+    for (int r = 1; r <= rb.ratio; ++r) {
+      const double tau = r * rb.smallStep;
+      b.col(r - 1) = rb.smallStep * gather(residualAt(t0 + tau, tau), s);
+    }
+  }
+  const Eigen::VectorXd rhsL = hL * gather(residualAt(t0 + hL, hL), large);
+
+  // Solve for X (per region, |S| x m) and Y.
+  std::vector<Eigen::MatrixXd> X(static_cast<std::size_t>(numRegions));
+  Eigen::VectorXd Y;
+  if (options_.method == AsyncSolveMethod::naive) {
+    Eigen::VectorXd rhs(d.naiveSystem.rows());
+    for (int i = 0; i < numRegions; ++i) {
+      const Eigen::MatrixXd& b = rhsS[static_cast<std::size_t>(i)];
+      rhs.segment(d.naiveOffsets[static_cast<std::size_t>(i)], b.size()) = Eigen::Map<const Eigen::VectorXd>(b.data(), b.size());
+    }
+    rhs.tail(rhsL.size()) = rhsL;
+    const Eigen::VectorXd sol = d.naiveSolver->solve(rhs);
+    for (int i = 0; i < numRegions; ++i) {
+      const Eigen::MatrixXd& b = rhsS[static_cast<std::size_t>(i)];
+      X[static_cast<std::size_t>(i)] =
+          Eigen::Map<const Eigen::MatrixXd>(sol.data() + d.naiveOffsets[static_cast<std::size_t>(i)], b.rows(), b.cols());
+    }
+    Y = sol.tail(rhsL.size());
+  } else {
+    // Forward substitution with H^{SS} (paper's Algorithm 1, indices corrected).
+    auto forwardSubstitute = [&](RegionBlocks& rb, const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
+      x.resize(b.rows(), b.cols());
+      Eigen::VectorXd sum = Eigen::VectorXd::Zero(b.rows()), rhs, xr;
+      for (int r = 1; r <= rb.ratio; ++r) {
+        rhs = b.col(r - 1);
+        if (r >= 2) rhs += rb.Mss * x.col(r - 2) - rb.G * sum;
+        xr = rb.solver->solve(rhs);
+        x.col(r - 1) = xr;
+        sum += xr;
+      }
+    };
+    std::vector<Eigen::MatrixXd> y(static_cast<std::size_t>(numRegions));
+    Eigen::VectorXd rhsSchur = rhsL;
+    for (int i = 0; i < numRegions; ++i) {
+      RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+      Eigen::MatrixXd& yi = y[static_cast<std::size_t>(i)];
+      forwardSubstitute(rb, rhsS[static_cast<std::size_t>(i)], yi);
+      if (rb.Mis.rows() == 0) continue;
+      // b^{L*} = b^L - H^{LS} y = b^L - (E sum_r y_r + P y_m) on the interface rows.
+      const Eigen::VectorXd ySum = yi.rowwise().sum();
+      const Eigen::VectorXd coupling = rb.E * ySum + rb.P * yi.col(rb.ratio - 1);
+      const std::vector<int>& pos = partition_.interfacePositions(i);
+      for (std::size_t k = 0; k < pos.size(); ++k) rhsSchur[pos[k]] -= coupling[static_cast<Eigen::Index>(k)];
+    }
+    Y = large.empty() ? Eigen::VectorXd() : d.schurSolver->solve(rhsSchur);
+    for (int i = 0; i < numRegions; ++i) {
+      RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+      Eigen::MatrixXd& xi = X[static_cast<std::size_t>(i)];
+      const std::vector<int>& pos = partition_.interfacePositions(i);
+      if (pos.empty()) {
+        xi = y[static_cast<std::size_t>(i)];
+        continue;
+      }
+      Eigen::VectorXd yInterface(static_cast<Eigen::Index>(pos.size()));
+      for (std::size_t k = 0; k < pos.size(); ++k) yInterface[static_cast<Eigen::Index>(k)] = Y[pos[k]];
+      if (options_.recovery == RecoveryMode::denseZ) {
+        xi = y[static_cast<std::size_t>(i)];
+        for (int r = 1; r <= rb.ratio; ++r) xi.col(r - 1) -= rb.z[static_cast<std::size_t>(r - 1)] * yInterface;
+      } else {
+        // X = (H^{SS})^{-1} (b^S - H^{SL} Y), block r of H^{SL} Y = B_r Y_I.
+        const double hS = rb.smallStep;
+        const Eigen::VectorXd mY = rb.Msi * yInterface, kY = rb.Ksi * yInterface;
+        Eigen::VectorXd dY;
+        if (damped) dY = rb.Dsi * yInterface;
+        Eigen::MatrixXd b = rhsS[static_cast<std::size_t>(i)];
+        for (int r = 1; r <= rb.ratio; ++r) {
+          b.col(r - 1) -= (mY + (double(r) * r * hS * hS) * kY) / rb.ratio;
+          if (damped) b.col(r - 1) -= (double(r) * hS / rb.ratio) * dY;
+        }
+        forwardSubstitute(rb, b, xi);
+      }
+    }
+  }
+
+  // New state: v^S_r = v^S_0 + X_r, u^S_m = u^S_0 + hS sum_r v^S_r; v^L = v^L_0 + Y, u^L = u^L_0 + hL v^L.
+  Eigen::VectorXd newU = u0, newV = v0;
+  for (int i = 0; i < numRegions; ++i) {
+    const RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    const std::vector<int>& s = partition_.regionDofs(i);
+    const Eigen::MatrixXd& xi = X[static_cast<std::size_t>(i)];
+    const Eigen::VectorXd vS0 = gather(v0, s), uS0 = gather(u0, s);
+    Eigen::VectorXd xSum = Eigen::VectorXd::Zero(xi.rows());
+    for (int r = 1; r <= rb.ratio; ++r) {
+      xSum += xi.col(r - 1);
+      if (observer_) {
+        const Eigen::VectorXd uS = uS0 + rb.smallStep * (double(r) * vS0 + xSum);
+        const Eigen::VectorXd vS = vS0 + xi.col(r - 1);
+        observer_(i, r, t0 + r * rb.smallStep, uS, vS);
+      }
+    }
+    const Eigen::VectorXd vS = vS0 + xi.col(rb.ratio - 1);
+    const Eigen::VectorXd uS = uS0 + rb.smallStep * (double(rb.ratio) * vS0 + xSum);
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      newV[s[k]] = vS[static_cast<Eigen::Index>(k)];
+      newU[s[k]] = uS[static_cast<Eigen::Index>(k)];
+    }
+  }
+  for (std::size_t k = 0; k < large.size(); ++k) {
+    newV[large[k]] = v0[large[k]] + Y[static_cast<Eigen::Index>(k)];
+    newU[large[k]] = u0[large[k]] + hL * newV[large[k]];
+  }
+  stats_.solveSeconds += solve.stop();
+
+  for (Eigen::Index k = 0; k < newU.size(); ++k) {
+    if (!std::isfinite(newU[k]) || !std::isfinite(newV[k])) {
+      throw NumericalError("async integrator: non-finite state at t = " + std::to_string(t0 + hL) + " (vertex " +
+                           std::to_string(k / 3) + ", coordinate " + std::to_string(k % 3) + ")");
+    }
+  }
+  displacement_ = std::move(newU);
+  velocity_ = std::move(newV);
+  time_ = t0 + hL;
+  ++stats_.steps;
+}
+
+}  // namespace asyncfem

@@ -1,0 +1,164 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+namespace asyncfem {
+
+Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh) {
+  Eigen::VectorXd omega(mesh.numElements());
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const Material& material = mesh.elementMaterial(e);
+    const ElementPositions x = mesh.elementRestPositions(e);
+    double volume = 0.0;
+    shapeFunctionGradients(x, &volume);
+    const ElementMatrix K = linearElementStiffness(x, material.youngsModulus, material.poissonRatio);
+    // Lumped mass is rho V / 4 on every DOF, so the generalized problem is K / (rho V / 4).
+    const double lumped = material.density * std::abs(volume) / 4.0;
+    Eigen::SelfAdjointEigenSolver<ElementMatrix> eigen(K / lumped, Eigen::EigenvaluesOnly);
+    omega[e] = std::sqrt(std::max(0.0, eigen.eigenvalues().maxCoeff()));
+  }
+  return omega;
+}
+
+std::vector<AsyncRegion> AutoRegionProposal::asyncRegions() const {
+  std::vector<AsyncRegion> out;
+  out.reserve(regions.size());
+  for (const ProposedRegion& r : regions) out.push_back(r.region);
+  return out;
+}
+
+AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options) {
+  if (!(options.largeTimestep > 0.0) || !(options.targetOmegaH > 0.0)) {
+    throw ValidationError("automatic regions: the large timestep and the omega*h target must be positive");
+  }
+  if (options.growLayers < 0 || options.maxRatio < 1) {
+    throw ValidationError("automatic regions: growLayers must be >= 0 and maxRatio >= 1");
+  }
+  const int nv = mesh.numVertices(), ne = mesh.numElements();
+  const Eigen::VectorXd omega = elementMaxFrequencies(mesh);
+  const double hL = options.largeTimestep;
+
+  // Vertex -> elements adjacency.
+  std::vector<int> offsets(static_cast<std::size_t>(nv) + 1, 0), incident(static_cast<std::size_t>(4 * ne));
+  for (int e = 0; e < ne; ++e)
+    for (int a = 0; a < 4; ++a) ++offsets[static_cast<std::size_t>(mesh.elements()(a, e)) + 1];
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  {
+    std::vector<int> fill(offsets.begin(), offsets.end() - 1);
+    for (int e = 0; e < ne; ++e)
+      for (int a = 0; a < 4; ++a) incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.elements()(a, e))]++)] = e;
+  }
+
+  std::vector<char> fast(static_cast<std::size_t>(nv), 0);
+  for (int e = 0; e < ne; ++e) {
+    if (omega[e] * hL > options.targetOmegaH)
+      for (int a = 0; a < 4; ++a) fast[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
+  }
+  // Grow by rings: every vertex sharing an element with a fast vertex.
+  for (int layer = 0; layer < options.growLayers; ++layer) {
+    std::vector<char> grown = fast;
+    for (int e = 0; e < ne; ++e) {
+      bool any = false;
+      for (int a = 0; a < 4; ++a) any = any || fast[static_cast<std::size_t>(mesh.elements()(a, e))];
+      if (any)
+        for (int a = 0; a < 4; ++a) grown[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
+    }
+    fast.swap(grown);
+  }
+  // Fill enclosed L vertices (every neighbour fast) until nothing changes.
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int v = 0; v < nv; ++v) {
+      if (fast[static_cast<std::size_t>(v)]) continue;
+      bool enclosed = offsets[static_cast<std::size_t>(v)] < offsets[static_cast<std::size_t>(v) + 1];
+      for (int k = offsets[static_cast<std::size_t>(v)]; enclosed && k < offsets[static_cast<std::size_t>(v) + 1]; ++k) {
+        const int e = incident[static_cast<std::size_t>(k)];
+        for (int a = 0; a < 4; ++a) {
+          const int w = mesh.elements()(a, e);
+          if (w != v && !fast[static_cast<std::size_t>(w)]) enclosed = false;
+        }
+      }
+      if (enclosed) {
+        fast[static_cast<std::size_t>(v)] = 1;
+        changed = true;
+      }
+    }
+  }
+
+  // Connected components of fast vertices (through elements), breadth first.
+  std::vector<int> component(static_cast<std::size_t>(nv), -1);
+  int numComponents = 0;
+  std::vector<int> queue;
+  for (int seed = 0; seed < nv; ++seed) {
+    if (!fast[static_cast<std::size_t>(seed)] || component[static_cast<std::size_t>(seed)] >= 0) continue;
+    queue.assign(1, seed);
+    component[static_cast<std::size_t>(seed)] = numComponents;
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const int v = queue[head];
+      for (int k = offsets[static_cast<std::size_t>(v)]; k < offsets[static_cast<std::size_t>(v) + 1]; ++k) {
+        const int e = incident[static_cast<std::size_t>(k)];
+        for (int a = 0; a < 4; ++a) {
+          const int w = mesh.elements()(a, e);
+          if (fast[static_cast<std::size_t>(w)] && component[static_cast<std::size_t>(w)] < 0) {
+            component[static_cast<std::size_t>(w)] = numComponents;
+            queue.push_back(w);
+          }
+        }
+      }
+    }
+    ++numComponents;
+  }
+
+  AutoRegionProposal proposal;
+  proposal.largeTimestep = hL;
+  proposal.targetOmegaH = options.targetOmegaH;
+  std::vector<ProposedRegion> regions(static_cast<std::size_t>(numComponents));
+  for (int e = 0; e < ne; ++e) {
+    int owner = -1;
+    bool allFast = true;
+    for (int a = 0; a < 4; ++a) {
+      const int c = component[static_cast<std::size_t>(mesh.elements()(a, e))];
+      if (c >= 0) owner = c;
+      allFast = allFast && c >= 0;
+    }
+    if (owner < 0) {
+      proposal.largeRegionMaxFrequency = std::max(proposal.largeRegionMaxFrequency, omega[e]);
+      continue;
+    }
+    // Every element touching a region is integrated (at least partly) at its substep.
+    ProposedRegion& r = regions[static_cast<std::size_t>(owner)];
+    r.maxFrequency = std::max(r.maxFrequency, omega[e]);
+    if (allFast) ++r.numElements;
+  }
+  for (int v = 0; v < nv; ++v) {
+    const int c = component[static_cast<std::size_t>(v)];
+    if (c >= 0) regions[static_cast<std::size_t>(c)].region.vertices.push_back(v);
+  }
+  for (ProposedRegion& r : regions) {
+    bool hasFree = false;
+    for (int v : r.region.vertices)
+      for (int c = 0; c < 3; ++c) hasFree = hasFree || !freeDofs.isFixed(3 * v + c);
+    if (!hasFree) continue;
+    const double wanted = std::ceil(r.maxFrequency * hL / options.targetOmegaH - 1e-12);
+    r.region.ratio = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(options.maxRatio)));
+    r.region.name = "auto" + std::to_string(proposal.regions.size() + 1);
+    proposal.regions.push_back(std::move(r));
+  }
+  // Interface sizes, from the partition the proposal defines.
+  const RegionPartition partition(mesh, freeDofs, proposal.asyncRegions());
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    proposal.regions[static_cast<std::size_t>(i)].numInterfaceDofs = static_cast<int>(partition.interfaceDofs(i).size());
+  }
+  return proposal;
+}
+
+}  // namespace asyncfem

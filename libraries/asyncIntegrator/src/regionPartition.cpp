@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
+#include <asyncfem/core/error.hpp>
+
+#include <algorithm>
+#include <string>
+
+namespace asyncfem {
+
+namespace {
+
+void sortUnique(std::vector<int>& ids) {
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+}
+
+}  // namespace
+
+std::vector<int> regionVertices(const TetMesh& mesh, const RegionSelector& selector) {
+  std::vector<int> vertices;
+  for (const std::string& name : selector.vertexSets) {
+    const std::vector<int>& set = mesh.vertexSet(name);
+    vertices.insert(vertices.end(), set.begin(), set.end());
+  }
+  for (const std::string& name : selector.elementSets) {
+    for (int e : mesh.elementSet(name))
+      for (int a = 0; a < 4; ++a) vertices.push_back(mesh.elements()(a, e));
+  }
+  if (selector.boxMin.size() != selector.boxMax.size()) {
+    throw ValidationError("region selector: every box needs both a min and a max corner");
+  }
+  for (std::size_t b = 0; b < selector.boxMin.size(); ++b) {
+    const Eigen::Vector3d& lo = selector.boxMin[b];
+    const Eigen::Vector3d& hi = selector.boxMax[b];
+    if (!((lo.array() <= hi.array()).all())) {
+      throw ValidationError("region selector: box " + std::to_string(b) + " has min > max");
+    }
+    for (int v = 0; v < mesh.numVertices(); ++v) {
+      const Eigen::Vector3d p = mesh.restPosition(v);
+      if ((p.array() >= lo.array()).all() && (p.array() <= hi.array()).all()) vertices.push_back(v);
+    }
+  }
+  for (int v : selector.vertices) {
+    if (v < 0 || v >= mesh.numVertices()) {
+      throw ValidationError("region selector: vertex " + std::to_string(v) + " outside [0, " +
+                            std::to_string(mesh.numVertices()) + ")");
+    }
+    vertices.push_back(v);
+  }
+  sortUnique(vertices);
+  return vertices;
+}
+
+RegionPartition::RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, std::vector<AsyncRegion> regions)
+    : regions_(std::move(regions)) {
+  const int n = mesh.numVertices();
+  if (freeDofs.numDofs() != 3 * n) {
+    throw ValidationError("region partition: the free-DOF map has " + std::to_string(freeDofs.numDofs()) +
+                          " DOFs but the mesh has " + std::to_string(3 * n));
+  }
+  vertexRegion_.assign(static_cast<std::size_t>(n), -1);
+  for (int i = 0; i < numRegions(); ++i) {
+    AsyncRegion& r = regions_[static_cast<std::size_t>(i)];
+    if (r.name.empty()) r.name = std::string("S").append(std::to_string(i + 1));
+    if (r.ratio < 1) {
+      throw ValidationError("region '" + r.name + "': ratio m = " + std::to_string(r.ratio) +
+                            " (hL / hS) must be an integer >= 1");
+    }
+    sortUnique(r.vertices);
+    for (int v : r.vertices) {
+      if (v < 0 || v >= n) {
+        throw ValidationError("region '" + r.name + "': vertex " + std::to_string(v) + " outside [0, " +
+                              std::to_string(n) + ")");
+      }
+      int& owner = vertexRegion_[static_cast<std::size_t>(v)];
+      if (owner >= 0) {
+        throw ValidationError("regions '" + regions_[static_cast<std::size_t>(owner)].name + "' and '" + r.name +
+                              "' overlap: vertex " + std::to_string(v) + " is in both");
+      }
+      owner = i;
+    }
+  }
+
+  // Elements: no element may touch two different fast regions; collect interface elements.
+  std::vector<std::vector<char>> touchesRegion(static_cast<std::size_t>(numRegions()),
+                                               std::vector<char>(static_cast<std::size_t>(3 * n), 0));
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    int fast = -1;
+    bool hasLarge = false;
+    for (int a = 0; a < 4; ++a) {
+      const int region = vertexRegion_[static_cast<std::size_t>(mesh.elements()(a, e))];
+      if (region < 0) {
+        hasLarge = true;
+      } else if (fast < 0) {
+        fast = region;
+      } else if (fast != region) {
+        throw ValidationError("element " + std::to_string(e) + " has vertices in regions '" +
+                              regions_[static_cast<std::size_t>(fast)].name + "' and '" +
+                              regions_[static_cast<std::size_t>(region)].name +
+                              "': fast regions must be separated by at least one element layer of L");
+      }
+    }
+    if (fast >= 0 && hasLarge) {
+      interfaceElements_.push_back(e);
+      for (int a = 0; a < 4; ++a) {
+        const int v = mesh.elements()(a, e);
+        if (vertexRegion_[static_cast<std::size_t>(v)] >= 0) continue;
+        for (int c = 0; c < 3; ++c) touchesRegion[static_cast<std::size_t>(fast)][static_cast<std::size_t>(3 * v + c)] = 1;
+      }
+    }
+  }
+
+  regionDofs_.assign(static_cast<std::size_t>(numRegions()), {});
+  interfaceDofs_.assign(static_cast<std::size_t>(numRegions()), {});
+  interfacePositions_.assign(static_cast<std::size_t>(numRegions()), {});
+  for (int dof : freeDofs.freeToFull()) {
+    const int region = vertexRegion_[static_cast<std::size_t>(dof / 3)];
+    if (region >= 0) {
+      regionDofs_[static_cast<std::size_t>(region)].push_back(dof);
+      continue;
+    }
+    const int position = static_cast<int>(largeDofs_.size());
+    largeDofs_.push_back(dof);
+    for (int i = 0; i < numRegions(); ++i) {
+      if (touchesRegion[static_cast<std::size_t>(i)][static_cast<std::size_t>(dof)]) {
+        interfaceDofs_[static_cast<std::size_t>(i)].push_back(dof);
+        interfacePositions_[static_cast<std::size_t>(i)].push_back(position);
+      }
+    }
+  }
+  for (int i = 0; i < numRegions(); ++i) {
+    if (regionDofs_[static_cast<std::size_t>(i)].empty()) {
+      throw ValidationError("region '" + regions_[static_cast<std::size_t>(i)].name +
+                            "' has no free degree of freedom (empty, or every vertex fixed)");
+    }
+  }
+}
+
+}  // namespace asyncfem

@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Small linear test systems and a dense single-rate backward Euler reference.
+#pragma once
+
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/forceModel/linearForceModel.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <memory>
+#include <random>
+
+namespace asyncfem::test {
+
+/// A 8 x 2 x 2-cell bar [0,1] x [0,0.25] x [0,0.25], fixed at x = 0, with a stiff light
+/// part for x > 0.75, random initial state and a time-varying pull on the x = 1 face.
+struct TestSystem {
+  TetMesh mesh;
+  DynamicSystem system;
+  Eigen::VectorXd u0, v0;
+};
+
+inline TestSystem makeTestSystem(double alpha, double beta, unsigned seed = 7) {
+  BoxMeshSpec spec;
+  spec.size = Eigen::Vector3d(1.0, 0.25, 0.25);
+  spec.cells = Eigen::Vector3i(8, 2, 2);
+  spec.material = Material{"soft", 1000.0, 1e5, 0.4};
+  spec.regions.push_back({"stiff", Eigen::Vector3d(0.75, -1, -1), Eigen::Vector3d(2, 2, 2), Material{"stiff", 200.0, 5e6, 0.3}});
+  TestSystem ts{makeBoxMesh(spec), {}, {}, {}};
+  MatrixAssembler assembler(ts.mesh);
+  ts.system.forceModel = std::make_shared<LinearForceModel>(linearStiffnessMatrix(ts.mesh, assembler));
+  ts.system.mass = massMatrix(ts.mesh, assembler, MassType::consistent);
+  ts.system.freeDofs = FreeDofs::fromFixedVertices(ts.mesh.numVertices(), ts.mesh.vertexSet("xmin"));
+  ts.system.rayleighMass = alpha;
+  ts.system.rayleighStiffness = beta;
+  const std::vector<int> pulled = ts.mesh.vertexSet("xmax");
+  ts.system.externalForce = [pulled](double t, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& f) {
+    for (int v : pulled) {
+      f[3 * v + 1] += -0.5 * std::cos(40.0 * t);
+      f[3 * v + 2] += 0.2 * std::sin(25.0 * t);
+    }
+  };
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const int n = ts.mesh.numDofs();
+  ts.u0.resize(n);
+  ts.v0.resize(n);
+  for (int k = 0; k < n; ++k) {
+    ts.u0[k] = 1e-3 * uniform(rng);
+    ts.v0[k] = 1e-2 * uniform(rng);
+  }
+  for (int k = 0; k < n; ++k) {
+    if (ts.system.freeDofs.isFixed(k)) ts.u0[k] = ts.v0[k] = 0.0;
+  }
+  return ts;
+}
+
+/// Dense single-rate backward Euler on the free DOFs (design note, paper Eq. 5), the
+/// independent reference the asynchronous integrator is checked against.
+class DenseBackwardEuler {
+public:
+  explicit DenseBackwardEuler(const DynamicSystem& system) : system_(system) {
+    const std::vector<int>& free = system.freeDofs.freeToFull();
+    const Eigen::MatrixXd M = Eigen::MatrixXd(system.mass);
+    Eigen::SparseMatrix<double> Ks = system.forceModel->createStiffnessMatrix();
+    system.forceModel->tangentStiffness(Eigen::VectorXd::Zero(system.numDofs()), Ks);
+    const Eigen::MatrixXd K = Eigen::MatrixXd(Ks);
+    const int nf = static_cast<int>(free.size());
+    M_.resize(nf, nf);
+    K_.resize(nf, nf);
+    for (int i = 0; i < nf; ++i)
+      for (int j = 0; j < nf; ++j) {
+        M_(i, j) = M(free[i], free[j]);
+        K_(i, j) = K(free[i], free[j]);
+      }
+    D_ = system.rayleighMass * M_ + system.rayleighStiffness * K_;
+  }
+
+  /// One step of size h from (u, v) at time t (full vectors), in place.
+  void step(double h, double t, Eigen::VectorXd& u, Eigen::VectorXd& v) const {
+    const FreeDofs& dofs = system_.freeDofs;
+    Eigen::VectorXd fext = Eigen::VectorXd::Zero(u.size());
+    if (system_.externalForce) system_.externalForce(t + h, u, v, fext);
+    const Eigen::VectorXd uf = dofs.restrict(u), vf = dofs.restrict(v), ff = dofs.restrict(fext);
+    const Eigen::MatrixXd A = M_ + h * D_ + h * h * K_;
+    const Eigen::VectorXd b = h * (ff - K_ * uf - D_ * vf - h * K_ * vf);
+    const Eigen::VectorXd dv = A.partialPivLu().solve(b);
+    const Eigen::VectorXd vNew = vf + dv;
+    const Eigen::VectorXd uNew = uf + h * vNew;
+    u = dofs.expand(uNew);
+    v = dofs.expand(vNew);
+  }
+
+private:
+  const DynamicSystem& system_;
+  Eigen::MatrixXd M_, K_, D_;
+};
+
+/// ||a - b|| / max(||a||, ||b||) in the infinity norm (purely relative: states here are ~1e-3).
+inline double relativeDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const double scale = std::max({1e-300, a.lpNorm<Eigen::Infinity>(), b.lpNorm<Eigen::Infinity>()});
+  return (a - b).lpNorm<Eigen::Infinity>() / scale;
+}
+
+/// Vertices of the mesh with rest x >= xMin.
+inline std::vector<int> verticesBeyond(const TetMesh& mesh, double xMin) {
+  std::vector<int> out;
+  for (int v = 0; v < mesh.numVertices(); ++v)
+    if (mesh.restPosition(v).x() >= xMin - 1e-12) out.push_back(v);
+  return out;
+}
+
+/// Vertices with rest x within 1e-9 of one of the given planes.
+inline std::vector<int> verticesOnPlanes(const TetMesh& mesh, std::initializer_list<double> planes) {
+  std::vector<int> out;
+  for (int v = 0; v < mesh.numVertices(); ++v)
+    for (double x : planes)
+      if (std::abs(mesh.restPosition(v).x() - x) < 1e-9) out.push_back(v);
+  return out;
+}
+
+}  // namespace asyncfem::test
