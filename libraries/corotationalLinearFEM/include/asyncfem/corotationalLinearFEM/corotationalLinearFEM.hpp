@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <asyncfem/forceModel/forceModel.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <memory>
+#include <vector>
+
+namespace asyncfem {
+
+/// Which tangent stiffness CorotationalLinearFEM returns.
+enum class TangentKind {
+  /// K_e^R = R K_e R^T (R acting block-wise on the four vertices): the rotated linear
+  /// stiffness, ignoring how R changes with x. Symmetric positive semi-definite; Vega
+  /// FEM's default. Not the derivative of the forces once elements are strained.
+  simple,
+  /// The full derivative d f_e / d x, including dR / dx (see CorotationalLinearFEM).
+  /// Symmetric (it is the Hessian of the energy) but may be indefinite under strong
+  /// compression or inversion.
+  exact,
+};
+
+/// Corotated linear FEM on linear tetrahedra (Mueller & Gross 2004; the model of Vega
+/// FEM's corotational linear FEM).
+///
+/// Per element e with rest positions X (12-vector, the four vertices stacked), current
+/// positions x = X + u (12), shape-function gradients g_a (rest configuration) and the
+/// linear element stiffness K_e (12x12, from linearElementStiffness, cached at
+/// construction):
+///   - deformation gradient F = sum_a x_a g_a^T = Ds Dm^{-1} (3x3, dimensionless);
+///   - rotation R from the polar decomposition F = R S (polarDecomposition(): SVD with
+///     the sign fix, det R = +1 also for flat and inverted elements);
+///   - internal force f_e = R K_e (R^T x - X) (12, force units, e.g. N), R acting on
+///     each vertex's 3-vector; assembled f_int = sum_e f_e, Vega's sign convention
+///     (f_int opposes the deformation, see ForceModel);
+///   - energy E_e = 1/2 (R^T x - X)^T K_e (R^T x - X) (energy units, e.g. J).
+/// Because R^T x - X has the symmetric displacement gradient S - I and the linear stress
+/// commutes with S, f_e is exactly dE_e/dx, and the internal forces have zero net force
+/// and zero net torque about any point for every deformation.
+///
+/// Tangent (TangentKind): simple = R K_e R^T. exact = d f_e / d x
+///     = R K_e R^T + R (Z + K_e Y) W,
+/// where W (3x12) maps dx to the axial vector w of R^T dR (column 3a + c is
+/// (tr(S) I - S)^{-1} (g_a x r_c), r_c = row c of R, see rotationDifferential()),
+/// Z (12x3) has the blocks -[(K_e v)_b]x, v = R^T x - X, and Y (12x3) the blocks
+/// [(R^T x)_b]x (b = vertex, [p]x the cross-product matrix). The exact element matrix
+/// is symmetrised, 1/2 (K + K^T), which changes it only by rounding (and where the
+/// pair-sum clamp of rotationDifferential() acts), so symmetric solvers see a
+/// symmetric matrix.
+///
+/// Assembly goes through a MatrixAssembler into its fixed pattern (values only), element
+/// loops are OpenMP-parallel and forces, tangent and energy are bit-identical for any
+/// thread count (per-element work is independent, sums run in a fixed order). Every
+/// evaluation first computes all element rotations once (stored, see rotations()), then
+/// forces and/or tangent from them, so forcesAndTangent() decomposes each F once.
+class CorotationalLinearFEM final : public ForceModel {
+ public:
+  /// Copies mesh's rest positions and connectivity, caches every element's K_e and
+  /// shape-function gradients, and builds its own MatrixAssembler. Throws
+  /// ValidationError naming the lowest degenerate element (|V| <= 1e-14 L^3 with L its
+  /// longest edge, or non-finite); inverted rest elements are accepted (|V| is used).
+  explicit CorotationalLinearFEM(const TetMesh& mesh, TangentKind tangentKind = TangentKind::simple);
+  /// Same, sharing an assembler built for mesh (e.g. with the mass matrix), so all
+  /// matrices have one pattern. Throws asyncfem::Error if assembler is null or was built
+  /// for a different number of vertices or elements.
+  CorotationalLinearFEM(const TetMesh& mesh, std::shared_ptr<const MatrixAssembler> assembler,
+                        TangentKind tangentKind = TangentKind::simple);
+
+  int numDofs() const override { return numDofs_; }
+  int numElements() const { return static_cast<int>(elements_.cols()); }
+  bool isLinear() const override { return false; }
+
+  TangentKind tangentKind() const { return tangentKind_; }
+  void setTangentKind(TangentKind kind) { tangentKind_ = kind; }
+
+  /// A 3n x 3n zero matrix in the assembler's pattern.
+  Eigen::SparseMatrix<double> createStiffnessMatrix() const override;
+  /// forces = f_int(u) = sum_e R_e K_e (R_e^T x_e - X_e), size 3n; displacement is u
+  /// (3n, length units). Throws asyncfem::Error on a size mismatch.
+  void internalForces(const Eigen::VectorXd& displacement, Eigen::VectorXd& forces) override;
+  /// stiffness = sum_e of the element tangents of tangentKind() (3n x 3n). If stiffness
+  /// does not have the assembler's size and entry count it is replaced by
+  /// createStiffnessMatrix() first; otherwise only its values are written.
+  void tangentStiffness(const Eigen::VectorXd& displacement, Eigen::SparseMatrix<double>& stiffness) override;
+  /// Both, with one polar decomposition per element.
+  void forcesAndTangent(const Eigen::VectorXd& displacement, Eigen::VectorXd& forces,
+                        Eigen::SparseMatrix<double>& stiffness) override;
+  /// sum_e 1/2 (R_e^T x_e - X_e)^T K_e (R_e^T x_e - X_e); summed in element order, so
+  /// independent of the thread count.
+  double elasticEnergy(const Eigen::VectorXd& displacement) override;
+
+  /// Element rotations R_e (numElements 3x3 matrices, det +1) of the last evaluation
+  /// (any of the four functions above); identities before the first one.
+  const std::vector<Eigen::Matrix3d>& rotations() const { return rotations_; }
+  /// The cached linear stiffness K_e of element e (12x12).
+  const ElementMatrix& elementStiffness(int e) const { return elementStiffness_[static_cast<std::size_t>(e)]; }
+  const MatrixAssembler& assembler() const { return *assembler_; }
+  const std::shared_ptr<const MatrixAssembler>& sharedAssembler() const { return assembler_; }
+
+ private:
+  void checkDisplacement(const Eigen::VectorXd& displacement, const char* caller) const;
+  // Positions of element e's vertices, x = X + u (3x4).
+  ElementPositions currentPositions(int e, const Eigen::VectorXd& displacement) const;
+  // Polar decompositions of every element; stores R (and, for the exact tangent,
+  // (tr S I - S)^{-1}).
+  void updateRotations(const Eigen::VectorXd& displacement, bool needDifferentialOperator);
+  void assembleForces(const Eigen::VectorXd& displacement, Eigen::VectorXd& forces) const;
+  void assembleTangent(const Eigen::VectorXd& displacement, Eigen::SparseMatrix<double>& stiffness) const;
+
+  std::shared_ptr<const MatrixAssembler> assembler_;
+  TangentKind tangentKind_;
+  int numDofs_ = 0;
+  Eigen::Matrix4Xi elements_;
+  std::vector<ElementPositions> restPositions_;              // X per element (3x4)
+  std::vector<Eigen::Matrix<double, 3, 4>> shapeGradients_;  // g_a per element (3x4)
+  std::vector<ElementMatrix> elementStiffness_;              // K_e
+  std::vector<Eigen::Matrix3d> rotations_;                   // R_e of the last evaluation
+  std::vector<Eigen::Matrix3d> differentialOperators_;       // (tr S I - S)^{-1}, exact tangent only
+  std::vector<double> elementEnergies_;                      // scratch for the ordered sum
+};
+
+}  // namespace asyncfem
