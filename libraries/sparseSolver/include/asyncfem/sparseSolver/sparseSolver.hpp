@@ -25,7 +25,7 @@ SolverKind parseSolverKind(const std::string& name);
 /// factorization libraries themselves (CHOLMOD's Common->fl and lnz, UMFPACK's Info).
 struct SolverStats {
   long long factorNonZeros = 0;      ///< non-zeros of L (Cholesky) or L+U (LU)
-  double factorFlops = 0.0;          ///< flops of the last numeric factorization
+  double factorFlops = 0.0;          ///< flops of the last numeric factorization (Eigen kinds: estimated from the factor)
   double solveFlopsPerRhs = 0.0;     ///< flops of one forward+back substitution (estimate 4*nnz(L) for Cholesky)
   int analyses = 0;
   int factorizations = 0;
@@ -35,23 +35,30 @@ struct SolverStats {
 
 /// A sparse direct solver: symbolic analysis once per pattern, numeric factorization
 /// whenever values change, then any number of solves. Matrices are Eigen column-major
-/// with int indices and full storage (both triangles) even for symmetric ones.
-/// CHOLMOD/UMFPACK types never appear here (pimpl).
+/// with int indices and full storage (both triangles) even for symmetric ones; the
+/// Cholesky kinds read only the upper triangle. Every matrix must be square and
+/// compressed (asyncfem::Error otherwise). CHOLMOD/UMFPACK types never appear here (pimpl).
+/// Threads: one solver object is not thread-safe, but distinct objects share no mutable
+/// state (each owns its CHOLMOD common / UMFPACK objects) and may run on distinct threads.
 class SparseSolver {
 public:
   virtual ~SparseSolver() = default;
 
-  /// Symbolic analysis (ordering, elimination tree) of A's pattern.
+  /// Symbolic analysis (ordering, elimination tree) of A's pattern. A later factorize()
+  /// reuses it as long as the matrix keeps this exact pattern (size and index arrays).
   virtual void analyzePattern(const Eigen::SparseMatrix<double>& matrix) = 0;
   /// Numeric factorization of A, which must have the analysed pattern. Throws
-  /// asyncfem::NumericalError when A is not positive definite (Cholesky) or singular.
+  /// asyncfem::NumericalError when A is not positive definite (Cholesky; the message names
+  /// the column) or singular (LU); asyncfem::Error when called before analyzePattern() or
+  /// with another pattern (the message says to call analyzePattern() again).
   virtual void factorize(const Eigen::SparseMatrix<double>& matrix) = 0;
   /// analyzePattern + factorize.
   void compute(const Eigen::SparseMatrix<double>& matrix) {
     analyzePattern(matrix);
     factorize(matrix);
   }
-  /// Solves A X = B for every column of B (n x k). X is resized.
+  /// Solves A X = B for every column of B (n x k). X is resized to n x k. Throws
+  /// asyncfem::Error when B does not have n rows or no factorization succeeded yet.
   virtual void solve(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) = 0;
   /// Convenience for one right-hand side.
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs) {
@@ -62,7 +69,8 @@ public:
 
   virtual SolverKind kind() const = 0;
   /// Fill-reducing ordering in effect after analyzePattern(): "metis", "amd", "colamd",
-  /// "natural", ... as the backend reports it ("default" when the backend does not say).
+  /// "natural", ... as the backend reports it ("default" when the backend does not say,
+  /// "none" before analyzePattern()). CHOLMOD reports "metis" unless its build lacks METIS.
   virtual std::string ordering() const { return "default"; }
   const SolverStats& stats() const { return stats_; }
   void resetStats() { stats_ = SolverStats{}; }
