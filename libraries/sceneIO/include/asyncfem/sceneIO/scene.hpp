@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+/// A scene as written in its JSON file (format: docs/scene-format.md), checked for types,
+/// ranges and unknown keys but not yet against the mesh (set names, vertex ids: that is
+/// buildSimulation's job). Plain data: utilities may change fields (command-line
+/// overrides) before building. Paths are already resolved against the scene's folder.
+struct Scene {
+  /// Where the mesh comes from.
+  enum class MeshSource { file, beam, box };
+  struct Mesh {
+    MeshSource source = MeshSource::file;
+    std::filesystem::path file;  ///< MeshSource::file: .veg, .node/.ele or .msh
+    BeamSpec beam;               ///< MeshSource::beam: makeBeamMesh parameters
+    BoxMeshSpec box;             ///< MeshSource::box: makeBoxMesh parameters
+  };
+
+  /// New material constants for the elements of an element set; fields left empty keep
+  /// the value of the material the elements had.
+  struct MaterialOverride {
+    std::string set;
+    std::optional<double> density;
+    std::optional<double> youngsModulus;
+    std::optional<double> poissonRatio;
+  };
+
+  /// Axis-aligned box [min, max] (inclusive) selecting the vertices whose rest position
+  /// lies in it.
+  struct Box {
+    Eigen::Vector3d min = Eigen::Vector3d::Zero();
+    Eigen::Vector3d max = Eigen::Vector3d::Zero();
+  };
+
+  /// Fixed vertices: the union of vertex sets, boxes and a Vega .bou file (1-based ids).
+  struct Fixed {
+    std::vector<std::string> sets;
+    std::vector<Box> boxes;
+    std::optional<std::filesystem::path> bouFile;
+  };
+
+  enum class ForceType {
+    pull,     ///< constant total force, split evenly over the vertices, during a window
+    impulse,  ///< total impulse (force x time), split evenly, delivered within one step
+  };
+  /// One external load, on a vertex set or on an explicit list of (0-based) vertex ids.
+  struct Force {
+    ForceType type = ForceType::pull;
+    std::string set;           ///< vertex set name, or empty when vertices are listed
+    std::vector<int> vertices;  ///< 0-based vertex ids (when set is empty)
+    Eigen::Vector3d vector = Eigen::Vector3d::Zero();  ///< pull: total force; impulse: total impulse
+    double start = 0.0;         ///< pull: active for start <= t < end
+    double end = std::numeric_limits<double>::infinity();
+    double time = 0.0;          ///< impulse: when it is delivered
+  };
+
+  enum class ForceModelKind { linear, corotational };
+  enum class Tangent { simple, exact };
+
+  /// Name of the scene for messages: the file name as given to loadScene, or the
+  /// sourceName given to parseScene. Every error reads "<sourceName>: <key path>: ...".
+  std::string sourceName = "scene";
+  /// Folder relative paths were resolved against.
+  std::filesystem::path baseDirectory;
+  std::string description;
+
+  Mesh mesh;
+  std::vector<MaterialOverride> materials;
+  Fixed fixed;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< acceleration, length / time^2
+  std::vector<Force> forces;
+  MassType mass = MassType::consistent;
+  double rayleighAlpha = 0.0;  ///< D = alpha M + beta K
+  double rayleighBeta = 0.0;
+  ForceModelKind forceModel = ForceModelKind::linear;
+  Tangent tangent = Tangent::simple;  ///< corotational only
+
+  struct Integrator {
+    std::string name = "backward-euler";
+    double timestep = 0.0;  ///< h (> 0)
+    /// Integrator-specific keys, passed through unparsed to the integrator's factory
+    /// (see IntegratorRegistry), which rejects keys it does not know.
+    nlohmann::json options = nlohmann::json::object();
+  } integrator;
+
+  struct Frames {
+    double rate = 30.0;  ///< frames per time unit; frame interval = 1 / rate
+    int count = 60;
+  } frames;
+
+  struct Output {
+    std::filesystem::path file;       ///< .afsim output; empty: none given in the scene
+    std::filesystem::path vtuFolder;  ///< empty: no .vtu files
+    int vtuEvery = 1;                 ///< write a .vtu every this many frames
+    bool velocities = false;          ///< also store velocities in the .afsim file
+    bool sync = false;                ///< fsync after every frame
+  } output;
+};
+
+/// Reads and parses a scene file. Relative paths in it resolve against its folder.
+/// Throws asyncfem::ParseError "FILE:LINE: invalid JSON ..." for malformed JSON, and
+/// asyncfem::ValidationError "FILE: key.path: message" for unknown keys, wrong types and
+/// bad values; asyncfem::Error if the file cannot be read.
+Scene loadScene(const std::filesystem::path& path);
+
+/// Parses a scene from JSON. basePath: folder relative paths resolve against;
+/// sourceName: what error messages call the scene.
+Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePath,
+                 const std::string& sourceName = "scene");
+
+/// Throws asyncfem::ValidationError "<scene.sourceName>: <keyPath>: <message>", the form
+/// of every scene error (for integrator factories reading their own options).
+[[noreturn]] void throwSceneError(const Scene& scene, const std::string& keyPath, const std::string& message);
+
+}  // namespace asyncfem

@@ -1,0 +1,395 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/sceneIO/jsonReader.hpp>
+#include <asyncfem/sceneIO/scene.hpp>
+
+#include <algorithm>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace asyncfem {
+
+namespace {
+
+using nlohmann::json;
+
+constexpr int maxInt = std::numeric_limits<int>::max();
+
+// Relative paths in a scene are relative to the scene file's folder.
+std::filesystem::path resolvePath(const std::filesystem::path& base, const std::string& text) {
+  const std::filesystem::path path(text);
+  return path.is_absolute() || base.empty() ? path.lexically_normal() : (base / path).lexically_normal();
+}
+
+std::string pathString(JsonObjectReader& reader, const std::string& key) {
+  const std::string text = reader.string(key, "");
+  if (text.empty()) {
+    reader.fail(key, "expected a non-empty path");
+  }
+  return text;
+}
+
+// A material object { "name", "density", "youngsModulus", "poissonRatio" } over defaults.
+Material parseMaterial(const json& value, const std::string& path, const std::string& source, Material material) {
+  JsonObjectReader reader(value, path, source);
+  material.name = reader.string("name", material.name);
+  if (material.name.empty()) {
+    reader.fail("name", "expected a non-empty name");
+  }
+  material.density = reader.number("density", material.density);
+  material.youngsModulus = reader.number("youngsModulus", material.youngsModulus);
+  material.poissonRatio = reader.number("poissonRatio", material.poissonRatio);
+  reader.finish();
+  if (material.density <= 0.0) {
+    reader.fail("density", "expected a density > 0");
+  }
+  if (material.youngsModulus <= 0.0) {
+    reader.fail("youngsModulus", "expected a Young's modulus > 0");
+  }
+  if (material.poissonRatio <= -1.0 || material.poissonRatio >= 0.5) {
+    reader.fail("poissonRatio", "expected a Poisson ratio in (-1, 0.5)");
+  }
+  return material;
+}
+
+void requirePositive(JsonObjectReader& reader, const std::string& key, double value) {
+  if (!(value > 0.0)) {
+    reader.fail(key, "expected a number > 0");
+  }
+}
+
+void parseMesh(JsonObjectReader& top, Scene& scene) {
+  const std::string source = scene.sourceName;
+  JsonObjectReader reader(top.required("mesh"), "mesh", source);
+  const bool hasFile = reader.has("file");
+  const bool hasGenerator = reader.has("generator");
+  if (hasFile == hasGenerator) {
+    JsonObjectReader::failAt(source, "mesh", "give either \"file\" or \"generator\"");
+  }
+  if (hasFile) {
+    scene.mesh.source = Scene::MeshSource::file;
+    scene.mesh.file = resolvePath(scene.baseDirectory, pathString(reader, "file"));
+    reader.finish();
+    return;
+  }
+  const std::string generator = reader.choice("generator", "", {"beam", "box"});
+  if (generator == "beam") {
+    scene.mesh.source = Scene::MeshSource::beam;
+    BeamSpec& beam = scene.mesh.beam;
+    beam.length = reader.number("length", beam.length);
+    requirePositive(reader, "length", beam.length);
+    beam.height = reader.number("height", beam.height);
+    requirePositive(reader, "height", beam.height);
+    beam.depth = reader.number("depth", beam.depth);
+    requirePositive(reader, "depth", beam.depth);
+    beam.cellsAlongLength = reader.integer("cellsAlongLength", beam.cellsAlongLength, 1, 100000);
+    beam.tipFraction = reader.number("tipFraction", beam.tipFraction);
+    if (beam.tipFraction < 0.0 || beam.tipFraction >= 1.0) {
+      reader.fail("tipFraction", "expected a fraction in [0, 1)");
+    }
+    if (const json* body = reader.find("body")) {
+      beam.body = parseMaterial(*body, reader.keyPath("body"), source, beam.body);
+    }
+    if (const json* tip = reader.find("tip")) {
+      beam.tip = parseMaterial(*tip, reader.keyPath("tip"), source, beam.tip);
+    }
+  } else {
+    scene.mesh.source = Scene::MeshSource::box;
+    BoxMeshSpec& box = scene.mesh.box;
+    box.origin = reader.vector3("origin", box.origin);
+    box.size = reader.vector3("size", box.size);
+    if ((box.size.array() <= 0.0).any()) {
+      reader.fail("size", "expected three sizes > 0");
+    }
+    if (const json* cells = reader.find("cells")) {
+      const std::string path = reader.keyPath("cells");
+      if (!cells->is_array() || cells->size() != 3) {
+        JsonObjectReader::failAt(source, path, "expected [nx, ny, nz] (three integers >= 1)");
+      }
+      for (int i = 0; i < 3; ++i) {
+        box.cells[i] = JsonObjectReader::toInteger((*cells)[static_cast<std::size_t>(i)],
+                                                   path + "[" + std::to_string(i) + "]", source, 1, 10000);
+      }
+    }
+    if (const json* material = reader.find("material")) {
+      box.material = parseMaterial(*material, reader.keyPath("material"), source, box.material);
+    }
+    if (const json* regions = reader.find("regions")) {
+      if (!regions->is_array()) {
+        reader.fail("regions", "expected an array of {name, min, max, material}");
+      }
+      for (std::size_t i = 0; i < regions->size(); ++i) {
+        const std::string path = reader.elementPath("regions", i);
+        JsonObjectReader region((*regions)[i], path, source);
+        BoxRegion result;
+        result.name = region.string("name", "");
+        if (result.name.empty()) {
+          region.fail("name", "expected a non-empty name");
+        }
+        result.min = JsonObjectReader::toVector3(region.required("min"), region.keyPath("min"), source);
+        result.max = JsonObjectReader::toVector3(region.required("max"), region.keyPath("max"), source);
+        if ((result.min.array() > result.max.array()).any()) {
+          JsonObjectReader::failAt(source, path, "expected min <= max");
+        }
+        result.material = parseMaterial(region.required("material"), region.keyPath("material"), source,
+                                        Material{result.name, 1000.0, 1e6, 0.45});
+        region.finish();
+        box.regions.push_back(result);
+      }
+    }
+  }
+  reader.finish();
+}
+
+void parseMaterials(JsonObjectReader& top, Scene& scene) {
+  const json* materials = top.find("materials");
+  if (materials == nullptr) {
+    return;
+  }
+  if (!materials->is_array()) {
+    top.fail("materials", "expected an array of {set, density, youngsModulus, poissonRatio}");
+  }
+  for (std::size_t i = 0; i < materials->size(); ++i) {
+    JsonObjectReader reader((*materials)[i], top.elementPath("materials", i), scene.sourceName);
+    Scene::MaterialOverride override;
+    override.set = JsonObjectReader::toString(reader.required("set"), reader.keyPath("set"), scene.sourceName);
+    override.density = reader.optionalNumber("density");
+    override.youngsModulus = reader.optionalNumber("youngsModulus");
+    override.poissonRatio = reader.optionalNumber("poissonRatio");
+    reader.finish();
+    if (!override.density && !override.youngsModulus && !override.poissonRatio) {
+      JsonObjectReader::failAt(scene.sourceName, reader.path(),
+                               "gives no constant to override (density, youngsModulus, poissonRatio)");
+    }
+    if (override.density && *override.density <= 0.0) {
+      reader.fail("density", "expected a density > 0");
+    }
+    if (override.youngsModulus && *override.youngsModulus <= 0.0) {
+      reader.fail("youngsModulus", "expected a Young's modulus > 0");
+    }
+    if (override.poissonRatio && (*override.poissonRatio <= -1.0 || *override.poissonRatio >= 0.5)) {
+      reader.fail("poissonRatio", "expected a Poisson ratio in (-1, 0.5)");
+    }
+    scene.materials.push_back(override);
+  }
+}
+
+void parseFixed(JsonObjectReader& top, Scene& scene) {
+  const json* fixed = top.find("fixed");
+  if (fixed == nullptr) {
+    return;
+  }
+  const std::string& source = scene.sourceName;
+  JsonObjectReader reader(*fixed, "fixed", source);
+  if (const json* sets = reader.find("sets")) {
+    if (!sets->is_array()) {
+      reader.fail("sets", "expected an array of vertex set names");
+    }
+    for (std::size_t i = 0; i < sets->size(); ++i) {
+      scene.fixed.sets.push_back(JsonObjectReader::toString((*sets)[i], reader.elementPath("sets", i), source));
+    }
+  }
+  if (const json* boxes = reader.find("boxes")) {
+    if (!boxes->is_array()) {
+      reader.fail("boxes", "expected an array of {min, max}");
+    }
+    for (std::size_t i = 0; i < boxes->size(); ++i) {
+      const std::string path = reader.elementPath("boxes", i);
+      JsonObjectReader boxReader((*boxes)[i], path, source);
+      Scene::Box box;
+      box.min = JsonObjectReader::toVector3(boxReader.required("min"), boxReader.keyPath("min"), source);
+      box.max = JsonObjectReader::toVector3(boxReader.required("max"), boxReader.keyPath("max"), source);
+      boxReader.finish();
+      if ((box.min.array() > box.max.array()).any()) {
+        JsonObjectReader::failAt(source, path, "expected min <= max in every coordinate");
+      }
+      scene.fixed.boxes.push_back(box);
+    }
+  }
+  if (reader.has("bou")) {
+    scene.fixed.bouFile = resolvePath(scene.baseDirectory, pathString(reader, "bou"));
+  }
+  reader.finish();
+}
+
+void parseForces(JsonObjectReader& top, Scene& scene) {
+  const json* forces = top.find("forces");
+  if (forces == nullptr) {
+    return;
+  }
+  const std::string& source = scene.sourceName;
+  if (!forces->is_array()) {
+    top.fail("forces", "expected an array of {type, set | vertices, ...}");
+  }
+  for (std::size_t i = 0; i < forces->size(); ++i) {
+    const std::string path = top.elementPath("forces", i);
+    JsonObjectReader reader((*forces)[i], path, source);
+    Scene::Force force;
+    const std::string type = reader.choice("type", "", {"pull", "impulse"});
+    force.type = type == "pull" ? Scene::ForceType::pull : Scene::ForceType::impulse;
+
+    const bool hasSet = reader.has("set");
+    const bool hasVertices = reader.has("vertices");
+    if (hasSet == hasVertices) {
+      JsonObjectReader::failAt(source, path, "give either \"set\" or \"vertices\"");
+    }
+    if (hasSet) {
+      force.set = reader.string("set", "");
+      if (force.set.empty()) {
+        reader.fail("set", "expected a non-empty vertex set name");
+      }
+    } else {
+      const json& vertices = *reader.find("vertices");
+      if (!vertices.is_array() || vertices.empty()) {
+        reader.fail("vertices", "expected a non-empty array of 0-based vertex ids");
+      }
+      for (std::size_t k = 0; k < vertices.size(); ++k) {
+        force.vertices.push_back(
+            JsonObjectReader::toInteger(vertices[k], reader.elementPath("vertices", k), source, 0, maxInt));
+      }
+    }
+
+    if (force.type == Scene::ForceType::pull) {
+      force.vector = JsonObjectReader::toVector3(reader.required("force"), reader.keyPath("force"), source);
+      if (const json* window = reader.find("window")) {
+        const std::string windowPath = reader.keyPath("window");
+        const char* expected = "expected [start, end] with start <= end";
+        if (!window->is_array() || window->size() != 2 || !(*window)[0].is_number() || !(*window)[1].is_number()) {
+          JsonObjectReader::failAt(source, windowPath, expected);
+        }
+        force.start = JsonObjectReader::toNumber((*window)[0], windowPath + "[0]", source);
+        force.end = JsonObjectReader::toNumber((*window)[1], windowPath + "[1]", source);
+        if (force.start > force.end) {
+          JsonObjectReader::failAt(source, windowPath, expected);
+        }
+      }
+    } else {
+      force.vector = JsonObjectReader::toVector3(reader.required("impulse"), reader.keyPath("impulse"), source);
+      force.time = reader.number("time", 0.0);
+      if (force.time < 0.0) {
+        reader.fail("time", "expected a time >= 0");
+      }
+    }
+    reader.finish();
+    scene.forces.push_back(std::move(force));
+  }
+}
+
+void parseIntegrator(JsonObjectReader& top, Scene& scene) {
+  JsonObjectReader reader(top.required("integrator"), "integrator", scene.sourceName);
+  scene.integrator.name = reader.string("name", scene.integrator.name);
+  if (scene.integrator.name.empty()) {
+    reader.fail("name", "expected a non-empty integrator name");
+  }
+  scene.integrator.timestep = reader.requiredNumber("timestep");
+  requirePositive(reader, "timestep", scene.integrator.timestep);
+  if (const json* options = reader.find("options")) {
+    if (!options->is_object()) {
+      reader.fail("options", "expected an object, got " + JsonObjectReader::describe(*options));
+    }
+    scene.integrator.options = *options;
+  }
+  reader.finish();
+}
+
+void parseOutput(JsonObjectReader& top, Scene& scene) {
+  const json* output = top.find("output");
+  if (output == nullptr) {
+    return;
+  }
+  JsonObjectReader reader(*output, "output", scene.sourceName);
+  if (reader.has("file")) {
+    scene.output.file = resolvePath(scene.baseDirectory, pathString(reader, "file"));
+  }
+  if (const json* vtu = reader.find("vtu")) {
+    JsonObjectReader vtuReader(*vtu, reader.keyPath("vtu"), scene.sourceName);
+    scene.output.vtuFolder = resolvePath(scene.baseDirectory, pathString(vtuReader, "folder"));
+    scene.output.vtuEvery = vtuReader.integer("every", 1, 1, maxInt);
+    vtuReader.finish();
+  }
+  scene.output.velocities = reader.boolean("velocities", false);
+  scene.output.sync = reader.boolean("sync", false);
+  reader.finish();
+}
+
+}  // namespace
+
+void throwSceneError(const Scene& scene, const std::string& keyPath, const std::string& message) {
+  JsonObjectReader::failAt(scene.sourceName, keyPath, message);
+}
+
+Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePath, const std::string& sourceName) {
+  Scene scene;
+  scene.sourceName = sourceName;
+  scene.baseDirectory = basePath;
+  JsonObjectReader top(json, "", sourceName);
+
+  scene.description = top.string("description", "");
+  parseMesh(top, scene);
+  parseMaterials(top, scene);
+  parseFixed(top, scene);
+  scene.gravity = top.vector3("gravity", Eigen::Vector3d::Zero());
+  parseForces(top, scene);
+  scene.mass = top.choice("mass", "consistent", {"consistent", "lumped"}) == "lumped" ? MassType::lumped
+                                                                                      : MassType::consistent;
+  if (const nlohmann::json* damping = top.find("damping")) {
+    JsonObjectReader reader(*damping, "damping", sourceName);
+    scene.rayleighAlpha = reader.number("alpha", 0.0);
+    scene.rayleighBeta = reader.number("beta", 0.0);
+    reader.finish();
+    if (scene.rayleighAlpha < 0.0) {
+      reader.fail("alpha", "expected alpha >= 0");
+    }
+    if (scene.rayleighBeta < 0.0) {
+      reader.fail("beta", "expected beta >= 0");
+    }
+  }
+  if (const nlohmann::json* forceModel = top.find("forceModel")) {
+    JsonObjectReader reader(*forceModel, "forceModel", sourceName);
+    const std::string type = reader.choice("type", "linear", {"linear", "corotational"});
+    scene.forceModel = type == "linear" ? Scene::ForceModelKind::linear : Scene::ForceModelKind::corotational;
+    if (reader.has("tangent")) {
+      if (scene.forceModel == Scene::ForceModelKind::linear) {
+        reader.fail("tangent", "only the corotational force model has a tangent choice");
+      }
+      scene.tangent = reader.choice("tangent", "simple", {"simple", "exact"}) == "exact" ? Scene::Tangent::exact
+                                                                                       : Scene::Tangent::simple;
+    }
+    reader.finish();
+  }
+  parseIntegrator(top, scene);
+  if (const nlohmann::json* frames = top.find("frames")) {
+    JsonObjectReader reader(*frames, "frames", sourceName);
+    scene.frames.rate = reader.number("rate", scene.frames.rate);
+    requirePositive(reader, "rate", scene.frames.rate);
+    scene.frames.count = reader.integer("count", scene.frames.count, 1, maxInt);
+    reader.finish();
+  }
+  parseOutput(top, scene);
+  top.finish();
+  return scene;
+}
+
+Scene loadScene(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw Error(name + ": cannot open the scene file");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  const std::string content = text.str();
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(content, nullptr, true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::parse_error& error) {
+    const std::size_t end = std::min(error.byte, content.size());
+    const auto line = static_cast<std::size_t>(
+        1 + std::count(content.begin(), content.begin() + static_cast<std::ptrdiff_t>(end > 0 ? end - 1 : 0), '\n'));
+    throw ParseError(name, line, std::string("invalid JSON: ") + error.what());
+  }
+  return parseScene(json, path.parent_path(), name);
+}
+
+}  // namespace asyncfem

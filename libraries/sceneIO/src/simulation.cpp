@@ -1,0 +1,414 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
+#include <asyncfem/forceModel/linearForceModel.hpp>
+#include <asyncfem/integrator/factory.hpp>
+#include <asyncfem/sceneIO/jsonReader.hpp>
+#include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/sparseSolver/sparseSolver.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace asyncfem {
+
+void IntegratorRegistry::add(const std::string& name, IntegratorFactory factory) {
+  factories_[name] = std::move(factory);
+}
+
+const IntegratorFactory* IntegratorRegistry::find(const std::string& name) const {
+  const auto it = factories_.find(name);
+  return it == factories_.end() ? nullptr : &it->second;
+}
+
+std::vector<std::string> IntegratorRegistry::names() const {
+  std::vector<std::string> result;
+  for (const auto& [name, factory] : factories_) {
+    result.push_back(name);
+  }
+  return result;
+}
+
+namespace {
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& name : names) {
+    list += (list.empty() ? "" : ", ") + name;
+  }
+  return list;
+}
+
+// The options every single-rate integrator accepts (IntegratorOptions).
+IntegratorOptions parseSingleRateOptions(const Scene& scene, const nlohmann::json& options) {
+  JsonObjectReader reader(options, "integrator.options", scene.sourceName);
+  IntegratorOptions result;
+  if (const auto solver = reader.optionalString("solver")) {
+    try {
+      result.solver = parseSolverKind(*solver);
+    } catch (const Error& error) {
+      reader.fail("solver", error.what());
+    }
+  }
+  result.maxIterations = reader.integer("maxIterations", result.maxIterations, 1, 1000);
+  result.tolerance = reader.number("tolerance", result.tolerance);
+  if (!(result.tolerance > 0.0)) {
+    reader.fail("tolerance", "expected a number > 0");
+  }
+  result.maxFrequency = reader.number("maxFrequency", result.maxFrequency);
+  if (result.maxFrequency < 0.0) {
+    reader.fail("maxFrequency", "expected a number >= 0 (0: estimate it)");
+  }
+  result.force = reader.boolean("force", result.force);
+  reader.finish();
+  return result;
+}
+
+TetMesh loadMesh(const Scene& scene) {
+  switch (scene.mesh.source) {
+    case Scene::MeshSource::beam: return makeBeamMesh(scene.mesh.beam);
+    case Scene::MeshSource::box: return makeBoxMesh(scene.mesh.box);
+    case Scene::MeshSource::file: break;
+  }
+  try {
+    return readMesh(scene.mesh.file);
+  } catch (const Error& error) {
+    throw ValidationError(scene.sourceName + ": mesh.file: " + error.what());
+  }
+}
+
+std::string knownSets(const std::map<std::string, std::vector<int>>& sets) {
+  std::vector<std::string> names;
+  for (const auto& [name, members] : sets) {
+    names.push_back(name);
+  }
+  return names.empty() ? "none" : joined(names);
+}
+
+const std::vector<int>& vertexSetAt(const Scene& scene, const TetMesh& mesh, const std::string& name,
+                                    const std::string& keyPath) {
+  const auto it = mesh.vertexSets().find(name);
+  if (it == mesh.vertexSets().end()) {
+    throwSceneError(scene, keyPath, "unknown vertex set \"" + name + "\" (known: " + knownSets(mesh.vertexSets()) + ")");
+  }
+  if (it->second.empty()) {
+    throwSceneError(scene, keyPath, "vertex set \"" + name + "\" is empty");
+  }
+  return it->second;
+}
+
+// Material overrides: new materials for the elements of each set. A material used only
+// by the set's elements is changed in place (keeping its name); otherwise the set's
+// elements get a copy named "<material>@<set>".
+TetMesh applyMaterialOverrides(const Scene& scene, TetMesh mesh) {
+  if (scene.materials.empty()) {
+    return mesh;
+  }
+  std::vector<Material> materials = mesh.materials();
+  std::vector<int> elementMaterials = mesh.elementMaterials();
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const Scene::MaterialOverride& override = scene.materials[i];
+    const std::string keyPath = "materials[" + std::to_string(i) + "].set";
+    std::vector<int> elements;
+    if (override.set == "allElements") {
+      elements.resize(static_cast<std::size_t>(mesh.numElements()));
+      for (int e = 0; e < mesh.numElements(); ++e) {
+        elements[static_cast<std::size_t>(e)] = e;
+      }
+    } else {
+      const auto it = mesh.elementSets().find(override.set);
+      if (it == mesh.elementSets().end()) {
+        throwSceneError(scene, keyPath, "unknown element set \"" + override.set +
+                                            "\" (known: allElements, " + knownSets(mesh.elementSets()) + ")");
+      }
+      elements = it->second;
+    }
+    std::map<int, std::vector<int>> byMaterial;
+    for (const int e : elements) {
+      byMaterial[elementMaterials[static_cast<std::size_t>(e)]].push_back(e);
+    }
+    for (const auto& [materialIndex, members] : byMaterial) {
+      Material material = materials[static_cast<std::size_t>(materialIndex)];
+      material.density = override.density.value_or(material.density);
+      material.youngsModulus = override.youngsModulus.value_or(material.youngsModulus);
+      material.poissonRatio = override.poissonRatio.value_or(material.poissonRatio);
+      const auto users = static_cast<std::size_t>(
+          std::count(elementMaterials.begin(), elementMaterials.end(), materialIndex));
+      if (users == members.size()) {
+        materials[static_cast<std::size_t>(materialIndex)] = material;
+        continue;
+      }
+      material.name += "@" + override.set;
+      const auto existing = std::find_if(materials.begin(), materials.end(),
+                                         [&](const Material& m) { return m.name == material.name; });
+      int newIndex = static_cast<int>(materials.size());
+      if (existing != materials.end()) {
+        newIndex = static_cast<int>(existing - materials.begin());
+        *existing = material;
+      } else {
+        materials.push_back(material);
+      }
+      for (const int e : members) {
+        elementMaterials[static_cast<std::size_t>(e)] = newIndex;
+      }
+    }
+  }
+  TetMesh result(mesh.restPositions(), mesh.elements(), materials, elementMaterials);
+  for (const auto& [name, members] : mesh.elementSets()) {
+    result.setElementSet(name, members);
+  }
+  for (const auto& [name, members] : mesh.vertexSets()) {
+    result.setVertexSet(name, members);
+  }
+  return result;
+}
+
+std::vector<int> collectFixedVertices(const Scene& scene, const TetMesh& mesh) {
+  std::vector<int> fixed;
+  for (std::size_t i = 0; i < scene.fixed.sets.size(); ++i) {
+    const auto& members =
+        vertexSetAt(scene, mesh, scene.fixed.sets[i], "fixed.sets[" + std::to_string(i) + "]");
+    fixed.insert(fixed.end(), members.begin(), members.end());
+  }
+  for (std::size_t i = 0; i < scene.fixed.boxes.size(); ++i) {
+    const Scene::Box& box = scene.fixed.boxes[i];
+    std::size_t selected = 0;
+    for (int v = 0; v < mesh.numVertices(); ++v) {
+      const Eigen::Vector3d x = mesh.restPosition(v);
+      if ((x.array() >= box.min.array()).all() && (x.array() <= box.max.array()).all()) {
+        fixed.push_back(v);
+        ++selected;
+      }
+    }
+    if (selected == 0) {
+      throwSceneError(scene, "fixed.boxes[" + std::to_string(i) + "]", "selects no vertex");
+    }
+  }
+  if (scene.fixed.bouFile) {
+    std::vector<int> fromFile;
+    try {
+      fromFile = readBou(*scene.fixed.bouFile, mesh.numVertices());
+    } catch (const Error& error) {
+      throwSceneError(scene, "fixed.bou", error.what());
+    }
+    fixed.insert(fixed.end(), fromFile.begin(), fromFile.end());
+  }
+  std::sort(fixed.begin(), fixed.end());
+  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+  if (!fixed.empty() && static_cast<int>(fixed.size()) == mesh.numVertices()) {
+    throwSceneError(scene, "fixed", "every vertex is fixed: nothing would move");
+  }
+  return fixed;
+}
+
+// One external load: the same force on each of its vertices while it is active.
+struct VertexLoad {
+  std::vector<int> vertices;
+  Eigen::Vector3d perVertex = Eigen::Vector3d::Zero();
+  bool leftOpen = false;  // window (start, end] instead of [start, end)
+  double start = 0.0;
+  double end = 0.0;
+
+  bool active(double time) const { return leftOpen ? (time > start && time <= end) : (time >= start && time < end); }
+};
+
+std::vector<VertexLoad> collectLoads(const Scene& scene, const TetMesh& mesh) {
+  std::vector<VertexLoad> loads;
+  for (std::size_t i = 0; i < scene.forces.size(); ++i) {
+    const Scene::Force& force = scene.forces[i];
+    const std::string keyPath = "forces[" + std::to_string(i) + "]";
+    VertexLoad load;
+    if (!force.set.empty()) {
+      load.vertices = vertexSetAt(scene, mesh, force.set, keyPath + ".set");
+    } else {
+      for (std::size_t k = 0; k < force.vertices.size(); ++k) {
+        const int v = force.vertices[k];
+        if (v < 0 || v >= mesh.numVertices()) {
+          throwSceneError(scene, keyPath + ".vertices[" + std::to_string(k) + "]",
+                          "vertex " + std::to_string(v) + " out of range [0, " + std::to_string(mesh.numVertices()) +
+                              ") (ids are 0-based)");
+        }
+      }
+      load.vertices = force.vertices;
+      std::sort(load.vertices.begin(), load.vertices.end());
+      load.vertices.erase(std::unique(load.vertices.begin(), load.vertices.end()), load.vertices.end());
+    }
+    const double count = static_cast<double>(load.vertices.size());
+    if (force.type == Scene::ForceType::pull) {
+      load.perVertex = force.vector / count;
+      load.start = force.start;
+      load.end = force.end;
+    } else {
+      // An impulse I is a force I / h over a window one step long. Integrators evaluate
+      // f_ext at step starts, step ends or both (averaged); the window
+      // (t + h/2, t + 3h/2] holds exactly one step time, far from its ends, so each of
+      // them delivers exactly I, in the step after t.
+      const double h = scene.integrator.timestep;
+      load.perVertex = force.vector / (h * count);
+      load.leftOpen = true;
+      load.start = force.time + (0.5 * h);
+      load.end = force.time + (1.5 * h);
+    }
+    if (load.perVertex.isZero(0.0)) {
+      continue;
+    }
+    loads.push_back(std::move(load));
+  }
+  return loads;
+}
+
+std::string formatNumber(double value) {
+  std::ostringstream out;
+  out.precision(6);
+  out << value;
+  return out.str();
+}
+
+}  // namespace
+
+IntegratorRegistry defaultIntegratorRegistry() {
+  IntegratorRegistry registry;
+  for (const std::string& name : integratorNames()) {
+    registry.add(name, [name](const Scene& scene, const TetMesh& /*mesh*/, DynamicSystem system,
+                              const nlohmann::json& options) {
+      const IntegratorOptions parsed = parseSingleRateOptions(scene, options);
+      return makeIntegrator(name, std::move(system), scene.integrator.timestep, parsed);
+    });
+  }
+  return registry;
+}
+
+Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registry) {
+  Simulation simulation;
+
+  // Cheap checks first, so a bad scene fails before the mesh is read and matrices built.
+  const IntegratorFactory* factory = registry.find(scene.integrator.name);
+  if (factory == nullptr) {
+    throwSceneError(scene, "integrator.name", "unknown integrator \"" + scene.integrator.name +
+                                                  "\" (known: " + joined(registry.names()) + ")");
+  }
+  const double h = scene.integrator.timestep;
+  if (!(h > 0.0) || !std::isfinite(h)) {
+    throwSceneError(scene, "integrator.timestep", "expected a number > 0");
+  }
+  if (!(scene.frames.rate > 0.0) || !std::isfinite(scene.frames.rate) || scene.frames.count < 1) {
+    throwSceneError(scene, "frames", "expected rate > 0 and count >= 1");
+  }
+  simulation.timestep = h;
+  simulation.frameInterval = 1.0 / scene.frames.rate;
+  simulation.numFrames = scene.frames.count;
+  const double ratio = simulation.frameInterval / h;
+  const double steps = std::round(ratio);
+  if (steps < 1.0 || std::abs(ratio - steps) > 1e-9 * ratio || steps > 1e9) {
+    throwSceneError(scene, "integrator.timestep",
+                    formatNumber(h) + " does not divide the frame interval 1 / frames.rate = " +
+                        formatNumber(simulation.frameInterval) + " into a whole number of steps (ratio " +
+                        formatNumber(ratio) + "); change integrator.timestep or frames.rate");
+  }
+  simulation.stepsPerFrame = static_cast<int>(steps);
+
+  auto mesh = std::make_shared<TetMesh>(applyMaterialOverrides(scene, loadMesh(scene)));
+  simulation.mesh = mesh;
+  simulation.fixedVertices = collectFixedVertices(scene, *mesh);
+  const std::vector<VertexLoad> loads = collectLoads(scene, *mesh);
+  const BoundingBox box = boundingBox(*mesh);
+  simulation.boundingBoxDiagonal = (box.max - box.min).norm();
+  simulation.blowUpDisplacement = 1000.0 * simulation.boundingBoxDiagonal;
+
+  DynamicSystem system;
+  auto assembler = std::make_shared<const MatrixAssembler>(*mesh);
+  if (scene.forceModel == Scene::ForceModelKind::linear) {
+    system.forceModel = std::make_shared<LinearForceModel>(linearStiffnessMatrix(*mesh, *assembler));
+    simulation.skipped.emplace_back("corotational rotations and per-step tangent (linear force model)");
+  } else {
+    const TangentKind tangent = scene.tangent == Scene::Tangent::exact ? TangentKind::exact : TangentKind::simple;
+    system.forceModel = std::make_shared<CorotationalLinearFEM>(*mesh, assembler, tangent);
+  }
+  system.mass = massMatrix(*mesh, *assembler, scene.mass);
+  system.freeDofs = FreeDofs::fromFixedVertices(mesh->numVertices(), simulation.fixedVertices);
+  system.rayleighMass = scene.rayleighAlpha;
+  system.rayleighStiffness = scene.rayleighBeta;
+
+  // External force: gravity M g (precomputed once) plus the loads active at time t.
+  Eigen::VectorXd gravityForce;
+  if (!scene.gravity.isZero(0.0)) {
+    const Eigen::VectorXd stackedGravity = scene.gravity.replicate(mesh->numVertices(), 1);
+    gravityForce = system.mass * stackedGravity;
+  } else {
+    simulation.skipped.emplace_back("gravity load (gravity is zero)");
+  }
+  if (gravityForce.size() > 0 || !loads.empty()) {
+    system.externalForce = [gravityForce, loads](double time, const Eigen::VectorXd& /*displacement*/,
+                                                 const Eigen::VectorXd& /*velocity*/, Eigen::VectorXd& forces) {
+      if (gravityForce.size() > 0) {
+        forces += gravityForce;
+      }
+      for (const VertexLoad& load : loads) {
+        if (!load.active(time)) {
+          continue;
+        }
+        for (const int v : load.vertices) {
+          forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
+        }
+      }
+    };
+  } else {
+    simulation.skipped.emplace_back("external force evaluation (no gravity, no loads)");
+  }
+  if (scene.output.vtuFolder.empty()) {
+    simulation.skipped.emplace_back("vtu output (output.vtu not set)");
+  }
+  if (!scene.output.velocities) {
+    simulation.skipped.emplace_back("velocity output (output.velocities = false)");
+  }
+
+  try {
+    simulation.integrator = (*factory)(scene, *mesh, std::move(system), scene.integrator.options);
+  } catch (const ValidationError& error) {
+    const std::string message = error.what();
+    // Factories reading their options already name the key.
+    if (message.rfind(scene.sourceName + ": ", 0) == 0) {
+      throw;
+    }
+    throwSceneError(scene, message.find("timestep") != std::string::npos ? "integrator.timestep" : "integrator",
+                    message);
+  } catch (const NumericalError& error) {
+    throw NumericalError(scene.sourceName + ": integrator: " + error.what());
+  }
+  return simulation;
+}
+
+void advanceFrame(Simulation& simulation, int frame) {
+  Integrator& integrator = *simulation.integrator;
+  for (int s = 0; s < simulation.stepsPerFrame; ++s) {
+    const auto where = [&] {
+      std::ostringstream out;
+      out << "frame " << frame << " (step " << ((static_cast<long long>(frame) * simulation.stepsPerFrame) + s + 1)
+          << ", t = " << formatNumber(integrator.time() + simulation.timestep) << ")";
+      return out.str();
+    };
+    try {
+      integrator.step();
+    } catch (const NumericalError& error) {
+      throw NumericalError(where() + ": " + error.what());
+    }
+    const Eigen::VectorXd& u = integrator.displacement();
+    if (!u.allFinite() || !integrator.velocity().allFinite()) {
+      throw NumericalError(where() + ": the state is not finite (NaN or infinity); the simulation is unstable");
+    }
+    const double maxDisplacement = u.size() > 0 ? u.cwiseAbs().maxCoeff() : 0.0;
+    if (maxDisplacement > simulation.blowUpDisplacement) {
+      throw NumericalError(where() + ": blow-up: max |u| = " + formatNumber(maxDisplacement) +
+                           " exceeds 1000 x the bounding-box diagonal (" +
+                           formatNumber(simulation.boundingBoxDiagonal) + "); the simulation is unstable");
+    }
+  }
+}
+
+}  // namespace asyncfem

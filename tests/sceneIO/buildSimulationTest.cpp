@@ -1,0 +1,320 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+#include <asyncfem/volumetricMesh/writers.hpp>
+
+#include "sceneTestUtilities.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace {
+
+using asyncfem::Scene;
+using asyncfem::Simulation;
+using asyncfem::test::smallScene;
+
+Simulation build(const nlohmann::json& json, const std::filesystem::path& base = "") {
+  return asyncfem::buildSimulation(asyncfem::parseScene(json, base, "scene.json"));
+}
+
+// f_ext(t) of a built simulation at rest (size 3n; zero when it has no external force).
+Eigen::VectorXd externalForce(const Simulation& simulation, double time) {
+  const asyncfem::DynamicSystem& system = simulation.integrator->system();
+  Eigen::VectorXd forces = Eigen::VectorXd::Zero(system.numDofs());
+  if (system.externalForce) {
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(system.numDofs());
+    system.externalForce(time, zero, zero, forces);
+  }
+  return forces;
+}
+
+bool contains(const std::vector<std::string>& list, const std::string& prefix) {
+  return std::any_of(list.begin(), list.end(), [&](const std::string& s) { return s.rfind(prefix, 0) == 0; });
+}
+
+TEST(BuildSimulation, GeneratorMeshAndTiming) {
+  const Simulation simulation = build(smallScene());
+  EXPECT_EQ(simulation.mesh->numVertices(), 12);
+  EXPECT_EQ(simulation.timestep, 0.01);
+  EXPECT_DOUBLE_EQ(simulation.frameInterval, 0.1);
+  EXPECT_EQ(simulation.stepsPerFrame, 10);
+  EXPECT_EQ(simulation.numFrames, 3);
+  EXPECT_EQ(simulation.integrator->name(), "backward-euler");
+  EXPECT_DOUBLE_EQ(simulation.boundingBoxDiagonal, std::sqrt(6.0));
+  EXPECT_DOUBLE_EQ(simulation.blowUpDisplacement, 1000.0 * std::sqrt(6.0));
+}
+
+TEST(BuildSimulation, StepsPerFrameToleratesRounding) {
+  auto json = smallScene();
+  json["frames"]["rate"] = 30;
+  json["integrator"]["timestep"] = 1.0 / 300.0;
+  EXPECT_EQ(build(json).stepsPerFrame, 10);
+  json["integrator"]["timestep"] = 1.0 / 290.0;
+  try {
+    (void)build(json);
+    FAIL() << "expected a timing error";
+  } catch (const asyncfem::ValidationError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("integrator.timestep"), std::string::npos) << message;
+    EXPECT_NE(message.find("frames.rate"), std::string::npos) << message;
+  }
+}
+
+TEST(BuildSimulation, FileMeshMatchesTheGenerator) {
+  const asyncfem::test::ScratchFolder folder;
+  asyncfem::BoxMeshSpec spec;
+  spec.size = Eigen::Vector3d(2, 1, 1);
+  spec.cells = Eigen::Vector3i(2, 1, 1);
+  spec.material = asyncfem::Material{"rubber", 1000, 1e5, 0.4};
+  std::filesystem::create_directories(folder.path() / "meshes");
+  asyncfem::writeVeg(folder.path() / "meshes/box.veg", makeBoxMesh(spec));
+  auto json = smallScene();
+  json["mesh"] = {{"file", "meshes/box.veg"}};
+  const Simulation fromFile = build(json, folder.path());
+  const Simulation generated = build(smallScene());
+  EXPECT_EQ(fromFile.mesh->numVertices(), generated.mesh->numVertices());
+  EXPECT_EQ(fromFile.mesh->restPositions(), generated.mesh->restPositions());
+  EXPECT_EQ(fromFile.fixedVertices, generated.fixedVertices);
+  const Eigen::MatrixXd massDifference =
+      Eigen::MatrixXd(fromFile.integrator->system().mass) - Eigen::MatrixXd(generated.integrator->system().mass);
+  EXPECT_LE(massDifference.cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(BuildSimulation, FixedBySetBoxAndBou) {
+  const asyncfem::test::ScratchFolder folder;
+  const Simulation bySet = build(smallScene());
+  ASSERT_EQ(bySet.fixedVertices.size(), 4U);  // the x = 0 face of a 2 x 1 x 1 cell box
+  for (const int v : bySet.fixedVertices) {
+    EXPECT_EQ(bySet.mesh->restPosition(v).x(), 0.0);
+  }
+  EXPECT_EQ(bySet.integrator->system().freeDofs.numFixed(), 12);
+
+  auto json = smallScene();
+  json["fixed"] = nlohmann::json::parse(R"({"boxes": [{"min": [-0.1, -0.1, -0.1], "max": [0.1, 1.1, 1.1]}]})");
+  EXPECT_EQ(build(json).fixedVertices, bySet.fixedVertices);
+
+  folder.write("fixed.bou", "# 1-based, Vega style\n1, 2,\n3\n");
+  json["fixed"] = nlohmann::json::parse(R"({"bou": "fixed.bou"})");
+  EXPECT_EQ(build(json, folder.path()).fixedVertices, (std::vector<int>{0, 1, 2}));
+
+  // The union of all three, without duplicates.
+  json["fixed"] = nlohmann::json::parse(R"({"sets": ["xmin"], "bou": "fixed.bou",
+                                           "boxes": [{"min": [1.9, -1, -1], "max": [2.1, 2, 2]}]})");
+  const Simulation all = build(json, folder.path());
+  EXPECT_EQ(all.fixedVertices.size(), 9U);  // 4 + 4 + the one .bou vertex (1) on neither face
+  EXPECT_TRUE(std::is_sorted(all.fixedVertices.begin(), all.fixedVertices.end()));
+
+  folder.write("bad.bou", "1, 2\n99\n");
+  json["fixed"] = nlohmann::json::parse(R"({"bou": "bad.bou"})");
+  try {
+    (void)build(json, folder.path());
+    FAIL() << "expected an error";
+  } catch (const asyncfem::Error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("scene.json: fixed.bou: "), std::string::npos) << message;
+    EXPECT_NE(message.find("bad.bou:2"), std::string::npos) << message;
+  }
+}
+
+TEST(BuildSimulation, GravityAddsMassTimesG) {
+  for (const char* mass : {"consistent", "lumped"}) {
+    auto json = smallScene();
+    json["gravity"] = {0.5, -9.81, 2.0};
+    json["mass"] = mass;
+    const Simulation simulation = build(json);
+    const Eigen::Vector3d g(0.5, -9.81, 2.0);
+    const Eigen::VectorXd stacked = g.replicate(simulation.mesh->numVertices(), 1);
+    const Eigen::VectorXd expected = simulation.integrator->system().mass * stacked;
+    const Eigen::VectorXd actual = externalForce(simulation, 0.37);
+    EXPECT_LE((actual - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff()) << mass;
+    // Total force = total mass * g (2 m^3 of density 1000).
+    const double totalMass = asyncfem::totalMass(*simulation.mesh);
+    EXPECT_NEAR(totalMass, 2000.0, 1e-9);
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0.0;
+      for (int v = 0; v < simulation.mesh->numVertices(); ++v) sum += actual[(3 * v) + c];
+      EXPECT_NEAR(sum, totalMass * g[c], 1e-9 * totalMass * 10.0) << mass << " component " << c;
+    }
+  }
+  const Simulation still = build(smallScene());
+  EXPECT_FALSE(still.integrator->system().externalForce);
+  EXPECT_TRUE(contains(still.skipped, "gravity load"));
+  EXPECT_TRUE(contains(still.skipped, "external force evaluation"));
+}
+
+TEST(BuildSimulation, PullIsOnOnlyInsideItsWindow) {
+  auto json = smallScene();
+  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -8, 0], "window": [0.1, 0.2]}])");
+  const Simulation simulation = build(json);
+  const std::vector<int>& pulled = simulation.mesh->vertexSet("xmax");
+  ASSERT_EQ(pulled.size(), 4U);
+  EXPECT_TRUE(externalForce(simulation, 0.05).isZero(0.0));
+  EXPECT_TRUE(externalForce(simulation, 0.2).isZero(0.0));  // the window is [start, end)
+  EXPECT_TRUE(externalForce(simulation, 0.25).isZero(0.0));
+  for (const double t : {0.1, 0.15, 0.1999}) {
+    const Eigen::VectorXd f = externalForce(simulation, t);
+    Eigen::VectorXd expected = Eigen::VectorXd::Zero(f.size());
+    for (const int v : pulled) expected[(3 * v) + 1] = -2.0;  // -8 split over 4 vertices
+    EXPECT_EQ(f, expected) << "t = " << t;
+  }
+}
+
+TEST(BuildSimulation, PullOnExplicitVertices) {
+  auto json = smallScene();
+  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "vertices": [5, 7, 5], "force": [4, 0, 0]}])");
+  const Eigen::VectorXd f = externalForce(build(json), 123.0);
+  EXPECT_EQ(f[15], 2.0);  // duplicates count once: 4 split over vertices 5 and 7
+  EXPECT_EQ(f[21], 2.0);
+  EXPECT_EQ(f.sum(), 4.0);
+}
+
+TEST(BuildSimulation, ImpulseIsDeliveredOnceWhateverTheEvaluationTimes) {
+  auto json = smallScene();
+  json["forces"] = nlohmann::json::parse(R"([{"type": "impulse", "set": "xmax", "impulse": [0, 0, 3], "time": 0.05}])");
+  const Simulation simulation = build(json);
+  const double h = simulation.timestep;
+  // Integrators evaluate f_ext at step starts (k h), step ends ((k + 1) h) or average both.
+  double delivered = 0.0;
+  int activeSteps = 0;
+  for (int k = 0; k <= 20; ++k) {
+    const Eigen::VectorXd f = externalForce(simulation, k * h);
+    delivered += h * f.sum();
+    activeSteps += f.isZero(0.0) ? 0 : 1;
+  }
+  EXPECT_NEAR(delivered, 3.0, 1e-12);
+  EXPECT_EQ(activeSteps, 1);
+}
+
+TEST(BuildSimulation, MaterialOverridesPerSet) {
+  auto json = smallScene();
+  json["mesh"]["regions"] = nlohmann::json::parse(
+      R"([{"name": "right", "min": [1, -1, -1], "max": [3, 2, 2],
+           "material": {"name": "hard", "density": 500, "youngsModulus": 1e7, "poissonRatio": 0.3}}])");
+  // "right" is the only user of "hard": changed in place. "allElements" also covers
+  // "rubber" elements, so only their copy changes.
+  json["materials"] = nlohmann::json::parse(
+      R"([{"set": "right", "youngsModulus": 2e7}, {"set": "allElements", "density": 10}])");
+  const Simulation simulation = build(json);
+  const asyncfem::TetMesh& mesh = *simulation.mesh;
+  const int hard = mesh.findMaterial("hard");
+  const int rubber = mesh.findMaterial("rubber");
+  ASSERT_GE(hard, 0);
+  ASSERT_GE(rubber, 0);
+  EXPECT_EQ(mesh.materials()[static_cast<std::size_t>(hard)], (asyncfem::Material{"hard", 10, 2e7, 0.3}));
+  EXPECT_EQ(mesh.materials()[static_cast<std::size_t>(rubber)], (asyncfem::Material{"rubber", 10, 1e5, 0.4}));
+
+  // A set covering part of a material's elements gets a copy named "<material>@<set>".
+  const asyncfem::test::ScratchFolder folder;
+  asyncfem::TetMesh box = *build(smallScene()).mesh;
+  box.setElementSet("pair", {0, 1});
+  asyncfem::writeVeg(folder.path() / "box.veg", box);
+  json = smallScene();
+  json["mesh"] = {{"file", "box.veg"}};
+  json["materials"] = nlohmann::json::parse(R"([{"set": "pair", "poissonRatio": 0.1}, {"set": "pair", "density": 7}])");
+  const Simulation partial = build(json, folder.path());
+  const int copy = partial.mesh->findMaterial("rubber@pair");
+  ASSERT_GE(copy, 0);
+  EXPECT_EQ(partial.mesh->materials()[static_cast<std::size_t>(copy)], (asyncfem::Material{"rubber@pair", 7, 1e5, 0.1}));
+  for (int e = 0; e < partial.mesh->numElements(); ++e) {
+    EXPECT_EQ(partial.mesh->elementMaterial(e).name, e < 2 ? "rubber@pair" : "rubber") << "element " << e;
+  }
+}
+
+TEST(BuildSimulation, BuildsOnlyWhatTheSceneUses) {
+  const Simulation linear = build(smallScene());
+  EXPECT_TRUE(linear.integrator->system().forceModel->isLinear());
+  EXPECT_TRUE(contains(linear.skipped, "corotational"));
+  EXPECT_TRUE(contains(linear.skipped, "vtu output"));
+  EXPECT_TRUE(contains(linear.skipped, "velocity output"));
+  EXPECT_TRUE(contains(linear.integrator->stats().skipped, "damping matrix"));
+  EXPECT_TRUE(contains(linear.integrator->stats().skipped, "refactorization"));
+
+  auto json = smallScene();
+  json["forceModel"] = {{"type", "corotational"}, {"tangent", "exact"}};
+  json["damping"] = {{"alpha", 0.1}, {"beta", 0.01}};
+  json["output"] = nlohmann::json::parse(R"({"vtu": {"folder": "v"}, "velocities": true})");
+  const Simulation corotational = build(json);
+  EXPECT_FALSE(corotational.integrator->system().forceModel->isLinear());
+  EXPECT_FALSE(contains(corotational.skipped, "corotational"));
+  EXPECT_FALSE(contains(corotational.skipped, "vtu output"));
+  EXPECT_FALSE(contains(corotational.skipped, "velocity output"));
+  EXPECT_FALSE(contains(corotational.integrator->stats().skipped, "damping matrix"));
+  EXPECT_EQ(corotational.integrator->system().rayleighMass, 0.1);
+  EXPECT_EQ(corotational.integrator->system().rayleighStiffness, 0.01);
+}
+
+TEST(BuildSimulation, SingleRateOptionsReachTheIntegrator) {
+  auto json = smallScene();
+  json["integrator"] = nlohmann::json::parse(
+      R"({"name": "symplectic-euler", "timestep": 0.001, "options": {"solver": "eigen-ldlt", "maxFrequency": 100}})");
+  const Simulation simulation = build(json);
+  EXPECT_EQ(simulation.integrator->name(), "symplectic-euler");
+  EXPECT_DOUBLE_EQ(simulation.integrator->stableTimestepEstimate(), 2.0 / 100.0);
+}
+
+TEST(BuildSimulation, RegistryAcceptsOtherIntegrators) {
+  asyncfem::IntegratorRegistry registry = asyncfem::defaultIntegratorRegistry();
+  bool called = false;
+  registry.add("custom", [&called](const Scene& scene, const asyncfem::TetMesh& mesh, asyncfem::DynamicSystem system,
+                                   const nlohmann::json& options) {
+    called = true;
+    EXPECT_EQ(mesh.numVertices(), 12);
+    EXPECT_EQ(options.at("regions").size(), 2U);
+    return asyncfem::defaultIntegratorRegistry().find("backward-euler")->operator()(scene, mesh, std::move(system),
+                                                                                  nlohmann::json::object());
+  });
+  auto json = smallScene();
+  json["integrator"]["name"] = "custom";
+  json["integrator"]["options"] = {{"regions", {1, 2}}};
+  const Simulation simulation = asyncfem::buildSimulation(asyncfem::parseScene(json, "", "scene.json"), registry);
+  EXPECT_TRUE(called);
+  EXPECT_NE(registry.find("backward-euler"), nullptr);
+}
+
+TEST(AdvanceFrame, PulledBeamMovesAndReturns) {
+  auto json = smallScene();
+  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -100, 0], "window": [0, 0.1]}])");
+  json["frames"]["count"] = 5;
+  Simulation simulation = build(json);
+  double previousTip = 0.0;
+  for (int frame = 0; frame < simulation.numFrames; ++frame) {
+    asyncfem::advanceFrame(simulation, frame);
+    EXPECT_NEAR(simulation.integrator->time(), (frame + 1) * 0.1, 1e-12);
+    const double tip = simulation.integrator->displacement()[(3 * simulation.mesh->vertexSet("xmax")[0]) + 1];
+    if (frame == 0) {
+      EXPECT_LT(tip, 0.0);  // pulled down during the first frame
+    }
+    previousTip = tip;
+  }
+  EXPECT_TRUE(std::isfinite(previousTip));
+  for (const int v : simulation.fixedVertices) {
+    EXPECT_TRUE(simulation.integrator->displacement().segment<3>(3 * v).isZero(0.0));
+  }
+}
+
+TEST(AdvanceFrame, UnstableExplicitRunNamesTheFrame) {
+  auto json = smallScene();
+  json["mesh"]["material"]["youngsModulus"] = 1e8;
+  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -100, 0]}])");
+  json["integrator"] = nlohmann::json::parse(
+      R"({"name": "central-differences", "timestep": 0.01, "options": {"force": true}})");
+  json["frames"]["count"] = 50;
+  Simulation simulation = build(json);
+  try {
+    for (int frame = 0; frame < simulation.numFrames; ++frame) {
+      asyncfem::advanceFrame(simulation, frame);
+    }
+    FAIL() << "expected the forced explicit run to blow up";
+  } catch (const asyncfem::NumericalError& error) {
+    const std::string message = error.what();
+    EXPECT_EQ(message.rfind("frame ", 0), 0U) << message;
+    EXPECT_NE(message.find("unstable"), std::string::npos) << message;
+  }
+}
+
+}  // namespace
