@@ -25,8 +25,7 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 bool bitIdentical(const SparseMatrix& a, const SparseMatrix& b) {
   return a.rows() == b.rows() && a.cols() == b.cols() && a.nonZeros() == b.nonZeros() &&
          std::memcmp(a.valuePtr(), b.valuePtr(), sizeof(double) * static_cast<std::size_t>(a.nonZeros())) == 0 &&
-         std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), sizeof(int) * static_cast<std::size_t>(a.nonZeros())) ==
-             0 &&
+         std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), sizeof(int) * static_cast<std::size_t>(a.nonZeros())) == 0 &&
          std::memcmp(a.outerIndexPtr(), b.outerIndexPtr(), sizeof(int) * static_cast<std::size_t>(a.cols() + 1)) == 0;
 }
 
@@ -70,7 +69,9 @@ void expectRigidModesInNullSpace(const TetMesh& mesh) {
   }
 }
 
-TEST(Assembler, RigidBodyModesAreInNullSpaceOfMixedMaterialBox) { expectRigidModesInNullSpace(test::mixedMaterialBox(4)); }
+TEST(Assembler, RigidBodyModesAreInNullSpaceOfMixedMaterialBox) {
+  expectRigidModesInNullSpace(test::mixedMaterialBox(4));
+}
 
 TEST(Assembler, RigidBodyModesAreInNullSpaceOfPerturbedMesh) {
   const TetMesh mesh = test::perturbedBox(5, 42);
@@ -208,16 +209,14 @@ TEST(Assembler, AssemblyIsBitIdenticalAcrossThreadCountsAndRepeats) {
   ASSERT_GT(assembler.numColors(), 1);
   omp_set_num_threads(1);
   const SparseMatrix serial = linearStiffnessMatrix(mesh, assembler);
-  const Eigen::VectorXd serialVector = assembler.assembleVector([&](int e, ElementVector& out) {
-    out = ElementVector::LinSpaced(0.1, 1.2) * std::sin(e);
-  });
+  const Eigen::VectorXd serialVector = assembler.assembleVector(
+      [&](int e, ElementVector& out) { out = ElementVector::LinSpaced(0.1, 1.2) * std::sin(e); });
   for (int threads : {2, 3, 4}) {
     omp_set_num_threads(threads);
     const SparseMatrix parallel = linearStiffnessMatrix(mesh, assembler);
     EXPECT_TRUE(bitIdentical(serial, parallel)) << threads << " threads";
-    const Eigen::VectorXd parallelVector = assembler.assembleVector([&](int e, ElementVector& out) {
-      out = ElementVector::LinSpaced(0.1, 1.2) * std::sin(e);
-    });
+    const Eigen::VectorXd parallelVector = assembler.assembleVector(
+        [&](int e, ElementVector& out) { out = ElementVector::LinSpaced(0.1, 1.2) * std::sin(e); });
     EXPECT_EQ(std::memcmp(serialVector.data(), parallelVector.data(), sizeof(double) * serialVector.size()), 0);
   }
   // Re-assembly into the same matrix overwrites (does not accumulate) the values.

@@ -255,7 +255,8 @@ void MatrixAssembler::checkPattern(const Eigen::SparseMatrix<double>& matrix, co
     throw Error(std::string("MatrixAssembler::") + caller + ": the " + std::to_string(matrix.rows()) + " x " +
                 std::to_string(matrix.cols()) + " matrix with " + std::to_string(matrix.nonZeros()) +
                 " stored entries does not have the assembler's pattern (" + std::to_string(numDofs_) + " x " +
-                std::to_string(numDofs_) + ", " + std::to_string(nonZeros()) + " entries); create it with createMatrix()");
+                std::to_string(numDofs_) + ", " + std::to_string(nonZeros()) +
+                " entries); create it with createMatrix()");
   }
 }
 
@@ -434,8 +435,7 @@ Eigen::SparseMatrix<double> massMatrix(const TetMesh& mesh, const MatrixAssemble
 }
 
 Eigen::SparseMatrix<double> rayleighDamping(const Eigen::SparseMatrix<double>& mass,
-                                            const Eigen::SparseMatrix<double>& stiffness, double alpha,
-                                            double beta) {
+                                            const Eigen::SparseMatrix<double>& stiffness, double alpha, double beta) {
   Eigen::SparseMatrix<double> damping;
   combine({alpha, beta}, {&mass, &stiffness}, damping);
   return damping;
@@ -450,8 +450,7 @@ bool samePattern(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix
   const Index outerBytes = (toIndex(static_cast<int>(a.cols())) + 1) * sizeof(int);
   const Index innerBytes = static_cast<Index>(a.nonZeros()) * sizeof(int);
   return std::memcmp(a.outerIndexPtr(), b.outerIndexPtr(), outerBytes) == 0 &&
-         (a.innerIndexPtr() == b.innerIndexPtr() ||
-          std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), innerBytes) == 0);
+         (a.innerIndexPtr() == b.innerIndexPtr() || std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), innerBytes) == 0);
 }
 
 }  // namespace

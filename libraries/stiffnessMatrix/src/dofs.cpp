@@ -132,8 +132,8 @@ Eigen::SparseMatrix<double> SubmatrixExtractor::extract(const Eigen::SparseMatri
 
 void SubmatrixExtractor::update(const Eigen::SparseMatrix<double>& full, Eigen::SparseMatrix<double>& sub) const {
   if (full.rows() != sourceRows_ || full.cols() != sourceCols_ || full.nonZeros() != sourceNonZeros_) {
-    throw Error("SubmatrixExtractor::update: the " + std::to_string(full.rows()) + " x " +
-                std::to_string(full.cols()) + " matrix with " + std::to_string(full.nonZeros()) +
+    throw Error("SubmatrixExtractor::update: the " + std::to_string(full.rows()) + " x " + std::to_string(full.cols()) +
+                " matrix with " + std::to_string(full.nonZeros()) +
                 " entries does not have the pattern the extractor was built for (" + std::to_string(sourceRows_) +
                 " x " + std::to_string(sourceCols_) + ", " + std::to_string(sourceNonZeros_) + " entries)");
   }

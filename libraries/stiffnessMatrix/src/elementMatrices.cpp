@@ -37,8 +37,7 @@ Eigen::Matrix<double, 3, 4> shapeFunctionGradients(const ElementPositions& restP
   return gradients;
 }
 
-ElementMatrix linearElementStiffness(const ElementPositions& restPositions, double youngsModulus,
-                                     double poissonRatio) {
+ElementMatrix linearElementStiffness(const ElementPositions& restPositions, double youngsModulus, double poissonRatio) {
   double signedVolume = 0.0;
   const Eigen::Matrix<double, 3, 4> g = shapeFunctionGradients(restPositions, &signedVolume);
   const Eigen::Vector2d lame = lameParameters(youngsModulus, poissonRatio);

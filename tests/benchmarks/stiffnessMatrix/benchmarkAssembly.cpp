@@ -97,8 +97,7 @@ void tripletBaseline(benchmark::State& state) {
       const ElementMatrix k = linearElementStiffness(mesh.elementRestPositions(e), m.youngsModulus, m.poissonRatio);
       const Eigen::Vector4i v = mesh.element(e);
       for (int j = 0; j < 12; ++j)
-        for (int i = 0; i < 12; ++i)
-          triplets.emplace_back((3 * v[i / 3]) + (i % 3), (3 * v[j / 3]) + (j % 3), k(i, j));
+        for (int i = 0; i < 12; ++i) triplets.emplace_back((3 * v[i / 3]) + (i % 3), (3 * v[j / 3]) + (j % 3), k(i, j));
     }
     Eigen::SparseMatrix<double> stiffness(mesh.numDofs(), mesh.numDofs());
     stiffness.setFromTriplets(triplets.begin(), triplets.end());

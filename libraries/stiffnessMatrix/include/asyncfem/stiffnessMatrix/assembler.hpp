@@ -88,8 +88,7 @@ public:
 private:
   friend void assembleLinearStiffness(const TetMesh& mesh, const MatrixAssembler& assembler,
                                       Eigen::SparseMatrix<double>& stiffness);
-  friend Eigen::SparseMatrix<double> massMatrix(const TetMesh& mesh, const MatrixAssembler& assembler,
-                                                MassType type);
+  friend Eigen::SparseMatrix<double> massMatrix(const TetMesh& mesh, const MatrixAssembler& assembler, MassType type);
   // Scatter-adds callback(e, Ke) for every element in the deterministic colour order;
   // defined (and instantiated) in assembler.cpp only, so callers need no OpenMP flags.
   template <class ElementFunction>
@@ -134,8 +133,7 @@ Eigen::SparseMatrix<double> massMatrix(const TetMesh& mesh, const MatrixAssemble
 /// Rayleigh damping D = alpha M + beta K (M and K must share a pattern; asyncfem::Error
 /// otherwise). alpha in 1/s, beta in s.
 Eigen::SparseMatrix<double> rayleighDamping(const Eigen::SparseMatrix<double>& mass,
-                                            const Eigen::SparseMatrix<double>& stiffness, double alpha,
-                                            double beta);
+                                            const Eigen::SparseMatrix<double>& stiffness, double alpha, double beta);
 
 /// out = sum_i coefficients[i] * matrices[i], all sharing one pattern (checked by
 /// comparing outer and inner index arrays: asyncfem::Error naming the first matrix that

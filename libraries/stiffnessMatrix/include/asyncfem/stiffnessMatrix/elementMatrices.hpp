@@ -20,14 +20,16 @@ Eigen::Vector2d lameParameters(double youngsModulus, double poissonRatio);
 /// checks the volume.
 Eigen::Matrix<double, 3, 4> shapeFunctionGradients(const ElementPositions& restPositions, double* signedVolume);
 
-/// Linear (constant-strain) element stiffness K_e = V B^T C B for isotropic material.
-/// Symmetric positive semi-definite, six rigid-body modes in its null space.
-ElementMatrix linearElementStiffness(const ElementPositions& restPositions, double youngsModulus,
-                                     double poissonRatio);
+/// Linear (constant-strain) element stiffness K_e = V B^T C B for isotropic material
+/// (12 x 12, units of E times length). V = |signed volume|, so either vertex order gives
+/// the same matrix. Exactly symmetric, positive semi-definite, six rigid-body modes in
+/// its null space. A degenerate element gives non-finite entries (callers check V).
+ElementMatrix linearElementStiffness(const ElementPositions& restPositions, double youngsModulus, double poissonRatio);
 
-/// Consistent mass of a linear tetrahedron: rho V / 20 * (1 + delta_ab) per coordinate.
+/// Consistent mass of a linear tetrahedron: rho V / 20 * (1 + delta_ab) per coordinate
+/// (12 x 12, zero between different coordinates). volume may be signed; |volume| is used.
 ElementMatrix consistentElementMass(double volume, double density);
-/// Lumped (row-sum) mass: rho V / 4 on each diagonal entry.
+/// Lumped (row-sum) mass: rho |V| / 4 on each diagonal entry, zero elsewhere.
 ElementMatrix lumpedElementMass(double volume, double density);
 
 }  // namespace asyncfem
