@@ -6,8 +6,10 @@
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 
+#include <Eigen/Dense>
 #include <Eigen/SparseCore>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -16,6 +18,11 @@ namespace asyncfem {
 namespace {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// Largest dense Z (doubles) the automatic recovery stores: 16M doubles = 128 MiB.
+constexpr double kMaxDenseZEntries = 16.0 * 1024 * 1024;
+/// Largest W = (A^L)^{-1} U (doubles) the low-rank Schur form stores: 64M = 512 MiB.
+constexpr double kMaxLowRankEntries = 64.0 * 1024 * 1024;
 
 /// Entries of a full vector at the listed global DOFs.
 Eigen::VectorXd gather(const Eigen::VectorXd& full, const std::vector<int>& dofs) {
@@ -64,7 +71,8 @@ struct RegionBlocks {
   SparseMatrix P;              // M^{IS} + hL D^{IS}  (F - E)
   std::unique_ptr<SparseSolver> solver;
   bool analyzed = false;
-  std::vector<Eigen::MatrixXd> z;  // Z_r blocks (denseZ recovery only)
+  std::vector<Eigen::MatrixXd> z;  // Z_r blocks (dense recovery only)
+  bool useDenseZ = false;
   Eigen::MatrixXd correction;      // C_i = H^{IS} Z, q x q
 };
 
@@ -80,8 +88,13 @@ struct AsyncBackwardEuler::Impl {
   SubmatrixExtractor massLL, stiffLL;
   SparseMatrix largeSystem;  // A^L
   SparseMatrix schur;        // H^{LL*} (or its symmetric part)
-  std::unique_ptr<SparseSolver> schurSolver;
+  std::unique_ptr<SparseSolver> schurSolver;  // of H^{LL*} (lu, symmetric) or of A^L (lowRank)
   bool schurAnalyzed = false;
+  // Low-rank form of H^{LL*} = A^L - U C U^T.
+  std::vector<int> interfaceUnion;  // positions in L of every region's interface DOFs
+  Eigen::MatrixXd unionCorrection;  // C, q x q
+  Eigen::MatrixXd lowRankBasis;     // W = (A^L)^{-1} U, |L| x q
+  Eigen::PartialPivLU<Eigen::MatrixXd> capacitance;  // I - U^T W C
   // Naive method.
   SparseMatrix naiveSystem;
   std::unique_ptr<SparseSolver> naiveSolver;
@@ -124,7 +137,6 @@ AsyncBackwardEuler::AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system
     rb.Mis = rb.massIS.extract(mass);
     rb.solver = makeSparseSolver(options_.regionSolver);
   }
-  d.schurSolver = makeSparseSolver(options_.schur == SchurMode::exact ? SolverKind::umfpack : SolverKind::cholmod);
   d.naiveSolver = makeSparseSolver(SolverKind::umfpack);
   if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
   if (d.linear) stats_.skipped.push_back("per-step refactorization (linear forces: blocks, Z and H^{LL*} factored once)");
@@ -230,6 +242,7 @@ void AsyncBackwardEuler::rebuildBlocks() {
     d.naiveSolver->factorize(d.naiveSystem);
     stats.factorizationSeconds += factor.stop();
     ++stats.factorizations;
+    stats.factorFlops += d.naiveSolver->stats().factorFlops;
     return;
   }
 
@@ -237,20 +250,28 @@ void AsyncBackwardEuler::rebuildBlocks() {
   // substitution with |I| right-hand sides, and the Schur corrections C_i = H^{IS} Z.
   factor.start();
   schurAsymmetry = 0.0;
-  d.schur = d.largeSystem;
-  const int numLarge = static_cast<int>(d.largeSystem.rows());
-  for (std::size_t i = 0; i < d.regions.size(); ++i) {
-    RegionBlocks& rb = d.regions[i];
+  for (RegionBlocks& rb : d.regions) {
     if (!rb.analyzed) {
       rb.solver->analyzePattern(rb.systemMatrix);
       rb.analyzed = true;
     }
     rb.solver->factorize(rb.systemMatrix);
     ++stats.factorizations;
+    stats.factorFlops += rb.solver->stats().factorFlops;
     const int m = rb.ratio;
     const double hS = rb.smallStep;
     const Eigen::Index q = rb.Msi.cols();
+    const double sizeS = static_cast<double>(rb.systemMatrix.rows());
     rb.z.clear();
+    // Recovery: X = y - Z Y_I (2 m |S| q flops, m |S| q doubles) or a second forward
+    // substitution (m solves and 2m sparse products). Automatic picks the cheaper in flops
+    // while Z fits in kMaxDenseZEntries.
+    const double denseFlops = 2.0 * m * sizeS * static_cast<double>(q);
+    const double substitutionFlops =
+        m * (rb.solver->stats().solveFlopsPerRhs + 4.0 * static_cast<double>(rb.Kss.nonZeros()));
+    rb.useDenseZ = options.recovery == RecoveryMode::denseZ ||
+                   (options.recovery == RecoveryMode::automatic && denseFlops <= substitutionFlops &&
+                    m * sizeS * static_cast<double>(q) <= kMaxDenseZEntries);
     if (q == 0) {
       rb.correction.resize(0, 0);
       continue;
@@ -272,7 +293,7 @@ void AsyncBackwardEuler::rebuildBlocks() {
         sum += x;
       }
       prev = x;
-      if (options.recovery == RecoveryMode::denseZ) rb.z.push_back(x);
+      if (rb.useDenseZ) rb.z.push_back(x);
     }
     // H^{IS} Z = E sum_r Z_r + (F - E) Z_m.
     rb.correction = rb.E * sum + rb.P * prev;
@@ -280,21 +301,97 @@ void AsyncBackwardEuler::rebuildBlocks() {
     if (norm > 0.0) {
       schurAsymmetry = std::max(schurAsymmetry, (rb.correction - rb.correction.transpose()).norm() / norm);
     }
-    const Eigen::MatrixXd applied = options.schur == SchurMode::exact
-                                        ? rb.correction
-                                        : Eigen::MatrixXd(0.5 * (rb.correction + rb.correction.transpose()));
-    d.schur -= scatterDense(applied, partition.interfacePositions(static_cast<int>(i)), numLarge);
-  }
-  d.schur.makeCompressed();
-  if (numLarge > 0) {
-    if (!d.schurAnalyzed) {
-      d.schurSolver->analyzePattern(d.schur);
-      d.schurAnalyzed = true;
-    }
-    d.schurSolver->factorize(d.schur);
-    ++stats.factorizations;
   }
   stats.factorizationSeconds += factor.stop();
+  factor.start();
+  buildSchurSolver();
+  stats.factorizationSeconds += factor.stop();
+}
+
+void AsyncBackwardEuler::buildSchurSolver() {
+  Impl& d = *impl_;
+  const int numLarge = static_cast<int>(d.largeSystem.rows());
+  if (numLarge == 0) return;
+  // Interface positions of all regions (inside L), and each region's place among them.
+  std::vector<int> all;
+  for (int i = 0; i < partition_.numRegions(); ++i) {
+    const std::vector<int>& pos = partition_.interfacePositions(i);
+    all.insert(all.end(), pos.begin(), pos.end());
+  }
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  const Eigen::Index q = static_cast<Eigen::Index>(all.size());
+
+  SchurMode mode = options_.schur;
+  if (mode == SchurMode::lowRank && static_cast<double>(numLarge) * static_cast<double>(q) > kMaxLowRankEntries) {
+    mode = SchurMode::lu;  // A^{-1} U would not fit: factor H^{LL*} itself
+  }
+  if (mode != schurModeUsed_ || !d.schurSolver) {
+    d.schurSolver = makeSparseSolver(mode == SchurMode::lu ? SolverKind::umfpack : SolverKind::cholmod);
+    d.schurAnalyzed = false;
+  }
+  schurModeUsed_ = mode;
+
+  if (mode == SchurMode::lowRank) {
+    // H^{LL*} = A^L - U C U^T with U the interface columns and C the sum of the regions'
+    // corrections. With W = (A^L)^{-1} U: x = y + W C z, y = (A^L)^{-1} b and
+    // (I - U^T W C) z = U^T y (see solveSchur). A^L is SPD: Cholesky.
+    if (!d.schurAnalyzed) {
+      d.schurSolver->analyzePattern(d.largeSystem);
+      d.schurAnalyzed = true;
+    }
+    d.schurSolver->factorize(d.largeSystem);
+    ++stats_.factorizations;
+    stats_.factorFlops += d.schurSolver->stats().factorFlops;
+    d.interfaceUnion = all;
+    if (q == 0) return;
+    std::vector<int> place(static_cast<std::size_t>(numLarge), -1);
+    for (Eigen::Index k = 0; k < q; ++k) place[static_cast<std::size_t>(all[static_cast<std::size_t>(k)])] = static_cast<int>(k);
+    d.unionCorrection.setZero(q, q);
+    for (int i = 0; i < partition_.numRegions(); ++i) {
+      const std::vector<int>& pos = partition_.interfacePositions(i);
+      const Eigen::MatrixXd& c = d.regions[static_cast<std::size_t>(i)].correction;
+      for (std::size_t b = 0; b < pos.size(); ++b)
+        for (std::size_t a = 0; a < pos.size(); ++a)
+          d.unionCorrection(place[static_cast<std::size_t>(pos[a])], place[static_cast<std::size_t>(pos[b])]) +=
+              c(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+    }
+    Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(numLarge, q);
+    for (Eigen::Index k = 0; k < q; ++k) selector(all[static_cast<std::size_t>(k)], k) = 1.0;
+    d.schurSolver->solve(selector, d.lowRankBasis);  // W
+    Eigen::MatrixXd interfaceRows(q, q);
+    for (Eigen::Index k = 0; k < q; ++k) interfaceRows.row(k) = d.lowRankBasis.row(all[static_cast<std::size_t>(k)]);
+    d.capacitance.compute(Eigen::MatrixXd::Identity(q, q) - interfaceRows * d.unionCorrection);
+    return;
+  }
+
+  Stopwatch assembly;
+  d.schur = d.largeSystem;
+  for (int i = 0; i < partition_.numRegions(); ++i) {
+    const Eigen::MatrixXd& c = d.regions[static_cast<std::size_t>(i)].correction;
+    if (c.size() == 0) continue;
+    const Eigen::MatrixXd applied = mode == SchurMode::symmetric ? Eigen::MatrixXd(0.5 * (c + c.transpose())) : c;
+    d.schur -= scatterDense(applied, partition_.interfacePositions(i), numLarge);
+  }
+  d.schur.makeCompressed();
+  stats_.assemblySeconds += assembly.stop();
+  if (!d.schurAnalyzed) {
+    d.schurSolver->analyzePattern(d.schur);
+    d.schurAnalyzed = true;
+  }
+  d.schurSolver->factorize(d.schur);
+  ++stats_.factorizations;
+  stats_.factorFlops += d.schurSolver->stats().factorFlops;
+}
+
+Eigen::VectorXd AsyncBackwardEuler::solveSchur(const Eigen::VectorXd& rhs) {
+  Impl& d = *impl_;
+  Eigen::VectorXd y = d.schurSolver->solve(rhs);
+  if (schurModeUsed_ != SchurMode::lowRank || d.interfaceUnion.empty()) return y;
+  const Eigen::VectorXd yInterface = gather(y, d.interfaceUnion);
+  const Eigen::VectorXd z = d.capacitance.solve(yInterface);
+  y.noalias() += d.lowRankBasis * (d.unionCorrection * z);
+  return y;
 }
 
 void AsyncBackwardEuler::step() {
@@ -394,7 +491,7 @@ void AsyncBackwardEuler::step() {
       const std::vector<int>& pos = partition_.interfacePositions(i);
       for (std::size_t k = 0; k < pos.size(); ++k) rhsSchur[pos[k]] -= coupling[static_cast<Eigen::Index>(k)];
     }
-    Y = large.empty() ? Eigen::VectorXd() : d.schurSolver->solve(rhsSchur);
+    Y = large.empty() ? Eigen::VectorXd() : solveSchur(rhsSchur);
     for (int i = 0; i < numRegions; ++i) {
       RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
       Eigen::MatrixXd& xi = X[static_cast<std::size_t>(i)];
@@ -405,7 +502,7 @@ void AsyncBackwardEuler::step() {
       }
       Eigen::VectorXd yInterface(static_cast<Eigen::Index>(pos.size()));
       for (std::size_t k = 0; k < pos.size(); ++k) yInterface[static_cast<Eigen::Index>(k)] = Y[pos[k]];
-      if (options_.recovery == RecoveryMode::denseZ) {
+      if (rb.useDenseZ) {
         xi = y[static_cast<std::size_t>(i)];
         for (int r = 1; r <= rb.ratio; ++r) xi.col(r - 1) -= rb.z[static_cast<std::size_t>(r - 1)] * yInterface;
       } else {
@@ -463,6 +560,46 @@ void AsyncBackwardEuler::step() {
   velocity_ = std::move(newV);
   time_ = t0 + hL;
   ++stats_.steps;
+  // Solve counts and flops, totalled over the solvers (Z columns included).
+  stats_.solvedRightHandSides = 0;
+  stats_.solveFlops = 0.0;
+  auto count = [this](const SparseSolver& solver) {
+    stats_.solvedRightHandSides += solver.stats().solvedRightHandSides;
+    stats_.solveFlops += static_cast<double>(solver.stats().solvedRightHandSides) * solver.stats().solveFlopsPerRhs;
+  };
+  count(*d.naiveSolver);
+  if (d.schurSolver) count(*d.schurSolver);
+  for (const RegionBlocks& rb : d.regions) count(*rb.solver);
+}
+
+double AsyncBackwardEuler::solveFloorSeconds(int repeats) {
+  Impl& d = *impl_;
+  if (!d.built) throw Error("solveFloorSeconds: take one step first (the factors are built lazily)");
+  std::vector<double> samples;
+  for (int k = 0; k < std::max(1, repeats); ++k) {
+    Stopwatch watch;
+    if (options_.method == AsyncSolveMethod::naive) {
+      d.naiveSolver->solve(Eigen::VectorXd::Random(d.naiveSystem.rows()));
+    } else {
+      for (RegionBlocks& rb : d.regions) {
+        const int solves = rb.useDenseZ ? rb.ratio : 2 * rb.ratio;
+        const Eigen::VectorXd rhs = Eigen::VectorXd::Random(rb.systemMatrix.rows());
+        for (int r = 0; r < solves; ++r) rb.solver->solve(rhs);
+      }
+      if (d.largeSystem.rows() > 0) d.schurSolver->solve(Eigen::VectorXd::Random(d.largeSystem.rows()));
+    }
+    samples.push_back(watch.stop());
+  }
+  std::sort(samples.begin(), samples.end());
+  return samples[samples.size() / 2];
+}
+
+long long AsyncBackwardEuler::factorNonZeros() const {
+  const Impl& d = *impl_;
+  long long total = 0;
+  if (options_.method == AsyncSolveMethod::naive) return d.naiveSolver->stats().factorNonZeros;
+  for (const RegionBlocks& rb : d.regions) total += rb.solver->stats().factorNonZeros;
+  return total + (d.schurSolver ? d.schurSolver->stats().factorNonZeros : 0);
 }
 
 }  // namespace asyncfem

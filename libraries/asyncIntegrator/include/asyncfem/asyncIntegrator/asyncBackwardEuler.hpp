@@ -16,8 +16,13 @@ namespace asyncfem {
 
 /// How H^{LL*} = A^L - sum_i H^{L S_i} (H^{S_i S_i})^{-1} H^{S_i L} is factored.
 enum class SchurMode {
-  exact,      ///< unsymmetric LU (UMFPACK): the exact asynchronous step
-  symmetric,  ///< Cholesky of its symmetric part: faster, approximate
+  /// Exact, and the default: H^{LL*} = A^L - U C U^T differs from the SPD A^L only by the
+  /// dense interface block C, so A^L is factored by Cholesky and C enters through a q x q
+  /// capacitance matrix (q = interface DOFs; W = (A^L)^{-1} U, |L| x q, is stored). Falls
+  /// back to lu when W would exceed 512 MiB.
+  lowRank,
+  lu,         ///< exact: unsymmetric LU (UMFPACK) of H^{LL*} itself, as in the paper
+  symmetric,  ///< approximate: Cholesky of the symmetric part of H^{LL*}, as in the paper
 };
 /// How one large step's block system is solved.
 enum class AsyncSolveMethod {
@@ -26,14 +31,15 @@ enum class AsyncSolveMethod {
 };
 /// How the S unknowns are recovered once Y is known (structured method only).
 enum class RecoveryMode {
+  automatic,     ///< per region, whichever of the two below needs fewer flops (Z up to 128 MiB)
   substitution,  ///< a second forward substitution (m_i sparse solves per region)
   denseZ,        ///< X = y - Z Y_I with Z = (H^{SS})^{-1} H^{SI} stored densely (m_i |S_i| x |I_i|)
 };
 
 struct AsyncOptions {
-  SchurMode schur = SchurMode::exact;
+  SchurMode schur = SchurMode::lowRank;
   AsyncSolveMethod method = AsyncSolveMethod::structured;
-  RecoveryMode recovery = RecoveryMode::substitution;
+  RecoveryMode recovery = RecoveryMode::automatic;
   SolverKind regionSolver = SolverKind::cholmod;  ///< factors A^{S_i} (SPD)
 };
 
@@ -70,14 +76,29 @@ public:
   /// max_i ||C_i - C_i^T||_F / ||C_i||_F of the Schur corrections C_i (0 with no
   /// interface): how far H^{LL*} is from symmetric, what the symmetric mode neglects.
   double schurAsymmetry() const { return schurAsymmetry_; }
+  /// The Schur mode in effect (lowRank may fall back to lu for very large interfaces).
+  SchurMode schurModeUsed() const { return schurModeUsed_; }
+
+  /// Seconds per large step of the sparse triangular solves alone, with the current
+  /// factors and random right-hand sides (median of `repeats`): per region 2 m_i solves
+  /// with A^{S_i} (m_i with denseZ recovery), plus one with H^{LL*}; for the naive method,
+  /// one solve with the full system. The floor under the structured step's cost, for
+  /// benchmarks. Needs one step() first (throws asyncfem::Error otherwise).
+  double solveFloorSeconds(int repeats = 5);
+  /// Sum over the factorizations this integrator owns of the solver libraries' factor
+  /// non-zeros (machine-independent size of the factors).
+  long long factorNonZeros() const;
 
 private:
   struct Impl;
   void rebuildBlocks();
+  void buildSchurSolver();
+  Eigen::VectorXd solveSchur(const Eigen::VectorXd& rhs);
   RegionPartition partition_;
   AsyncOptions options_;
   SubstepObserver observer_;
   double schurAsymmetry_ = 0.0;
+  SchurMode schurModeUsed_ = SchurMode::lowRank;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -1,0 +1,208 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Benchmarks of the asynchronous integrator, printed as Markdown tables. Every time is a
+// median of per-step wall times after warm-up steps, and every ratio compares two
+// configurations measured in the same run.
+//
+//   benchmarkAsync --study growth   async vs single-rate at hL and hS as |S| grows, and the
+//                                   solve floor (sparse solves alone) under each async step
+//   benchmarkAsync --study ratio    structured vs naive as m grows
+//   benchmarkAsync --study schur    exact vs symmetric H^{LL*}: time and trajectory difference
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/forceModel/linearForceModel.hpp>
+#include <asyncfem/integrator/factory.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+using namespace asyncfem;
+
+struct Bench {
+  TetMesh mesh;
+  DynamicSystem system;
+};
+
+/// A cantilever bar along x, fixed at x = 0, body soft, last 10% stiff and light; a
+/// constant downward pull on the free end.
+Bench makeBench(int cellsAlong) {
+  BeamSpec spec;
+  spec.cellsAlongLength = cellsAlong;
+  spec.tipFraction = 0.1;
+  Bench b{makeBeamMesh(spec), {}};
+  MatrixAssembler assembler(b.mesh);
+  b.system.forceModel = std::make_shared<LinearForceModel>(linearStiffnessMatrix(b.mesh, assembler));
+  b.system.mass = massMatrix(b.mesh, assembler, MassType::consistent);
+  b.system.freeDofs = FreeDofs::fromFixedVertices(b.mesh.numVertices(), b.mesh.vertexSet("root"));
+  const std::vector<int> end = b.mesh.vertexSet("xmax");
+  b.system.externalForce = [end](double, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& f) {
+    for (int v : end) f[3 * v + 1] -= 0.05;
+  };
+  return b;
+}
+
+std::vector<int> verticesBeyond(const TetMesh& mesh, double x) {
+  std::vector<int> out;
+  for (int v = 0; v < mesh.numVertices(); ++v)
+    if (mesh.restPosition(v).x() >= x - 1e-12) out.push_back(v);
+  return out;
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+/// Median seconds per step() over `steps` steps after `warmup` untimed ones (the first
+/// step includes the one-time factorizations of linear models; its time is returned
+/// separately in setupSeconds).
+double timePerStep(Integrator& integrator, int warmup, int steps, double* setupSeconds = nullptr) {
+  Stopwatch first;
+  integrator.step();
+  if (setupSeconds) *setupSeconds = first.stop();
+  for (int k = 1; k < warmup; ++k) integrator.step();
+  std::vector<double> samples;
+  for (int k = 0; k < steps; ++k) {
+    Stopwatch watch;
+    integrator.step();
+    samples.push_back(watch.stop());
+  }
+  return median(samples);
+}
+
+std::string cpuModel() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  }
+  return "unknown CPU";
+}
+
+void growthStudy(int cells, int ratio, double hL, int steps) {
+  const Bench b = makeBench(cells);
+  std::printf("### Cost per large step as S grows (bar of %d tets, %d vertices, m = %d, hL = %g)\n\n",
+              b.mesh.numElements(), b.mesh.numVertices(), ratio, hL);
+  auto single = [&](double h) {
+    auto be = makeIntegrator("backward-euler", b.system, h);
+    return timePerStep(*be, 3, steps);
+  };
+  const double singleL = single(hL);
+  const double singleS = single(hL / ratio) * ratio;  // m small steps per large step
+  std::printf("single-rate backward Euler: %.3f ms per step at hL, %.3f ms per large step at hS (%d steps)\n\n",
+              1e3 * singleL, 1e3 * singleS, ratio);
+  std::printf("| S (fraction of length) | S vertices | interface DOFs | async ms/step | solves-only floor ms | "
+              "async / floor | async / single-rate hL | async / single-rate hS | setup s |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+  for (double fraction : {0.05, 0.1, 0.25, 0.5, 0.75, 1.0}) {
+    std::vector<AsyncRegion> regions{{"S", verticesBeyond(b.mesh, 1.0 - fraction), ratio}};
+    AsyncBackwardEuler async(b.mesh, b.system, hL, regions);
+    double setup = 0;
+    const double t = timePerStep(async, 3, steps, &setup);
+    const double floor = async.solveFloorSeconds(steps);
+    std::printf("| %.2f | %zu | %zu | %.3f | %.3f | %.2f | %.2f | %.2f | %.2f |\n", fraction,
+                regions[0].vertices.size(), async.partition().interfaceDofs(0).size(), 1e3 * t, 1e3 * floor,
+                t / floor, t / singleL, t / singleS, setup);
+  }
+  std::printf("\n");
+}
+
+void ratioStudy(int cells, double hL, int steps, int maxNaiveRatio) {
+  const Bench b = makeBench(cells);
+  const std::vector<int> tip = verticesBeyond(b.mesh, 0.9);
+  std::printf("### Structured against naive as m grows (bar of %d tets, |S| = %zu vertices, hL = %g)\n\n",
+              b.mesh.numElements(), tip.size(), hL);
+  std::printf("| m | structured ms/step | naive ms/step | naive / structured | structured setup s | naive setup s | "
+              "naive factor nnz | structured factor nnz |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  for (int m : {2, 4, 8, 16, 32, 64}) {
+    std::vector<AsyncRegion> regions{{"tip", tip, m}};
+    AsyncBackwardEuler structured(b.mesh, b.system, hL, regions);
+    double setupStructured = 0, setupNaive = 0;
+    const double ts = timePerStep(structured, 2, steps, &setupStructured);
+    if (m > maxNaiveRatio) {
+      std::printf("| %d | %.3f | (skipped: m > %d) | | %.2f | | | %lld |\n", m, 1e3 * ts, maxNaiveRatio, setupStructured,
+                  structured.factorNonZeros());
+      continue;
+    }
+    AsyncOptions naiveOptions;
+    naiveOptions.method = AsyncSolveMethod::naive;
+    AsyncBackwardEuler naive(b.mesh, b.system, hL, regions, naiveOptions);
+    const double tn = timePerStep(naive, 2, steps, &setupNaive);
+    std::printf("| %d | %.3f | %.3f | %.1f | %.2f | %.2f | %lld | %lld |\n", m, 1e3 * ts, 1e3 * tn, tn / ts,
+                setupStructured, setupNaive, naive.factorNonZeros(), structured.factorNonZeros());
+  }
+  std::printf("\n");
+}
+
+void schurStudy(int cells, int ratio, double hL, int steps) {
+  const Bench b = makeBench(cells);
+  std::printf("### Exact (UMFPACK LU) against symmetric (CHOLMOD) H^{LL*} (bar of %d tets, m = %d, hL = %g, %d steps)\n\n",
+              b.mesh.numElements(), ratio, hL, steps);
+  std::printf("| S (fraction) | exact ms/step | symmetric ms/step | exact setup s | symmetric setup s | "
+              "asymmetry of the correction | max relative trajectory difference |\n");
+  std::printf("|---|---|---|---|---|---|---|\n");
+  for (double fraction : {0.1, 0.25, 0.5}) {
+    std::vector<AsyncRegion> regions{{"S", verticesBeyond(b.mesh, 1.0 - fraction), ratio}};
+    AsyncOptions symmetricOptions;
+    symmetricOptions.schur = SchurMode::symmetric;
+    AsyncBackwardEuler exact(b.mesh, b.system, hL, regions);
+    AsyncBackwardEuler symmetric(b.mesh, b.system, hL, regions, symmetricOptions);
+    double setupExact = 0, setupSymmetric = 0;
+    std::vector<double> te, tsym;
+    double worst = 0;
+    for (int k = 0; k < steps; ++k) {
+      Stopwatch a;
+      exact.step();
+      (k == 0 ? setupExact : te.emplace_back()) = a.stop();
+      Stopwatch c;
+      symmetric.step();
+      (k == 0 ? setupSymmetric : tsym.emplace_back()) = c.stop();
+      const double scale = std::max(exact.displacement().lpNorm<Eigen::Infinity>(), 1e-300);
+      worst = std::max(worst, (exact.displacement() - symmetric.displacement()).lpNorm<Eigen::Infinity>() / scale);
+    }
+    std::printf("| %.2f | %.3f | %.3f | %.2f | %.2f | %.2e | %.2e |\n", fraction, 1e3 * median(te), 1e3 * median(tsym),
+                setupExact, setupSymmetric, exact.schurAsymmetry(), worst);
+  }
+  std::printf("\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Benchmarks of the asynchronous integrator (Markdown tables on stdout)"};
+  std::string study = "all";
+  int cells = 40, ratioCells = 20, ratio = 8, steps = 20, maxNaiveRatio = 64;
+  double hL = 5e-3;
+  app.add_option("--study", study, "growth | ratio | schur | all")->check(CLI::IsMember({"growth", "ratio", "schur", "all"}));
+  app.add_option("--cells", cells, "cells along the bar for the growth and schur studies")->check(CLI::Range(2, 400));
+  app.add_option("--ratio-cells", ratioCells, "cells along the bar for the ratio study")->check(CLI::Range(2, 400));
+  app.add_option("--m", ratio, "substeps per large step (growth, schur)")->check(CLI::Range(1, 1000));
+  app.add_option("--steps", steps, "timed steps per configuration")->check(CLI::Range(3, 100000));
+  app.add_option("--max-naive-m", maxNaiveRatio, "largest m for the naive solver")->check(CLI::Range(1, 1000));
+  app.add_option("--dt", hL, "large timestep hL")->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
+  try {
+    std::printf("Machine: %s, %u hardware threads. Command: benchmarkAsync --study %s --cells %d --ratio-cells %d "
+                "--m %d --steps %d --dt %g\n\n",
+                cpuModel().c_str(), std::thread::hardware_concurrency(), study.c_str(), cells, ratioCells, ratio,
+                steps, hL);
+    if (study == "growth" || study == "all") growthStudy(cells, ratio, hL, steps);
+    if (study == "ratio" || study == "all") ratioStudy(ratioCells, hL, steps, maxNaiveRatio);
+    if (study == "schur" || study == "all") schurStudy(cells, ratio, hL, steps);
+  } catch (const asyncfem::Error& e) {
+    std::fprintf(stderr, "benchmarkAsync: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
