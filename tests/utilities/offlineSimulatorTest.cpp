@@ -1,0 +1,270 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// offlineSimulator end to end: runs the built executable on scenes written by the tests
+// and checks its exit status, messages and the .afsim file it leaves.
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/simulationIO/simulationFile.hpp>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string simulatorPath = std::string(ASYNCFEM_BIN_DIR) + "/offlineSimulator";
+
+struct RunResult {
+  int exitCode = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string readText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class OfflineSimulatorTest : public ::testing::Test {
+protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    folder_ = fs::temp_directory_path() / ("asyncfem-offlineSimulator-" + std::string(info->name()));
+    fs::remove_all(folder_);
+    fs::create_directories(folder_);
+  }
+  void TearDown() override { fs::remove_all(folder_); }
+
+  /// A box of 3 x 1 x 1 cells fixed at x = 0, pulled at x = 3 for 0.1 s, backward Euler
+  /// with 5 steps per frame, output "out/run.afsim" next to the scene.
+  static nlohmann::json smallScene() {
+    return nlohmann::json::parse(R"({
+      "mesh": {"generator": "box", "size": [3, 1, 1], "cells": [3, 1, 1],
+               "material": {"density": 1000, "youngsModulus": 1e5, "poissonRatio": 0.4}},
+      "fixed": {"sets": ["xmin"]},
+      "forces": [{"type": "pull", "set": "xmax", "force": [0, -50, 0], "window": [0, 0.1]}],
+      "integrator": {"name": "backward-euler", "timestep": 0.01},
+      "frames": {"rate": 20, "count": 6},
+      "output": {"file": "out/run.afsim"}
+    })");
+  }
+
+  fs::path writeScene(const nlohmann::json& scene, const std::string& name = "scene.json") const {
+    const fs::path path = folder_ / name;
+    std::ofstream(path) << scene.dump(2);
+    return path;
+  }
+
+  /// Runs the simulator with the shell-quoted arguments; stdout and stderr separately
+  /// (both are files, so stderr is not a terminal).
+  RunResult run(const std::string& arguments) const {
+    const fs::path out = folder_ / "stdout.txt";
+    const fs::path err = folder_ / "stderr.txt";
+    const std::string command = "'" + simulatorPath + "' " + arguments + " > '" + out.string() + "' 2> '" +
+                                err.string() + "' < /dev/null";
+    const int status = std::system(command.c_str());
+    RunResult result;
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = readText(out);
+    result.err = readText(err);
+    return result;
+  }
+
+  // Built by appending: GCC 12 warns falsely (-Wrestrict) about "literal" + std::string.
+  static std::string quoted(const fs::path& path) {
+    std::string text(1, '\'');
+    text += path.string();
+    text += '\'';
+    return text;
+  }
+
+  fs::path folder_;
+};
+
+TEST_F(OfflineSimulatorTest, WritesTheRequestedFrames) {
+  const fs::path scene = writeScene(smallScene());
+  const RunResult r = run(quoted(scene));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  asyncfem::SimulationReader reader(folder_ / "out/run.afsim");  // relative to the scene's folder
+  EXPECT_EQ(reader.numFrames(), 6);
+  EXPECT_FALSE(reader.hasTruncatedFrame());
+  EXPECT_EQ(reader.numVertices(), 16);
+  EXPECT_DOUBLE_EQ(reader.header().frameInterval, 0.05);
+  EXPECT_DOUBLE_EQ(reader.header().timestep, 0.01);
+  EXPECT_FALSE(reader.header().hasVelocities);
+  reader.verifyAll();
+  for (int k = 0; k < 6; ++k) {
+    const asyncfem::SimulationFrame frame = reader.readFrame(k);
+    EXPECT_NEAR(frame.time, 0.05 * (k + 1), 1e-12);
+    EXPECT_TRUE(frame.displacement.allFinite());
+  }
+  EXPECT_LT(reader.readFrame(1).displacement.minCoeff(), 0.0);  // pulled down
+
+  // The summary: time split and what was skipped.
+  for (const char* expected : {"6 frames", "forces", "assembly", "factorization", "solve", "output", "skipped:",
+                               "damping matrix", "corotational", "vtu output", "velocity output"}) {
+    EXPECT_NE(r.out.find(expected), std::string::npos) << "missing '" << expected << "' in\n" << r.out;
+  }
+  // stderr is a file: plain progress lines, no bar redrawn with carriage returns.
+  EXPECT_NE(r.err.find("offlineSimulator: frame 6/6 (100%)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\r'), std::string::npos);
+}
+
+TEST_F(OfflineSimulatorTest, CommandLineOverridesTheScene) {
+  const fs::path scene = writeScene(smallScene());
+  const fs::path output = folder_ / "elsewhere/override.afsim";
+  const RunResult r =
+      run(quoted(scene) + " --frames 3 --dt 0.025 --integrator trapezoidal --output " + quoted(output) +
+          " --vtu " + quoted(folder_ / "vtu"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_FALSE(fs::exists(folder_ / "out/run.afsim"));
+  asyncfem::SimulationReader reader(output);
+  EXPECT_EQ(reader.numFrames(), 3);
+  EXPECT_DOUBLE_EQ(reader.header().timestep, 0.025);
+  EXPECT_NE(r.out.find("integrator trapezoidal"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(2 per frame)"), std::string::npos) << r.out;
+  for (int k = 0; k < 3; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%05d.vtu", k);
+    EXPECT_TRUE(fs::exists(folder_ / "vtu" / name)) << name;
+  }
+  EXPECT_FALSE(fs::exists(folder_ / "vtu/frame_00003.vtu"));
+}
+
+TEST_F(OfflineSimulatorTest, VelocitiesOnlyWhenRequested) {
+  auto json = smallScene();
+  json["output"]["velocities"] = true;
+  const RunResult r = run(quoted(writeScene(json)) + " --quiet");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  asyncfem::SimulationReader reader(folder_ / "out/run.afsim");
+  EXPECT_TRUE(reader.header().hasVelocities);
+  EXPECT_EQ(reader.readFrame(0).velocity.size(), 48);
+}
+
+TEST_F(OfflineSimulatorTest, ProgressFlagDrawsTheBar) {
+  const RunResult r = run(quoted(writeScene(smallScene())) + " --progress");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find('\r'), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("ETA"), std::string::npos) << r.err;
+}
+
+TEST_F(OfflineSimulatorTest, UnstableExplicitRunStopsNamingTheFrame) {
+  auto json = smallScene();
+  json["mesh"]["material"]["youngsModulus"] = 1e8;
+  json["forces"][0].erase("window");
+  json["integrator"] = nlohmann::json::parse(R"({"name": "central-differences", "timestep": 0.01,
+                                                 "options": {"force": true}})");
+  json["frames"] = {{"rate", 100}, {"count", 200}};
+  const RunResult r = run(quoted(writeScene(json)));
+  ASSERT_NE(r.exitCode, 0);
+  const std::size_t at = r.err.find("offlineSimulator: frame ");
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const int failedFrame = std::stoi(r.err.substr(at + std::string("offlineSimulator: frame ").size()));
+  EXPECT_NE(r.err.find("unstable"), std::string::npos) << r.err;
+
+  // Every frame before the failing one is there, complete and finite; the failing one is not.
+  asyncfem::SimulationReader reader(folder_ / "out/run.afsim");
+  EXPECT_EQ(reader.numFrames(), failedFrame);
+  EXPECT_FALSE(reader.hasTruncatedFrame());
+  for (int k = 0; k < reader.numFrames(); ++k) {
+    EXPECT_TRUE(reader.readFrame(k).displacement.allFinite()) << "frame " << k;
+  }
+}
+
+TEST_F(OfflineSimulatorTest, SceneErrorsNameTheKeyAndLeaveOutputAlone) {
+  const fs::path output = folder_ / "out/run.afsim";
+  fs::create_directories(output.parent_path());
+  std::ofstream(output) << "previous results";
+  auto json = smallScene();
+  json["forces"][0]["window"] = {0.5, 0.1};
+  const RunResult r = run(quoted(writeScene(json)));
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.err.find("offlineSimulator: " + (folder_ / "scene.json").string() +
+                       ": forces[0].window: expected [start, end] with start <= end"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(readText(output), "previous results");
+
+  json = smallScene();
+  json["output"].erase("file");
+  const RunResult noOutput = run(quoted(writeScene(json)));
+  EXPECT_EQ(noOutput.exitCode, 1);
+  EXPECT_NE(noOutput.err.find("offlineSimulator: no output file"), std::string::npos) << noOutput.err;
+
+  const RunResult missing = run(quoted(folder_ / "missing.json"));
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_EQ(missing.err.rfind("offlineSimulator: ", 0), 0U) << missing.err;
+
+  const RunResult badOption = run(quoted(writeScene(smallScene())) + " --dt -1");
+  EXPECT_NE(badOption.exitCode, 0);
+  EXPECT_EQ(badOption.err.rfind("offlineSimulator: ", 0), 0U) << badOption.err;
+}
+
+TEST_F(OfflineSimulatorTest, KilledRunLeavesEveryFinishedFrameReadable) {
+  auto json = smallScene();
+  json["mesh"]["cells"] = {6, 2, 2};
+  json["mesh"]["size"] = {6, 2, 2};
+  json["forces"][0].erase("window");
+  json["frames"] = {{"rate", 100}, {"count", 100000000}};
+  json["integrator"]["timestep"] = 0.01;
+  const fs::path scene = writeScene(json);
+  const fs::path output = folder_ / "out/run.afsim";
+
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const int devNull = ::open("/dev/null", O_WRONLY);
+    ::dup2(devNull, STDOUT_FILENO);
+    ::dup2(devNull, STDERR_FILENO);
+    const std::string sceneArgument = scene.string();
+    ::execl(simulatorPath.c_str(), simulatorPath.c_str(), sceneArgument.c_str(), "--quiet",
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Wait until some frames are on disk (at most 60 s), then kill without warning.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  std::int64_t seen = 0;
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::error_code ignored;
+    if (fs::exists(output, ignored) && fs::file_size(output, ignored) > 64) {
+      try {
+        seen = asyncfem::SimulationReader(output).numFrames();
+      } catch (const asyncfem::Error&) {
+        seen = 0;  // the header itself may be in flight
+      }
+      if (seen >= 5) {
+        break;
+      }
+    }
+  }
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before it was killed";
+  ASSERT_GE(seen, 5) << "no frames appeared within 60 s";
+
+  asyncfem::SimulationReader reader(output);
+  EXPECT_GE(reader.numFrames(), seen);
+  EXPECT_NO_THROW(reader.verifyAll());
+  for (std::int64_t k = 0; k < reader.numFrames(); ++k) {
+    EXPECT_NEAR(reader.readFrame(k).time, 0.01 * static_cast<double>(k + 1), 1e-9);
+  }
+}
+
+}  // namespace

@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "progress.hpp"
+
+#include <cmath>
+
+namespace asyncfem::offline {
+
+ProgressReporter::ProgressReporter(ProgressStyle style, int totalFrames, std::FILE* out)
+    : style_(style), totalFrames_(totalFrames > 0 ? totalFrames : 1), out_(out) {}
+
+std::string ProgressReporter::formatSeconds(double seconds) {
+  char text[32];
+  if (seconds < 60.0) {
+    std::snprintf(text, sizeof(text), "%.1f s", seconds);
+  } else if (seconds < 3600.0) {
+    const int whole = static_cast<int>(seconds);
+    std::snprintf(text, sizeof(text), "%d:%02d", whole / 60, whole % 60);
+  } else {
+    const int whole = static_cast<int>(seconds);
+    std::snprintf(text, sizeof(text), "%d:%02d:%02d", whole / 3600, (whole / 60) % 60, whole % 60);
+  }
+  return text;
+}
+
+void ProgressReporter::update(int framesDone) {
+  if (style_ == ProgressStyle::none) {
+    return;
+  }
+  const Clock::time_point now = Clock::now();
+  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  const double fraction = static_cast<double>(framesDone) / totalFrames_;
+  const double remaining = framesDone > 0 ? elapsed * (totalFrames_ - framesDone) / framesDone : 0.0;
+  const int percent = static_cast<int>(std::floor(100.0 * fraction));
+
+  if (style_ == ProgressStyle::bar) {
+    // Redraw at most ~20 times a second, and always for the last frame.
+    if (framesDone < totalFrames_ && barDrawn_ && now - lastPrint_ < std::chrono::milliseconds(50)) {
+      return;
+    }
+    constexpr int width = 30;
+    const int filled = static_cast<int>(std::round(fraction * width));
+    std::string bar(static_cast<std::size_t>(filled), '#');
+    bar.append(static_cast<std::size_t>(width - filled), '.');
+    std::fprintf(out_, "\r[%s] %d/%d frames %3d%%  elapsed %s  ETA %s   ", bar.c_str(), framesDone, totalFrames_,
+                 percent, formatSeconds(elapsed).c_str(), formatSeconds(remaining).c_str());
+    std::fflush(out_);
+    barDrawn_ = true;
+    lastPrint_ = now;
+    return;
+  }
+  // Plain lines: every 10% of the frames or every 10 s, whichever comes first.
+  const bool step = percent / 10 > lastPercentPrinted_ / 10;
+  const bool late = now - lastPrint_ >= std::chrono::seconds(10);
+  if (!step && !late && framesDone < totalFrames_) {
+    return;
+  }
+  if (framesDone == totalFrames_ && lastPercentPrinted_ == 100) {
+    return;
+  }
+  std::fprintf(out_, "offlineSimulator: frame %d/%d (%d%%), elapsed %s, ETA %s\n", framesDone, totalFrames_, percent,
+               formatSeconds(elapsed).c_str(), formatSeconds(remaining).c_str());
+  std::fflush(out_);
+  lastPercentPrinted_ = percent;
+  lastPrint_ = now;
+}
+
+void ProgressReporter::finish() {
+  if (style_ == ProgressStyle::bar && barDrawn_) {
+    std::fputc('\n', out_);
+    std::fflush(out_);
+    barDrawn_ = false;
+  }
+}
+
+}  // namespace asyncfem::offline
