@@ -424,15 +424,10 @@ void AsyncBackwardEuler::step() {
   const Eigen::VectorXd stiffVelocity = d.stiffness * v0;
   Eigen::VectorXd dampVelocity;
   if (damped) dampVelocity = alpha * (system_.mass * v0) + beta * stiffVelocity;
+  // The state-dependent part, once per large step: f_int(u_0) + D v_0 (full vector).
+  Eigen::VectorXd stateForce = d.internalForce;
+  if (damped) stateForce += dampVelocity;
   Eigen::VectorXd externalForce;
-  auto residualAt = [&](double t, double tau) {
-    // f_ext(t0 + tau) - f_int(u_0) - D v_0 - tau K v_0 as a full vector.
-    evaluateExternalForce(t, externalForce);
-    Eigen::VectorXd r = externalForce - d.internalForce - tau * stiffVelocity;
-    if (damped) r -= dampVelocity;
-    return r;
-  };
-
   const std::vector<int>& large = partition_.largeDofs();
   const int numRegions = partition_.numRegions();
   std::vector<Eigen::MatrixXd> rhsS(static_cast<std::size_t>(numRegions));  // |S| x m, column r-1 = b_r
@@ -443,10 +438,20 @@ void AsyncBackwardEuler::step() {
     b.resize(static_cast<Eigen::Index>(s.size()), rb.ratio);
     for (int r = 1; r <= rb.ratio; ++r) {
       const double tau = r * rb.smallStep;
-      b.col(r - 1) = rb.smallStep * gather(residualAt(t0 + tau, tau), s);
+      evaluateExternalForce(t0 + tau, externalForce);
+      for (std::size_t k = 0; k < s.size(); ++k) {
+        const int dof = s[k];
+        b(static_cast<Eigen::Index>(k), r - 1) =
+            rb.smallStep * (externalForce[dof] - stateForce[dof] - tau * stiffVelocity[dof]);
+      }
     }
   }
-  const Eigen::VectorXd rhsL = hL * gather(residualAt(t0 + hL, hL), large);
+  evaluateExternalForce(t0 + hL, externalForce);
+  Eigen::VectorXd rhsL(static_cast<Eigen::Index>(large.size()));
+  for (std::size_t k = 0; k < large.size(); ++k) {
+    const int dof = large[k];
+    rhsL[static_cast<Eigen::Index>(k)] = hL * (externalForce[dof] - stateForce[dof] - hL * stiffVelocity[dof]);
+  }
 
   // Solve for X (per region, |S| x m) and Y.
   std::vector<Eigen::MatrixXd> X(static_cast<std::size_t>(numRegions));
