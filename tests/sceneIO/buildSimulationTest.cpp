@@ -1,16 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <gtest/gtest.h>
+
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
+#include <cmath>
 
 #include "sceneTestUtilities.hpp"
-
-#include <gtest/gtest.h>
-
-#include <algorithm>
-#include <cmath>
 
 namespace {
 
@@ -149,7 +148,8 @@ TEST(BuildSimulation, GravityAddsMassTimesG) {
 
 TEST(BuildSimulation, PullIsOnOnlyInsideItsWindow) {
   auto json = smallScene();
-  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -8, 0], "window": [0.1, 0.2]}])");
+  json["forces"] =
+      nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -8, 0], "window": [0.1, 0.2]}])");
   const Simulation simulation = build(json);
   const std::vector<int>& pulled = simulation.mesh->vertexSet("xmax");
   ASSERT_EQ(pulled.size(), 4U);
@@ -197,8 +197,8 @@ TEST(BuildSimulation, MaterialOverridesPerSet) {
            "material": {"name": "hard", "density": 500, "youngsModulus": 1e7, "poissonRatio": 0.3}}])");
   // "right" is the only user of "hard": changed in place. "allElements" also covers
   // "rubber" elements, so only their copy changes.
-  json["materials"] = nlohmann::json::parse(
-      R"([{"set": "right", "youngsModulus": 2e7}, {"set": "allElements", "density": 10}])");
+  json["materials"] =
+      nlohmann::json::parse(R"([{"set": "right", "youngsModulus": 2e7}, {"set": "allElements", "density": 10}])");
   const Simulation simulation = build(json);
   const asyncfem::TetMesh& mesh = *simulation.mesh;
   const int hard = mesh.findMaterial("hard");
@@ -219,7 +219,8 @@ TEST(BuildSimulation, MaterialOverridesPerSet) {
   const Simulation partial = build(json, folder.path());
   const int copy = partial.mesh->findMaterial("rubber@pair");
   ASSERT_GE(copy, 0);
-  EXPECT_EQ(partial.mesh->materials()[static_cast<std::size_t>(copy)], (asyncfem::Material{"rubber@pair", 7, 1e5, 0.1}));
+  EXPECT_EQ(partial.mesh->materials()[static_cast<std::size_t>(copy)],
+            (asyncfem::Material{"rubber@pair", 7, 1e5, 0.1}));
   for (int e = 0; e < partial.mesh->numElements(); ++e) {
     EXPECT_EQ(partial.mesh->elementMaterial(e).name, e < 2 ? "rubber@pair" : "rubber") << "element " << e;
   }
@@ -265,8 +266,10 @@ TEST(BuildSimulation, RegistryAcceptsOtherIntegrators) {
     called = true;
     EXPECT_EQ(mesh.numVertices(), 12);
     EXPECT_EQ(options.at("regions").size(), 2U);
-    return asyncfem::defaultIntegratorRegistry().find("backward-euler")->operator()(scene, mesh, std::move(system),
-                                                                                  nlohmann::json::object());
+    return asyncfem::defaultIntegratorRegistry()
+        .find("backward-euler")
+        ->
+        operator()(scene, mesh, std::move(system), nlohmann::json::object());
   });
   auto json = smallScene();
   json["integrator"]["name"] = "custom";
@@ -278,7 +281,8 @@ TEST(BuildSimulation, RegistryAcceptsOtherIntegrators) {
 
 TEST(AdvanceFrame, PulledBeamMovesAndReturns) {
   auto json = smallScene();
-  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -100, 0], "window": [0, 0.1]}])");
+  json["forces"] =
+      nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -100, 0], "window": [0, 0.1]}])");
   json["frames"]["count"] = 5;
   Simulation simulation = build(json);
   double previousTip = 0.0;
@@ -301,8 +305,8 @@ TEST(AdvanceFrame, UnstableExplicitRunNamesTheFrame) {
   auto json = smallScene();
   json["mesh"]["material"]["youngsModulus"] = 1e8;
   json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -100, 0]}])");
-  json["integrator"] = nlohmann::json::parse(
-      R"({"name": "central-differences", "timestep": 0.01, "options": {"force": true}})");
+  json["integrator"] =
+      nlohmann::json::parse(R"({"name": "central-differences", "timestep": 0.01, "options": {"force": true}})");
   json["frames"]["count"] = 50;
   Simulation simulation = build(json);
   try {

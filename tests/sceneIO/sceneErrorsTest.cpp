@@ -1,15 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // One case per documented scene error (docs/scene-format.md, "Errors"): each must name
 // the scene and the full key path of what is wrong.
+#include <gtest/gtest.h>
+
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
+#include <string>
 
 #include "sceneTestUtilities.hpp"
-
-#include <gtest/gtest.h>
-
-#include <string>
 
 namespace {
 
@@ -50,8 +49,10 @@ const ErrorCase cases[] = {
     {"MisspelledNestedKey", R"({"integrator": {"timestpe": 1}})", "scene.json: integrator.timestpe: unknown key"},
     {"TopLevelNotObject", R"({"mesh": 3})", "scene.json: mesh: expected an object"},
     {"MeshMissing", R"({"mesh": null})", "scene.json: mesh: required key missing"},
-    {"MeshFileAndGenerator", R"({"mesh": {"file": "a.veg"}})", "scene.json: mesh: give either \"file\" or \"generator\""},
-    {"MeshGeneratorUnknown", R"({"mesh": {"generator": "sphere"}})", "scene.json: mesh.generator: unknown value \"sphere\""},
+    {"MeshFileAndGenerator", R"({"mesh": {"file": "a.veg"}})",
+     "scene.json: mesh: give either \"file\" or \"generator\""},
+    {"MeshGeneratorUnknown", R"({"mesh": {"generator": "sphere"}})",
+     "scene.json: mesh.generator: unknown value \"sphere\""},
     {"MeshBoxSizeNotPositive", R"({"mesh": {"size": [1, 0, 1]}})", "scene.json: mesh.size: expected three sizes > 0"},
     {"MeshBoxCellsNotInteger", R"({"mesh": {"cells": [2, 1.5, 1]}})", "scene.json: mesh.cells[1]: expected an integer"},
     {"MeshBoxUnknownKey", R"({"mesh": {"length": 2}})", "scene.json: mesh.length: unknown key"},
@@ -59,7 +60,8 @@ const ErrorCase cases[] = {
      "scene.json: mesh.material.poissonRatio: expected a Poisson ratio in (-1, 0.5)"},
     {"MeshMaterialDensity", R"({"mesh": {"material": {"density": -1}}})",
      "scene.json: mesh.material.density: expected a density > 0"},
-    {"MeshBeamLength", R"({"mesh": {"generator": "beam", "size": null, "cells": null, "material": null, "length": -1}})",
+    {"MeshBeamLength",
+     R"({"mesh": {"generator": "beam", "size": null, "cells": null, "material": null, "length": -1}})",
      "scene.json: mesh.length: expected a number > 0"},
     {"MeshBeamTipFraction",
      R"({"mesh": {"generator": "beam", "size": null, "cells": null, "material": null, "tipFraction": 1}})",
@@ -124,7 +126,8 @@ const ErrorCase cases[] = {
      "scene.json: forces[0].vertices[1]: vertex 12 out of range [0, 12)", true},
     {"MassUnknown", R"({"mass": "diagonal"})", "scene.json: mass: unknown value \"diagonal\""},
     {"DampingNegative", R"({"damping": {"alpha": -0.1}})", "scene.json: damping.alpha: expected alpha >= 0"},
-    {"DampingNotNumber", R"({"damping": {"beta": "0.1"}})", "scene.json: damping.beta: expected a number, got a string"},
+    {"DampingNotNumber", R"({"damping": {"beta": "0.1"}})",
+     "scene.json: damping.beta: expected a number, got a string"},
     {"ForceModelUnknown", R"({"forceModel": {"type": "neo-hookean"}})",
      "scene.json: forceModel.type: unknown value \"neo-hookean\""},
     {"ForceModelTangentOnLinear", R"({"forceModel": {"type": "linear", "tangent": "exact"}})",
@@ -150,7 +153,8 @@ const ErrorCase cases[] = {
      "scene.json: integrator.options.tolerance: expected a number > 0", true},
     {"IntegratorOptionForce", R"({"integrator": {"options": {"force": 1}}})",
      "scene.json: integrator.options.force: expected true or false", true},
-    {"ExplicitAboveStableTimestep", R"({"mesh": {"material": {"youngsModulus": 1e8}}, "integrator": {"name": "central-differences"}})",
+    {"ExplicitAboveStableTimestep",
+     R"({"mesh": {"material": {"youngsModulus": 1e8}}, "integrator": {"name": "central-differences"}})",
      "scene.json: integrator.timestep: ", true},
     {"StepsPerFrameNotInteger", R"({"integrator": {"timestep": 0.03}})",
      "scene.json: integrator.timestep: 0.03 does not divide the frame interval 1 / frames.rate", true},

@@ -1,11 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/sceneIO/scene.hpp>
-
-#include "sceneTestUtilities.hpp"
-
 #include <gtest/gtest.h>
 
+#include <asyncfem/sceneIO/scene.hpp>
 #include <cmath>
+
+#include "sceneTestUtilities.hpp"
 
 namespace {
 

@@ -3,10 +3,10 @@
 #pragma once
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 
 namespace asyncfem::test {
@@ -25,7 +25,7 @@ inline nlohmann::json smallScene() {
 
 /// A fresh folder under the system temporary folder, removed when the test ends.
 class ScratchFolder {
-public:
+ public:
   ScratchFolder() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     path_ = std::filesystem::temp_directory_path() /
@@ -48,7 +48,7 @@ public:
     return file;
   }
 
-private:
+ private:
   std::filesystem::path path_;
 };
 

@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/simulationIO/crc32.hpp>
-
 #include <gtest/gtest.h>
 
+#include <asyncfem/simulationIO/crc32.hpp>
 #include <string>
 
 namespace {

@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <gtest/gtest.h>
+
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/simulationIO/crc32.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -21,7 +20,7 @@ using asyncfem::SimulationReader;
 using asyncfem::SimulationWriter;
 
 class SimulationFileTest : public ::testing::Test {
-protected:
+ protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     directory_ = fs::temp_directory_path() / ("asyncfem-simulationIO-" + std::string(info->name()));

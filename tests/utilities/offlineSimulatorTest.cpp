@@ -1,23 +1,21 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // offlineSimulator end to end: runs the built executable on scenes written by the tests
 // and checks its exit status, messages and the .afsim file it leaves.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <thread>
-
-#include <fcntl.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 namespace {
 
@@ -39,7 +37,7 @@ std::string readText(const fs::path& path) {
 }
 
 class OfflineSimulatorTest : public ::testing::Test {
-protected:
+ protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     folder_ = fs::temp_directory_path() / ("asyncfem-offlineSimulator-" + std::string(info->name()));
@@ -73,8 +71,8 @@ protected:
   RunResult run(const std::string& arguments) const {
     const fs::path out = folder_ / "stdout.txt";
     const fs::path err = folder_ / "stderr.txt";
-    const std::string command = "'" + simulatorPath + "' " + arguments + " > '" + out.string() + "' 2> '" +
-                                err.string() + "' < /dev/null";
+    const std::string command =
+        "'" + simulatorPath + "' " + arguments + " > '" + out.string() + "' 2> '" + err.string() + "' < /dev/null";
     const int status = std::system(command.c_str());
     RunResult result;
     result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -114,8 +112,8 @@ TEST_F(OfflineSimulatorTest, WritesTheRequestedFrames) {
   EXPECT_LT(reader.readFrame(1).displacement.minCoeff(), 0.0);  // pulled down
 
   // The summary: time split and what was skipped.
-  for (const char* expected : {"6 frames", "forces", "assembly", "factorization", "solve", "output", "skipped:",
-                               "damping matrix", "corotational", "vtu output", "velocity output"}) {
+  for (const char* expected : {"6 frames", "forces", "assembly", "factorization", "solve", "output",
+                               "skipped:", "damping matrix", "corotational", "vtu output", "velocity output"}) {
     EXPECT_NE(r.out.find(expected), std::string::npos) << "missing '" << expected << "' in\n" << r.out;
   }
   // stderr is a file: plain progress lines, no bar redrawn with carriage returns.
@@ -126,9 +124,8 @@ TEST_F(OfflineSimulatorTest, WritesTheRequestedFrames) {
 TEST_F(OfflineSimulatorTest, CommandLineOverridesTheScene) {
   const fs::path scene = writeScene(smallScene());
   const fs::path output = folder_ / "elsewhere/override.afsim";
-  const RunResult r =
-      run(quoted(scene) + " --frames 3 --dt 0.025 --integrator trapezoidal --output " + quoted(output) +
-          " --vtu " + quoted(folder_ / "vtu"));
+  const RunResult r = run(quoted(scene) + " --frames 3 --dt 0.025 --integrator trapezoidal --output " + quoted(output) +
+                          " --vtu " + quoted(folder_ / "vtu"));
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_FALSE(fs::exists(folder_ / "out/run.afsim"));
   asyncfem::SimulationReader reader(output);

@@ -8,17 +8,15 @@
 // frame; progress on stderr, the run summary on stdout. Errors print
 // "offlineSimulator: <message>" on stderr and exit with status 1. What it prints is
 // described in docs/scene-format.md, section "Running a scene".
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
-
-#include "progress.hpp"
-
-#include <CLI/CLI.hpp>
-
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -26,7 +24,7 @@
 #include <sstream>
 #include <string>
 
-#include <unistd.h>
+#include "progress.hpp"
 
 namespace {
 
@@ -95,9 +93,9 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
   std::ostringstream out;
   out.setf(std::ios::fixed);
   out.precision(3);
-  out << "offlineSimulator: " << scene.sourceName << ": " << frames << " frames, " << steps << " steps of h = "
-      << std::defaultfloat << simulation.timestep << " (" << simulation.stepsPerFrame << " per frame), "
-      << std::fixed << (setupSeconds + loopSeconds) << " s\n";
+  out << "offlineSimulator: " << scene.sourceName << ": " << frames << " frames, " << steps
+      << " steps of h = " << std::defaultfloat << simulation.timestep << " (" << simulation.stepsPerFrame
+      << " per frame), " << std::fixed << (setupSeconds + loopSeconds) << " s\n";
   out << "  mesh        " << simulation.mesh->numVertices() << " vertices, " << simulation.mesh->numElements()
       << " elements, " << simulation.fixedVertices.size() << " fixed vertices\n";
   out << "  model       "
@@ -107,8 +105,8 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
                                                                   : "corotational (simple tangent)"))
       << ", " << (scene.mass == asyncfem::MassType::lumped ? "lumped" : "consistent") << " mass, integrator "
       << simulation.integrator->name() << "\n";
-  out << "  setup       " << setupSeconds << " s (mesh, matrices, first factorization: "
-      << before.factorizationSeconds << " s)\n";
+  out << "  setup       " << setupSeconds << " s (mesh, matrices, first factorization: " << before.factorizationSeconds
+      << " s)\n";
   out << "  per frame   " << milliseconds(loopSeconds, frames) << "   (total " << loopSeconds << " s)\n";
   out << "    forces        " << milliseconds(forces, frames) << "\n";
   out << "    assembly      " << milliseconds(assembly, frames) << "\n";
@@ -134,18 +132,18 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"Runs a scene file (docs/scene-format.md) and writes its frames to an .afsim file "
-               "(docs/simulation-output.md)."};
+  CLI::App app{
+      "Runs a scene file (docs/scene-format.md) and writes its frames to an .afsim file "
+      "(docs/simulation-output.md)."};
   CommandLine options;
   app.add_option("scene", options.scene, "Scene file (.json)")->required();
   app.add_option("-o,--output", options.output,
                  "Output .afsim file (replaces output.file; truncated at the start of the run)");
   app.add_option("--integrator", options.integrator, "Integrator name (replaces integrator.name)");
-  app.add_option("--dt", options.timestep, "Timestep h (replaces integrator.timestep)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--frames", options.frames, "Number of frames (replaces frames.count)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--vtu", options.vtuFolder, "Also write FOLDER/frame_NNNNN.vtu per frame (replaces output.vtu.folder)");
+  app.add_option("--dt", options.timestep, "Timestep h (replaces integrator.timestep)")->check(CLI::PositiveNumber);
+  app.add_option("--frames", options.frames, "Number of frames (replaces frames.count)")->check(CLI::PositiveNumber);
+  app.add_option("--vtu", options.vtuFolder,
+                 "Also write FOLDER/frame_NNNNN.vtu per frame (replaces output.vtu.folder)");
   app.add_flag("--progress", options.progress, "Draw the progress bar even when stderr is not a terminal");
   app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
   try {

@@ -17,14 +17,14 @@ enum class ProgressStyle {
 
 /// Reports "frame k of n" with elapsed time and an estimate of the time left.
 class ProgressReporter {
-public:
+ public:
   ProgressReporter(ProgressStyle style, int totalFrames, std::FILE* out = stderr);
   /// Call after each finished frame (framesDone = 1 .. totalFrames).
   void update(int framesDone);
   /// Ends the bar's line (call once, also on errors, before printing anything else).
   void finish();
 
-private:
+ private:
   using Clock = std::chrono::steady_clock;
   static std::string formatSeconds(double seconds);
 

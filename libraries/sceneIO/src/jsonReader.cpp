@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/jsonReader.hpp>
-
-#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -16,9 +15,7 @@ JsonObjectReader::JsonObjectReader(const nlohmann::json& value, std::string path
   }
 }
 
-std::string JsonObjectReader::keyPath(const std::string& key) const {
-  return path_.empty() ? key : path_ + "." + key;
-}
+std::string JsonObjectReader::keyPath(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
 
 std::string JsonObjectReader::elementPath(const std::string& key, std::size_t index) const {
   return keyPath(key) + "[" + std::to_string(index) + "]";
@@ -34,15 +31,23 @@ void JsonObjectReader::fail(const std::string& key, const std::string& message) 
 
 std::string JsonObjectReader::describe(const nlohmann::json& value) {
   switch (value.type()) {
-    case nlohmann::json::value_t::null: return "null";
-    case nlohmann::json::value_t::boolean: return "a boolean";
-    case nlohmann::json::value_t::string: return "a string";
-    case nlohmann::json::value_t::array: return "an array";
-    case nlohmann::json::value_t::object: return "an object";
+    case nlohmann::json::value_t::null:
+      return "null";
+    case nlohmann::json::value_t::boolean:
+      return "a boolean";
+    case nlohmann::json::value_t::string:
+      return "a string";
+    case nlohmann::json::value_t::array:
+      return "an array";
+    case nlohmann::json::value_t::object:
+      return "an object";
     case nlohmann::json::value_t::number_integer:
-    case nlohmann::json::value_t::number_unsigned: return "an integer";
-    case nlohmann::json::value_t::number_float: return "a number";
-    default: return "an unsupported value";
+    case nlohmann::json::value_t::number_unsigned:
+      return "an integer";
+    case nlohmann::json::value_t::number_float:
+      return "a number";
+    default:
+      return "an unsupported value";
   }
 }
 
@@ -64,8 +69,7 @@ const nlohmann::json& JsonObjectReader::required(const std::string& key) {
   return *value;
 }
 
-double JsonObjectReader::toNumber(const nlohmann::json& value, const std::string& path,
-                                  const std::string& sourceName) {
+double JsonObjectReader::toNumber(const nlohmann::json& value, const std::string& path, const std::string& sourceName) {
   if (!value.is_number()) {
     failAt(sourceName, path, "expected a number, got " + describe(value));
   }
@@ -76,8 +80,8 @@ double JsonObjectReader::toNumber(const nlohmann::json& value, const std::string
   return number;
 }
 
-int JsonObjectReader::toInteger(const nlohmann::json& value, const std::string& path,
-                                const std::string& sourceName, int minimum, int maximum) {
+int JsonObjectReader::toInteger(const nlohmann::json& value, const std::string& path, const std::string& sourceName,
+                                int minimum, int maximum) {
   const auto range = [&] {
     return "expected an integer in [" + std::to_string(minimum) + ", " + std::to_string(maximum) + "]";
   };

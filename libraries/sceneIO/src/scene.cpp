@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/jsonReader.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
-
-#include <algorithm>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -331,8 +330,8 @@ Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePa
   parseFixed(top, scene);
   scene.gravity = top.vector3("gravity", Eigen::Vector3d::Zero());
   parseForces(top, scene);
-  scene.mass = top.choice("mass", "consistent", {"consistent", "lumped"}) == "lumped" ? MassType::lumped
-                                                                                      : MassType::consistent;
+  scene.mass =
+      top.choice("mass", "consistent", {"consistent", "lumped"}) == "lumped" ? MassType::lumped : MassType::consistent;
   if (const nlohmann::json* damping = top.find("damping")) {
     JsonObjectReader reader(*damping, "damping", sourceName);
     scene.rayleighAlpha = reader.number("alpha", 0.0);
@@ -354,7 +353,7 @@ Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePa
         reader.fail("tangent", "only the corotational force model has a tangent choice");
       }
       scene.tangent = reader.choice("tangent", "simple", {"simple", "exact"}) == "exact" ? Scene::Tangent::exact
-                                                                                       : Scene::Tangent::simple;
+                                                                                         : Scene::Tangent::simple;
     }
     reader.finish();
   }

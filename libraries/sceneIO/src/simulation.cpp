@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
@@ -11,8 +12,6 @@
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
-
-#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -72,9 +71,12 @@ IntegratorOptions parseSingleRateOptions(const Scene& scene, const nlohmann::jso
 
 TetMesh loadMesh(const Scene& scene) {
   switch (scene.mesh.source) {
-    case Scene::MeshSource::beam: return makeBeamMesh(scene.mesh.beam);
-    case Scene::MeshSource::box: return makeBoxMesh(scene.mesh.box);
-    case Scene::MeshSource::file: break;
+    case Scene::MeshSource::beam:
+      return makeBeamMesh(scene.mesh.beam);
+    case Scene::MeshSource::box:
+      return makeBoxMesh(scene.mesh.box);
+    case Scene::MeshSource::file:
+      break;
   }
   try {
     return readMesh(scene.mesh.file);
@@ -95,7 +97,8 @@ const std::vector<int>& vertexSetAt(const Scene& scene, const TetMesh& mesh, con
                                     const std::string& keyPath) {
   const auto it = mesh.vertexSets().find(name);
   if (it == mesh.vertexSets().end()) {
-    throwSceneError(scene, keyPath, "unknown vertex set \"" + name + "\" (known: " + knownSets(mesh.vertexSets()) + ")");
+    throwSceneError(scene, keyPath,
+                    "unknown vertex set \"" + name + "\" (known: " + knownSets(mesh.vertexSets()) + ")");
   }
   if (it->second.empty()) {
     throwSceneError(scene, keyPath, "vertex set \"" + name + "\" is empty");
@@ -124,8 +127,9 @@ TetMesh applyMaterialOverrides(const Scene& scene, TetMesh mesh) {
     } else {
       const auto it = mesh.elementSets().find(override.set);
       if (it == mesh.elementSets().end()) {
-        throwSceneError(scene, keyPath, "unknown element set \"" + override.set +
-                                            "\" (known: allElements, " + knownSets(mesh.elementSets()) + ")");
+        throwSceneError(
+            scene, keyPath,
+            "unknown element set \"" + override.set + "\" (known: allElements, " + knownSets(mesh.elementSets()) + ")");
       }
       elements = it->second;
     }
@@ -138,15 +142,15 @@ TetMesh applyMaterialOverrides(const Scene& scene, TetMesh mesh) {
       material.density = override.density.value_or(material.density);
       material.youngsModulus = override.youngsModulus.value_or(material.youngsModulus);
       material.poissonRatio = override.poissonRatio.value_or(material.poissonRatio);
-      const auto users = static_cast<std::size_t>(
-          std::count(elementMaterials.begin(), elementMaterials.end(), materialIndex));
+      const auto users =
+          static_cast<std::size_t>(std::count(elementMaterials.begin(), elementMaterials.end(), materialIndex));
       if (users == members.size()) {
         materials[static_cast<std::size_t>(materialIndex)] = material;
         continue;
       }
       material.name += "@" + override.set;
-      const auto existing = std::find_if(materials.begin(), materials.end(),
-                                         [&](const Material& m) { return m.name == material.name; });
+      const auto existing =
+          std::find_if(materials.begin(), materials.end(), [&](const Material& m) { return m.name == material.name; });
       int newIndex = static_cast<int>(materials.size());
       if (existing != materials.end()) {
         newIndex = static_cast<int>(existing - materials.begin());
@@ -172,8 +176,7 @@ TetMesh applyMaterialOverrides(const Scene& scene, TetMesh mesh) {
 std::vector<int> collectFixedVertices(const Scene& scene, const TetMesh& mesh) {
   std::vector<int> fixed;
   for (std::size_t i = 0; i < scene.fixed.sets.size(); ++i) {
-    const auto& members =
-        vertexSetAt(scene, mesh, scene.fixed.sets[i], "fixed.sets[" + std::to_string(i) + "]");
+    const auto& members = vertexSetAt(scene, mesh, scene.fixed.sets[i], "fixed.sets[" + std::to_string(i) + "]");
     fixed.insert(fixed.end(), members.begin(), members.end());
   }
   for (std::size_t i = 0; i < scene.fixed.boxes.size(); ++i) {
@@ -275,11 +278,11 @@ std::string formatNumber(double value) {
 IntegratorRegistry defaultIntegratorRegistry() {
   IntegratorRegistry registry;
   for (const std::string& name : integratorNames()) {
-    registry.add(name, [name](const Scene& scene, const TetMesh& /*mesh*/, DynamicSystem system,
-                              const nlohmann::json& options) {
-      const IntegratorOptions parsed = parseSingleRateOptions(scene, options);
-      return makeIntegrator(name, std::move(system), scene.integrator.timestep, parsed);
-    });
+    registry.add(
+        name, [name](const Scene& scene, const TetMesh& /*mesh*/, DynamicSystem system, const nlohmann::json& options) {
+          const IntegratorOptions parsed = parseSingleRateOptions(scene, options);
+          return makeIntegrator(name, std::move(system), scene.integrator.timestep, parsed);
+        });
   }
   return registry;
 }
@@ -290,8 +293,8 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
   // Cheap checks first, so a bad scene fails before the mesh is read and matrices built.
   const IntegratorFactory* factory = registry.find(scene.integrator.name);
   if (factory == nullptr) {
-    throwSceneError(scene, "integrator.name", "unknown integrator \"" + scene.integrator.name +
-                                                  "\" (known: " + joined(registry.names()) + ")");
+    throwSceneError(scene, "integrator.name",
+                    "unknown integrator \"" + scene.integrator.name + "\" (known: " + joined(registry.names()) + ")");
   }
   const double h = scene.integrator.timestep;
   if (!(h > 0.0) || !std::isfinite(h)) {

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/simulationIO/crc32.hpp>
-
 #include <array>
+#include <asyncfem/simulationIO/crc32.hpp>
 
 namespace asyncfem {
 

@@ -1,16 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <sys/types.h>
+
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/simulationIO/crc32.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
-
-#include "detail/byteOrder.hpp"
-
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <string>
 
-#include <sys/types.h>
+#include "detail/byteOrder.hpp"
 
 namespace asyncfem {
 
@@ -40,37 +39,42 @@ SimulationReader::SimulationReader(const std::filesystem::path& path) : path_(pa
   if (got < sizeof(detail::simulationMagic) ||
       std::memcmp(bytes, detail::simulationMagic, sizeof(detail::simulationMagic)) != 0) {
     if (got < sizeof(detail::simulationMagic)) {
-      throw ParseError(name, 0, "truncated header: " + std::to_string(got) + " bytes, expected " +
-                                    std::to_string(simulationHeaderBytes));
+      throw ParseError(
+          name, 0,
+          "truncated header: " + std::to_string(got) + " bytes, expected " + std::to_string(simulationHeaderBytes));
     }
     throw ParseError(name, 0, "not an AsyncFEM simulation file (bad magic)");
   }
   if (got < sizeof(bytes)) {
-    throw ParseError(name, 0, "truncated header: " + std::to_string(got) + " bytes, expected " +
-                                  std::to_string(simulationHeaderBytes));
+    throw ParseError(
+        name, 0,
+        "truncated header: " + std::to_string(got) + " bytes, expected " + std::to_string(simulationHeaderBytes));
   }
   const std::uint32_t version = detail::getU32(bytes + detail::offsetVersion);
   if (version != simulationFileVersion) {
-    throw ParseError(name, 0, "unsupported format version " + std::to_string(version) + " (this build reads " +
-                                  std::to_string(simulationFileVersion) + ")");
+    throw ParseError(name, 0,
+                     "unsupported format version " + std::to_string(version) + " (this build reads " +
+                         std::to_string(simulationFileVersion) + ")");
   }
   const std::uint32_t headerBytes = detail::getU32(bytes + detail::offsetHeaderBytes);
   if (headerBytes != simulationHeaderBytes) {
-    throw ParseError(name, 0, "header size " + std::to_string(headerBytes) + ", expected " +
-                                  std::to_string(simulationHeaderBytes));
+    throw ParseError(
+        name, 0, "header size " + std::to_string(headerBytes) + ", expected " + std::to_string(simulationHeaderBytes));
   }
   const std::uint32_t storedCrc = detail::getU32(bytes + detail::offsetHeaderCrc);
   const std::uint32_t actualCrc = crc32(bytes, detail::offsetHeaderCrc);
   if (storedCrc != actualCrc) {
-    throw ParseError(name, 0, "header checksum mismatch (stored " + hex32(storedCrc) + ", computed " +
-                                  hex32(actualCrc) + "): the header is corrupted");
+    throw ParseError(name, 0,
+                     "header checksum mismatch (stored " + hex32(storedCrc) + ", computed " + hex32(actualCrc) +
+                         "): the header is corrupted");
   }
 
   // Sizes are checked before anything is allocated from them.
   const std::uint64_t numVertices = detail::getU64(bytes + detail::offsetNumVertices);
   if (numVertices == 0 || numVertices > static_cast<std::uint64_t>(maxSimulationFileVertices)) {
-    throw ParseError(name, 0, "header claims " + std::to_string(numVertices) + " vertices (expected 1 to " +
-                                  std::to_string(maxSimulationFileVertices) + ")");
+    throw ParseError(name, 0,
+                     "header claims " + std::to_string(numVertices) + " vertices (expected 1 to " +
+                         std::to_string(maxSimulationFileVertices) + ")");
   }
   header_.numVertices = static_cast<std::int64_t>(numVertices);
   header_.frameInterval = detail::getF64(bytes + detail::offsetFrameInterval);
@@ -86,9 +90,10 @@ SimulationReader::SimulationReader(const std::filesystem::path& path) : path_(pa
   header_.hasVelocities = (flags & detail::flagVelocities) != 0;
   const std::uint64_t recordBytes = detail::getU64(bytes + detail::offsetRecordBytes);
   if (recordBytes != static_cast<std::uint64_t>(header_.recordBytes())) {
-    throw ParseError(name, 0, "header record size " + std::to_string(recordBytes) + " disagrees with " +
-                                  std::to_string(numVertices) + " vertices (expected " +
-                                  std::to_string(header_.recordBytes()) + ")");
+    throw ParseError(name, 0,
+                     "header record size " + std::to_string(recordBytes) + " disagrees with " +
+                         std::to_string(numVertices) + " vertices (expected " + std::to_string(header_.recordBytes()) +
+                         ")");
   }
   refresh();
 }
@@ -131,14 +136,14 @@ void SimulationReader::readFrame(std::int64_t k, SimulationFrame& out) {
   const std::uint32_t storedCrc = detail::getU32(in + crcOffset);
   const std::uint32_t actualCrc = crc32(in, crcOffset);
   if (storedCrc != actualCrc) {
-    throw ParseError(path_.string(), 0, "frame " + std::to_string(k) + ": checksum mismatch (stored " +
-                                            hex32(storedCrc) + ", computed " + hex32(actualCrc) +
-                                            "): the record is corrupted");
+    throw ParseError(path_.string(), 0,
+                     "frame " + std::to_string(k) + ": checksum mismatch (stored " + hex32(storedCrc) + ", computed " +
+                         hex32(actualCrc) + "): the record is corrupted");
   }
   const auto index = static_cast<std::int64_t>(detail::getU64(in));
   if (index != k) {
-    throw ParseError(path_.string(), 0, "frame " + std::to_string(k) + ": record says it is frame " +
-                                            std::to_string(index));
+    throw ParseError(path_.string(), 0,
+                     "frame " + std::to_string(k) + ": record says it is frame " + std::to_string(index));
   }
   out.index = index;
   out.time = detail::getF64(in + 8);

@@ -1,16 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <unistd.h>
+
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/simulationIO/crc32.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
-
-#include "detail/byteOrder.hpp"
-
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <string>
 
-#include <unistd.h>
+#include "detail/byteOrder.hpp"
 
 namespace asyncfem {
 

@@ -2,7 +2,6 @@
 #pragma once
 
 #include <asyncfem/simulationIO/simulationFile.hpp>
-
 #include <bit>
 #include <cstdint>
 #include <cstring>

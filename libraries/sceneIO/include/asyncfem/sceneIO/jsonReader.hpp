@@ -3,7 +3,6 @@
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
-
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,7 +16,7 @@ namespace asyncfem {
 ///
 /// Used by the scene parser and by integrator factories reading `integrator.options`.
 class JsonObjectReader {
-public:
+ public:
   /// value must be a JSON object (else an error naming path). path: the object's own key
   /// path ("" for the document root, "integrator.options", "forces[2]").
   JsonObjectReader(const nlohmann::json& value, std::string path, std::string sourceName);
@@ -46,8 +45,7 @@ public:
   std::string string(const std::string& key, const std::string& defaultValue);
   std::optional<std::string> optionalString(const std::string& key);
   /// A string that must be one of choices (the error lists them).
-  std::string choice(const std::string& key, const std::string& defaultValue,
-                     const std::vector<std::string>& choices);
+  std::string choice(const std::string& key, const std::string& defaultValue, const std::vector<std::string>& choices);
   /// [x, y, z], three finite numbers.
   Eigen::Vector3d vector3(const std::string& key, const Eigen::Vector3d& defaultValue);
   std::optional<Eigen::Vector3d> optionalVector3(const std::string& key);
@@ -61,17 +59,16 @@ public:
 
   /// Conversions of a value at an arbitrary path (elements of arrays).
   static double toNumber(const nlohmann::json& value, const std::string& path, const std::string& sourceName);
-  static int toInteger(const nlohmann::json& value, const std::string& path, const std::string& sourceName,
-                       int minimum, int maximum);
+  static int toInteger(const nlohmann::json& value, const std::string& path, const std::string& sourceName, int minimum,
+                       int maximum);
   static std::string toString(const nlohmann::json& value, const std::string& path, const std::string& sourceName);
-  static Eigen::Vector3d toVector3(const nlohmann::json& value, const std::string& path,
-                                   const std::string& sourceName);
+  static Eigen::Vector3d toVector3(const nlohmann::json& value, const std::string& path, const std::string& sourceName);
   /// Throws "<sourceName>: <path>: <message>".
   [[noreturn]] static void failAt(const std::string& sourceName, const std::string& path, const std::string& message);
   /// "a number", "a string", ... for messages.
   static std::string describe(const nlohmann::json& value);
 
-private:
+ private:
   const nlohmann::json& value_;
   std::string path_;
   std::string sourceName_;

@@ -1,14 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <Eigen/Core>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
-
-#include <Eigen/Core>
-#include <nlohmann/json.hpp>
-
 #include <filesystem>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,12 +57,12 @@ struct Scene {
   /// One external load, on a vertex set or on an explicit list of (0-based) vertex ids.
   struct Force {
     ForceType type = ForceType::pull;
-    std::string set;           ///< vertex set name, or empty when vertices are listed
-    std::vector<int> vertices;  ///< 0-based vertex ids (when set is empty)
+    std::string set;                                   ///< vertex set name, or empty when vertices are listed
+    std::vector<int> vertices;                         ///< 0-based vertex ids (when set is empty)
     Eigen::Vector3d vector = Eigen::Vector3d::Zero();  ///< pull: total force; impulse: total impulse
-    double start = 0.0;         ///< pull: active for start <= t < end
+    double start = 0.0;                                ///< pull: active for start <= t < end
     double end = std::numeric_limits<double>::infinity();
-    double time = 0.0;          ///< impulse: when it is delivered
+    double time = 0.0;  ///< impulse: when it is delivered
   };
 
   enum class ForceModelKind { linear, corotational };

@@ -4,12 +4,10 @@
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
-#include <nlohmann/json.hpp>
-
 #include <functional>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -30,7 +28,7 @@ using IntegratorFactory = std::function<std::unique_ptr<Integrator>(
 ///     registry.add("async", makeAsyncFromScene);
 ///     Simulation simulation = buildSimulation(scene, registry);
 class IntegratorRegistry {
-public:
+ public:
   /// Adds (or replaces) the factory for name.
   void add(const std::string& name, IntegratorFactory factory);
   /// The factory for name, or nullptr.
@@ -38,7 +36,7 @@ public:
   /// Registered names, sorted.
   std::vector<std::string> names() const;
 
-private:
+ private:
   std::map<std::string, IntegratorFactory> factories_;
 };
 

@@ -2,7 +2,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -60,7 +59,7 @@ struct SimulationFrame {
 /// Errors (cannot create, write failure, wrong vector size, non-finite values) throw
 /// asyncfem::Error naming the file.
 class SimulationWriter {
-public:
+ public:
   struct Options {
     /// Also fsync() after every frame, so frames survive a machine crash, not only a
     /// killed process (slower).
@@ -86,7 +85,7 @@ public:
   /// Flushes and closes; further appends throw. The destructor closes too (silently).
   void close();
 
-private:
+ private:
   struct FileCloser {
     void operator()(std::FILE* file) const;
   };
@@ -112,7 +111,7 @@ private:
 /// reported by truncatedTrailingBytes(). readFrame() verifies the record's checksum and
 /// index and throws a ParseError naming the frame if they do not match.
 class SimulationReader {
-public:
+ public:
   explicit SimulationReader(const std::filesystem::path& path);
   ~SimulationReader();
   SimulationReader(const SimulationReader&) = delete;
@@ -137,7 +136,7 @@ public:
   /// Reads and checks every complete frame; throws at the first bad one.
   void verifyAll();
 
-private:
+ private:
   struct FileCloser {
     void operator()(std::FILE* file) const;
   };
