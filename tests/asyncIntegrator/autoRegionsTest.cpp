@@ -78,5 +78,23 @@ TEST(AutoRegions, NothingProposedWhenEverythingMeetsTheTarget) {
   EXPECT_THROW(suggestRegions(ts.mesh, ts.system.freeDofs, options), ValidationError);
 }
 
+// Relative mode (the default): the stiff, light tip is about an order of magnitude
+// "faster" than the median element, so it alone becomes a region, whatever hL is.
+TEST(AutoRegions, RelativeModeFindsTheStiffPartAtAnyTimestep) {
+  const test::TestSystem ts = test::makeTestSystem(0, 0);
+  double targetPerTimestep = -1;  // the relative target is proportional to hL
+  for (double hL : {1e-4, 1e-2, 1.0}) {
+    AutoRegionOptions options;
+    options.largeTimestep = hL;
+    options.growLayers = 0;
+    const AutoRegionProposal proposal = suggestRegions(ts.mesh, ts.system.freeDofs, options);
+    ASSERT_EQ(proposal.regions.size(), 1u) << "hL " << hL;
+    for (int v : proposal.regions[0].region.vertices) EXPECT_GE(ts.mesh.restPosition(v).x(), 0.75 - 1e-12);
+    EXPECT_GE(proposal.regions[0].region.ratio, 2);
+    if (targetPerTimestep < 0) targetPerTimestep = proposal.targetOmegaH / hL;
+    EXPECT_NEAR(proposal.targetOmegaH / hL, targetPerTimestep, 1e-12 * targetPerTimestep);
+  }
+}
+
 }  // namespace
 }  // namespace asyncfem

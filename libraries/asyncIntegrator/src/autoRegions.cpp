@@ -37,8 +37,11 @@ std::vector<AsyncRegion> AutoRegionProposal::asyncRegions() const {
 }
 
 AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options) {
-  if (!(options.largeTimestep > 0.0) || !(options.targetOmegaH > 0.0)) {
-    throw ValidationError("automatic regions: the large timestep and the omega*h target must be positive");
+  if (!(options.largeTimestep > 0.0) || !std::isfinite(options.largeTimestep)) {
+    throw ValidationError("automatic regions: the large timestep must be positive");
+  }
+  if (!(options.targetOmegaH > 0.0) && !(options.relativeThreshold > 1.0)) {
+    throw ValidationError("automatic regions: give an omega*h target > 0 or a relative threshold > 1");
   }
   if (options.growLayers < 0 || options.maxRatio < 1) {
     throw ValidationError("automatic regions: growLayers must be >= 0 and maxRatio >= 1");
@@ -46,6 +49,13 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   const int nv = mesh.numVertices(), ne = mesh.numElements();
   const Eigen::VectorXd omega = elementMaxFrequencies(mesh);
   const double hL = options.largeTimestep;
+  double target = options.targetOmegaH;
+  if (!(target > 0.0)) {
+    std::vector<double> sorted(omega.data(), omega.data() + omega.size());
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    const double median = sorted.empty() ? 0.0 : sorted[sorted.size() / 2];
+    target = options.relativeThreshold * median * hL;
+  }
 
   // Vertex -> elements adjacency.
   std::vector<int> offsets(static_cast<std::size_t>(nv) + 1, 0), incident(static_cast<std::size_t>(4 * ne));
@@ -60,7 +70,7 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
 
   std::vector<char> fast(static_cast<std::size_t>(nv), 0);
   for (int e = 0; e < ne; ++e) {
-    if (omega[e] * hL > options.targetOmegaH)
+    if (omega[e] * hL > target)
       for (int a = 0; a < 4; ++a) fast[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
   }
   // Grow by rings: every vertex sharing an element with a fast vertex.
@@ -120,7 +130,7 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
 
   AutoRegionProposal proposal;
   proposal.largeTimestep = hL;
-  proposal.targetOmegaH = options.targetOmegaH;
+  proposal.targetOmegaH = target;
   std::vector<ProposedRegion> regions(static_cast<std::size_t>(numComponents));
   for (int e = 0; e < ne; ++e) {
     int owner = -1;
@@ -148,7 +158,7 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
     for (int v : r.region.vertices)
       for (int c = 0; c < 3; ++c) hasFree = hasFree || !freeDofs.isFixed(3 * v + c);
     if (!hasFree) continue;
-    const double wanted = std::ceil(r.maxFrequency * hL / options.targetOmegaH - 1e-12);
+    const double wanted = std::ceil(r.maxFrequency * hL / target - 1e-12);
     r.region.ratio = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(options.maxRatio)));
     r.region.name = "auto" + std::to_string(proposal.regions.size() + 1);
     proposal.regions.push_back(std::move(r));

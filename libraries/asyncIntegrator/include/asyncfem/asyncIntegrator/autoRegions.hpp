@@ -20,8 +20,13 @@ Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh);
 struct AutoRegionOptions {
   double largeTimestep = 1e-2;  ///< hL (s)
   /// Target for omega * h in every region: an element with omega_e hL above it wants a
-  /// fast region with ratio ceil(omega_e hL / target).
-  double targetOmegaH = 2.0;
+  /// fast region with ratio ceil(omega_e hL / target). <= 0: relative mode (below).
+  double targetOmegaH = 0.0;
+  /// Relative mode: target = relativeThreshold * median(omega_e) * hL. Implicit integrators
+  /// run with omega_max h far above 1 (the highest element modes are invisible and damped
+  /// away); what matters is that stiff or light parts are not resolved much worse than the
+  /// bulk, so the default marks elements more than 3x "faster" than the median one.
+  double relativeThreshold = 3.0;
   /// Rings of vertices added around each fast region (0: none). Growing moves the
   /// interface away from the stiff material and rounds its outline, which keeps the
   /// interface (the dense part of H^{LL*}) small relative to |S|.
@@ -41,7 +46,7 @@ struct AutoRegionProposal {
   std::vector<ProposedRegion> regions;
   double largeRegionMaxFrequency = 0.0;  ///< max omega_e over elements touching no fast vertex
   double largeTimestep = 0.0;
-  double targetOmegaH = 0.0;
+  double targetOmegaH = 0.0;  ///< the target in effect (absolute, or from the relative mode)
   /// The regions alone, ready for RegionPartition / AsyncBackwardEuler.
   std::vector<AsyncRegion> asyncRegions() const;
 };
