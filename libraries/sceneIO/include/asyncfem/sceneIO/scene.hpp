@@ -86,7 +86,7 @@ struct Scene {
   ForceModelKind forceModel = ForceModelKind::linear;
   Tangent tangent = Tangent::simple;  ///< corotational only
 
-  struct Integrator {
+  struct IntegratorSettings {
     std::string name = "backward-euler";
     double timestep = 0.0;  ///< h (> 0)
     /// Integrator-specific keys, passed through unparsed to the integrator's factory
@@ -94,12 +94,12 @@ struct Scene {
     nlohmann::json options = nlohmann::json::object();
   } integrator;
 
-  struct Frames {
+  struct FrameSettings {
     double rate = 30.0;  ///< frames per time unit; frame interval = 1 / rate
     int count = 60;
   } frames;
 
-  struct Output {
+  struct OutputSettings {
     std::filesystem::path file;       ///< .afsim output; empty: none given in the scene
     std::filesystem::path vtuFolder;  ///< empty: no .vtu files
     int vtuEvery = 1;                 ///< write a .vtu every this many frames
