@@ -204,7 +204,8 @@ TEST(Assembler, SlotMapAgreesWithTripletAssembly) {
 
 TEST(Assembler, AssemblyIsBitIdenticalAcrossThreadCountsAndRepeats) {
   const ThreadCountGuard guard;
-  const TetMesh mesh = test::perturbedBox(8, 11);
+  // 24576 elements: above the size from which the assembler uses threads.
+  const TetMesh mesh = test::perturbedBox(16, 11);
   const MatrixAssembler assembler(mesh);
   ASSERT_GT(assembler.numColors(), 1);
   omp_set_num_threads(1);
@@ -240,7 +241,7 @@ TEST(Assembler, ShuffledNumberingStaysCorrectAndDeterministic) {
   // Random vertex and element numbering defeats the locality the chunk colouring relies
   // on; the assembler must shrink its chunks and still be exact and deterministic.
   const ThreadCountGuard guard;
-  const TetMesh box = test::mixedMaterialBox(6);
+  const TetMesh box = test::mixedMaterialBox(16);  // 24576 elements: threaded assembly
   std::mt19937 random(17);
   std::vector<int> vertexOrder(static_cast<std::size_t>(box.numVertices()));
   std::vector<int> elementOrder(static_cast<std::size_t>(box.numElements()));

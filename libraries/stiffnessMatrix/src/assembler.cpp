@@ -22,6 +22,12 @@ using Index = std::size_t;
 
 Index toIndex(int i) { return static_cast<Index>(i); }
 
+// Below this many elements an assembly takes about 2 ms on one core; the handful of
+// barriers (one per colour) of a threaded run then gains little and, on a loaded machine
+// where a thread may be descheduled at a barrier, can cost several times the work. The
+// result does not depend on this choice: the summation order is fixed by the colouring.
+constexpr int kMinElementsForThreads = 16384;
+
 // Prefix sum of counts in place: counts[i] becomes the start of segment i; returns the
 // total. counts has one trailing entry that receives the total.
 long long exclusiveScan(std::vector<int>& counts) {
@@ -271,7 +277,7 @@ void MatrixAssembler::assembleWith(const ElementFunction& elementMatrix, Eigen::
   // on the thread count or the schedule.
   std::exception_ptr firstError;
   int firstErrorElement = INT_MAX;
-#pragma omp parallel
+#pragma omp parallel if (numElements_ >= kMinElementsForThreads)
   {
 #pragma omp for schedule(static)
     for (Eigen::Index k = 0; k < nnz; ++k) values[k] = 0.0;
@@ -336,7 +342,7 @@ Eigen::VectorXd MatrixAssembler::assembleVector(const ElementVectorFunction& ele
   const int numColors = this->numColors();
   std::exception_ptr firstError;
   int firstErrorElement = INT_MAX;
-#pragma omp parallel
+#pragma omp parallel if (numElements_ >= kMinElementsForThreads)
   {
     for (int color = 0; color < numColors; ++color) {
 #pragma omp for schedule(dynamic, 1)
