@@ -427,7 +427,7 @@ void AsyncBackwardEuler::step() {
   // The state-dependent part, once per large step: f_int(u_0) + D v_0 (full vector).
   Eigen::VectorXd stateForce = d.internalForce;
   if (damped) stateForce += dampVelocity;
-  Eigen::VectorXd externalForce;
+  Eigen::VectorXd externalForce, predicted;
   const std::vector<int>& large = partition_.largeDofs();
   const int numRegions = partition_.numRegions();
   std::vector<Eigen::MatrixXd> rhsS(static_cast<std::size_t>(numRegions));  // |S| x m, column r-1 = b_r
@@ -438,7 +438,13 @@ void AsyncBackwardEuler::step() {
     b.resize(static_cast<Eigen::Index>(s.size()), rb.ratio);
     for (int r = 1; r <= rb.ratio; ++r) {
       const double tau = r * rb.smallStep;
-      evaluateExternalForce(t0 + tau, externalForce);
+      if (options_.substepStatePrediction && system_.externalForce) {
+        predicted = u0 + tau * v0;
+        externalForce.setZero(u0.size());
+        system_.externalForce(t0 + tau, predicted, v0, externalForce);
+      } else {
+        evaluateExternalForce(t0 + tau, externalForce);
+      }
       for (std::size_t k = 0; k < s.size(); ++k) {
         const int dof = s[k];
         b(static_cast<Eigen::Index>(k), r - 1) =

@@ -318,6 +318,59 @@ void throwSceneError(const Scene& scene, const std::string& keyPath, const std::
   JsonObjectReader::failAt(scene.sourceName, keyPath, message);
 }
 
+void parseContact(JsonObjectReader& top, Scene& scene) {
+  const nlohmann::json* contact = top.find("contact");
+  if (contact == nullptr) return;
+  const std::string& source = scene.sourceName;
+  JsonObjectReader reader(*contact, "contact", source);
+  Scene::Contact& out = scene.contact;
+  if (const nlohmann::json* ground = reader.find("ground")) {
+    JsonObjectReader groundReader(*ground, reader.keyPath("ground"), source);
+    ContactPlane plane;
+    plane.normal = groundReader.vector3("up", Eigen::Vector3d::UnitY());
+    if (!(plane.normal.norm() > 0.0)) groundReader.fail("up", "expected a non-zero vector");
+    plane.normal.normalize();
+    plane.offset = groundReader.number("height", 0.0);
+    groundReader.finish();
+    out.planes.push_back(plane);
+  }
+  if (const nlohmann::json* planes = reader.find("planes")) {
+    if (!planes->is_array()) reader.fail("planes", "expected an array of {\"point\": [x, y, z], \"normal\": [x, y, z]}");
+    for (std::size_t i = 0; i < planes->size(); ++i) {
+      JsonObjectReader planeReader((*planes)[i], reader.elementPath("planes", i), source);
+      const Eigen::Vector3d point = JsonObjectReader::toVector3(planeReader.required("point"), planeReader.keyPath("point"), source);
+      Eigen::Vector3d normal = JsonObjectReader::toVector3(planeReader.required("normal"), planeReader.keyPath("normal"), source);
+      if (!(normal.norm() > 0.0)) planeReader.fail("normal", "expected a non-zero vector");
+      planeReader.finish();
+      normal.normalize();
+      out.planes.push_back({normal, normal.dot(point)});
+    }
+  }
+  if (const nlohmann::json* spheres = reader.find("spheres")) {
+    if (!spheres->is_array()) reader.fail("spheres", "expected an array of {\"center\": [x, y, z], \"radius\": r}");
+    for (std::size_t i = 0; i < spheres->size(); ++i) {
+      JsonObjectReader sphereReader((*spheres)[i], reader.elementPath("spheres", i), source);
+      ContactSphere sphere;
+      sphere.center = JsonObjectReader::toVector3(sphereReader.required("center"), sphereReader.keyPath("center"), source);
+      sphere.radius = sphereReader.requiredNumber("radius");
+      requirePositive(sphereReader, "radius", sphere.radius);
+      sphereReader.finish();
+      out.spheres.push_back(sphere);
+    }
+  }
+  PenaltyContactParameters& p = out.parameters;
+  p.stiffness = reader.number("stiffness", p.stiffness);
+  requirePositive(reader, "stiffness", p.stiffness);
+  p.damping = reader.number("damping", p.damping);
+  if (p.damping < 0.0) reader.fail("damping", "expected damping >= 0");
+  p.friction = reader.number("friction", p.friction);
+  if (p.friction < 0.0) reader.fail("friction", "expected a Coulomb coefficient >= 0");
+  p.frictionViscosity = reader.number("frictionViscosity", p.frictionViscosity);
+  requirePositive(reader, "frictionViscosity", p.frictionViscosity);
+  reader.finish();
+  if (!out.enabled()) reader.fail("ground", "contact needs a ground, planes or spheres");
+}
+
 Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePath, const std::string& sourceName) {
   Scene scene;
   scene.sourceName = sourceName;
@@ -357,6 +410,7 @@ Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePa
     }
     reader.finish();
   }
+  parseContact(top, scene);
   parseIntegrator(top, scene);
   if (const nlohmann::json* frames = top.find("frames")) {
     JsonObjectReader reader(*frames, "frames", sourceName);

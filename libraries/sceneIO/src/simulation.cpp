@@ -5,6 +5,7 @@
 #include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/integrator/factory.hpp>
 #include <asyncfem/sceneIO/jsonReader.hpp>
+#include <asyncfem/sceneIO/asyncScene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
@@ -277,6 +278,7 @@ std::string formatNumber(double value) {
 
 IntegratorRegistry defaultIntegratorRegistry() {
   IntegratorRegistry registry;
+  registry.add("async", asyncIntegratorFactory());
   for (const std::string& name : integratorNames()) {
     registry.add(
         name, [name](const Scene& scene, const TetMesh& /*mesh*/, DynamicSystem system, const nlohmann::json& options) {
@@ -346,9 +348,17 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
   } else {
     simulation.skipped.emplace_back("gravity load (gravity is zero)");
   }
-  if (gravityForce.size() > 0 || !loads.empty()) {
-    system.externalForce = [gravityForce, loads](double time, const Eigen::VectorXd& /*displacement*/,
-                                                 const Eigen::VectorXd& /*velocity*/, Eigen::VectorXd& forces) {
+  std::shared_ptr<const PenaltyContact> contact;
+  if (scene.contact.enabled()) {
+    contact = std::make_shared<PenaltyContact>(mesh->restPositions(), scene.contact.planes, scene.contact.spheres,
+                                               scene.contact.parameters);
+    simulation.contact = contact;
+  } else {
+    simulation.skipped.emplace_back("contact (no obstacles)");
+  }
+  if (gravityForce.size() > 0 || !loads.empty() || contact) {
+    system.externalForce = [gravityForce, loads, contact](double time, const Eigen::VectorXd& displacement,
+                                                          const Eigen::VectorXd& velocity, Eigen::VectorXd& forces) {
       if (gravityForce.size() > 0) {
         forces += gravityForce;
       }
@@ -360,6 +370,7 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
           forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
         }
       }
+      if (contact) contact->addForces(displacement, velocity, forces);
     };
   } else {
     simulation.skipped.emplace_back("external force evaluation (no gravity, no loads)");

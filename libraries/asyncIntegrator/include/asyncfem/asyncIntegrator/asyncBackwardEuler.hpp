@@ -41,6 +41,13 @@ struct AsyncOptions {
   AsyncSolveMethod method = AsyncSolveMethod::structured;
   RecoveryMode recovery = RecoveryMode::automatic;
   SolverKind regionSolver = SolverKind::cholmod;  ///< factors A^{S_i} (SPD)
+  /// State passed to the external force function at substep r of a fast region: false
+  /// (default) passes the large step's start state (u_0, v_0), so state-dependent forces
+  /// such as penalty contact act once per large step, as in the paper; true passes the
+  /// predicted state (u_0 + r hS v_0, v_0), so contacts of S vertices are tested at every
+  /// substep (an explicit prediction: the substep states themselves are unknowns of the
+  /// implicit solve).
+  bool substepStatePrediction = false;
 };
 
 /// Called after a large step for every substep r = 1..m_i of fast region i, only when a

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <asyncfem/contact/penaltyContact.hpp>
+
 #include <Eigen/Core>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
@@ -84,6 +86,13 @@ struct Scene {
   double rayleighAlpha = 0.0;  ///< D = alpha M + beta K
   double rayleighBeta = 0.0;
   ForceModelKind forceModel = ForceModelKind::linear;
+  /// Penalty contact with static obstacles (docs/scene-format.md, "contact").
+  struct Contact {
+    std::vector<ContactPlane> planes;    ///< the ground is one of them
+    std::vector<ContactSphere> spheres;
+    PenaltyContactParameters parameters;
+    bool enabled() const { return !planes.empty() || !spheres.empty(); }
+  } contact;
   Tangent tangent = Tangent::simple;  ///< corotational only
 
   struct IntegratorSettings {

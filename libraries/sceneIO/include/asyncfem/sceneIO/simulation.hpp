@@ -21,8 +21,8 @@ using IntegratorFactory = std::function<std::unique_ptr<Integrator>(
     const Scene& scene, const TetMesh& mesh, DynamicSystem system, const nlohmann::json& options)>;
 
 /// Integrator name -> factory. defaultIntegratorRegistry() holds the single-rate
-/// integrators of library `integrator`; other libraries (e.g. the asynchronous
-/// integrator, name "async") add theirs with add() before buildSimulation():
+/// integrators of library `integrator` and the asynchronous integrator ("async"); other
+/// libraries add theirs with add() before buildSimulation():
 ///
 ///     IntegratorRegistry registry = defaultIntegratorRegistry();
 ///     registry.add("async", makeAsyncFromScene);
@@ -42,7 +42,7 @@ class IntegratorRegistry {
 
 /// "backward-euler", "trapezoidal", "central-differences", "symplectic-euler", each
 /// reading the options keys solver, maxIterations, tolerance, maxFrequency, force (see
-/// docs/scene-format.md and IntegratorOptions).
+/// docs/scene-format.md and IntegratorOptions), and "async" (asyncScene.hpp).
 IntegratorRegistry defaultIntegratorRegistry();
 
 /// A scene ready to run: the mesh, the integrator (which owns the DynamicSystem and the
@@ -58,6 +58,8 @@ struct Simulation {
   int numFrames = 0;
 
   std::vector<int> fixedVertices;  ///< sorted, 0-based
+  /// The penalty contact model when the scene has obstacles (for reports: penetration).
+  std::shared_ptr<const PenaltyContact> contact;
   /// Diagonal of the rest bounding box, and the blow-up limit on max |u| (1000 times it).
   double boundingBoxDiagonal = 0.0;
   double blowUpDisplacement = 0.0;

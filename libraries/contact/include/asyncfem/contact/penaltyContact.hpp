@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace asyncfem {
+
+/// A static half-space obstacle {x : n . x >= offset}; the body must stay on the side n
+/// points to. The ground is a plane with n = up.
+struct ContactPlane {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  ///< normalised by the model
+  double offset = 0.0;                                ///< n . x on the plane
+};
+
+/// A static solid sphere obstacle.
+struct ContactSphere {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 1.0;
+};
+
+/// Penalty contact of the mesh vertices against static planes and spheres.
+///
+/// For a vertex at x = X + u with velocity v and penetration depth d > 0 along the
+/// obstacle's outward normal n (plane: d = offset - n . x; sphere: d = r - |x - c|,
+/// n = (x - c)/|x - c|), the force is
+///     f_n = (k d - c (v . n)) n, clamped so that its normal component is >= 0
+///           (the obstacle pushes, never pulls),
+/// and with Coulomb friction (mu > 0) a tangential force opposing the tangential
+/// velocity v_t,
+///     f_t = -min(mu |f_n|, eta |v_t|) v_t / |v_t|,
+/// regularised by eta (viscous below the sliding threshold, so resting contact does not
+/// chatter). k: stiffness (force / length per vertex), c: normal damping (force /
+/// velocity per vertex). Frictionless when mu = 0 (default).
+///
+/// The forces are explicit (evaluated at one state); integrators apply them once per
+/// (large) step.
+struct PenaltyContactParameters {
+  double stiffness = 1e4;
+  double damping = 0.0;
+  double friction = 0.0;           ///< Coulomb coefficient mu
+  double frictionViscosity = 1e3;  ///< eta
+};
+
+class PenaltyContact {
+public:
+  /// restPositions: 3 x n. Throws asyncfem::ValidationError for a non-positive stiffness,
+  /// negative damping/friction, a zero plane normal or a non-positive sphere radius.
+  PenaltyContact(Eigen::Matrix3Xd restPositions, std::vector<ContactPlane> planes, std::vector<ContactSphere> spheres,
+                 PenaltyContactParameters parameters);
+
+  /// Adds the contact forces at state (u, v) (both 3n) to forces (3n). Only vertices in
+  /// `vertices` are tested when it is non-null (e.g. a fast region's vertices).
+  void addForces(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, Eigen::VectorXd& forces,
+                 const std::vector<int>* vertices = nullptr) const;
+
+  /// Largest penetration depth over all vertices and obstacles at u (0 if none).
+  double maxPenetration(const Eigen::VectorXd& displacement) const;
+  /// Number of vertices in contact at u.
+  int activeContacts(const Eigen::VectorXd& displacement) const;
+
+  const PenaltyContactParameters& parameters() const { return parameters_; }
+
+private:
+  template <class Visitor>
+  void forEachContact(const Eigen::VectorXd& displacement, const std::vector<int>* vertices, Visitor&& visit) const;
+
+  Eigen::Matrix3Xd restPositions_;
+  std::vector<ContactPlane> planes_;
+  std::vector<ContactSphere> spheres_;
+  PenaltyContactParameters parameters_;
+};
+
+}  // namespace asyncfem

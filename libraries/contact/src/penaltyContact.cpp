@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/contact/penaltyContact.hpp>
+#include <asyncfem/core/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace asyncfem {
+
+PenaltyContact::PenaltyContact(Eigen::Matrix3Xd restPositions, std::vector<ContactPlane> planes,
+                               std::vector<ContactSphere> spheres, PenaltyContactParameters parameters)
+    : restPositions_(std::move(restPositions)),
+      planes_(std::move(planes)),
+      spheres_(std::move(spheres)),
+      parameters_(parameters) {
+  const PenaltyContactParameters& p = parameters_;
+  if (!(p.stiffness > 0.0) || !std::isfinite(p.stiffness)) throw ValidationError("contact: stiffness must be > 0");
+  if (!(p.damping >= 0.0) || !(p.friction >= 0.0) || !(p.frictionViscosity > 0.0)) {
+    throw ValidationError("contact: damping and friction must be >= 0 and the friction viscosity > 0");
+  }
+  for (std::size_t i = 0; i < planes_.size(); ++i) {
+    const double norm = planes_[i].normal.norm();
+    if (!(norm > 0.0) || !std::isfinite(norm)) {
+      throw ValidationError("contact: plane " + std::to_string(i) + " has a zero or non-finite normal");
+    }
+    // n . x >= offset is the allowed side; scale offset with the normal to keep the plane.
+    planes_[i].normal /= norm;
+    planes_[i].offset /= norm;
+  }
+  for (std::size_t i = 0; i < spheres_.size(); ++i) {
+    if (!(spheres_[i].radius > 0.0)) throw ValidationError("contact: sphere " + std::to_string(i) + " needs a radius > 0");
+  }
+}
+
+template <class Visitor>
+void PenaltyContact::forEachContact(const Eigen::VectorXd& displacement, const std::vector<int>* vertices,
+                                    Visitor&& visit) const {
+  const int n = static_cast<int>(restPositions_.cols());
+  const int count = vertices ? static_cast<int>(vertices->size()) : n;
+  for (int k = 0; k < count; ++k) {
+    const int v = vertices ? (*vertices)[static_cast<std::size_t>(k)] : k;
+    const Eigen::Vector3d x = restPositions_.col(v) + displacement.segment<3>(3 * v);
+    for (const ContactPlane& plane : planes_) {
+      const double depth = plane.offset - plane.normal.dot(x);
+      if (depth > 0.0) visit(v, depth, plane.normal);
+    }
+    for (const ContactSphere& sphere : spheres_) {
+      const Eigen::Vector3d r = x - sphere.center;
+      const double distance = r.norm();
+      const double depth = sphere.radius - distance;
+      if (depth > 0.0) {
+        const Eigen::Vector3d normal = distance > 0.0 ? Eigen::Vector3d(r / distance) : Eigen::Vector3d::UnitY();
+        visit(v, depth, normal);
+      }
+    }
+  }
+}
+
+void PenaltyContact::addForces(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                               Eigen::VectorXd& forces, const std::vector<int>* vertices) const {
+  const PenaltyContactParameters& p = parameters_;
+  forEachContact(displacement, vertices, [&](int v, double depth, const Eigen::Vector3d& normal) {
+    const Eigen::Vector3d vel = velocity.segment<3>(3 * v);
+    const double normalVelocity = vel.dot(normal);
+    const double normalForce = std::max(0.0, p.stiffness * depth - p.damping * normalVelocity);
+    Eigen::Vector3d f = normalForce * normal;
+    if (p.friction > 0.0) {
+      const Eigen::Vector3d tangential = vel - normalVelocity * normal;
+      const double speed = tangential.norm();
+      if (speed > 0.0) {
+        const double magnitude = std::min(p.friction * normalForce, p.frictionViscosity * speed);
+        f -= (magnitude / speed) * tangential;
+      }
+    }
+    forces.segment<3>(3 * v) += f;
+  });
+}
+
+double PenaltyContact::maxPenetration(const Eigen::VectorXd& displacement) const {
+  double worst = 0.0;
+  forEachContact(displacement, nullptr, [&](int, double depth, const Eigen::Vector3d&) { worst = std::max(worst, depth); });
+  return worst;
+}
+
+int PenaltyContact::activeContacts(const Eigen::VectorXd& displacement) const {
+  int count = 0;
+  int last = -1;
+  forEachContact(displacement, nullptr, [&](int v, double, const Eigen::Vector3d&) {
+    if (v != last) ++count;
+    last = v;
+  });
+  return count;
+}
+
+}  // namespace asyncfem

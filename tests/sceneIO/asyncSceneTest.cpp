@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Scenes that name the asynchronous integrator, and scenes with contact.
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/sceneIO/simulation.hpp>
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "sceneTestUtilities.hpp"
+
+namespace {
+
+using asyncfem::Simulation;
+
+/// A 4 x 1 x 1-cell bar fixed at x = 0 with a stiff end x >= 3, pulled down at x = 4.
+nlohmann::json barScene() {
+  return nlohmann::json::parse(R"({
+    "mesh": {"generator": "box", "size": [4, 1, 1], "cells": [4, 1, 1],
+             "material": {"name": "soft", "density": 1000, "youngsModulus": 1e5, "poissonRatio": 0.4},
+             "regions": [{"name": "end", "min": [3, -1, -1], "max": [5, 2, 2],
+                          "material": {"name": "stiff", "density": 200, "youngsModulus": 5e6, "poissonRatio": 0.3}}]},
+    "fixed": {"sets": ["xmin"]},
+    "forces": [{"type": "pull", "set": "xmax", "force": [0, -10, 0], "window": [0, 0.05]}],
+    "integrator": {"name": "async", "timestep": 0.01,
+                   "options": {"regions": [{"name": "end", "ratio": 4, "elementSets": ["end"]}]}},
+    "frames": {"rate": 50, "count": 3}
+  })");
+}
+
+Simulation build(const nlohmann::json& json) {
+  return asyncfem::buildSimulation(asyncfem::parseScene(json, "", "scene.json"));
+}
+
+std::string errorOf(const nlohmann::json& json) {
+  try {
+    build(json);
+  } catch (const asyncfem::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(AsyncScene, BuildsAndRunsTheNamedRegions) {
+  Simulation simulation = build(barScene());
+  auto* async = dynamic_cast<asyncfem::AsyncBackwardEuler*>(simulation.integrator.get());
+  ASSERT_NE(async, nullptr);
+  ASSERT_EQ(async->partition().numRegions(), 1);
+  EXPECT_EQ(async->partition().ratio(0), 4);
+  for (int dof : async->partition().regionDofs(0)) EXPECT_GE(simulation.mesh->restPosition(dof / 3).x(), 3.0 - 1e-12);
+  for (int frame = 0; frame < simulation.numFrames; ++frame) asyncfem::advanceFrame(simulation, frame);
+  EXPECT_GT(simulation.integrator->displacement().norm(), 0.0);
+}
+
+TEST(AsyncScene, SelectorsAndSolverOptions) {
+  nlohmann::json scene = barScene();
+  scene["integrator"]["options"] = nlohmann::json::parse(R"({
+    "regions": [{"name": "a", "ratio": 3, "boxes": [{"min": [3.9, -1, -1], "max": [4.1, 2, 2]}]},
+                {"name": "b", "ratio": 2, "vertices": [1]}],
+    "schur": "lu", "recovery": "substitution", "method": "structured", "regionSolver": "eigen-ldlt"})");
+  Simulation simulation = build(scene);
+  auto* async = dynamic_cast<asyncfem::AsyncBackwardEuler*>(simulation.integrator.get());
+  ASSERT_NE(async, nullptr);
+  EXPECT_EQ(async->partition().numRegions(), 2);
+  EXPECT_EQ(async->options().schur, asyncfem::SchurMode::lu);
+  EXPECT_EQ(async->options().regionSolver, asyncfem::SolverKind::eigenLDLT);
+  asyncfem::advanceFrame(simulation, 0);
+}
+
+TEST(AsyncScene, AutomaticRegionsByDefault) {
+  nlohmann::json scene = barScene();
+  scene["integrator"]["options"] = nlohmann::json::object();
+  Simulation simulation = build(scene);
+  auto* async = dynamic_cast<asyncfem::AsyncBackwardEuler*>(simulation.integrator.get());
+  ASSERT_NE(async, nullptr);
+  ASSERT_GE(async->partition().numRegions(), 1);  // the stiff, light end
+  asyncfem::advanceFrame(simulation, 0);
+}
+
+TEST(AsyncScene, ErrorsNameTheKey) {
+  struct Case {
+    const char* options;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {R"({"regions": [{"ratio": 0, "vertexSets": ["xmax"]}]})", "integrator.options.regions[0].ratio"},
+      {R"({"regions": [{"ratio": 2, "vertexSets": ["nope"]}]})", "unknown vertex set 'nope'"},
+      {R"({"regions": [{"ratio": 2}]})", "integrator.options.regions[0]: selects no vertex"},
+      {R"({"regions": [{"ratio": 2, "vertices": [999]}]})", "integrator.options.regions[0].vertices[0]"},
+      {R"({"regions": [{"ratio": 2, "vertexSets": ["xmax"]}, {"ratio": 2, "vertexSets": ["xmax"]}]})",
+       "integrator.options.regions: regions"},
+      {R"({"regions": "everything"})", "integrator.options.regions: expected \"auto\""},
+      {R"({"regions": "auto", "schur": "fast"})", "integrator.options.schur"},
+      {R"({"regions": "auto", "bogus": 1})", "bogus"},
+      {R"({"regions": "auto", "auto": {"target": -1}})", "integrator.options.auto.target"},
+      {R"({"regions": "auto", "substepContact": true})", "integrator.options.substepContact"},
+      {R"({"regions": [{"ratio": 2, "vertexSets": ["xmin"]}]})", "no free degree of freedom"},
+  };
+  for (const Case& c : cases) {
+    nlohmann::json scene = barScene();
+    scene["integrator"]["options"] = nlohmann::json::parse(c.options);
+    const std::string message = errorOf(scene);
+    EXPECT_NE(message.find(c.expected), std::string::npos) << "options " << c.options << "\nmessage: " << message;
+    EXPECT_EQ(message.rfind("scene.json", 0), 0u) << message;
+  }
+}
+
+nlohmann::json droppedCube() {
+  return nlohmann::json::parse(R"({
+    "mesh": {"generator": "box", "origin": [0, 0.05, 0], "size": [0.2, 0.2, 0.2], "cells": [2, 2, 2],
+             "material": {"name": "rubber", "density": 1000, "youngsModulus": 2e5, "poissonRatio": 0.4}},
+    "gravity": [0, -9.81, 0],
+    "contact": {"ground": {"height": 0}, "stiffness": 2e4, "damping": 20},
+    "integrator": {"name": "backward-euler", "timestep": 0.002},
+    "frames": {"rate": 50, "count": 50}
+  })");
+}
+
+TEST(ContactScene, GroundStopsAFallingCube) {
+  Simulation simulation = build(droppedCube());
+  ASSERT_NE(simulation.contact, nullptr);
+  double lowest = 1e9;
+  for (int frame = 0; frame < simulation.numFrames; ++frame) {
+    asyncfem::advanceFrame(simulation, frame);
+    const Eigen::VectorXd& u = simulation.integrator->displacement();
+    for (int v = 0; v < simulation.mesh->numVertices(); ++v) {
+      lowest = std::min(lowest, simulation.mesh->restPosition(v).y() + u[3 * v + 1]);
+    }
+  }
+  // Without contact the cube falls 0.5 g t^2 = 4.9 m in 1 s; with it, it stops near y = 0.
+  // Impact: it falls 0.05 m (v = 1 m/s); a spring of k * 9 contact vertices stops mass 8 kg
+  // within v sqrt(m / (9 k)) = 6.7e-3. At rest: m g / (9 k) = 4.4e-4 (below 1e-3).
+  EXPECT_GT(lowest, -1e-2);
+  EXPECT_LT(simulation.contact->maxPenetration(simulation.integrator->displacement()), 1e-3);
+  EXPECT_GT(simulation.contact->activeContacts(simulation.integrator->displacement()), 0);
+}
+
+TEST(ContactScene, ErrorsNameTheKey) {
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"stiffness": 1e4})", "contact.ground: contact needs a ground, planes or spheres"},
+      {R"({"ground": {"height": 0}, "stiffness": -1})", "contact.stiffness"},
+      {R"({"ground": {"up": [0, 0, 0]}})", "contact.ground.up"},
+      {R"({"spheres": [{"center": [0, 0, 0], "radius": 0}]})", "contact.spheres[0].radius"},
+      {R"({"planes": [{"point": [0, 0, 0]}]})", "contact.planes[0]"},
+      {R"({"ground": {"height": 0}, "friction": -0.1})", "contact.friction"},
+      {R"({"ground": {"height": 0}, "slip": 1})", "slip"},
+  };
+  for (const auto& [contact, expected] : cases) {
+    nlohmann::json scene = droppedCube();
+    scene["contact"] = nlohmann::json::parse(contact);
+    const std::string message = errorOf(scene);
+    EXPECT_NE(message.find(expected), std::string::npos) << contact << "\nmessage: " << message;
+  }
+}
+
+}  // namespace
