@@ -1,0 +1,200 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The asynchronous step with corotational forces (the paper's Algorithm 2), and contact.
+#include "asyncTestSystem.hpp"
+
+#include <asyncfem/contact/penaltyContact.hpp>
+#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
+#include <asyncfem/integrator/backwardEuler.hpp>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+namespace asyncfem {
+namespace {
+
+using test::relativeDifference;
+
+/// The test system of asyncTestSystem.hpp with a corotational force model instead.
+test::TestSystem makeCorotationalSystem(double alpha, double beta) {
+  test::TestSystem ts = test::makeTestSystem(alpha, beta);
+  ts.system.forceModel = std::make_shared<CorotationalLinearFEM>(ts.mesh, TangentKind::simple);
+  return ts;
+}
+
+// m = 1: the nonlinear asynchronous step equals a corotational single-rate (linearized)
+// backward Euler step at hL. Tolerance 1e-9: same equations, different factorizations.
+TEST(NonlinearAsync, RatioOneEqualsCorotationalBackwardEuler) {
+  for (double alpha : {0.0, 0.5}) {
+    test::TestSystem ts = makeCorotationalSystem(alpha, alpha * 1e-3);
+    ts.u0 *= 100.0;  // a visibly nonlinear state (~0.1 displacement on a 1-long bar)
+    const double hL = 2e-3;
+    AsyncBackwardEuler async(ts.mesh, ts.system, hL, {{"tip", test::verticesBeyond(ts.mesh, 0.75), 1}});
+    BackwardEuler single(ts.system, hL);
+    async.setState(ts.u0, ts.v0);
+    single.setState(ts.u0, ts.v0);
+    for (int k = 0; k < 4; ++k) {
+      async.step();
+      single.step();
+    }
+    EXPECT_LT(relativeDifference(async.displacement(), single.displacement()), 1e-9);
+    EXPECT_LT(relativeDifference(async.velocity(), single.velocity()), 1e-9);
+    // Refactored every large step: one A^S and one A^L per step.
+    EXPECT_EQ(async.stats().factorizations, 2 * 4);
+  }
+}
+
+// The nonlinear step equals the exact-structure naive solve, with m > 1 and damping.
+TEST(NonlinearAsync, StructuredEqualsNaive) {
+  test::TestSystem ts = makeCorotationalSystem(0.2, 1e-3);
+  ts.u0 *= 100.0;
+  AsyncOptions naiveOptions;
+  naiveOptions.method = AsyncSolveMethod::naive;
+  std::vector<AsyncRegion> regions{{"tip", test::verticesBeyond(ts.mesh, 0.75), 6}};
+  AsyncBackwardEuler structured(ts.mesh, ts.system, 2e-3, regions);
+  AsyncBackwardEuler naive(ts.mesh, ts.system, 2e-3, regions, naiveOptions);
+  structured.setState(ts.u0, ts.v0);
+  naive.setState(ts.u0, ts.v0);
+  for (int k = 0; k < 4; ++k) {
+    structured.step();
+    naive.step();
+  }
+  EXPECT_LT(relativeDifference(structured.velocity(), naive.velocity()), 1e-9);
+}
+
+// At tiny amplitudes corotational forces are linear, so the nonlinear asynchronous step
+// equals the linear one. The difference is second order in the amplitude (rotations of
+// size |grad u| ~ 1e-6 here), so 1e-5 relative is a loose bound.
+TEST(NonlinearAsync, TinyAmplitudesMatchTheLinearStep) {
+  test::TestSystem linear = test::makeTestSystem(0.1, 1e-3);
+  test::TestSystem corotational = makeCorotationalSystem(0.1, 1e-3);
+  linear.system.externalForce = nullptr;  // the pull would drive amplitudes far from tiny
+  corotational.system.externalForce = nullptr;
+  std::vector<AsyncRegion> regions{{"tip", test::verticesBeyond(linear.mesh, 0.75), 5}};
+  AsyncBackwardEuler a(linear.mesh, linear.system, 2e-3, regions);
+  AsyncBackwardEuler b(corotational.mesh, corotational.system, 2e-3, regions);
+  a.setState(1e-3 * linear.u0, 1e-3 * linear.v0);
+  b.setState(1e-3 * linear.u0, 1e-3 * linear.v0);
+  for (int k = 0; k < 5; ++k) {
+    a.step();
+    b.step();
+  }
+  EXPECT_LT(relativeDifference(a.displacement(), b.displacement()), 1e-5);
+}
+
+/// Rest positions rotated rigidly by angle about axis, as a displacement field.
+Eigen::VectorXd rigidRotation(const TetMesh& mesh, double angle, const Eigen::Vector3d& axis) {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+  Eigen::VectorXd u(mesh.numDofs());
+  for (int v = 0; v < mesh.numVertices(); ++v) u.segment<3>(3 * v) = R * mesh.restPosition(v) - mesh.restPosition(v);
+  return u;
+}
+
+double maxEdgeStrain(const TetMesh& mesh, const Eigen::VectorXd& u) {
+  double worst = 0.0;
+  for (int e = 0; e < mesh.numElements(); ++e)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) {
+        const int i = mesh.elements()(a, e), j = mesh.elements()(b, e);
+        const double rest = (mesh.restPosition(i) - mesh.restPosition(j)).norm();
+        const double now = (mesh.restPosition(i) + u.segment<3>(3 * i) - mesh.restPosition(j) - u.segment<3>(3 * j)).norm();
+        worst = std::max(worst, std::abs(now - rest) / rest);
+      }
+  return worst;
+}
+
+// A large rigid rotation of the whole (unconstrained) mesh at rest stays exactly where it
+// is (no elastic force, so no motion), and a spinning mesh keeps its shape far better than
+// with linear forces, which inflate it.
+TEST(NonlinearAsync, RigidRotationCausesNoDeformation) {
+  test::TestSystem ts = makeCorotationalSystem(0.0, 0.0);
+  ts.system.freeDofs = FreeDofs(ts.mesh.numDofs(), {});
+  ts.system.externalForce = nullptr;
+  std::vector<AsyncRegion> regions{{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}};
+  const Eigen::VectorXd rotated = rigidRotation(ts.mesh, 1.2, Eigen::Vector3d(1, 2, 3));
+  AsyncBackwardEuler still(ts.mesh, ts.system, 2e-3, regions);
+  still.setState(rotated, Eigen::VectorXd::Zero(ts.mesh.numDofs()));
+  for (int k = 0; k < 10; ++k) still.step();
+  // 1e-9: forces at a rigid rotation are zero to round-off (~1e-12 of E * area).
+  EXPECT_LT(relativeDifference(still.displacement(), rotated), 1e-9);
+  EXPECT_LT(still.velocity().lpNorm<Eigen::Infinity>(), 1e-9);
+
+  // Spin about the bar's axis at 20 rad/s for 0.1 s (2 radians).
+  const Eigen::Vector3d omega(20.0, 0.0, 0.0);
+  Eigen::VectorXd spin(ts.mesh.numDofs());
+  for (int v = 0; v < ts.mesh.numVertices(); ++v) spin.segment<3>(3 * v) = omega.cross(ts.mesh.restPosition(v));
+  test::TestSystem linear = test::makeTestSystem(0.0, 0.0);
+  linear.system.freeDofs = ts.system.freeDofs;
+  linear.system.externalForce = nullptr;
+  AsyncBackwardEuler spinning(ts.mesh, ts.system, 2e-3, regions);
+  AsyncBackwardEuler spinningLinear(linear.mesh, linear.system, 2e-3, regions);
+  spinning.setState(Eigen::VectorXd::Zero(ts.mesh.numDofs()), spin);
+  spinningLinear.setState(Eigen::VectorXd::Zero(ts.mesh.numDofs()), spin);
+  for (int k = 0; k < 50; ++k) {
+    spinning.step();
+    spinningLinear.step();
+  }
+  const double corotationalStrain = maxEdgeStrain(ts.mesh, spinning.displacement());
+  const double linearStrain = maxEdgeStrain(ts.mesh, spinningLinear.displacement());
+  EXPECT_GT(linearStrain, 0.1);  // linear FEM visibly inflates a rotated body
+  EXPECT_LT(corotationalStrain, 0.1 * linearStrain);
+}
+
+// A body dropped on the ground comes to rest with small penetration and never gains
+// energy after its first impact (energy = kinetic + elastic + gravitational + penalty).
+TEST(NonlinearAsync, DroppedBodyRestsOnTheGround) {
+  BoxMeshSpec spec;
+  spec.origin = Eigen::Vector3d(0.0, 0.02, 0.0);
+  spec.size = Eigen::Vector3d(0.3, 0.1, 0.1);
+  spec.cells = Eigen::Vector3i(6, 2, 2);
+  spec.material = Material{"soft", 1000.0, 2e5, 0.4};
+  spec.regions.push_back({"stiff", Eigen::Vector3d(0.2, -1, -1), Eigen::Vector3d(1, 1, 1), Material{"stiff", 500.0, 5e6, 0.3}});
+  const TetMesh mesh = makeBoxMesh(spec);
+  MatrixAssembler assembler(mesh);
+  DynamicSystem system;
+  system.forceModel = std::make_shared<CorotationalLinearFEM>(mesh, TangentKind::simple);
+  system.mass = massMatrix(mesh, assembler, MassType::consistent);
+  system.freeDofs = FreeDofs(mesh.numDofs(), {});
+  const Eigen::Vector3d g(0.0, -9.81, 0.0);
+  const Eigen::VectorXd gravity = system.mass * g.replicate(mesh.numVertices(), 1);
+  PenaltyContactParameters parameters;
+  parameters.stiffness = 2e3;
+  parameters.damping = 5.0;
+  auto contact = std::make_shared<PenaltyContact>(mesh.restPositions(), std::vector<ContactPlane>{ContactPlane{}},
+                                                  std::vector<ContactSphere>{}, parameters);
+  system.externalForce = [gravity, contact](double, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                                            Eigen::VectorXd& f) {
+    f += gravity;
+    contact->addForces(u, v, f);
+  };
+  std::vector<AsyncRegion> regions{{"stiff", test::verticesBeyond(mesh, 0.25), 4}};
+  AsyncBackwardEuler async(mesh, system, 2e-3, regions);
+  auto energy = [&]() {
+    const Eigen::VectorXd& u = async.displacement();
+    double penalty = 0.0;
+    for (int v = 0; v < mesh.numVertices(); ++v) {
+      const double depth = -(mesh.restPosition(v).y() + u[3 * v + 1]);
+      if (depth > 0) penalty += 0.5 * parameters.stiffness * depth * depth;
+    }
+    return async.mechanicalEnergy() - gravity.dot(u) + penalty;
+  };
+  bool impacted = false;
+  double afterImpact = 0.0, worstGain = 0.0;
+  for (int k = 0; k < 1000; ++k) {  // 2 s
+    async.step();
+    const bool touching = contact->activeContacts(async.displacement()) > 0;
+    if (touching && !impacted) {
+      impacted = true;
+      afterImpact = energy();
+    }
+    if (impacted) worstGain = std::max(worstGain, energy() - afterImpact);
+  }
+  ASSERT_TRUE(impacted);
+  // Resting penetration m g / (k * contact vertices) = 3 kg * 9.81 / (2e3 * 21) = 7e-4.
+  EXPECT_LT(contact->maxPenetration(async.displacement()), 2e-3);
+  EXPECT_LT(async.velocity().lpNorm<Eigen::Infinity>(), 0.05);  // at rest
+  // No gain beyond 1% of the energy at impact (explicit penalty forces can pump a little).
+  EXPECT_LT(worstGain, 0.01 * std::abs(afterImpact) + 1e-9) << "energy at impact " << afterImpact;
+}
+
+}  // namespace
+}  // namespace asyncfem
