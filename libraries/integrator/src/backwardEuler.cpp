@@ -84,6 +84,8 @@ void BackwardEuler::stepLinear() {
     // b = h ( f_ext - K (u + (beta + h) v) - alpha M v ).
     TimeInto timer(stats_.forceSeconds);
     work_ = u_ + (beta + h) * v_;
+    // A serial product on purpose: an OpenMP one leaves spinning threads that compete
+    // with the solver's BLAS threads in the back-substitution right after it.
     rhs_.noalias() -= free_->stiffness * work_;
     if (alpha != 0.0) rhs_.noalias() -= alpha * (free_->mass * v_);
     rhs_ *= h;
