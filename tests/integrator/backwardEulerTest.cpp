@@ -1,14 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "testSystems.hpp"
-
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/integrator/backwardEuler.hpp>
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/integrator/backwardEuler.hpp>
 #include <limits>
 #include <string>
+
+#include "testSystems.hpp"
 
 namespace asyncfem::test {
 namespace {
@@ -154,7 +153,7 @@ TEST(BackwardEuler, NonFiniteStateThrowsAndKeepsPreviousState) {
 /// K(u) = K + diag(3 c u.^2), energy u^T K u / 2 + c sum u^4 / 4. Not linear, so the
 /// integrators take the refactoring path.
 class CubicForceModel final : public ForceModel {
-public:
+ public:
   CubicForceModel(Eigen::SparseMatrix<double> stiffness, double cubic)
       : stiffness_(std::move(stiffness)), cubic_(cubic) {}
   int numDofs() const override { return static_cast<int>(stiffness_.rows()); }
@@ -171,7 +170,7 @@ public:
     return 0.5 * u.dot(stiffness_ * u) + 0.25 * cubic_ * u.array().pow(4).sum();
   }
 
-private:
+ private:
   Eigen::SparseMatrix<double> stiffness_;
   double cubic_;
 };

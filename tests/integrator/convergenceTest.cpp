@@ -1,16 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Observed convergence order of the single-rate integrators against the exact modal
 // solution of a small linear bar.
-#include "testSystems.hpp"
+#include <gtest/gtest.h>
 
 #include <asyncfem/integrator/factory.hpp>
 #include <asyncfem/integrator/stableTimestep.hpp>
-
-#include <gtest/gtest.h>
-
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include "testSystems.hpp"
 
 namespace asyncfem::test {
 namespace {
@@ -74,7 +73,8 @@ TEST(IntegratorConvergence, BackwardEulerIsFirstOrder) {
   const double endTime = 2.0 * M_PI / s.reference->omega()[0];
   const double omega = s.reference->omega()[1];
   const int first = static_cast<int>(std::ceil(omega * omega * endTime * endTime / 0.1));
-  const double order = observedOrder(s, "backward-euler", endTime, {first, 2 * first, 4 * first, 8 * first, 16 * first});
+  const double order =
+      observedOrder(s, "backward-euler", endTime, {first, 2 * first, 4 * first, 8 * first, 16 * first});
   EXPECT_NEAR(order, 1.0, orderTolerance);
 }
 
@@ -95,8 +95,8 @@ TEST(IntegratorConvergence, CentralDifferencesIsSecondOrder) {
     options.maxFrequency = estimateMaxFrequency(s.body.mesh, massType);
     // Start at half the stable step: every step count keeps h omega_max < 2.
     const int first = static_cast<int>(std::ceil(endTime / (0.5 * stableTimestepFromFrequency(options.maxFrequency))));
-    const double order = observedOrder(s, "central-differences", endTime, {first, 2 * first, 4 * first, 8 * first},
-                                       options);
+    const double order =
+        observedOrder(s, "central-differences", endTime, {first, 2 * first, 4 * first, 8 * first}, options);
     EXPECT_NEAR(order, 2.0, orderTolerance) << (massType == MassType::lumped ? "lumped" : "consistent");
   }
 }
@@ -107,8 +107,7 @@ TEST(IntegratorConvergence, SymplecticEulerIsFirstOrder) {
   IntegratorOptions options;
   options.maxFrequency = estimateMaxFrequency(s.body.mesh, MassType::lumped);
   const int first = static_cast<int>(std::ceil(endTime / (0.5 * stableTimestepFromFrequency(options.maxFrequency))));
-  const double order =
-      observedOrder(s, "symplectic-euler", endTime, {first, 2 * first, 4 * first, 8 * first}, options);
+  const double order = observedOrder(s, "symplectic-euler", endTime, {first, 2 * first, 4 * first, 8 * first}, options);
   EXPECT_NEAR(order, 1.0, orderTolerance);
 }
 

@@ -1,14 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Backward Euler with the corotational force model (the refactoring path).
-#include "testSystems.hpp"
-
-#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
-#include <asyncfem/integrator/backwardEuler.hpp>
-
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
+#include <asyncfem/integrator/backwardEuler.hpp>
 #include <memory>
+
+#include "testSystems.hpp"
 
 namespace asyncfem::test {
 namespace {

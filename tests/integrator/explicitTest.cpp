@@ -1,17 +1,16 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Central differences and symplectic Euler: stable-timestep estimate and check, mass
 // handling, numerical failure, fixed DOFs.
-#include "testSystems.hpp"
+#include <gtest/gtest.h>
 
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/centralDifferences.hpp>
 #include <asyncfem/integrator/stableTimestep.hpp>
 #include <asyncfem/integrator/symplecticEuler.hpp>
-
-#include <gtest/gtest.h>
-
 #include <limits>
 #include <string>
+
+#include "testSystems.hpp"
 
 namespace asyncfem::test {
 namespace {

@@ -1,12 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "testSystems.hpp"
+#include <gtest/gtest.h>
 
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/factory.hpp>
-
-#include <gtest/gtest.h>
-
 #include <string>
+
+#include "testSystems.hpp"
 
 namespace asyncfem::test {
 namespace {

@@ -1,16 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SparseCore>
 #include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
-
-#include <Eigen/Core>
-#include <Eigen/Eigenvalues>
-#include <Eigen/SparseCore>
-
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -29,7 +27,7 @@ struct BarBody {
 };
 
 inline BarBody makeBar(MassType massType = MassType::consistent, double alpha = 0.0, double beta = 0.0,
-                             Eigen::Vector3i cells = Eigen::Vector3i(4, 1, 1)) {
+                       Eigen::Vector3i cells = Eigen::Vector3i(4, 1, 1)) {
   BarBody body;
   BoxMeshSpec spec;
   spec.size = Eigen::Vector3d(1.0, 0.2, 0.2);
@@ -64,7 +62,7 @@ inline Eigen::MatrixXd denseFree(const Eigen::SparseMatrix<double>& matrix, cons
 /// with K phi = lambda M phi (phi M-orthonormal) every modal coordinate q_i = phi_i^T M u
 /// is q_i(0) cos(omega_i t) + q_i'(0) / omega_i sin(omega_i t).
 class ModalReference {
-public:
+ public:
   ModalReference(const Eigen::MatrixXd& stiffness, const Eigen::MatrixXd& mass) : mass_(mass) {
     Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(stiffness, mass);
     modes_ = solver.eigenvectors();
@@ -84,7 +82,7 @@ public:
     return modes_ * q;
   }
 
-private:
+ private:
   Eigen::MatrixXd mass_;
   Eigen::MatrixXd modes_;
   Eigen::VectorXd omega_;

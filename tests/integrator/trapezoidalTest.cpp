@@ -1,12 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "testSystems.hpp"
-
-#include <asyncfem/integrator/trapezoidal.hpp>
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <asyncfem/integrator/trapezoidal.hpp>
 #include <cmath>
+
+#include "testSystems.hpp"
 
 namespace asyncfem::test {
 namespace {

@@ -1,11 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
+#include <string>
 
 #include "detail/freeSystem.hpp"
-
-#include <algorithm>
-#include <string>
 
 namespace asyncfem {
 

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/integrator.hpp>
-
 #include <cmath>
 #include <limits>
 #include <string>

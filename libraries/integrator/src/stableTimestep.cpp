@@ -1,16 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/stableTimestep.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
-
-#include "detail/freeSystem.hpp"
-
-#include <Eigen/Eigenvalues>
-
-#include <algorithm>
 #include <cmath>
 #include <string>
+
+#include "detail/freeSystem.hpp"
 
 namespace asyncfem {
 

@@ -6,8 +6,7 @@
 namespace asyncfem {
 
 SymplecticEuler::SymplecticEuler(DynamicSystem system, double timestep, const IntegratorOptions& options)
-    : Integrator(std::move(system), timestep),
-      core_(std::make_unique<detail::ExplicitCore>(system_, options, stats_)) {
+    : Integrator(std::move(system), timestep), core_(std::make_unique<detail::ExplicitCore>(system_, options, stats_)) {
   core_->checkTimestep(timestep_, "symplectic Euler");
 }
 

@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/trapezoidal.hpp>
+#include <string>
 
 #include "detail/freeSystem.hpp"
-
-#include <string>
 
 namespace asyncfem {
 

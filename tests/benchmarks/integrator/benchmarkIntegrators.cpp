@@ -10,6 +10,9 @@
 // Usage: OMP_WAIT_POLICY=passive build/bin/benchmarkIntegrators [--benchmark_filter=...]
 // (without it, OpenMP threads left spinning by the element loops compete with the BLAS
 // threads of the factorization and the corotational numbers measure that contention).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
@@ -18,10 +21,6 @@
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
-
-#include <benchmark/benchmark.h>
-
-#include <algorithm>
 #include <fstream>
 #include <map>
 #include <memory>

@@ -3,7 +3,6 @@
 
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/stableTimestep.hpp>
-
 #include <limits>
 #include <sstream>
 
@@ -18,8 +17,7 @@ ExplicitCore::ExplicitCore(const DynamicSystem& system, const IntegratorOptions&
   massSolver_.setup(free_.mass, options.solver, stats);
   if (massSolver_.diagonal()) stats.skipped.emplace_back("mass factorization (diagonal mass matrix)");
   if (!system.damped()) stats.skipped.emplace_back("damping matrix (alpha = beta = 0)");
-  maxFrequency_ = options.maxFrequency > 0.0 ? options.maxFrequency
-                                             : estimateMaxFrequency(free_.stiffness, free_.mass);
+  maxFrequency_ = options.maxFrequency > 0.0 ? options.maxFrequency : estimateMaxFrequency(free_.stiffness, free_.mass);
 }
 
 double ExplicitCore::stableTimestep() const {

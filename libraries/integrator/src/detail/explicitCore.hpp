@@ -3,10 +3,9 @@
 
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/integrator/integratorOptions.hpp>
+#include <string>
 
 #include "detail/freeSystem.hpp"
-
-#include <string>
 
 namespace asyncfem::detail {
 
@@ -14,7 +13,7 @@ namespace asyncfem::detail {
 /// solve, the omega_max estimate and the timestep check, and the acceleration
 /// a = M^{-1} (f_ext(t) - f_int(u) - D v) on the free DOFs.
 class ExplicitCore {
-public:
+ public:
   ExplicitCore(const DynamicSystem& system, const IntegratorOptions& options, IntegratorStats& stats);
 
   /// 2 / omega_max (+inf without stiffness).
@@ -29,7 +28,7 @@ public:
                     const Eigen::VectorXd& fullVelocity, const Eigen::VectorXd& dampingVelocity,
                     Eigen::VectorXd& acceleration, IntegratorStats& stats);
 
-private:
+ private:
   FreeSystem free_;
   FreeMassSolver massSolver_;
   bool linear_ = false;

@@ -3,7 +3,6 @@
 
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
-
 #include <cmath>
 #include <string>
 
@@ -26,8 +25,8 @@ Eigen::SparseMatrix<double> embedInPattern(const Eigen::SparseMatrix<double>& ma
       if (target && target.row() == it.row()) {
         target.valueRef() += it.value();
       } else if (it.value() != 0.0) {
-        throw ValidationError(what + " has a non-zero entry (" + std::to_string(it.row()) + ", " +
-                              std::to_string(col) + ") outside the force model's stiffness pattern");
+        throw ValidationError(what + " has a non-zero entry (" + std::to_string(it.row()) + ", " + std::to_string(col) +
+                              ") outside the force model's stiffness pattern");
       }
     }
   }

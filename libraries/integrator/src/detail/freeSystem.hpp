@@ -1,14 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
-
-#include <Eigen/Core>
-#include <Eigen/SparseCore>
-
 #include <memory>
 #include <string>
 #include <vector>
@@ -39,13 +37,13 @@ void checkFiniteState(const Eigen::VectorXd& displacement, const Eigen::VectorXd
 
 /// Adds the wall time of its lifetime to a stats field (one of IntegratorStats' seconds).
 class TimeInto {
-public:
+ public:
   explicit TimeInto(double& seconds) : seconds_(seconds) { watch_.start(); }
   ~TimeInto() { seconds_ += watch_.stop(); }
   TimeInto(const TimeInto&) = delete;
   TimeInto& operator=(const TimeInto&) = delete;
 
-private:
+ private:
   double& seconds_;
   Stopwatch watch_;
 };
@@ -54,7 +52,7 @@ private:
 /// them. Every free matrix shares the pattern of the force model's stiffness restricted
 /// to the free DOFs, so combinations are value-wise sums (combine()).
 class FreeSystem {
-public:
+ public:
   FreeSystem(const DynamicSystem& system, SolverKind solverKind);
 
   /// Evaluates f_int(u) and K(u) (u full) with the force model, then copies the free
@@ -65,8 +63,8 @@ public:
   void evaluateForces(const DynamicSystem& system, const Eigen::VectorXd& displacement, IntegratorStats& stats);
 
   /// systemMatrix = sum_i coefficients[i] * matrices[i] (free matrices of this object).
-  void assemble(const std::vector<double>& coefficients, const std::vector<const Eigen::SparseMatrix<double>*>& matrices,
-                IntegratorStats& stats);
+  void assemble(const std::vector<double>& coefficients,
+                const std::vector<const Eigen::SparseMatrix<double>*>& matrices, IntegratorStats& stats);
   /// Numeric factorization of systemMatrix (symbolic analysis the first time only).
   void factorize(IntegratorStats& stats);
   /// x = systemMatrix^{-1} rhs with the last factorization.
@@ -75,12 +73,12 @@ public:
   const Eigen::VectorXd& fullForces() const { return fullForces_; }
   SparseSolver& solver() { return *solver_; }
 
-  Eigen::SparseMatrix<double> mass;             ///< M on the free DOFs
-  Eigen::SparseMatrix<double> stiffness;        ///< K on the free DOFs (constant, or tangent at step start)
-  Eigen::SparseMatrix<double> iterateStiffness; ///< K at a Newton iterate (free)
-  Eigen::SparseMatrix<double> systemMatrix;     ///< the combination last assembled
+  Eigen::SparseMatrix<double> mass;              ///< M on the free DOFs
+  Eigen::SparseMatrix<double> stiffness;         ///< K on the free DOFs (constant, or tangent at step start)
+  Eigen::SparseMatrix<double> iterateStiffness;  ///< K at a Newton iterate (free)
+  Eigen::SparseMatrix<double> systemMatrix;      ///< the combination last assembled
 
-private:
+ private:
   SubmatrixExtractor extractor_;
   Eigen::SparseMatrix<double> fullStiffness_;
   Eigen::VectorXd fullForces_;
@@ -92,14 +90,14 @@ private:
 /// Solves M x = b on the free DOFs: a division for a diagonal (lumped) M, otherwise a
 /// sparse Cholesky factored once.
 class FreeMassSolver {
-public:
+ public:
   FreeMassSolver() = default;
   /// Factors (or inverts the diagonal of) the free mass matrix; adds to stats.
   void setup(const Eigen::SparseMatrix<double>& freeMass, SolverKind kind, IntegratorStats& stats);
   bool diagonal() const { return diagonal_; }
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, IntegratorStats& stats);
 
-private:
+ private:
   bool diagonal_ = false;
   Eigen::VectorXd inverseDiagonal_;
   std::unique_ptr<SparseSolver> solver_;

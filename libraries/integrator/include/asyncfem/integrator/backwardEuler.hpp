@@ -3,7 +3,6 @@
 
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/integrator/integratorOptions.hpp>
-
 #include <memory>
 #include <string>
 
@@ -43,7 +42,7 @@ class FreeSystem;
 /// J dv_delta = -R and stops once |R|_2 <= tolerance * |b_0|_2, b_0 the right-hand side
 /// of the linearized step (the residual of the linearized equations at dv = 0).
 class BackwardEuler final : public Integrator {
-public:
+ public:
   /// system: validated; h > 0. Factors at once for linear force models.
   BackwardEuler(DynamicSystem system, double timestep, const IntegratorOptions& options = {});
   ~BackwardEuler() override;
@@ -60,7 +59,7 @@ public:
   /// step is taken as is).
   double lastRelativeResidual() const { return lastRelativeResidual_; }
 
-private:
+ private:
   void stepLinear();
   void stepNonlinear();
   void assembleAndFactor();

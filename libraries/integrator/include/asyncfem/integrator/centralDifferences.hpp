@@ -3,7 +3,6 @@
 
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/integrator/integratorOptions.hpp>
-
 #include <memory>
 #include <string>
 
@@ -35,7 +34,7 @@ class ExplicitCore;
 /// constructor and setTimestep() throw asyncfem::ValidationError for a larger h unless
 /// options.force is set.
 class CentralDifferences final : public Integrator {
-public:
+ public:
   CentralDifferences(DynamicSystem system, double timestep, const IntegratorOptions& options = {});
   ~CentralDifferences() override;
 
@@ -47,10 +46,10 @@ public:
   /// omega_max used for the check (rad per time unit).
   double maxFrequency() const;
 
-protected:
+ protected:
   void stateChanged() override { accelerationStale_ = true; }
 
-private:
+ private:
   std::unique_ptr<detail::ExplicitCore> core_;
   bool accelerationStale_ = true;
   Eigen::VectorXd acceleration_;  // free

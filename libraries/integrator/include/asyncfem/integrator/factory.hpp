@@ -3,7 +3,6 @@
 
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/integrator/integratorOptions.hpp>
-
 #include <memory>
 #include <string>
 #include <vector>

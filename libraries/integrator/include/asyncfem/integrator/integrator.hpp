@@ -1,12 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include <asyncfem/forceModel/forceModel.hpp>
-#include <asyncfem/stiffnessMatrix/dofs.hpp>
-
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
+#include <asyncfem/forceModel/forceModel.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <functional>
 #include <memory>
 #include <string>
@@ -27,8 +25,8 @@ struct DynamicSystem {
   std::shared_ptr<ForceModel> forceModel;
   Eigen::SparseMatrix<double> mass;  ///< 3n x 3n, in the force model's stiffness pattern
   FreeDofs freeDofs;
-  double rayleighMass = 0.0;       ///< alpha
-  double rayleighStiffness = 0.0;  ///< beta
+  double rayleighMass = 0.0;            ///< alpha
+  double rayleighStiffness = 0.0;       ///< beta
   ExternalForceFunction externalForce;  ///< may be empty: no external force
 
   int numDofs() const { return static_cast<int>(mass.rows()); }
@@ -46,9 +44,9 @@ struct IntegratorStats {
   long long steps = 0;                ///< calls to step()
   long long factorizations = 0;
   long long solvedRightHandSides = 0;
-  double factorFlops = 0.0;           ///< sum over factorizations, as the solver library reports
-  double solveFlops = 0.0;            ///< sum over back-substitutions (estimate from factor non-zeros)
-  std::vector<std::string> skipped;   ///< work the configuration made unnecessary, for the run summary
+  double factorFlops = 0.0;          ///< sum over factorizations, as the solver library reports
+  double solveFlops = 0.0;           ///< sum over back-substitutions (estimate from factor non-zeros)
+  std::vector<std::string> skipped;  ///< work the configuration made unnecessary, for the run summary
 };
 
 /// One time integrator: owns the state (u, v, t) of a DynamicSystem and advances it by
@@ -57,7 +55,7 @@ struct IntegratorStats {
 ///
 /// State vectors are full (3n); fixed DOFs are kept at exactly zero.
 class Integrator {
-public:
+ public:
   Integrator(DynamicSystem system, double timestep);
   virtual ~Integrator() = default;
   Integrator(const Integrator&) = delete;
@@ -85,7 +83,7 @@ public:
   double mechanicalEnergy() const;
   const IntegratorStats& stats() const { return stats_; }
 
-protected:
+ protected:
   /// The external force at time t and the current state (size 3n; zero if none).
   void evaluateExternalForce(double time, Eigen::VectorXd& forces) const;
   /// Zeroes the fixed entries of a full vector.

@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <Eigen/SparseCore>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
-#include <Eigen/SparseCore>
 
 namespace asyncfem {
 

@@ -3,7 +3,6 @@
 
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/integrator/integratorOptions.hpp>
-
 #include <memory>
 #include <string>
 
@@ -23,7 +22,7 @@ class ExplicitCore;
 /// limit as central differences; the same estimate and check apply (see
 /// CentralDifferences), and M is factored once the same way.
 class SymplecticEuler final : public Integrator {
-public:
+ public:
   SymplecticEuler(DynamicSystem system, double timestep, const IntegratorOptions& options = {});
   ~SymplecticEuler() override;
 
@@ -33,7 +32,7 @@ public:
   double stableTimestepEstimate() const override;
   double maxFrequency() const;
 
-private:
+ private:
   std::unique_ptr<detail::ExplicitCore> core_;
   Eigen::VectorXd u_, v_, a_, fullU_, fullV_;
 };

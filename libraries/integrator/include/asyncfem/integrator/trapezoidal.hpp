@@ -3,7 +3,6 @@
 
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/integrator/integratorOptions.hpp>
-
 #include <memory>
 #include <string>
 
@@ -40,7 +39,7 @@ class FreeMassSolver;
 /// f_int(u) - D v (one mass factorization, kept) at the first step and whenever
 /// setState() changes the state, and taken from the solve afterwards.
 class Trapezoidal final : public Integrator {
-public:
+ public:
   Trapezoidal(DynamicSystem system, double timestep, const IntegratorOptions& options = {});
   ~Trapezoidal() override;
 
@@ -55,10 +54,10 @@ public:
   /// Relative Newton residual after the last step, -1 when not evaluated.
   double lastRelativeResidual() const { return lastRelativeResidual_; }
 
-protected:
+ protected:
   void stateChanged() override { accelerationStale_ = true; }
 
-private:
+ private:
   void computeAcceleration();
   void assembleAndFactor();
 
