@@ -1,0 +1,29 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+#include <asyncfem/render/image.hpp>
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+/// Glyph cell of the built-in bitmap font: 5 x 7 dots plus one column and one row of
+/// spacing. Letters (drawn upper case), digits, space and . , : ; - _ + = / ( ) % # ' "
+/// ! ? < > * are defined; other characters draw as a hollow box.
+inline constexpr int glyphWidth = 5;
+inline constexpr int glyphHeight = 7;
+
+/// Width in pixels of text drawn at the given scale (each dot is scale x scale pixels).
+int textWidth(const std::string& text, int scale);
+/// Draws text with its top-left corner at (x, y), clipped to the image.
+void drawText(Image& image, int x, int y, const std::string& text, int scale, const Eigen::Vector3f& color);
+
+/// Places images left to right, each under a coloured bar holding its label (centred,
+/// in white), and returns the combined image. All images must have the same height and
+/// labels must be empty or one per image (asyncfem::Error otherwise); without labels no
+/// bar is drawn. barColors cycles through the given colours (a default palette if empty).
+Image composeSideBySide(const std::vector<Image>& images, const std::vector<std::string>& labels, int barHeight,
+                        const std::vector<Eigen::Vector3f>& barColors = {});
+
+}  // namespace asyncfem

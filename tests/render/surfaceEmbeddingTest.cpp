@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// SurfaceEmbedding: the tet boundary, embedded render meshes read through assimp.
+#include <gtest/gtest.h>
+
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/render/surfaceEmbedding.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+#include <fstream>
+
+#include "renderTestHelpers.hpp"
+
+namespace {
+
+using namespace asyncfem;
+using namespace asyncfem::renderTesting;
+
+TEST(SurfaceEmbedding, BoundaryFollowsTheMeshExactly) {
+  const TetMesh mesh = renderTestBar();
+  const SurfaceEmbedding surface = SurfaceEmbedding::boundary(mesh);
+  EXPECT_EQ(surface.triangles().size(), boundaryTriangles(mesh).size());
+  EXPECT_EQ(surface.numOutsideVertices(), 0);
+  const Eigen::VectorXd u = bentBar(mesh);
+  const Eigen::Matrix3Xd x = surface.positions(u);
+  for (int k = 0; k < surface.numSurfaceVertices(); ++k) {
+    const int v = surface.tetVertices()(0, k);
+    EXPECT_EQ(x.col(k), Eigen::Vector3d(mesh.restPosition(v) + u.segment<3>(3 * v)));
+  }
+  EXPECT_THROW(surface.positions(Eigen::VectorXd::Zero(4)), Error);
+}
+
+/// A small closed octahedron centred in the bar plus one vertex 0.05 outside it.
+SurfaceMesh octahedronWithOutlier() {
+  SurfaceMesh s;
+  s.vertices.resize(3, 7);
+  const Eigen::Vector3d c(0.93, 0.21, 0.17);
+  s.vertices << c.x() + 0.15, c.x() - 0.15, c.x(), c.x(), c.x(), c.x(), 2.05,  //
+      c.y(), c.y(), c.y() + 0.15, c.y() - 0.15, c.y(), c.y(), 0.3,             //
+      c.z(), c.z(), c.z(), c.z(), c.z() + 0.15, c.z() - 0.15, 0.1;
+  s.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}, {0, 6, 2}};
+  return s;
+}
+
+TEST(SurfaceEmbedding, EmbeddedMeshReadFromObjFollowsATranslationExactly) {
+  const TetMesh mesh = renderTestBar();
+  const auto folder = freshFolder("embedding");
+  writeObj(folder / "shape.obj", octahedronWithOutlier());
+  const SurfaceMesh loaded = loadSurfaceMesh(folder / "shape.obj");
+  ASSERT_EQ(loaded.vertices.cols(), 7);
+  ASSERT_EQ(loaded.triangles.size(), 9U);
+
+  const SurfaceEmbedding surface = SurfaceEmbedding::embed(mesh, loaded);
+  EXPECT_EQ(surface.numOutsideVertices(), 1);
+  // assimp stores coordinates as float: 0.05 to about 1e-7.
+  EXPECT_NEAR(surface.maxOutsideDistance(), 0.05, 1e-6);
+  // Inside vertices: convex weights summing to 1 that reproduce the position.
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_GE(surface.weights().col(k).minCoeff(), -1e-12);
+    EXPECT_NEAR(surface.weights().col(k).sum(), 1.0, 1e-14);
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 4; ++a) {
+      p += surface.weights()(a, k) * mesh.restPosition(surface.tetVertices()(a, k));
+    }
+    EXPECT_LE((p - loaded.vertices.col(k)).norm(), 1e-14);
+  }
+
+  const Eigen::Vector3d t(0.4, -1.25, 3.0);
+  Eigen::VectorXd u(mesh.numDofs());
+  for (int v = 0; v < mesh.numVertices(); ++v) {
+    u.segment<3>(3 * v) = t;
+  }
+  const Eigen::Matrix3Xd x = surface.positions(u);
+  // x = p + sum_a w_a t = p + t (sum_a w_a = 1 to rounding), also for the outside vertex.
+  for (int k = 0; k < 7; ++k) {
+    EXPECT_LE((x.col(k) - (loaded.vertices.col(k) + t)).cwiseAbs().maxCoeff(), 1e-14) << "vertex " << k;
+  }
+  EXPECT_EQ(surface.positions(Eigen::VectorXd::Zero(mesh.numDofs())), loaded.vertices);
+  std::filesystem::remove_all(folder);
+}
+
+TEST(SurfaceEmbedding, EmbeddedMeshFollowsAnAffineMotion) {
+  // Barycentric weights reproduce every affine field, inside and outside.
+  const TetMesh mesh = renderTestBar();
+  const SurfaceMesh shape = octahedronWithOutlier();
+  const SurfaceEmbedding surface = SurfaceEmbedding::embed(mesh, shape);
+  Eigen::Matrix3d a;
+  a << 0.1, -0.3, 0.2, 0.05, 0.0, -0.1, 0.3, 0.2, -0.05;
+  Eigen::VectorXd u(mesh.numDofs());
+  for (int v = 0; v < mesh.numVertices(); ++v) {
+    u.segment<3>(3 * v) = a * mesh.restPosition(v);
+  }
+  const Eigen::Matrix3Xd x = surface.positions(u);
+  for (int k = 0; k < 7; ++k) {
+    EXPECT_LE((x.col(k) - (shape.vertices.col(k) + a * shape.vertices.col(k))).norm(), 1e-13);
+  }
+}
+
+TEST(SurfaceEmbedding, ReadsOtherFormatsAndWeldsSeams) {
+  const auto folder = freshFolder("formats");
+  // ASCII STL stores every triangle's corners separately: welding joins them.
+  std::ofstream(folder / "two.stl") << "solid two\n"
+                                       "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                                       "endloop\nendfacet\n"
+                                       "facet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\n"
+                                       "endloop\nendfacet\nendsolid two\n";
+  const SurfaceMesh stl = loadSurfaceMesh(folder / "two.stl");
+  EXPECT_EQ(stl.triangles.size(), 2U);
+  EXPECT_EQ(stl.vertices.cols(), 4);
+  // ASCII PLY with a quad: triangulated.
+  std::ofstream(folder / "quad.ply") << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                        "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                        "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+  const SurfaceMesh ply = loadSurfaceMesh(folder / "quad.ply");
+  EXPECT_EQ(ply.triangles.size(), 2U);
+  EXPECT_EQ(ply.vertices.cols(), 4);
+  try {
+    loadSurfaceMesh(folder / "missing.obj");
+    FAIL() << "expected Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.obj"), std::string::npos) << e.what();
+  }
+  std::ofstream(folder / "garbage.obj") << "this is not\na mesh\n";
+  EXPECT_THROW(loadSurfaceMesh(folder / "garbage.obj"), Error);
+  std::filesystem::remove_all(folder);
+}
+
+TEST(SurfaceEmbedding, BadSurfaceIsAnError) {
+  const TetMesh mesh = renderTestBar();
+  SurfaceMesh bad = octahedronWithOutlier();
+  bad.triangles.push_back({0, 1, 7});
+  try {
+    SurfaceEmbedding::embed(mesh, bad);
+    FAIL() << "expected ValidationError";
+  } catch (const ValidationError& e) {
+    EXPECT_NE(std::string(e.what()).find("vertex 7"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
