@@ -58,5 +58,6 @@ function(asyncfem_add_test name)
     ASYNCFEM_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data"
     ASYNCFEM_MODELS_DIR="${PROJECT_SOURCE_DIR}/models"
     ASYNCFEM_BIN_DIR="${CMAKE_RUNTIME_OUTPUT_DIRECTORY}")
-  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
+  # Idle OpenMP threads sleep rather than spin (see asyncfem/core/threading.hpp).
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600 ENVIRONMENT OMP_WAIT_POLICY=passive)
 endfunction()

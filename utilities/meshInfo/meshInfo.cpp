@@ -6,6 +6,7 @@
 //
 // Text goes to stdout, reader warnings to stderr; errors print "meshInfo: <message>"
 // on stderr and exit with status 1.
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
@@ -180,6 +181,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  asyncfem::preferPassiveThreadWaiting(argv);
   try {
     return run(argc, argv);
   } catch (const asyncfem::Error& e) {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // suggestRegions: proposes fast regions and ratios for the asynchronous integrator from the
 // materials and element sizes of a mesh (see docs/asynchronous-integrator.md).
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
@@ -30,6 +31,7 @@ nlohmann::json proposalJson(const AutoRegionProposal& proposal) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  asyncfem::preferPassiveThreadWaiting(argv);
   CLI::App app{"Proposes fast regions and ratios for the asynchronous integrator.\n"
                "Input: a scene (.json: its mesh, fixed vertices and integrator.timestep) or a mesh file."};
   std::string input, writePath;

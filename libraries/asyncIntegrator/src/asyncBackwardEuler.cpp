@@ -58,6 +58,38 @@ SparseMatrix scatterDense(const Eigen::MatrixXd& block, const std::vector<int>& 
   return out;
 }
 
+/// out = a A + b B. When A and B share one pattern (blocks cut from M and K, which the
+/// assembler builds on one pattern) only values are written, into out's storage if it
+/// already has that pattern; otherwise Eigen's general sum.
+void combineInto(double a, const SparseMatrix& A, double b, const SparseMatrix& B, SparseMatrix& out) {
+  auto samePattern = [](const SparseMatrix& x, const SparseMatrix& y) {
+    return x.rows() == y.rows() && x.cols() == y.cols() && x.isCompressed() && y.isCompressed() &&
+           x.nonZeros() == y.nonZeros() &&
+           std::equal(x.outerIndexPtr(), x.outerIndexPtr() + x.outerSize() + 1, y.outerIndexPtr()) &&
+           std::equal(x.innerIndexPtr(), x.innerIndexPtr() + x.nonZeros(), y.innerIndexPtr());
+  };
+  if (!samePattern(A, B)) {
+    out = a * A + b * B;
+    out.makeCompressed();
+    return;
+  }
+  if (!samePattern(out, A)) out = A;
+  const double* av = A.valuePtr();
+  const double* bv = B.valuePtr();
+  double* ov = out.valuePtr();
+  for (Eigen::Index k = 0; k < A.nonZeros(); ++k) ov[k] = a * av[k] + b * bv[k];
+}
+
+/// sub = full(rows, cols) through the extractor, values only after the first call.
+void updateBlock(const SubmatrixExtractor& extractor, const SparseMatrix& full, SparseMatrix& sub, bool& cut) {
+  if (!cut) {
+    sub = extractor.extract(full);
+    cut = true;
+  } else {
+    extractor.update(full, sub);
+  }
+}
+
 /// Blocks of one fast region S_i (rows/columns named as in the design note; "I" is the
 /// interface subset of L, the only L DOFs the coupling blocks touch).
 struct RegionBlocks {
@@ -65,6 +97,7 @@ struct RegionBlocks {
   double smallStep = 0.0;  // hS
   SubmatrixExtractor massSS, massSI, massIS, stiffSS, stiffSI, stiffIS;
   SparseMatrix Mss, Kss, Dss, Msi, Ksi, Dsi, Mis, Kis, Dis;
+  bool cut = false;  // K blocks extracted once; later only their values are updated
   SparseMatrix systemMatrix;   // A^S = M + hS D + hS^2 K
   SparseMatrix G;              // hS^2 K^{SS}
   SparseMatrix E;              // hL hS K^{IS}
@@ -86,6 +119,8 @@ struct AsyncBackwardEuler::Impl {
   Eigen::VectorXd internalForce;
   std::vector<RegionBlocks> regions;
   SubmatrixExtractor massLL, stiffLL;
+  SparseMatrix Mll, Kll;     // M^{LL} (constant), K^{LL}
+  bool cutLL = false;
   SparseMatrix largeSystem;  // A^L
   SparseMatrix schur;        // H^{LL*} (or its symmetric part)
   std::unique_ptr<SparseSolver> schurSolver;  // of H^{LL*} (lu, symmetric) or of A^L (lowRank)
@@ -167,28 +202,34 @@ void AsyncBackwardEuler::rebuildBlocks() {
   Stopwatch assembly, factor;
 
   assembly.start();
-  const SparseMatrix Mll = d.massLL.extract(system.mass);
-  const SparseMatrix Kll = d.stiffLL.extract(d.stiffness);
+  // Blocks of M are constant: cut once. Blocks of K are updated in place (values only)
+  // and every combination below reuses its pattern, so a refactorization step allocates
+  // nothing here.
+  if (!d.cutLL) d.Mll = d.massLL.extract(system.mass);
+  updateBlock(d.stiffLL, d.stiffness, d.Kll, d.cutLL);
   // A^L = M^{LL} + hL D^{LL} + hL^2 K^{LL}, D = alpha M + beta K.
-  d.largeSystem = (1.0 + hL * alpha) * Mll + (hL * hL + hL * beta) * Kll;
-  d.largeSystem.makeCompressed();
+  combineInto(1.0 + hL * alpha, d.Mll, hL * hL + hL * beta, d.Kll, d.largeSystem);
   for (RegionBlocks& rb : d.regions) {
     const double hS = hL / rb.ratio;
     rb.smallStep = hS;
-    rb.Kss = rb.stiffSS.extract(d.stiffness);
-    rb.Ksi = rb.stiffSI.extract(d.stiffness);
-    rb.Kis = rb.stiffIS.extract(d.stiffness);
+    bool cut = rb.cut;
+    updateBlock(rb.stiffSS, d.stiffness, rb.Kss, cut);
+    cut = rb.cut;
+    updateBlock(rb.stiffSI, d.stiffness, rb.Ksi, cut);
+    cut = rb.cut;
+    updateBlock(rb.stiffIS, d.stiffness, rb.Kis, cut);
+    rb.cut = true;
     if (damped) {
-      rb.Dss = alpha * rb.Mss + beta * rb.Kss;
-      rb.Dsi = alpha * rb.Msi + beta * rb.Ksi;
-      rb.Dis = alpha * rb.Mis + beta * rb.Kis;
+      combineInto(alpha, rb.Mss, beta, rb.Kss, rb.Dss);
+      combineInto(alpha, rb.Msi, beta, rb.Ksi, rb.Dsi);
+      combineInto(alpha, rb.Mis, beta, rb.Kis, rb.Dis);
     }
     // A^S = M^{SS} + hS D^{SS} + hS^2 K^{SS}
-    rb.systemMatrix = (1.0 + hS * alpha) * rb.Mss + (hS * hS + hS * beta) * rb.Kss;
-    rb.systemMatrix.makeCompressed();
-    rb.G = (hS * hS) * rb.Kss;
-    rb.E = (hL * hS) * rb.Kis;
-    rb.P = damped ? SparseMatrix(rb.Mis + hL * rb.Dis) : rb.Mis;
+    combineInto(1.0 + hS * alpha, rb.Mss, hS * hS + hS * beta, rb.Kss, rb.systemMatrix);
+    combineInto(0.0, rb.Mss, hS * hS, rb.Kss, rb.G);
+    combineInto(0.0, rb.Mis, hL * hS, rb.Kis, rb.E);
+    // P = M^{IS} + hL D^{IS} = (1 + hL alpha) M^{IS} + hL beta K^{IS}
+    combineInto(1.0 + hL * alpha, rb.Mis, hL * beta, rb.Kis, rb.P);
   }
   stats.assemblySeconds += assembly.stop();
 
@@ -276,6 +317,9 @@ void AsyncBackwardEuler::rebuildBlocks() {
       rb.correction.resize(0, 0);
       continue;
     }
+    // Z: one multi-right-hand-side solve per substep (|I| columns at once: BLAS-3 work
+    // in the supernodal solve, threaded by the BLAS).
+    Stopwatch zWatch;
     const Eigen::MatrixXd Msi = Eigen::MatrixXd(rb.Msi), Ksi = Eigen::MatrixXd(rb.Ksi);
     const Eigen::MatrixXd Dsi = damped ? Eigen::MatrixXd(rb.Dsi) : Eigen::MatrixXd();
     Eigen::MatrixXd sum, prev, rhs, x;
@@ -297,6 +341,7 @@ void AsyncBackwardEuler::rebuildBlocks() {
     }
     // H^{IS} Z = E sum_r Z_r + (F - E) Z_m.
     rb.correction = rb.E * sum + rb.P * prev;
+    zColumnSeconds_ += zWatch.stop();
     const double norm = rb.correction.norm();
     if (norm > 0.0) {
       schurAsymmetry = std::max(schurAsymmetry, (rb.correction - rb.correction.transpose()).norm() / norm);

@@ -83,6 +83,10 @@ public:
   /// max_i ||C_i - C_i^T||_F / ||C_i||_F of the Schur corrections C_i (0 with no
   /// interface): how far H^{LL*} is from symmetric, what the symmetric mode neglects.
   double schurAsymmetry() const { return schurAsymmetry_; }
+  /// Seconds spent computing the Z columns and the Schur corrections C_i (included in
+  /// stats().factorizationSeconds): the part of a refactorization the paper's Algorithm 2
+  /// adds over single-rate.
+  double zColumnSeconds() const { return zColumnSeconds_; }
   /// The Schur mode in effect (lowRank may fall back to lu for very large interfaces).
   SchurMode schurModeUsed() const { return schurModeUsed_; }
 
@@ -105,6 +109,7 @@ private:
   AsyncOptions options_;
   SubstepObserver observer_;
   double schurAsymmetry_ = 0.0;
+  double zColumnSeconds_ = 0.0;
   SchurMode schurModeUsed_ = SchurMode::lowRank;
   std::unique_ptr<Impl> impl_;
 };

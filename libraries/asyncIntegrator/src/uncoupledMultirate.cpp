@@ -1,0 +1,295 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Uncoupled (compound-step) multirate backward Euler; the equations are in the header.
+#include <Eigen/SparseCore>
+#include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <cmath>
+#include <string>
+
+namespace asyncfem {
+
+namespace {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+Eigen::VectorXd gather(const Eigen::VectorXd& full, const std::vector<int>& dofs) {
+  Eigen::VectorXd out(static_cast<Eigen::Index>(dofs.size()));
+  for (std::size_t k = 0; k < dofs.size(); ++k) out[static_cast<Eigen::Index>(k)] = full[dofs[k]];
+  return out;
+}
+
+/// The blocks one fast region needs for its lone substeps r >= 2 (I: its interface DOFs).
+struct RegionBlocks {
+  int ratio = 1;
+  double smallStep = 0.0;
+  SubmatrixExtractor massSS, massSI, stiffSS, stiffSI;
+  SparseMatrix Mss, Msi, Kss, Ksi;
+  SparseMatrix systemMatrix;  // A^S
+  std::unique_ptr<SparseSolver> solver;
+  bool analyzed = false;
+};
+
+}  // namespace
+
+struct UncoupledMultirate::Impl {
+  bool linear = true;
+  bool built = false;
+  SparseMatrix stiffness;  // K(u_0), full
+  Eigen::VectorXd internalForce;
+  SubmatrixExtractor freeMass, freeStiffness;
+  SparseMatrix Mff, Kff;
+  std::vector<int> freeRegion;  // region of every free DOF (-1: L)
+  SparseMatrix compound;
+  std::unique_ptr<SparseSolver> compoundSolver;
+  bool compoundAnalyzed = false;
+  std::vector<RegionBlocks> regions;
+};
+
+UncoupledMultirate::UncoupledMultirate(const TetMesh& mesh, DynamicSystem system, double largeTimestep,
+                                       std::vector<AsyncRegion> regions, UncoupledMultirateOptions options)
+    : Integrator(std::move(system), largeTimestep),
+      partition_(mesh, system_.freeDofs, std::move(regions)),
+      options_(options),
+      impl_(std::make_unique<Impl>()) {
+  if (mesh.numDofs() != system_.numDofs()) {
+    throw ValidationError("multirate-uncoupled integrator: mesh has " + std::to_string(mesh.numDofs()) +
+                          " DOFs but the dynamic system has " + std::to_string(system_.numDofs()));
+  }
+  Impl& d = *impl_;
+  d.linear = system_.forceModel->isLinear();
+  d.stiffness = system_.forceModel->createStiffnessMatrix();
+  d.stiffness.makeCompressed();
+  const std::vector<int>& free = system_.freeDofs.freeToFull();
+  d.freeMass = SubmatrixExtractor(system_.mass, free, free);
+  d.freeStiffness = SubmatrixExtractor(d.stiffness, free, free);
+  d.Mff = d.freeMass.extract(system_.mass);
+  d.freeRegion.resize(free.size());
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    d.freeRegion[k] = partition_.vertexRegion()[static_cast<std::size_t>(free[k] / 3)];
+  }
+  d.compoundSolver = makeSparseSolver(options_.compoundSolver);
+  d.regions.resize(static_cast<std::size_t>(partition_.numRegions()));
+  for (int i = 0; i < partition_.numRegions(); ++i) {
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    const std::vector<int>& s = partition_.regionDofs(i);
+    const std::vector<int>& iface = partition_.interfaceDofs(i);
+    rb.ratio = partition_.ratio(i);
+    rb.massSS = SubmatrixExtractor(system_.mass, s, s);
+    rb.massSI = SubmatrixExtractor(system_.mass, s, iface);
+    rb.stiffSS = SubmatrixExtractor(d.stiffness, s, s);
+    rb.stiffSI = SubmatrixExtractor(d.stiffness, s, iface);
+    rb.Mss = rb.massSS.extract(system_.mass);
+    rb.Msi = rb.massSI.extract(system_.mass);
+    rb.solver = makeSparseSolver(options_.regionSolver);
+  }
+  if (!system_.damped()) stats_.skipped.push_back("damping terms (alpha = beta = 0)");
+  if (d.linear) stats_.skipped.push_back("per-step refactorization (linear forces: factored once)");
+}
+
+UncoupledMultirate::~UncoupledMultirate() = default;
+
+void UncoupledMultirate::setTimestep(double timestep) {
+  Integrator::setTimestep(timestep);
+  if (impl_) impl_->built = false;
+}
+
+void UncoupledMultirate::rebuild() {
+  Impl& d = *impl_;
+  const double hL = timestep();
+  const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
+  Stopwatch assembly, factor;
+  assembly.start();
+  if (d.Kff.size() == 0) {
+    d.Kff = d.freeStiffness.extract(d.stiffness);
+  } else {
+    d.freeStiffness.update(d.stiffness, d.Kff);
+  }
+  // Row of a fast region i: c (M + hS D + hS^2 K) with c = 1/m_i on L columns (the
+  // interpolated v^L_1); row of L: M + hL D + hL^2 K (backward Euler at hL).
+  auto rowStep = [&](int region) { return region < 0 ? hL : hL / partition_.ratio(region); };
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(d.Mff.nonZeros() + d.Kff.nonZeros()));
+  auto add = [&](const SparseMatrix& matrix, bool isMass) {
+    for (int c = 0; c < matrix.outerSize(); ++c) {
+      const int columnRegion = d.freeRegion[static_cast<std::size_t>(c)];
+      for (SparseMatrix::InnerIterator it(matrix, c); it; ++it) {
+        const int rowRegion = d.freeRegion[static_cast<std::size_t>(it.row())];
+        const double h = rowStep(rowRegion);
+        const double scale = (rowRegion >= 0 && columnRegion < 0) ? 1.0 / partition_.ratio(rowRegion) : 1.0;
+        const double weight = isMass ? 1.0 + h * alpha : h * h + h * beta;
+        triplets.emplace_back(static_cast<int>(it.row()), c, scale * weight * it.value());
+      }
+    }
+  };
+  add(d.Mff, true);
+  add(d.Kff, false);
+  d.compound.resize(d.Mff.rows(), d.Mff.cols());
+  d.compound.setFromTriplets(triplets.begin(), triplets.end());
+  d.compound.makeCompressed();
+  for (RegionBlocks& rb : d.regions) {
+    rb.smallStep = hL / rb.ratio;
+    const double hS = rb.smallStep;
+    if (rb.Kss.size() == 0) {
+      rb.Kss = rb.stiffSS.extract(d.stiffness);
+      rb.Ksi = rb.stiffSI.extract(d.stiffness);
+    } else {
+      rb.stiffSS.update(d.stiffness, rb.Kss);
+      rb.stiffSI.update(d.stiffness, rb.Ksi);
+    }
+    rb.systemMatrix = (1.0 + hS * alpha) * rb.Mss + (hS * hS + hS * beta) * rb.Kss;
+    rb.systemMatrix.makeCompressed();
+  }
+  stats_.assemblySeconds += assembly.stop();
+
+  factor.start();
+  if (!d.compoundAnalyzed) {
+    d.compoundSolver->analyzePattern(d.compound);
+    d.compoundAnalyzed = true;
+  }
+  d.compoundSolver->factorize(d.compound);
+  ++stats_.factorizations;
+  stats_.factorFlops += d.compoundSolver->stats().factorFlops;
+  for (RegionBlocks& rb : d.regions) {
+    if (rb.ratio == 1) continue;  // no lone substep: A^S is never solved
+    if (!rb.analyzed) {
+      rb.solver->analyzePattern(rb.systemMatrix);
+      rb.analyzed = true;
+    }
+    rb.solver->factorize(rb.systemMatrix);
+    ++stats_.factorizations;
+    stats_.factorFlops += rb.solver->stats().factorFlops;
+  }
+  stats_.factorizationSeconds += factor.stop();
+}
+
+void UncoupledMultirate::step() {
+  Impl& d = *impl_;
+  const double hL = timestep();
+  const double t0 = time();
+  const Eigen::VectorXd& u0 = displacement_;
+  const Eigen::VectorXd& v0 = velocity_;
+  const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
+  const bool damped = system_.damped();
+
+  Stopwatch forces, solve;
+  forces.start();
+  if (d.linear) {
+    if (!d.built) system_.forceModel->tangentStiffness(u0, d.stiffness);
+    system_.forceModel->internalForces(u0, d.internalForce);
+  } else {
+    system_.forceModel->forcesAndTangent(u0, d.internalForce, d.stiffness);
+  }
+  stats_.forceSeconds += forces.stop();
+  if (!d.linear || !d.built) {
+    rebuild();
+    d.built = true;
+  }
+
+  solve.start();
+  // Compound right-hand side: b = h (f_ext(t_0 + h) - f_int(u_0) - D v_0 - h K v_0) with
+  // h = hS_i on the rows of S_i and hL on the rows of L.
+  const Eigen::VectorXd stiffVelocity = d.stiffness * v0;
+  Eigen::VectorXd stateForce = d.internalForce;
+  if (damped) stateForce += alpha * (system_.mass * v0) + beta * stiffVelocity;
+  const int numRegions = partition_.numRegions();
+  std::vector<Eigen::VectorXd> externalAtFirstSubstep(static_cast<std::size_t>(numRegions));
+  for (int i = 0; i < numRegions; ++i) {
+    evaluateExternalForce(t0 + d.regions[static_cast<std::size_t>(i)].smallStep,
+                          externalAtFirstSubstep[static_cast<std::size_t>(i)]);
+  }
+  Eigen::VectorXd externalForce;
+  evaluateExternalForce(t0 + hL, externalForce);
+  const std::vector<int>& free = system_.freeDofs.freeToFull();
+  Eigen::VectorXd rhs(static_cast<Eigen::Index>(free.size()));
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    const int dof = free[k];
+    const int region = d.freeRegion[k];
+    const double h = region < 0 ? hL : d.regions[static_cast<std::size_t>(region)].smallStep;
+    const double fext = region < 0 ? externalForce[dof] : externalAtFirstSubstep[static_cast<std::size_t>(region)][dof];
+    rhs[static_cast<Eigen::Index>(k)] = h * (fext - stateForce[dof] - h * stiffVelocity[dof]);
+  }
+  const Eigen::VectorXd change = d.compoundSolver->solve(rhs);  // X_i on S rows, Y on L rows
+
+  Eigen::VectorXd newU = u0, newV = v0;
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    if (d.freeRegion[k] >= 0) continue;
+    const int dof = free[k];
+    newV[dof] = v0[dof] + change[static_cast<Eigen::Index>(k)];
+    newU[dof] = u0[dof] + hL * newV[dof];
+  }
+
+  const std::vector<int>& fullToFree = system_.freeDofs.fullToFree();
+  for (int i = 0; i < numRegions; ++i) {
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    const double hS = rb.smallStep;
+    const int m = rb.ratio;
+    const std::vector<int>& s = partition_.regionDofs(i);
+    const std::vector<int>& iface = partition_.interfaceDofs(i);
+    const Eigen::VectorXd uS0 = gather(u0, s);
+    Eigen::VectorXd vS = gather(v0, s);
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      vS[static_cast<Eigen::Index>(k)] += change[fullToFree[static_cast<std::size_t>(s[k])]];
+    }
+    Eigen::VectorXd uS = uS0 + hS * vS;
+    if (m > 1) {
+      // L frozen: its interface velocity change Y_I, interpolated over the substeps.
+      const Eigen::VectorXd vL0 = gather(v0, iface);
+      Eigen::VectorXd changeL(static_cast<Eigen::Index>(iface.size()));
+      for (std::size_t k = 0; k < iface.size(); ++k) {
+        changeL[static_cast<Eigen::Index>(k)] = change[fullToFree[static_cast<std::size_t>(iface[k])]];
+      }
+      const Eigen::VectorXd fintS = gather(d.internalForce, s);
+      Eigen::VectorXd rhsS, dS, vLr;
+      for (int r = 2; r <= m; ++r) {
+        evaluateExternalForce(t0 + r * hS, externalForce);
+        vLr = vL0 + (double(r) / m) * changeL;
+        const Eigen::VectorXd uLdiff = (r * hS) * vLr;
+        const Eigen::VectorXd uSdiff = uS + hS * vS - uS0;
+        rhsS = hS * (gather(externalForce, s) - fintS);
+        rhsS -= rb.Msi * ((1.0 / m) * changeL);
+        rhsS -= hS * (rb.Kss * uSdiff + rb.Ksi * uLdiff);
+        if (damped) {
+          rhsS -= (hS * alpha) * (rb.Mss * vS + rb.Msi * vLr);
+          rhsS -= (hS * beta) * (rb.Kss * vS + rb.Ksi * vLr);
+        }
+        dS = rb.solver->solve(rhsS);
+        vS += dS;
+        uS += hS * vS;
+      }
+    }
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      newV[s[k]] = vS[static_cast<Eigen::Index>(k)];
+      newU[s[k]] = uS[static_cast<Eigen::Index>(k)];
+    }
+  }
+  stats_.solveSeconds += solve.stop();
+
+  for (Eigen::Index k = 0; k < newU.size(); ++k) {
+    if (!std::isfinite(newU[k]) || !std::isfinite(newV[k])) {
+      throw NumericalError("multirate-uncoupled integrator: non-finite state at t = " + std::to_string(t0 + hL) +
+                           " (vertex " + std::to_string(k / 3) + ", coordinate " + std::to_string(k % 3) + ")");
+    }
+  }
+  displacement_ = std::move(newU);
+  velocity_ = std::move(newV);
+  time_ = t0 + hL;
+  ++stats_.steps;
+  stats_.solvedRightHandSides = d.compoundSolver->stats().solvedRightHandSides;
+  stats_.solveFlops =
+      static_cast<double>(d.compoundSolver->stats().solvedRightHandSides) * d.compoundSolver->stats().solveFlopsPerRhs;
+  for (const RegionBlocks& rb : d.regions) {
+    stats_.solvedRightHandSides += rb.solver->stats().solvedRightHandSides;
+    stats_.solveFlops +=
+        static_cast<double>(rb.solver->stats().solvedRightHandSides) * rb.solver->stats().solveFlopsPerRhs;
+  }
+}
+
+long long UncoupledMultirate::factorNonZeros() const {
+  long long total = impl_->compoundSolver->stats().factorNonZeros;
+  for (const RegionBlocks& rb : impl_->regions) total += rb.solver->stats().factorNonZeros;
+  return total;
+}
+
+}  // namespace asyncfem
