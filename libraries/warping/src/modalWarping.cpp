@@ -60,7 +60,8 @@ Eigen::VectorXd ModalWarping::rotationVectors(const Eigen::Ref<const Eigen::Vect
 Eigen::VectorXd ModalWarping::warp(const Eigen::Ref<const Eigen::VectorXd>& displacement) {
   const Eigen::VectorXd rotations = rotationVectors(displacement);
   Eigen::VectorXd warped(displacement.size());
-#pragma omp parallel for schedule(static)
+  // Threads pay off only for large meshes (the loop body is a few dozen flops).
+#pragma omp parallel for schedule(static) if (numVertices_ >= 16384)
   for (int i = 0; i < numVertices_; ++i) {
     const Eigen::Vector3d w = rotations.segment<3>(3 * static_cast<Eigen::Index>(i));
     const Eigen::Vector3d u = displacement.segment<3>(3 * static_cast<Eigen::Index>(i));

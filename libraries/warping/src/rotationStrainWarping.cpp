@@ -13,6 +13,9 @@ namespace asyncfem {
 
 namespace {
 
+// Smallest loop (elements or vertices) run on several OpenMP threads.
+constexpr int kParallelThreshold = 8192;
+
 // Union-find with path halving; the representative is the lowest id of the set, so
 // component numbering (by representative order) is deterministic.
 int findRoot(std::vector<int>& parent, int v) {
@@ -177,7 +180,9 @@ Eigen::VectorXd RotationStrainWarping::warp(const Eigen::Ref<const Eigen::Vector
   const Eigen::Map<const Eigen::Matrix3Xd> u(displacement.data(), 3, numVertices_);
 
   // Element pass: F_e = exp([omega_e]x) (I + S_e); contribution V_e (F_e - I) grad N_a.
-#pragma omp parallel for schedule(static)
+  // Threads only pay off beyond a few thousand elements (a parallel region costs about
+  // as much as 1000 elements here, and far more when the cores are oversubscribed).
+#pragma omp parallel for schedule(static) if (numElements_ >= kParallelThreshold)
   for (int e = 0; e < numElements_; ++e) {
     Eigen::Matrix<double, 3, 4> vertexDisplacements;
     for (int a = 0; a < 4; ++a) {
@@ -197,7 +202,7 @@ Eigen::VectorXd RotationStrainWarping::warp(const Eigen::Ref<const Eigen::Vector
   const auto numUnknown = static_cast<Eigen::Index>(unknownVertices_.size());
   const auto numConstrained = static_cast<Eigen::Index>(constrainedVertices_.size());
   rightHandSide_.resize(numUnknown, 3);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (numUnknown >= kParallelThreshold)
   for (Eigen::Index k = 0; k < numUnknown; ++k) {
     const auto v = static_cast<std::size_t>(unknownVertices_[static_cast<std::size_t>(k)]);
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
