@@ -6,6 +6,7 @@
 #include <asyncfem/integrator/factory.hpp>
 #include <asyncfem/sceneIO/jsonReader.hpp>
 #include <asyncfem/sceneIO/asyncScene.hpp>
+#include <asyncfem/sceneIO/multirateScene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
@@ -279,6 +280,7 @@ std::string formatNumber(double value) {
 IntegratorRegistry defaultIntegratorRegistry() {
   IntegratorRegistry registry;
   registry.add("async", asyncIntegratorFactory());
+  registry.add("multirate-uncoupled", uncoupledMultirateIntegratorFactory());
   for (const std::string& name : integratorNames()) {
     registry.add(
         name, [name](const Scene& scene, const TetMesh& /*mesh*/, DynamicSystem system, const nlohmann::json& options) {

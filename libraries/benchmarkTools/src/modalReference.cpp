@@ -1,0 +1,171 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Dense>
+#include <algorithm>
+#include <asyncfem/benchmarkTools/modalReference.hpp>
+#include <asyncfem/core/error.hpp>
+#include <cmath>
+#include <string>
+
+namespace asyncfem {
+
+void advanceDampedOscillator(double lambda, double damping, double force, double duration, double& position,
+                             double& rate) {
+  const double tau = duration;
+  if (tau <= 0.0) return;
+  const double c = damping;
+  if (lambda <= 0.0) {
+    // Rigid mode: q'' + c q' = p.
+    if (c * tau < 1e-8) {
+      position += rate * tau + 0.5 * force * tau * tau;
+      rate += force * tau;
+      return;
+    }
+    const double decay = std::exp(-c * tau);
+    const double steady = force / c;
+    // q' = steady + (q'_0 - steady) e^{-c t}; q = q_0 + steady t + (q'_0 - steady)(1 - e^{-c t}) / c
+    position += steady * tau + (rate - steady) * (-std::expm1(-c * tau)) / c;
+    rate = steady + (rate - steady) * decay;
+    return;
+  }
+  const double equilibrium = force / lambda;
+  const double x0 = position - equilibrium;
+  const double r0 = rate;
+  const double mu = 0.5 * c;
+  const double discriminant = mu * mu - lambda;  // g^2
+  // e^{-mu tau} cosh(g tau) =: a and e^{-mu tau} sinh(g tau) / g =: b, then
+  // exp(A tau) = a I + b (A + mu I), A + mu I = [mu 1; -lambda -mu].
+  double a = 0.0, b = 0.0;
+  const double scale = std::max(mu * mu, lambda);
+  if (std::abs(discriminant) <= 1e-12 * scale) {
+    const double decay = std::exp(-mu * tau);
+    a = decay;
+    b = decay * tau;
+  } else if (discriminant < 0.0) {
+    const double omega = std::sqrt(-discriminant);
+    const double decay = std::exp(-mu * tau);
+    a = decay * std::cos(omega * tau);
+    b = decay * std::sin(omega * tau) / omega;
+  } else {
+    const double g = std::sqrt(discriminant);
+    const double slow = -lambda / (mu + g);  // g - mu, without cancellation
+    const double fast = -(g + mu);
+    const double eSlow = std::exp(slow * tau), eFast = std::exp(fast * tau);
+    a = 0.5 * (eSlow + eFast);
+    b = 0.5 * (eSlow - eFast) / g;
+  }
+  const double x = a * x0 + b * (mu * x0 + r0);
+  const double r = a * r0 + b * (-lambda * x0 - mu * r0);
+  position = equilibrium + x;
+  rate = r;
+}
+
+ModalReference::ModalReference(const Eigen::SparseMatrix<double>& mass, const Eigen::SparseMatrix<double>& stiffness,
+                               const FreeDofs& freeDofs, double alpha, double beta)
+    : freeDofs_(freeDofs), alpha_(alpha), beta_(beta) {
+  const std::vector<int>& free = freeDofs.freeToFull();
+  const Eigen::Index n = static_cast<Eigen::Index>(free.size());
+  SubmatrixExtractor extractor(mass, free, free);
+  freeMass_ = extractor.extract(mass);
+  const Eigen::MatrixXd denseMass = Eigen::MatrixXd(freeMass_);
+  const Eigen::MatrixXd denseStiffness = Eigen::MatrixXd(SubmatrixExtractor(stiffness, free, free).extract(stiffness));
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(denseStiffness, denseMass,
+                                                                   Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+  if (solver.info() != Eigen::Success) {
+    throw NumericalError("modal reference: generalized eigendecomposition of the " + std::to_string(n) +
+                         " free DOFs failed (is the mass matrix positive definite on them?)");
+  }
+  eigenvalues_ = solver.eigenvalues();
+  modes_ = solver.eigenvectors();
+}
+
+std::vector<Eigen::VectorXd> ModalReference::displacements(const PiecewiseConstantLoad& load,
+                                                           const std::vector<double>& times,
+                                                           const Eigen::VectorXd& initialDisplacement,
+                                                           const Eigen::VectorXd& initialVelocity) const {
+  const int numDofs = freeDofs_.numDofs();
+  const Eigen::Index n = eigenvalues_.size();
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    if (!(times[k] >= 0.0) || (k > 0 && times[k] < times[k - 1])) {
+      throw Error("modal reference: requested times must be >= 0 and ascending (entry " + std::to_string(k) + ")");
+    }
+  }
+  if (load.forces.size() != load.breakpoints.size() + 1) {
+    throw Error("modal reference: a piecewise-constant load needs breakpoints.size() + 1 force vectors");
+  }
+  for (std::size_t k = 0; k < load.breakpoints.size(); ++k) {
+    if (!(load.breakpoints[k] > 0.0) || (k > 0 && load.breakpoints[k] <= load.breakpoints[k - 1])) {
+      throw Error("modal reference: load breakpoints must be > 0 and strictly ascending (entry " + std::to_string(k) +
+                  ")");
+    }
+  }
+  auto checkSize = [numDofs](const Eigen::VectorXd& v, const std::string& what) {
+    if (v.size() != 0 && v.size() != numDofs) {
+      throw Error("modal reference: " + what + " has " + std::to_string(v.size()) + " entries, expected " +
+                  std::to_string(numDofs));
+    }
+  };
+  checkSize(initialDisplacement, "the initial displacement");
+  checkSize(initialVelocity, "the initial velocity");
+  // Modal coordinates: q = Phi^T M u (Phi M-orthonormal), modal force Phi^T f.
+  auto modal = [&](const Eigen::VectorXd& full, bool weightByMass) -> Eigen::VectorXd {
+    if (full.size() == 0) return Eigen::VectorXd::Zero(n);
+    const Eigen::VectorXd restricted = freeDofs_.restrict(full);
+    if (weightByMass) return modes_.transpose() * (freeMass_ * restricted);
+    return modes_.transpose() * restricted;
+  };
+  std::vector<Eigen::VectorXd> modalForces;
+  for (const Eigen::VectorXd& f : load.forces) {
+    checkSize(f, "a load vector");
+    modalForces.push_back(modal(f, false));
+  }
+  std::vector<Eigen::VectorXd> modalImpulses;
+  for (const PiecewiseConstantLoad::Impulse& impulse : load.impulses) {
+    checkSize(impulse.impulse, "an impulse");
+    modalImpulses.push_back(modal(impulse.impulse, false));
+  }
+  Eigen::VectorXd q = modal(initialDisplacement, true);
+  Eigen::VectorXd rate = modal(initialVelocity, true);
+  const Eigen::VectorXd damping = alpha_ * Eigen::VectorXd::Ones(n) + beta_ * eigenvalues_;
+  // Rigid modes: eigenvalues at round-off level relative to the largest.
+  const double rigidBelow = 1e-12 * std::max(1.0, eigenvalues_.size() > 0 ? eigenvalues_.maxCoeff() : 1.0);
+
+  // Events in time order: requested outputs, load changes, impulses (outputs first at
+  // equal times, then impulses).
+  struct Event {
+    double time;
+    int kind;  // 0: output, 1: impulse, 2: breakpoint
+    std::size_t index;
+  };
+  std::vector<Event> events;
+  for (std::size_t k = 0; k < times.size(); ++k) events.push_back({times[k], 0, k});
+  for (std::size_t k = 0; k < load.impulses.size(); ++k) events.push_back({load.impulses[k].time, 1, k});
+  for (std::size_t k = 0; k < load.breakpoints.size(); ++k) events.push_back({load.breakpoints[k], 2, k});
+  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
+    return a.time < b.time || (a.time == b.time && a.kind < b.kind);
+  });
+
+  std::vector<Eigen::VectorXd> out(times.size());
+  double now = 0.0;
+  std::size_t piece = 0;
+  for (const Event& event : events) {
+    const double duration = event.time - now;
+    if (duration > 0.0) {
+      const Eigen::VectorXd& p = modalForces[piece];
+      for (Eigen::Index j = 0; j < n; ++j) {
+        const double lambda = eigenvalues_[j] <= rigidBelow ? 0.0 : eigenvalues_[j];
+        advanceDampedOscillator(lambda, damping[j], p[j], duration, q[j], rate[j]);
+      }
+      now = event.time;
+    }
+    if (event.kind == 0) {
+      out[event.index] = freeDofs_.expand(modes_ * q);
+    } else if (event.kind == 1) {
+      rate += modalImpulses[event.index];
+    } else {
+      piece = event.index + 1;
+    }
+  }
+  return out;
+}
+
+}  // namespace asyncfem
