@@ -1,0 +1,230 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// frameRenderer end to end: runs the built executable on simulation files written by the
+// tests and checks its exit status, messages and the PNG files it leaves.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <asyncfem/render/image.hpp>
+#include <asyncfem/render/surfaceMesh.hpp>
+#include <asyncfem/simulationIO/simulationFile.hpp>
+#include <asyncfem/volumetricMesh/writers.hpp>
+#include <fstream>
+#include <sstream>
+
+#include "renderTestHelpers.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace asyncfem;
+
+const std::string rendererPath = std::string(ASYNCFEM_BIN_DIR) + "/frameRenderer";
+
+struct RunResult {
+  int exitCode = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string readText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class FrameRendererTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = renderTesting::freshFolder(std::string("frameRenderer-") +
+                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    mesh_ = renderTesting::renderTestBar();
+    writeVeg(folder_ / "bar.veg", mesh_);
+    // Six frames bending the bar a little more each time.
+    SimulationFileHeader header;
+    header.numVertices = mesh_.numVertices();
+    header.frameInterval = 0.1;
+    SimulationWriter writer(folder_ / "run.afsim", header);
+    const Eigen::VectorXd bent = renderTesting::bentBar(mesh_);
+    for (int k = 0; k < 6; ++k) {
+      writer.appendFrame(0.1 * (k + 1), (k + 1) / 6.0 * bent);
+    }
+  }
+  void TearDown() override { fs::remove_all(folder_); }
+
+  RunResult run(const std::string& arguments) const {
+    const std::string command =
+        "cd '" + folder_.string() + "' && '" + rendererPath + "' " + arguments + " > stdout.txt 2> stderr.txt";
+    const int status = std::system(command.c_str());
+    RunResult result;
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = readText(folder_ / "stdout.txt");
+    result.err = readText(folder_ / "stderr.txt");
+    return result;
+  }
+
+  fs::path folder_;
+  TetMesh mesh_;
+};
+
+TEST_F(FrameRendererTest, WritesTheSelectedFramesAtTheRequestedSize) {
+  const RunResult r = run("run.afsim --mesh bar.veg --output out --frames 0:6:2 --width 96 --height 64");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("3 frames"), std::string::npos) << r.out;
+  for (const int k : {0, 2, 4}) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%05d.png", k);
+    ASSERT_TRUE(fs::exists(folder_ / "out" / name)) << name;
+    const Image image = readPng(folder_ / "out" / name);
+    EXPECT_EQ(image.width, 96);
+    EXPECT_EQ(image.height, 64);
+  }
+  EXPECT_FALSE(fs::exists(folder_ / "out" / "frame_00001.png"));
+  EXPECT_FALSE(fs::exists(folder_ / "out" / "frame_00006.png"));
+}
+
+TEST_F(FrameRendererTest, SameInputRendersTheSameFileTwice) {
+  for (const char* out : {"a", "b"}) {
+    const RunResult r =
+        run(std::string("run.afsim --mesh bar.veg --frames 3 --width 80 --height 60 --ground -q -o ") + out);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+  }
+  const std::string a = readText(folder_ / "a" / "frame_00003.png");
+  EXPECT_FALSE(a.empty());
+  EXPECT_EQ(a, readText(folder_ / "b" / "frame_00003.png"));
+  // Also with one thread against two (each frame is drawn by one context either way).
+  ASSERT_EQ(run("run.afsim --mesh bar.veg --frames 2:4 --width 80 --height 60 --ground -q -j 1 -o c").exitCode, 0);
+  ASSERT_EQ(run("run.afsim --mesh bar.veg --frames 2:4 --width 80 --height 60 --ground -q -j 2 -o d").exitCode, 0);
+  EXPECT_EQ(readText(folder_ / "c" / "frame_00003.png"), readText(folder_ / "d" / "frame_00003.png"));
+  EXPECT_EQ(readText(folder_ / "c" / "frame_00003.png"), a);
+}
+
+int orangePixels(const Image& image) {
+  int count = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = image.pixel(x, y);
+      count += p[0] > p[2] + 40 && p[0] > p[1] + 20 ? 1 : 0;
+    }
+  }
+  return count;
+}
+
+TEST_F(FrameRendererTest, TintSetColoursItsRegionOnly) {
+  ASSERT_EQ(run("run.afsim --mesh bar.veg --frames 5 --width 120 --height 80 -q -o plain").exitCode, 0);
+  const RunResult r = run("run.afsim --mesh bar.veg --frames 5 --width 120 --height 80 -q -o tinted --tint-set xmax");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(orangePixels(readPng(folder_ / "plain" / "frame_00005.png")), 0);
+  EXPECT_GT(orangePixels(readPng(folder_ / "tinted" / "frame_00005.png")), 20);
+  const RunResult bad = run("run.afsim --mesh bar.veg --frames 5 -q -o x --tint-set nothere");
+  EXPECT_EQ(bad.exitCode, 1);
+  EXPECT_NE(bad.err.find("nothere"), std::string::npos) << bad.err;
+}
+
+TEST_F(FrameRendererTest, OptionsCombine) {
+  SurfaceMesh shape;
+  shape.vertices.resize(3, 4);
+  shape.vertices << 0.2, 1.8, 1.0, 1.0, 0.1, 0.1, 0.35, 0.1, 0.1, 0.1, 0.1, 0.35;
+  shape.triangles = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {0, 2, 3}};
+  writeObj(folder_ / "shape.obj", shape);
+  for (const std::string options :
+       {"--warp rotation-strain --fixed-set xmin", "--warp modal", "--render-mesh shape.obj --ground",
+        "--camera-position 1,1,5 --camera-target 1,0,0 --fov 40", "--view-direction 0,1,0.2 --supersampling 1"}) {
+    const RunResult r = run("run.afsim --mesh bar.veg --frames 4:6 --width 64 --height 48 -q -o out " + options);
+    EXPECT_EQ(r.exitCode, 0) << options << ": " << r.err;
+    EXPECT_TRUE(fs::exists(folder_ / "out" / "frame_00005.png")) << options;
+  }
+}
+
+TEST_F(FrameRendererTest, CompareDrawsBothRunsSideBySide) {
+  fs::copy_file(folder_ / "run.afsim", folder_ / "other.afsim");
+  const RunResult r =
+      run("run.afsim --mesh bar.veg --frames 1 --width 161 --height 90 -q -o out --compare other.afsim --labels "
+          "\"async,single-rate\"");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Image image = readPng(folder_ / "out" / "frame_00001.png");
+  EXPECT_EQ(image.width, 161);
+  EXPECT_EQ(image.height, 90);
+  // The same run on both sides: the two panels (80 and 81 pixels wide) show the object.
+  EXPECT_NE(image.pixel(40, 50)[0], 255);
+  const RunResult labels = run("run.afsim --mesh bar.veg -q -o out --compare other.afsim --labels onlyone");
+  EXPECT_EQ(labels.exitCode, 1);
+  EXPECT_NE(labels.err.find("two labels"), std::string::npos) << labels.err;
+}
+
+TEST_F(FrameRendererTest, MissingSimulationFileIsAClearError) {
+  const RunResult r = run("nothere.afsim --mesh bar.veg -o out");
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_EQ(r.err.rfind("frameRenderer: ", 0), 0U) << r.err;
+  EXPECT_NE(r.err.find("nothere.afsim: no such simulation file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(folder_ / "out"));
+}
+
+TEST_F(FrameRendererTest, TruncatedSimulationFileIsAClearError) {
+  const std::string bytes = readText(folder_ / "run.afsim");
+  std::ofstream(folder_ / "header.afsim", std::ios::binary) << bytes.substr(0, 30);
+  const RunResult header = run("header.afsim --mesh bar.veg -o out");
+  EXPECT_EQ(header.exitCode, 1);
+  EXPECT_NE(header.err.find("header.afsim"), std::string::npos) << header.err;
+  EXPECT_NE(header.err.find("truncated header"), std::string::npos) << header.err;
+
+  std::ofstream(folder_ / "record.afsim", std::ios::binary) << bytes.substr(0, 64 + 100);
+  const RunResult record = run("record.afsim --mesh bar.veg -o out");
+  EXPECT_EQ(record.exitCode, 1);
+  EXPECT_NE(record.err.find("holds no complete frame"), std::string::npos) << record.err;
+
+  // A partial last frame (an interrupted run): the complete frames still render, with a
+  // warning; asking for the partial one is out of range.
+  const std::int64_t recordBytes = (static_cast<std::int64_t>(bytes.size()) - 64) / 6;
+  std::ofstream(folder_ / "partial.afsim", std::ios::binary)
+      << bytes.substr(0, static_cast<std::size_t>(64 + (5 * recordBytes) + 10));
+  const RunResult partial = run("partial.afsim --mesh bar.veg --width 32 --height 32 -o out");
+  EXPECT_EQ(partial.exitCode, 0) << partial.err;
+  EXPECT_NE(partial.err.find("partial frame"), std::string::npos) << partial.err;
+  EXPECT_TRUE(fs::exists(folder_ / "out" / "frame_00004.png"));
+  const RunResult beyond = run("partial.afsim --mesh bar.veg --frames 5 -o out");
+  EXPECT_EQ(beyond.exitCode, 1);
+  EXPECT_NE(beyond.err.find("start 5 is beyond the 5 frames"), std::string::npos) << beyond.err;
+}
+
+TEST_F(FrameRendererTest, FramesOutOfRangeAreAClearError) {
+  const RunResult r = run("run.afsim --mesh bar.veg --frames 0:20:5 -o out");
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.err.find("frames 0:20:5: stop 20 is beyond the 6 frames of run.afsim (frames 0 to 5)"), std::string::npos)
+      << r.err;
+  for (const char* bad : {"--frames 3:3", "--frames a:b", "--frames 0:4:0", "--frames 1:2:3:4"}) {
+    const RunResult b = run(std::string("run.afsim --mesh bar.veg -o out ") + bad);
+    EXPECT_EQ(b.exitCode, 1) << bad;
+    EXPECT_NE(b.err.find("frames"), std::string::npos) << bad << ": " << b.err;
+  }
+}
+
+TEST_F(FrameRendererTest, VertexCountMismatchIsAClearError) {
+  BoxMeshSpec spec;
+  spec.cells = Eigen::Vector3i(2, 2, 2);
+  writeVeg(folder_ / "small.veg", makeBoxMesh(spec));
+  const RunResult r = run("run.afsim --mesh small.veg -o out");
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(
+      r.err.find("run.afsim has " + std::to_string(mesh_.numVertices()) + " vertices but the mesh (small.veg) has 27"),
+      std::string::npos)
+      << r.err;
+  const RunResult neither = run("run.afsim -o out");
+  EXPECT_EQ(neither.exitCode, 1);
+  EXPECT_NE(neither.err.find("--mesh"), std::string::npos) << neither.err;
+}
+
+TEST_F(FrameRendererTest, SceneGivesTheMesh) {
+  std::ofstream(folder_ / "scene.json") << R"({
+    "mesh": {"file": "bar.veg"},
+    "fixed": {"sets": ["xmin"]},
+    "integrator": {"name": "backward-euler", "timestep": 0.01},
+    "frames": {"rate": 10, "count": 6}
+  })";
+  const RunResult r =
+      run("run.afsim --scene scene.json --frames 0 --width 48 --height 32 -q -o out --warp rotation-strain");
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(fs::exists(folder_ / "out" / "frame_00000.png"));
+}
+
+}  // namespace

@@ -1,0 +1,523 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// frameRenderer: draws the frames of a simulation output file (.afsim) as PNG images.
+//
+//   frameRenderer SIM.afsim (--mesh MESH | --scene SCENE.json) [--output DIR] [--frames start:stop:step]
+//                 [--width W] [--height H] [--warp none|rotation-strain|modal] [--tint-set NAME]
+//                 [--render-mesh FILE] [--ground] [--compare OTHER.afsim --labels "a,b"] ...
+//
+// Writes DIR/frame_NNNNN.png (NNNNN = the frame's index in the file). Progress on stderr,
+// a summary on stdout. Errors print "frameRenderer: <message>" on stderr and exit with
+// status 1 (2 for unusable command-line options). Reference: docs/rendering.md.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/render/renderer.hpp>
+#include <asyncfem/render/surfaceEmbedding.hpp>
+#include <asyncfem/render/text.hpp>
+#include <asyncfem/sceneIO/scene.hpp>
+#include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/simulationIO/simulationFile.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
+#include <asyncfem/warping/warping.hpp>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "frameSelection.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace asyncfem;
+
+struct CommandLine {
+  std::string simulation;
+  std::optional<std::string> mesh;
+  std::optional<std::string> scene;
+  std::string output = "frames";
+  std::string frames;
+  int width = 640;
+  int height = 480;
+  std::string warp = "none";
+  std::optional<std::string> tintSet;
+  std::vector<float> tintColor{0.95F, 0.45F, 0.12F};
+  std::vector<std::string> fixedSets;
+  std::optional<std::string> renderMesh;
+  bool ground = false;
+  std::optional<std::string> compare;
+  std::optional<std::string> labels;
+  std::vector<double> cameraPosition;
+  std::vector<double> cameraTarget;
+  std::vector<double> cameraUp{0.0, 1.0, 0.0};
+  std::vector<double> viewDirection;
+  double fieldOfView = 30.0;
+  int supersampling = 2;
+  int threads = 0;
+  bool progress = false;
+  bool quiet = false;
+};
+
+Eigen::Vector3d toVector(const std::vector<double>& values) { return {values[0], values[1], values[2]}; }
+
+// ---------------------------------------------------------------------------------------
+// Progress on stderr: a bar redrawn in place on a terminal (or with --progress), plain
+// lines every 10% otherwise, nothing with --quiet.
+
+class Progress {
+ public:
+  enum class Style { none, bar, lines };
+  Progress(Style style, std::size_t total) : style_(style), total_(std::max<std::size_t>(total, 1)) {}
+
+  void update(std::size_t done) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (style_ == Style::none) {
+      return;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double eta = done > 0 ? elapsed * static_cast<double>(total_ - done) / static_cast<double>(done) : 0.0;
+    const int percent = static_cast<int>((100 * done) / total_);
+    if (style_ == Style::bar) {
+      if (done < total_ && drawn_ && now - last_ < std::chrono::milliseconds(50)) {
+        return;
+      }
+      constexpr int width = 30;
+      const auto filled = static_cast<std::size_t>((width * done) / total_);
+      const std::string bar = std::string(filled, '#') + std::string(width - filled, '.');
+      std::fprintf(stderr, "\r[%s] %zu/%zu frames %3d%%  elapsed %.1f s  ETA %.1f s   ", bar.c_str(), done, total_,
+                   percent, elapsed, eta);
+      std::fflush(stderr);
+      drawn_ = true;
+      last_ = now;
+      return;
+    }
+    if (percent / 10 > lastPercent_ / 10 || done == total_) {
+      std::fprintf(stderr, "frameRenderer: frame %zu/%zu (%d%%), elapsed %.1f s, ETA %.1f s\n", done, total_, percent,
+                   elapsed, eta);
+      lastPercent_ = percent;
+    }
+  }
+  void finish() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (style_ == Style::bar && drawn_) {
+      std::fputc('\n', stderr);
+      drawn_ = false;
+    }
+  }
+
+ private:
+  Style style_;
+  std::size_t total_;
+  std::mutex mutex_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point last_ = start_;
+  int lastPercent_ = 0;
+  bool drawn_ = false;
+};
+
+// ---------------------------------------------------------------------------------------
+// What every worker shares (read-only) and what each owns.
+
+struct Run {
+  std::string label;
+  fs::path file;
+};
+
+struct Shared {
+  std::shared_ptr<const TetMesh> mesh;
+  std::vector<int> fixedVertices;
+  WarpingKind warping = WarpingKind::none;
+  SurfaceEmbedding surface;
+  std::optional<Eigen::Matrix3Xf> colors;  // per surface vertex, when a set is tinted
+  std::vector<Run> runs;                   // one, or two with --compare
+};
+
+/// A worker's own state: readers of every run and warping objects (neither is
+/// thread-safe), and, when rendering, its own OSMesa context.
+struct Worker {
+  std::vector<std::unique_ptr<SimulationReader>> readers;
+  std::vector<std::unique_ptr<Warping>> warpings;
+  SimulationFrame frame;
+
+  explicit Worker(const Shared& shared) {
+    for (const Run& run : shared.runs) {
+      readers.push_back(std::make_unique<SimulationReader>(run.file));
+      warpings.push_back(makeWarping(shared.warping, *shared.mesh, shared.fixedVertices));
+    }
+  }
+  /// Surface positions of run r at frame k (-1: the rest shape).
+  Eigen::Matrix3Xd surfacePositions(const Shared& shared, std::size_t r, std::int64_t k) {
+    if (k < 0) {
+      return shared.surface.restSurface().vertices;
+    }
+    readers[r]->readFrame(k, frame);
+    return shared.surface.positions(warpings[r]->warp(frame.displacement));
+  }
+};
+
+/// Runs job(worker, i) for i in [0, count) on `threads` threads, each with its own
+/// Worker; rethrows the first exception after every thread stopped.
+template <class Job>
+void forEachParallel(const Shared& shared, int threads, std::size_t count, const Job& job) {
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr error;
+  std::mutex errorMutex;
+  const auto body = [&](int thread) {
+    try {
+      Worker worker(shared);
+      for (std::size_t i = next++; i < count && !failed; i = next++) {
+        job(worker, thread, i);
+      }
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(errorMutex);
+      if (!error) {
+        error = std::current_exception();
+      }
+      failed = true;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) {
+    pool.emplace_back(body, t);
+  }
+  body(0);
+  for (std::thread& thread : pool) {
+    thread.join();
+  }
+  if (error) {
+    std::rethrow_exception(error);
+  }
+}
+
+/// 1, 2 or 5 times a power of ten, near x.
+double roundLength(double x) {
+  const double power = std::pow(10.0, std::floor(std::log10(x)));
+  for (const double m : {1.0, 2.0, 5.0}) {
+    if (m * power >= 0.7 * x) {
+      return m * power;
+    }
+  }
+  return 10.0 * power;
+}
+
+std::string frameName(std::int64_t k) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "frame_%05lld.png", static_cast<long long>(k));
+  return name;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"Draws the frames of an .afsim simulation file (docs/simulation-output.md) as PNG images."};
+  CommandLine options;
+  app.add_option("simulation", options.simulation, "Simulation output (.afsim) from offlineSimulator")->required();
+  app.add_option("--mesh", options.mesh, "The tet mesh the simulation ran on (.veg, .node/.ele, .msh)");
+  app.add_option("--scene", options.scene, "The scene the simulation ran (its mesh and fixed vertices are used)");
+  app.add_option("-o,--output", options.output, "Folder for frame_NNNNN.png (created)")->capture_default_str();
+  app.add_option("--frames", options.frames, "Frames to draw, start:stop:step (stop exclusive; default all)");
+  app.add_option("--width", options.width, "Image width in pixels")->check(CLI::Range(16, 4096))->capture_default_str();
+  app.add_option("--height", options.height, "Image height in pixels")
+      ->check(CLI::Range(16, 4096))
+      ->capture_default_str();
+  app.add_option("--warp", options.warp, "Warping of the linear displacement: none, rotation-strain, modal")
+      ->check(CLI::IsMember({"none", "rotation-strain", "modal"}))
+      ->capture_default_str();
+  app.add_option("--tint-set", options.tintSet, "Vertex set drawn in the tint colour (e.g. the fast region)");
+  app.add_option("--tint-color", options.tintColor, "Tint colour r,g,b in [0, 1]")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--fixed-set", options.fixedSets,
+                 "With --mesh: vertex sets held fixed in the simulation (rotation-strain warping keeps them)")
+      ->delimiter(',');
+  app.add_option("--render-mesh", options.renderMesh,
+                 "Surface mesh (any format assimp reads) embedded in the tet mesh");
+  app.add_flag("--ground", options.ground, "Draw a checkered ground plane with a shadow under the object");
+  app.add_option("--compare", options.compare, "Second .afsim of the same mesh, drawn on the right");
+  app.add_option("--labels", options.labels, "Labels of the two runs with --compare, \"left,right\"");
+  app.add_option("--camera-position", options.cameraPosition, "Eye position x,y,z (with --camera-target)")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option("--camera-target", options.cameraTarget, "Point looked at x,y,z (with --camera-position)")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option("--camera-up", options.cameraUp, "Up direction x,y,z")->delimiter(',')->expected(3);
+  app.add_option("--view-direction", options.viewDirection,
+                 "Fitted camera: direction from the object to the eye x,y,z (default 0.45,0.35,1)")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option("--fov", options.fieldOfView, "Vertical field of view in degrees")
+      ->check(CLI::Range(1.0, 170.0))
+      ->capture_default_str();
+  app.add_option("--supersampling", options.supersampling, "Antialiasing: render s x s samples per pixel")
+      ->check(CLI::Range(1, 4))
+      ->capture_default_str();
+  app.add_option("-j,--threads", options.threads, "Rendering threads (default: the number of cores, at most 8)")
+      ->check(CLI::Range(1, 64));
+  app.add_flag("--progress", options.progress, "Draw the progress bar even when stderr is not a terminal");
+  app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "frameRenderer: " << e.what() << " (see --help)\n";
+    return 2;
+  }
+  if (options.mesh.has_value() == options.scene.has_value()) {
+    throw Error("give the mesh with --mesh FILE or --scene SCENE.json (exactly one of them)");
+  }
+  if (options.cameraPosition.empty() != options.cameraTarget.empty()) {
+    throw Error("--camera-position and --camera-target go together");
+  }
+  if (options.labels && !options.compare) {
+    throw Error("--labels needs --compare");
+  }
+  Stopwatch total;
+  total.start();
+
+  // The simulation files first: a missing or broken file is the most common mistake.
+  Shared shared;
+  shared.warping = parseWarpingKind(options.warp);
+  shared.runs.push_back({fs::path(options.simulation).stem().string(), options.simulation});
+  if (options.compare) {
+    shared.runs.push_back({fs::path(*options.compare).stem().string(), *options.compare});
+    if (options.labels) {
+      const std::size_t comma = options.labels->find(',');
+      if (comma == std::string::npos || options.labels->find(',', comma + 1) != std::string::npos) {
+        throw Error("--labels \"" + *options.labels + "\": expected two labels separated by one comma");
+      }
+      shared.runs[0].label = options.labels->substr(0, comma);
+      shared.runs[1].label = options.labels->substr(comma + 1);
+    }
+  }
+  std::int64_t numFrames = -1;
+  std::int64_t numVertices = 0;
+  for (const Run& run : shared.runs) {
+    if (!fs::exists(run.file)) {
+      throw Error(run.file.string() + ": no such simulation file");
+    }
+    SimulationReader reader(run.file);
+    if (reader.hasTruncatedFrame() && !options.quiet) {
+      std::cerr << "frameRenderer: warning: " << run.file.string() << " ends in a partial frame ("
+                << reader.truncatedTrailingBytes() << " bytes, an interrupted run); it is ignored\n";
+    }
+    if (reader.numFrames() == 0) {
+      throw Error(run.file.string() + ": holds no complete frame" +
+                  (reader.hasTruncatedFrame() ? " (the file is truncated inside its first frame)" : ""));
+    }
+    if (numVertices != 0 && reader.numVertices() != numVertices) {
+      throw Error(run.file.string() + ": " + std::to_string(reader.numVertices()) + " vertices, but " +
+                  shared.runs.front().file.string() + " has " + std::to_string(numVertices));
+    }
+    numVertices = reader.numVertices();
+    numFrames = numFrames < 0 ? reader.numFrames() : std::min(numFrames, reader.numFrames());
+  }
+  const std::string framesSource =
+      shared.runs.size() == 1 ? shared.runs[0].file.string() : "both simulation files (the shorter one)";
+  const std::vector<std::int64_t> frames =
+      frames::selectFrames(frames::parseFrameSelection(options.frames), numFrames, framesSource);
+
+  // The mesh, and the vertices held fixed in the simulation.
+  if (options.scene) {
+    const Scene scene = loadScene(*options.scene);
+    Simulation simulation = buildSimulation(scene);
+    shared.mesh = simulation.mesh;
+    shared.fixedVertices = simulation.fixedVertices;
+  } else {
+    auto mesh = std::make_shared<TetMesh>(readMesh(*options.mesh));
+    for (const std::string& set : options.fixedSets) {
+      const std::vector<int>& vertices = mesh->vertexSet(set);
+      shared.fixedVertices.insert(shared.fixedVertices.end(), vertices.begin(), vertices.end());
+    }
+    shared.mesh = std::move(mesh);
+  }
+  const std::string meshName = options.scene ? *options.scene : *options.mesh;
+  if (shared.mesh->numVertices() != numVertices) {
+    throw Error(shared.runs.front().file.string() + " has " + std::to_string(numVertices) + " vertices but the mesh (" +
+                meshName + ") has " + std::to_string(shared.mesh->numVertices()) +
+                ": the simulation did not run on this mesh");
+  }
+  shared.surface = options.renderMesh ? SurfaceEmbedding::embed(*shared.mesh, loadSurfaceMesh(*options.renderMesh))
+                                      : SurfaceEmbedding::boundary(*shared.mesh);
+  RenderStyle style;
+  if (options.tintSet) {
+    const std::vector<int>& tinted = shared.mesh->vertexSet(*options.tintSet);
+    Eigen::Matrix3Xf tetColors = style.surfaceColor.replicate(1, shared.mesh->numVertices());
+    const Eigen::Vector3f tint(options.tintColor[0], options.tintColor[1], options.tintColor[2]);
+    for (const int v : tinted) {
+      tetColors.col(v) = tint;
+    }
+    shared.colors = shared.surface.interpolate(tetColors);
+  }
+
+  const int maxThreads = std::max(
+      1, options.threads > 0 ? options.threads : static_cast<int>(std::min(8U, std::thread::hardware_concurrency())));
+  const int threads = std::min(maxThreads, static_cast<int>(frames.size()));
+
+  // Camera: fitted to the rest shape and every frame of every run (so that renders of
+  // different frame selections share one camera), unless given.
+  const int bar = shared.runs.size() > 1 ? std::max(14, options.height / 14) : 0;
+  const int leftWidth = shared.runs.size() > 1 ? options.width / 2 : options.width;
+  const int panelHeight = options.height - bar;
+  Stopwatch boundsWatch;
+  boundsWatch.start();
+  std::vector<BoundingBox> frameBoxes(shared.runs.size() * static_cast<std::size_t>(numFrames + 1));
+  forEachParallel(shared, std::min(maxThreads, static_cast<int>(frameBoxes.size())), frameBoxes.size(),
+                  [&](Worker& worker, int, std::size_t i) {
+                    const std::size_t r = i / static_cast<std::size_t>(numFrames + 1);
+                    const std::int64_t k = static_cast<std::int64_t>(i % static_cast<std::size_t>(numFrames + 1)) - 1;
+                    const Eigen::Matrix3Xd x = worker.surfacePositions(shared, r, k);
+                    frameBoxes[i] = {x.rowwise().minCoeff(), x.rowwise().maxCoeff()};
+                  });
+  BoundingBox box = frameBoxes.front();
+  for (const BoundingBox& b : frameBoxes) {
+    box.min = box.min.cwiseMin(b.min);
+    box.max = box.max.cwiseMax(b.max);
+  }
+  const double boundsSeconds = boundsWatch.stop();
+  const Eigen::Vector3d up = toVector(options.cameraUp);
+  if (!(up.norm() > 0.0)) {
+    throw Error("--camera-up must not be zero");
+  }
+  Camera camera;
+  if (!options.cameraPosition.empty()) {
+    camera.position = toVector(options.cameraPosition);
+    camera.target = toVector(options.cameraTarget);
+    camera.up = up;
+    camera.verticalFieldOfViewDegrees = options.fieldOfView;
+  } else {
+    const Eigen::Vector3d direction =
+        options.viewDirection.empty() ? defaultViewDirection() : toVector(options.viewDirection);
+    camera = fitCamera(box, static_cast<double>(leftWidth) / panelHeight, direction, up, options.fieldOfView);
+  }
+  const double diagonal = std::max((box.max - box.min).norm(), 1e-12);
+  if (options.ground) {
+    const Eigen::Vector3d center = 0.5 * (box.min + box.max);
+    const Eigen::Vector3d n = up.normalized();
+    // Lowest point of the box along up, a little below it.
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d c((corner & 1) != 0 ? box.max.x() : box.min.x(),
+                              (corner & 2) != 0 ? box.max.y() : box.min.y(),
+                              (corner & 4) != 0 ? box.max.z() : box.min.z());
+      lowest = std::min(lowest, n.dot(c));
+    }
+    style.ground = GroundPlane{center + ((lowest - n.dot(center) - (0.02 * diagonal)) * n), 4.0 * diagonal,
+                               roundLength(diagonal / 6.0), true};
+  }
+
+  fs::create_directories(options.output);
+  Progress::Style progressStyle = Progress::Style::lines;
+  if (options.quiet) {
+    progressStyle = Progress::Style::none;
+  } else if (options.progress || ::isatty(STDERR_FILENO) != 0) {
+    progressStyle = Progress::Style::bar;
+  }
+  Progress progress(progressStyle, frames.size());
+  std::atomic<std::size_t> done{0};
+  // One renderer (OSMesa context) per thread and panel; panels may differ in width by one.
+  std::vector<std::vector<std::unique_ptr<OffscreenRenderer>>> renderers(static_cast<std::size_t>(threads));
+  std::vector<double> renderSeconds(static_cast<std::size_t>(threads), 0.0);
+  std::vector<double> pngSeconds(static_cast<std::size_t>(threads), 0.0);
+  Stopwatch renderWatch;
+  renderWatch.start();
+  try {
+    forEachParallel(shared, threads, frames.size(), [&](Worker& worker, int thread, std::size_t i) {
+      auto& own = renderers[static_cast<std::size_t>(thread)];
+      own.resize(shared.runs.size());
+      Stopwatch watch;
+      watch.start();
+      std::vector<Image> panels;
+      for (std::size_t r = 0; r < shared.runs.size(); ++r) {
+        if (!own[r]) {
+          const int panelWidth = r == 0 ? leftWidth : options.width - leftWidth;
+          own[r] = std::make_unique<OffscreenRenderer>(panelWidth, panelHeight, options.supersampling);
+        }
+        const Eigen::Matrix3Xd x = worker.surfacePositions(shared, r, frames[i]);
+        panels.push_back(own[r]->render({{x, shared.surface.triangles(), shared.colors ? &*shared.colors : nullptr}},
+                                        camera, style));
+      }
+      Image image;
+      if (panels.size() == 1) {
+        image = std::move(panels.front());
+      } else {
+        std::vector<std::string> labels;
+        for (const Run& run : shared.runs) {
+          labels.push_back(run.label);
+        }
+        image = composeSideBySide(panels, labels, bar);
+      }
+      renderSeconds[static_cast<std::size_t>(thread)] += watch.stop();
+      watch.start();
+      writePng(fs::path(options.output) / frameName(frames[i]), image);
+      pngSeconds[static_cast<std::size_t>(thread)] += watch.stop();
+      progress.update(++done);
+    });
+  } catch (...) {
+    progress.finish();
+    throw;
+  }
+  progress.finish();
+  const double renderWall = renderWatch.stop();
+
+  if (!options.quiet) {
+    double render = 0.0;
+    double png = 0.0;
+    for (int t = 0; t < threads; ++t) {
+      render += renderSeconds[static_cast<std::size_t>(t)];
+      png += pngSeconds[static_cast<std::size_t>(t)];
+    }
+    std::ostringstream out;
+    out.setf(std::ios::fixed);
+    out.precision(2);
+    out << "frameRenderer: " << frames.size() << " frames"
+        << (options.frames.empty() ? "" : " (" + options.frames + ")") << " of " << shared.runs.front().file.string();
+    if (shared.runs.size() > 1) {
+      out << " and " << shared.runs[1].file.string();
+    }
+    out << " -> " << (fs::path(options.output) / "frame_NNNNN.png").string() << " (" << options.width << " x "
+        << options.height << "), " << total.stop() << " s\n";
+    out << "  surface     " << (options.renderMesh ? *options.renderMesh : std::string("tet mesh boundary")) << ", "
+        << shared.surface.numSurfaceVertices() << " vertices, " << shared.surface.triangles().size() << " triangles";
+    if (shared.surface.numOutsideVertices() > 0) {
+      out << " (" << shared.surface.numOutsideVertices() << " outside the tet mesh, up to "
+          << shared.surface.maxOutsideDistance() << " away)";
+    }
+    out << "\n  warping     " << options.warp << "\n";
+    out << "  camera      " << (options.cameraPosition.empty() ? "fitted to all frames" : "given") << ", bounds "
+        << boundsSeconds << " s\n";
+    out << "  per frame   " << 1e3 * renderWall / static_cast<double>(frames.size()) << " ms wall on " << threads
+        << (threads == 1 ? " thread" : " threads") << " (per thread: draw "
+        << 1e3 * render / static_cast<double>(frames.size()) << " ms, PNG "
+        << 1e3 * png / static_cast<double>(frames.size()) << " ms)\n";
+    std::cout << out.str() << std::flush;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "frameRenderer: " << e.what() << "\n";
+    return 1;
+  }
+}
