@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/simulationIO/checkpoint.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <chrono>
 #include <csignal>
@@ -16,6 +17,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace {
 
@@ -87,6 +89,71 @@ class OfflineSimulatorTest : public ::testing::Test {
     text += path.string();
     text += '\'';
     return text;
+  }
+
+  /// Starts the simulator with these arguments, stdout to /dev/null and stderr to
+  /// errorFile; returns the child's pid.
+  static pid_t start(const std::vector<std::string>& arguments, const fs::path& errorFile) {
+    const pid_t child = ::fork();
+    if (child == 0) {
+      const int devNull = ::open("/dev/null", O_WRONLY);
+      const int error = ::open(errorFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(devNull, STDOUT_FILENO);
+      ::dup2(error, STDERR_FILENO);
+      std::vector<char*> argv;
+      argv.push_back(const_cast<char*>(simulatorPath.c_str()));
+      for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+      argv.push_back(nullptr);
+      ::execv(simulatorPath.c_str(), argv.data());
+      ::_exit(127);
+    }
+    return child;
+  }
+
+  /// Waits (at most 60 s) until output holds at least `frames` complete frames; returns
+  /// the count last seen.
+  static std::int64_t waitForFrames(const fs::path& output, std::int64_t frames) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    std::int64_t seen = 0;
+    while (std::chrono::steady_clock::now() < deadline && seen < frames) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      std::error_code ignored;
+      if (fs::exists(output, ignored) && fs::file_size(output, ignored) > 64) {
+        try {
+          seen = asyncfem::SimulationReader(output).numFrames();
+        } catch (const asyncfem::Error&) {
+          seen = 0;  // the header itself may be in flight
+        }
+      }
+    }
+    return seen;
+  }
+
+  /// A run that would go on for a very long time: 6 x 2 x 2 box, pulled, one step per frame.
+  static nlohmann::json endlessScene() {
+    auto json = smallScene();
+    json["mesh"]["cells"] = {6, 2, 2};
+    json["mesh"]["size"] = {6, 2, 2};
+    json["forces"][0].erase("window");
+    json["frames"] = {{"rate", 100}, {"count", 100000000}};
+    json["integrator"]["timestep"] = 0.01;
+    json["output"]["velocities"] = true;
+    return json;
+  }
+
+  /// Runs scene uninterrupted for `frames` frames into reference and expects output to
+  /// hold exactly the same bytes (and the checkpoints to agree).
+  void expectSameAsUninterrupted(const fs::path& scene, std::int64_t frames, const fs::path& output,
+                                 const std::string& extra = "") const {
+    const fs::path reference = folder_ / "reference.afsim";
+    const RunResult r =
+        run(quoted(scene) + " --quiet --frames " + std::to_string(frames) + " --output " + quoted(reference) + extra);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::string expected = readText(reference);
+    const std::string actual = readText(output);
+    ASSERT_EQ(expected.size(), actual.size());
+    EXPECT_TRUE(expected == actual) << "the resumed run differs from the uninterrupted one";
+    EXPECT_TRUE(readText(asyncfem::checkpointPathFor(reference)) == readText(asyncfem::checkpointPathFor(output)));
   }
 
   fs::path folder_;
@@ -173,6 +240,9 @@ TEST_F(OfflineSimulatorTest, UnstableExplicitRunStopsNamingTheFrame) {
   ASSERT_NE(at, std::string::npos) << r.err;
   const int failedFrame = std::stoi(r.err.substr(at + std::string("offlineSimulator: frame ").size()));
   EXPECT_NE(r.err.find("unstable"), std::string::npos) << r.err;
+  // It says where: the vertex and that it is one of the (single-rate) mesh.
+  EXPECT_NE(r.err.find(" at vertex "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" of the mesh"), std::string::npos) << r.err;
 
   // Every frame before the failing one is there, complete and finite; the failing one is not.
   asyncfem::SimulationReader reader(folder_ / "out/run.afsim");
@@ -262,6 +332,142 @@ TEST_F(OfflineSimulatorTest, KilledRunLeavesEveryFinishedFrameReadable) {
   for (std::int64_t k = 0; k < reader.numFrames(); ++k) {
     EXPECT_NEAR(reader.readFrame(k).time, 0.01 * static_cast<double>(k + 1), 1e-9);
   }
+}
+
+TEST_F(OfflineSimulatorTest, ResumedRunIsBitIdenticalForEveryIntegrator) {
+  // Each integrator's full state (u, v, t and, for the trapezoidal rule and central
+  // differences, the acceleration) goes through the checkpoint.
+  const std::vector<std::pair<std::string, nlohmann::json>> integrators = {
+      {"backward-euler", nlohmann::json::parse(R"({"name": "backward-euler", "timestep": 0.01})")},
+      {"trapezoidal", nlohmann::json::parse(R"({"name": "trapezoidal", "timestep": 0.01})")},
+      {"central-differences", nlohmann::json::parse(R"({"name": "central-differences", "timestep": 0.001})")},
+      {"symplectic-euler", nlohmann::json::parse(R"({"name": "symplectic-euler", "timestep": 0.001})")},
+      {"async", nlohmann::json::parse(R"({"name": "async", "timestep": 0.01,
+          "options": {"regions": [{"name": "tip", "ratio": 4, "vertexSets": ["xmax"]}]}})")},
+      {"corotational", nlohmann::json::parse(R"({"name": "trapezoidal", "timestep": 0.05,
+                                                 "options": {"maxIterations": 3}})")},
+  };
+  for (const auto& [label, integrator] : integrators) {
+    SCOPED_TRACE(label);
+    auto json = smallScene();
+    json["integrator"] = integrator;
+    json["output"]["velocities"] = true;
+    if (label == "corotational") {
+      json["forceModel"] = {{"type", "corotational"}};
+    }
+    const fs::path scene = writeScene(json, label + ".json");
+    const fs::path output = folder_ / (label + ".afsim");
+    const RunResult first = run(quoted(scene) + " --quiet --frames 4 --output " + quoted(output));
+    ASSERT_EQ(first.exitCode, 0) << first.err;
+    const RunResult resumed = run(quoted(scene) + " --frames 9 --resume --output " + quoted(output));
+    ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+    EXPECT_NE(resumed.out.find("5 frames (resumed after frame 4 of 9)"), std::string::npos) << resumed.out;
+    expectSameAsUninterrupted(scene, 9, output);
+  }
+}
+
+TEST_F(OfflineSimulatorTest, SignalStopsAfterTheFrameAndTheRunResumesBitIdentically) {
+  const fs::path scene = writeScene(endlessScene());
+  const fs::path output = folder_ / "out/run.afsim";
+  for (const int signal : {SIGINT, SIGTERM}) {
+    SCOPED_TRACE(signal == SIGINT ? "SIGINT" : "SIGTERM");
+    const fs::path errorFile = folder_ / "interrupted.txt";
+    fs::remove(output);  // so that the frames waited for are this run's
+    const pid_t child = start({scene.string()}, errorFile);
+    ASSERT_GT(child, 0);
+    const std::int64_t seen = waitForFrames(output, 5);
+    ::kill(child, signal);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    ASSERT_GE(seen, 5) << "no frames appeared within 60 s";
+    // A clean stop: the exit status says which signal, the message how to go on.
+    ASSERT_TRUE(WIFEXITED(status)) << "the simulator did not handle the signal";
+    EXPECT_EQ(WEXITSTATUS(status), 128 + signal);
+    const std::string message = readText(errorFile);
+    EXPECT_NE(message.find(signal == SIGINT ? "interrupted by SIGINT" : "interrupted by SIGTERM"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("frames are complete in " + output.string()), std::string::npos) << message;
+    EXPECT_NE(message.find("--resume"), std::string::npos) << message;
+
+    // Every frame is complete (no partial record), and the checkpoint is at the last one.
+    asyncfem::SimulationReader reader(output);
+    EXPECT_FALSE(reader.hasTruncatedFrame());
+    EXPECT_NO_THROW(reader.verifyAll());
+    const std::int64_t frames = reader.numFrames();
+    EXPECT_GE(frames, seen);
+    EXPECT_NE(message.find(std::to_string(frames) + " of 100000000 frames are complete"), std::string::npos) << message;
+    EXPECT_EQ(asyncfem::readCheckpoint(asyncfem::checkpointPathFor(output)).frames, frames);
+
+    const RunResult resumed = run(quoted(scene) + " --quiet --resume --frames " + std::to_string(frames + 3));
+    ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+    expectSameAsUninterrupted(scene, frames + 3, output);
+  }
+}
+
+TEST_F(OfflineSimulatorTest, KilledRunResumesFromItsLastCheckpoint) {
+  // Checkpoints every 7 frames: the frames after the last one are recomputed on resume.
+  const fs::path scene = writeScene(endlessScene());
+  const fs::path output = folder_ / "out/run.afsim";
+  const pid_t child = start({scene.string(), "--checkpoint-every", "7"}, folder_ / "killed.txt");
+  ASSERT_GT(child, 0);
+  const std::int64_t seen = waitForFrames(output, 10);
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before it was killed";
+  ASSERT_GE(seen, 10) << "no frames appeared within 60 s";
+  const std::int64_t checkpointed = asyncfem::readCheckpoint(asyncfem::checkpointPathFor(output)).frames;
+  EXPECT_EQ(checkpointed % 7, 0);
+  EXPECT_LE(checkpointed, asyncfem::SimulationReader(output).numFrames());
+
+  const std::int64_t frames = asyncfem::SimulationReader(output).numFrames() + 2;
+  const RunResult resumed = run(quoted(scene) + " --resume --checkpoint-every 7 --frames " + std::to_string(frames));
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+  EXPECT_NE(resumed.out.find("(resumed after frame " + std::to_string(checkpointed) + " of "), std::string::npos)
+      << resumed.out;
+  expectSameAsUninterrupted(scene, frames, output, " --checkpoint-every 7");
+}
+
+TEST_F(OfflineSimulatorTest, ResumeRefusesWhatItCannotContinueExactly) {
+  auto json = smallScene();
+  const fs::path scene = writeScene(json);
+  const fs::path output = folder_ / "out/run.afsim";
+  const fs::path checkpoint = asyncfem::checkpointPathFor(output);
+  ASSERT_EQ(run(quoted(scene) + " --quiet --frames 3").exitCode, 0);
+  const std::string threeFrames = readText(output);
+
+  // Nothing left to do: the file stays as it is.
+  const RunResult same = run(quoted(scene) + " --quiet --resume --frames 3");
+  EXPECT_EQ(same.exitCode, 0) << same.err;
+  EXPECT_TRUE(readText(output) == threeFrames);
+
+  const RunResult fewer = run(quoted(scene) + " --resume --frames 2");
+  EXPECT_EQ(fewer.exitCode, 1);
+  EXPECT_NE(fewer.err.find("already has 3 finished frames, more than the 2 requested"), std::string::npos) << fewer.err;
+
+  json["mesh"]["material"]["youngsModulus"] = 2e5;
+  const RunResult changed = run(quoted(writeScene(json)) + " --resume --frames 6");
+  EXPECT_EQ(changed.exitCode, 1);
+  EXPECT_NE(changed.err.find("different scene, mesh, integrator or timestep"), std::string::npos) << changed.err;
+  const RunResult otherStep = run(quoted(scene) + " --resume --frames 6 --dt 0.005");
+  EXPECT_EQ(otherStep.exitCode, 1);
+  EXPECT_NE(otherStep.err.find("different scene, mesh, integrator or timestep"), std::string::npos) << otherStep.err;
+  EXPECT_TRUE(readText(output) == threeFrames);
+
+  // A corrupted checkpoint is named, and so is a missing one.
+  std::string bytes = readText(checkpoint);
+  bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 1);
+  std::ofstream(checkpoint, std::ios::binary) << bytes;
+  const RunResult corrupted = run(quoted(scene) + " --resume --frames 6");
+  EXPECT_EQ(corrupted.exitCode, 1);
+  EXPECT_NE(corrupted.err.find(checkpoint.string() + ": checkpoint checksum mismatch"), std::string::npos)
+      << corrupted.err;
+  fs::remove(checkpoint);
+  const RunResult missing = run(quoted(scene) + " --resume --frames 6");
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_NE(missing.err.find("cannot resume: no checkpoint"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("run without --resume to start over"), std::string::npos) << missing.err;
+  EXPECT_TRUE(readText(output) == threeFrames);
 }
 
 }  // namespace

@@ -2,24 +2,38 @@
 // offlineSimulator: runs a scene file and stores its frames.
 //
 //   offlineSimulator SCENE.json [--output FILE.afsim] [--integrator NAME] [--dt H]
-//                    [--frames N] [--vtu FOLDER] [--progress] [--quiet]
+//                    [--frames N] [--vtu FOLDER] [--resume] [--checkpoint-every K]
+//                    [--progress] [--quiet]
 //
 // Frames go to one .afsim file (docs/simulation-output.md), optionally one .vtu per
-// frame; progress on stderr, the run summary on stdout. Errors print
-// "offlineSimulator: <message>" on stderr and exit with status 1. What it prints is
-// described in docs/scene-format.md, section "Running a scene".
+// frame; progress on stderr, the run summary on stdout. After every K-th frame (default
+// every frame) the full state goes to FILE.afsim.checkpoint, so that --resume continues
+// an interrupted run and produces exactly the file an uninterrupted run would have.
+// SIGINT and SIGTERM stop the run after the current frame, with a checkpoint, and exit
+// with status 128 + the signal number. Errors print "offlineSimulator: <message>" on
+// stderr and exit with status 1. What it prints is described in docs/scene-format.md,
+// section "Running a scene".
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/simulationIO/checkpoint.hpp>
+#include <asyncfem/simulationIO/crc32.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
+#include <bit>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -39,9 +53,182 @@ struct CommandLine {
   std::optional<double> timestep;
   std::optional<int> frames;
   std::optional<std::string> vtuFolder;
+  bool resume = false;
+  int checkpointEvery = 1;
   bool progress = false;
   bool quiet = false;
 };
+
+// The signal that asked the run to stop (0: none). A signal handler can only set a flag
+// of this type, so this one piece of state is global; the loop polls it between frames.
+volatile std::sig_atomic_t stopSignal = 0;
+
+extern "C" void requestStop(int signal) {
+  stopSignal = signal;
+  // write() is async-signal-safe; the handler was installed with SA_RESETHAND, so a
+  // second signal ends the process at once (finished frames are safe either way).
+  static constexpr char message[] =
+      "\nofflineSimulator: stopping after the current frame (send the signal again to stop at once)\n";
+  const ssize_t ignored = ::write(STDERR_FILENO, message, sizeof(message) - 1);
+  static_cast<void>(ignored);
+}
+
+void installStopHandlers() {
+  struct sigaction action {};
+  action.sa_handler = requestStop;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+}
+
+const char* signalName(int signal) {
+  switch (signal) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    default:
+      return "a signal";
+  }
+}
+
+std::string readFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+template <typename T>
+std::uint32_t crcOf(const T& value, std::uint32_t crc) {
+  return asyncfem::crc32(&value, sizeof(value), crc);
+}
+
+// Identity of a run, stored in its checkpoint so that --resume refuses to continue a file
+// with different physics: the scene file without frames.count and output (which a resumed
+// run may change), the integrator and timestep after command-line overrides, and the mesh
+// as built (rest positions, elements, materials, fixed vertices).
+std::uint32_t runFingerprint(const fs::path& sceneFile, const asyncfem::Scene& scene,
+                             const asyncfem::Simulation& simulation) {
+  nlohmann::json json = nlohmann::json::parse(readFile(sceneFile));
+  if (json.is_object()) {
+    json.erase("output");
+    if (json.contains("frames") && json["frames"].is_object()) json["frames"].erase("count");
+  }
+  const std::string text = json.dump();
+  std::uint32_t crc = asyncfem::crc32(text.data(), text.size());
+  crc = asyncfem::crc32(scene.integrator.name.data(), scene.integrator.name.size(), crc);
+  crc = crcOf(std::bit_cast<std::uint64_t>(simulation.timestep), crc);
+  crc = crcOf(std::bit_cast<std::uint64_t>(simulation.frameInterval), crc);
+  const asyncfem::TetMesh& mesh = *simulation.mesh;
+  crc = asyncfem::crc32(mesh.restPositions().data(),
+                        sizeof(double) * static_cast<std::size_t>(mesh.restPositions().size()), crc);
+  crc = asyncfem::crc32(mesh.elements().data(), sizeof(int) * static_cast<std::size_t>(mesh.elements().size()), crc);
+  crc = asyncfem::crc32(mesh.elementMaterials().data(), sizeof(int) * mesh.elementMaterials().size(), crc);
+  for (const asyncfem::Material& material : mesh.materials()) {
+    crc = crcOf(std::bit_cast<std::uint64_t>(material.density), crc);
+    crc = crcOf(std::bit_cast<std::uint64_t>(material.youngsModulus), crc);
+    crc = crcOf(std::bit_cast<std::uint64_t>(material.poissonRatio), crc);
+  }
+  crc = asyncfem::crc32(simulation.fixedVertices.data(), sizeof(int) * simulation.fixedVertices.size(), crc);
+  return crc;
+}
+
+asyncfem::SimulationCheckpoint captureCheckpoint(const asyncfem::Integrator& integrator, std::int64_t frames,
+                                                 std::uint32_t fingerprint) {
+  asyncfem::SimulationCheckpoint checkpoint;
+  checkpoint.frames = frames;
+  checkpoint.time = integrator.time();
+  checkpoint.fingerprint = fingerprint;
+  checkpoint.integrator = integrator.name();
+  checkpoint.displacement = integrator.displacement();
+  checkpoint.velocity = integrator.velocity();
+  checkpoint.internalState = integrator.internalState();
+  return checkpoint;
+}
+
+// Restores the state of the checkpoint next to the output after checking that it belongs
+// to this run and to the frames in the output file; returns the frames to keep.
+std::int64_t restoreFromCheckpoint(const asyncfem::Scene& scene, asyncfem::Simulation& simulation,
+                                   const asyncfem::SimulationFileHeader& header, std::uint32_t fingerprint) {
+  const fs::path& output = scene.output.file;
+  const fs::path checkpointFile = asyncfem::checkpointPathFor(output);
+  const std::string restart = "; run without --resume to start over";
+  if (!fs::exists(output)) {
+    throw asyncfem::Error("cannot resume: " + output.string() + " does not exist" + restart);
+  }
+  if (!fs::exists(checkpointFile)) {
+    throw asyncfem::Error("cannot resume: no checkpoint " + checkpointFile.string() + " next to " + output.string() +
+                          restart);
+  }
+  const asyncfem::SimulationCheckpoint checkpoint = asyncfem::readCheckpoint(checkpointFile);
+  asyncfem::Integrator& integrator = *simulation.integrator;
+  if (checkpoint.fingerprint != fingerprint || checkpoint.integrator != integrator.name() ||
+      checkpoint.displacement.size() != integrator.displacement().size()) {
+    throw asyncfem::Error("cannot resume: " + checkpointFile.string() +
+                          " was written by a run with a different scene, mesh, integrator or timestep" + restart);
+  }
+  if (checkpoint.frames > simulation.numFrames) {
+    throw asyncfem::Error("cannot resume: " + output.string() + " already has " + std::to_string(checkpoint.frames) +
+                          " finished frames, more than the " + std::to_string(simulation.numFrames) +
+                          " requested (frames.count or --frames)");
+  }
+  asyncfem::SimulationReader reader(output);
+  const asyncfem::SimulationFileHeader& stored = reader.header();
+  if (stored.numVertices != header.numVertices || stored.hasVelocities != header.hasVelocities ||
+      std::bit_cast<std::uint64_t>(stored.frameInterval) != std::bit_cast<std::uint64_t>(header.frameInterval) ||
+      std::bit_cast<std::uint64_t>(stored.timestep) != std::bit_cast<std::uint64_t>(header.timestep)) {
+    throw asyncfem::Error("cannot resume: the header of " + output.string() +
+                          " does not match this run (vertex count, frame interval, timestep or output.velocities)" +
+                          restart);
+  }
+  if (reader.numFrames() < checkpoint.frames) {
+    throw asyncfem::Error("cannot resume: " + output.string() + " holds " + std::to_string(reader.numFrames()) +
+                          " complete frames but its checkpoint says " + std::to_string(checkpoint.frames) + restart);
+  }
+  if (checkpoint.frames > 0) {
+    // The last kept record must hold exactly the checkpoint's state.
+    const asyncfem::SimulationFrame last = reader.readFrame(checkpoint.frames - 1);
+    const auto bytes = static_cast<std::size_t>(last.displacement.size()) * sizeof(double);
+    if (std::bit_cast<std::uint64_t>(last.time) != std::bit_cast<std::uint64_t>(checkpoint.time) ||
+        std::memcmp(last.displacement.data(), checkpoint.displacement.data(), bytes) != 0) {
+      throw asyncfem::Error("cannot resume: frame " + std::to_string(checkpoint.frames - 1) + " of " + output.string() +
+                            " differs from the state in " + checkpointFile.string() + restart);
+    }
+  }
+  integrator.setState(checkpoint.displacement, checkpoint.velocity, checkpoint.time);
+  integrator.setInternalState(checkpoint.internalState);
+  return checkpoint.frames;
+}
+
+// The command to continue an interrupted run: this one, with --resume added.
+std::string resumeCommand(int argc, char** argv) {
+  std::string command;
+  bool hasResume = false;
+  for (int i = 0; i < argc; ++i) {
+    const std::string argument = argv[i];
+    hasResume = hasResume || argument == "--resume";
+    if (i > 0) command += ' ';
+    if (!argument.empty() &&
+        argument.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_./=+:,") ==
+            std::string::npos) {
+      command += argument;
+    } else {
+      command += '\'';
+      for (const char c : argument) {
+        if (c == '\'') {
+          command += "'\\''";
+        } else {
+          command += c;
+        }
+      }
+      command += '\'';
+    }
+  }
+  if (!hasResume) command += " --resume";
+  return command;
+}
 
 // Command-line values replace the scene's; paths given here are relative to the
 // current folder, not the scene's.
@@ -80,9 +267,10 @@ std::string milliseconds(double seconds, int frames) {
 
 void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simulation,
                   const asyncfem::IntegratorStats& before, double setupSeconds, double loopSeconds,
-                  double outputSeconds, std::int64_t outputBytes) {
+                  double outputSeconds, std::int64_t outputBytes, int firstFrame) {
   const asyncfem::IntegratorStats& after = simulation.integrator->stats();
-  const int frames = simulation.numFrames;
+  // Frames computed by this run (a resumed run starts at firstFrame).
+  const int frames = std::max(simulation.numFrames - firstFrame, 1);
   const double forces = after.forceSeconds - before.forceSeconds;
   const double assembly = after.assemblySeconds - before.assemblySeconds;
   const double factorization = after.factorizationSeconds - before.factorizationSeconds;
@@ -93,9 +281,12 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
   std::ostringstream out;
   out.setf(std::ios::fixed);
   out.precision(3);
-  out << "offlineSimulator: " << scene.sourceName << ": " << frames << " frames, " << steps
-      << " steps of h = " << std::defaultfloat << simulation.timestep << " (" << simulation.stepsPerFrame
-      << " per frame), " << std::fixed << (setupSeconds + loopSeconds) << " s\n";
+  out << "offlineSimulator: " << scene.sourceName << ": " << (simulation.numFrames - firstFrame) << " frames";
+  if (firstFrame > 0) {
+    out << " (resumed after frame " << firstFrame << " of " << simulation.numFrames << ")";
+  }
+  out << ", " << steps << " steps of h = " << std::defaultfloat << simulation.timestep << " ("
+      << simulation.stepsPerFrame << " per frame), " << std::fixed << (setupSeconds + loopSeconds) << " s\n";
   out << "  mesh        " << simulation.mesh->numVertices() << " vertices, " << simulation.mesh->numElements()
       << " elements, " << simulation.fixedVertices.size() << " fixed vertices\n";
   out << "  model       "
@@ -123,7 +314,8 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
   for (const std::string& item : simulation.skipped) {
     out << "    - " << item << "\n";
   }
-  out << "  output      " << scene.output.file.string() << " (" << frames << " frames, " << outputBytes << " bytes)";
+  out << "  output      " << scene.output.file.string() << " (" << simulation.numFrames << " frames, " << outputBytes
+      << " bytes; checkpoint " << asyncfem::checkpointPathFor(scene.output.file).string() << ")";
   if (!scene.output.vtuFolder.empty()) {
     out << ", .vtu files in " << scene.output.vtuFolder.string();
   }
@@ -144,6 +336,13 @@ int run(int argc, char** argv) {
   app.add_option("--frames", options.frames, "Number of frames (replaces frames.count)")->check(CLI::PositiveNumber);
   app.add_option("--vtu", options.vtuFolder,
                  "Also write FOLDER/frame_NNNNN.vtu per frame (replaces output.vtu.folder)");
+  app.add_flag("--resume", options.resume,
+               "Continue the output file from its last checkpoint instead of starting over; the result is "
+               "bit-identical to an uninterrupted run (frames.count / --frames may be raised)");
+  app.add_option("--checkpoint-every", options.checkpointEvery,
+                 "Write the checkpoint (OUTPUT.checkpoint) every K frames (default 1); a resumed run recomputes "
+                 "the frames after the last one")
+      ->check(CLI::PositiveNumber);
   app.add_flag("--progress", options.progress, "Draw the progress bar even when stderr is not a terminal");
   app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
   try {
@@ -176,7 +375,23 @@ int run(int argc, char** argv) {
   header.frameInterval = simulation.frameInterval;
   header.timestep = simulation.timestep;
   header.hasVelocities = scene.output.velocities;
-  asyncfem::SimulationWriter writer(scene.output.file, header, asyncfem::SimulationWriter::Options{scene.output.sync});
+  const asyncfem::SimulationWriter::Options writerOptions{scene.output.sync};
+  const std::uint32_t fingerprint = runFingerprint(options.scene, scene, simulation);
+  const fs::path checkpointFile = asyncfem::checkpointPathFor(scene.output.file);
+
+  int firstFrame = 0;
+  std::unique_ptr<asyncfem::SimulationWriter> writer;
+  if (options.resume) {
+    firstFrame = static_cast<int>(restoreFromCheckpoint(scene, simulation, header, fingerprint));
+    writer = asyncfem::SimulationWriter::continueFile(scene.output.file, header, firstFrame, writerOptions);
+  } else {
+    writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, header, writerOptions);
+    // The rest state, so that a run stopped before its first frame can be resumed too.
+    asyncfem::writeCheckpoint(checkpointFile, captureCheckpoint(*simulation.integrator, 0, fingerprint),
+                              scene.output.sync);
+  }
+  std::int64_t checkpointFrames = firstFrame;
+  installStopHandlers();
 
   ProgressStyle style = ProgressStyle::lines;
   if (options.quiet) {
@@ -184,22 +399,29 @@ int run(int argc, char** argv) {
   } else if (options.progress || ::isatty(STDERR_FILENO) != 0) {
     style = ProgressStyle::bar;
   }
-  ProgressReporter progress(style, simulation.numFrames);
+  ProgressReporter progress(style, simulation.numFrames, firstFrame);
 
   asyncfem::Stopwatch loopWatch;
   asyncfem::Stopwatch outputWatch;
   loopWatch.start();
-  int frame = 0;
+  int frame = firstFrame;
   try {
-    for (; frame < simulation.numFrames; ++frame) {
+    for (; frame < simulation.numFrames && stopSignal == 0; ++frame) {
       asyncfem::advanceFrame(simulation, frame);
       {
         const asyncfem::ScopedTimer timer(outputWatch);
         const asyncfem::Integrator& integrator = *simulation.integrator;
         if (header.hasVelocities) {
-          writer.appendFrame(integrator.time(), integrator.displacement(), integrator.velocity());
+          writer->appendFrame(integrator.time(), integrator.displacement(), integrator.velocity());
         } else {
-          writer.appendFrame(integrator.time(), integrator.displacement());
+          writer->appendFrame(integrator.time(), integrator.displacement());
+        }
+        // After the record, so that the checkpoint never runs ahead of the file.
+        const int done = frame + 1;
+        if (done % options.checkpointEvery == 0 || done == simulation.numFrames || stopSignal != 0) {
+          asyncfem::writeCheckpoint(checkpointFile, captureCheckpoint(integrator, done, fingerprint),
+                                    scene.output.sync);
+          checkpointFrames = done;
         }
         if (!scene.output.vtuFolder.empty() && frame % scene.output.vtuEvery == 0) {
           asyncfem::writeVtu(scene.output.vtuFolder / vtuName(frame), *simulation.mesh, integrator.displacement());
@@ -210,16 +432,30 @@ int run(int argc, char** argv) {
   } catch (const asyncfem::Error& error) {
     progress.finish();
     // The frames before the failing one are complete, checksummed records.
-    throw asyncfem::Error(std::string(error.what()) + "; the " + std::to_string(writer.numFrames()) +
+    throw asyncfem::Error(std::string(error.what()) + "; the " + std::to_string(writer->numFrames()) +
                           " frames before it are kept in " + scene.output.file.string());
   }
   const double loopSeconds = loopWatch.stop();
   progress.finish();
-  writer.close();
+  if (stopSignal != 0 && checkpointFrames != writer->numFrames()) {
+    // The signal came after the last frame's checkpoint decision.
+    asyncfem::writeCheckpoint(
+        checkpointFile, captureCheckpoint(*simulation.integrator, writer->numFrames(), fingerprint), scene.output.sync);
+    checkpointFrames = writer->numFrames();
+  }
+  writer->close();
 
+  if (stopSignal != 0 && frame < simulation.numFrames) {
+    std::cerr << "offlineSimulator: interrupted by " << signalName(stopSignal) << ": " << writer->numFrames() << " of "
+              << simulation.numFrames << " frames are complete in " << scene.output.file.string()
+              << " (checkpoint after frame " << checkpointFrames << " in " << checkpointFile.string()
+              << "); continue the run with:\n  " << resumeCommand(argc, argv) << "\n";
+    return 128 + static_cast<int>(stopSignal);
+  }
   if (!options.quiet) {
     const auto bytes = static_cast<std::int64_t>(fs::file_size(scene.output.file));
-    printSummary(scene, simulation, statsAfterSetup, setupSeconds, loopSeconds, outputWatch.totalSeconds(), bytes);
+    printSummary(scene, simulation, statsAfterSetup, setupSeconds, loopSeconds, outputWatch.totalSeconds(), bytes,
+                 firstFrame);
   }
   return 0;
 }

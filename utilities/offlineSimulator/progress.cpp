@@ -5,8 +5,10 @@
 
 namespace asyncfem::offline {
 
-ProgressReporter::ProgressReporter(ProgressStyle style, int totalFrames, std::FILE* out)
-    : style_(style), totalFrames_(totalFrames > 0 ? totalFrames : 1), out_(out) {}
+ProgressReporter::ProgressReporter(ProgressStyle style, int totalFrames, int firstFrame, std::FILE* out)
+    : style_(style), totalFrames_(totalFrames > 0 ? totalFrames : 1), firstFrame_(firstFrame), out_(out) {
+  lastPercentPrinted_ = static_cast<int>(std::floor(100.0 * firstFrame_ / totalFrames_));
+}
 
 std::string ProgressReporter::formatSeconds(double seconds) {
   char text[32];
@@ -29,7 +31,8 @@ void ProgressReporter::update(int framesDone) {
   const Clock::time_point now = Clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   const double fraction = static_cast<double>(framesDone) / totalFrames_;
-  const double remaining = framesDone > 0 ? elapsed * (totalFrames_ - framesDone) / framesDone : 0.0;
+  const int framesThisRun = framesDone - firstFrame_;
+  const double remaining = framesThisRun > 0 ? elapsed * (totalFrames_ - framesDone) / framesThisRun : 0.0;
   const int percent = static_cast<int>(std::floor(100.0 * fraction));
 
   if (style_ == ProgressStyle::bar) {

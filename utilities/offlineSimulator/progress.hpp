@@ -18,8 +18,10 @@ enum class ProgressStyle {
 /// Reports "frame k of n" with elapsed time and an estimate of the time left.
 class ProgressReporter {
  public:
-  ProgressReporter(ProgressStyle style, int totalFrames, std::FILE* out = stderr);
-  /// Call after each finished frame (framesDone = 1 .. totalFrames).
+  /// firstFrame: frames already done when the run starts (a resumed run); the time left
+  /// is estimated from the frames done since.
+  ProgressReporter(ProgressStyle style, int totalFrames, int firstFrame = 0, std::FILE* out = stderr);
+  /// Call after each finished frame (framesDone = firstFrame + 1 .. totalFrames).
   void update(int framesDone);
   /// Ends the bar's line (call once, also on errors, before printing anything else).
   void finish();
@@ -30,6 +32,7 @@ class ProgressReporter {
 
   ProgressStyle style_;
   int totalFrames_;
+  int firstFrame_;
   std::FILE* out_;
   Clock::time_point start_ = Clock::now();
   Clock::time_point lastPrint_ = Clock::now();

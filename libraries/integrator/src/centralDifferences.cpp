@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/centralDifferences.hpp>
+#include <string>
 
 #include "detail/explicitCore.hpp"
 
@@ -19,6 +21,25 @@ void CentralDifferences::setTimestep(double timestep) {
   // Check first so that a refused timestep leaves the integrator unchanged.
   if (core_) core_->checkTimestep(timestep, "central differences");
   Integrator::setTimestep(timestep);
+}
+
+Eigen::VectorXd CentralDifferences::internalState() const {
+  if (accelerationStale_) return {};
+  return acceleration_;
+}
+
+void CentralDifferences::setInternalState(const Eigen::VectorXd& state) {
+  if (state.size() == 0) {
+    accelerationStale_ = true;
+    return;
+  }
+  const int freeDofs = system_.freeDofs.numFree();
+  if (state.size() != freeDofs || !state.allFinite()) {
+    throw Error("central-differences: setInternalState: expected the acceleration on the free DOFs, " +
+                std::to_string(freeDofs) + " finite values (got " + std::to_string(state.size()) + ")");
+  }
+  acceleration_ = state;
+  accelerationStale_ = false;
 }
 
 void CentralDifferences::step() {

@@ -54,6 +54,15 @@ void Integrator::setState(const Eigen::VectorXd& displacement, const Eigen::Vect
   stateChanged();
 }
 
+Eigen::VectorXd Integrator::internalState() const { return {}; }
+
+void Integrator::setInternalState(const Eigen::VectorXd& state) {
+  if (state.size() != 0) {
+    throw Error(name() + ": setInternalState: this integrator keeps no state beyond u, v and t (got " +
+                std::to_string(state.size()) + " values)");
+  }
+}
+
 double Integrator::mechanicalEnergy() const {
   const double kinetic = 0.5 * velocity_.dot(system_.mass * velocity_);
   return kinetic + system_.forceModel->elasticEnergy(displacement_);

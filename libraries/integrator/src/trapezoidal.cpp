@@ -47,6 +47,25 @@ void Trapezoidal::assembleAndFactor() {
   factorizationStale_ = false;
 }
 
+Eigen::VectorXd Trapezoidal::internalState() const {
+  if (accelerationStale_) return {};
+  return acceleration_;
+}
+
+void Trapezoidal::setInternalState(const Eigen::VectorXd& state) {
+  if (state.size() == 0) {
+    accelerationStale_ = true;
+    return;
+  }
+  if (state.size() != system_.numDofs() || !state.allFinite()) {
+    throw Error("trapezoidal: setInternalState: expected the acceleration, " + std::to_string(system_.numDofs()) +
+                " finite values (got " + std::to_string(state.size()) + ")");
+  }
+  acceleration_ = state;
+  zeroFixed(acceleration_);
+  accelerationStale_ = false;
+}
+
 const Eigen::VectorXd& Trapezoidal::acceleration() {
   if (accelerationStale_) computeAcceleration();
   return acceleration_;

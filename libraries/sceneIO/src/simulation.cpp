@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
@@ -15,6 +16,7 @@
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace asyncfem {
@@ -400,27 +402,96 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
   return simulation;
 }
 
+namespace {
+
+// Where a vertex lies, for messages: the asynchronous integrator's region (S_i with its
+// name, or L), else "the mesh"; plus the first named vertex set holding it, if any.
+std::string describeVertex(const Simulation& simulation, int vertex) {
+  std::ostringstream out;
+  out << "vertex " << vertex;
+  const auto* async = dynamic_cast<const AsyncBackwardEuler*>(simulation.integrator.get());
+  const std::vector<int>* regionOfVertex = async != nullptr ? &async->partition().vertexRegion() : nullptr;
+  if (regionOfVertex != nullptr && vertex >= 0 && vertex < static_cast<int>(regionOfVertex->size())) {
+    const int region = (*regionOfVertex)[static_cast<std::size_t>(vertex)];
+    if (region >= 0) {
+      out << " in fast region S_" << (region + 1) << " '" << async->partition().region(region).name << "'";
+    } else {
+      out << " in the large-step region L";
+    }
+  } else {
+    out << " of the mesh";
+  }
+  if (simulation.mesh) {
+    for (const auto& [name, members] : simulation.mesh->vertexSets()) {
+      if (std::binary_search(members.begin(), members.end(), vertex)) {
+        out << " (vertex set '" << name << "')";
+        break;
+      }
+    }
+  }
+  return out.str();
+}
+
+// The vertex an integrator's NumericalError names ("... (vertex 17, ..."), or -1.
+int vertexNamedIn(const std::string& message) {
+  const std::string key = "(vertex ";
+  const std::size_t at = message.find(key);
+  if (at == std::string::npos) return -1;
+  std::size_t position = at + key.size();
+  long long vertex = 0;
+  bool digits = false;
+  while (position < message.size() && message[position] >= '0' && message[position] <= '9' && vertex < (1LL << 40)) {
+    vertex = (10 * vertex) + (message[position] - '0');
+    digits = true;
+    ++position;
+  }
+  return digits && vertex <= std::numeric_limits<int>::max() ? static_cast<int>(vertex) : -1;
+}
+
+}  // namespace
+
 void advanceFrame(Simulation& simulation, int frame) {
   Integrator& integrator = *simulation.integrator;
   for (int s = 0; s < simulation.stepsPerFrame; ++s) {
+    // The time the step ends at, taken before the step (which advances time() on success).
+    const double stepEnd = integrator.time() + simulation.timestep;
     const auto where = [&] {
       std::ostringstream out;
       out << "frame " << frame << " (step " << ((static_cast<long long>(frame) * simulation.stepsPerFrame) + s + 1)
-          << ", t = " << formatNumber(integrator.time() + simulation.timestep) << ")";
+          << ", t = " << formatNumber(stepEnd) << ")";
       return out.str();
     };
     try {
       integrator.step();
     } catch (const NumericalError& error) {
-      throw NumericalError(where() + ": " + error.what());
+      const int vertex = vertexNamedIn(error.what());
+      const std::string location = vertex >= 0 ? " [" + describeVertex(simulation, vertex) + "]" : "";
+      throw NumericalError(where() + ": " + error.what() + location);
     }
     const Eigen::VectorXd& u = integrator.displacement();
-    if (!u.allFinite() || !integrator.velocity().allFinite()) {
-      throw NumericalError(where() + ": the state is not finite (NaN or infinity); the simulation is unstable");
+    const Eigen::VectorXd& v = integrator.velocity();
+    // The first vertex with a non-finite entry, and the one with the largest |u|.
+    Eigen::Index firstNonFinite = -1;
+    Eigen::Index largest = 0;
+    double maxDisplacement = 0.0;
+    for (Eigen::Index i = 0; i < u.size(); ++i) {
+      if (!std::isfinite(u[i]) || !std::isfinite(v[i])) {
+        firstNonFinite = i;
+        break;
+      }
+      if (std::abs(u[i]) > maxDisplacement) {
+        maxDisplacement = std::abs(u[i]);
+        largest = i;
+      }
     }
-    const double maxDisplacement = u.size() > 0 ? u.cwiseAbs().maxCoeff() : 0.0;
+    if (firstNonFinite >= 0) {
+      throw NumericalError(where() + ": the state is not finite (NaN or infinity), first at " +
+                           describeVertex(simulation, static_cast<int>(firstNonFinite / 3)) +
+                           "; the simulation is unstable");
+    }
     if (maxDisplacement > simulation.blowUpDisplacement) {
-      throw NumericalError(where() + ": blow-up: max |u| = " + formatNumber(maxDisplacement) +
+      throw NumericalError(where() + ": blow-up: max |u| = " + formatNumber(maxDisplacement) + " at " +
+                           describeVertex(simulation, static_cast<int>(largest / 3)) +
                            " exceeds 1000 x the bounding-box diagonal (" +
                            formatNumber(simulation.boundingBoxDiagonal) + "); the simulation is unstable");
     }

@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <sys/types.h>
 #include <unistd.h>
 
 #include <asyncfem/core/error.hpp>
@@ -25,15 +26,7 @@ namespace {
 
 std::string systemMessage() { return std::strerror(errno); }
 
-}  // namespace
-
-SimulationWriter::SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header)
-    : SimulationWriter(path, header, Options{}) {}
-
-SimulationWriter::SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header,
-                                   Options options)
-    : path_(path), header_(header), options_(options) {
-  const std::string name = path.string();
+void checkHeader(const std::string& name, const SimulationFileHeader& header) {
   if (header.numVertices <= 0 || header.numVertices > maxSimulationFileVertices) {
     throw Error(name + ": cannot write a simulation file with " + std::to_string(header.numVertices) + " vertices");
   }
@@ -41,12 +34,10 @@ SimulationWriter::SimulationWriter(const std::filesystem::path& path, const Simu
       header.timestep < 0.0) {
     throw Error(name + ": frame interval and timestep must be finite and >= 0");
   }
-  file_.reset(std::fopen(name.c_str(), "wb"));
-  if (!file_) {
-    throw Error(name + ": cannot create: " + systemMessage());
-  }
+}
 
-  unsigned char bytes[simulationHeaderBytes] = {};
+void encodeHeader(const SimulationFileHeader& header, unsigned char (&bytes)[simulationHeaderBytes]) {
+  std::memset(bytes, 0, sizeof(bytes));
   std::memcpy(bytes, detail::simulationMagic, sizeof(detail::simulationMagic));
   detail::putU32(bytes + detail::offsetVersion, simulationFileVersion);
   detail::putU32(bytes + detail::offsetHeaderBytes, static_cast<std::uint32_t>(simulationHeaderBytes));
@@ -56,10 +47,71 @@ SimulationWriter::SimulationWriter(const std::filesystem::path& path, const Simu
   detail::putU64(bytes + detail::offsetFlags, header.hasVelocities ? detail::flagVelocities : 0);
   detail::putU64(bytes + detail::offsetRecordBytes, static_cast<std::uint64_t>(header.recordBytes()));
   detail::putU32(bytes + detail::offsetHeaderCrc, crc32(bytes, detail::offsetHeaderCrc));
+}
+
+}  // namespace
+
+SimulationWriter::SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header)
+    : SimulationWriter(path, header, Options{}) {}
+
+SimulationWriter::SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header,
+                                   Options options)
+    : path_(path), header_(header), options_(options) {
+  const std::string name = path.string();
+  checkHeader(name, header);
+  file_.reset(std::fopen(name.c_str(), "wb"));
+  if (!file_) {
+    throw Error(name + ": cannot create: " + systemMessage());
+  }
+
+  unsigned char bytes[simulationHeaderBytes];
+  encodeHeader(header, bytes);
   if (std::fwrite(bytes, 1, sizeof(bytes), file_.get()) != sizeof(bytes) || std::fflush(file_.get()) != 0) {
     throw Error(name + ": cannot write the header: " + systemMessage());
   }
   buffer_.resize(static_cast<std::size_t>(header.recordBytes()));
+}
+
+SimulationWriter::SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header,
+                                   Options options, std::int64_t keepFrames, ContinueTag)
+    : path_(path), header_(header), options_(options) {
+  const std::string name = path.string();
+  checkHeader(name, header);
+  file_.reset(std::fopen(name.c_str(), "r+b"));
+  if (!file_) {
+    throw Error(name + ": cannot open to continue it: " + systemMessage());
+  }
+  unsigned char expected[simulationHeaderBytes];
+  encodeHeader(header, expected);
+  unsigned char stored[simulationHeaderBytes] = {};
+  if (std::fread(stored, 1, sizeof(stored), file_.get()) != sizeof(stored) ||
+      std::memcmp(stored, expected, sizeof(stored)) != 0) {
+    throw Error(name +
+                ": cannot continue it: its header differs from this run's (vertex count, frame interval, "
+                "timestep or velocity output changed)");
+  }
+  if (::fseeko(file_.get(), 0, SEEK_END) != 0) {
+    throw Error(name + ": cannot seek: " + systemMessage());
+  }
+  const auto size = static_cast<std::int64_t>(::ftello(file_.get()));
+  const std::int64_t complete = (size - simulationHeaderBytes) / header.recordBytes();
+  if (keepFrames < 0 || keepFrames > complete) {
+    throw Error(name + ": cannot continue after frame " + std::to_string(keepFrames) + ": the file holds only " +
+                std::to_string(complete) + " complete frames");
+  }
+  const std::int64_t keepBytes = simulationHeaderBytes + (keepFrames * header.recordBytes());
+  if (std::fflush(file_.get()) != 0 || ::ftruncate(::fileno(file_.get()), static_cast<off_t>(keepBytes)) != 0 ||
+      ::fseeko(file_.get(), static_cast<off_t>(keepBytes), SEEK_SET) != 0) {
+    throw Error(name + ": cannot cut the file after frame " + std::to_string(keepFrames) + ": " + systemMessage());
+  }
+  numFrames_ = keepFrames;
+  buffer_.resize(static_cast<std::size_t>(header.recordBytes()));
+}
+
+std::unique_ptr<SimulationWriter> SimulationWriter::continueFile(const std::filesystem::path& path,
+                                                                 const SimulationFileHeader& header,
+                                                                 std::int64_t keepFrames, Options options) {
+  return std::unique_ptr<SimulationWriter>(new SimulationWriter(path, header, options, keepFrames, ContinueTag{}));
 }
 
 SimulationWriter::~SimulationWriter() = default;

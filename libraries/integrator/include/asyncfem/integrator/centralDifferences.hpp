@@ -41,6 +41,9 @@ class CentralDifferences final : public Integrator {
   std::string name() const override { return "central-differences"; }
   void step() override;
   void setTimestep(double timestep) override;
+  /// a_k on the free DOFs, or empty while it is stale (recomputed from u, v, t).
+  Eigen::VectorXd internalState() const override;
+  void setInternalState(const Eigen::VectorXd& state) override;
   /// 2 / omega_max.
   double stableTimestepEstimate() const override;
   /// omega_max used for the check (rad per time unit).

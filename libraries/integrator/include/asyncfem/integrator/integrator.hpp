@@ -71,6 +71,19 @@ class Integrator {
 
   /// Sets u and v (size 3n; fixed entries are zeroed) and the time.
   void setState(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, double time = 0.0);
+  /// What the next step() depends on beyond (u, v, t), for checkpoints: restoring
+  /// (u, v, t) with setState() and then this with setInternalState() makes the following
+  /// steps bit-identical to those of the integrator it was taken from. Factorizations
+  /// and other quantities recomputed deterministically from (u, v, t) and h are not part
+  /// of it. Empty when there is nothing (the default; backward Euler, symplectic Euler,
+  /// the asynchronous integrator) or when the quantity is stale and would be recomputed
+  /// from (u, v, t) anyway; the trapezoidal rule returns its acceleration a_k (3n), central
+  /// differences its a_k on the free DOFs.
+  virtual Eigen::VectorXd internalState() const;
+  /// Restores internalState(); call after setState(). An empty vector keeps the default
+  /// (quantities derived from (u, v, t)). Throws asyncfem::Error if the size is not one
+  /// internalState() returns for this integrator or the values are not finite.
+  virtual void setInternalState(const Eigen::VectorXd& state);
   const Eigen::VectorXd& displacement() const { return displacement_; }
   const Eigen::VectorXd& velocity() const { return velocity_; }
   double time() const { return time_; }

@@ -46,6 +46,9 @@ class Trapezoidal final : public Integrator {
   std::string name() const override { return "trapezoidal"; }
   void step() override;
   void setTimestep(double timestep) override;
+  /// a_k (full, 3n), or empty while it is stale (it is then recomputed from u, v, t).
+  Eigen::VectorXd internalState() const override;
+  void setInternalState(const Eigen::VectorXd& state) override;
 
   const IntegratorOptions& options() const { return options_; }
   /// a_k (full, 3n), consistent with the current state; computes it if it is stale.

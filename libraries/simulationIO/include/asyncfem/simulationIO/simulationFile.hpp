@@ -69,6 +69,16 @@ class SimulationWriter {
   SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header);
   SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header, Options options);
   ~SimulationWriter();
+
+  /// Continues the file an earlier run left at path (for restarting an interrupted run):
+  /// its 64-byte header must be exactly the one `header` describes; its first keepFrames
+  /// complete records are kept, everything after them (an interrupted append, frames
+  /// past the last checkpoint) is cut off, and appendFrame() continues with frame
+  /// keepFrames. Throws asyncfem::Error naming the file if it cannot be opened, its
+  /// header differs, or it holds fewer than keepFrames complete records.
+  static std::unique_ptr<SimulationWriter> continueFile(const std::filesystem::path& path,
+                                                        const SimulationFileHeader& header, std::int64_t keepFrames,
+                                                        Options options);
   SimulationWriter(const SimulationWriter&) = delete;
   SimulationWriter& operator=(const SimulationWriter&) = delete;
 
@@ -89,6 +99,9 @@ class SimulationWriter {
   struct FileCloser {
     void operator()(std::FILE* file) const;
   };
+  struct ContinueTag {};
+  SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header, Options options,
+                   std::int64_t keepFrames, ContinueTag);
   void appendRecord(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
                     const Eigen::Ref<const Eigen::VectorXd>* velocity);
 
