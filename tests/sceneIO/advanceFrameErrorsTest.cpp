@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// advanceFrame's numerical-failure messages: they name the frame, the step, the time and
+// where the failure is (the vertex, its region for the asynchronous integrator or "the
+// mesh", and a vertex set holding it).
+#include <gtest/gtest.h>
+
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/sceneIO/simulation.hpp>
+#include <string>
+
+#include "sceneTestUtilities.hpp"
+
+namespace {
+
+using asyncfem::test::smallScene;
+
+// Runs every frame; returns the NumericalError's message, or "" if none was thrown.
+std::string failureOf(const nlohmann::json& json) {
+  asyncfem::Simulation simulation = asyncfem::buildSimulation(asyncfem::parseScene(json, "", "scene.json"));
+  try {
+    for (int frame = 0; frame < simulation.numFrames; ++frame) asyncfem::advanceFrame(simulation, frame);
+  } catch (const asyncfem::NumericalError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(AdvanceFrameErrors, BlowUpInAFastRegionNamesTheRegion) {
+  // A load far beyond anything physical on the free end, which is the fast region S_1:
+  // the (linear, implicit, stable) run exceeds the blow-up limit in its first step.
+  auto json = smallScene();
+  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -1e15, 0]}])");
+  json["integrator"] = nlohmann::json::parse(R"({"name": "async", "timestep": 0.01,
+      "options": {"regions": [{"name": "end", "ratio": 2, "vertexSets": ["xmax"]}]}})");
+  const std::string message = failureOf(json);
+  EXPECT_EQ(message.rfind("frame 0 (step 1, t = 0.01): blow-up: max |u| = ", 0), 0U) << message;
+  EXPECT_NE(message.find(" in fast region S_1 'end' (vertex set 'xmax')"), std::string::npos) << message;
+  EXPECT_NE(message.find("the simulation is unstable"), std::string::npos) << message;
+}
+
+TEST(AdvanceFrameErrors, BlowUpInTheLargeStepRegionSaysL) {
+  auto json = smallScene();
+  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -1e15, 0]}])");
+  json["integrator"] = nlohmann::json::parse(R"({"name": "async", "timestep": 0.01,
+      "options": {"regions": [{"name": "root", "ratio": 2, "boxes": [{"min": [0.9, 0, 0], "max": [1.1, 1, 1]}]}]}})");
+  const std::string message = failureOf(json);
+  EXPECT_NE(message.find(" in the large-step region L (vertex set 'xmax')"), std::string::npos) << message;
+}
+
+TEST(AdvanceFrameErrors, UnstableExplicitRunNamesTheFrameAndTheMesh) {
+  // Central differences forced far above its stable timestep: the state grows by orders
+  // of magnitude per step until the blow-up check stops it.
+  auto json = smallScene();
+  json["mesh"]["material"]["youngsModulus"] = 1e9;
+  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -1, 0]}])");
+  json["integrator"] = nlohmann::json::parse(R"({"name": "central-differences", "timestep": 0.01,
+                                                 "options": {"force": true}})");
+  json["frames"] = {{"rate", 10}, {"count", 50}};
+  const std::string message = failureOf(json);
+  ASSERT_EQ(message.rfind("frame ", 0), 0U) << message;
+  EXPECT_NE(message.find(" at vertex "), std::string::npos) << message;
+  EXPECT_NE(message.find(" of the mesh"), std::string::npos) << message;
+  EXPECT_NE(message.find("unstable"), std::string::npos) << message;
+}
+
+}  // namespace
