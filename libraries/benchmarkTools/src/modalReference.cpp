@@ -6,6 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include "detail/generalizedEigen.hpp"
+
 namespace asyncfem {
 
 void advanceDampedOscillator(double lambda, double damping, double force, double duration, double& position,
@@ -66,17 +68,16 @@ ModalReference::ModalReference(const Eigen::SparseMatrix<double>& mass, const Ei
   const Eigen::Index n = static_cast<Eigen::Index>(free.size());
   SubmatrixExtractor extractor(mass, free, free);
   freeMass_ = extractor.extract(mass);
-  const Eigen::MatrixXd denseMass = Eigen::MatrixXd(freeMass_);
-  const Eigen::MatrixXd denseStiffness = Eigen::MatrixXd(SubmatrixExtractor(stiffness, free, free).extract(stiffness));
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(denseStiffness, denseMass,
-                                                                   Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
-  if (solver.info() != Eigen::Success) {
+  Eigen::MatrixXd denseMass = Eigen::MatrixXd(freeMass_);
+  Eigen::MatrixXd denseStiffness = Eigen::MatrixXd(SubmatrixExtractor(stiffness, free, free).extract(stiffness));
+  if (!detail::solveGeneralizedEigen(denseStiffness, denseMass, eigenvalues_)) {
     throw NumericalError("modal reference: generalized eigendecomposition of the " + std::to_string(n) +
                          " free DOFs failed (is the mass matrix positive definite on them?)");
   }
-  eigenvalues_ = solver.eigenvalues();
-  modes_ = solver.eigenvectors();
+  modes_ = std::move(denseStiffness);
 }
+
+std::string ModalReference::backend() { return detail::generalizedEigenBackend(); }
 
 std::vector<Eigen::VectorXd> ModalReference::displacements(const PiecewiseConstantLoad& load,
                                                            const std::vector<double>& times,

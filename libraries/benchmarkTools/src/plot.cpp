@@ -111,8 +111,19 @@ std::vector<std::pair<double, std::string>> ticks(const Axis& axis) {
   std::vector<std::pair<double, std::string>> out;
   if (axis.log) {
     const int first = static_cast<int>(std::ceil(axis.lo)), last = static_cast<int>(std::floor(axis.hi));
-    const int stride = std::max(1, (last - first + 1) / 8);
-    for (int k = first; k <= last; k += stride) out.emplace_back(k, "1E" + std::to_string(k));
+    if (axis.hi - axis.lo >= 3.0) {
+      const int stride = std::max(1, (last - first + 1) / 8);
+      for (int k = first; k <= last; k += stride) out.emplace_back(k, "1E" + std::to_string(k));
+      return out;
+    }
+    // Short log axes: 1-2-5 ticks inside every decade, labelled as plain numbers.
+    for (int k = static_cast<int>(std::floor(axis.lo)); k <= static_cast<int>(std::ceil(axis.hi)); ++k) {
+      for (const double factor : {1.0, 2.0, 5.0}) {
+        const double position = k + std::log10(factor);
+        if (position >= axis.lo && position <= axis.hi)
+          out.emplace_back(position, formatTick(factor * std::pow(10.0, k)));
+      }
+    }
     return out;
   }
   const double span = axis.hi - axis.lo;

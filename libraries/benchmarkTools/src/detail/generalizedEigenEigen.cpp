@@ -1,0 +1,19 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Dense>
+
+#include "detail/generalizedEigen.hpp"
+
+namespace asyncfem::detail {
+
+bool solveGeneralizedEigen(Eigen::MatrixXd& stiffness, Eigen::MatrixXd& mass, Eigen::VectorXd& eigenvalues) {
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(stiffness, mass,
+                                                                   Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+  if (solver.info() != Eigen::Success) return false;
+  eigenvalues = solver.eigenvalues();
+  stiffness = solver.eigenvectors();
+  return true;
+}
+
+std::string generalizedEigenBackend() { return "Eigen GeneralizedSelfAdjointEigenSolver"; }
+
+}  // namespace asyncfem::detail

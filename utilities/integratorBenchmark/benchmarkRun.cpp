@@ -1,0 +1,337 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "benchmarkRun.hpp"
+
+#include <algorithm>
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/integrator/stableTimestep.hpp>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+namespace asyncfem::bench {
+
+bool isMultirate(const std::string& integrator) { return integrator == "async" || integrator == "multirate-uncoupled"; }
+
+namespace {
+
+// Regions of the scene's own integrator options, or "auto".
+nlohmann::json sceneRegions(const Scene& scene) {
+  if (isMultirate(scene.integrator.name) && scene.integrator.options.contains("regions")) {
+    return scene.integrator.options["regions"];
+  }
+  return "auto";
+}
+
+void setRatio(nlohmann::json& options, int ratio, const std::string& where) {
+  if (!options.contains("regions") || !options["regions"].is_array()) {
+    throw ValidationError(where +
+                          ": \"ratio\" needs explicit regions (the scene's or the configuration's), not \"auto\"");
+  }
+  for (nlohmann::json& region : options["regions"]) region["ratio"] = ratio;
+}
+
+// Multirate configurations without regions inherit the scene's.
+void completeOptions(Configuration& configuration, const Scene& scene) {
+  if (isMultirate(configuration.integrator) && !configuration.options.contains("regions")) {
+    configuration.options["regions"] = sceneRegions(scene);
+    if (scene.integrator.options.contains("auto") && configuration.options["regions"] == "auto") {
+      configuration.options["auto"] = scene.integrator.options["auto"];
+    }
+  }
+}
+
+std::string defaultLabel(const Configuration& c) {
+  std::ostringstream out;
+  out << c.integrator;
+  if (c.stepsPerFrame > 0) {
+    out << " spf=" << c.stepsPerFrame;
+  } else {
+    out << " h=" << c.timestep;
+  }
+  if (isMultirate(c.integrator) && c.options.contains("regions") && c.options["regions"].is_array() &&
+      !c.options["regions"].empty() && c.options["regions"][0].contains("ratio")) {
+    out << " m=" << c.options["regions"][0]["ratio"].get<int>();
+  }
+  for (const char* key : {"schur", "method", "recovery"}) {
+    if (c.options.contains(key)) out << " " << c.options[key].get<std::string>();
+  }
+  return out.str();
+}
+
+}  // namespace
+
+std::vector<Configuration> readConfigurations(const std::string& path, const Scene& scene) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open the configuration file");
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(in, nullptr, true, true);
+  } catch (const nlohmann::json::parse_error& error) {
+    throw ParseError(path, 0, std::string("invalid JSON: ") + error.what());
+  }
+  if (!json.is_object() || !json.contains("configurations") || !json["configurations"].is_array()) {
+    throw ValidationError(path + ": expected {\"configurations\": [...]}");
+  }
+  std::vector<Configuration> out;
+  const nlohmann::json& list = json["configurations"];
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where = path + ": configurations[" + std::to_string(i) + "]";
+    const nlohmann::json& item = list[i];
+    if (!item.is_object()) throw ValidationError(where + ": expected an object");
+    Configuration c;
+    for (const auto& [key, value] : item.items()) {
+      if (key == "label") {
+        c.label = value.get<std::string>();
+      } else if (key == "integrator") {
+        c.integrator = value.get<std::string>();
+      } else if (key == "stepsPerFrame") {
+        c.stepsPerFrame = value.get<int>();
+      } else if (key == "timestep") {
+        c.timestep = value.get<double>();
+      } else if (key == "options") {
+        c.options = value;
+      } else if (key == "plot") {
+        c.plotTrajectory = value.get<bool>();
+      } else if (key != "ratio") {
+        throw ValidationError(
+            where + "." + key +
+            ": unknown key (known: label, integrator, stepsPerFrame, timestep, ratio, options, plot)");
+      }
+    }
+    if (c.stepsPerFrame <= 0 && !(c.timestep > 0.0)) {
+      throw ValidationError(where + ": give stepsPerFrame (>= 1) or timestep (> 0)");
+    }
+    completeOptions(c, scene);
+    if (item.contains("ratio")) setRatio(c.options, item["ratio"].get<int>(), where + ".ratio");
+    if (c.label.empty()) c.label = defaultLabel(c);
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+Configuration parseConfigurationSpec(const std::string& spec, const Scene& scene) {
+  std::vector<std::string> parts;
+  std::stringstream stream(spec);
+  for (std::string part; std::getline(stream, part, ':');) parts.push_back(part);
+  if (parts.empty() || parts[0].empty())
+    throw ValidationError("--config \"" + spec + "\": expected NAME[:key=value]...");
+  Configuration c;
+  c.integrator = parts[0];
+  c.plotTrajectory = true;
+  int ratio = 0;
+  for (std::size_t k = 1; k < parts.size(); ++k) {
+    const std::size_t eq = parts[k].find('=');
+    if (eq == std::string::npos)
+      throw ValidationError("--config \"" + spec + "\": \"" + parts[k] + "\" is not key=value");
+    const std::string key = parts[k].substr(0, eq), value = parts[k].substr(eq + 1);
+    try {
+      if (key == "spf") {
+        c.stepsPerFrame = std::stoi(value);
+      } else if (key == "dt") {
+        c.timestep = std::stod(value);
+      } else if (key == "ratio") {
+        ratio = std::stoi(value);
+      } else if (key == "schur" || key == "method" || key == "recovery" || key == "solver") {
+        c.options[key] = value;
+      } else if (key == "label") {
+        c.label = value;
+      } else {
+        throw ValidationError("--config \"" + spec + "\": unknown key \"" + key +
+                              "\" (known: spf, dt, ratio, schur, method, recovery, solver, label)");
+      }
+    } catch (const std::logic_error&) {
+      throw ValidationError("--config \"" + spec + "\": bad number in \"" + parts[k] + "\"");
+    }
+  }
+  if (c.stepsPerFrame <= 0 && !(c.timestep > 0.0)) {
+    if (scene.integrator.timestep > 0.0) {
+      c.timestep = scene.integrator.timestep;
+    } else {
+      throw ValidationError("--config \"" + spec + "\": give spf=N or dt=H");
+    }
+  }
+  completeOptions(c, scene);
+  if (ratio > 0) setRatio(c.options, ratio, "--config \"" + spec + "\"");
+  if (c.label.empty()) c.label = defaultLabel(c);
+  return c;
+}
+
+std::vector<Configuration> defaultConfigurations(const Scene& scene, const Simulation& baseline) {
+  const double frame = 1.0 / scene.frames.rate;
+  // Steps per frame of the scene's own (large) timestep, at least 1.
+  const int sceneSteps = std::max(1, static_cast<int>(std::lround(frame / scene.integrator.timestep)));
+  const bool explicitRegions = isMultirate(scene.integrator.name) && scene.integrator.options.contains("regions") &&
+                               scene.integrator.options["regions"].is_array();
+  std::vector<Configuration> out;
+  auto add = [&](const std::string& integrator, int spf, int ratio, nlohmann::json options, bool plot) {
+    Configuration c;
+    c.integrator = integrator;
+    c.stepsPerFrame = spf;
+    c.options = std::move(options);
+    c.plotTrajectory = plot;
+    completeOptions(c, scene);
+    if (ratio > 0 && explicitRegions) setRatio(c.options, ratio, "default configuration");
+    c.label = defaultLabel(c);
+    out.push_back(std::move(c));
+  };
+  const int sceneRatio = explicitRegions && !scene.integrator.options["regions"].empty()
+                             ? scene.integrator.options["regions"][0].value("ratio", 8)
+                             : 8;
+  for (const int spf : {1, 2, 4, 8, 16, 32, 64}) {
+    add("backward-euler", spf, 0, nlohmann::json::object(), spf == sceneSteps || spf == sceneSteps * sceneRatio);
+  }
+  for (const int spf : {sceneSteps, 4 * sceneSteps}) add("trapezoidal", spf, 0, nlohmann::json::object(), false);
+  // Central differences at the largest step below the stable limit (rigorous element bound).
+  const double omega = estimateMaxFrequency(*baseline.mesh, scene.mass);
+  const int explicitSteps = static_cast<int>(std::ceil(frame / (0.95 * stableTimestepFromFrequency(omega))));
+  if (static_cast<long long>(explicitSteps) * scene.frames.count <= 2000000) {
+    add("central-differences", explicitSteps, 0, nlohmann::json::object(), false);
+  }
+  if (explicitRegions) {
+    for (const int ratio : {2, 4, 8, 16, 32})
+      add("async", sceneSteps, ratio, nlohmann::json::object(), ratio == sceneRatio);
+    for (const int spf : {std::max(1, sceneSteps / 2), 2 * sceneSteps}) {
+      if (spf != sceneSteps) add("async", spf, sceneRatio, nlohmann::json::object(), false);
+    }
+    add("async", sceneSteps, sceneRatio, {{"schur", "symmetric"}}, false);
+    add("async", sceneSteps, sceneRatio, {{"schur", "lu"}}, false);
+    add("async", sceneSteps, sceneRatio, {{"method", "naive"}}, false);
+    for (const int ratio : {4, 8, 16}) {
+      add("multirate-uncoupled", sceneSteps, ratio, nlohmann::json::object(), ratio == sceneRatio);
+    }
+  } else {
+    add("async", sceneSteps, 0, nlohmann::json::object(), true);
+    add("multirate-uncoupled", sceneSteps, 0, nlohmann::json::object(), true);
+  }
+  return out;
+}
+
+Scene configuredScene(const Scene& scene, const Configuration& configuration, int frames) {
+  Scene out = scene;
+  out.integrator.name = configuration.integrator;
+  out.integrator.timestep = configuration.stepsPerFrame > 0 ? 1.0 / (scene.frames.rate * configuration.stepsPerFrame)
+                                                            : configuration.timestep;
+  out.integrator.options = configuration.options;
+  out.frames.count = frames;
+  out.output = Scene::OutputSettings{};
+  return out;
+}
+
+RunResult runConfiguration(const Scene& scene, const Configuration& configuration, int frames, int repeats) {
+  RunResult result;
+  result.configuration = configuration;
+  const Scene configured = configuredScene(scene, configuration, frames);
+  result.timestep = configured.integrator.timestep;
+  result.stepsPerFrame = static_cast<int>(std::lround(1.0 / (scene.frames.rate * result.timestep)));
+  for (int repeat = 0; repeat < std::max(1, repeats); ++repeat) {
+    Stopwatch setup;
+    Simulation simulation = buildSimulation(configured);
+    const double setupSeconds = setup.stop();
+    Integrator& integrator = *simulation.integrator;
+    IntegratorStats afterWarmUp;
+    double timedSeconds = 0.0;
+    int timedFrames = 0;
+    bool failed = false;
+    for (int frame = 0; frame < frames; ++frame) {
+      Stopwatch watch;
+      try {
+        advanceFrame(simulation, frame);
+      } catch (const NumericalError& error) {
+        if (repeat == 0) {
+          result.failedFrame = frame;
+          result.failure = error.what();
+        }
+        failed = true;
+        break;
+      }
+      const double seconds = watch.stop();
+      if (frame == 0) {
+        // Warm-up: linear models factor here; excluded from the time per frame.
+        afterWarmUp = integrator.stats();
+        if (repeat == 0) result.firstFrameSeconds = seconds;
+      } else {
+        timedSeconds += seconds;
+        ++timedFrames;
+      }
+      if (repeat == 0) result.frames.push_back(integrator.displacement());
+    }
+    if (repeat == 0) {
+      result.setupSeconds = setupSeconds;
+      const IntegratorStats& end = integrator.stats();
+      const double count = std::max(1, timedFrames);
+      result.factorizationsPerFrame = static_cast<double>(end.factorizations - afterWarmUp.factorizations) / count;
+      result.solvesPerFrame = static_cast<double>(end.solvedRightHandSides - afterWarmUp.solvedRightHandSides) / count;
+      result.factorFlopsPerFrame = (end.factorFlops - afterWarmUp.factorFlops) / count;
+      result.solveFlopsPerFrame = (end.solveFlops - afterWarmUp.solveFlops) / count;
+      if (const auto* async = dynamic_cast<const AsyncBackwardEuler*>(&integrator)) {
+        result.factorNonZeros = async->factorNonZeros();
+        std::ostringstream ratios;
+        for (int i = 0; i < async->partition().numRegions(); ++i)
+          ratios << (i ? "," : "") << async->partition().ratio(i);
+        result.ratios = ratios.str();
+      } else if (const auto* multirate = dynamic_cast<const UncoupledMultirate*>(&integrator)) {
+        result.factorNonZeros = multirate->factorNonZeros();
+        std::ostringstream ratios;
+        for (int i = 0; i < multirate->partition().numRegions(); ++i) {
+          ratios << (i ? "," : "") << multirate->partition().ratio(i);
+        }
+        result.ratios = ratios.str();
+      }
+    }
+    if (failed) break;  // an unstable configuration is not timed again
+    if (timedFrames > 0) result.secondsPerFrame.push_back(timedSeconds / timedFrames);
+  }
+  result.completed = result.failedFrame < 0;
+  if (!result.secondsPerFrame.empty()) {
+    result.medianSecondsPerFrame = median(result.secondsPerFrame);
+    result.minSecondsPerFrame = *std::min_element(result.secondsPerFrame.begin(), result.secondsPerFrame.end());
+  }
+  return result;
+}
+
+std::string machineDescription() {
+  std::string model = "unknown CPU";
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);) {
+    if (line.rfind("model name", 0) == 0) {
+      const std::size_t colon = line.find(':');
+      if (colon != std::string::npos) model = line.substr(colon + 2);
+      break;
+    }
+  }
+  std::string load = "unknown";
+  std::ifstream loadavg("/proc/loadavg");
+  if (loadavg) {
+    std::string a, b, c;
+    loadavg >> a >> b >> c;
+    load = a + " " + b + " " + c;
+  }
+  std::ostringstream out;
+  out << "nproc " << std::thread::hardware_concurrency() << ", " << model << ", load average " << load;
+  return out.str();
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+std::string formatTimestep(double timestep) {
+  const double inverse = 1.0 / timestep;
+  const double rounded = std::round(inverse);
+  std::ostringstream out;
+  if (rounded >= 1.0 && std::abs(inverse - rounded) <= 1e-9 * inverse) {
+    out << "1/" << static_cast<long long>(rounded);
+  } else {
+    out << timestep;
+  }
+  return out.str();
+}
+
+}  // namespace asyncfem::bench

@@ -1,0 +1,465 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// integratorBenchmark: run time against error for integrator configurations on a scene.
+//
+//   integratorBenchmark SCENE.json [--configs FILE.json] [--config SPEC]... [--frames N]
+//                       [--repeats R] [--out DIR] [--reference auto|modal|trapezoidal]
+//                       [--max-modal-dofs N] [--vertex V] [--quick]
+//   integratorBenchmark --table [--models DIR] [--table-frames N] [--repeats R] [--out DIR]
+//
+// For every configuration: wall time per frame (median over repeats, frame 0 excluded),
+// factorizations, back-substitutions and their flops per frame, and the relative L2 error
+// of the displacement over the frames against a reference (exact modal solution for
+// linear scenes, else a fine trapezoidal run), per vertex group (each fast region, L,
+// all). Then the equal-cost and equal-error single-rate answers for every multirate
+// configuration, CSV files and PNG plots. docs/benchmarks.md describes the output.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <asyncfem/benchmarkTools/costInterpolation.hpp>
+#include <asyncfem/benchmarkTools/errorMetrics.hpp>
+#include <asyncfem/benchmarkTools/modalReference.hpp>
+#include <asyncfem/benchmarkTools/plot.hpp>
+#include <asyncfem/benchmarkTools/sceneReference.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/sceneIO/asyncScene.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "benchmarkRun.hpp"
+#include "performanceTable.hpp"
+#include "pngWriter.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace asyncfem;
+using namespace asyncfem::bench;
+
+struct CommandLine {
+  std::string scene;
+  std::string configsFile;
+  std::vector<std::string> configSpecs;
+  std::optional<int> frames;
+  int repeats = 3;
+  std::string out = "benchmark-out";
+  std::string reference = "auto";
+  int maxModalDofs = 5000;
+  std::optional<int> vertex;
+  bool quick = false;
+  bool table = false;
+  std::string models = "models";
+  int tableFrames = 20;
+};
+
+std::string formatDouble(double value, int precision = 4) {
+  std::ostringstream out;
+  out.precision(precision);
+  out << value;
+  return out.str();
+}
+
+struct Reference {
+  std::string description;
+  Trajectory frames;
+};
+
+// The exact modal solution when the scene allows it, else a trapezoidal run at a step far
+// below every configuration's smallest step (design note, "What accurate means here").
+Reference computeReference(const Scene& scene, const Simulation& baseline, const std::vector<Configuration>& configs,
+                           int frames, const CommandLine& options) {
+  const std::string reason = modalReferenceUnsupportedReason(scene, baseline, options.maxModalDofs);
+  Reference reference;
+  if (options.reference == "modal" && !reason.empty()) {
+    throw Error("--reference modal: not available for this scene: " + reason);
+  }
+  if (options.reference != "trapezoidal" && reason.empty()) {
+    Stopwatch watch;
+    const DynamicSystem& system = baseline.integrator->system();
+    Eigen::SparseMatrix<double> stiffness = system.forceModel->createStiffnessMatrix();
+    system.forceModel->tangentStiffness(Eigen::VectorXd::Zero(system.numDofs()), stiffness);
+    const ModalReference modal(system.mass, stiffness, system.freeDofs, system.rayleighMass, system.rayleighStiffness);
+    reference.frames = modal.displacements(sceneLoad(scene, baseline), frameTimes(scene, frames));
+    reference.description =
+        "exact modal solution (" + std::to_string(modal.numFree()) + " modes, " + formatDouble(watch.stop(), 3) + " s)";
+    return reference;
+  }
+  // Smallest step of any configuration (substeps included), divided by 4.
+  double smallest = 1.0 / scene.frames.rate;
+  for (const Configuration& c : configs) {
+    const Scene configured = configuredScene(scene, c, frames);
+    double h = configured.integrator.timestep;
+    if (isMultirate(c.integrator) && c.options.contains("regions") && c.options["regions"].is_array()) {
+      int maxRatio = 1;
+      for (const nlohmann::json& region : c.options["regions"]) maxRatio = std::max(maxRatio, region.value("ratio", 1));
+      h /= maxRatio;
+    }
+    smallest = std::min(smallest, h);
+  }
+  const int stepsPerFrame = static_cast<int>(std::ceil((1.0 / scene.frames.rate) / (smallest / 4.0)));
+  Configuration fine;
+  fine.integrator = "trapezoidal";
+  fine.stepsPerFrame = stepsPerFrame;
+  Stopwatch watch;
+  const RunResult run = runConfiguration(scene, fine, frames, 1);
+  if (!run.completed) throw Error("the trapezoidal reference run failed: " + run.failure);
+  reference.frames = run.frames;
+  reference.description = "trapezoidal run at h = " + formatTimestep(run.timestep) + " (" +
+                          (reason.empty() ? std::string("requested") : "no modal reference: " + reason) + ", " +
+                          formatDouble(watch.stop(), 3) + " s)";
+  return reference;
+}
+
+// Vertex groups for the errors: each fast region of the first multirate configuration, L
+// (every other vertex) and all vertices.
+std::vector<VertexGroup> errorGroups(const Scene& scene, const Simulation& baseline,
+                                     const std::vector<Configuration>& configs) {
+  std::vector<VertexGroup> groups;
+  const TetMesh& mesh = *baseline.mesh;
+  for (const Configuration& c : configs) {
+    if (!isMultirate(c.integrator)) continue;
+    const Scene configured = configuredScene(scene, c, 1);
+    const AsyncSceneOptions parsed =
+        parseAsyncOptions(configured, mesh, baseline.integrator->system().freeDofs, c.options);
+    std::vector<bool> fast(static_cast<std::size_t>(mesh.numVertices()), false);
+    for (const AsyncRegion& region : parsed.regions) {
+      groups.push_back({region.name.empty() ? "S" + std::to_string(groups.size()) : region.name, region.vertices});
+      for (const int v : region.vertices) fast[static_cast<std::size_t>(v)] = true;
+    }
+    VertexGroup large{"L", {}};
+    for (int v = 0; v < mesh.numVertices(); ++v) {
+      if (!fast[static_cast<std::size_t>(v)]) large.vertices.push_back(v);
+    }
+    if (!large.vertices.empty()) groups.push_back(large);
+    break;
+  }
+  groups.push_back({"all", {}});
+  return groups;
+}
+
+std::string family(const Configuration& c) {
+  std::string name = c.integrator;
+  for (const char* key : {"schur", "method"}) {
+    if (c.options.contains(key)) name += " " + c.options[key].get<std::string>();
+  }
+  return name;
+}
+
+void writeResultsCsv(const fs::path& path, const std::vector<RunResult>& results,
+                     const std::vector<VertexGroup>& groups) {
+  std::ofstream out(path);
+  out << "label,integrator,timestep,steps_per_frame,ratios,completed,failed_frame,seconds_per_frame_median,"
+         "seconds_per_frame_min,repeats,setup_seconds,first_frame_seconds,factorizations_per_frame,solves_per_frame,"
+         "factor_flops_per_frame,solve_flops_per_frame,factor_nonzeros";
+  for (const VertexGroup& g : groups) out << ",error_" << g.name;
+  out << "\n";
+  out.precision(8);
+  for (const RunResult& r : results) {
+    out << '"' << r.configuration.label << "\"," << r.configuration.integrator << ',' << r.timestep << ','
+        << r.stepsPerFrame << ",\"" << r.ratios << "\"," << (r.completed ? 1 : 0) << ',' << r.failedFrame << ','
+        << r.medianSecondsPerFrame << ',' << r.minSecondsPerFrame << ',' << r.secondsPerFrame.size() << ','
+        << r.setupSeconds << ',' << r.firstFrameSeconds << ',' << r.factorizationsPerFrame << ',' << r.solvesPerFrame
+        << ',' << r.factorFlopsPerFrame << ',' << r.solveFlopsPerFrame << ',' << r.factorNonZeros;
+    for (const VertexGroup& g : groups) {
+      const auto it = r.errors.find(g.name);
+      out << ',' << (it == r.errors.end() ? std::nan("") : it->second);
+    }
+    out << "\n";
+  }
+}
+
+struct EqualAnswers {
+  const RunResult* run = nullptr;
+  std::string group;
+  std::string costKind;  // "time" or "flops"
+  EqualCostAnswer atEqualCost;
+  EqualErrorAnswer atEqualError;
+  std::string problem;  // non-empty: could not answer
+};
+
+std::vector<EqualAnswers> equalAnswers(const std::vector<RunResult>& results,
+                                       const std::vector<std::string>& groupNames) {
+  std::vector<EqualAnswers> answers;
+  for (const std::string& group : groupNames) {
+    for (const std::string& costKind : {std::string("time"), std::string("flops")}) {
+      std::vector<SingleRatePoint> points;
+      for (const RunResult& r : results) {
+        if (r.configuration.integrator != "backward-euler" || !r.completed) continue;
+        const double cost = costKind == "time" ? r.medianSecondsPerFrame : r.flopsPerFrame();
+        const auto it = r.errors.find(group);
+        if (it == r.errors.end() || !(cost > 0.0) || !(it->second > 0.0)) continue;
+        points.push_back({r.timestep, cost, it->second});
+      }
+      for (const RunResult& r : results) {
+        if (!isMultirate(r.configuration.integrator) || !r.completed) continue;
+        EqualAnswers answer;
+        answer.run = &r;
+        answer.group = group;
+        answer.costKind = costKind;
+        const double cost = costKind == "time" ? r.medianSecondsPerFrame : r.flopsPerFrame();
+        const auto it = r.errors.find(group);
+        try {
+          if (points.size() < 2) throw Error("fewer than two measured single-rate backward Euler points");
+          if (it == r.errors.end()) throw Error("no error for group " + group);
+          answer.atEqualCost = singleRateAtEqualCost(points, cost);
+          answer.atEqualError = singleRateAtEqualError(points, it->second);
+        } catch (const Error& error) {
+          answer.problem = error.what();
+        }
+        answers.push_back(answer);
+      }
+    }
+  }
+  return answers;
+}
+
+void plotPareto(const fs::path& path, const std::vector<RunResult>& results, const std::string& group,
+                const std::string& sceneName) {
+  PlotSpec spec;
+  spec.title = "Error vs time per frame: " + sceneName + " (" + group + ")";
+  spec.xLabel = "wall time per frame (s, median)";
+  spec.yLabel = "relative L2 error of u over the frames (" + group + ")";
+  spec.logX = spec.logY = true;
+  std::map<std::string, std::size_t> seriesOf;
+  for (const RunResult& r : results) {
+    const auto it = r.errors.find(group);
+    if (!r.completed || it == r.errors.end()) continue;
+    const std::string name = family(r.configuration);
+    if (!seriesOf.count(name)) {
+      seriesOf[name] = spec.series.size();
+      const int index = static_cast<int>(spec.series.size());
+      spec.series.push_back({name, {}, {}, paletteColor(index), paletteMarker(index), name == "backward-euler"});
+    }
+    PlotSeries& s = spec.series[seriesOf[name]];
+    s.x.push_back(r.medianSecondsPerFrame);
+    s.y.push_back(it->second);
+  }
+  for (PlotSeries& s : spec.series) {
+    // Connected series are drawn in increasing time.
+    std::vector<std::size_t> order(s.x.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s.x[a] < s.x[b]; });
+    std::vector<double> x, y;
+    for (const std::size_t k : order) {
+      x.push_back(s.x[k]);
+      y.push_back(s.y[k]);
+    }
+    s.x = x;
+    s.y = y;
+  }
+  writePng(path, renderPlot(spec, 1100, 650));
+}
+
+void plotVertex(const fs::path& path, const std::vector<RunResult>& results, const Reference& reference,
+                const Scene& scene, int vertex, const std::string& sceneName) {
+  PlotSpec spec;
+  spec.title = "Displacement of vertex " + std::to_string(vertex) + ": " + sceneName;
+  spec.xLabel = "time (s)";
+  spec.yLabel = "|u| of vertex " + std::to_string(vertex);
+  const std::vector<double> times = frameTimes(scene, static_cast<int>(reference.frames.size()));
+  spec.series.push_back(
+      {"reference", times, vertexDisplacementNorms(reference.frames, vertex), {0, 0, 0}, Marker::none, true});
+  int index = 0;
+  for (const RunResult& r : results) {
+    if (!r.configuration.plotTrajectory || r.frames.empty()) continue;
+    const std::vector<double> t = frameTimes(scene, static_cast<int>(r.frames.size()));
+    spec.series.push_back(
+        {r.configuration.label, t, vertexDisplacementNorms(r.frames, vertex), paletteColor(index), Marker::none, true});
+    ++index;
+  }
+  writePng(path, renderPlot(spec, 1100, 650));
+}
+
+// The vertex of the first fast region (else of the whole mesh) with the largest reference
+// displacement over the frames.
+int chooseVertex(const Reference& reference, const std::vector<VertexGroup>& groups, int numVertices) {
+  std::vector<int> candidates = groups.size() > 1 ? groups.front().vertices : std::vector<int>{};
+  if (candidates.empty()) {
+    for (int v = 0; v < numVertices; ++v) candidates.push_back(v);
+  }
+  int best = candidates.front();
+  double bestNorm = -1.0;
+  for (const int v : candidates) {
+    double peak = 0.0;
+    for (const Eigen::VectorXd& u : reference.frames) peak = std::max(peak, u.segment<3>(3 * v).norm());
+    if (peak > bestNorm) {
+      bestNorm = peak;
+      best = v;
+    }
+  }
+  return best;
+}
+
+int runBenchmark(const CommandLine& options) {
+  Scene scene = loadScene(options.scene);
+  const std::string sceneName = fs::path(options.scene).stem().string();
+  int frames = options.frames.value_or(scene.frames.count);
+  int repeats = options.repeats;
+  if (options.quick) {
+    frames = std::min(frames, 30);
+    repeats = 1;
+  }
+  fs::create_directories(options.out);
+
+  // A single-rate build of the scene gives the mesh and matrices.
+  Configuration baselineConfig;
+  baselineConfig.stepsPerFrame = 1;
+  const Simulation baseline = buildSimulation(configuredScene(scene, baselineConfig, 1));
+
+  std::vector<Configuration> configs;
+  if (!options.configsFile.empty()) configs = readConfigurations(options.configsFile, scene);
+  for (const std::string& spec : options.configSpecs) configs.push_back(parseConfigurationSpec(spec, scene));
+  if (configs.empty()) configs = defaultConfigurations(scene, baseline);
+
+  std::cout << "# integratorBenchmark: " << options.scene << "\n\n";
+  std::cout << "Machine: " << machineDescription() << "\n";
+  std::cout << "Mesh: " << baseline.mesh->numVertices() << " vertices, " << baseline.mesh->numElements() << " tets, "
+            << baseline.integrator->system().freeDofs.numFree() << " free DOFs; " << frames << " frames at "
+            << scene.frames.rate << " per s; " << repeats
+            << " repeats (time per frame: median over repeats of the mean over frames 1.., frame 0 is warm-up)\n";
+  std::cout.flush();
+
+  const Reference reference = computeReference(scene, baseline, configs, frames, options);
+  std::cout << "Reference: " << reference.description << "\n";
+  const std::vector<VertexGroup> groups = errorGroups(scene, baseline, configs);
+
+  std::vector<RunResult> results;
+  for (std::size_t k = 0; k < configs.size(); ++k) {
+    std::cerr << "integratorBenchmark: [" << (k + 1) << "/" << configs.size() << "] " << configs[k].label << "\n";
+    // Long explicit runs (thousands of steps per frame) are timed once.
+    const bool longRun =
+        configs[k].stepsPerFrame > 0 && static_cast<long long>(configs[k].stepsPerFrame) * frames > 20000;
+    RunResult r = runConfiguration(scene, configs[k], frames, longRun ? 1 : repeats);
+    for (const VertexGroup& g : groups) r.errors[g.name] = relativeL2Error(r.frames, reference.frames, g);
+    results.push_back(std::move(r));
+  }
+
+  // Results table.
+  std::cout << "\n| configuration | h | m | time/frame (ms) | factor./frame | solves/frame | Mflop/frame |";
+  for (const VertexGroup& g : groups) std::cout << " error " << g.name << " |";
+  std::cout << "\n|---|---|---|---|---|---|---|";
+  for (std::size_t g = 0; g < groups.size(); ++g) std::cout << "---|";
+  std::cout << "\n";
+  for (const RunResult& r : results) {
+    std::cout << "| " << r.configuration.label << " | " << formatTimestep(r.timestep) << " | "
+              << (r.ratios.empty() ? "-" : r.ratios) << " | " << formatDouble(1e3 * r.medianSecondsPerFrame, 3) << " | "
+              << formatDouble(r.factorizationsPerFrame, 3) << " | " << formatDouble(r.solvesPerFrame, 4) << " | "
+              << formatDouble(1e-6 * r.flopsPerFrame(), 4) << " |";
+    for (const VertexGroup& g : groups) std::cout << " " << formatDouble(r.errors.at(g.name), 3) << " |";
+    std::cout << "\n";
+  }
+  for (const RunResult& r : results) {
+    if (!r.completed) {
+      std::cout << "\nUNSTABLE: " << r.configuration.label << " stopped at frame " << r.failedFrame << ": " << r.failure
+                << "\n";
+    }
+  }
+  writeResultsCsv(fs::path(options.out) / "results.csv", results, groups);
+
+  // Equal cost and equal error against single-rate backward Euler.
+  std::vector<std::string> answerGroups{"all"};
+  if (groups.size() > 1) answerGroups.insert(answerGroups.begin(), groups.front().name);
+  const std::vector<EqualAnswers> answers = equalAnswers(results, answerGroups);
+  std::cout << "\n## Equal cost and equal error against single-rate backward Euler\n\n"
+               "Interpolation: piecewise linear in log-log between the measured backward Euler runs "
+               "(cost against h and error against h; extended along the end segment outside the measured "
+               "range, marked *). Cost = median wall time per frame, or factor + solve flops per frame.\n\n";
+  std::cout << "| configuration | error of | cost | multirate cost | multirate error | BE h at equal cost | BE error "
+               "there | BE h at equal error | BE cost there | speed-up at equal error |\n";
+  std::cout << "|---|---|---|---|---|---|---|---|---|---|\n";
+  std::ofstream equalCsv(fs::path(options.out) / "equal-cost-error.csv");
+  equalCsv << "label,group,cost_kind,multirate_cost,multirate_error,equal_cost_timestep,equal_cost_error,"
+              "equal_error_timestep,equal_error_cost,speedup_at_equal_error,extrapolated,problem\n";
+  equalCsv.precision(8);
+  for (const EqualAnswers& a : answers) {
+    const RunResult& r = *a.run;
+    const double cost = a.costKind == "time" ? r.medianSecondsPerFrame : r.flopsPerFrame();
+    const double error = r.errors.at(a.group);
+    const std::string unit = a.costKind == "time" ? " ms" : " Mflop";
+    const double scale = a.costKind == "time" ? 1e3 : 1e-6;
+    if (!a.problem.empty()) {
+      std::cout << "| " << r.configuration.label << " | " << a.group << " | " << a.costKind << " | "
+                << formatDouble(scale * cost, 3) << unit << " | " << formatDouble(error, 3) << " | n/a: " << a.problem
+                << " | | | | |\n";
+      equalCsv << '"' << r.configuration.label << "\"," << a.group << ',' << a.costKind << ',' << cost << ',' << error
+               << ",,,,,,,\"" << a.problem << "\"\n";
+      continue;
+    }
+    const double speedup = a.atEqualError.cost / cost;
+    const std::string costMark = a.atEqualCost.extrapolated ? "*" : "";
+    const std::string errorMark = a.atEqualError.extrapolated ? "*" : "";
+    std::cout << "| " << r.configuration.label << " | " << a.group << " | " << a.costKind << " | "
+              << formatDouble(scale * cost, 3) << unit << " | " << formatDouble(error, 3) << " | "
+              << formatDouble(a.atEqualCost.timestep, 3) << costMark << " | " << formatDouble(a.atEqualCost.error, 3)
+              << costMark << " | " << formatDouble(a.atEqualError.timestep, 3) << errorMark << " | "
+              << formatDouble(scale * a.atEqualError.cost, 3) << unit << errorMark << " | " << formatDouble(speedup, 3)
+              << "x" << errorMark << " |\n";
+    equalCsv << '"' << r.configuration.label << "\"," << a.group << ',' << a.costKind << ',' << cost << ',' << error
+             << ',' << a.atEqualCost.timestep << ',' << a.atEqualCost.error << ',' << a.atEqualError.timestep << ','
+             << a.atEqualError.cost << ',' << speedup << ','
+             << ((a.atEqualCost.extrapolated || a.atEqualError.extrapolated) ? 1 : 0) << ",\n";
+  }
+
+  // Plots.
+  if (pngSupported()) {
+    for (const VertexGroup& g : groups) {
+      if (g.name != "all" && g.name != groups.front().name) continue;
+      const fs::path path = fs::path(options.out) / ("pareto-" + g.name + ".png");
+      plotPareto(path, results, g.name, sceneName);
+      std::cout << "\nWrote " << path.string();
+    }
+    const int vertex = options.vertex.value_or(chooseVertex(reference, groups, baseline.mesh->numVertices()));
+    const fs::path path = fs::path(options.out) / "vertex-displacement.png";
+    plotVertex(path, results, reference, scene, vertex, sceneName);
+    std::cout << "\nWrote " << path.string() << " (vertex " << vertex << ")\n";
+  } else {
+    std::cout << "\nNo plots: this build has no PNG support (configure with ASYNCFEM_WITH_RENDER=ON); CSV only.\n";
+  }
+  std::cout << "Wrote " << (fs::path(options.out) / "results.csv").string() << " and "
+            << (fs::path(options.out) / "equal-cost-error.csv").string() << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Run time against error of integrator configurations on a scene (docs/benchmarks.md)"};
+  CommandLine options;
+  app.add_option("scene", options.scene, "Scene file (JSON)");
+  app.add_option("--configs", options.configsFile, "JSON file {\"configurations\": [...]}");
+  app.add_option("--config", options.configSpecs,
+                 "NAME[:spf=N|dt=H][:ratio=M][:schur=..][:method=..][:recovery=..][:label=..] (repeatable)");
+  app.add_option("--frames", options.frames, "Frames per run (default: the scene's)")->check(CLI::PositiveNumber);
+  app.add_option("--repeats", options.repeats, "Timed repeats per configuration")->check(CLI::PositiveNumber);
+  app.add_option("--out", options.out, "Output folder for CSV and PNG files");
+  app.add_option("--reference", options.reference, "auto, modal or trapezoidal")
+      ->check(CLI::IsMember({"auto", "modal", "trapezoidal"}));
+  app.add_option("--max-modal-dofs", options.maxModalDofs, "Largest free-DOF count for the modal reference");
+  app.add_option("--vertex", options.vertex, "Vertex of the displacement plot (default: chosen automatically)");
+  app.add_flag("--quick", options.quick, "At most 30 frames and one repeat (smoke test)");
+  app.add_flag("--table", options.table, "Print the performance table of every scene in --models");
+  app.add_option("--models", options.models, "Folder of scenes for --table (models/*/*.json)");
+  app.add_option("--table-frames", options.tableFrames, "Frames per run for --table")->check(CLI::PositiveNumber);
+  try {
+    app.parse(argc, argv);
+    if (!options.table && options.scene.empty())
+      throw CLI::ValidationError("scene", "a scene file is required (or --table)");
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? 0 : 2;
+  }
+  try {
+    if (options.table) {
+      return printPerformanceTable(options.models, options.tableFrames, options.repeats, options.out);
+    }
+    return runBenchmark(options);
+  } catch (const std::exception& error) {
+    std::cerr << "integratorBenchmark: " << error.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,142 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "performanceTable.hpp"
+
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/sceneIO/asyncScene.hpp>
+#include <asyncfem/warping/rotationStrainWarping.hpp>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "benchmarkRun.hpp"
+
+namespace asyncfem::bench {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string milliseconds(double seconds) {
+  std::ostringstream out;
+  out.precision(3);
+  out << 1e3 * seconds;
+  return out.str();
+}
+
+// One row, or the reason the scene has none.
+std::string tableRow(const fs::path& path, int frames, int repeats) {
+  const Scene scene = loadScene(path);
+  const std::string name = path.parent_path().filename().string() + "/" + path.filename().string();
+  if (scene.integrator.name != "async") {
+    return "";  // single-rate variants of a scene have no row of their own
+  }
+  const int count = std::min(frames, scene.frames.count);
+  Configuration async;
+  async.integrator = "async";
+  async.timestep = scene.integrator.timestep;
+  async.options = scene.integrator.options;
+  async.label = "async";
+  const Simulation simulation = buildSimulation(configuredScene(scene, async, 1));
+  const AsyncSceneOptions parsed =
+      parseAsyncOptions(scene, *simulation.mesh, simulation.integrator->system().freeDofs, scene.integrator.options);
+  std::ostringstream sizes, ratios;
+  int maxRatio = 1;
+  for (std::size_t i = 0; i < parsed.regions.size(); ++i) {
+    sizes << (i ? ", " : "") << parsed.regions[i].vertices.size();
+    ratios << (i ? ", " : "") << parsed.regions[i].ratio;
+    maxRatio = std::max(maxRatio, parsed.regions[i].ratio);
+  }
+  std::cerr << "integratorBenchmark --table: " << name << " (async, warping, backward Euler at hL and hS)\n";
+  const RunResult asyncRun = runConfiguration(scene, async, count, repeats);
+
+  // Rotation-strain warping of every async frame (what display would add per frame).
+  std::string warping = "n/a";
+  if (!asyncRun.frames.empty()) {
+    RotationStrainWarping warper(*simulation.mesh, simulation.fixedVertices);
+    std::vector<double> perRepeat;
+    for (int repeat = 0; repeat < std::max(1, repeats); ++repeat) {
+      Stopwatch watch;
+      for (const Eigen::VectorXd& u : asyncRun.frames) warper.warp(u);
+      perRepeat.push_back(watch.stop() / static_cast<double>(asyncRun.frames.size()));
+    }
+    warping = milliseconds(median(perRepeat));
+  }
+
+  Configuration large;
+  large.integrator = "backward-euler";
+  large.timestep = scene.integrator.timestep;
+  Configuration small = large;
+  small.timestep = scene.integrator.timestep / maxRatio;
+  const RunResult largeRun = runConfiguration(scene, large, count, repeats);
+  const RunResult smallRun = runConfiguration(scene, small, count, repeats);
+  auto cell = [](const RunResult& r) {
+    return r.completed ? milliseconds(r.medianSecondsPerFrame)
+                       : "unstable (frame " + std::to_string(r.failedFrame) + ")";
+  };
+  std::ostringstream row;
+  row << "| " << name << " | " << simulation.mesh->numVertices() << " | " << simulation.mesh->numElements() << " | "
+      << sizes.str() << " | " << formatTimestep(scene.integrator.timestep) << " | " << ratios.str() << " | "
+      << (scene.forceModel == Scene::ForceModelKind::linear ? "linear" : "corotational") << " | " << cell(asyncRun)
+      << " | " << warping << " | " << cell(largeRun) << " | " << cell(smallRun) << " | ";
+  if (asyncRun.completed && smallRun.completed && asyncRun.medianSecondsPerFrame > 0.0) {
+    std::ostringstream ratio;
+    ratio.precision(3);
+    ratio << smallRun.medianSecondsPerFrame / asyncRun.medianSecondsPerFrame << "x";
+    row << ratio.str();
+  } else {
+    row << "n/a";
+  }
+  row << " |";
+  return row.str();
+}
+
+}  // namespace
+
+int printPerformanceTable(const std::string& modelsFolder, int frames, int repeats, const std::string& outFolder) {
+  std::vector<fs::path> scenes;
+  if (!fs::is_directory(modelsFolder)) throw Error(modelsFolder + ": not a folder (--models)");
+  for (const fs::directory_entry& folder : fs::directory_iterator(modelsFolder)) {
+    if (!folder.is_directory()) continue;
+    for (const fs::directory_entry& file : fs::directory_iterator(folder.path())) {
+      if (file.is_regular_file() && file.path().extension() == ".json") scenes.push_back(file.path());
+    }
+  }
+  std::sort(scenes.begin(), scenes.end());
+  std::ostringstream table;
+  table << "Machine: " << machineDescription() << "\n";
+  table << "Frames per run: up to " << frames << " (frame 0 excluded from the times), repeats: " << repeats
+        << ", times are wall-clock milliseconds per frame (median over repeats). Warping: rotation-strain "
+           "warping (libraries/warping) of every async frame.\n\n";
+  table << "| scene | vertices | tets | \\|S_i\\| | hL (s) | m_i | forces | async | warping | single-rate hL | "
+           "single-rate hS | hS / async |\n";
+  table << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::vector<std::string> skipped;
+  for (const fs::path& path : scenes) {
+    std::string row;
+    try {
+      row = tableRow(path, frames, repeats);
+    } catch (const std::exception& error) {
+      row = "| " + path.parent_path().filename().string() + "/" + path.filename().string() +
+            " | error: " + error.what() + " |";
+    }
+    if (row.empty()) {
+      skipped.push_back(path.parent_path().filename().string() + "/" + path.filename().string());
+      continue;
+    }
+    table << row << "\n";
+  }
+  if (!skipped.empty()) {
+    table << "\nNot in the table (their integrator is not \"async\"):";
+    for (const std::string& name : skipped) table << " " << name;
+    table << "\n";
+  }
+  std::cout << table.str();
+  fs::create_directories(outFolder);
+  std::ofstream(fs::path(outFolder) / "performance-table.md") << table.str();
+  return 0;
+}
+
+}  // namespace asyncfem::bench
