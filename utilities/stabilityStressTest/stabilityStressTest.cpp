@@ -1,0 +1,279 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// stabilityStressTest: free vibration of a two-material bar under every integrator, over a
+// grid of stiffness ratios, timestep ratios, damping and mesh quality.
+//
+//   stabilityStressTest [--frames N] [--full] [--cells NX NY NZ] [--seed S] [--csv FILE]
+//
+// Every run starts from a bent bar at rest (u_y = 0.02 x^2 / L, zero velocity) with no
+// external force and reports the energy growth (max over frames of mechanical energy /
+// initial energy), the first frame with a non-finite value or blow-up (advanceFrame's
+// checks: nothing unstable is ever stored) and the maximum displacement. Runs that blow
+// up or gain energy are listed by integrator and configuration at the end.
+// docs/benchmarks.md lists the grid and the results.
+#include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/sceneIO/scene.hpp>
+#include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/writers.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace asyncfem;
+
+struct Options {
+  int frames = 100;
+  bool full = false;
+  std::vector<int> cells{8, 2, 2};
+  unsigned seed = 1;
+  std::string csv = "stability.csv";
+};
+
+struct Damping {
+  std::string name;
+  double alpha, beta;
+};
+
+struct Case {
+  std::string integrator;  // registry name
+  std::string variant;     // "" or "symmetric"
+  double stiffnessRatio;
+  int ratio;
+  Damping damping;
+  bool perturbed;
+};
+
+struct Outcome {
+  double energyGrowth = 0.0;
+  int failedFrame = -1;
+  std::string failure;
+  double maxDisplacement = 0.0;
+  double seconds = 0.0;
+};
+
+constexpr double kLength = 1.0;
+
+BoxMeshSpec barSpec(const Options& options, double stiffnessRatio) {
+  BoxMeshSpec spec;
+  spec.size = Eigen::Vector3d(kLength, 0.25, 0.25);
+  spec.cells = Eigen::Vector3i(options.cells[0], options.cells[1], options.cells[2]);
+  spec.material = Material{"soft", 1000.0, 1e5, 0.4};
+  // The last quarter is stiffer by stiffnessRatio (and lighter, as the paper's stiff parts).
+  spec.regions.push_back({"stiff", Eigen::Vector3d(0.75 * kLength, -1, -1), Eigen::Vector3d(2 * kLength, 2, 2),
+                          Material{"stiff", 500.0, 1e5 * stiffnessRatio, 0.4}});
+  return spec;
+}
+
+// The bar with interior vertices moved randomly by up to 0.4 cell widths per axis: slivers
+// and badly shaped elements, never degenerate ones (retries with a new draw otherwise).
+TetMesh perturbedBar(const BoxMeshSpec& spec, unsigned seed, double* worstQuality) {
+  const TetMesh regular = makeBoxMesh(spec);
+  const Eigen::Vector3d cell = spec.size.cwiseQuotient(spec.cells.cast<double>());
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-0.4, 0.4);
+  for (int attempt = 0; attempt < 20; ++attempt) {
+    Eigen::Matrix3Xd positions = regular.restPositions();
+    for (int v = 0; v < regular.numVertices(); ++v) {
+      for (int c = 0; c < 3; ++c) {
+        const double x = positions(c, v);
+        const bool boundary =
+            std::abs(x - spec.origin[c]) < 1e-12 || std::abs(x - spec.origin[c] - spec.size[c]) < 1e-12;
+        const double shift = uniform(rng) * cell[c];
+        if (!boundary) positions(c, v) += shift;
+      }
+    }
+    // Quality: 6 sqrt(2) V / l_max^3 (1 for a regular tet, 0 for a flat one).
+    double worst = 1e300;
+    bool inverted = false;
+    for (int e = 0; e < regular.numElements(); ++e) {
+      const Eigen::Vector4i t = regular.element(e);
+      const Eigen::Vector3d a = positions.col(t[0]), b = positions.col(t[1]), c = positions.col(t[2]),
+                            d = positions.col(t[3]);
+      const double volume = (b - a).cross(c - a).dot(d - a) / 6.0;
+      double longest = 0.0;
+      for (const auto& [p, q] : {std::pair{a, b}, {a, c}, {a, d}, {b, c}, {b, d}, {c, d}}) {
+        longest = std::max(longest, (p - q).norm());
+      }
+      const double original = [&] {
+        const Eigen::Matrix<double, 3, 4> rest = regular.elementRestPositions(e);
+        return (rest.col(1) - rest.col(0)).cross(rest.col(2) - rest.col(0)).dot(rest.col(3) - rest.col(0));
+      }();
+      if (volume * original <= 0.0) inverted = true;
+      worst = std::min(worst, 6.0 * std::sqrt(2.0) * std::abs(volume) / std::pow(longest, 3));
+    }
+    if (inverted || worst < 1e-3) continue;
+    TetMesh mesh(positions, regular.elements(), regular.materials(), regular.elementMaterials());
+    for (const auto& [name, members] : regular.elementSets()) mesh.setElementSet(name, members);
+    for (const auto& [name, members] : regular.vertexSets()) mesh.setVertexSet(name, members);
+    *worstQuality = worst;
+    return mesh;
+  }
+  throw Error("could not perturb the bar without inverting or flattening an element; use more cells");
+}
+
+Scene sceneFor(const Case& run, const fs::path& meshFile) {
+  Scene scene;
+  scene.sourceName = "stress";
+  scene.mesh.source = Scene::MeshSource::file;
+  scene.mesh.file = meshFile;
+  scene.fixed.sets = {"xmin"};
+  scene.rayleighAlpha = run.damping.alpha;
+  scene.rayleighBeta = run.damping.beta;
+  scene.integrator.name = run.integrator;
+  scene.integrator.timestep = 1.0 / 120.0;
+  scene.frames.rate = 30.0;
+  if (run.integrator != "backward-euler") {
+    scene.integrator.options = {{"regions", {{{"name", "stiff"}, {"ratio", run.ratio}, {"elementSets", {"stiff"}}}}}};
+    if (!run.variant.empty()) scene.integrator.options["schur"] = run.variant;
+  }
+  return scene;
+}
+
+Outcome runCase(const Case& run, const fs::path& meshFile, int frames) {
+  Outcome outcome;
+  Stopwatch watch;
+  Scene scene = sceneFor(run, meshFile);
+  scene.frames.count = frames;
+  Simulation simulation = buildSimulation(scene);
+  Integrator& integrator = *simulation.integrator;
+  const Eigen::Matrix3Xd& rest = simulation.mesh->restPositions();
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(integrator.system().numDofs());
+  for (int v = 0; v < rest.cols(); ++v) u[3 * v + 1] = 0.02 * rest(0, v) * rest(0, v) / kLength;
+  integrator.setState(u, Eigen::VectorXd::Zero(u.size()));
+  const double initialEnergy = integrator.mechanicalEnergy();
+  for (int frame = 0; frame < frames; ++frame) {
+    try {
+      advanceFrame(simulation, frame);
+    } catch (const NumericalError& error) {
+      outcome.failedFrame = frame;
+      outcome.failure = error.what();
+      break;
+    }
+    outcome.energyGrowth = std::max(outcome.energyGrowth, integrator.mechanicalEnergy() / initialEnergy);
+    outcome.maxDisplacement = std::max(outcome.maxDisplacement, integrator.displacement().cwiseAbs().maxCoeff());
+  }
+  outcome.seconds = watch.stop();
+  return outcome;
+}
+
+std::string describe(const Case& c) {
+  std::ostringstream out;
+  out << c.integrator << (c.variant.empty() ? "" : " " + c.variant) << ", stiffness ratio " << c.stiffnessRatio;
+  if (c.integrator != "backward-euler") out << ", m = " << c.ratio;
+  out << ", damping " << c.damping.name << ", " << (c.perturbed ? "perturbed" : "regular") << " mesh";
+  return out.str();
+}
+
+int run(const Options& options) {
+  const int frames = options.full ? std::max(options.frames, 10000) : options.frames;
+  const std::vector<double> stiffnessRatios =
+      options.full ? std::vector<double>{1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6} : std::vector<double>{1, 1e2, 1e4, 1e6};
+  const std::vector<int> ratios =
+      options.full ? std::vector<int>{1, 2, 8, 32, 100, 200} : std::vector<int>{1, 8, 50, 200};
+  const std::vector<Damping> dampings = {{"none", 0.0, 0.0}, {"light", 0.1, 1e-4}, {"heavy", 5.0, 1e-2}};
+  const std::vector<std::pair<std::string, std::string>> integrators = {
+      {"async", ""}, {"async", "symmetric"}, {"multirate-uncoupled", ""}, {"backward-euler", ""}};
+
+  const fs::path folder = fs::temp_directory_path() / ("asyncfem-stress-" + std::to_string(options.seed));
+  fs::create_directories(folder);
+  std::ofstream csv(options.csv);
+  csv << "integrator,variant,stiffness_ratio,ratio,damping,mesh,frames,energy_growth,failed_frame,max_displacement,"
+         "seconds,failure\n";
+  std::cout << "# stabilityStressTest: " << frames << " frames per run (hL = 1/120, 30 frames per s), bar "
+            << options.cells[0] << "x" << options.cells[1] << "x" << options.cells[2]
+            << " cells, free vibration from a bent state\n\n";
+  std::cout << "| integrator | stiffness ratio | m | damping | mesh | energy growth | first bad frame | max abs(u) |\n";
+  std::cout << "|---|---|---|---|---|---|---|---|\n";
+  std::vector<std::string> problems;
+  int runs = 0;
+  Stopwatch total;
+  for (const double stiffnessRatio : stiffnessRatios) {
+    const BoxMeshSpec spec = barSpec(options, stiffnessRatio);
+    for (const bool perturbed : {false, true}) {
+      double quality = 1.0;
+      const TetMesh mesh = perturbed ? perturbedBar(spec, options.seed, &quality) : makeBoxMesh(spec);
+      const fs::path meshFile = folder / ("bar-" + std::to_string(runs) + (perturbed ? "-perturbed" : "") + ".veg");
+      writeVeg(meshFile, mesh);
+      for (const Damping& damping : dampings) {
+        for (const auto& [integrator, variant] : integrators) {
+          for (const int ratio : ratios) {
+            if (integrator == "backward-euler" && ratio != ratios.front()) continue;  // m does not apply
+            const Case c{integrator, variant, stiffnessRatio, ratio, damping, perturbed};
+            Outcome o;
+            try {
+              o = runCase(c, meshFile, frames);
+            } catch (const Error& error) {
+              o.failedFrame = 0;
+              o.failure = std::string("setup failed: ") + error.what();
+            }
+            ++runs;
+            const bool grows = o.energyGrowth > 1.0 + 1e-9;
+            std::cout << "| " << integrator << (variant.empty() ? "" : " " + variant) << " | " << stiffnessRatio
+                      << " | " << (integrator == "backward-euler" ? std::string("-") : std::to_string(ratio)) << " | "
+                      << damping.name << " | "
+                      << (perturbed ? "perturbed (q " + std::to_string(quality).substr(0, 5) + ")" : "regular") << " | "
+                      << o.energyGrowth << " | "
+                      << (o.failedFrame < 0 ? std::string("-") : std::to_string(o.failedFrame)) << " | "
+                      << o.maxDisplacement << " |\n";
+            std::cout.flush();
+            csv << integrator << ',' << variant << ',' << stiffnessRatio << ',' << ratio << ',' << damping.name << ','
+                << (perturbed ? "perturbed" : "regular") << ',' << frames << ',' << o.energyGrowth << ','
+                << o.failedFrame << ',' << o.maxDisplacement << ',' << o.seconds << ",\"" << o.failure << "\"\n";
+            if (o.failedFrame >= 0) {
+              problems.push_back("BLOW-UP: " + describe(c) + ": frame " + std::to_string(o.failedFrame) + ": " +
+                                 o.failure);
+            } else if (grows) {
+              std::ostringstream line;
+              line << "ENERGY GROWTH: " << describe(c) << ": max E/E0 = " << o.energyGrowth;
+              problems.push_back(line.str());
+            }
+          }
+        }
+      }
+    }
+  }
+  std::cout << "\n"
+            << runs << " runs in " << total.stop() << " s; " << problems.size()
+            << " with a blow-up or energy growth (E/E0 > 1 + 1e-9)\n";
+  for (const std::string& line : problems) std::cout << "- " << line << "\n";
+  std::cout << "CSV: " << options.csv << "\n";
+  fs::remove_all(folder);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Stability stress test of the integrators (docs/benchmarks.md)"};
+  Options options;
+  app.add_option("--frames", options.frames, "Frames per run (default 100; --full: at least 10000)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--full", options.full, "The full grid: 7 stiffness ratios, 6 timestep ratios, >= 10000 frames");
+  app.add_option("--cells", options.cells, "Cells of the bar along x, y, z")->expected(3);
+  app.add_option("--seed", options.seed, "Seed of the vertex perturbation");
+  app.add_option("--csv", options.csv, "CSV output file");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? 0 : 2;
+  }
+  try {
+    return run(options);
+  } catch (const std::exception& error) {
+    std::cerr << "stabilityStressTest: " << error.what() << "\n";
+    return 1;
+  }
+}
