@@ -1,0 +1,40 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <asyncfem/tetMesher/implicit.hpp>
+#include <asyncfem/tetMesher/signedDistance.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
+
+#include <Eigen/Geometry>
+
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+/// Rest-position centroid of every element, 3 x numElements.
+Eigen::Matrix3Xd elementCentroids(const TetMesh& mesh);
+
+/// Sets the element set `name` to the given elements and the vertex set `name` to their
+/// vertices (replacing sets of that name).
+void setElementAndVertexSet(TetMesh& mesh, const std::string& name, std::vector<int> elements);
+
+/// Element (and vertex) set `name`: the elements whose centroid lies in box (bounds
+/// included). Returns the number of elements; an empty box makes an empty set.
+int addBoxSet(TetMesh& mesh, const std::string& name, const Eigen::AlignedBox3d& box);
+
+/// One element (and vertex) set per part name: each element goes to the part whose
+/// function is smallest (most inside) at the element centroid. Parts sharing a name share
+/// a set. Returns the number of elements per distinct name, in first-appearance order.
+std::vector<int> addImplicitPartSets(TetMesh& mesh, const std::vector<ImplicitPart>& parts);
+
+/// One element (and vertex) set per part of distance.surface(): each element goes to the
+/// part of the triangle nearest its centroid. Parts that receive no element get no set.
+/// Returns the number of elements per part (indexed like surface().partNames).
+std::vector<int> addNearestPartSets(TetMesh& mesh, const SignedDistance& distance);
+
+/// Gives every element of element set `set` the material (added to the mesh, or replacing
+/// the material of the same name). ValidationError if the set does not exist.
+void assignSetMaterial(TetMesh& mesh, const std::string& set, const Material& material);
+
+}  // namespace asyncfem

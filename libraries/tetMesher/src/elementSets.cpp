@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/tetMesher/elementSets.hpp>
+
+#include <algorithm>
+#include <limits>
+#include <map>
+
+namespace asyncfem {
+
+Eigen::Matrix3Xd elementCentroids(const TetMesh& mesh) {
+  Eigen::Matrix3Xd centroids(3, mesh.numElements());
+  for (int e = 0; e < mesh.numElements(); ++e) centroids.col(e) = mesh.elementRestPositions(e).rowwise().mean();
+  return centroids;
+}
+
+void setElementAndVertexSet(TetMesh& mesh, const std::string& name, std::vector<int> elements) {
+  std::vector<int> vertices;
+  vertices.reserve(4 * elements.size());
+  for (int e : elements)
+    for (int a = 0; a < 4; ++a) vertices.push_back(mesh.elements()(a, e));
+  mesh.setElementSet(name, std::move(elements));
+  mesh.setVertexSet(name, std::move(vertices));
+}
+
+int addBoxSet(TetMesh& mesh, const std::string& name, const Eigen::AlignedBox3d& box) {
+  const Eigen::Matrix3Xd centroids = elementCentroids(mesh);
+  std::vector<int> members;
+  for (int e = 0; e < mesh.numElements(); ++e)
+    if (box.contains(centroids.col(e))) members.push_back(e);
+  const int count = static_cast<int>(members.size());
+  setElementAndVertexSet(mesh, name, std::move(members));
+  return count;
+}
+
+std::vector<int> addImplicitPartSets(TetMesh& mesh, const std::vector<ImplicitPart>& parts) {
+  std::vector<std::string> names;
+  std::map<std::string, int> nameIndex;
+  std::vector<int> partToName;
+  for (const ImplicitPart& part : parts) {
+    const auto [it, inserted] = nameIndex.try_emplace(part.name, static_cast<int>(names.size()));
+    if (inserted) names.push_back(part.name);
+    partToName.push_back(it->second);
+  }
+  std::vector<std::vector<int>> members(names.size());
+  const Eigen::Matrix3Xd centroids = elementCentroids(mesh);
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    int best = -1;
+    double bestValue = std::numeric_limits<double>::infinity();
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      const double value = parts[p].function(centroids.col(e));
+      if (value < bestValue) {
+        bestValue = value;
+        best = static_cast<int>(p);
+      }
+    }
+    if (best >= 0) members[static_cast<std::size_t>(partToName[static_cast<std::size_t>(best)])].push_back(e);
+  }
+  std::vector<int> counts;
+  for (std::size_t n = 0; n < names.size(); ++n) {
+    counts.push_back(static_cast<int>(members[n].size()));
+    setElementAndVertexSet(mesh, names[n], std::move(members[n]));
+  }
+  return counts;
+}
+
+std::vector<int> addNearestPartSets(TetMesh& mesh, const SignedDistance& distance) {
+  const TriangleSurface& surface = distance.surface();
+  std::vector<std::vector<int>> members(surface.partNames.size());
+  const Eigen::Matrix3Xd centroids = elementCentroids(mesh);
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    int triangle = -1;
+    distance.distance(centroids.col(e), &triangle);
+    const int part = surface.triangleParts.empty() ? 0 : surface.triangleParts[static_cast<std::size_t>(triangle)];
+    members[static_cast<std::size_t>(part)].push_back(e);
+  }
+  std::vector<int> counts;
+  for (std::size_t p = 0; p < members.size(); ++p) {
+    counts.push_back(static_cast<int>(members[p].size()));
+    if (!members[p].empty()) setElementAndVertexSet(mesh, surface.partNames[p], std::move(members[p]));
+  }
+  return counts;
+}
+
+void assignSetMaterial(TetMesh& mesh, const std::string& set, const Material& material) {
+  mesh.elementSet(set);  // throws, naming the known sets, if absent
+  const int index = mesh.addMaterial(material);
+  mesh.assignMaterial(set, index);
+}
+
+}  // namespace asyncfem

@@ -1,0 +1,481 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
+#include <asyncfem/tetMesher/meshChecks.hpp>
+
+#include <Eigen/Dense>
+
+#include <asyncfem/volumetricMesh/queries.hpp>
+
+#include <algorithm>
+#include <map>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace asyncfem {
+
+namespace {
+
+/// The body-centred cubic lattice: black vertices at the corners of n cubes of size h,
+/// red vertices at their centres. Ids: black first (x fastest), then red.
+struct BccLattice {
+  Eigen::Vector3d origin;
+  double spacing = 0.0;
+  Eigen::Array3i cells;  // cubes per axis
+
+  long long numBlack() const { return static_cast<long long>(cells.x() + 1) * (cells.y() + 1) * (cells.z() + 1); }
+  long long numRed() const { return static_cast<long long>(cells.x()) * cells.y() * cells.z(); }
+  long long numVertices() const { return numBlack() + numRed(); }
+  bool isRed(long long id) const { return id >= numBlack(); }
+
+  long long black(int i, int j, int k) const {
+    return i + static_cast<long long>(cells.x() + 1) * (j + static_cast<long long>(cells.y() + 1) * k);
+  }
+  long long red(int i, int j, int k) const {
+    return numBlack() + i + static_cast<long long>(cells.x()) * (j + static_cast<long long>(cells.y()) * k);
+  }
+  Eigen::Vector3d position(long long id) const {
+    if (!isRed(id)) {
+      const long long nx = cells.x() + 1, ny = cells.y() + 1;
+      return origin + spacing * Eigen::Vector3d(static_cast<double>(id % nx), static_cast<double>((id / nx) % ny),
+                                                static_cast<double>(id / (nx * ny)));
+    }
+    const long long r = id - numBlack();
+    const long long nx = cells.x(), ny = cells.y();
+    return origin + spacing * Eigen::Vector3d(static_cast<double>(r % nx) + 0.5,
+                                              static_cast<double>((r / nx) % ny) + 0.5,
+                                              static_cast<double>(r / (nx * ny)) + 0.5);
+  }
+};
+
+int signOf(double value) { return value < 0.0 ? -1 : (value > 0.0 ? 1 : 0); }
+
+std::uint64_t edgeKey(long long a, long long b) {
+  const auto lo = static_cast<std::uint64_t>(std::min(a, b));
+  const auto hi = static_cast<std::uint64_t>(std::max(a, b));
+  return (hi << 32) ^ lo ^ (hi >> 32);  // ids fit in 32 bits (checked), so this is injective
+}
+
+/// Root of f on the segment from x0 (value f0) to x1 (value f1), f0 f1 < 0, by the
+/// Illinois variant of regula falsi; returns the parameter t in (0, 1).
+double findRoot(const ImplicitFunction& f, const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, double f0, double f1,
+                int iterations) {
+  double t0 = 0.0, t1 = 1.0;
+  int lastSide = 0;
+  double t = f0 / (f0 - f1);
+  for (int it = 0; it < iterations && t1 - t0 > 1e-12; ++it) {
+    t = (t0 * f1 - t1 * f0) / (f1 - f0);
+    if (!(t > t0 && t < t1)) t = 0.5 * (t0 + t1);
+    const double ft = f(x0 + t * (x1 - x0));
+    if (ft == 0.0) return t;
+    if ((ft < 0.0) == (f0 < 0.0)) {
+      t0 = t;
+      f0 = ft;
+      if (lastSide == -1) f1 *= 0.5;
+      lastSide = -1;
+    } else {
+      t1 = t;
+      f1 = ft;
+      if (lastSide == 1) f0 *= 0.5;
+      lastSide = 1;
+    }
+  }
+  return t;
+}
+
+/// Boundary edges (vertex pairs) shared by more than two boundary triangles.
+std::vector<std::pair<int, int>> nonManifoldBoundaryEdges(const TetMesh& mesh) {
+  std::map<std::pair<int, int>, int> count;
+  for (const auto& t : boundaryTriangles(mesh))
+    for (int i = 0; i < 3; ++i) {
+      const int a = t[static_cast<std::size_t>(i)], b = t[static_cast<std::size_t>((i + 1) % 3)];
+      ++count[{std::min(a, b), std::max(a, b)}];
+    }
+  std::vector<std::pair<int, int>> edges;
+  for (const auto& [edge, uses] : count)
+    if (uses > 2) edges.push_back(edge);
+  return edges;
+}
+
+/// Builds the output mesh tetrahedron by tetrahedron.
+class StencilBuilder {
+public:
+  StencilBuilder(const BccLattice& lattice, const std::vector<int>& signs,
+                 const std::unordered_map<long long, Eigen::Vector3d>& warped,
+                 const std::unordered_map<std::uint64_t, Eigen::Vector3d>& cuts)
+      : lattice_(lattice), signs_(signs), warped_(warped), cuts_(cuts) {}
+
+  /// Fills the part of lattice tetrahedron (b0, b1, r0, r1) where f <= 0.
+  void fill(const std::array<long long, 4>& tet) {
+    std::array<long long, 4> neg{}, zero{}, pos{};
+    int numNeg = 0, numZero = 0, numPos = 0;
+    for (long long v : tet) {
+      const int s = signs_[static_cast<std::size_t>(v)];
+      if (s < 0) neg[static_cast<std::size_t>(numNeg++)] = v;
+      else if (s == 0) zero[static_cast<std::size_t>(numZero++)] = v;
+      else pos[static_cast<std::size_t>(numPos++)] = v;
+    }
+    // No inside vertex: nothing to fill. This includes tetrahedra whose four vertices were
+    // all warped onto the surface; keeping those would break the angle bound (they can be
+    // nearly flat slivers lying along the surface).
+    if (numNeg == 0) return;
+    if (numPos == 0) {
+      emit(lat(tet[0]), lat(tet[1]), lat(tet[2]), lat(tet[3]));
+      return;
+    }
+    if (numPos == 1) {
+      const long long p = pos[0];
+      if (numNeg == 3) {
+        // Corner cut off: a prism between the three inside vertices and their cut points.
+        const std::array<long long, 3> o{neg[0], neg[1], neg[2]};
+        std::array<int, 3> a{}, b{};
+        std::array<Diagonal, 3> diagonals{};
+        for (int i = 0; i < 3; ++i) {
+          a[static_cast<std::size_t>(i)] = lat(o[static_cast<std::size_t>(i)]);
+          b[static_cast<std::size_t>(i)] = cut(p, o[static_cast<std::size_t>(i)]);
+        }
+        for (int i = 0; i < 3; ++i) {
+          const bool fromFirst = diagonalFromFirst(o[static_cast<std::size_t>(i)], o[static_cast<std::size_t>((i + 1) % 3)]);
+          diagonals[static_cast<std::size_t>(i)] = fromFirst ? Diagonal::Forward : Diagonal::Backward;
+        }
+        emitPrism(a, b, diagonals);
+      } else if (numNeg == 2) {
+        // Pyramid: apex at the surface vertex, base quad in the face (p, n0, n1).
+        const long long n0 = neg[0], n1 = neg[1];
+        const int apex = lat(zero[0]);
+        const int A = lat(n0), B = lat(n1), cA = cut(p, n0), cB = cut(p, n1);
+        if (diagonalFromFirst(n0, n1)) {
+          emit(apex, A, B, cB);
+          emit(apex, A, cB, cA);
+        } else {
+          emit(apex, A, B, cA);
+          emit(apex, B, cB, cA);
+        }
+      } else {
+        emit(lat(neg[0]), lat(zero[0]), lat(zero[1]), cut(p, neg[0]));
+      }
+      return;
+    }
+    if (numPos == 2) {
+      const long long p0 = pos[0], p1 = pos[1];
+      if (numNeg == 2) {
+        // Wedge around the inside edge (n0, n1): a prism whose triangles hold n0 and n1.
+        const long long n0 = neg[0], n1 = neg[1];
+        const std::array<int, 3> a{lat(n0), cut(p0, n0), cut(p1, n0)};
+        const std::array<int, 3> b{lat(n1), cut(p0, n1), cut(p1, n1)};
+        const bool fromFirst = diagonalFromFirst(n0, n1);
+        std::array<Diagonal, 3> diagonals{fromFirst ? Diagonal::Forward : Diagonal::Backward, Diagonal::Free,
+                                          fromFirst ? Diagonal::Backward : Diagonal::Forward};
+        emitPrism(a, b, diagonals);
+      } else {
+        const long long n = neg[0];
+        emit(lat(n), lat(zero[0]), cut(p0, n), cut(p1, n));
+      }
+      return;
+    }
+    const long long n = neg[0];
+    emit(lat(n), cut(pos[0], n), cut(pos[1], n), cut(pos[2], n));
+  }
+
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Eigen::Vector4i> elements;
+  std::vector<long long> sources;  // lattice vertex of each output vertex, -1 for cut points
+  int cutPointsUsed = 0;
+
+private:
+  enum class Diagonal { Forward, Backward, Free };
+
+  Eigen::Vector3d position(long long v) const {
+    const auto it = warped_.find(v);
+    return it != warped_.end() ? it->second : lattice_.position(v);
+  }
+
+  /// Output index of lattice vertex v (created on first use).
+  int lat(long long v) {
+    const auto [it, inserted] = latticeOutput_.try_emplace(v, static_cast<int>(positions.size()));
+    if (inserted) {
+      positions.push_back(position(v));
+      sources.push_back(v);
+    }
+    return it->second;
+  }
+
+  /// Output index of the cut point on lattice edge (u, v).
+  int cut(long long u, long long v) {
+    const std::uint64_t key = edgeKey(u, v);
+    const auto [it, inserted] = cutOutput_.try_emplace(key, static_cast<int>(positions.size()));
+    if (inserted) {
+      const auto found = cuts_.find(key);
+      if (found == cuts_.end()) throw Error("stuffIsosurface: internal error: missing cut point");
+      positions.push_back(found->second);
+      sources.push_back(-1);
+      ++cutPointsUsed;
+    }
+    return it->second;
+  }
+
+  /// The quadrilateral (A, B, c(P,B), c(P,A)) that a face (P, A, B) with A, B inside and P
+  /// outside leaves is split either by the diagonal A - c(P,B) (returns true) or by
+  /// B - c(P,A). The choice depends only on A and B, so the two lattice tetrahedra sharing
+  /// the face agree. For a short (black-red) edge the diagonal leaves the red vertex, so
+  /// in a corner-cut prism (one outside vertex) the two short-edge quads share a vertex and
+  /// the prism always splits into three tetrahedra; for a long edge the lower id decides.
+  bool diagonalFromFirst(long long A, long long B) const {
+    const bool redA = lattice_.isRed(A), redB = lattice_.isRed(B);
+    if (redA != redB) return redA;
+    return A < B;
+  }
+
+  void emit(int a, int b, int c, int d) {
+    Eigen::Vector4i t(a, b, c, d);
+    const Eigen::Vector3d x0 = positions[static_cast<std::size_t>(a)];
+    Eigen::Matrix3d edges;
+    edges << positions[static_cast<std::size_t>(b)] - x0, positions[static_cast<std::size_t>(c)] - x0,
+        positions[static_cast<std::size_t>(d)] - x0;
+    if (edges.determinant() < 0.0) std::swap(t[2], t[3]);
+    elements.push_back(t);
+  }
+
+  /// Pyramid with apex x over the quad (q0, q1, q2, q3), split along q0-q2 or q1-q3.
+  void emitPyramid(int x, const std::array<int, 4>& q, bool diagonal02) {
+    if (diagonal02) {
+      emit(x, q[0], q[1], q[2]);
+      emit(x, q[0], q[2], q[3]);
+    } else {
+      emit(x, q[1], q[2], q[3]);
+      emit(x, q[1], q[3], q[0]);
+    }
+  }
+
+  /// Prism with triangles a and b and lateral edges a_i - b_i. Quad i is
+  /// (a_i, a_{i+1}, b_{i+1}, b_i); Forward means its diagonal a_i - b_{i+1}, Backward
+  /// a_{i+1} - b_i, Free lets this function choose (the shorter, unless that would make
+  /// the three diagonals cyclic, which no three-tetrahedron split can honour).
+  void emitPrism(const std::array<int, 3>& a, const std::array<int, 3>& b, std::array<Diagonal, 3> diagonals) {
+    for (int i = 0; i < 3; ++i) {
+      if (diagonals[static_cast<std::size_t>(i)] != Diagonal::Free) continue;
+      const Diagonal other1 = diagonals[static_cast<std::size_t>((i + 1) % 3)];
+      const Diagonal other2 = diagonals[static_cast<std::size_t>((i + 2) % 3)];
+      const std::size_t i0 = static_cast<std::size_t>(i), i1 = static_cast<std::size_t>((i + 1) % 3);
+      const double forward = (positions[static_cast<std::size_t>(a[i0])] - positions[static_cast<std::size_t>(b[i1])]).norm();
+      const double backward = (positions[static_cast<std::size_t>(a[i1])] - positions[static_cast<std::size_t>(b[i0])]).norm();
+      Diagonal choice = forward <= backward ? Diagonal::Forward : Diagonal::Backward;
+      if (other1 == other2 && other1 == choice) choice = choice == Diagonal::Forward ? Diagonal::Backward : Diagonal::Forward;
+      diagonals[static_cast<std::size_t>(i)] = choice;
+    }
+    for (int i = 0; i < 3; ++i) {
+      const std::size_t prev = static_cast<std::size_t>((i + 2) % 3), cur = static_cast<std::size_t>(i);
+      const std::size_t next = static_cast<std::size_t>((i + 1) % 3), after = static_cast<std::size_t>((i + 2) % 3);
+      // The quad opposite vertex a_i / b_i is quad i+1: (a_{i+1}, a_{i+2}, b_{i+2}, b_{i+1}).
+      const std::array<int, 4> opposite{a[next], a[after], b[after], b[next]};
+      const bool opposite02 = diagonals[next] == Diagonal::Forward;
+      if (diagonals[prev] == Diagonal::Backward && diagonals[cur] == Diagonal::Forward) {
+        // Both diagonals at a_i: cut off tetrahedron (a_i, b_0, b_1, b_2).
+        emit(a[cur], b[0], b[1], b[2]);
+        emitPyramid(a[cur], opposite, opposite02);
+        return;
+      }
+      if (diagonals[prev] == Diagonal::Forward && diagonals[cur] == Diagonal::Backward) {
+        emit(b[cur], a[0], a[1], a[2]);
+        emitPyramid(b[cur], opposite, opposite02);
+        return;
+      }
+    }
+    throw Error("stuffIsosurface: internal error: cyclic prism diagonals");
+  }
+
+  const BccLattice& lattice_;
+  const std::vector<int>& signs_;
+  const std::unordered_map<long long, Eigen::Vector3d>& warped_;
+  const std::unordered_map<std::uint64_t, Eigen::Vector3d>& cuts_;
+  std::unordered_map<long long, int> latticeOutput_;
+  std::unordered_map<std::uint64_t, int> cutOutput_;
+};
+
+}  // namespace
+
+TetMesh stuffIsosurface(const ImplicitFunction& f, const Eigen::AlignedBox3d& bounds, double spacing,
+                        const MesherOptions& options, StuffingReport* report) {
+  if (!(spacing > 0.0) || !std::isfinite(spacing)) {
+    throw ValidationError("stuffIsosurface: spacing must be a finite number > 0, got " + std::to_string(spacing));
+  }
+  if (bounds.isEmpty() || !bounds.min().allFinite() || !bounds.max().allFinite()) {
+    throw ValidationError("stuffIsosurface: empty or non-finite bounds");
+  }
+  if (!f) throw ValidationError("stuffIsosurface: no implicit function");
+
+  BccLattice lattice;
+  lattice.spacing = spacing;
+  // Two cells of margin on each side, so the outermost lattice layers lie outside the solid.
+  lattice.origin = bounds.min() - Eigen::Vector3d::Constant(2.0 * spacing);
+  const Eigen::Array3d extent = (bounds.max() - bounds.min()).array() / spacing;
+  for (int a = 0; a < 3; ++a) {
+    const double cells = std::ceil(extent[a]) + 4.0;
+    if (cells > 1e6) throw ValidationError("stuffIsosurface: spacing too small for the bounds");
+    lattice.cells[a] = static_cast<int>(cells);
+  }
+  const long long numLattice = lattice.numVertices();
+  const long long limit = std::min<long long>(options.maxLatticeVertices, std::numeric_limits<std::int32_t>::max());
+  if (numLattice > limit) {
+    throw ValidationError("stuffIsosurface: the lattice would have " + std::to_string(numLattice) +
+                          " vertices (limit " + std::to_string(limit) + "); use a larger spacing");
+  }
+
+  // 1. Sample f at every lattice vertex.
+  std::vector<double> values(static_cast<std::size_t>(numLattice));
+  bool nonFinite = false;
+#pragma omp parallel for schedule(dynamic, 4096) if (options.parallel) reduction(|| : nonFinite)
+  for (long long v = 0; v < numLattice; ++v) {
+    const double value = f(lattice.position(v));
+    values[static_cast<std::size_t>(v)] = value;
+    if (!std::isfinite(value)) nonFinite = true;
+  }
+  if (nonFinite) throw ValidationError("stuffIsosurface: the implicit function returned a non-finite value");
+  std::vector<int> signs(values.size());
+  for (std::size_t v = 0; v < values.size(); ++v) signs[v] = signOf(values[v]);
+
+  // 2. Cut points on sign-changing edges, and 3. the closest violating cut point per vertex.
+  std::unordered_map<std::uint64_t, Eigen::Vector3d> cuts;
+  struct Violation {
+    double distance;
+    Eigen::Vector3d point;
+  };
+  std::unordered_map<long long, Violation> violations;
+  auto visitEdge = [&](long long u, long long v, double alpha) {
+    const double fu = values[static_cast<std::size_t>(u)], fv = values[static_cast<std::size_t>(v)];
+    if (!((fu < 0.0 && fv > 0.0) || (fu > 0.0 && fv < 0.0))) return;
+    const Eigen::Vector3d xu = lattice.position(u), xv = lattice.position(v);
+    const double t = findRoot(f, xu, xv, fu, fv, options.cutPointIterations);
+    const Eigen::Vector3d point = xu + t * (xv - xu);
+    cuts.emplace(edgeKey(u, v), point);
+    const double length = (xv - xu).norm();
+    auto consider = [&](long long w, double distance) {
+      if (distance >= alpha * length) return;
+      const auto [it, inserted] = violations.try_emplace(w, Violation{distance, point});
+      if (!inserted && distance < it->second.distance) it->second = Violation{distance, point};
+    };
+    consider(u, t * length);
+    consider(v, (1.0 - t) * length);
+  };
+  const Eigen::Array3i& n = lattice.cells;
+  for (int k = 0; k <= n.z(); ++k)
+    for (int j = 0; j <= n.y(); ++j)
+      for (int i = 0; i <= n.x(); ++i) {
+        const long long b = lattice.black(i, j, k);
+        if (i < n.x()) visitEdge(b, lattice.black(i + 1, j, k), options.alphaLong);
+        if (j < n.y()) visitEdge(b, lattice.black(i, j + 1, k), options.alphaLong);
+        if (k < n.z()) visitEdge(b, lattice.black(i, j, k + 1), options.alphaLong);
+      }
+  for (int k = 0; k < n.z(); ++k)
+    for (int j = 0; j < n.y(); ++j)
+      for (int i = 0; i < n.x(); ++i) {
+        const long long r = lattice.red(i, j, k);
+        if (i + 1 < n.x()) visitEdge(r, lattice.red(i + 1, j, k), options.alphaLong);
+        if (j + 1 < n.y()) visitEdge(r, lattice.red(i, j + 1, k), options.alphaLong);
+        if (k + 1 < n.z()) visitEdge(r, lattice.red(i, j, k + 1), options.alphaLong);
+        for (int corner = 0; corner < 8; ++corner) {
+          visitEdge(r, lattice.black(i + (corner & 1), j + ((corner >> 1) & 1), k + ((corner >> 2) & 1)),
+                    options.alphaShort);
+        }
+      }
+  std::unordered_map<long long, Eigen::Vector3d> warped;
+  warped.reserve(violations.size());
+  for (const auto& [v, violation] : violations) {
+    warped.emplace(v, violation.point);
+    signs[static_cast<std::size_t>(v)] = 0;
+  }
+
+  // 4. Stencils. Each BCC tetrahedron pairs the red edge between two face-adjacent cube
+  // centres with one of the four black edges of the face they share.
+  auto fillAll = [&](StencilBuilder& builder) {
+    long long latticeTets = 0;
+    for (int k = 0; k < n.z(); ++k)
+      for (int j = 0; j < n.y(); ++j)
+        for (int i = 0; i < n.x(); ++i) {
+          const Eigen::Array3i cell(i, j, k);
+          for (int axis = 0; axis < 3; ++axis) {
+            Eigen::Array3i next = cell;
+            ++next[axis];
+            if (next[axis] >= n[axis]) continue;
+            const long long r0 = lattice.red(i, j, k), r1 = lattice.red(next.x(), next.y(), next.z());
+            const int b = (axis + 1) % 3, d = (axis + 2) % 3;
+            auto corner = [&](int s, int t) {
+              Eigen::Array3i c = next;
+              c[b] += s;
+              c[d] += t;
+              return lattice.black(c.x(), c.y(), c.z());
+            };
+            const std::array<std::array<long long, 2>, 4> blackEdges{
+                {{corner(0, 0), corner(1, 0)}, {corner(0, 1), corner(1, 1)}, {corner(0, 0), corner(0, 1)},
+                 {corner(1, 0), corner(1, 1)}}};
+            for (const auto& edge : blackEdges) {
+              ++latticeTets;
+              const std::array<long long, 4> tet{edge[0], edge[1], r0, r1};
+              bool anyInside = false;
+              for (long long v : tet) anyInside = anyInside || signs[static_cast<std::size_t>(v)] < 0;
+              if (anyInside) builder.fill(tet);
+            }
+          }
+        }
+    return latticeTets;
+  };
+
+  // Where the surface is thinner than the lattice resolves, two warped vertices can pinch
+  // two sheets of the boundary together along an edge. Such vertices go back to their
+  // lattice positions (their cut points are known from step 2), which restores the
+  // marching-tetrahedra structure there, and the stencils are rebuilt.
+  int unwarped = 0;
+  for (int attempt = 0;; ++attempt) {
+    StencilBuilder builder(lattice, signs, warped, cuts);
+    const long long latticeTets = fillAll(builder);
+    if (builder.elements.empty()) {
+      throw ValidationError("stuffIsosurface: no element: the solid is empty at spacing " + std::to_string(spacing) +
+                            " (is f negative inside, and is the spacing small enough for the shape?)");
+    }
+    Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(builder.positions.size()));
+    for (std::size_t v = 0; v < builder.positions.size(); ++v) positions.col(static_cast<Eigen::Index>(v)) = builder.positions[v];
+    Eigen::Matrix4Xi elements(4, static_cast<Eigen::Index>(builder.elements.size()));
+    for (std::size_t e = 0; e < builder.elements.size(); ++e) elements.col(static_cast<Eigen::Index>(e)) = builder.elements[e];
+    TetMesh mesh(std::move(positions), std::move(elements), {options.material},
+                 std::vector<int>(builder.elements.size(), 0));
+    std::vector<long long> pinched;
+    if (options.repairPinches && attempt < 32) {
+      for (const auto& [a, b] : nonManifoldBoundaryEdges(mesh)) {
+        for (int v : {a, b}) {
+          const long long source = builder.sources[static_cast<std::size_t>(v)];
+          if (source >= 0 && warped.count(source) > 0) pinched.push_back(source);
+        }
+      }
+    }
+    if (!pinched.empty()) {
+      for (long long v : pinched) {
+        if (warped.erase(v) > 0) {
+          signs[static_cast<std::size_t>(v)] = signOf(values[static_cast<std::size_t>(v)]);
+          ++unwarped;
+        }
+      }
+      continue;
+    }
+    if (report != nullptr) {
+      report->latticeVertices = numLattice;
+      report->latticeTetrahedra = latticeTets;
+      report->cutPoints = builder.cutPointsUsed;
+      report->warpedVertices = static_cast<int>(warped.size());
+      report->unwarpedVertices = unwarped;
+      report->elements = mesh.numElements();
+      report->vertices = mesh.numVertices();
+    }
+    if (options.check) {
+      validateTetMesh(mesh, "stuffIsosurface (spacing " + std::to_string(spacing) +
+                                "; a failure here usually means parts of the solid thinner than about two spacings)");
+    }
+    return mesh;
+  }
+}
+
+}  // namespace asyncfem

@@ -1,0 +1,241 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// tetMesher: a closed surface (any format assimp reads) or a built-in example model to a
+// quality tetrahedral mesh by isosurface stuffing, written as .veg (or .vtu).
+//
+//   tetMesher SURFACE --output OUT.veg [--spacing H | --cells N] [--set NAME:x0,y0,z0,x1,y1,z1]...
+//             [--part-sets] [--material SET:rho,E,nu]... [--default-material rho,E,nu]
+//             [--repair] [--weld-tolerance T] [--quiet]
+//   tetMesher --model dinosaur|flower|dragon|drop --output OUT.veg [--spacing H] [--set ...]
+//
+// The report goes to stdout; errors print "tetMesher: <message>" on stderr and exit 1
+// (2 for unusable command-line options). docs/tet-mesher.md describes everything.
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/tetMesher/elementSets.hpp>
+#include <asyncfem/tetMesher/exampleModels.hpp>
+#include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
+#include <asyncfem/tetMesher/meshChecks.hpp>
+#include <asyncfem/tetMesher/signedDistance.hpp>
+#include <asyncfem/tetMesher/triangleSurface.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+#include <asyncfem/volumetricMesh/writers.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using asyncfem::TetMesh;
+using asyncfem::ValidationError;
+
+/// Parses "a,b,c,..." into exactly `count` finite numbers.
+std::vector<double> parseNumbers(const std::string& text, std::size_t count, const std::string& what) {
+  std::vector<double> values;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    while (used < item.size() && std::isspace(static_cast<unsigned char>(item[used]))) ++used;
+    if (used == 0 || used != item.size() || !std::isfinite(value)) {
+      throw ValidationError(what + ": \"" + item + "\" is not a number");
+    }
+    values.push_back(value);
+  }
+  if (values.size() != count) {
+    throw ValidationError(what + ": expected " + std::to_string(count) + " comma-separated numbers, got " +
+                          std::to_string(values.size()));
+  }
+  return values;
+}
+
+/// Splits "NAME:rest" at the first colon.
+std::pair<std::string, std::string> splitName(const std::string& text, const std::string& what) {
+  const std::size_t colon = text.find(':');
+  if (colon == std::string::npos || colon == 0) throw ValidationError(what + ": expected NAME:values, got \"" + text + "\"");
+  return {text.substr(0, colon), text.substr(colon + 1)};
+}
+
+struct Options {
+  std::string input;
+  std::string model;
+  std::string output;
+  double spacing = 0.0;
+  int cells = 0;
+  std::vector<std::string> boxSets;
+  bool partSets = false;
+  std::vector<std::string> materials;
+  std::string defaultMaterial;
+  bool repair = false;
+  double weldTolerance = -1.0;
+  bool quiet = false;
+};
+
+void printQuality(const TetMesh& mesh, const asyncfem::StuffingReport& stuffing, double spacing) {
+  const asyncfem::MeshQuality quality = asyncfem::meshQuality(mesh);
+  const asyncfem::MeshCheckReport check = asyncfem::checkTetMesh(mesh);
+  std::printf("lattice: spacing %.6g, %lld lattice vertices, %d vertices warped onto the surface, %d cut points\n",
+              spacing, stuffing.latticeVertices, stuffing.warpedVertices, stuffing.cutPoints);
+  if (stuffing.unwarpedVertices > 0) {
+    std::printf("pinches: %d vertices left on the lattice to keep the boundary manifold (thin parts); the angle "
+                "bound does not hold next to them\n",
+                stuffing.unwarpedVertices);
+  }
+  std::printf("mesh: %d vertices, %d tetrahedra, %d boundary triangles, %d connected component%s\n",
+              mesh.numVertices(), mesh.numElements(), check.boundaryTriangles, check.components,
+              check.components == 1 ? "" : "s");
+  std::printf("quality: dihedral angles min %.2f, max %.2f degrees; worst aspect ratio %.3f\n",
+              quality.minDihedralDegrees, quality.maxDihedralDegrees, quality.worstAspectRatio);
+  std::printf("checks: no inverted or degenerate element, every vertex used, boundary closed and outward\n");
+}
+
+void printSets(const TetMesh& mesh) {
+  for (const auto& [name, members] : mesh.elementSets()) {
+    std::printf("set %s: %zu elements, %zu vertices\n", name.c_str(), members.size(), mesh.vertexSet(name).size());
+  }
+  for (const asyncfem::Material& m : mesh.materials()) {
+    std::printf("material %s: density %g, Young's modulus %g, Poisson ratio %g\n", m.name.c_str(), m.density,
+                m.youngsModulus, m.poissonRatio);
+  }
+}
+
+int run(const Options& options) {
+  if (options.input.empty() == options.model.empty()) {
+    throw ValidationError("give either a surface file or --model NAME");
+  }
+  if (options.spacing > 0.0 && options.cells > 0) throw ValidationError("give either --spacing or --cells, not both");
+  asyncfem::MesherOptions mesherOptions;
+  if (!options.defaultMaterial.empty()) {
+    const std::vector<double> v = parseNumbers(options.defaultMaterial, 3, "--default-material");
+    mesherOptions.material = asyncfem::Material{"default", v[0], v[1], v[2]};
+  }
+
+  TetMesh mesh;
+  asyncfem::StuffingReport stuffing;
+  double spacing = options.spacing;
+  std::optional<asyncfem::SignedDistance> distance;
+  if (!options.model.empty()) {
+    const asyncfem::ExampleModel model = asyncfem::exampleModelFromName(options.model);
+    if (options.cells > 0) throw ValidationError("--cells applies to surfaces; give --spacing for a model");
+    if (spacing <= 0.0) spacing = asyncfem::exampleModelShape(model).spacing;
+    mesh = asyncfem::makeExampleModel(model, spacing, &stuffing);
+    if (!options.quiet) std::printf("model: %s\n", options.model.c_str());
+  } else {
+    asyncfem::TriangleSurface surface = asyncfem::readSurface(options.input);
+    const int inputVertices = surface.numVertices();
+    const Eigen::AlignedBox3d inputBounds = surface.bounds();
+    const double diagonal = inputBounds.diagonal().norm();
+    const double tolerance = options.weldTolerance >= 0.0 ? options.weldTolerance : 1e-7 * diagonal;
+    const int welded = asyncfem::weldVertices(surface, tolerance);
+    const asyncfem::SurfaceTopology topology = asyncfem::surfaceTopology(surface);
+    asyncfem::SignMode mode = asyncfem::SignMode::Pseudonormal;
+    if (!options.quiet) {
+      std::printf("surface: %s: %d triangles, %d vertices (%d welded away from %d at tolerance %.3g), %zu part%s\n",
+                  options.input.c_str(), surface.numTriangles(), surface.numVertices(), welded, inputVertices,
+                  tolerance, surface.partNames.size(), surface.partNames.size() == 1 ? "" : "s");
+    }
+    if (!topology.closed()) {
+      if (!options.repair) asyncfem::requireClosedSurface(surface, options.input);
+      mode = asyncfem::SignMode::WindingNumber;
+      if (!options.quiet) {
+        std::printf("repair: the surface is not closed (%d open, %d non-manifold, %d inconsistently oriented edges, "
+                    "e.g. %s); inside/outside from the generalized winding number\n",
+                    topology.boundaryEdges, topology.nonManifoldEdges, topology.misorientedEdges,
+                    topology.example.c_str());
+      }
+    }
+    if (topology.signedVolume < 0.0) {
+      asyncfem::flipOrientation(surface);
+      if (!options.quiet) std::printf("surface: normals pointed inward; triangles reversed\n");
+    }
+    const double enclosed = std::abs(topology.signedVolume);
+    if (spacing <= 0.0) spacing = inputBounds.sizes().maxCoeff() / (options.cells > 0 ? options.cells : 30);
+    distance.emplace(std::move(surface), mode);
+    const Eigen::AlignedBox3d bounds(inputBounds.min().array() - spacing, inputBounds.max().array() + spacing);
+    mesh = asyncfem::stuffIsosurface(distance->function(), bounds, spacing, mesherOptions, &stuffing);
+    if (!options.quiet && enclosed > 0.0) {
+      const double volume = asyncfem::totalVolume(mesh);
+      std::printf("volume: mesh %.6g, surface %.6g (%+.2f%%)\n", volume, enclosed, 100.0 * (volume - enclosed) / enclosed);
+    }
+    if (options.partSets) asyncfem::addNearestPartSets(mesh, *distance);
+  }
+  for (const std::string& text : options.boxSets) {
+    const auto [name, numbers] = splitName(text, "--set");
+    const std::vector<double> v = parseNumbers(numbers, 6, "--set " + name);
+    const Eigen::AlignedBox3d box(Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Vector3d(v[3], v[4], v[5]));
+    if (box.isEmpty()) throw ValidationError("--set " + name + ": expected min <= max");
+    if (asyncfem::addBoxSet(mesh, name, box) == 0) {
+      throw ValidationError("--set " + name + ": no element centroid lies in the box");
+    }
+  }
+  for (const std::string& text : options.materials) {
+    const auto [name, numbers] = splitName(text, "--material");
+    const std::vector<double> v = parseNumbers(numbers, 3, "--material " + name);
+    asyncfem::assignSetMaterial(mesh, name, asyncfem::Material{name, v[0], v[1], v[2]});
+  }
+
+  if (!options.quiet) {
+    printQuality(mesh, stuffing, spacing);
+    printSets(mesh);
+  }
+  const std::filesystem::path output(options.output);
+  if (output.has_parent_path()) std::filesystem::create_directories(output.parent_path());
+  if (output.extension() == ".vtu") {
+    asyncfem::writeVtu(output, mesh);
+  } else if (output.extension() == ".veg") {
+    asyncfem::writeVeg(output, mesh);
+  } else {
+    throw ValidationError("--output " + options.output + ": expected a .veg or .vtu file");
+  }
+  if (!options.quiet) std::printf("wrote %s\n", options.output.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Tetrahedral meshes by isosurface stuffing from closed surfaces or built-in example models"};
+  Options options;
+  app.add_option("surface", options.input, "Closed triangle surface (any format assimp reads: OBJ, STL, PLY, OFF, ...)");
+  app.add_option("--model", options.model, "Built-in example model: dinosaur, flower, dragon, drop");
+  app.add_option("-o,--output", options.output, "Output mesh (.veg, or .vtu for ParaView)")->required();
+  app.add_option("--spacing", options.spacing, "BCC lattice spacing (length units of the input)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--cells", options.cells, "Lattice cells across the longest side of the bounding box (default 30)")
+      ->check(CLI::Range(1, 2000));
+  app.add_option("--set", options.boxSets, "Element and vertex set of the elements whose centroid lies in a box: "
+                                          "NAME:xmin,ymin,zmin,xmax,ymax,zmax (repeatable)");
+  app.add_flag("--part-sets", options.partSets,
+               "One set per named surface part (assimp mesh/node name): the elements nearest that part");
+  app.add_option("--material", options.materials, "Material of a set: SET:density,youngsModulus,poissonRatio (repeatable)");
+  app.add_option("--default-material", options.defaultMaterial, "Material of all other elements: density,E,nu "
+                                                                "(default 1000,1e6,0.45)");
+  app.add_flag("--repair", options.repair,
+               "Mesh a surface with holes or non-manifold edges using the generalized winding number");
+  app.add_option("--weld-tolerance", options.weldTolerance,
+                 "Merge surface vertices closer than this (default 1e-7 x bounding-box diagonal)");
+  app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    return run(options);
+  } catch (const std::exception& e) {
+    std::cerr << "tetMesher: " << e.what() << "\n";
+    return 1;
+  }
+}
