@@ -230,7 +230,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; unusable options exit 2 (not CLI11's own codes).
+    return app.exit(e) == 0 ? 0 : 2;
   }
   try {
     return run(options);

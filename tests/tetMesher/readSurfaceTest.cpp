@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Surfaces read through assimp (built only with ASYNCFEM_WITH_ASSIMP): OBJ files written
+// here are read, welded, meshed and checked.
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/tetMesher/elementSets.hpp>
+#include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
+#include <asyncfem/tetMesher/meshChecks.hpp>
+#include <asyncfem/tetMesher/signedDistance.hpp>
+#include <asyncfem/tetMesher/triangleSurface.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+
+#include "surfaces.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+namespace asyncfem {
+namespace {
+
+using Eigen::Vector3d;
+
+std::filesystem::path writeTemp(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / ("asyncfem-tetMesher-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto path = dir / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(ReadSurface, ObjCubeWithSeamsMeshesCorrectly) {
+  ASSERT_TRUE(surfaceReaderAvailable());
+  const auto path = writeTemp("cube.obj", test::toObj(test::splitCube(Vector3d(1.0, 2.0, 3.0), 2.0)));
+  TriangleSurface surface = readSurface(path);
+  EXPECT_EQ(surface.numTriangles(), 12);
+  weldVertices(surface, 1e-9);
+  EXPECT_EQ(surface.numVertices(), 8);
+  ASSERT_NO_THROW(requireClosedSurface(surface, path.string()));
+  EXPECT_NEAR(surfaceTopology(surface).signedVolume, 8.0, 1e-9);
+
+  const SignedDistance distance(surface);
+  const TetMesh mesh = stuffIsosurface(distance.function(), surface.bounds(), 0.2);
+  const MeshCheckReport check = checkTetMesh(mesh);
+  EXPECT_TRUE(check.ok()) << check.firstProblem;
+  EXPECT_EQ(check.components, 1);
+  // Edges and corners are rounded off by about a cut-point distance: a few percent of 8.
+  EXPECT_NEAR(totalVolume(mesh), 8.0, 0.08 * 8.0);
+  const BoundingBox box = boundingBox(mesh);
+  EXPECT_NEAR(box.min.x(), 1.0, 0.1);
+  EXPECT_NEAR(box.max.z(), 5.0, 0.1);
+  EXPECT_GE(meshQuality(mesh).minDihedralDegrees, 9.0);
+}
+
+TEST(ReadSurface, ObjSphereAndNamedParts) {
+  const TriangleSurface sphere = test::uvSphere(Vector3d::Zero(), 1.0, 40, 20);
+  const auto spherePath = writeTemp("sphere.obj", test::toObj(sphere));
+  TriangleSurface read = readSurface(spherePath);
+  weldVertices(read, 1e-9);
+  ASSERT_TRUE(surfaceTopology(read).closed());
+  const SignedDistance distance(read);
+  const TetMesh mesh = stuffIsosurface(distance.function(), read.bounds(), 0.15);
+  EXPECT_TRUE(checkTetMesh(mesh).ok());
+  EXPECT_NEAR(totalVolume(mesh), std::abs(surfaceTopology(read).signedVolume), 0.04 * 4.19);
+
+  const TriangleSurface parts = test::concatenate(test::uvSphere(Vector3d(-1.2, 0, 0), 1.0, 24, 12), "left",
+                                                  test::uvSphere(Vector3d(1.2, 0, 0), 1.0, 24, 12), "right");
+  TriangleSurface twoParts = readSurface(writeTemp("parts.obj", test::toObj(parts)));
+  ASSERT_EQ(twoParts.partNames.size(), 2u);
+  weldVertices(twoParts, 1e-9);
+  const SignedDistance twoDistance(twoParts);
+  TetMesh twoMesh = stuffIsosurface(twoDistance.function(), twoParts.bounds(), 0.2);
+  addNearestPartSets(twoMesh, twoDistance);
+  EXPECT_EQ(checkTetMesh(twoMesh).components, 2);
+  const std::vector<std::string> names = twoParts.partNames;
+  const Eigen::Matrix3Xd centroids = elementCentroids(twoMesh);
+  const int leftIndex = names[0] == "left" ? 0 : 1;
+  for (int e : twoMesh.elementSet(names[static_cast<std::size_t>(leftIndex)])) EXPECT_LT(centroids(0, e), 0.0);
+}
+
+TEST(ReadSurface, MissingOrEmptyFilesAreErrors) {
+  EXPECT_THROW(readSurface("/nonexistent/surface.obj"), Error);
+  EXPECT_THROW(readSurface(writeTemp("empty.obj", "# nothing\n")), Error);
+}
+
+}  // namespace
+}  // namespace asyncfem

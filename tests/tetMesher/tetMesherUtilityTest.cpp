@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// End-to-end runs of the tetMesher utility on OBJ files written here (needs assimp).
+#include <asyncfem/tetMesher/triangleSurface.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
+
+#include "surfaces.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+#include <sys/wait.h>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <unistd.h>
+
+namespace asyncfem {
+namespace {
+
+const std::string kTetMesher = std::string(ASYNCFEM_BIN_DIR) + "/tetMesher";
+
+struct RunResult {
+  int status;
+  std::string output;  // stdout and stderr together
+};
+
+RunResult run(const std::string& arguments) {
+  const auto log = std::filesystem::temp_directory_path() / ("asyncfem-tetMesher-run-" + std::to_string(::getpid()));
+  const std::string command = kTetMesher + " " + arguments + " > " + log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  std::ifstream in(log);
+  RunResult result{WIFEXITED(status) ? WEXITSTATUS(status) : -1,
+             std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>())};
+  std::filesystem::remove(log);
+  return result;
+}
+
+std::filesystem::path scratch(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("asyncfem-tetMesher-cli-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
+TEST(TetMesherUtility, MeshesAnObjWithPartAndBoxSets) {
+  const auto obj = scratch("two.obj");
+  std::ofstream(obj) << test::toObj(test::concatenate(test::uvSphere(Eigen::Vector3d(-1.1, 0, 0), 1.0, 24, 12),
+                                                      "left", test::uvSphere(Eigen::Vector3d(1.1, 0, 0), 1.0, 24, 12),
+                                                      "right"));
+  const auto veg = scratch("two.veg");
+  const RunResult result = run(obj.string() + " --cells 20 --part-sets --set upper:-3,0,-2,3,2,2 --material left:500,1e7,0.4 -o " +
+                         veg.string());
+  ASSERT_EQ(result.status, 0) << result.output;
+  EXPECT_NE(result.output.find("quality: dihedral angles min"), std::string::npos) << result.output;
+  const TetMesh mesh = readVeg(veg);
+  EXPECT_FALSE(mesh.elementSet("left").empty());
+  EXPECT_FALSE(mesh.elementSet("right").empty());
+  EXPECT_FALSE(mesh.elementSet("upper").empty());
+  EXPECT_GE(mesh.findMaterial("left"), 0);
+}
+
+TEST(TetMesherUtility, OpenSurfaceIsAnErrorUnlessRepaired) {
+  TriangleSurface cube = test::splitCube(Eigen::Vector3d::Zero(), 1.0);
+  cube.triangles.conservativeResize(3, cube.numTriangles() - 1);
+  cube.triangleParts.pop_back();
+  const auto obj = scratch("open.obj");
+  std::ofstream(obj) << test::toObj(cube);
+  const auto veg = scratch("open.veg");
+  std::filesystem::remove(veg);
+  const RunResult refused = run(obj.string() + " --cells 10 -o " + veg.string());
+  EXPECT_EQ(refused.status, 1) << refused.output;
+  EXPECT_NE(refused.output.find("tetMesher: "), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("3 open boundary edges"), std::string::npos) << refused.output;
+  EXPECT_FALSE(std::filesystem::exists(veg));
+
+  const RunResult repaired = run(obj.string() + " --cells 10 --repair -o " + veg.string());
+  ASSERT_EQ(repaired.status, 0) << repaired.output;
+  EXPECT_NE(repaired.output.find("generalized winding number"), std::string::npos) << repaired.output;
+  EXPECT_GT(readVeg(veg).numElements(), 100);
+}
+
+TEST(TetMesherUtility, BadOptionsAreErrors) {
+  EXPECT_EQ(run("--model nosuch -o " + scratch("x.veg").string()).status, 1);
+  EXPECT_NE(run("--model nosuch -o " + scratch("x.veg").string()).output.find("known: dinosaur"), std::string::npos);
+  EXPECT_EQ(run("--model drop --set bad:1,2 -o " + scratch("x.veg").string()).status, 1);
+  EXPECT_EQ(run("--model drop -o " + scratch("x.txt").string()).status, 1);
+  EXPECT_EQ(run("--spacing -1 --model drop -o " + scratch("x.veg").string()).status, 2);
+}
+
+}  // namespace
+}  // namespace asyncfem
