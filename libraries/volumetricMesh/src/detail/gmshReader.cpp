@@ -6,6 +6,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
 
+#include <algorithm>
 #include <array>
 #include <map>
 #include <string>
@@ -21,6 +22,10 @@ using detail::LineCursor;
 
 constexpr long long kTetrahedron = 4;       // 4-node tetrahedron
 constexpr long long kQuadraticTet = 11;     // 10-node tetrahedron
+// Every element of a volume entity joins each of the entity's physical groups, so the
+// set memberships are (elements) x (groups per entity): a bound on the latter keeps
+// them linear in the file size.
+constexpr std::size_t kMaxPhysicalTagsPerEntity = 64;
 
 class GmshParser {
 public:
@@ -168,6 +173,13 @@ private:
       auto& physicals = volumePhysicals_[tag];
       for (std::size_t p = 0; p < static_cast<std::size_t>(numPhysicals); ++p) {
         physicals.push_back(detail::integerAt(cursor_, tokens[8 + p], "physical tag"));
+      }
+      // A tag listed twice (or an entity listed twice) adds nothing.
+      std::sort(physicals.begin(), physicals.end());
+      physicals.erase(std::unique(physicals.begin(), physicals.end()), physicals.end());
+      if (physicals.size() > kMaxPhysicalTagsPerEntity) {
+        cursor_.fail("volume entity " + std::to_string(tag) + " is in " + std::to_string(physicals.size()) +
+                     " physical groups; at most " + std::to_string(kMaxPhysicalTagsPerEntity) + " are supported");
       }
     }
     expectEnd("Entities", "$Entities has more lines than its counts");
