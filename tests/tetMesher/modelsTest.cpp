@@ -2,23 +2,21 @@
 // The shipped example models: each .veg loads, is a valid mesh with the documented sets,
 // counts and quality (models/README.md, docs/tet-mesher.md), equals what the generator
 // produces now, and its scene runs.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/exampleModels.hpp>
 #include <asyncfem/tetMesher/meshChecks.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
-
-#include <gtest/gtest.h>
-
-#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <sys/wait.h>
-#include <unistd.h>
 
 namespace asyncfem {
 namespace {
@@ -36,7 +34,11 @@ const std::vector<Documented>& documented() {
   static const std::vector<Documented> table{
       {ExampleModel::Dinosaur, 1946, 7418, 16.59, 143.14, {"head", "tail", "body", "feet"}},
       {ExampleModel::Flower, 1484, 4879, 19.66, 141.97, {"petals", "upperLeaves", "stem", "base"}},
-      {ExampleModel::Dragon, 1996, 7493, 18.16, 148.17,
+      {ExampleModel::Dragon,
+       1996,
+       7493,
+       18.16,
+       148.17,
        {"jaw", "s1", "s2", "s3", "s4", "s5", "s6", "head", "neck", "body", "tail", "feet"}},
       {ExampleModel::Drop, 1097, 4507, 19.40, 138.33, {"stiffPart", "soft"}},
   };
@@ -118,7 +120,9 @@ TEST(ExampleModels, FastRegionsAreStifferLighterAndSeparated) {
   EXPECT_GT(waveSpeed(dragon, "jaw"), 11.0 * waveSpeed(dragon, "body"));
   std::vector<int> previous = dragon.elementSet("jaw");
   for (int k = 1; k <= 6; ++k) {
-    const std::vector<int> current = dragon.elementSet("s" + std::to_string(k));
+    std::string name = "s";
+    name += std::to_string(k);
+    const std::vector<int> current = dragon.elementSet(name);
     EXPECT_GT(current.size(), previous.size()) << "s" << k;
     EXPECT_TRUE(std::includes(current.begin(), current.end(), previous.begin(), previous.end())) << "s" << k;
     previous = current;
@@ -145,8 +149,8 @@ TEST(ExampleModels, ScenesRunWithTheAsyncIntegrator) {
     SCOPED_TRACE(exampleModelName(d.model));
     const auto output = std::filesystem::temp_directory_path() /
                         ("asyncfem-model-" + exampleModelName(d.model) + "-" + std::to_string(::getpid()) + ".afsim");
-    const std::string command = simulator + " " + modelFile(d.model, ".json").string() + " --frames 3 --quiet --output " +
-                                output.string();
+    const std::string command =
+        simulator + " " + modelFile(d.model, ".json").string() + " --frames 3 --quiet --output " + output.string();
     const int status = std::system(command.c_str());
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command;
     EXPECT_TRUE(std::filesystem::exists(output));

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Surfaces read through assimp (built only with ASYNCFEM_WITH_ASSIMP): OBJ files written
 // here are read, welded, meshed and checked.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/elementSets.hpp>
 #include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
@@ -8,16 +11,11 @@
 #include <asyncfem/tetMesher/signedDistance.hpp>
 #include <asyncfem/tetMesher/triangleSurface.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
-
-#include "surfaces.hpp"
-
-#include <gtest/gtest.h>
-
 #include <filesystem>
 #include <fstream>
 #include <string>
 
-#include <unistd.h>
+#include "surfaces.hpp"
 
 namespace asyncfem {
 namespace {

@@ -1,14 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Isosurface stuffing on analytic solids: validity, the dihedral-angle range, volume and
 // the boundary (closed, outward by the divergence theorem).
+#include <gtest/gtest.h>
+
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/implicit.hpp>
 #include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
 #include <asyncfem/tetMesher/meshChecks.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -73,8 +72,8 @@ void expectGoodMesh(const Case& c) {
 TEST(StuffIsosurface, SphereIsValidWithBoundedAnglesAndVolume) {
   for (double spacing : {0.1, 0.137, 0.2}) {
     expectGoodMesh({"sphere h=" + std::to_string(spacing), implicitSphere(Vector3d(0.03, -0.02, 0.05), 1.0),
-                    Eigen::AlignedBox3d(Vector3d::Constant(-1.1), Vector3d::Constant(1.1)), spacing,
-                    4.0 / 3.0 * kPi, 0.02});
+                    Eigen::AlignedBox3d(Vector3d::Constant(-1.1), Vector3d::Constant(1.1)), spacing, 4.0 / 3.0 * kPi,
+                    0.02});
   }
 }
 
@@ -116,8 +115,8 @@ TEST(StuffIsosurface, IsDeterministic) {
 
 TEST(StuffIsosurface, ThinPartsAreRepairedIntoAManifoldBoundary) {
   // Two spheres almost touching: the gap between them is far below the lattice spacing.
-  const ImplicitFunction f = implicitUnion(
-      {implicitSphere(Vector3d(-0.5, 0.0, 0.0), 0.49), implicitSphere(Vector3d(0.5, 0.01, 0.0), 0.49)});
+  const ImplicitFunction f =
+      implicitUnion({implicitSphere(Vector3d(-0.5, 0.0, 0.0), 0.49), implicitSphere(Vector3d(0.5, 0.01, 0.0), 0.49)});
   const Eigen::AlignedBox3d box(Vector3d(-1.0, -0.5, -0.5), Vector3d(1.0, 0.5, 0.5));
   for (double spacing : {0.09, 0.11, 0.13}) {
     const TetMesh mesh = stuffIsosurface(f, box, spacing);  // throws if a check fails
@@ -204,11 +203,11 @@ TEST(ImplicitPrimitives, SignsAndDistances) {
   EXPECT_NEAR(implicitEllipsoid(Vector3d::Zero(), Vector3d(2, 1, 1))(Vector3d(2, 0, 0)), 0.0, 1e-15);
   EXPECT_NEAR(implicitTaperedCapsule(Vector3d::Zero(), Vector3d::UnitX(), 0.4, 0.2)(Vector3d(1.0, 0.2, 0.0)), 0.0,
               1e-15);
-  const ImplicitFunction smooth = implicitSmoothUnion(
-      {implicitSphere(Vector3d(-1, 0, 0), 1.0), implicitSphere(Vector3d(1, 0, 0), 1.0)}, 0.2);
+  const ImplicitFunction smooth =
+      implicitSmoothUnion({implicitSphere(Vector3d(-1, 0, 0), 1.0), implicitSphere(Vector3d(1, 0, 0), 1.0)}, 0.2);
   EXPECT_LT(smooth(Vector3d::Zero()), -0.04);  // blended below the sharp union's 0
-  EXPECT_GT(implicitDifference(implicitSphere(Vector3d::Zero(), 1.0), implicitSphere(Vector3d::Zero(), 0.5))(
-                Vector3d::Zero()),
+  EXPECT_GT(implicitDifference(implicitSphere(Vector3d::Zero(), 1.0),
+                               implicitSphere(Vector3d::Zero(), 0.5))(Vector3d::Zero()),
             0.0);
   EXPECT_THROW(implicitSphere(Vector3d::Zero(), -1.0), ValidationError);
   EXPECT_THROW(implicitBox(Vector3d::Zero(), Vector3d::Ones(), 1.0), ValidationError);

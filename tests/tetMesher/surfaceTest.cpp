@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Triangle surfaces: welding, topology errors, the signed distance and its two signs, and
 // meshing a surface through SignedDistance.
+#include <gtest/gtest.h>
+
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/elementSets.hpp>
 #include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
@@ -8,14 +10,11 @@
 #include <asyncfem/tetMesher/signedDistance.hpp>
 #include <asyncfem/tetMesher/triangleSurface.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
-
-#include "surfaces.hpp"
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <numbers>
 #include <string>
+
+#include "surfaces.hpp"
 
 namespace asyncfem {
 namespace {
@@ -72,10 +71,12 @@ TEST(SignedDistance, MatchesTheCubeAndASphere) {
   const SignedDistance pseudo(cube, SignMode::Pseudonormal);
   const SignedDistance winding(cube, SignMode::WindingNumber);
   // Inside (face, edge and corner regions) and outside points with known distances.
-  const std::vector<std::pair<Vector3d, double>> samples{
-      {Vector3d(1.0, 1.0, 1.0), -1.0}, {Vector3d(0.3, 1.0, 1.0), -0.3}, {Vector3d(3.0, 1.0, 1.0), 1.0},
-      {Vector3d(3.0, 3.0, 1.0), std::sqrt(2.0)}, {Vector3d(-1.0, -1.0, -1.0), std::sqrt(3.0)},
-      {Vector3d(1.0, 2.5, 1.0), 0.5}};
+  const std::vector<std::pair<Vector3d, double>> samples{{Vector3d(1.0, 1.0, 1.0), -1.0},
+                                                         {Vector3d(0.3, 1.0, 1.0), -0.3},
+                                                         {Vector3d(3.0, 1.0, 1.0), 1.0},
+                                                         {Vector3d(3.0, 3.0, 1.0), std::sqrt(2.0)},
+                                                         {Vector3d(-1.0, -1.0, -1.0), std::sqrt(3.0)},
+                                                         {Vector3d(1.0, 2.5, 1.0), 0.5}};
   for (const auto& [x, expected] : samples) {
     EXPECT_NEAR(pseudo(x), expected, 1e-12) << x.transpose();
     EXPECT_NEAR(winding(x), expected, 1e-12) << x.transpose();

@@ -2,9 +2,8 @@
 // Small triangle surfaces for the tetMesher tests, built in code (and written as OBJ).
 #pragma once
 
-#include <asyncfem/tetMesher/triangleSurface.hpp>
-
 #include <array>
+#include <asyncfem/tetMesher/triangleSurface.hpp>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -53,8 +52,8 @@ inline TriangleSurface uvSphere(const Eigen::Vector3d& centre, double radius, in
     for (int j = 0; j < ring; ++j) {
       const double phi = 2.0 * std::numbers::pi * j / ring;
       s.vertices.col(1 + (i - 1) * ring + j) =
-          centre + radius * Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                                            std::cos(theta));
+          centre +
+          radius * Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
     }
   }
   std::vector<Eigen::Vector3i> triangles;

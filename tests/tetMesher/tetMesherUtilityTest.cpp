@@ -1,22 +1,19 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // End-to-end runs of the tetMesher utility on OBJ files written here (needs assimp).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <asyncfem/tetMesher/triangleSurface.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
-
-#include "surfaces.hpp"
-
-#include <gtest/gtest.h>
-
 #include <cstdio>
 #include <cstdlib>
-
-#include <sys/wait.h>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
 
-#include <unistd.h>
+#include "surfaces.hpp"
 
 namespace asyncfem {
 namespace {
@@ -34,7 +31,7 @@ RunResult run(const std::string& arguments) {
   const int status = std::system(command.c_str());
   std::ifstream in(log);
   RunResult result{WIFEXITED(status) ? WEXITSTATUS(status) : -1,
-             std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>())};
+                   std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>())};
   std::filesystem::remove(log);
   return result;
 }
@@ -47,12 +44,13 @@ std::filesystem::path scratch(const std::string& name) {
 
 TEST(TetMesherUtility, MeshesAnObjWithPartAndBoxSets) {
   const auto obj = scratch("two.obj");
-  std::ofstream(obj) << test::toObj(test::concatenate(test::uvSphere(Eigen::Vector3d(-1.1, 0, 0), 1.0, 24, 12),
-                                                      "left", test::uvSphere(Eigen::Vector3d(1.1, 0, 0), 1.0, 24, 12),
+  std::ofstream(obj) << test::toObj(test::concatenate(test::uvSphere(Eigen::Vector3d(-1.1, 0, 0), 1.0, 24, 12), "left",
+                                                      test::uvSphere(Eigen::Vector3d(1.1, 0, 0), 1.0, 24, 12),
                                                       "right"));
   const auto veg = scratch("two.veg");
-  const RunResult result = run(obj.string() + " --cells 20 --part-sets --set upper:-3,0,-2,3,2,2 --material left:500,1e7,0.4 -o " +
-                         veg.string());
+  const RunResult result =
+      run(obj.string() + " --cells 20 --part-sets --set upper:-3,0,-2,3,2,2 --material left:500,1e7,0.4 -o " +
+          veg.string());
   ASSERT_EQ(result.status, 0) << result.output;
   EXPECT_NE(result.output.find("quality: dihedral angles min"), std::string::npos) << result.output;
   const TetMesh mesh = readVeg(veg);

@@ -9,6 +9,7 @@
 //
 // The report goes to stdout; errors print "tetMesher: <message>" on stderr and exit 1
 // (2 for unusable command-line options). docs/tet-mesher.md describes everything.
+#include <CLI/CLI.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/elementSets.hpp>
 #include <asyncfem/tetMesher/exampleModels.hpp>
@@ -18,9 +19,6 @@
 #include <asyncfem/tetMesher/triangleSurface.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
-
-#include <CLI/CLI.hpp>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -64,7 +62,8 @@ std::vector<double> parseNumbers(const std::string& text, std::size_t count, con
 /// Splits "NAME:rest" at the first colon.
 std::pair<std::string, std::string> splitName(const std::string& text, const std::string& what) {
   const std::size_t colon = text.find(':');
-  if (colon == std::string::npos || colon == 0) throw ValidationError(what + ": expected NAME:values, got \"" + text + "\"");
+  if (colon == std::string::npos || colon == 0)
+    throw ValidationError(what + ": expected NAME:values, got \"" + text + "\"");
   return {text.substr(0, colon), text.substr(colon + 1)};
 }
 
@@ -89,13 +88,13 @@ void printQuality(const TetMesh& mesh, const asyncfem::StuffingReport& stuffing,
   std::printf("lattice: spacing %.6g, %lld lattice vertices, %d vertices warped onto the surface, %d cut points\n",
               spacing, stuffing.latticeVertices, stuffing.warpedVertices, stuffing.cutPoints);
   if (stuffing.unwarpedVertices > 0) {
-    std::printf("pinches: %d vertices left on the lattice to keep the boundary manifold (thin parts); the angle "
-                "bound does not hold next to them\n",
-                stuffing.unwarpedVertices);
+    std::printf(
+        "pinches: %d vertices left on the lattice to keep the boundary manifold (thin parts); the angle "
+        "bound does not hold next to them\n",
+        stuffing.unwarpedVertices);
   }
-  std::printf("mesh: %d vertices, %d tetrahedra, %d boundary triangles, %d connected component%s\n",
-              mesh.numVertices(), mesh.numElements(), check.boundaryTriangles, check.components,
-              check.components == 1 ? "" : "s");
+  std::printf("mesh: %d vertices, %d tetrahedra, %d boundary triangles, %d connected component%s\n", mesh.numVertices(),
+              mesh.numElements(), check.boundaryTriangles, check.components, check.components == 1 ? "" : "s");
   std::printf("quality: dihedral angles min %.2f, max %.2f degrees; worst aspect ratio %.3f\n",
               quality.minDihedralDegrees, quality.maxDihedralDegrees, quality.worstAspectRatio);
   std::printf("checks: no inverted or degenerate element, every vertex used, boundary closed and outward\n");
@@ -150,10 +149,10 @@ int run(const Options& options) {
       if (!options.repair) asyncfem::requireClosedSurface(surface, options.input);
       mode = asyncfem::SignMode::WindingNumber;
       if (!options.quiet) {
-        std::printf("repair: the surface is not closed (%d open, %d non-manifold, %d inconsistently oriented edges, "
-                    "e.g. %s); inside/outside from the generalized winding number\n",
-                    topology.boundaryEdges, topology.nonManifoldEdges, topology.misorientedEdges,
-                    topology.example.c_str());
+        std::printf(
+            "repair: the surface is not closed (%d open, %d non-manifold, %d inconsistently oriented edges, "
+            "e.g. %s); inside/outside from the generalized winding number\n",
+            topology.boundaryEdges, topology.nonManifoldEdges, topology.misorientedEdges, topology.example.c_str());
       }
     }
     if (topology.signedVolume < 0.0) {
@@ -167,7 +166,8 @@ int run(const Options& options) {
     mesh = asyncfem::stuffIsosurface(distance->function(), bounds, spacing, mesherOptions, &stuffing);
     if (!options.quiet && enclosed > 0.0) {
       const double volume = asyncfem::totalVolume(mesh);
-      std::printf("volume: mesh %.6g, surface %.6g (%+.2f%%)\n", volume, enclosed, 100.0 * (volume - enclosed) / enclosed);
+      std::printf("volume: mesh %.6g, surface %.6g (%+.2f%%)\n", volume, enclosed,
+                  100.0 * (volume - enclosed) / enclosed);
     }
     if (options.partSets) asyncfem::addNearestPartSets(mesh, *distance);
   }
@@ -208,20 +208,24 @@ int run(const Options& options) {
 int main(int argc, char** argv) {
   CLI::App app{"Tetrahedral meshes by isosurface stuffing from closed surfaces or built-in example models"};
   Options options;
-  app.add_option("surface", options.input, "Closed triangle surface (any format assimp reads: OBJ, STL, PLY, OFF, ...)");
+  app.add_option("surface", options.input,
+                 "Closed triangle surface (any format assimp reads: OBJ, STL, PLY, OFF, ...)");
   app.add_option("--model", options.model, "Built-in example model: dinosaur, flower, dragon, drop");
   app.add_option("-o,--output", options.output, "Output mesh (.veg, or .vtu for ParaView)")->required();
   app.add_option("--spacing", options.spacing, "BCC lattice spacing (length units of the input)")
       ->check(CLI::PositiveNumber);
   app.add_option("--cells", options.cells, "Lattice cells across the longest side of the bounding box (default 30)")
       ->check(CLI::Range(1, 2000));
-  app.add_option("--set", options.boxSets, "Element and vertex set of the elements whose centroid lies in a box: "
-                                          "NAME:xmin,ymin,zmin,xmax,ymax,zmax (repeatable)");
+  app.add_option("--set", options.boxSets,
+                 "Element and vertex set of the elements whose centroid lies in a box: "
+                 "NAME:xmin,ymin,zmin,xmax,ymax,zmax (repeatable)");
   app.add_flag("--part-sets", options.partSets,
                "One set per named surface part (assimp mesh/node name): the elements nearest that part");
-  app.add_option("--material", options.materials, "Material of a set: SET:density,youngsModulus,poissonRatio (repeatable)");
-  app.add_option("--default-material", options.defaultMaterial, "Material of all other elements: density,E,nu "
-                                                                "(default 1000,1e6,0.45)");
+  app.add_option("--material", options.materials,
+                 "Material of a set: SET:density,youngsModulus,poissonRatio (repeatable)");
+  app.add_option("--default-material", options.defaultMaterial,
+                 "Material of all other elements: density,E,nu "
+                 "(default 1000,1e6,0.45)");
   app.add_flag("--repair", options.repair,
                "Mesh a surface with holes or non-manifold edges using the generalized winding number");
   app.add_option("--weld-tolerance", options.weldTolerance,

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/tetMesher/elementSets.hpp>
-
 #include <algorithm>
+#include <asyncfem/tetMesher/elementSets.hpp>
 #include <limits>
 #include <map>
 

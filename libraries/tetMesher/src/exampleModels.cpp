@@ -1,11 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
+#include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/elementSets.hpp>
 #include <asyncfem/tetMesher/exampleModels.hpp>
 #include <asyncfem/tetMesher/meshChecks.hpp>
-
-#include <algorithm>
-#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -36,8 +35,8 @@ ImplicitModel dinosaur() {
   addLegs(p, 0.26, 0.14, 0.55, 0.085, Vector3d(0.12, 0.07, 0.1));
   // Head set = neck + head.
   p.push_back({"head", implicitTaperedCapsule(Vector3d(0.34, 0.72, 0.0), Vector3d(0.7, 1.15, 0.0), 0.13, 0.085)});
-  p.push_back({"head", implicitOrientedEllipsoid(Vector3d(0.8, 1.19, 0.0), Vector3d(1.0, -0.25, 0.0),
-                                                 Vector3d::UnitY(), Vector3d(0.17, 0.095, 0.095))});
+  p.push_back({"head", implicitOrientedEllipsoid(Vector3d(0.8, 1.19, 0.0), Vector3d(1.0, -0.25, 0.0), Vector3d::UnitY(),
+                                                 Vector3d(0.17, 0.095, 0.095))});
   p.push_back({"tail", implicitTaperedCapsule(Vector3d(-0.38, 0.62, 0.0), Vector3d(-0.85, 0.5, 0.0), 0.14, 0.085)});
   p.push_back({"tail", implicitTaperedCapsule(Vector3d(-0.85, 0.5, 0.0), Vector3d(-1.2, 0.48, 0.0), 0.085, 0.06)});
   model.blend = 0.05;
@@ -77,10 +76,10 @@ ImplicitModel dragon() {
   p.push_back({"body", implicitEllipsoid(Vector3d(0.0, 0.58, 0.0), Vector3d(0.52, 0.25, 0.24))});
   addLegs(p, 0.3, 0.15, 0.5, 0.08, Vector3d(0.12, 0.065, 0.09));
   p.push_back({"neck", implicitTaperedCapsule(Vector3d(0.42, 0.66, 0.0), Vector3d(0.78, 1.02, 0.0), 0.13, 0.085)});
-  p.push_back({"head", implicitOrientedEllipsoid(Vector3d(0.9, 1.08, 0.0), Vector3d(1.0, -0.2, 0.0),
-                                                 Vector3d::UnitY(), Vector3d(0.18, 0.1, 0.1))});
-  p.push_back({"jaw", implicitOrientedEllipsoid(Vector3d(1.0, 0.97, 0.0), Vector3d(1.0, -0.5, 0.0),
-                                                Vector3d::UnitY(), Vector3d(0.16, 0.05, 0.075))});
+  p.push_back({"head", implicitOrientedEllipsoid(Vector3d(0.9, 1.08, 0.0), Vector3d(1.0, -0.2, 0.0), Vector3d::UnitY(),
+                                                 Vector3d(0.18, 0.1, 0.1))});
+  p.push_back({"jaw", implicitOrientedEllipsoid(Vector3d(1.0, 0.97, 0.0), Vector3d(1.0, -0.5, 0.0), Vector3d::UnitY(),
+                                                Vector3d(0.16, 0.05, 0.075))});
   p.push_back({"tail", implicitTaperedCapsule(Vector3d(-0.45, 0.58, 0.0), Vector3d(-1.0, 0.42, 0.0), 0.14, 0.08)});
   p.push_back({"tail", implicitTaperedCapsule(Vector3d(-1.0, 0.42, 0.0), Vector3d(-1.35, 0.5, 0.0), 0.08, 0.06)});
   p.push_back({"tail", implicitEllipsoid(Vector3d(-1.42, 0.52, 0.0), Vector3d(0.1, 0.06, 0.1))});
@@ -127,10 +126,14 @@ ExampleModel exampleModelFromName(const std::string& name) {
 
 ImplicitModel exampleModelShape(ExampleModel model) {
   switch (model) {
-    case ExampleModel::Dinosaur: return dinosaur();
-    case ExampleModel::Flower: return flower();
-    case ExampleModel::Dragon: return dragon();
-    case ExampleModel::Drop: return drop();
+    case ExampleModel::Dinosaur:
+      return dinosaur();
+    case ExampleModel::Flower:
+      return flower();
+    case ExampleModel::Dragon:
+      return dragon();
+    case ExampleModel::Drop:
+      return drop();
   }
   throw ValidationError("unknown example model");
 }
@@ -141,10 +144,18 @@ TetMesh makeExampleModel(ExampleModel model, double spacing, StuffingReport* rep
   MesherOptions options;
   // The soft default material of each model; the fast parts get stiffer, lighter ones.
   switch (model) {
-    case ExampleModel::Dinosaur: options.material = Material{"body", 1000.0, 1e5, 0.45}; break;
-    case ExampleModel::Flower: options.material = Material{"stem", 1000.0, 2e5, 0.45}; break;
-    case ExampleModel::Dragon: options.material = Material{"body", 1000.0, 1.5e5, 0.45}; break;
-    case ExampleModel::Drop: options.material = Material{"soft", 1000.0, 1e5, 0.45}; break;
+    case ExampleModel::Dinosaur:
+      options.material = Material{"body", 1000.0, 1e5, 0.45};
+      break;
+    case ExampleModel::Flower:
+      options.material = Material{"stem", 1000.0, 2e5, 0.45};
+      break;
+    case ExampleModel::Dragon:
+      options.material = Material{"body", 1000.0, 1.5e5, 0.45};
+      break;
+    case ExampleModel::Drop:
+      options.material = Material{"soft", 1000.0, 1e5, 0.45};
+      break;
   }
   TetMesh mesh = stuffIsosurface(implicitUnionOfParts(shape.parts, shape.blend), shape.bounds,
                                  spacing > 0.0 ? spacing : shape.spacing, options, report);

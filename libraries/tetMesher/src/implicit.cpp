@@ -1,10 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/implicit.hpp>
-
-#include <Eigen/Geometry>
-
-#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -102,7 +100,9 @@ ImplicitFunction implicitTorus(const Eigen::Vector3d& center, const Eigen::Vecto
   };
 }
 
-ImplicitFunction implicitUnion(std::vector<ImplicitFunction> parts) { return implicitSmoothUnion(std::move(parts), 0.0); }
+ImplicitFunction implicitUnion(std::vector<ImplicitFunction> parts) {
+  return implicitSmoothUnion(std::move(parts), 0.0);
+}
 
 ImplicitFunction implicitSmoothUnion(std::vector<ImplicitFunction> parts, double blend) {
   if (parts.empty()) throw ValidationError("implicit union: no parts");

@@ -1,18 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
 #include <asyncfem/tetMesher/meshChecks.hpp>
-
-#include <Eigen/Dense>
-
 #include <asyncfem/volumetricMesh/queries.hpp>
-
-#include <algorithm>
-#include <map>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -104,7 +101,7 @@ std::vector<std::pair<int, int>> nonManifoldBoundaryEdges(const TetMesh& mesh) {
 
 /// Builds the output mesh tetrahedron by tetrahedron.
 class StencilBuilder {
-public:
+ public:
   StencilBuilder(const BccLattice& lattice, const std::vector<int>& signs,
                  const std::unordered_map<long long, Eigen::Vector3d>& warped,
                  const std::unordered_map<std::uint64_t, Eigen::Vector3d>& cuts)
@@ -116,9 +113,12 @@ public:
     int numNeg = 0, numZero = 0, numPos = 0;
     for (long long v : tet) {
       const int s = signs_[static_cast<std::size_t>(v)];
-      if (s < 0) neg[static_cast<std::size_t>(numNeg++)] = v;
-      else if (s == 0) zero[static_cast<std::size_t>(numZero++)] = v;
-      else pos[static_cast<std::size_t>(numPos++)] = v;
+      if (s < 0)
+        neg[static_cast<std::size_t>(numNeg++)] = v;
+      else if (s == 0)
+        zero[static_cast<std::size_t>(numZero++)] = v;
+      else
+        pos[static_cast<std::size_t>(numPos++)] = v;
     }
     // No inside vertex: nothing to fill. This includes tetrahedra whose four vertices were
     // all warped onto the surface; keeping those would break the angle bound (they can be
@@ -140,7 +140,8 @@ public:
           b[static_cast<std::size_t>(i)] = cut(p, o[static_cast<std::size_t>(i)]);
         }
         for (int i = 0; i < 3; ++i) {
-          const bool fromFirst = diagonalFromFirst(o[static_cast<std::size_t>(i)], o[static_cast<std::size_t>((i + 1) % 3)]);
+          const bool fromFirst =
+              diagonalFromFirst(o[static_cast<std::size_t>(i)], o[static_cast<std::size_t>((i + 1) % 3)]);
           diagonals[static_cast<std::size_t>(i)] = fromFirst ? Diagonal::Forward : Diagonal::Backward;
         }
         emitPrism(a, b, diagonals);
@@ -187,7 +188,7 @@ public:
   std::vector<long long> sources;  // lattice vertex of each output vertex, -1 for cut points
   int cutPointsUsed = 0;
 
-private:
+ private:
   enum class Diagonal { Forward, Backward, Free };
 
   Eigen::Vector3d position(long long v) const {
@@ -262,10 +263,13 @@ private:
       const Diagonal other1 = diagonals[static_cast<std::size_t>((i + 1) % 3)];
       const Diagonal other2 = diagonals[static_cast<std::size_t>((i + 2) % 3)];
       const std::size_t i0 = static_cast<std::size_t>(i), i1 = static_cast<std::size_t>((i + 1) % 3);
-      const double forward = (positions[static_cast<std::size_t>(a[i0])] - positions[static_cast<std::size_t>(b[i1])]).norm();
-      const double backward = (positions[static_cast<std::size_t>(a[i1])] - positions[static_cast<std::size_t>(b[i0])]).norm();
+      const double forward =
+          (positions[static_cast<std::size_t>(a[i0])] - positions[static_cast<std::size_t>(b[i1])]).norm();
+      const double backward =
+          (positions[static_cast<std::size_t>(a[i1])] - positions[static_cast<std::size_t>(b[i0])]).norm();
       Diagonal choice = forward <= backward ? Diagonal::Forward : Diagonal::Backward;
-      if (other1 == other2 && other1 == choice) choice = choice == Diagonal::Forward ? Diagonal::Backward : Diagonal::Forward;
+      if (other1 == other2 && other1 == choice)
+        choice = choice == Diagonal::Forward ? Diagonal::Backward : Diagonal::Forward;
       diagonals[static_cast<std::size_t>(i)] = choice;
     }
     for (int i = 0; i < 3; ++i) {
@@ -410,9 +414,10 @@ TetMesh stuffIsosurface(const ImplicitFunction& f, const Eigen::AlignedBox3d& bo
               c[d] += t;
               return lattice.black(c.x(), c.y(), c.z());
             };
-            const std::array<std::array<long long, 2>, 4> blackEdges{
-                {{corner(0, 0), corner(1, 0)}, {corner(0, 1), corner(1, 1)}, {corner(0, 0), corner(0, 1)},
-                 {corner(1, 0), corner(1, 1)}}};
+            const std::array<std::array<long long, 2>, 4> blackEdges{{{corner(0, 0), corner(1, 0)},
+                                                                      {corner(0, 1), corner(1, 1)},
+                                                                      {corner(0, 0), corner(0, 1)},
+                                                                      {corner(1, 0), corner(1, 1)}}};
             for (const auto& edge : blackEdges) {
               ++latticeTets;
               const std::array<long long, 4> tet{edge[0], edge[1], r0, r1};
@@ -438,9 +443,11 @@ TetMesh stuffIsosurface(const ImplicitFunction& f, const Eigen::AlignedBox3d& bo
                             " (is f negative inside, and is the spacing small enough for the shape?)");
     }
     Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(builder.positions.size()));
-    for (std::size_t v = 0; v < builder.positions.size(); ++v) positions.col(static_cast<Eigen::Index>(v)) = builder.positions[v];
+    for (std::size_t v = 0; v < builder.positions.size(); ++v)
+      positions.col(static_cast<Eigen::Index>(v)) = builder.positions[v];
     Eigen::Matrix4Xi elements(4, static_cast<Eigen::Index>(builder.elements.size()));
-    for (std::size_t e = 0; e < builder.elements.size(); ++e) elements.col(static_cast<Eigen::Index>(e)) = builder.elements[e];
+    for (std::size_t e = 0; e < builder.elements.size(); ++e)
+      elements.col(static_cast<Eigen::Index>(e)) = builder.elements[e];
     TetMesh mesh(std::move(positions), std::move(elements), {options.material},
                  std::vector<int>(builder.elements.size(), 0));
     std::vector<long long> pinched;

@@ -1,12 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/meshChecks.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
-
-#include <Eigen/Geometry>
-
-#include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <map>

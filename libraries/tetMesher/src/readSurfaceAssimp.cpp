@@ -1,13 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // readSurface through assimp; compiled only with ASYNCFEM_WITH_ASSIMP=ON (otherwise
 // readSurfaceUnavailable.cpp provides the functions).
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/tetMesher/triangleSurface.hpp>
-
-#include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <assimp/Importer.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/tetMesher/triangleSurface.hpp>
 #include <map>
 #include <string>
 #include <vector>
@@ -80,9 +79,11 @@ TriangleSurface readSurface(const std::filesystem::path& path) {
   if (collector.triangles.empty()) throw ValidationError(path.string() + ": the file holds no triangles");
   TriangleSurface surface;
   surface.vertices.resize(3, static_cast<Eigen::Index>(collector.vertices.size()));
-  for (std::size_t v = 0; v < collector.vertices.size(); ++v) surface.vertices.col(static_cast<Eigen::Index>(v)) = collector.vertices[v];
+  for (std::size_t v = 0; v < collector.vertices.size(); ++v)
+    surface.vertices.col(static_cast<Eigen::Index>(v)) = collector.vertices[v];
   surface.triangles.resize(3, static_cast<Eigen::Index>(collector.triangles.size()));
-  for (std::size_t t = 0; t < collector.triangles.size(); ++t) surface.triangles.col(static_cast<Eigen::Index>(t)) = collector.triangles[t];
+  for (std::size_t t = 0; t < collector.triangles.size(); ++t)
+    surface.triangles.col(static_cast<Eigen::Index>(t)) = collector.triangles[t];
   surface.triangleParts = std::move(collector.parts);
   surface.partNames = std::move(collector.partNames);
   return surface;

@@ -8,7 +8,8 @@ namespace asyncfem {
 bool surfaceReaderAvailable() { return false; }
 
 TriangleSurface readSurface(const std::filesystem::path& path) {
-  throw Error(path.string() + ": cannot read surfaces: this build has no assimp (configure with "
+  throw Error(path.string() +
+              ": cannot read surfaces: this build has no assimp (configure with "
               "-DASYNCFEM_WITH_ASSIMP=ON)");
 }
 

@@ -1,11 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/tetMesher/signedDistance.hpp>
-
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <array>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/tetMesher/signedDistance.hpp>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -55,8 +53,8 @@ ClosestPoint closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vecto
 
 struct Node {
   Eigen::AlignedBox3d box;
-  int left = -1, right = -1;  // children, or -1 for a leaf
-  int begin = 0, end = 0;     // leaf: triangles order[begin, end)
+  int left = -1, right = -1;                             // children, or -1 for a leaf
+  int begin = 0, end = 0;                                // leaf: triangles order[begin, end)
   Eigen::Vector3d areaNormal = Eigen::Vector3d::Zero();  // sum of area-weighted normals
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();      // area-weighted centroid
   double radius = 0.0;                                   // max distance from centre to a vertex
@@ -70,9 +68,9 @@ struct SignedDistance::Impl {
   double farFieldRatio = 2.0;
   std::vector<Node> nodes;
   std::vector<int> order;
-  std::vector<Eigen::Vector3d> faceNormals;             // unit
+  std::vector<Eigen::Vector3d> faceNormals;                 // unit
   std::vector<std::array<Eigen::Vector3d, 3>> edgeNormals;  // per triangle, edge i = (i, i+1)
-  std::vector<Eigen::Vector3d> vertexNormals;           // angle-weighted
+  std::vector<Eigen::Vector3d> vertexNormals;               // angle-weighted
 
   Eigen::Vector3d corner(int t, int c) const { return surface.vertices.col(surface.triangles(c, t)); }
 
@@ -135,7 +133,8 @@ struct SignedDistance::Impl {
     for (int t = 0; t < m; ++t)
       for (int c = 0; c < 3; ++c) {
         const int u = surface.triangles(c, t), v = surface.triangles((c + 1) % 3, t);
-        edgeNormals[static_cast<std::size_t>(t)][static_cast<std::size_t>(c)] = edgeSums.at({std::min(u, v), std::max(u, v)});
+        edgeNormals[static_cast<std::size_t>(t)][static_cast<std::size_t>(c)] =
+            edgeSums.at({std::min(u, v), std::max(u, v)});
       }
   }
 
@@ -213,7 +212,9 @@ struct SignedDistance::Impl {
     if (distance == 0.0) return 0.0;
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     switch (closest.feature) {
-      case Feature::Face: normal = faceNormals[static_cast<std::size_t>(t)]; break;
+      case Feature::Face:
+        normal = faceNormals[static_cast<std::size_t>(t)];
+        break;
       case Feature::Edge:
         normal = edgeNormals[static_cast<std::size_t>(t)][static_cast<std::size_t>(closest.index)];
         break;

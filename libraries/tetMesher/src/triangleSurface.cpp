@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/tetMesher/triangleSurface.hpp>
-
 #include <algorithm>
 #include <array>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/tetMesher/triangleSurface.hpp>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -76,15 +75,17 @@ int weldVertices(TriangleSurface& surface, double tolerance) {
     representative[static_cast<std::size_t>(v)] = match;
   }
   Eigen::Matrix3Xd vertices(3, static_cast<Eigen::Index>(kept.size()));
-  for (std::size_t i = 0; i < kept.size(); ++i) vertices.col(static_cast<Eigen::Index>(i)) = surface.vertices.col(kept[i]);
+  for (std::size_t i = 0; i < kept.size(); ++i)
+    vertices.col(static_cast<Eigen::Index>(i)) = surface.vertices.col(kept[i]);
   std::vector<Eigen::Vector3i> triangles;
   std::vector<int> parts;
   for (int t = 0; t < surface.numTriangles(); ++t) {
     Eigen::Vector3i tri;
     for (int c = 0; c < 3; ++c) {
       const int v = surface.triangles(c, t);
-      if (v < 0 || v >= n) throw ValidationError("weldVertices: triangle " + std::to_string(t) + " has vertex " +
-                                                 std::to_string(v) + " out of range");
+      if (v < 0 || v >= n)
+        throw ValidationError("weldVertices: triangle " + std::to_string(t) + " has vertex " + std::to_string(v) +
+                              " out of range");
       tri[c] = representative[static_cast<std::size_t>(v)];
     }
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
@@ -129,7 +130,7 @@ SurfaceTopology surfaceTopology(const TriangleSurface& surface) {
       }
     }
   }
-  topology.example = !boundaryExample.empty() ? boundaryExample
+  topology.example = !boundaryExample.empty()      ? boundaryExample
                      : !nonManifoldExample.empty() ? nonManifoldExample
                                                    : misorientedExample;
   return topology;
@@ -140,8 +141,8 @@ void requireClosedSurface(const TriangleSurface& surface, const std::string& sou
   const SurfaceTopology topology = surfaceTopology(surface);
   if (topology.closed()) return;
   throw ValidationError(source + ": the surface is not closed: " + std::to_string(topology.boundaryEdges) +
-                        " open boundary edges, " + std::to_string(topology.nonManifoldEdges) +
-                        " non-manifold edges, " + std::to_string(topology.misorientedEdges) +
+                        " open boundary edges, " + std::to_string(topology.nonManifoldEdges) + " non-manifold edges, " +
+                        std::to_string(topology.misorientedEdges) +
                         " inconsistently oriented edges after welding (e.g. " + topology.example +
                         "); close the surface, or mesh it with the generalized winding number (--repair), "
                         "which tolerates small holes");

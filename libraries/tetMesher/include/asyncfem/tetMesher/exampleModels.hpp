@@ -1,12 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <Eigen/Geometry>
 #include <asyncfem/tetMesher/implicit.hpp>
 #include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
-#include <Eigen/Geometry>
-
 #include <string>
 #include <vector>
 

@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <Eigen/Geometry>
 #include <asyncfem/tetMesher/implicit.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
-#include <Eigen/Geometry>
 
 namespace asyncfem {
 
@@ -42,9 +41,9 @@ struct MesherOptions {
 struct StuffingReport {
   long long latticeVertices = 0;  ///< black + red BCC lattice vertices evaluated
   long long latticeTetrahedra = 0;
-  int cutPoints = 0;              ///< cut points used as mesh vertices
-  int warpedVertices = 0;         ///< lattice vertices moved onto the surface
-  int unwarpedVertices = 0;       ///< warped vertices moved back to undo boundary pinches
+  int cutPoints = 0;         ///< cut points used as mesh vertices
+  int warpedVertices = 0;    ///< lattice vertices moved onto the surface
+  int unwarpedVertices = 0;  ///< warped vertices moved back to undo boundary pinches
   int elements = 0;
   int vertices = 0;
 };

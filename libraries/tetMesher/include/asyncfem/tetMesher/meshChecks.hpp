@@ -2,7 +2,6 @@
 #pragma once
 
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
 #include <string>
 
 namespace asyncfem {
@@ -18,16 +17,16 @@ MeshQuality meshQuality(const TetMesh& mesh);
 
 /// Everything validateTetMesh checks, counted.
 struct MeshCheckReport {
-  int invertedElements = 0;     ///< signed volume < 0
-  int degenerateElements = 0;   ///< |volume| <= 1e-10 (mean edge)^3, or min dihedral < 0.01 degrees
+  int invertedElements = 0;    ///< signed volume < 0
+  int degenerateElements = 0;  ///< |volume| <= 1e-10 (mean edge)^3, or min dihedral < 0.01 degrees
   int unusedVertices = 0;
   int boundaryTriangles = 0;
-  int openBoundaryEdges = 0;        ///< boundary edges in one boundary triangle
-  int nonManifoldBoundaryEdges = 0; ///< boundary edges in three or more boundary triangles
-  int misorientedBoundaryEdges = 0; ///< edges whose two boundary triangles run the same way
-  int components = 0;               ///< connected components (elements sharing a face)
-  double elementVolume = 0.0;       ///< sum of signed element volumes
-  double boundaryVolume = 0.0;      ///< sum over boundary triangles of x_a . (x_b x x_c) / 6
+  int openBoundaryEdges = 0;         ///< boundary edges in one boundary triangle
+  int nonManifoldBoundaryEdges = 0;  ///< boundary edges in three or more boundary triangles
+  int misorientedBoundaryEdges = 0;  ///< edges whose two boundary triangles run the same way
+  int components = 0;                ///< connected components (elements sharing a face)
+  double elementVolume = 0.0;        ///< sum of signed element volumes
+  double boundaryVolume = 0.0;       ///< sum over boundary triangles of x_a . (x_b x x_c) / 6
   /// First problem found, for messages ("" when every check passes).
   std::string firstProblem;
   bool ok() const { return firstProblem.empty(); }

@@ -1,11 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <Eigen/Core>
 #include <asyncfem/tetMesher/implicit.hpp>
 #include <asyncfem/tetMesher/triangleSurface.hpp>
-
-#include <Eigen/Core>
-
 #include <memory>
 #include <vector>
 
@@ -30,10 +28,9 @@ enum class SignMode {
 /// triangles (median splits along the longest axis, leaves of up to 4) answers closest-point
 /// queries in about O(log m). Safe to call from several threads at once.
 class SignedDistance {
-public:
+ public:
   /// The surface is copied. ValidationError for a surface without triangles.
-  explicit SignedDistance(TriangleSurface surface, SignMode mode = SignMode::Pseudonormal,
-                          double farFieldRatio = 2.0);
+  explicit SignedDistance(TriangleSurface surface, SignMode mode = SignMode::Pseudonormal, double farFieldRatio = 2.0);
   ~SignedDistance();
   SignedDistance(SignedDistance&&) noexcept;
   SignedDistance& operator=(SignedDistance&&) noexcept;
@@ -52,7 +49,7 @@ public:
   /// while this object (or the one it is moved into) lives.
   ImplicitFunction function() const;
 
-private:
+ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

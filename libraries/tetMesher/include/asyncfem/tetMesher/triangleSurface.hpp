@@ -3,7 +3,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -33,10 +32,10 @@ int weldVertices(TriangleSurface& surface, double tolerance);
 
 /// Edge topology of a welded surface.
 struct SurfaceTopology {
-  int boundaryEdges = 0;      ///< edges in exactly one triangle (holes)
-  int nonManifoldEdges = 0;   ///< edges in three or more triangles
-  int misorientedEdges = 0;   ///< edges in two triangles that traverse it the same way
-  int degenerateTriangles = 0;///< zero-area triangles
+  int boundaryEdges = 0;        ///< edges in exactly one triangle (holes)
+  int nonManifoldEdges = 0;     ///< edges in three or more triangles
+  int misorientedEdges = 0;     ///< edges in two triangles that traverse it the same way
+  int degenerateTriangles = 0;  ///< zero-area triangles
   /// One example of the first kind found above, for messages: "edge (x, y, z) - (x, y, z)".
   std::string example;
   double signedVolume = 0.0;  ///< divergence-theorem volume (negative: normals point in)
