@@ -17,6 +17,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
@@ -111,7 +112,9 @@ std::uint32_t crcOf(const T& value, std::uint32_t crc) {
 // as built (rest positions, elements, materials, fixed vertices).
 std::uint32_t runFingerprint(const fs::path& sceneFile, const asyncfem::Scene& scene,
                              const asyncfem::Simulation& simulation) {
-  nlohmann::json json = nlohmann::json::parse(readFile(sceneFile));
+  // Scenes may carry // comments, as loadScene accepts them.
+  nlohmann::json json = nlohmann::json::parse(readFile(sceneFile), nullptr, /*allow_exceptions=*/true,
+                                              /*ignore_comments=*/true);
   if (json.is_object()) {
     json.erase("output");
     if (json.contains("frames") && json["frames"].is_object()) json["frames"].erase("count");
@@ -463,6 +466,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  asyncfem::preferPassiveThreadWaiting(argv);
   try {
     return run(argc, argv);
   } catch (const std::exception& e) {
