@@ -471,3 +471,26 @@ TEST_F(OfflineSimulatorTest, ResumeRefusesWhatItCannotContinueExactly) {
 }
 
 }  // namespace
+
+namespace {
+
+// Every scene shipped in models/ runs through the simulator as a user would start it
+// (comments, relative mesh paths and all): two frames, exit 0, two finite frames written.
+TEST_F(OfflineSimulatorTest, EveryShippedSceneRuns) {
+  int scenes = 0;
+  for (const auto& folder : fs::directory_iterator(ASYNCFEM_MODELS_DIR)) {
+    if (!folder.is_directory()) continue;
+    for (const auto& entry : fs::directory_iterator(folder.path())) {
+      if (entry.path().extension() != ".json") continue;
+      ++scenes;
+      const fs::path output = folder_ / (entry.path().stem().string() + ".afsim");
+      const RunResult result = run(quoted(entry.path()) + " --frames 2 --quiet --output " + quoted(output));
+      ASSERT_EQ(result.exitCode, 0) << entry.path() << "\n" << result.err;
+      asyncfem::SimulationReader reader(output);
+      EXPECT_EQ(reader.numFrames(), 2) << entry.path();
+    }
+  }
+  EXPECT_GE(scenes, 2);  // at least the default scene and its single-rate twin
+}
+
+}  // namespace
