@@ -83,7 +83,8 @@ public:
     // Other positive statuses are warnings about the determinant, not failures.
     if (status < UMFPACK_OK) {
       numeric_.reset();
-      throw NumericalError("umfpack: numeric factorization failed (UMFPACK status " + std::to_string(status) + ")");
+      throw NumericalError("umfpack: numeric factorization failed (UMFPACK status " + std::to_string(status) +
+                           (status == UMFPACK_ERROR_out_of_memory ? ": out of memory" : "") + ")");
     }
     // Kept for the iterative refinement umfpack_di_solve does with A; the pattern is the
     // analysed one, held in signature_.
