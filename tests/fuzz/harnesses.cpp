@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string_view>
+#include <system_error>
 
 namespace asyncfem::fuzz {
 
@@ -20,14 +21,28 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The readers take paths, so each input goes through a file in a folder of this process.
+// The readers take paths, so each input goes through a file in a folder of this process,
+// removed when the process exits normally (libFuzzer's -max_total_time ends with exit()).
+class ScratchFolder {
+ public:
+  ScratchFolder() : path_(fs::temp_directory_path() / ("asyncfem-fuzz-" + std::to_string(::getpid()))) {
+    fs::create_directories(path_);
+  }
+  ~ScratchFolder() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
 const fs::path& scratchFolder() {
-  static const fs::path folder = [] {
-    const fs::path path = fs::temp_directory_path() / ("asyncfem-fuzz-" + std::to_string(::getpid()));
-    fs::create_directories(path);
-    return path;
-  }();
-  return folder;
+  static const ScratchFolder folder;
+  return folder.path();
 }
 
 fs::path writeInput(const std::string& name, const std::uint8_t* data, std::size_t size) {
