@@ -29,6 +29,11 @@ function(asyncfem_add_library name)
     target_compile_features(${target} PUBLIC cxx_std_20)
     target_compile_options(${target} PRIVATE ${ASYNCFEM_WARNING_FLAGS})
     set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+    if(ASYNCFEM_SANITIZE)
+      # Sanitized static libraries need the sanitizer runtimes wherever they are linked,
+      # including projects that find the installed package.
+      target_link_options(${target} INTERFACE -fsanitize=address,undefined)
+    endif()
   endif()
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
   add_library(asyncfem::${name} ALIAS ${target})
