@@ -47,6 +47,15 @@ TEST(AdvanceFrameErrors, BlowUpInTheLargeStepRegionSaysL) {
   EXPECT_NE(message.find(" in the large-step region L (vertex set 'xmax')"), std::string::npos) << message;
 }
 
+TEST(AdvanceFrameErrors, BlowUpUnderTheUncoupledMultirateSchemeNamesTheRegion) {
+  auto json = smallScene();
+  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -1e15, 0]}])");
+  json["integrator"] = nlohmann::json::parse(R"({"name": "multirate-uncoupled", "timestep": 0.01,
+      "options": {"regions": [{"name": "end", "ratio": 2, "vertexSets": ["xmax"]}]}})");
+  const std::string message = failureOf(json);
+  EXPECT_NE(message.find(" in fast region S_1 'end' (vertex set 'xmax')"), std::string::npos) << message;
+}
+
 TEST(AdvanceFrameErrors, UnstableExplicitRunNamesTheFrameAndTheMesh) {
   // Central differences forced far above its stable timestep: the state grows by orders
   // of magnitude per step until the blow-up check stops it.

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Scenes that name the asynchronous integrator, and scenes with contact.
+#include <gtest/gtest.h>
+
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
-
-#include <gtest/gtest.h>
-
+#include <cmath>
 #include <string>
 
 #include "sceneTestUtilities.hpp"
@@ -134,6 +134,27 @@ TEST(ContactScene, GroundStopsAFallingCube) {
   EXPECT_GT(lowest, -1e-2);
   EXPECT_LT(simulation.contact->maxPenetration(simulation.integrator->displacement()), 1e-3);
   EXPECT_GT(simulation.contact->activeContacts(simulation.integrator->displacement()), 0);
+}
+
+TEST(ContactScene, WarnsWhenTheExplicitContactIsTooStiffForTheStep) {
+  // omega = sqrt(k / m) of the lightest vertex on the penalty spring (every vertex of the
+  // 2x2x2 cube but its centre is on the boundary, and the centre is the heaviest). The
+  // warning fires exactly when omega h > 1: check a step well below and one well above.
+  nlohmann::json scene = droppedCube();
+  const Simulation probe = build(scene);
+  const Eigen::VectorXd lumped = probe.integrator->system().mass * Eigen::VectorXd::Ones(probe.mesh->numDofs());
+  const double omega = std::sqrt(2e4 / lumped.minCoeff());
+  const double frame = 1.0 / 50.0;
+  ASSERT_GT(omega * frame, 2.0) << "the coarse step must exceed the threshold";
+  const int finer = static_cast<int>(std::ceil(omega * frame / 0.5));  // omega h <= 0.5
+  scene["integrator"]["timestep"] = frame / finer;
+  const Simulation fine = build(scene);
+  EXPECT_TRUE(fine.warnings.empty()) << fine.warnings.front();
+  scene["integrator"]["timestep"] = frame;
+  const Simulation coarse = build(scene);
+  ASSERT_EQ(coarse.warnings.size(), 1u);
+  EXPECT_NE(coarse.warnings.front().find("contact.stiffness"), std::string::npos) << coarse.warnings.front();
+  EXPECT_NE(coarse.warnings.front().find("omega h"), std::string::npos) << coarse.warnings.front();
 }
 
 TEST(ContactScene, ErrorsNameTheKey) {

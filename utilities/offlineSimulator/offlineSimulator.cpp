@@ -17,9 +17,9 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <asyncfem/core/threading.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/simulationIO/checkpoint.hpp>
@@ -362,6 +362,7 @@ int run(int argc, char** argv) {
   asyncfem::Scene scene = asyncfem::loadScene(options.scene);
   applyOverrides(options, scene);
   asyncfem::Simulation simulation = asyncfem::buildSimulation(scene);
+  for (const std::string& warning : simulation.warnings) std::cerr << "offlineSimulator: warning: " << warning << "\n";
   const double setupSeconds = setupWatch.stop();
   const asyncfem::IntegratorStats statsAfterSetup = simulation.integrator->stats();
 

@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/integrator/factory.hpp>
-#include <asyncfem/sceneIO/jsonReader.hpp>
 #include <asyncfem/sceneIO/asyncScene.hpp>
+#include <asyncfem/sceneIO/jsonReader.hpp>
 #include <asyncfem/sceneIO/multirateScene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
@@ -293,6 +294,46 @@ IntegratorRegistry defaultIntegratorRegistry() {
   return registry;
 }
 
+namespace {
+
+// Penalty contact is explicit: its force is evaluated at one state per (large) step. A
+// boundary vertex of lumped mass m on a penalty spring k oscillates at omega = sqrt(k / m);
+// once omega h approaches 2 the explicit force feeds energy in at every bounce (measured:
+// benchmarkAsync --study contact, docs/asynchronous-integrator.md). Warn from omega h > 1.
+std::vector<std::string> contactStepWarnings(const Scene& scene, const TetMesh& mesh,
+                                             const Eigen::SparseMatrix<double>& mass) {
+  const double k = scene.contact.parameters.stiffness;
+  const double h = scene.integrator.timestep;
+  const Eigen::VectorXd lumped = mass * Eigen::VectorXd::Ones(mass.cols());
+  double lightest = std::numeric_limits<double>::infinity();
+  int vertex = -1;
+  for (const std::array<int, 3>& triangle : boundaryTriangles(mesh)) {
+    for (const int v : triangle) {
+      const double m = lumped[3 * static_cast<Eigen::Index>(v)];
+      if (m > 0.0 && m < lightest) {
+        lightest = m;
+        vertex = v;
+      }
+    }
+  }
+  std::vector<std::string> warnings;
+  if (vertex < 0) return warnings;
+  const double omegaH = std::sqrt(k / lightest) * h;
+  if (omegaH > 1.0) {
+    warnings.push_back(
+        scene.sourceName + ": contact.stiffness: " + formatNumber(k) + " on the lightest boundary vertex (" +
+        std::to_string(vertex) + ", lumped mass " + formatNumber(lightest) +
+        ") gives omega h = " + formatNumber(omegaH) + " at integrator.timestep " + formatNumber(h) +
+        "; penalty contact is explicit and can add energy at impacts when omega h > 1: lower contact.stiffness "
+        "below " +
+        formatNumber(lightest / (h * h)) + " or the timestep" +
+        (scene.integrator.name == "async" ? " (substepContact only helps the fast regions)" : ""));
+  }
+  return warnings;
+}
+
+}  // namespace
+
 Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registry) {
   Simulation simulation;
 
@@ -357,6 +398,7 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
     contact = std::make_shared<PenaltyContact>(mesh->restPositions(), scene.contact.planes, scene.contact.spheres,
                                                scene.contact.parameters);
     simulation.contact = contact;
+    simulation.warnings = contactStepWarnings(scene, *mesh, system.mass);
   } else {
     simulation.skipped.emplace_back("contact (no obstacles)");
   }
@@ -409,12 +451,18 @@ namespace {
 std::string describeVertex(const Simulation& simulation, int vertex) {
   std::ostringstream out;
   out << "vertex " << vertex;
-  const auto* async = dynamic_cast<const AsyncBackwardEuler*>(simulation.integrator.get());
-  const std::vector<int>* regionOfVertex = async != nullptr ? &async->partition().vertexRegion() : nullptr;
+  // Both multirate integrators partition the mesh into L and fast regions.
+  const RegionPartition* partition = nullptr;
+  if (const auto* async = dynamic_cast<const AsyncBackwardEuler*>(simulation.integrator.get())) {
+    partition = &async->partition();
+  } else if (const auto* multirate = dynamic_cast<const UncoupledMultirate*>(simulation.integrator.get())) {
+    partition = &multirate->partition();
+  }
+  const std::vector<int>* regionOfVertex = partition != nullptr ? &partition->vertexRegion() : nullptr;
   if (regionOfVertex != nullptr && vertex >= 0 && vertex < static_cast<int>(regionOfVertex->size())) {
     const int region = (*regionOfVertex)[static_cast<std::size_t>(vertex)];
     if (region >= 0) {
-      out << " in fast region S_" << (region + 1) << " '" << async->partition().region(region).name << "'";
+      out << " in fast region S_" << (region + 1) << " '" << partition->region(region).name << "'";
     } else {
       out << " in the large-step region L";
     }

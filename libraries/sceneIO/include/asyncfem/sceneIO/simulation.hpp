@@ -68,6 +68,9 @@ struct Simulation {
   /// machinery for a linear scene, gravity, ...); the integrator's own list is in
   /// integrator->stats().skipped.
   std::vector<std::string> skipped;
+  /// Things that will run but that the user should know about (printed by the utilities),
+  /// e.g. an explicit contact stiffness too high for the timestep.
+  std::vector<std::string> warnings;
 };
 
 /// Builds what a scene describes, and only that: the mesh (file or generator) with the
