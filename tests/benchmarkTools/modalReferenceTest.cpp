@@ -6,6 +6,7 @@
 #include <asyncfem/benchmarkTools/errorMetrics.hpp>
 #include <asyncfem/benchmarkTools/modalReference.hpp>
 #include <asyncfem/benchmarkTools/sceneReference.hpp>
+#include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <cmath>
@@ -131,6 +132,13 @@ Scene smallBoxScene(const std::string& integrator, double timestep) {
   return parseScene(json, ".", "box.json");
 }
 
+// The exact modal solution of a built scene's linear system.
+ModalReference modalReferenceOf(const DynamicSystem& system) {
+  Eigen::SparseMatrix<double> K = system.forceModel->createStiffnessMatrix();
+  system.forceModel->tangentStiffness(Eigen::VectorXd::Zero(system.numDofs()), K);
+  return ModalReference(system.mass, K, system.freeDofs, system.rayleighMass, system.rayleighStiffness);
+}
+
 TEST(ModalReference, AgreesWithFineTrapezoidalOnAMesh) {
   // Gravity from t = 0 on a 24-element cantilever; trapezoidal at h = 1e-5 is second order
   // and undamped numerically; 1e-3 relative L2 is far above its error ((omega h)^2 / 12
@@ -138,9 +146,7 @@ TEST(ModalReference, AgreesWithFineTrapezoidalOnAMesh) {
   const Scene scene = smallBoxScene("trapezoidal", 1e-5);
   Simulation simulation = buildSimulation(scene);
   const DynamicSystem& system = simulation.integrator->system();
-  Eigen::SparseMatrix<double> K = system.forceModel->createStiffnessMatrix();
-  system.forceModel->tangentStiffness(Eigen::VectorXd::Zero(system.numDofs()), K);
-  ModalReference reference(system.mass, K, system.freeDofs, system.rayleighMass, system.rayleighStiffness);
+  const ModalReference reference = modalReferenceOf(system);
   const Trajectory exact = reference.displacements(sceneLoad(scene, simulation), frameTimes(scene, 10));
   Trajectory run;
   for (int frame = 0; frame < 10; ++frame) {
@@ -149,6 +155,40 @@ TEST(ModalReference, AgreesWithFineTrapezoidalOnAMesh) {
   }
   EXPECT_LT(relativeL2Error(run, exact, {"all", {}}), 1e-3);
   EXPECT_GT(exact.back().norm(), 0.0);
+}
+
+TEST(ModalReference, MotionKeptPerBandMeasuresAmplitudePerFrequency) {
+  const Scene scene = smallBoxScene("backward-euler", 1e-3);
+  Simulation simulation = buildSimulation(scene);
+  const DynamicSystem& system = simulation.integrator->system();
+  const ModalReference reference = modalReferenceOf(system);
+  const Trajectory exact = reference.displacements(sceneLoad(scene, simulation), frameTimes(scene, 10));
+  // Modal coordinates of M-orthonormal modes keep the M-norm (Parseval): |q|^2 = u^T M u.
+  const Eigen::VectorXd& u = exact.back();
+  const double energyNorm = u.dot(system.mass * u);
+  ASSERT_GT(energyNorm, 0.0);
+  // Relative 1e-9: the eigenvectors are M-orthonormal to round-off of a dense solve.
+  EXPECT_NEAR(reference.modalCoordinates(u).squaredNorm() / energyNorm, 1.0, 1e-9);
+  EXPECT_THROW(reference.modalCoordinates(Eigen::VectorXd::Zero(3)), asyncfem::Error);
+
+  // Bands split at the median frequency: every mode is counted once; the exact solution
+  // keeps 1 in each band with motion; a run at half amplitude keeps 0.5 (to round-off).
+  const Eigen::VectorXd& lambda = reference.eigenvalues();
+  const double median = std::sqrt(lambda[lambda.size() / 2]);
+  const std::vector<double> edges{0.0, median};
+  const std::vector<ModalBand> same = motionKeptPerBand(reference, exact, exact, edges);
+  ASSERT_EQ(same.size(), 2u);
+  EXPECT_EQ(same[0].modes + same[1].modes, reference.numFree());
+  Trajectory half = exact;
+  for (Eigen::VectorXd& frame : half) frame *= 0.5;
+  const std::vector<ModalBand> halved = motionKeptPerBand(reference, half, exact, edges);
+  for (std::size_t b = 0; b < 2; ++b) {
+    if (std::isnan(same[b].kept)) continue;  // no reference motion in the band
+    expectClose(same[b].kept, 1.0, 1e-12);
+    expectClose(halved[b].kept, 0.5, 1e-12);
+  }
+  EXPECT_FALSE(std::isnan(same[0].kept)) << "the pulled box must move its low modes";
+  EXPECT_THROW(motionKeptPerBand(reference, exact, exact, {1.0, 0.5}), asyncfem::Error);
 }
 
 TEST(ErrorMetrics, RunAgainstItselfIsZero) {

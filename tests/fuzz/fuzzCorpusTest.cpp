@@ -8,10 +8,17 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <ostream>
 #include <string>
 #include <vector>
 
 #include "harnesses.hpp"
+
+namespace asyncfem::fuzz {
+// GoogleTest prints a test's parameter next to its name: print the harness's name rather
+// than the raw bytes of the struct.
+void PrintTo(const Harness& harness, std::ostream* out) { *out << harness.name; }
+}  // namespace asyncfem::fuzz
 
 namespace {
 

@@ -2,7 +2,9 @@
 // stabilityStressTest: free vibration of a two-material bar under every integrator, over a
 // grid of stiffness ratios, timestep ratios, damping and mesh quality.
 //
-//   stabilityStressTest [--frames N] [--full] [--cells NX NY NZ] [--seed S] [--csv FILE]
+//   stabilityStressTest [--frames N] [--full] [--jobs J] [--cells NX NY NZ] [--seed S] [--csv FILE]
+//                       [--stiffness-ratios R...] [--ratios M...] [--damping D...] [--integrators I...]
+//                       [--meshes regular|perturbed]
 //
 // Every run starts from a bent bar at rest (u_y = 0.02 x^2 / L, zero velocity) with no
 // external force and reports the energy growth (max over frames of mechanical energy /
@@ -10,22 +12,29 @@
 // checks: nothing unstable is ever stored) and the maximum displacement. Runs that blow
 // up or gain energy are listed by integrator and configuration at the end.
 // docs/benchmarks.md lists the grid and the results.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
+#include <mutex>
 #include <random>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -39,6 +48,13 @@ struct Options {
   std::vector<int> cells{8, 2, 2};
   unsigned seed = 1;
   std::string csv = "stability.csv";
+  int jobs = 1;
+  // Narrow the grid (empty: all of it).
+  std::vector<double> stiffnessRatios;
+  std::vector<int> ratios;
+  std::vector<std::string> dampings;     // none, light, heavy
+  std::vector<std::string> integrators;  // async, async-symmetric, multirate-uncoupled, backward-euler
+  std::vector<std::string> meshes;       // regular, perturbed
 };
 
 struct Damping {
@@ -176,76 +192,141 @@ std::string describe(const Case& c) {
   return out.str();
 }
 
+// The selection lists the user can narrow: an empty list means the grid's default.
+template <typename T>
+std::vector<T> chosen(const std::vector<T>& requested, std::vector<T> grid) {
+  return requested.empty() ? grid : requested;
+}
+
 int run(const Options& options) {
   const int frames = options.full ? std::max(options.frames, 10000) : options.frames;
   const std::vector<double> stiffnessRatios =
-      options.full ? std::vector<double>{1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6} : std::vector<double>{1, 1e2, 1e4, 1e6};
+      chosen(options.stiffnessRatios, options.full ? std::vector<double>{1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6}
+                                                   : std::vector<double>{1, 1e2, 1e4, 1e6});
   const std::vector<int> ratios =
-      options.full ? std::vector<int>{1, 2, 8, 32, 100, 200} : std::vector<int>{1, 8, 50, 200};
-  const std::vector<Damping> dampings = {{"none", 0.0, 0.0}, {"light", 0.1, 1e-4}, {"heavy", 5.0, 1e-2}};
-  const std::vector<std::pair<std::string, std::string>> integrators = {
+      chosen(options.ratios, options.full ? std::vector<int>{1, 2, 8, 32, 100, 200} : std::vector<int>{1, 8, 50, 200});
+  const std::vector<Damping> allDampings = {{"none", 0.0, 0.0}, {"light", 0.1, 1e-4}, {"heavy", 5.0, 1e-2}};
+  const std::vector<std::pair<std::string, std::string>> allIntegrators = {
       {"async", ""}, {"async", "symmetric"}, {"multirate-uncoupled", ""}, {"backward-euler", ""}};
+  std::vector<Damping> dampings;
+  for (const Damping& damping : allDampings) {
+    if (options.dampings.empty() ||
+        std::find(options.dampings.begin(), options.dampings.end(), damping.name) != options.dampings.end()) {
+      dampings.push_back(damping);
+    }
+  }
+  std::vector<std::pair<std::string, std::string>> integrators;
+  for (const auto& entry : allIntegrators) {
+    const std::string name = entry.second.empty() ? entry.first : entry.first + "-" + entry.second;
+    if (options.integrators.empty() ||
+        std::find(options.integrators.begin(), options.integrators.end(), name) != options.integrators.end()) {
+      integrators.push_back(entry);
+    }
+  }
+  std::vector<bool> meshes;
+  for (const bool perturbed : {false, true}) {
+    const std::string name = perturbed ? "perturbed" : "regular";
+    if (options.meshes.empty() ||
+        std::find(options.meshes.begin(), options.meshes.end(), name) != options.meshes.end()) {
+      meshes.push_back(perturbed);
+    }
+  }
 
-  const fs::path folder = fs::temp_directory_path() / ("asyncfem-stress-" + std::to_string(options.seed));
+  const fs::path folder = fs::temp_directory_path() / ("asyncfem-stress-" + std::to_string(::getpid()));
   fs::create_directories(folder);
-  std::ofstream csv(options.csv);
-  csv << "integrator,variant,stiffness_ratio,ratio,damping,mesh,frames,energy_growth,failed_frame,max_displacement,"
-         "seconds,failure\n";
-  std::cout << "# stabilityStressTest: " << frames << " frames per run (hL = 1/120, 30 frames per s), bar "
-            << options.cells[0] << "x" << options.cells[1] << "x" << options.cells[2]
-            << " cells, free vibration from a bent state\n\n";
-  std::cout << "| integrator | stiffness ratio | m | damping | mesh | energy growth | first bad frame | max abs(u) |\n";
-  std::cout << "|---|---|---|---|---|---|---|---|\n";
-  std::vector<std::string> problems;
-  int runs = 0;
-  Stopwatch total;
+  // Every case of the grid, with the mesh file it runs on (written once per mesh).
+  struct Job {
+    Case c;
+    fs::path meshFile;
+    double quality;
+  };
+  std::vector<Job> jobs;
   for (const double stiffnessRatio : stiffnessRatios) {
     const BoxMeshSpec spec = barSpec(options, stiffnessRatio);
-    for (const bool perturbed : {false, true}) {
+    for (const bool perturbed : meshes) {
       double quality = 1.0;
       const TetMesh mesh = perturbed ? perturbedBar(spec, options.seed, &quality) : makeBoxMesh(spec);
-      const fs::path meshFile = folder / ("bar-" + std::to_string(runs) + (perturbed ? "-perturbed" : "") + ".veg");
+      const fs::path meshFile =
+          folder / ("bar-" + std::to_string(jobs.size()) + (perturbed ? "-perturbed" : "") + ".veg");
       writeVeg(meshFile, mesh);
       for (const Damping& damping : dampings) {
         for (const auto& [integrator, variant] : integrators) {
           for (const int ratio : ratios) {
             if (integrator == "backward-euler" && ratio != ratios.front()) continue;  // m does not apply
-            const Case c{integrator, variant, stiffnessRatio, ratio, damping, perturbed};
-            Outcome o;
-            try {
-              o = runCase(c, meshFile, frames);
-            } catch (const Error& error) {
-              o.failedFrame = 0;
-              o.failure = std::string("setup failed: ") + error.what();
-            }
-            ++runs;
-            const bool grows = o.energyGrowth > 1.0 + 1e-9;
-            std::cout << "| " << integrator << (variant.empty() ? "" : " " + variant) << " | " << stiffnessRatio
-                      << " | " << (integrator == "backward-euler" ? std::string("-") : std::to_string(ratio)) << " | "
-                      << damping.name << " | "
-                      << (perturbed ? "perturbed (q " + std::to_string(quality).substr(0, 5) + ")" : "regular") << " | "
-                      << o.energyGrowth << " | "
-                      << (o.failedFrame < 0 ? std::string("-") : std::to_string(o.failedFrame)) << " | "
-                      << o.maxDisplacement << " |\n";
-            std::cout.flush();
-            csv << integrator << ',' << variant << ',' << stiffnessRatio << ',' << ratio << ',' << damping.name << ','
-                << (perturbed ? "perturbed" : "regular") << ',' << frames << ',' << o.energyGrowth << ','
-                << o.failedFrame << ',' << o.maxDisplacement << ',' << o.seconds << ",\"" << o.failure << "\"\n";
-            if (o.failedFrame >= 0) {
-              problems.push_back("BLOW-UP: " + describe(c) + ": frame " + std::to_string(o.failedFrame) + ": " +
-                                 o.failure);
-            } else if (grows) {
-              std::ostringstream line;
-              line << "ENERGY GROWTH: " << describe(c) << ": max E/E0 = " << o.energyGrowth;
-              problems.push_back(line.str());
-            }
+            jobs.push_back({Case{integrator, variant, stiffnessRatio, ratio, damping, perturbed}, meshFile, quality});
           }
         }
       }
     }
   }
+
+  std::ofstream csv(options.csv);
+  if (!csv) throw Error(options.csv + ": cannot open for writing");
+  csv << "integrator,variant,stiffness_ratio,ratio,damping,mesh,frames,energy_growth,failed_frame,max_displacement,"
+         "seconds,failure\n";
+  const int workers = std::max(1, std::min<int>(options.jobs, static_cast<int>(jobs.size())));
+  std::cout << "# stabilityStressTest: " << jobs.size() << " runs of " << frames
+            << " frames (hL = 1/120, 30 frames per s), bar " << options.cells[0] << "x" << options.cells[1] << "x"
+            << options.cells[2] << " cells, free vibration from a bent state, " << workers << " worker thread"
+            << (workers > 1 ? "s" : "") << "\n\n";
+  std::cout
+      << "| integrator | stiffness ratio | m | damping | mesh | energy growth | first bad frame | max abs(u) | s |\n";
+  std::cout << "|---|---|---|---|---|---|---|---|---|\n";
+
+  // Runs are independent: workers take the next case; results are printed in grid order.
+  std::vector<Outcome> outcomes(jobs.size());
+  std::vector<char> done(jobs.size(), 0);
+  std::atomic<std::size_t> next{0};
+  std::mutex mutex;
+  std::size_t printed = 0;
+  std::vector<std::string> problems;
+  auto report = [&](std::size_t index) {
+    const Case& c = jobs[index].c;
+    const Outcome& o = outcomes[index];
+    const bool grows = o.energyGrowth > 1.0 + 1e-9;
+    std::cout << "| " << c.integrator << (c.variant.empty() ? "" : " " + c.variant) << " | " << c.stiffnessRatio
+              << " | " << (c.integrator == "backward-euler" ? std::string("-") : std::to_string(c.ratio)) << " | "
+              << c.damping.name << " | "
+              << (c.perturbed ? "perturbed (q " + std::to_string(jobs[index].quality).substr(0, 5) + ")" : "regular")
+              << " | " << o.energyGrowth << " | "
+              << (o.failedFrame < 0 ? std::string("-") : std::to_string(o.failedFrame)) << " | " << o.maxDisplacement
+              << " | " << std::fixed << std::setprecision(1) << o.seconds << std::defaultfloat << std::setprecision(6)
+              << " |\n";
+    std::cout.flush();
+    csv << c.integrator << ',' << c.variant << ',' << c.stiffnessRatio << ',' << c.ratio << ',' << c.damping.name << ','
+        << (c.perturbed ? "perturbed" : "regular") << ',' << frames << ',' << o.energyGrowth << ',' << o.failedFrame
+        << ',' << o.maxDisplacement << ',' << o.seconds << ",\"" << o.failure << "\"\n";
+    csv.flush();
+    if (o.failedFrame >= 0) {
+      problems.push_back("BLOW-UP: " + describe(c) + ": frame " + std::to_string(o.failedFrame) + ": " + o.failure);
+    } else if (grows) {
+      std::ostringstream line;
+      line << "ENERGY GROWTH: " << describe(c) << ": max E/E0 = " << o.energyGrowth;
+      problems.push_back(line.str());
+    }
+  };
+  auto work = [&] {
+    for (std::size_t index = next++; index < jobs.size(); index = next++) {
+      Outcome o;
+      try {
+        o = runCase(jobs[index].c, jobs[index].meshFile, frames);
+      } catch (const std::exception& error) {
+        o.failedFrame = 0;
+        o.failure = std::string("setup failed: ") + error.what();
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      outcomes[index] = o;
+      done[index] = 1;
+      while (printed < jobs.size() && done[printed]) report(printed++);
+    }
+  };
+  Stopwatch total;
+  std::vector<std::thread> pool;
+  for (int w = 1; w < workers; ++w) pool.emplace_back(work);
+  work();
+  for (std::thread& thread : pool) thread.join();
   std::cout << "\n"
-            << runs << " runs in " << total.stop() << " s; " << problems.size()
+            << jobs.size() << " runs in " << total.stop() << " s; " << problems.size()
             << " with a blow-up or energy growth (E/E0 > 1 + 1e-9)\n";
   for (const std::string& line : problems) std::cout << "- " << line << "\n";
   std::cout << "CSV: " << options.csv << "\n";
@@ -256,6 +337,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  asyncfem::preferPassiveThreadWaiting(argv);
   CLI::App app{"Stability stress test of the integrators (docs/benchmarks.md)"};
   Options options;
   app.add_option("--frames", options.frames, "Frames per run (default 100; --full: at least 10000)")
@@ -264,6 +346,16 @@ int main(int argc, char** argv) {
   app.add_option("--cells", options.cells, "Cells of the bar along x, y, z")->expected(3);
   app.add_option("--seed", options.seed, "Seed of the vertex perturbation");
   app.add_option("--csv", options.csv, "CSV output file");
+  app.add_option("--jobs", options.jobs, "Runs in parallel (each run is single-threaded work on a small mesh)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--stiffness-ratios", options.stiffnessRatios, "Only these stiffness ratios")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--ratios", options.ratios, "Only these timestep ratios m")->check(CLI::PositiveNumber);
+  app.add_option("--damping", options.dampings, "Only these damping levels")
+      ->check(CLI::IsMember({"none", "light", "heavy"}));
+  app.add_option("--integrators", options.integrators, "Only these integrators")
+      ->check(CLI::IsMember({"async", "async-symmetric", "multirate-uncoupled", "backward-euler"}));
+  app.add_option("--meshes", options.meshes, "Only these meshes")->check(CLI::IsMember({"regular", "perturbed"}));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

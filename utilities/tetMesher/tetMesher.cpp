@@ -11,6 +11,7 @@
 // (2 for unusable command-line options). docs/tet-mesher.md describes everything.
 #include <CLI/CLI.hpp>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/tetMesher/elementSets.hpp>
 #include <asyncfem/tetMesher/exampleModels.hpp>
 #include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
@@ -206,6 +207,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  asyncfem::preferPassiveThreadWaiting(argv);
   CLI::App app{"Tetrahedral meshes by isosurface stuffing from closed surfaces or built-in example models"};
   Options options;
   app.add_option("surface", options.input,

@@ -4,6 +4,7 @@
 #include <asyncfem/benchmarkTools/modalReference.hpp>
 #include <asyncfem/core/error.hpp>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "detail/generalizedEigen.hpp"
@@ -167,6 +168,57 @@ std::vector<Eigen::VectorXd> ModalReference::displacements(const PiecewiseConsta
     }
   }
   return out;
+}
+
+Eigen::VectorXd ModalReference::modalCoordinates(const Eigen::VectorXd& displacement) const {
+  const Eigen::Index numDofs = freeDofs_.numDofs();
+  if (displacement.size() != numDofs) {
+    throw Error("modal reference: a displacement has " + std::to_string(displacement.size()) + " entries, expected " +
+                std::to_string(numDofs));
+  }
+  return modes_.transpose() * (freeMass_ * freeDofs_.restrict(displacement));
+}
+
+std::vector<ModalBand> motionKeptPerBand(const ModalReference& modal, const std::vector<Eigen::VectorXd>& run,
+                                         const std::vector<Eigen::VectorXd>& reference,
+                                         const std::vector<double>& bandEdges) {
+  if (bandEdges.empty() || bandEdges.front() < 0.0 || !std::is_sorted(bandEdges.begin(), bandEdges.end())) {
+    throw Error("motionKeptPerBand: band edges must be ascending and >= 0");
+  }
+  const Eigen::VectorXd& lambda = modal.eigenvalues();
+  std::vector<ModalBand> bands(bandEdges.size());
+  std::vector<int> bandOf(static_cast<std::size_t>(lambda.size()), -1);
+  for (std::size_t b = 0; b < bands.size(); ++b) {
+    bands[b].lowOmega = bandEdges[b];
+    bands[b].highOmega = b + 1 < bandEdges.size() ? bandEdges[b + 1] : std::numeric_limits<double>::infinity();
+  }
+  for (Eigen::Index j = 0; j < lambda.size(); ++j) {
+    const double omega = std::sqrt(std::max(0.0, lambda[j]));
+    for (std::size_t b = 0; b < bands.size(); ++b) {
+      if (omega >= bands[b].lowOmega && omega < bands[b].highOmega) {
+        bandOf[static_cast<std::size_t>(j)] = static_cast<int>(b);
+        ++bands[b].modes;
+        break;
+      }
+    }
+  }
+  std::vector<double> runSum(bands.size(), 0.0), referenceSum(bands.size(), 0.0);
+  const std::size_t frames = std::min(run.size(), reference.size());
+  for (std::size_t k = 0; k < frames; ++k) {
+    const Eigen::VectorXd q = modal.modalCoordinates(run[k]);
+    const Eigen::VectorXd r = modal.modalCoordinates(reference[k]);
+    for (Eigen::Index j = 0; j < q.size(); ++j) {
+      const int b = bandOf[static_cast<std::size_t>(j)];
+      if (b < 0) continue;
+      runSum[static_cast<std::size_t>(b)] += q[j] * q[j];
+      referenceSum[static_cast<std::size_t>(b)] += r[j] * r[j];
+    }
+  }
+  for (std::size_t b = 0; b < bands.size(); ++b) {
+    bands[b].kept =
+        referenceSum[b] > 0.0 ? std::sqrt(runSum[b] / referenceSum[b]) : std::numeric_limits<double>::quiet_NaN();
+  }
+  return bands;
 }
 
 }  // namespace asyncfem

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,11 @@ class ModalReference {
                                              const Eigen::VectorXd& initialDisplacement = {},
                                              const Eigen::VectorXd& initialVelocity = {}) const;
 
+  /// Modal coordinates q = Phi^T M u of a full (3n) displacement (its free part): the
+  /// amplitude of every mode, in the order of eigenvalues(). Throws asyncfem::Error for a
+  /// wrong size.
+  Eigen::VectorXd modalCoordinates(const Eigen::VectorXd& displacement) const;
+
  private:
   FreeDofs freeDofs_;
   Eigen::SparseMatrix<double> freeMass_;
@@ -88,5 +94,25 @@ class ModalReference {
   Eigen::MatrixXd modes_;  // free x free, columns M-orthonormal
   double alpha_ = 0.0, beta_ = 0.0;
 };
+
+/// Motion kept per frequency band: for the modes with omega_j = sqrt(lambda_j) in
+/// [bandEdges[b], bandEdges[b + 1]) (the last band is open above), the RMS over frames and
+/// modes of the run's modal coordinates divided by the reference's,
+///
+///     sqrt( sum_k sum_{j in band} q_j(u_k)^2 ) / sqrt( sum_k sum_{j in band} q_j(r_k)^2 ),
+///
+/// on frames 0 .. min(run, reference) - 1. 1 means the band keeps the exact amount of
+/// motion; below 1 is artificial damping, above 1 spurious excitation. Insensitive to
+/// phase, so it complements relativeL2Error: it measures what the paper calls retained
+/// motion. A band without modes or without reference motion gives NaN. bandEdges:
+/// ascending, first >= 0.
+struct ModalBand {
+  double lowOmega = 0.0, highOmega = 0.0;  ///< rad/s; highOmega = inf for the last band
+  int modes = 0;
+  double kept = 0.0;  ///< run / reference RMS (NaN when undefined)
+};
+std::vector<ModalBand> motionKeptPerBand(const ModalReference& modal, const std::vector<Eigen::VectorXd>& run,
+                                         const std::vector<Eigen::VectorXd>& reference,
+                                         const std::vector<double>& bandEdges);
 
 }  // namespace asyncfem
