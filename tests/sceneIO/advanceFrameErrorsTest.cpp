@@ -72,4 +72,37 @@ TEST(AdvanceFrameErrors, UnstableExplicitRunNamesTheFrameAndTheMesh) {
   EXPECT_NE(message.find("unstable"), std::string::npos) << message;
 }
 
+// The uncoupled multirate comparator at m = 200 on a uniform bar (stiffness ratio 1) is
+// unstable (docs/benchmarks.md, stabilityStressTest): after the pull ends, its energy
+// grows without any load. The energy check stops it long before the displacement limit.
+nlohmann::json unstableMultirateBar(const std::string& integrator) {
+  return nlohmann::json::parse(R"({
+    "mesh": {"generator": "box", "size": [1, 0.25, 0.25], "cells": [8, 2, 2],
+             "material": {"name": "soft", "density": 1000, "youngsModulus": 1e5, "poissonRatio": 0.4}},
+    "fixed": {"sets": ["xmin"]},
+    "forces": [{"type": "pull", "set": "xmax", "force": [0, -1, 0], "window": [0, 0.2]}],
+    "integrator": {"name": ")" +
+                               integrator + R"(", "timestep": 0.008333333333333333,
+                   "options": {"regions": [{"name": "end", "ratio": 200,
+                                            "boxes": [{"min": [0.74, -1, -1], "max": [2, 2, 2]}]}]}},
+    "frames": {"rate": 30, "count": 150}
+  })");
+}
+
+TEST(AdvanceFrameErrors, EnergyGrowthAfterTheLoadsIsABlowUp) {
+  const std::string message = failureOf(unstableMultirateBar("multirate-uncoupled"));
+  EXPECT_EQ(message.rfind("frame ", 0), 0U) << message;
+  EXPECT_NE(message.find("energy blow-up: with no load changing since t = 0.2"), std::string::npos) << message;
+  EXPECT_NE(message.find("in fast region S_1 'end'"), std::string::npos) << message;
+  // Well before max |u| reaches 1000 x the bounding-box diagonal: |u| is still below 1 m.
+  const std::size_t at = message.find("largest |u| = ");
+  ASSERT_NE(at, std::string::npos) << message;
+  EXPECT_LT(std::stod(message.substr(at + 14)), 1.0) << message;
+}
+
+TEST(AdvanceFrameErrors, StableIntegratorsPassTheEnergyCheck) {
+  // The same scene under the asynchronous integrator: it dissipates, never trips the check.
+  EXPECT_EQ(failureOf(unstableMultirateBar("async")), "");
+}
+
 }  // namespace

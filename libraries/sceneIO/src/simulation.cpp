@@ -402,6 +402,25 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
   } else {
     simulation.skipped.emplace_back("contact (no obstacles)");
   }
+  // Energy check (advanceFrame): once the last load window has closed, with no contact,
+  // the total energy with the potential of the constant loads can only stay or decrease.
+  if (!contact) {
+    double from = 0.0;
+    Eigen::VectorXd constant =
+        gravityForce.size() > 0 ? gravityForce : Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh->numDofs()));
+    for (const VertexLoad& load : loads) {
+      if (std::isfinite(load.end)) {
+        from = std::max(from, load.end);
+        continue;
+      }
+      from = std::max(from, load.start);
+      for (const int v : load.vertices) constant.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
+    }
+    simulation.energyCheckFrom = from;
+    simulation.constantLoad = std::move(constant);
+  } else {
+    simulation.skipped.emplace_back("energy blow-up check (contact forces do work)");
+  }
   if (gravityForce.size() > 0 || !loads.empty() || contact) {
     system.externalForce = [gravityForce, loads, contact](double time, const Eigen::VectorXd& displacement,
                                                           const Eigen::VectorXd& velocity, Eigen::VectorXd& forces) {
@@ -542,6 +561,30 @@ void advanceFrame(Simulation& simulation, int frame) {
                            describeVertex(simulation, static_cast<int>(largest / 3)) +
                            " exceeds 1000 x the bounding-box diagonal (" +
                            formatNumber(simulation.boundingBoxDiagonal) + "); the simulation is unstable");
+    }
+  }
+  // Energy blow-up: after the loads, growth of the total energy to ten times its size is
+  // an instability (a stable integrator keeps or dissipates it; explicit ones let it
+  // oscillate by far less than that below their stable step).
+  if (integrator.time() >= simulation.energyCheckFrom + 0.5 * simulation.timestep) {
+    const Eigen::VectorXd& u = integrator.displacement();
+    const double mechanical = integrator.mechanicalEnergy();
+    const double energy = mechanical - simulation.constantLoad.dot(u);
+    if (simulation.freeEnergyScale <= 0.0) {
+      simulation.freeEnergy = energy;
+      simulation.freeEnergyScale = std::max(mechanical, std::abs(energy));
+      simulation.freeEnergyTime = integrator.time();
+    } else if (energy - simulation.freeEnergy > 9.0 * simulation.freeEnergyScale) {
+      Eigen::Index largest = 0;
+      u.cwiseAbs().maxCoeff(&largest);
+      std::ostringstream out;
+      out << "frame " << frame << " (t = " << formatNumber(integrator.time())
+          << "): energy blow-up: with no load changing since t = " << formatNumber(simulation.energyCheckFrom)
+          << ", the total energy (kinetic + elastic - constant loads . u) grew from "
+          << formatNumber(simulation.freeEnergy) << " at t = " << formatNumber(simulation.freeEnergyTime) << " to "
+          << formatNumber(energy) << "; largest |u| = " << formatNumber(std::abs(u[largest])) << " at "
+          << describeVertex(simulation, static_cast<int>(largest / 3)) << "; the simulation is unstable";
+      throw NumericalError(out.str());
     }
   }
 }

@@ -5,6 +5,7 @@
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -63,6 +64,14 @@ struct Simulation {
   /// Diagonal of the rest bounding box, and the blow-up limit on max |u| (1000 times it).
   double boundingBoxDiagonal = 0.0;
   double blowUpDisplacement = 0.0;
+  /// Energy check of advanceFrame: from this time on no load changes and no contact acts,
+  /// so the total energy E = kinetic + elastic - constantLoad . u cannot grow (infinity:
+  /// never checked, e.g. with contact). constantLoad: gravity plus pulls without an end.
+  double energyCheckFrom = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd constantLoad;
+  /// Set by advanceFrame at the first frame of that free phase: E there, the scale growth
+  /// is measured against (max of kinetic + elastic and |E|) and the time.
+  double freeEnergy = 0.0, freeEnergyScale = -1.0, freeEnergyTime = 0.0;
 
   /// Work the scene made unnecessary and the builder therefore did not do (corotational
   /// machinery for a linear scene, gravity, ...); the integrator's own list is in
@@ -88,9 +97,11 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
 
 /// Advances the simulation by one frame (stepsPerFrame steps). frame is the 0-based frame
 /// index used in messages. After every step it checks that u and v are finite and that
-/// max |u| <= blowUpDisplacement; otherwise (or if the integrator itself fails
-/// numerically) it throws asyncfem::NumericalError naming the frame, the step and the
-/// time. The state is then unusable; the caller must not store it.
+/// max |u| <= blowUpDisplacement; after the frame, once no load changes (energyCheckFrom),
+/// that the total energy has not grown to ten times its size at the start of that free
+/// phase. Otherwise (or if the integrator itself fails numerically) it throws
+/// asyncfem::NumericalError naming the frame, the step and the time. The state is then unusable; the caller must not
+/// store it.
 void advanceFrame(Simulation& simulation, int frame);
 
 }  // namespace asyncfem
