@@ -474,13 +474,17 @@ TEST_F(OfflineSimulatorTest, ResumeRefusesWhatItCannotContinueExactly) {
 
 namespace {
 
-// Every scene shipped in models/ runs through the simulator as a user would start it
-// (comments, relative mesh paths and all): two frames, exit 0, two finite frames written.
+// Every scene shipped in models/ and the benchmark scenes in tests/benchmarks/scenes run
+// through the simulator as a user would start them (comments, relative mesh paths and
+// all): two frames, exit 0, two finite frames written.
 TEST_F(OfflineSimulatorTest, EveryShippedSceneRuns) {
   int scenes = 0;
+  std::vector<fs::path> folders{fs::path(ASYNCFEM_TEST_DATA_DIR).parent_path() / "benchmarks" / "scenes"};
   for (const auto& folder : fs::directory_iterator(ASYNCFEM_MODELS_DIR)) {
-    if (!folder.is_directory()) continue;
-    for (const auto& entry : fs::directory_iterator(folder.path())) {
+    if (folder.is_directory()) folders.push_back(folder.path());
+  }
+  for (const fs::path& folder : folders) {
+    for (const auto& entry : fs::directory_iterator(folder)) {
       if (entry.path().extension() != ".json") continue;
       ++scenes;
       const fs::path output = folder_ / (entry.path().stem().string() + ".afsim");
@@ -490,7 +494,7 @@ TEST_F(OfflineSimulatorTest, EveryShippedSceneRuns) {
       EXPECT_EQ(reader.numFrames(), 2) << entry.path();
     }
   }
-  EXPECT_GE(scenes, 2);  // at least the default scene and its single-rate twin
+  EXPECT_GE(scenes, 4);  // at least the default scene, its single-rate twin and the two benchmark scenes
 }
 
 }  // namespace

@@ -28,9 +28,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <string>
@@ -48,6 +51,8 @@ struct Options {
   std::vector<int> cells{8, 2, 2};
   unsigned seed = 1;
   std::string csv = "stability.csv";
+  std::string scene;         // --scene: stress a user's scene instead of the built-in grid
+  bool framesGiven = false;  // --frames was on the command line
   int jobs = 1;
   // Narrow the grid (empty: all of it).
   std::vector<double> stiffnessRatios;
@@ -73,6 +78,7 @@ struct Case {
 
 struct Outcome {
   double energyGrowth = 0.0;
+  bool energyMeasured = false;  ///< false when the loads never end or contact acts
   int failedFrame = -1;
   std::string failure;
   double maxDisplacement = 0.0;
@@ -157,18 +163,14 @@ Scene sceneFor(const Case& run, const fs::path& meshFile) {
   return scene;
 }
 
-Outcome runCase(const Case& run, const fs::path& meshFile, int frames) {
+// Runs `frames` frames of a built simulation. Energy growth is max E / E_ref over the
+// frames that end at or after `freeFrom` (E = kinetic + elastic - constant loads . u): no
+// load changes from then on, so the energy may only stay or decrease. E_ref: `referenceEnergy` when given (> 0), else
+// the energy of the first of those frames.
+Outcome runSimulation(Simulation& simulation, int frames, double freeFrom, double referenceEnergy = -1.0) {
   Outcome outcome;
   Stopwatch watch;
-  Scene scene = sceneFor(run, meshFile);
-  scene.frames.count = frames;
-  Simulation simulation = buildSimulation(scene);
   Integrator& integrator = *simulation.integrator;
-  const Eigen::Matrix3Xd& rest = simulation.mesh->restPositions();
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(integrator.system().numDofs());
-  for (int v = 0; v < rest.cols(); ++v) u[3 * v + 1] = 0.02 * rest(0, v) * rest(0, v) / kLength;
-  integrator.setState(u, Eigen::VectorXd::Zero(u.size()));
-  const double initialEnergy = integrator.mechanicalEnergy();
   for (int frame = 0; frame < frames; ++frame) {
     try {
       advanceFrame(simulation, frame);
@@ -177,11 +179,31 @@ Outcome runCase(const Case& run, const fs::path& meshFile, int frames) {
       outcome.failure = error.what();
       break;
     }
-    outcome.energyGrowth = std::max(outcome.energyGrowth, integrator.mechanicalEnergy() / initialEnergy);
+    if (integrator.time() >= freeFrom) {
+      outcome.energyMeasured = true;
+      // Total energy, with the potential of the loads that stay constant (gravity, endless pulls).
+      const double potential =
+          simulation.constantLoad.size() > 0 ? simulation.constantLoad.dot(integrator.displacement()) : 0.0;
+      const double energy = integrator.mechanicalEnergy() - potential;
+      if (referenceEnergy < 0.0) referenceEnergy = energy;
+      if (referenceEnergy > 0.0) outcome.energyGrowth = std::max(outcome.energyGrowth, energy / referenceEnergy);
+    }
     outcome.maxDisplacement = std::max(outcome.maxDisplacement, integrator.displacement().cwiseAbs().maxCoeff());
   }
   outcome.seconds = watch.stop();
   return outcome;
+}
+
+Outcome runCase(const Case& run, const fs::path& meshFile, int frames) {
+  Scene scene = sceneFor(run, meshFile);
+  scene.frames.count = frames;
+  Simulation simulation = buildSimulation(scene);
+  Integrator& integrator = *simulation.integrator;
+  const Eigen::Matrix3Xd& rest = simulation.mesh->restPositions();
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(integrator.system().numDofs());
+  for (int v = 0; v < rest.cols(); ++v) u[3 * v + 1] = 0.02 * rest(0, v) * rest(0, v) / kLength;
+  integrator.setState(u, Eigen::VectorXd::Zero(u.size()));
+  return runSimulation(simulation, frames, 0.0, integrator.mechanicalEnergy());  // free from t = 0: E / E_0
 }
 
 std::string describe(const Case& c) {
@@ -190,6 +212,37 @@ std::string describe(const Case& c) {
   if (c.integrator != "backward-euler") out << ", m = " << c.ratio;
   out << ", damping " << c.damping.name << ", " << (c.perturbed ? "perturbed" : "regular") << " mesh";
   return out.str();
+}
+
+// Runs work(i) for i in [0, count) on `workers` threads (cases are independent); calls
+// report(i, outcome) in index order, under a lock, as soon as cases 0..i are done. A case
+// that throws is reported as failed at frame 0.
+void runOrdered(std::size_t count, int workers, const std::function<Outcome(std::size_t)>& work,
+                const std::function<void(std::size_t, const Outcome&)>& report) {
+  std::vector<Outcome> outcomes(count);
+  std::vector<char> done(count, 0);
+  std::atomic<std::size_t> next{0};
+  std::mutex mutex;
+  std::size_t reported = 0;
+  auto worker = [&] {
+    for (std::size_t index = next++; index < count; index = next++) {
+      Outcome outcome;
+      try {
+        outcome = work(index);
+      } catch (const std::exception& error) {
+        outcome.failedFrame = 0;
+        outcome.failure = std::string("setup failed: ") + error.what();
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      outcomes[index] = outcome;
+      done[index] = 1;
+      for (; reported < count && done[reported]; ++reported) report(reported, outcomes[reported]);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int w = 1; w < workers; ++w) pool.emplace_back(worker);
+  worker();
+  for (std::thread& thread : pool) thread.join();
 }
 
 // The selection lists the user can narrow: an empty list means the grid's default.
@@ -273,16 +326,9 @@ int run(const Options& options) {
       << "| integrator | stiffness ratio | m | damping | mesh | energy growth | first bad frame | max abs(u) | s |\n";
   std::cout << "|---|---|---|---|---|---|---|---|---|\n";
 
-  // Runs are independent: workers take the next case; results are printed in grid order.
-  std::vector<Outcome> outcomes(jobs.size());
-  std::vector<char> done(jobs.size(), 0);
-  std::atomic<std::size_t> next{0};
-  std::mutex mutex;
-  std::size_t printed = 0;
   std::vector<std::string> problems;
-  auto report = [&](std::size_t index) {
+  auto report = [&](std::size_t index, const Outcome& o) {
     const Case& c = jobs[index].c;
-    const Outcome& o = outcomes[index];
     const bool grows = o.energyGrowth > 1.0 + 1e-9;
     std::cout << "| " << c.integrator << (c.variant.empty() ? "" : " " + c.variant) << " | " << c.stiffnessRatio
               << " | " << (c.integrator == "backward-euler" ? std::string("-") : std::to_string(c.ratio)) << " | "
@@ -305,26 +351,10 @@ int run(const Options& options) {
       problems.push_back(line.str());
     }
   };
-  auto work = [&] {
-    for (std::size_t index = next++; index < jobs.size(); index = next++) {
-      Outcome o;
-      try {
-        o = runCase(jobs[index].c, jobs[index].meshFile, frames);
-      } catch (const std::exception& error) {
-        o.failedFrame = 0;
-        o.failure = std::string("setup failed: ") + error.what();
-      }
-      const std::lock_guard<std::mutex> lock(mutex);
-      outcomes[index] = o;
-      done[index] = 1;
-      while (printed < jobs.size() && done[printed]) report(printed++);
-    }
-  };
   Stopwatch total;
-  std::vector<std::thread> pool;
-  for (int w = 1; w < workers; ++w) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+  runOrdered(
+      jobs.size(), workers, [&](std::size_t index) { return runCase(jobs[index].c, jobs[index].meshFile, frames); },
+      report);
   std::cout << "\n"
             << jobs.size() << " runs in " << total.stop() << " s; " << problems.size()
             << " with a blow-up or energy growth (E/E0 > 1 + 1e-9)\n";
@@ -334,6 +364,92 @@ int run(const Options& options) {
   return 0;
 }
 
+// A number as the tables print it (6 significant digits).
+std::string formatGrowth(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+// --scene: a user's multirate scene under several ratios m (every region's ratio set to
+// m), and backward Euler at its large step, for its frames (or --frames); energy growth
+// is measured once the loads are over.
+int runScene(const Options& options) {
+  const Scene base = loadScene(options.scene);
+  const bool multirate = base.integrator.name == "async" || base.integrator.name == "multirate-uncoupled";
+  if (!multirate || !base.integrator.options.contains("regions") || !base.integrator.options["regions"].is_array()) {
+    throw Error(options.scene +
+                ": integrator: --scene needs an \"async\" or \"multirate-uncoupled\" scene with explicit "
+                "regions (not \"auto\")");
+  }
+  const int frames = options.framesGiven ? options.frames : base.frames.count;
+  const std::vector<int> ratios = chosen(options.ratios, {2, 4, 8, 16, 32, 64});
+  const std::vector<std::string> integrators = chosen(
+      options.integrators, {base.integrator.name == "async" ? "async" : "multirate-uncoupled", "backward-euler"});
+  struct Job {
+    std::string integrator;  // name from the --integrators list
+    int ratio;
+  };
+  std::vector<Job> jobs;
+  for (const std::string& integrator : integrators) {
+    for (const int ratio : ratios) {
+      if (integrator == "backward-euler" && ratio != ratios.front()) continue;  // m does not apply
+      jobs.push_back({integrator, ratio});
+    }
+  }
+  auto sceneFor = [&](const Job& job) {
+    Scene scene = base;
+    scene.frames.count = frames;
+    if (job.integrator == "backward-euler") {
+      scene.integrator.name = "backward-euler";
+      scene.integrator.options = nlohmann::json::object();
+      return scene;
+    }
+    scene.integrator.name = job.integrator == "multirate-uncoupled" ? "multirate-uncoupled" : "async";
+    for (nlohmann::json& region : scene.integrator.options["regions"]) region["ratio"] = job.ratio;
+    if (job.integrator == "async-symmetric") scene.integrator.options["schur"] = "symmetric";
+    if (scene.integrator.name == "multirate-uncoupled") {
+      for (const char* key : {"schur", "method", "recovery", "substepContact"}) scene.integrator.options.erase(key);
+    }
+    return scene;
+  };
+  const int workers = std::max(1, std::min<int>(options.jobs, static_cast<int>(jobs.size())));
+  std::cout << "# stabilityStressTest --scene " << options.scene << ": " << jobs.size() << " runs of " << frames
+            << " frames, hL = " << base.integrator.timestep
+            << "; energy growth from when the last load window closes (not measured with contact)"
+            << "\n\n| integrator | m | energy growth | first bad frame | max abs(u) | s |\n|---|---|---|---|---|---|\n";
+  std::vector<std::string> problems;
+  Stopwatch total;
+  runOrdered(
+      jobs.size(), workers,
+      [&](std::size_t index) {
+        Simulation simulation = buildSimulation(sceneFor(jobs[index]));
+        return runSimulation(simulation, frames, simulation.energyCheckFrom);
+      },
+      [&](std::size_t index, const Outcome& o) {
+        const Job& job = jobs[index];
+        const std::string m = job.integrator == "backward-euler" ? std::string("-") : std::to_string(job.ratio);
+        std::cout << "| " << job.integrator << " | " << m << " | "
+                  << (o.energyMeasured ? formatGrowth(o.energyGrowth) : std::string("-")) << " | "
+                  << (o.failedFrame < 0 ? std::string("-") : std::to_string(o.failedFrame)) << " | "
+                  << o.maxDisplacement << " | " << std::fixed << std::setprecision(1) << o.seconds << std::defaultfloat
+                  << std::setprecision(6) << " |\n";
+        std::cout.flush();
+        const std::string what = job.integrator + (m == "-" ? "" : ", m = " + m);
+        if (o.failedFrame >= 0) {
+          problems.push_back("BLOW-UP: " + what + ": frame " + std::to_string(o.failedFrame) + ": " + o.failure);
+        } else if (o.energyMeasured && o.energyGrowth > 1.0 + 1e-9) {
+          std::ostringstream line;
+          line << "ENERGY GROWTH: " << what << ": max E/E_free = " << o.energyGrowth;
+          problems.push_back(line.str());
+        }
+      });
+  std::cout << "\n"
+            << jobs.size() << " runs in " << total.stop() << " s; " << problems.size()
+            << " with a blow-up or energy growth (E/E_free > 1 + 1e-9)\n";
+  for (const std::string& line : problems) std::cout << "- " << line << "\n";
+  return problems.empty() ? 0 : 3;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -345,7 +461,11 @@ int main(int argc, char** argv) {
   app.add_flag("--full", options.full, "The full grid: 7 stiffness ratios, 6 timestep ratios, >= 10000 frames");
   app.add_option("--cells", options.cells, "Cells of the bar along x, y, z")->expected(3);
   app.add_option("--seed", options.seed, "Seed of the vertex perturbation");
-  app.add_option("--csv", options.csv, "CSV output file");
+  app.add_option("--csv", options.csv, "CSV output file (grid mode)");
+  app.add_option("--scene", options.scene,
+                 "Stress this async or multirate-uncoupled scene instead of the grid: every region's ratio set to each "
+                 "--ratios value (default 2 4 8 16 32 64), plus backward Euler; exit status 3 when a run blows up or "
+                 "gains energy after its loads end");
   app.add_option("--jobs", options.jobs, "Runs in parallel (each run is single-threaded work on a small mesh)")
       ->check(CLI::PositiveNumber);
   app.add_option("--stiffness-ratios", options.stiffnessRatios, "Only these stiffness ratios")
@@ -362,8 +482,9 @@ int main(int argc, char** argv) {
     const int code = app.exit(error);
     return code == 0 ? 0 : 2;
   }
+  options.framesGiven = app.count("--frames") > 0;
   try {
-    return run(options);
+    return options.scene.empty() ? run(options) : runScene(options);
   } catch (const std::exception& error) {
     std::cerr << "stabilityStressTest: " << error.what() << "\n";
     return 1;
