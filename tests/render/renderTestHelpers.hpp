@@ -2,6 +2,8 @@
 // Shared meshes and pixel queries of the render tests.
 #pragma once
 
+#include <unistd.h>
+
 #include <Eigen/Core>
 #include <asyncfem/render/image.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
@@ -39,7 +41,8 @@ inline bool differsFrom(const Image& image, int x, int y, const Eigen::Vector3i&
 
 /// A fresh temporary folder for one test, removed by the caller.
 inline std::filesystem::path freshFolder(const std::string& name) {
-  const std::filesystem::path folder = std::filesystem::temp_directory_path() / ("asyncfem-render-" + name);
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / ("asyncfem-render-" + name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(folder);
   std::filesystem::create_directories(folder);
   return folder;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -28,8 +29,8 @@ class ScratchFolder {
  public:
   ScratchFolder() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            ("asyncfem-" + std::string(info->test_suite_name()) + "-" + std::string(info->name()));
+    path_ = std::filesystem::temp_directory_path() / ("asyncfem-" + std::string(info->test_suite_name()) + "-" +
+                                                      std::string(info->name()) + "-" + std::to_string(::getpid()));
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }

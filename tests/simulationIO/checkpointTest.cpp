@@ -2,6 +2,7 @@
 // The checkpoint next to a simulation output file, and continuing that file after a
 // given frame (what offlineSimulator --resume relies on).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/simulationIO/checkpoint.hpp>
@@ -25,7 +26,8 @@ class CheckpointTest : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    directory_ = fs::temp_directory_path() / ("asyncfem-checkpoint-" + std::string(info->name()));
+    directory_ = fs::temp_directory_path() /
+                 ("asyncfem-checkpoint-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
     fs::remove_all(directory_);
     fs::create_directories(directory_);
   }

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/simulationIO/crc32.hpp>
@@ -23,7 +24,8 @@ class SimulationFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    directory_ = fs::temp_directory_path() / ("asyncfem-simulationIO-" + std::string(info->name()));
+    directory_ = fs::temp_directory_path() /
+                 ("asyncfem-simulationIO-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
     fs::remove_all(directory_);
     fs::create_directories(directory_);
   }

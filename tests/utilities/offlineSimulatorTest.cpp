@@ -42,7 +42,8 @@ class OfflineSimulatorTest : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    folder_ = fs::temp_directory_path() / ("asyncfem-offlineSimulator-" + std::string(info->name()));
+    folder_ = fs::temp_directory_path() /
+              ("asyncfem-offlineSimulator-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
     fs::remove_all(folder_);
     fs::create_directories(folder_);
   }
