@@ -1,17 +1,17 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Asynchronous implicit backward Euler. Every equation number refers to the design note
 // shared/design/async-backward-euler.md ("row r", "last row", "Solving it in O(m)").
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+#include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
-
-#include <Eigen/Dense>
-#include <Eigen/SparseCore>
-
-#include <algorithm>
 #include <cmath>
 #include <string>
+
+#include "detail/multirateSupport.hpp"
 
 namespace asyncfem {
 
@@ -24,12 +24,8 @@ constexpr double kMaxDenseZEntries = 16.0 * 1024 * 1024;
 /// Largest W = (A^L)^{-1} U (doubles) the low-rank Schur form stores: 64M = 512 MiB.
 constexpr double kMaxLowRankEntries = 64.0 * 1024 * 1024;
 
-/// Entries of a full vector at the listed global DOFs.
-Eigen::VectorXd gather(const Eigen::VectorXd& full, const std::vector<int>& dofs) {
-  Eigen::VectorXd out(static_cast<Eigen::Index>(dofs.size()));
-  for (std::size_t k = 0; k < dofs.size(); ++k) out[static_cast<Eigen::Index>(k)] = full[dofs[k]];
-  return out;
-}
+using detail::gather;
+using detail::updateBlock;
 
 /// Appends the entries of block, shifted by (rowOffset, colOffset), to triplets; with a
 /// column map, block column c goes to colOffset + columnMap[c] (and likewise rows).
@@ -52,7 +48,8 @@ SparseMatrix scatterDense(const Eigen::MatrixXd& block, const std::vector<int>& 
   triplets.reserve(static_cast<std::size_t>(block.size()));
   for (Eigen::Index c = 0; c < block.cols(); ++c)
     for (Eigen::Index r = 0; r < block.rows(); ++r)
-      triplets.emplace_back(positions[static_cast<std::size_t>(r)], positions[static_cast<std::size_t>(c)], block(r, c));
+      triplets.emplace_back(positions[static_cast<std::size_t>(r)], positions[static_cast<std::size_t>(c)],
+                            block(r, c));
   SparseMatrix out(size, size);
   out.setFromTriplets(triplets.begin(), triplets.end());
   return out;
@@ -80,16 +77,6 @@ void combineInto(double a, const SparseMatrix& A, double b, const SparseMatrix& 
   for (Eigen::Index k = 0; k < A.nonZeros(); ++k) ov[k] = a * av[k] + b * bv[k];
 }
 
-/// sub = full(rows, cols) through the extractor, values only after the first call.
-void updateBlock(const SubmatrixExtractor& extractor, const SparseMatrix& full, SparseMatrix& sub, bool& cut) {
-  if (!cut) {
-    sub = extractor.extract(full);
-    cut = true;
-  } else {
-    extractor.update(full, sub);
-  }
-}
-
 /// Blocks of one fast region S_i (rows/columns named as in the design note; "I" is the
 /// interface subset of L, the only L DOFs the coupling blocks touch).
 struct RegionBlocks {
@@ -97,16 +84,16 @@ struct RegionBlocks {
   double smallStep = 0.0;  // hS
   SubmatrixExtractor massSS, massSI, massIS, stiffSS, stiffSI, stiffIS;
   SparseMatrix Mss, Kss, Dss, Msi, Ksi, Dsi, Mis, Kis, Dis;
-  bool cut = false;  // K blocks extracted once; later only their values are updated
-  SparseMatrix systemMatrix;   // A^S = M + hS D + hS^2 K
-  SparseMatrix G;              // hS^2 K^{SS}
-  SparseMatrix E;              // hL hS K^{IS}
-  SparseMatrix P;              // M^{IS} + hL D^{IS}  (F - E)
+  bool cut = false;           // K blocks extracted once; later only their values are updated
+  SparseMatrix systemMatrix;  // A^S = M + hS D + hS^2 K
+  SparseMatrix G;             // hS^2 K^{SS}
+  SparseMatrix E;             // hL hS K^{IS}
+  SparseMatrix P;             // M^{IS} + hL D^{IS}  (F - E)
   std::unique_ptr<SparseSolver> solver;
   bool analyzed = false;
   std::vector<Eigen::MatrixXd> z;  // Z_r blocks (dense recovery only)
   bool useDenseZ = false;
-  Eigen::MatrixXd correction;      // C_i = H^{IS} Z, q x q
+  Eigen::MatrixXd correction;  // C_i = H^{IS} Z, q x q
 };
 
 }  // namespace
@@ -114,21 +101,21 @@ struct RegionBlocks {
 struct AsyncBackwardEuler::Impl {
   double largeStep = 0.0;
   bool linear = true;
-  bool built = false;  // blocks and factors valid for the current timestep (linear models)
+  bool built = false;      // blocks and factors valid for the current timestep (linear models)
   SparseMatrix stiffness;  // full 3n x 3n tangent K(u_0)
   Eigen::VectorXd internalForce;
   std::vector<RegionBlocks> regions;
   SubmatrixExtractor massLL, stiffLL;
-  SparseMatrix Mll, Kll;     // M^{LL} (constant), K^{LL}
+  SparseMatrix Mll, Kll;  // M^{LL} (constant), K^{LL}
   bool cutLL = false;
-  SparseMatrix largeSystem;  // A^L
-  SparseMatrix schur;        // H^{LL*} (or its symmetric part)
+  SparseMatrix largeSystem;                   // A^L
+  SparseMatrix schur;                         // H^{LL*} (or its symmetric part)
   std::unique_ptr<SparseSolver> schurSolver;  // of H^{LL*} (lu, symmetric) or of A^L (lowRank)
   bool schurAnalyzed = false;
   // Low-rank form of H^{LL*} = A^L - U C U^T.
-  std::vector<int> interfaceUnion;  // positions in L of every region's interface DOFs
-  Eigen::MatrixXd unionCorrection;  // C, q x q
-  Eigen::MatrixXd lowRankBasis;     // W = (A^L)^{-1} U, |L| x q
+  std::vector<int> interfaceUnion;                   // positions in L of every region's interface DOFs
+  Eigen::MatrixXd unionCorrection;                   // C, q x q
+  Eigen::MatrixXd lowRankBasis;                      // W = (A^L)^{-1} U, |L| x q
   Eigen::PartialPivLU<Eigen::MatrixXd> capacitance;  // I - U^T W C
   // Naive method.
   SparseMatrix naiveSystem;
@@ -174,8 +161,10 @@ AsyncBackwardEuler::AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system
   }
   d.naiveSolver = makeSparseSolver(SolverKind::umfpack);
   if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
-  if (d.linear) stats_.skipped.push_back("per-step refactorization (linear forces: blocks, Z and H^{LL*} factored once)");
-  if (options_.method == AsyncSolveMethod::naive) stats_.skipped.push_back("Schur complement (naive full-system solve)");
+  if (d.linear)
+    stats_.skipped.push_back("per-step refactorization (linear forces: blocks, Z and H^{LL*} factored once)");
+  if (options_.method == AsyncSolveMethod::naive)
+    stats_.skipped.push_back("Schur complement (naive full-system solve)");
 }
 
 AsyncBackwardEuler::~AsyncBackwardEuler() = default;
@@ -207,17 +196,15 @@ void AsyncBackwardEuler::rebuildBlocks() {
   // nothing here.
   if (!d.cutLL) d.Mll = d.massLL.extract(system.mass);
   updateBlock(d.stiffLL, d.stiffness, d.Kll, d.cutLL);
+  d.cutLL = true;
   // A^L = M^{LL} + hL D^{LL} + hL^2 K^{LL}, D = alpha M + beta K.
   combineInto(1.0 + hL * alpha, d.Mll, hL * hL + hL * beta, d.Kll, d.largeSystem);
   for (RegionBlocks& rb : d.regions) {
     const double hS = hL / rb.ratio;
     rb.smallStep = hS;
-    bool cut = rb.cut;
-    updateBlock(rb.stiffSS, d.stiffness, rb.Kss, cut);
-    cut = rb.cut;
-    updateBlock(rb.stiffSI, d.stiffness, rb.Ksi, cut);
-    cut = rb.cut;
-    updateBlock(rb.stiffIS, d.stiffness, rb.Kis, cut);
+    updateBlock(rb.stiffSS, d.stiffness, rb.Kss, rb.cut);
+    updateBlock(rb.stiffSI, d.stiffness, rb.Ksi, rb.cut);
+    updateBlock(rb.stiffIS, d.stiffness, rb.Kis, rb.cut);
     rb.cut = true;
     if (damped) {
       combineInto(alpha, rb.Mss, beta, rb.Kss, rb.Dss);
@@ -276,14 +263,8 @@ void AsyncBackwardEuler::rebuildBlocks() {
     d.naiveSystem.makeCompressed();
     stats.assemblySeconds += assembly.stop();
     factor.start();
-    if (!d.naiveAnalyzed) {
-      d.naiveSolver->analyzePattern(d.naiveSystem);
-      d.naiveAnalyzed = true;
-    }
-    d.naiveSolver->factorize(d.naiveSystem);
+    detail::factorizeCounted(*d.naiveSolver, d.naiveSystem, d.naiveAnalyzed, stats);
     stats.factorizationSeconds += factor.stop();
-    ++stats.factorizations;
-    stats.factorFlops += d.naiveSolver->stats().factorFlops;
     return;
   }
 
@@ -292,13 +273,7 @@ void AsyncBackwardEuler::rebuildBlocks() {
   factor.start();
   schurAsymmetry = 0.0;
   for (RegionBlocks& rb : d.regions) {
-    if (!rb.analyzed) {
-      rb.solver->analyzePattern(rb.systemMatrix);
-      rb.analyzed = true;
-    }
-    rb.solver->factorize(rb.systemMatrix);
-    ++stats.factorizations;
-    stats.factorFlops += rb.solver->stats().factorFlops;
+    detail::factorizeCounted(*rb.solver, rb.systemMatrix, rb.analyzed, stats);
     const int m = rb.ratio;
     const double hS = rb.smallStep;
     const Eigen::Index q = rb.Msi.cols();
@@ -381,17 +356,12 @@ void AsyncBackwardEuler::buildSchurSolver() {
     // H^{LL*} = A^L - U C U^T with U the interface columns and C the sum of the regions'
     // corrections. With W = (A^L)^{-1} U: x = y + W C z, y = (A^L)^{-1} b and
     // (I - U^T W C) z = U^T y (see solveSchur). A^L is SPD: Cholesky.
-    if (!d.schurAnalyzed) {
-      d.schurSolver->analyzePattern(d.largeSystem);
-      d.schurAnalyzed = true;
-    }
-    d.schurSolver->factorize(d.largeSystem);
-    ++stats_.factorizations;
-    stats_.factorFlops += d.schurSolver->stats().factorFlops;
+    detail::factorizeCounted(*d.schurSolver, d.largeSystem, d.schurAnalyzed, stats_);
     d.interfaceUnion = all;
     if (q == 0) return;
     std::vector<int> place(static_cast<std::size_t>(numLarge), -1);
-    for (Eigen::Index k = 0; k < q; ++k) place[static_cast<std::size_t>(all[static_cast<std::size_t>(k)])] = static_cast<int>(k);
+    for (Eigen::Index k = 0; k < q; ++k)
+      place[static_cast<std::size_t>(all[static_cast<std::size_t>(k)])] = static_cast<int>(k);
     d.unionCorrection.setZero(q, q);
     for (int i = 0; i < partition_.numRegions(); ++i) {
       const std::vector<int>& pos = partition_.interfacePositions(i);
@@ -420,13 +390,7 @@ void AsyncBackwardEuler::buildSchurSolver() {
   }
   d.schur.makeCompressed();
   stats_.assemblySeconds += assembly.stop();
-  if (!d.schurAnalyzed) {
-    d.schurSolver->analyzePattern(d.schur);
-    d.schurAnalyzed = true;
-  }
-  d.schurSolver->factorize(d.schur);
-  ++stats_.factorizations;
-  stats_.factorFlops += d.schurSolver->stats().factorFlops;
+  detail::factorizeCounted(*d.schurSolver, d.schur, d.schurAnalyzed, stats_);
 }
 
 Eigen::VectorXd AsyncBackwardEuler::solveSchur(const Eigen::VectorXd& rhs) {
@@ -448,17 +412,8 @@ void AsyncBackwardEuler::step() {
   const bool damped = system_.damped();
   const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
 
-  Stopwatch forces, solve;
-  forces.start();
-  if (d.linear) {
-    if (!d.built) {
-      system_.forceModel->tangentStiffness(u0, d.stiffness);
-    }
-    system_.forceModel->internalForces(u0, d.internalForce);
-  } else {
-    system_.forceModel->forcesAndTangent(u0, d.internalForce, d.stiffness);
-  }
-  stats_.forceSeconds += forces.stop();
+  detail::evaluateForces(system_, d.linear, d.built, u0, d.internalForce, d.stiffness, stats_);
+  Stopwatch solve;
   if (!d.linear || !d.built) {
     rebuildBlocks();
     d.built = true;
@@ -511,14 +466,15 @@ void AsyncBackwardEuler::step() {
     Eigen::VectorXd rhs(d.naiveSystem.rows());
     for (int i = 0; i < numRegions; ++i) {
       const Eigen::MatrixXd& b = rhsS[static_cast<std::size_t>(i)];
-      rhs.segment(d.naiveOffsets[static_cast<std::size_t>(i)], b.size()) = Eigen::Map<const Eigen::VectorXd>(b.data(), b.size());
+      rhs.segment(d.naiveOffsets[static_cast<std::size_t>(i)], b.size()) =
+          Eigen::Map<const Eigen::VectorXd>(b.data(), b.size());
     }
     rhs.tail(rhsL.size()) = rhsL;
     const Eigen::VectorXd sol = d.naiveSolver->solve(rhs);
     for (int i = 0; i < numRegions; ++i) {
       const Eigen::MatrixXd& b = rhsS[static_cast<std::size_t>(i)];
-      X[static_cast<std::size_t>(i)] =
-          Eigen::Map<const Eigen::MatrixXd>(sol.data() + d.naiveOffsets[static_cast<std::size_t>(i)], b.rows(), b.cols());
+      X[static_cast<std::size_t>(i)] = Eigen::Map<const Eigen::MatrixXd>(
+          sol.data() + d.naiveOffsets[static_cast<std::size_t>(i)], b.rows(), b.cols());
     }
     Y = sol.tail(rhsL.size());
   } else {
@@ -606,12 +562,7 @@ void AsyncBackwardEuler::step() {
   }
   stats_.solveSeconds += solve.stop();
 
-  for (Eigen::Index k = 0; k < newU.size(); ++k) {
-    if (!std::isfinite(newU[k]) || !std::isfinite(newV[k])) {
-      throw NumericalError("async integrator: non-finite state at t = " + std::to_string(t0 + hL) + " (vertex " +
-                           std::to_string(k / 3) + ", coordinate " + std::to_string(k % 3) + ")");
-    }
-  }
+  detail::checkFiniteState("async", newU, newV, t0 + hL);
   displacement_ = std::move(newU);
   velocity_ = std::move(newV);
   time_ = t0 + hL;
@@ -619,13 +570,9 @@ void AsyncBackwardEuler::step() {
   // Solve counts and flops, totalled over the solvers (Z columns included).
   stats_.solvedRightHandSides = 0;
   stats_.solveFlops = 0.0;
-  auto count = [this](const SparseSolver& solver) {
-    stats_.solvedRightHandSides += solver.stats().solvedRightHandSides;
-    stats_.solveFlops += static_cast<double>(solver.stats().solvedRightHandSides) * solver.stats().solveFlopsPerRhs;
-  };
-  count(*d.naiveSolver);
-  if (d.schurSolver) count(*d.schurSolver);
-  for (const RegionBlocks& rb : d.regions) count(*rb.solver);
+  detail::addSolveCounts(*d.naiveSolver, stats_);
+  if (d.schurSolver) detail::addSolveCounts(*d.schurSolver, stats_);
+  for (const RegionBlocks& rb : d.regions) detail::addSolveCounts(*rb.solver, stats_);
 }
 
 double AsyncBackwardEuler::solveFloorSeconds(int repeats) {

@@ -8,17 +8,16 @@
 #include <cmath>
 #include <string>
 
+#include "detail/multirateSupport.hpp"
+
 namespace asyncfem {
 
 namespace {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
-Eigen::VectorXd gather(const Eigen::VectorXd& full, const std::vector<int>& dofs) {
-  Eigen::VectorXd out(static_cast<Eigen::Index>(dofs.size()));
-  for (std::size_t k = 0; k < dofs.size(); ++k) out[static_cast<Eigen::Index>(k)] = full[dofs[k]];
-  return out;
-}
+using detail::gather;
+using detail::updateBlock;
 
 /// The blocks one fast region needs for its lone substeps r >= 2 (I: its interface DOFs).
 struct RegionBlocks {
@@ -26,6 +25,7 @@ struct RegionBlocks {
   double smallStep = 0.0;
   SubmatrixExtractor massSS, massSI, stiffSS, stiffSI;
   SparseMatrix Mss, Msi, Kss, Ksi;
+  bool cut = false;           // K blocks extracted once; later only their values are updated
   SparseMatrix systemMatrix;  // A^S
   std::unique_ptr<SparseSolver> solver;
   bool analyzed = false;
@@ -40,6 +40,7 @@ struct UncoupledMultirate::Impl {
   Eigen::VectorXd internalForce;
   SubmatrixExtractor freeMass, freeStiffness;
   SparseMatrix Mff, Kff;
+  bool cutFree = false;
   std::vector<int> freeRegion;  // region of every free DOF (-1: L)
   SparseMatrix compound;
   std::unique_ptr<SparseSolver> compoundSolver;
@@ -101,11 +102,8 @@ void UncoupledMultirate::rebuild() {
   const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
   Stopwatch assembly, factor;
   assembly.start();
-  if (d.Kff.size() == 0) {
-    d.Kff = d.freeStiffness.extract(d.stiffness);
-  } else {
-    d.freeStiffness.update(d.stiffness, d.Kff);
-  }
+  updateBlock(d.freeStiffness, d.stiffness, d.Kff, d.cutFree);
+  d.cutFree = true;
   // Row of a fast region i: c (M + hS D + hS^2 K) with c = 1/m_i on L columns (the
   // interpolated v^L_1); row of L: M + hL D + hL^2 K (backward Euler at hL).
   auto rowStep = [&](int region) { return region < 0 ? hL : hL / partition_.ratio(region); };
@@ -131,35 +129,19 @@ void UncoupledMultirate::rebuild() {
   for (RegionBlocks& rb : d.regions) {
     rb.smallStep = hL / rb.ratio;
     const double hS = rb.smallStep;
-    if (rb.Kss.size() == 0) {
-      rb.Kss = rb.stiffSS.extract(d.stiffness);
-      rb.Ksi = rb.stiffSI.extract(d.stiffness);
-    } else {
-      rb.stiffSS.update(d.stiffness, rb.Kss);
-      rb.stiffSI.update(d.stiffness, rb.Ksi);
-    }
+    updateBlock(rb.stiffSS, d.stiffness, rb.Kss, rb.cut);
+    updateBlock(rb.stiffSI, d.stiffness, rb.Ksi, rb.cut);
+    rb.cut = true;
     rb.systemMatrix = (1.0 + hS * alpha) * rb.Mss + (hS * hS + hS * beta) * rb.Kss;
     rb.systemMatrix.makeCompressed();
   }
   stats_.assemblySeconds += assembly.stop();
 
   factor.start();
-  if (!d.compoundAnalyzed) {
-    d.compoundSolver->analyzePattern(d.compound);
-    d.compoundAnalyzed = true;
-  }
-  d.compoundSolver->factorize(d.compound);
-  ++stats_.factorizations;
-  stats_.factorFlops += d.compoundSolver->stats().factorFlops;
+  detail::factorizeCounted(*d.compoundSolver, d.compound, d.compoundAnalyzed, stats_);
   for (RegionBlocks& rb : d.regions) {
     if (rb.ratio == 1) continue;  // no lone substep: A^S is never solved
-    if (!rb.analyzed) {
-      rb.solver->analyzePattern(rb.systemMatrix);
-      rb.analyzed = true;
-    }
-    rb.solver->factorize(rb.systemMatrix);
-    ++stats_.factorizations;
-    stats_.factorFlops += rb.solver->stats().factorFlops;
+    detail::factorizeCounted(*rb.solver, rb.systemMatrix, rb.analyzed, stats_);
   }
   stats_.factorizationSeconds += factor.stop();
 }
@@ -173,15 +155,8 @@ void UncoupledMultirate::step() {
   const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
   const bool damped = system_.damped();
 
-  Stopwatch forces, solve;
-  forces.start();
-  if (d.linear) {
-    if (!d.built) system_.forceModel->tangentStiffness(u0, d.stiffness);
-    system_.forceModel->internalForces(u0, d.internalForce);
-  } else {
-    system_.forceModel->forcesAndTangent(u0, d.internalForce, d.stiffness);
-  }
-  stats_.forceSeconds += forces.stop();
+  detail::evaluateForces(system_, d.linear, d.built, u0, d.internalForce, d.stiffness, stats_);
+  Stopwatch solve;
   if (!d.linear || !d.built) {
     rebuild();
     d.built = true;
@@ -266,24 +241,15 @@ void UncoupledMultirate::step() {
   }
   stats_.solveSeconds += solve.stop();
 
-  for (Eigen::Index k = 0; k < newU.size(); ++k) {
-    if (!std::isfinite(newU[k]) || !std::isfinite(newV[k])) {
-      throw NumericalError("multirate-uncoupled integrator: non-finite state at t = " + std::to_string(t0 + hL) +
-                           " (vertex " + std::to_string(k / 3) + ", coordinate " + std::to_string(k % 3) + ")");
-    }
-  }
+  detail::checkFiniteState("multirate-uncoupled", newU, newV, t0 + hL);
   displacement_ = std::move(newU);
   velocity_ = std::move(newV);
   time_ = t0 + hL;
   ++stats_.steps;
-  stats_.solvedRightHandSides = d.compoundSolver->stats().solvedRightHandSides;
-  stats_.solveFlops =
-      static_cast<double>(d.compoundSolver->stats().solvedRightHandSides) * d.compoundSolver->stats().solveFlopsPerRhs;
-  for (const RegionBlocks& rb : d.regions) {
-    stats_.solvedRightHandSides += rb.solver->stats().solvedRightHandSides;
-    stats_.solveFlops +=
-        static_cast<double>(rb.solver->stats().solvedRightHandSides) * rb.solver->stats().solveFlopsPerRhs;
-  }
+  stats_.solvedRightHandSides = 0;
+  stats_.solveFlops = 0.0;
+  detail::addSolveCounts(*d.compoundSolver, stats_);
+  for (const RegionBlocks& rb : d.regions) detail::addSolveCounts(*rb.solver, stats_);
 }
 
 long long UncoupledMultirate::factorNonZeros() const {
