@@ -205,14 +205,17 @@ void writeMotionKept(const fs::path& path, const Scene& scene, const std::vector
   std::cout << "\n## Motion kept per frequency band\n\nRMS over frames of the modal coordinates of each band, run / "
                "exact (1: nothing lost; below 1: artificial damping; insensitive to phase). Bands by omega hL, hL = "
             << formatTimestep(hL) << " (the scene's step).\n\n| configuration |";
-  const std::vector<ModalBand> header = motionKeptPerBand(modal, reference.frames, reference.frames, edges);
+  // The reference is projected onto the modes once and compared with every run.
+  const std::vector<Eigen::VectorXd> referenceModal = modalTrajectory(modal, reference.frames);
+  const std::vector<ModalBand> header = motionKeptPerBand(modal.eigenvalues(), referenceModal, referenceModal, edges);
   for (std::size_t b = 0; b < header.size(); ++b)
     std::cout << " " << names[b] << " (" << header[b].modes << " modes) |";
   std::cout << "\n|---|";
   for (std::size_t b = 0; b < header.size(); ++b) std::cout << "---|";
   std::cout << "\n";
   for (const RunResult& r : results) {
-    const std::vector<ModalBand> bands = motionKeptPerBand(modal, r.frames, reference.frames, edges);
+    const std::vector<ModalBand> bands =
+        motionKeptPerBand(modal.eigenvalues(), modalTrajectory(modal, r.frames), referenceModal, edges);
     std::cout << "| " << r.configuration.label << " |";
     csv << '"' << r.configuration.label << '"';
     for (const ModalBand& band : bands) {

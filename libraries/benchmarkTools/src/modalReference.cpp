@@ -179,13 +179,21 @@ Eigen::VectorXd ModalReference::modalCoordinates(const Eigen::VectorXd& displace
   return modes_.transpose() * (freeMass_ * freeDofs_.restrict(displacement));
 }
 
-std::vector<ModalBand> motionKeptPerBand(const ModalReference& modal, const std::vector<Eigen::VectorXd>& run,
-                                         const std::vector<Eigen::VectorXd>& reference,
+std::vector<Eigen::VectorXd> modalTrajectory(const ModalReference& modal, const std::vector<Eigen::VectorXd>& run) {
+  std::vector<Eigen::VectorXd> out;
+  out.reserve(run.size());
+  for (const Eigen::VectorXd& u : run) out.push_back(modal.modalCoordinates(u));
+  return out;
+}
+
+std::vector<ModalBand> motionKeptPerBand(const Eigen::VectorXd& eigenvalues,
+                                         const std::vector<Eigen::VectorXd>& runModal,
+                                         const std::vector<Eigen::VectorXd>& referenceModal,
                                          const std::vector<double>& bandEdges) {
   if (bandEdges.empty() || bandEdges.front() < 0.0 || !std::is_sorted(bandEdges.begin(), bandEdges.end())) {
     throw Error("motionKeptPerBand: band edges must be ascending and >= 0");
   }
-  const Eigen::VectorXd& lambda = modal.eigenvalues();
+  const Eigen::VectorXd& lambda = eigenvalues;
   std::vector<ModalBand> bands(bandEdges.size());
   std::vector<int> bandOf(static_cast<std::size_t>(lambda.size()), -1);
   for (std::size_t b = 0; b < bands.size(); ++b) {
@@ -203,10 +211,10 @@ std::vector<ModalBand> motionKeptPerBand(const ModalReference& modal, const std:
     }
   }
   std::vector<double> runSum(bands.size(), 0.0), referenceSum(bands.size(), 0.0);
-  const std::size_t frames = std::min(run.size(), reference.size());
+  const std::size_t frames = std::min(runModal.size(), referenceModal.size());
   for (std::size_t k = 0; k < frames; ++k) {
-    const Eigen::VectorXd q = modal.modalCoordinates(run[k]);
-    const Eigen::VectorXd r = modal.modalCoordinates(reference[k]);
+    const Eigen::VectorXd& q = runModal[k];
+    const Eigen::VectorXd& r = referenceModal[k];
     for (Eigen::Index j = 0; j < q.size(); ++j) {
       const int b = bandOf[static_cast<std::size_t>(j)];
       if (b < 0) continue;
@@ -219,6 +227,17 @@ std::vector<ModalBand> motionKeptPerBand(const ModalReference& modal, const std:
         referenceSum[b] > 0.0 ? std::sqrt(runSum[b] / referenceSum[b]) : std::numeric_limits<double>::quiet_NaN();
   }
   return bands;
+}
+
+std::vector<ModalBand> motionKeptPerBand(const ModalReference& modal, const std::vector<Eigen::VectorXd>& run,
+                                         const std::vector<Eigen::VectorXd>& reference,
+                                         const std::vector<double>& bandEdges) {
+  const std::size_t frames = std::min(run.size(), reference.size());
+  const std::vector<Eigen::VectorXd> runFrames(run.begin(), run.begin() + static_cast<std::ptrdiff_t>(frames));
+  const std::vector<Eigen::VectorXd> referenceFrames(reference.begin(),
+                                                     reference.begin() + static_cast<std::ptrdiff_t>(frames));
+  return motionKeptPerBand(modal.eigenvalues(), modalTrajectory(modal, runFrames),
+                           modalTrajectory(modal, referenceFrames), bandEdges);
 }
 
 }  // namespace asyncfem

@@ -115,4 +115,14 @@ std::vector<ModalBand> motionKeptPerBand(const ModalReference& modal, const std:
                                          const std::vector<Eigen::VectorXd>& reference,
                                          const std::vector<double>& bandEdges);
 
+/// The same from modal coordinates already computed (modalTrajectory), so a reference
+/// compared with many runs is projected once; eigenvalues: ModalReference::eigenvalues().
+std::vector<ModalBand> motionKeptPerBand(const Eigen::VectorXd& eigenvalues,
+                                         const std::vector<Eigen::VectorXd>& runModal,
+                                         const std::vector<Eigen::VectorXd>& referenceModal,
+                                         const std::vector<double>& bandEdges);
+
+/// modalCoordinates of every frame of a trajectory.
+std::vector<Eigen::VectorXd> modalTrajectory(const ModalReference& modal, const std::vector<Eigen::VectorXd>& run);
+
 }  // namespace asyncfem
