@@ -17,7 +17,7 @@ IntegratorFactory uncoupledMultirateIntegratorFactory() {
     }
     // Keys of the async integrator that have no meaning here: reject them by name rather
     // than silently ignoring a setting the user expects to matter.
-    for (const char* key : {"schur", "method", "recovery", "substepContact"}) {
+    for (const char* key : {"coupling", "schur", "method", "recovery", "substepContact"}) {
       if (options.contains(key)) {
         JsonObjectReader::failAt(scene.sourceName, path + "." + key,
                                  "used by \"async\" only, not by \"multirate-uncoupled\"");

@@ -36,7 +36,20 @@ enum class RecoveryMode {
   denseZ,        ///< X = y - Z Y_I with Z = (H^{SS})^{-1} H^{SI} stored densely (m_i |S_i| x |I_i|)
 };
 
+/// How a fast region and L exchange forces inside a large step (docs/asynchronous-integrator.md,
+/// section "Coupling").
+enum class AsyncCoupling {
+  /// L moves at its end-of-step velocity inside the large step, interface
+  /// elements are subcycled with S and L receives their force averaged over the substeps.
+  /// The discrete energy of a free linear run never increases, for every ratio m.
+  stable,
+  /// Zhao, Li & Barbic 2016 as published: L's velocity interpolated linearly, the interface
+  /// force on L taken at the end of the step. Only conditionally stable in m.
+  paper,
+};
+
 struct AsyncOptions {
+  AsyncCoupling coupling = AsyncCoupling::paper;
   SchurMode schur = SchurMode::lowRank;
   AsyncSolveMethod method = AsyncSolveMethod::structured;
   RecoveryMode recovery = RecoveryMode::automatic;
