@@ -1,13 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Asynchronous implicit backward Euler. Every equation number refers to the design note
-// shared/design/async-backward-euler.md ("row r", "last row", "Solving it in O(m)").
+// Asynchronous implicit backward Euler. Equation numbers (A1)-(A12) refer to
+// docs/asynchronous-integrator.md, section "Method".
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <array>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>
 #include <string>
 
@@ -39,6 +41,15 @@ void appendTriplets(const SparseMatrix& block, double scale, int rowOffset, int 
       triplets.emplace_back(rowOffset + row, colOffset + col, scale * it.value());
     }
   }
+}
+
+/// Address of the stored entry (row, column) of a compressed matrix, or nullptr.
+double* findEntry(SparseMatrix& matrix, int row, int column) {
+  const int* begin = matrix.innerIndexPtr() + matrix.outerIndexPtr()[column];
+  const int* end = matrix.innerIndexPtr() + matrix.outerIndexPtr()[column + 1];
+  const int* it = std::lower_bound(begin, end, row);
+  if (it == end || *it != row) return nullptr;
+  return matrix.valuePtr() + (it - matrix.innerIndexPtr());
 }
 
 /// A dense q x q block scattered into a |L| x |L| sparse matrix at the listed positions,
@@ -77,8 +88,62 @@ void combineInto(double a, const SparseMatrix& A, double b, const SparseMatrix& 
   for (Eigen::Index k = 0; k < A.nonZeros(); ++k) ov[k] = a * av[k] + b * bv[k];
 }
 
-/// Blocks of one fast region S_i (rows/columns named as in the design note; "I" is the
-/// interface subset of L, the only L DOFs the coupling blocks touch).
+/// The scalar coefficients of the coupling blocks of one fast region, Eqs. (A5)-(A6) and
+/// (A9)-(A10), for r, i = 1..m (entry r - 1, i - 1):
+///   B_r = bM[r] M^{SI} + bD[r] D^{SI} + bK[r] K^{SI}     (S row r, coefficient of Y)
+///   E_i = eM[i] M^{IS} + eD[i] D^{IS} + eK[i] K^{IS}     (L row, coefficient of X_i)
+/// and interfaceWeight = (1 - theta) hL^2, the share of the interface elements' stiffness
+/// taken out of A^L (Eq. A11; 0 for the paper's coupling).
+struct CouplingCoefficients {
+  Eigen::VectorXd bM, bD, bK, eM, eD, eK;
+  double interfaceWeight = 0.0;
+};
+
+CouplingCoefficients couplingCoefficients(AsyncCoupling coupling, int m, double hL) {
+  const double hS = hL / m;
+  CouplingCoefficients c;
+  for (Eigen::VectorXd* v : {&c.bM, &c.bD, &c.bK, &c.eM, &c.eD, &c.eK}) v->setZero(m);
+  for (int r = 1; r <= m; ++r) {
+    const Eigen::Index k = r - 1;
+    if (coupling == AsyncCoupling::paper) {
+      // L's velocity interpolated linearly, u^L_r = u^L_0 + r hS v^L_r; the interface force
+      // on L taken at the end of the step (Eqs. A5, A6).
+      c.bM[k] = 1.0 / m;
+      c.bD[k] = r * hS / m;
+      c.bK[k] = double(r) * r * hS * hS / m;
+      c.eK[k] = hL * hS;
+      if (r == m) {
+        c.eM[k] = 1.0;
+        c.eD[k] = hL;
+      }
+    } else {
+      // L at its end-of-step velocity from the first substep on, the interface elements'
+      // force on L averaged over the substeps (Eqs. A9, A10).
+      c.bM[k] = r == 1 ? 1.0 : 0.0;
+      c.bD[k] = hS;
+      c.bK[k] = r * hS * hS;
+      c.eD[k] = hS;
+      c.eK[k] = (m - r + 1) * hS * hS;
+      if (r == m) c.eM[k] = 1.0;
+    }
+  }
+  if (coupling == AsyncCoupling::stable) {
+    const double theta = (m + 1.0) / (2.0 * m);
+    c.interfaceWeight = (1.0 - theta) * hL * hL;
+  }
+  return c;
+}
+
+/// One interface element of a fast region (vertices in S_i and in L): where its DOFs sit
+/// among the region's interface DOFs I_i (-1 for S DOFs and fixed DOFs), and its tangent.
+struct InterfaceElement {
+  int element = 0;
+  std::array<int, 12> interfaceIndex{};
+  Eigen::Matrix<double, 12, 12> tangent;
+};
+
+/// Blocks of one fast region S_i (rows/columns named as in docs/asynchronous-integrator.md;
+/// "I" is the interface subset of L, the only L DOFs the coupling blocks touch).
 struct RegionBlocks {
   int ratio = 1;
   double smallStep = 0.0;  // hS
@@ -87,8 +152,10 @@ struct RegionBlocks {
   bool cut = false;           // K blocks extracted once; later only their values are updated
   SparseMatrix systemMatrix;  // A^S = M + hS D + hS^2 K
   SparseMatrix G;             // hS^2 K^{SS}
-  SparseMatrix E;             // hL hS K^{IS}
-  SparseMatrix P;             // M^{IS} + hL D^{IS}  (F - E)
+  CouplingCoefficients coupling;
+  // Stable coupling: the interface elements and K_I^{II}, their stiffness on I x I (dense).
+  std::vector<InterfaceElement> interfaceElements;
+  Eigen::MatrixXd interfaceStiffness;
   std::unique_ptr<SparseSolver> solver;
   bool analyzed = false;
   std::vector<Eigen::MatrixXd> z;  // Z_r blocks (dense recovery only)
@@ -96,13 +163,24 @@ struct RegionBlocks {
   Eigen::MatrixXd correction;  // C_i = H^{IS} Z, q x q
 };
 
+/// H^{IS} x for x_1..x_m the columns of x (|S| x m or, for Z, blocks side by side): sum_i
+/// E_i x_i = M^{IS} (x eM) + D^{IS} (x eD) + K^{IS} (x eK), Eq. (A7).
+Eigen::MatrixXd applyInterfaceRow(const RegionBlocks& rb, bool damped, const Eigen::MatrixXd& weightedM,
+                                  const Eigen::MatrixXd& weightedD, const Eigen::MatrixXd& weightedK) {
+  Eigen::MatrixXd out = rb.Mis * weightedM;
+  out += rb.Kis * weightedK;
+  if (damped) out += rb.Dis * weightedD;
+  return out;
+}
+
 }  // namespace
 
 struct AsyncBackwardEuler::Impl {
   double largeStep = 0.0;
   bool linear = true;
-  bool built = false;      // blocks and factors valid for the current timestep (linear models)
-  SparseMatrix stiffness;  // full 3n x 3n tangent K(u_0)
+  bool built = false;              // blocks and factors valid for the current timestep (linear models)
+  SparseMatrix stiffness;          // full 3n x 3n tangent K(u_0)
+  bool perElementTangent = false;  // interface element tangents from the force model (else cached linear ones)
   Eigen::VectorXd internalForce;
   std::vector<RegionBlocks> regions;
   SubmatrixExtractor massLL, stiffLL;
@@ -123,6 +201,105 @@ struct AsyncBackwardEuler::Impl {
   bool naiveAnalyzed = false;
   std::vector<int> naiveOffsets;  // first row of region i's X_1; last entry = first row of Y
 };
+
+namespace {
+
+/// Interface elements of every fast region, with their constant linear stiffness when the
+/// force model has no per-element tangent (linear models built from a matrix). Then the
+/// model's K must be the mesh's linear FEM stiffness, which is checked on every column of
+/// an interface DOF (relative 1e-10: the same element matrices summed in another order
+/// differ by round-off, ~1e-15; a different material or a scaled K differs by far more).
+/// Returns whether the force model gives per-element tangents (then they are recomputed at
+/// every rebuild; otherwise the cached linear ones are used).
+bool findInterfaceElements(const TetMesh& mesh, const RegionPartition& partition, const DynamicSystem& system,
+                           std::vector<RegionBlocks>& regions) {
+  const std::vector<int>& vertexRegion = partition.vertexRegion();
+  std::vector<std::vector<int>> interfaceIndex(regions.size());
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    std::vector<int>& index = interfaceIndex[static_cast<std::size_t>(i)];
+    index.assign(static_cast<std::size_t>(mesh.numDofs()), -1);
+    const std::vector<int>& iface = partition.interfaceDofs(i);
+    for (std::size_t k = 0; k < iface.size(); ++k) index[static_cast<std::size_t>(iface[k])] = static_cast<int>(k);
+  }
+  Eigen::VectorXd probe = Eigen::VectorXd::Zero(mesh.numDofs());
+  Eigen::Matrix<double, 12, 12> tangent;
+  const bool perElement = mesh.numElements() > 0 && system.forceModel->elementTangent(probe, 0, tangent);
+  if (!perElement && !system.forceModel->isLinear()) {
+    throw ValidationError(
+        "async integrator: the stable coupling needs the tangent of each interface element, and this nonlinear "
+        "force model gives none (ForceModel::elementTangent); use the coupling \"paper\"");
+  }
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const Eigen::Vector4i vertices = mesh.element(e);
+    int fast = -1;
+    bool touchesLarge = false;
+    for (int a = 0; a < 4; ++a) {
+      const int region = vertexRegion[static_cast<std::size_t>(vertices[a])];
+      if (region >= 0) fast = region;
+      if (region < 0) touchesLarge = true;
+    }
+    if (fast < 0 || !touchesLarge) continue;
+    InterfaceElement element;
+    element.element = e;
+    for (int a = 0; a < 4; ++a)
+      for (int c = 0; c < 3; ++c)
+        element.interfaceIndex[static_cast<std::size_t>(3 * a + c)] =
+            interfaceIndex[static_cast<std::size_t>(fast)][static_cast<std::size_t>(3 * vertices[a] + c)];
+    if (!perElement) {
+      const Material& material = mesh.elementMaterial(e);
+      element.tangent =
+          linearElementStiffness(mesh.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
+    }
+    regions[static_cast<std::size_t>(fast)].interfaceElements.push_back(element);
+  }
+  if (perElement) return true;
+
+  // Check the matrix model against the mesh on the columns of the interface DOFs.
+  Eigen::SparseMatrix<double> stiffness = system.forceModel->createStiffnessMatrix();
+  system.forceModel->tangentStiffness(probe, stiffness);
+  std::vector<int> columnOf(static_cast<std::size_t>(mesh.numDofs()), -1);
+  std::vector<int> columns;
+  for (int i = 0; i < partition.numRegions(); ++i)
+    for (int dof : partition.interfaceDofs(i)) {
+      if (columnOf[static_cast<std::size_t>(dof)] < 0) {
+        columnOf[static_cast<std::size_t>(dof)] = static_cast<int>(columns.size());
+        columns.push_back(dof);
+      }
+    }
+  if (columns.empty()) return false;
+  Eigen::MatrixXd fromMesh = Eigen::MatrixXd::Zero(mesh.numDofs(), static_cast<Eigen::Index>(columns.size()));
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const Eigen::Vector4i vertices = mesh.element(e);
+    bool touches = false;
+    for (int a = 0; a < 4 && !touches; ++a)
+      for (int c = 0; c < 3; ++c) touches = touches || columnOf[static_cast<std::size_t>(3 * vertices[a] + c)] >= 0;
+    if (!touches) continue;
+    const Material& material = mesh.elementMaterial(e);
+    const ElementMatrix ke =
+        linearElementStiffness(mesh.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
+    for (int q = 0; q < 12; ++q) {
+      const int column = columnOf[static_cast<std::size_t>(3 * vertices[q / 3] + q % 3)];
+      if (column < 0) continue;
+      for (int p = 0; p < 12; ++p) fromMesh(3 * vertices[p / 3] + p % 3, column) += ke(p, q);
+    }
+  }
+  Eigen::MatrixXd fromModel = Eigen::MatrixXd::Zero(fromMesh.rows(), fromMesh.cols());
+  for (std::size_t k = 0; k < columns.size(); ++k)
+    for (SparseMatrix::InnerIterator it(stiffness, columns[k]); it; ++it)
+      fromModel(it.row(), static_cast<Eigen::Index>(k)) = it.value();
+  const double scale = std::max(fromMesh.cwiseAbs().maxCoeff(), 1e-300);
+  const double difference = (fromMesh - fromModel).cwiseAbs().maxCoeff() / scale;
+  if (!(difference <= 1e-10)) {
+    throw ValidationError(
+        "async integrator: the stable coupling needs the stiffness of each interface element; the force model "
+        "gives no per-element tangent and its K differs from the mesh's linear FEM stiffness on the interface "
+        "columns (relative difference " +
+        std::to_string(difference) + "): build it from this mesh, or use the coupling \"paper\"");
+  }
+  return false;
+}
+
+}  // namespace
 
 AsyncBackwardEuler::AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system, double largeTimestep,
                                        std::vector<AsyncRegion> regions, AsyncOptions options)
@@ -158,6 +335,9 @@ AsyncBackwardEuler::AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system
     rb.Msi = rb.massSI.extract(mass);
     rb.Mis = rb.massIS.extract(mass);
     rb.solver = makeSparseSolver(options_.regionSolver);
+  }
+  if (options_.coupling == AsyncCoupling::stable) {
+    d.perElementTangent = findInterfaceElements(mesh, partition_, system_, d.regions);
   }
   d.naiveSolver = makeSparseSolver(SolverKind::umfpack);
   if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
@@ -214,10 +394,9 @@ void AsyncBackwardEuler::rebuildBlocks() {
     // A^S = M^{SS} + hS D^{SS} + hS^2 K^{SS}
     combineInto(1.0 + hS * alpha, rb.Mss, hS * hS + hS * beta, rb.Kss, rb.systemMatrix);
     combineInto(0.0, rb.Mss, hS * hS, rb.Kss, rb.G);
-    combineInto(0.0, rb.Mis, hL * hS, rb.Kis, rb.E);
-    // P = M^{IS} + hL D^{IS} = (1 + hL alpha) M^{IS} + hL beta K^{IS}
-    combineInto(1.0 + hL * alpha, rb.Mis, hL * beta, rb.Kis, rb.P);
+    rb.coupling = couplingCoefficients(options.coupling, rb.ratio, hL);
   }
+  if (options.coupling == AsyncCoupling::stable) subtractInterfaceStiffness();
   stats.assemblySeconds += assembly.stop();
 
   if (options.method == AsyncSolveMethod::naive) {
@@ -237,24 +416,24 @@ void AsyncBackwardEuler::rebuildBlocks() {
       const RegionBlocks& rb = d.regions[i];
       const int m = rb.ratio;
       const int s = static_cast<int>(rb.Mss.rows());
-      const double hS = rb.smallStep;
       const std::vector<int>& ifacePos = partition.interfacePositions(static_cast<int>(i));
       const SparseMatrix C = rb.G - rb.Mss;
+      const CouplingCoefficients& k = rb.coupling;
       for (int r = 1; r <= m; ++r) {
         const int row = d.naiveOffsets[i] + (r - 1) * s;
         appendTriplets(rb.systemMatrix, 1.0, row, row, triplets);
         if (r >= 2) appendTriplets(C, 1.0, row, row - s, triplets);
         for (int j = 1; j <= r - 2; ++j) appendTriplets(rb.G, 1.0, row, d.naiveOffsets[i] + (j - 1) * s, triplets);
-        // B_r = (M^{SL} + r hS D^{SL} + r^2 hS^2 K^{SL}) / m, columns at the interface.
-        SparseMatrix B = rb.Msi + (double(r) * r * hS * hS) * rb.Ksi;
-        if (damped) B += (double(r) * hS) * rb.Dsi;
-        appendTriplets(B, 1.0 / m, row, offset, triplets, nullptr, &ifacePos);
+        // B_r (Eq. A5 or A9), columns at the interface.
+        SparseMatrix B = k.bM[r - 1] * rb.Msi + k.bK[r - 1] * rb.Ksi;
+        if (damped) B += k.bD[r - 1] * rb.Dsi;
+        appendTriplets(B, 1.0, row, offset, triplets, nullptr, &ifacePos);
       }
-      // Last row: E on X_1..X_{m-1}, F = P + E on X_m (rows at the interface of L).
+      // Last row: E_j on X_j (Eq. A6 or A10), rows at the interface of L.
       for (int j = 1; j <= m; ++j) {
-        const int col = d.naiveOffsets[i] + (j - 1) * s;
-        appendTriplets(rb.E, 1.0, offset, col, triplets, &ifacePos, nullptr);
-        if (j == m) appendTriplets(rb.P, 1.0, offset, col, triplets, &ifacePos, nullptr);
+        SparseMatrix E = k.eM[j - 1] * rb.Mis + k.eK[j - 1] * rb.Kis;
+        if (damped) E += k.eD[j - 1] * rb.Dis;
+        appendTriplets(E, 1.0, offset, d.naiveOffsets[i] + (j - 1) * s, triplets, &ifacePos, nullptr);
       }
     }
     appendTriplets(d.largeSystem, 1.0, offset, offset, triplets);
@@ -275,7 +454,6 @@ void AsyncBackwardEuler::rebuildBlocks() {
   for (RegionBlocks& rb : d.regions) {
     detail::factorizeCounted(*rb.solver, rb.systemMatrix, rb.analyzed, stats);
     const int m = rb.ratio;
-    const double hS = rb.smallStep;
     const Eigen::Index q = rb.Msi.cols();
     const double sizeS = static_cast<double>(rb.systemMatrix.rows());
     rb.z.clear();
@@ -297,25 +475,28 @@ void AsyncBackwardEuler::rebuildBlocks() {
     Stopwatch zWatch;
     const Eigen::MatrixXd Msi = Eigen::MatrixXd(rb.Msi), Ksi = Eigen::MatrixXd(rb.Ksi);
     const Eigen::MatrixXd Dsi = damped ? Eigen::MatrixXd(rb.Dsi) : Eigen::MatrixXd();
-    Eigen::MatrixXd sum, prev, rhs, x;
+    const CouplingCoefficients& k = rb.coupling;
+    const Eigen::Index sizeRows = rb.systemMatrix.rows();
+    Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(sizeRows, q), prev, rhs, x;
+    Eigen::MatrixXd weightedM = Eigen::MatrixXd::Zero(sizeRows, q), weightedK = weightedM, weightedD;
+    if (damped) weightedD = weightedM;
     for (int r = 1; r <= m; ++r) {
-      rhs = (1.0 / m) * Msi + (double(r) * r * hS * hS / m) * Ksi;
-      if (damped) rhs += (double(r) * hS / m) * Dsi;
+      rhs = k.bM[r - 1] * Msi + k.bK[r - 1] * Ksi;
+      if (damped) rhs += k.bD[r - 1] * Dsi;
       if (r >= 2) {
         rhs -= rb.G * sum;
         rhs += rb.Mss * prev;
       }
       rb.solver->solve(rhs, x);
-      if (r == 1) {
-        sum = x;
-      } else {
-        sum += x;
-      }
+      sum += x;
+      if (k.eM[r - 1] != 0.0) weightedM += k.eM[r - 1] * x;
+      weightedK += k.eK[r - 1] * x;
+      if (damped) weightedD += k.eD[r - 1] * x;
       prev = x;
       if (rb.useDenseZ) rb.z.push_back(x);
     }
-    // H^{IS} Z = E sum_r Z_r + (F - E) Z_m.
-    rb.correction = rb.E * sum + rb.P * prev;
+    // C_i = H^{IS} Z = sum_r E_r Z_r (Eq. A7).
+    rb.correction = applyInterfaceRow(rb, damped, weightedM, weightedD, weightedK);
     zColumnSeconds_ += zWatch.stop();
     const double norm = rb.correction.norm();
     if (norm > 0.0) {
@@ -326,6 +507,44 @@ void AsyncBackwardEuler::rebuildBlocks() {
   factor.start();
   buildSchurSolver();
   stats.factorizationSeconds += factor.stop();
+}
+
+// Stable coupling: A^L becomes Â^L = A^L - sum_i (1 - theta_i) hL^2 K_{I_i}^{II} (Eq. A11),
+// with K_{I_i} the tangent of region i's interface elements at u_0. The change lies on
+// entries of interface-vertex pairs that share an element, so A^L's pattern holds them.
+void AsyncBackwardEuler::subtractInterfaceStiffness() {
+  Impl& d = *impl_;
+  const std::vector<int>& large = partition_.largeDofs();
+  for (int i = 0; i < partition_.numRegions(); ++i) {
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    const std::vector<int>& pos = partition_.interfacePositions(i);
+    const auto q = static_cast<Eigen::Index>(pos.size());
+    rb.interfaceStiffness.setZero(q, q);
+    for (InterfaceElement& element : rb.interfaceElements) {
+      if (d.perElementTangent) system_.forceModel->elementTangent(displacement_, element.element, element.tangent);
+      for (int b = 0; b < 12; ++b) {
+        const int column = element.interfaceIndex[static_cast<std::size_t>(b)];
+        if (column < 0) continue;
+        for (int a = 0; a < 12; ++a) {
+          const int row = element.interfaceIndex[static_cast<std::size_t>(a)];
+          if (row >= 0) rb.interfaceStiffness(row, column) += element.tangent(a, b);
+        }
+      }
+    }
+    for (Eigen::Index b = 0; b < q; ++b) {
+      for (Eigen::Index a = 0; a < q; ++a) {
+        if (rb.interfaceStiffness(a, b) == 0.0) continue;
+        const int row = pos[static_cast<std::size_t>(a)], column = pos[static_cast<std::size_t>(b)];
+        double* entry = findEntry(d.largeSystem, row, column);
+        if (entry == nullptr) {
+          throw Error("async integrator: interface DOFs " + std::to_string(large[static_cast<std::size_t>(row)]) +
+                      " and " + std::to_string(large[static_cast<std::size_t>(column)]) +
+                      " share an element but not an entry of A^L (the mass and stiffness patterns differ)");
+        }
+        *entry -= rb.coupling.interfaceWeight * rb.interfaceStiffness(a, b);
+      }
+    }
+  }
 }
 
 void AsyncBackwardEuler::buildSchurSolver() {
@@ -458,6 +677,16 @@ void AsyncBackwardEuler::step() {
     const int dof = large[k];
     rhsL[static_cast<Eigen::Index>(k)] = hL * (externalForce[dof] - stateForce[dof] - hL * stiffVelocity[dof]);
   }
+  // Stable coupling: b^L += (1 - theta) hL^2 (K^{IS} v^S_0 + K_I^{II} v^I_0) (Eq. A12).
+  for (int i = 0; i < numRegions && options_.coupling == AsyncCoupling::stable; ++i) {
+    const RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    const std::vector<int>& pos = partition_.interfacePositions(i);
+    if (pos.empty()) continue;
+    const Eigen::VectorXd correction =
+        rb.coupling.interfaceWeight * (rb.Kis * gather(v0, partition_.regionDofs(i)) +
+                                       rb.interfaceStiffness * gather(v0, partition_.interfaceDofs(i)));
+    for (std::size_t k = 0; k < pos.size(); ++k) rhsL[pos[k]] += correction[static_cast<Eigen::Index>(k)];
+  }
 
   // Solve for X (per region, |S| x m) and Y.
   std::vector<Eigen::MatrixXd> X(static_cast<std::size_t>(numRegions));
@@ -497,9 +726,10 @@ void AsyncBackwardEuler::step() {
       Eigen::MatrixXd& yi = y[static_cast<std::size_t>(i)];
       forwardSubstitute(rb, rhsS[static_cast<std::size_t>(i)], yi);
       if (rb.Mis.rows() == 0) continue;
-      // b^{L*} = b^L - H^{LS} y = b^L - (E sum_r y_r + P y_m) on the interface rows.
-      const Eigen::VectorXd ySum = yi.rowwise().sum();
-      const Eigen::VectorXd coupling = rb.E * ySum + rb.P * yi.col(rb.ratio - 1);
+      // b^{L*} = b^L - H^{LS} y = b^L - sum_r E_r y_r on the interface rows (Eq. A7).
+      const CouplingCoefficients& k = rb.coupling;
+      const Eigen::VectorXd coupling =
+          applyInterfaceRow(rb, damped, yi * k.eM, damped ? Eigen::VectorXd(yi * k.eD) : Eigen::VectorXd(), yi * k.eK);
       const std::vector<int>& pos = partition_.interfacePositions(i);
       for (std::size_t k = 0; k < pos.size(); ++k) rhsSchur[pos[k]] -= coupling[static_cast<Eigen::Index>(k)];
     }
@@ -519,14 +749,14 @@ void AsyncBackwardEuler::step() {
         for (int r = 1; r <= rb.ratio; ++r) xi.col(r - 1) -= rb.z[static_cast<std::size_t>(r - 1)] * yInterface;
       } else {
         // X = (H^{SS})^{-1} (b^S - H^{SL} Y), block r of H^{SL} Y = B_r Y_I.
-        const double hS = rb.smallStep;
+        const CouplingCoefficients& k = rb.coupling;
         const Eigen::VectorXd mY = rb.Msi * yInterface, kY = rb.Ksi * yInterface;
         Eigen::VectorXd dY;
         if (damped) dY = rb.Dsi * yInterface;
         Eigen::MatrixXd b = rhsS[static_cast<std::size_t>(i)];
         for (int r = 1; r <= rb.ratio; ++r) {
-          b.col(r - 1) -= (mY + (double(r) * r * hS * hS) * kY) / rb.ratio;
-          if (damped) b.col(r - 1) -= (double(r) * hS / rb.ratio) * dY;
+          b.col(r - 1) -= k.bM[r - 1] * mY + k.bK[r - 1] * kY;
+          if (damped) b.col(r - 1) -= k.bD[r - 1] * dY;
         }
         forwardSubstitute(rb, b, xi);
       }

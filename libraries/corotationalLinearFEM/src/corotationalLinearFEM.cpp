@@ -234,6 +234,25 @@ void CorotationalLinearFEM::forcesAndTangent(const Eigen::VectorXd& displacement
   assembleTangent(displacement, stiffness);
 }
 
+bool CorotationalLinearFEM::elementTangent(const Eigen::VectorXd& displacement, int element,
+                                           ElementMatrix& tangent) const {
+  checkDisplacement(displacement, "elementTangent");
+  if (element < 0 || element >= numElements()) {
+    throw Error("CorotationalLinearFEM::elementTangent: element " + std::to_string(element) + " is out of range [0, " +
+                std::to_string(numElements()) + ")");
+  }
+  const Index i = toIndex(element);
+  const ElementPositions x = currentPositions(element, displacement);
+  const PolarDecomposition polar = polarDecomposition(x * shapeGradients_[i].transpose());
+  if (tangentKind_ == TangentKind::simple) {
+    simpleElementTangent(elementStiffness_[i], polar.rotation, tangent);
+  } else {
+    exactElementTangent(elementStiffness_[i], polar.rotation, rotationDifferentialOperator(polar), shapeGradients_[i],
+                        x, restPositions_[i], tangent);
+  }
+  return true;
+}
+
 double CorotationalLinearFEM::elasticEnergy(const Eigen::VectorXd& displacement) {
   checkDisplacement(displacement, "elasticEnergy");
   updateRotations(displacement, false);

@@ -117,6 +117,7 @@ private:
   struct Impl;
   void rebuildBlocks();
   void buildSchurSolver();
+  void subtractInterfaceStiffness();
   Eigen::VectorXd solveSchur(const Eigen::VectorXd& rhs);
   RegionPartition partition_;
   AsyncOptions options_;

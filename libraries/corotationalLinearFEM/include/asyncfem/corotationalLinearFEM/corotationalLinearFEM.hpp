@@ -92,6 +92,11 @@ class CorotationalLinearFEM final : public ForceModel {
   /// sum_e 1/2 (R_e^T x_e - X_e)^T K_e (R_e^T x_e - X_e); summed in element order, so
   /// independent of the thread count.
   double elasticEnergy(const Eigen::VectorXd& displacement) override;
+  /// Element e's tangent of tangentKind() at displacement (its own polar decomposition,
+  /// independent of the cached rotations), equal to its contribution to
+  /// tangentStiffness(). Throws asyncfem::Error on a size mismatch or an element out of
+  /// range.
+  bool elementTangent(const Eigen::VectorXd& displacement, int element, ElementMatrix& tangent) const override;
 
   /// Element rotations R_e (numElements 3x3 matrices, det +1) of the last evaluation
   /// (any of the four functions above); identities before the first one.

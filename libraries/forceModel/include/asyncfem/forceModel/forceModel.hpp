@@ -37,6 +37,21 @@ public:
   }
   /// Elastic potential energy at u (0 at rest).
   virtual double elasticEnergy(const Eigen::VectorXd& displacement) = 0;
+
+  /// The tangent stiffness of one element alone, d f_e / d u_e at displacement (12 x 12,
+  /// the DOFs of the element's four vertices in connectivity order), for models that are
+  /// sums of per-element terms over the tet mesh they were built for; the entries equal
+  /// that element's contribution to tangentStiffness() at the same displacement. Returns
+  /// false (the default) when the model has no per-element form. The asynchronous
+  /// integrator's stable coupling asks for the interface elements, a few per step, so
+  /// implementations need not be fast.
+  virtual bool elementTangent(const Eigen::VectorXd& displacement, int element,
+                              Eigen::Matrix<double, 12, 12>& tangent) const {
+    (void)displacement;
+    (void)element;
+    (void)tangent;
+    return false;
+  }
 };
 
 }  // namespace asyncfem
