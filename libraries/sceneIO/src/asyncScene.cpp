@@ -66,7 +66,7 @@ AsyncSceneOptions parseAsyncOptions(const Scene& scene, const TetMesh& mesh, con
                                     const nlohmann::json& options) {
   JsonObjectReader reader(options, "integrator.options", scene.sourceName);
   AsyncSceneOptions out;
-  const std::string coupling = reader.choice("coupling", "paper", {"stable", "paper"});
+  const std::string coupling = reader.choice("coupling", "stable", {"stable", "paper"});
   out.solver.coupling = coupling == "paper" ? AsyncCoupling::paper : AsyncCoupling::stable;
   const std::string schur = reader.choice("schur", "low-rank", {"low-rank", "lu", "symmetric"});
   out.solver.schur = schur == "lu" ? SchurMode::lu : schur == "symmetric" ? SchurMode::symmetric : SchurMode::lowRank;

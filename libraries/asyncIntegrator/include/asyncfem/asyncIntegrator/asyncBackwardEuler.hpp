@@ -21,8 +21,10 @@ enum class SchurMode {
   /// capacitance matrix (q = interface DOFs; W = (A^L)^{-1} U, |L| x q, is stored). Falls
   /// back to lu when W would exceed 512 MiB.
   lowRank,
-  lu,         ///< exact: unsymmetric LU (UMFPACK) of H^{LL*} itself, as in the paper
-  symmetric,  ///< approximate: Cholesky of the symmetric part of H^{LL*}, as in the paper
+  lu,  ///< exact: unsymmetric LU (UMFPACK) of H^{LL*} itself, as in the paper
+  /// Cholesky of the symmetric part of H^{LL*}, as in the paper: approximate for the paper
+  /// coupling; exact (to round-off) for the stable one, whose H^{LL*} is symmetric.
+  symmetric,
 };
 /// How one large step's block system is solved.
 enum class AsyncSolveMethod {
@@ -37,9 +39,9 @@ enum class RecoveryMode {
 };
 
 /// How a fast region and L exchange forces inside a large step (docs/asynchronous-integrator.md,
-/// section "Coupling").
+/// section "Method", Eqs. A4-A12).
 enum class AsyncCoupling {
-  /// L moves at its end-of-step velocity inside the large step, interface
+  /// The default. L moves at its end-of-step velocity inside the large step, interface
   /// elements are subcycled with S and L receives their force averaged over the substeps.
   /// The discrete energy of a free linear run never increases, for every ratio m.
   stable,
@@ -49,7 +51,7 @@ enum class AsyncCoupling {
 };
 
 struct AsyncOptions {
-  AsyncCoupling coupling = AsyncCoupling::paper;
+  AsyncCoupling coupling = AsyncCoupling::stable;
   SchurMode schur = SchurMode::lowRank;
   AsyncSolveMethod method = AsyncSolveMethod::structured;
   RecoveryMode recovery = RecoveryMode::automatic;
@@ -70,10 +72,16 @@ using SubstepObserver = std::function<void(int region, int substep, double time,
                                            const Eigen::VectorXd& regionDisplacement,
                                            const Eigen::VectorXd& regionVelocity)>;
 
-/// Asynchronous implicit backward Euler (Zhao, Li & Barbič 2016; equations as corrected in
-/// the design note shared/design/async-backward-euler.md). Fast regions S_i take m_i
-/// backward Euler substeps of hS_i = hL / m_i per large step hL = timestep() while L takes
-/// one, coupled implicitly: L's velocity is interpolated linearly inside the large step.
+/// Asynchronous implicit backward Euler (Zhao, Li & Barbič 2016, with the equations of
+/// docs/asynchronous-integrator.md). Fast regions S_i take m_i backward Euler substeps of
+/// hS_i = hL / m_i per large step hL = timestep() while L takes one, coupled implicitly
+/// (AsyncCoupling: by default L moves at its end-of-step velocity and receives the
+/// interface elements' force averaged over the substeps, which never gains energy).
+///
+/// The stable coupling needs the tangent of each interface element: from the force
+/// model's elementTangent(), or, for linear models built from a matrix, from the mesh's
+/// linear element stiffness (the model's K is then checked against the mesh's on the
+/// interface columns; a mismatch throws asyncfem::ValidationError).
 ///
 /// Linear force models: every block, Z and H^{LL*} are built and factored once (and again
 /// only after setTimestep). Nonlinear force models (corotational): f_int(u_0) and K(u_0) are
