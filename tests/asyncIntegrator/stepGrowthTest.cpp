@@ -5,6 +5,7 @@
 
 #include <asyncfem/asyncIntegrator/stepGrowth.hpp>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
 #include <cstdio>
 
@@ -124,6 +125,19 @@ TEST(StepGrowth, RejectsSystemsWhoseStepIsNotLinear) {
   EXPECT_FALSE(homogeneous.externalForce);
   EXPECT_EQ(homogeneous.forceModel, ts.system.forceModel);  // already linear: shared
   EXPECT_EQ(homogeneous.freeDofs.numFree(), ts.system.freeDofs.numFree());
+
+  // A corotational model: rejected as it is, replaced by its tangent at rest.
+  DynamicSystem corotational = homogeneous;
+  corotational.forceModel = std::make_shared<CorotationalLinearFEM>(ts.mesh, TangentKind::simple);
+  BackwardEuler nonlinear(corotational, 0.01);
+  EXPECT_THROW(estimateStepGrowth(nonlinear), Error);
+  BackwardEuler linearized(homogeneousLinearSystem(corotational), 0.01);
+  ASSERT_TRUE(linearized.system().forceModel->isLinear());
+  const auto& restTangent = dynamic_cast<const LinearForceModel&>(*linearized.system().forceModel);
+  const auto& linear = dynamic_cast<const LinearForceModel&>(*ts.system.forceModel);
+  EXPECT_LT((Eigen::MatrixXd(restTangent.stiffness()) - Eigen::MatrixXd(linear.stiffness())).norm(),
+            1e-9 * Eigen::MatrixXd(linear.stiffness()).norm());  // K(0) of corotational FEM is linear FEM's K
+  EXPECT_LT(estimateStepGrowth(linearized).spectralRadius, 1.0);
 }
 
 }  // namespace
