@@ -10,7 +10,7 @@
 namespace asyncfem {
 
 /// Per-step growth above which checkPaperCoupling() warns: the estimate of a step that
-/// never gains energy stays below 1 + 5e-6 (stepGrowth.hpp: its Ritz values lie in the
+/// never gains energy stays below 1 + 1e-5 (stepGrowth.hpp: its Ritz values lie in the
 /// numerical range, widened only by the rigid-mode weighting), and a growth of 1e-4 per
 /// large step needs 3,500 large steps to double the energy.
 inline constexpr double kStepGrowthWarningTolerance = 1e-4;
