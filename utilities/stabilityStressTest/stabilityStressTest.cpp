@@ -416,7 +416,9 @@ int runScene(const Options& options) {
     for (nlohmann::json& region : scene.integrator.options["regions"]) region["ratio"] = job.ratio;
     if (job.integrator == "async-symmetric") scene.integrator.options["schur"] = "symmetric";
     if (scene.integrator.name == "multirate-uncoupled") {
-      for (const char* key : {"schur", "method", "recovery", "substepContact"}) scene.integrator.options.erase(key);
+      for (const char* key : {"coupling", "schur", "method", "recovery", "substepContact"}) {
+        scene.integrator.options.erase(key);
+      }
     }
     return scene;
   };
@@ -444,9 +446,14 @@ int runScene(const Options& options) {
       [&](std::size_t index, const Outcome& o) {
         const Job& job = jobs[index];
         const std::string m = job.integrator == "backward-euler" ? std::string("-") : std::to_string(job.ratio);
-        std::cout << "| " << job.integrator << " | " << m << " | " << formatGrowth(o.stepGrowth->spectralRadius)
-                  << (o.stepGrowth->converged ? "" : " (not converged)") << " | " << std::fixed << std::setprecision(1)
-                  << o.stepGrowth->seconds << std::defaultfloat << std::setprecision(6) << " | "
+        std::ostringstream estimate;  // "-" when the scene failed before the estimate
+        if (o.stepGrowth) {
+          estimate << formatGrowth(o.stepGrowth->spectralRadius) << (o.stepGrowth->converged ? "" : " (not converged)")
+                   << " | " << std::fixed << std::setprecision(1) << o.stepGrowth->seconds;
+        } else {
+          estimate << "- | -";
+        }
+        std::cout << "| " << job.integrator << " | " << m << " | " << estimate.str() << " | "
                   << (o.energyMeasured ? formatGrowth(o.energyGrowth) : std::string("-")) << " | "
                   << (o.failedFrame < 0 ? std::string("-") : std::to_string(o.failedFrame)) << " | "
                   << o.maxDisplacement << " | " << std::fixed << std::setprecision(1) << o.seconds << std::defaultfloat
