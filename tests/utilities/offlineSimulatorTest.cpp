@@ -189,6 +189,63 @@ TEST_F(OfflineSimulatorTest, WritesTheRequestedFrames) {
   EXPECT_EQ(r.err.find('\r'), std::string::npos);
 }
 
+/// A bar 1 x 0.25 x 0.25 (8 x 2 x 2 cells) fixed at x = 0 whose last quarter, stiff and
+/// light, is the fast region "tip" (the asynchronous integrator's test bar), hL = 0.1, one
+/// frame. With the paper's coupling its step grows by 1.21657 per large step at m = 32 and
+/// shrinks (0.938) at m = 8 (tests/asyncIntegrator/stepGrowthTest.cpp, dense map).
+nlohmann::json tipBarScene(const std::string& coupling, int ratio) {
+  nlohmann::json scene = nlohmann::json::parse(R"({
+    "mesh": {"generator": "box", "size": [1, 0.25, 0.25], "cells": [8, 2, 2],
+             "material": {"density": 1000, "youngsModulus": 1e5, "poissonRatio": 0.4},
+             "regions": [{"name": "tip", "min": [0.75, -1, -1], "max": [2, 2, 2],
+                          "material": {"density": 200, "youngsModulus": 5e6, "poissonRatio": 0.3}}]},
+    "fixed": {"sets": ["xmin"]},
+    "forces": [{"type": "pull", "set": "xmax", "force": [0, -1, 0], "window": [0, 0.1]}],
+    "integrator": {"name": "async", "timestep": 0.1,
+                   "options": {"regions": [{"name": "tip", "elementSets": ["tip"]}]}},
+    "frames": {"rate": 10, "count": 1},
+    "output": {"file": "out/run.afsim"}
+  })");
+  scene["integrator"]["options"]["regions"][0]["ratio"] = ratio;
+  if (!coupling.empty()) scene["integrator"]["options"]["coupling"] = coupling;
+  return scene;
+}
+
+TEST_F(OfflineSimulatorTest, WarnsWhenThePaperCouplingGrows) {
+  const RunResult unstable = run(quoted(writeScene(tipBarScene("paper", 32))));
+  ASSERT_EQ(unstable.exitCode, 0) << unstable.err;
+  for (const char* expected :
+       {"warning", "integrator.options.coupling", "tip (m = 32)", "1.2165", "\"coupling\": \"stable\"", "smaller m"}) {
+    EXPECT_NE(unstable.err.find(expected), std::string::npos) << "missing '" << expected << "' in\n" << unstable.err;
+  }
+  EXPECT_NE(unstable.out.find("stability   paper coupling, tip (m = 32): step growth estimate 1.2165"),
+            std::string::npos)
+      << unstable.out;
+
+  // Below 1: the estimate in the summary, no warning.
+  const RunResult stable = run(quoted(writeScene(tipBarScene("paper", 8))));
+  ASSERT_EQ(stable.exitCode, 0) << stable.err;
+  EXPECT_EQ(stable.err.find("warning"), std::string::npos) << stable.err;
+  EXPECT_NE(stable.out.find("step growth estimate 0.938"), std::string::npos) << stable.out;
+
+  // Skipped on request.
+  const RunResult skipped = run(quoted(writeScene(tipBarScene("paper", 32))) + " --no-stability-check");
+  ASSERT_EQ(skipped.exitCode, 0) << skipped.err;
+  EXPECT_EQ(skipped.err.find("warning"), std::string::npos) << skipped.err;
+  EXPECT_EQ(skipped.out.find("stability"), std::string::npos) << skipped.out;
+}
+
+TEST_F(OfflineSimulatorTest, NoStabilityCheckForTheStableCouplingOrSingleRate) {
+  nlohmann::json singleRate = tipBarScene("", 32);
+  singleRate["integrator"] = {{"name", "backward-euler"}, {"timestep", 0.1}};
+  for (const nlohmann::json& scene : {tipBarScene("stable", 32), singleRate}) {
+    const RunResult r = run(quoted(writeScene(scene)));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("stability"), std::string::npos) << r.out;
+  }
+}
+
 TEST_F(OfflineSimulatorTest, CommandLineOverridesTheScene) {
   const fs::path scene = writeScene(smallScene());
   const fs::path output = folder_ / "elsewhere/override.afsim";

@@ -3,14 +3,16 @@
 //
 //   offlineSimulator SCENE.json [--output FILE.afsim] [--integrator NAME] [--dt H]
 //                    [--frames N] [--vtu FOLDER] [--resume] [--checkpoint-every K]
-//                    [--progress] [--quiet]
+//                    [--progress] [--quiet] [--no-stability-check]
 //
 // Frames go to one .afsim file (docs/simulation-output.md), optionally one .vtu per
 // frame; progress on stderr, the run summary on stdout. After every K-th frame (default
 // every frame) the full state goes to FILE.afsim.checkpoint, so that --resume continues
 // an interrupted run and produces exactly the file an uninterrupted run would have.
 // SIGINT and SIGTERM stop the run after the current frame, with a checkpoint, and exit
-// with status 128 + the signal number. Errors print "offlineSimulator: <message>" on
+// with status 128 + the signal number. A scene that runs the asynchronous integrator with
+// the paper's coupling gets its step growth estimated before the run (a few dozen steps
+// of the linearized scene) and a warning when a large step can grow. Errors print "offlineSimulator: <message>" on
 // stderr and exit with status 1. What it prints is described in docs/scene-format.md,
 // section "Running a scene".
 #include <unistd.h>
@@ -22,6 +24,7 @@
 #include <asyncfem/core/threading.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/sceneIO/stepGrowthCheck.hpp>
 #include <asyncfem/simulationIO/checkpoint.hpp>
 #include <asyncfem/simulationIO/crc32.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
@@ -32,6 +35,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -58,6 +62,7 @@ struct CommandLine {
   int checkpointEvery = 1;
   bool progress = false;
   bool quiet = false;
+  bool noStabilityCheck = false;
 };
 
 // The signal that asked the run to stop (0: none). A signal handler can only set a flag
@@ -270,7 +275,8 @@ std::string milliseconds(double seconds, int frames) {
 
 void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simulation,
                   const asyncfem::IntegratorStats& before, double setupSeconds, double loopSeconds,
-                  double outputSeconds, std::int64_t outputBytes, int firstFrame) {
+                  double outputSeconds, std::int64_t outputBytes, int firstFrame,
+                  const std::optional<asyncfem::PaperCouplingCheck>& couplingCheck) {
   const asyncfem::IntegratorStats& after = simulation.integrator->stats();
   // Frames computed by this run (a resumed run starts at firstFrame).
   const int frames = std::max(simulation.numFrames - firstFrame, 1);
@@ -289,7 +295,8 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
     out << " (resumed after frame " << firstFrame << " of " << simulation.numFrames << ")";
   }
   out << ", " << steps << " steps of h = " << std::defaultfloat << simulation.timestep << " ("
-      << simulation.stepsPerFrame << " per frame), " << std::fixed << (setupSeconds + loopSeconds) << " s\n";
+      << simulation.stepsPerFrame << " per frame), " << std::fixed
+      << (setupSeconds + loopSeconds + (couplingCheck ? couplingCheck->estimate.seconds : 0.0)) << " s\n";
   out << "  mesh        " << simulation.mesh->numVertices() << " vertices, " << simulation.mesh->numElements()
       << " elements, " << simulation.fixedVertices.size() << " fixed vertices\n";
   out << "  model       "
@@ -301,6 +308,14 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
       << simulation.integrator->name() << "\n";
   out << "  setup       " << setupSeconds << " s (mesh, matrices, first factorization: " << before.factorizationSeconds
       << " s)\n";
+  if (couplingCheck) {
+    const asyncfem::StepGrowthEstimate& estimate = couplingCheck->estimate;
+    out << "  stability   paper coupling, " << couplingCheck->regions << ": step growth estimate " << std::defaultfloat
+        << std::setprecision(6) << estimate.spectralRadius << std::setprecision(3)
+        << (estimate.converged ? "" : " (not converged)") << " from " << estimate.steps
+        << " steps of the linearized scene, " << std::fixed << estimate.seconds << " s"
+        << (couplingCheck->warning.empty() ? "" : " (WARNING above)") << "\n";
+  }
   out << "  per frame   " << milliseconds(loopSeconds, frames) << "   (total " << loopSeconds << " s)\n";
   out << "    forces        " << milliseconds(forces, frames) << "\n";
   out << "    assembly      " << milliseconds(assembly, frames) << "\n";
@@ -348,6 +363,9 @@ int run(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_flag("--progress", options.progress, "Draw the progress bar even when stderr is not a terminal");
   app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
+  app.add_flag("--no-stability-check", options.noStabilityCheck,
+               "Skip the step-growth estimate (a few dozen steps) made before runs of the asynchronous integrator "
+               "with the paper's coupling");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -365,6 +383,13 @@ int run(int argc, char** argv) {
   for (const std::string& warning : simulation.warnings) std::cerr << "offlineSimulator: warning: " << warning << "\n";
   const double setupSeconds = setupWatch.stop();
   const asyncfem::IntegratorStats statsAfterSetup = simulation.integrator->stats();
+  // On a separate integrator built for the linearized scene: the run's own state and
+  // statistics are untouched.
+  const std::optional<asyncfem::PaperCouplingCheck> couplingCheck =
+      options.noStabilityCheck ? std::nullopt : asyncfem::checkPaperCoupling(scene, simulation);
+  if (couplingCheck && !couplingCheck->warning.empty()) {
+    std::cerr << "offlineSimulator: warning: " << couplingCheck->warning << "\n";
+  }
 
   // The output file is created (truncated) only once the scene has been built, so a
   // scene error leaves an existing file alone; from here on it holds this run's frames.
@@ -459,7 +484,7 @@ int run(int argc, char** argv) {
   if (!options.quiet) {
     const auto bytes = static_cast<std::int64_t>(fs::file_size(scene.output.file));
     printSummary(scene, simulation, statsAfterSetup, setupSeconds, loopSeconds, outputWatch.totalSeconds(), bytes,
-                 firstFrame);
+                 firstFrame, couplingCheck);
   }
   return 0;
 }

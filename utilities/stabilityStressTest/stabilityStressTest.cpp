@@ -10,7 +10,10 @@
 // external force and reports the energy growth (max over frames of mechanical energy /
 // initial energy), the first frame with a non-finite value or blow-up (advanceFrame's
 // checks: nothing unstable is ever stored) and the maximum displacement. Runs that blow
-// up or gain energy are listed by integrator and configuration at the end.
+// up or gain energy are listed by integrator and configuration at the end. With --scene
+// SCENE.json it runs a user's multirate scene at each --ratios value instead, printing
+// beside the measured energy growth the estimated spectral radius of the scene's linearized
+// step (estimateSceneStepGrowth).
 // docs/benchmarks.md lists the grid and the results.
 #include <unistd.h>
 
@@ -22,6 +25,7 @@
 #include <asyncfem/core/threading.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/sceneIO/stepGrowthCheck.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
 #include <atomic>
@@ -34,6 +38,7 @@
 #include <limits>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -83,6 +88,8 @@ struct Outcome {
   std::string failure;
   double maxDisplacement = 0.0;
   double seconds = 0.0;
+  /// --scene: estimateSceneStepGrowth() of the run's scene, before the run.
+  std::optional<StepGrowthEstimate> stepGrowth;
 };
 
 constexpr double kLength = 1.0;
@@ -409,27 +416,44 @@ int runScene(const Options& options) {
     for (nlohmann::json& region : scene.integrator.options["regions"]) region["ratio"] = job.ratio;
     if (job.integrator == "async-symmetric") scene.integrator.options["schur"] = "symmetric";
     if (scene.integrator.name == "multirate-uncoupled") {
-      for (const char* key : {"schur", "method", "recovery", "substepContact"}) scene.integrator.options.erase(key);
+      for (const char* key : {"coupling", "schur", "method", "recovery", "substepContact"}) {
+        scene.integrator.options.erase(key);
+      }
     }
     return scene;
   };
   const int workers = std::max(1, std::min<int>(options.jobs, static_cast<int>(jobs.size())));
-  std::cout << "# stabilityStressTest --scene " << options.scene << ": " << jobs.size() << " runs of " << frames
-            << " frames, hL = " << base.integrator.timestep
-            << "; energy growth from when the last load window closes (not measured with contact)"
-            << "\n\n| integrator | m | energy growth | first bad frame | max abs(u) | s |\n|---|---|---|---|---|---|\n";
+  std::cout
+      << "# stabilityStressTest --scene " << options.scene << ": " << jobs.size() << " runs of " << frames
+      << " frames, hL = " << base.integrator.timestep
+      << "; energy growth from when the last load window closes (not measured with contact); step growth "
+         "estimate: spectral radius of one (large) step of the linearized scene, estimated from a few dozen "
+         "steps before the run (its own seconds in \"estimate s\")"
+      << "\n\n| integrator | m | step growth estimate | estimate s | energy growth | first bad frame | max abs(u) | s "
+         "|\n|---|---|---|---|---|---|---|---|\n";
   std::vector<std::string> problems;
   Stopwatch total;
   runOrdered(
       jobs.size(), workers,
       [&](std::size_t index) {
-        Simulation simulation = buildSimulation(sceneFor(jobs[index]));
-        return runSimulation(simulation, frames, simulation.energyCheckFrom);
+        const Scene scene = sceneFor(jobs[index]);
+        Simulation simulation = buildSimulation(scene);
+        const StepGrowthEstimate stepGrowth = estimateSceneStepGrowth(scene, simulation);
+        Outcome outcome = runSimulation(simulation, frames, simulation.energyCheckFrom);
+        outcome.stepGrowth = stepGrowth;
+        return outcome;
       },
       [&](std::size_t index, const Outcome& o) {
         const Job& job = jobs[index];
         const std::string m = job.integrator == "backward-euler" ? std::string("-") : std::to_string(job.ratio);
-        std::cout << "| " << job.integrator << " | " << m << " | "
+        std::ostringstream estimate;  // "-" when the scene failed before the estimate
+        if (o.stepGrowth) {
+          estimate << formatGrowth(o.stepGrowth->spectralRadius) << (o.stepGrowth->converged ? "" : " (not converged)")
+                   << " | " << std::fixed << std::setprecision(1) << o.stepGrowth->seconds;
+        } else {
+          estimate << "- | -";
+        }
+        std::cout << "| " << job.integrator << " | " << m << " | " << estimate.str() << " | "
                   << (o.energyMeasured ? formatGrowth(o.energyGrowth) : std::string("-")) << " | "
                   << (o.failedFrame < 0 ? std::string("-") : std::to_string(o.failedFrame)) << " | "
                   << o.maxDisplacement << " | " << std::fixed << std::setprecision(1) << o.seconds << std::defaultfloat
