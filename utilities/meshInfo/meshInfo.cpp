@@ -148,30 +148,27 @@ int run(int argc, char** argv) {
   TetMesh mesh;
   asyncfem::MeshReadReport report;
   std::string source = input;
+  if (!generate.empty()) report.format = "generated";
   if (generate == "beam") {
     asyncfem::BeamSpec spec;
     if (cells > 0) spec.cellsAlongLength = cells;
     mesh = asyncfem::makeBeamMesh(spec);
     source = "generated beam, " + std::to_string(spec.cellsAlongLength) + " cells along the length";
-    report.format = "generated";
   } else if (generate == "box") {
     asyncfem::BoxMeshSpec spec;
     if (cells > 0) spec.cells = Eigen::Vector3i::Constant(cells);
     mesh = asyncfem::makeBoxMesh(spec);
     source = "generated box, " + std::to_string(spec.cells.x()) + " cells per axis";
-    report.format = "generated";
   } else if (generate == "antenna") {
     asyncfem::AntennaSpec spec;
     if (cells > 0) spec.rodCells = cells;
     mesh = asyncfem::makeAntennaMesh(spec);
     source = "generated antenna on a block, rod of " + std::to_string(spec.rodCells) + " cells";
-    report.format = "generated";
   } else if (generate == "snail") {
     asyncfem::SnailSpec spec;
     if (cells > 0) spec.tentacleCells = cells;
     mesh = asyncfem::makeSnailMesh(spec);
     source = "generated snail, tentacles of " + std::to_string(spec.tentacleCells) + " cells";
-    report.format = "generated";
   } else {
     mesh = asyncfem::readMesh(input, {}, &report);
   }
