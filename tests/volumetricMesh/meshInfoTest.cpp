@@ -84,6 +84,20 @@ TEST(MeshInfo, GenerateAndWrite) {
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "b.vtu"));
 }
 
+TEST(MeshInfo, GeneratesTheCellModels) {
+  test::ScratchDir dir;
+  // --cells sets the rod's (tentacles') length in cells: 4 rod cells add 4 layers of 4 vertices;
+  // the fast region is the rod's 20 vertices plus 28 block vertices around its foot.
+  const auto antenna = dir.path() / "antenna.veg";
+  const RunResult r = runMeshInfo("--generate antenna --cells 4 --write " + quoted(antenna.string()));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("rodAndRing: 48"), std::string::npos) << r.output;
+  EXPECT_EQ(readVeg(antenna).numVertices(), 11 * 5 * 11 + 4 * 4);
+  const RunResult snail = runMeshInfo("--generate snail");
+  ASSERT_EQ(snail.exitCode, 0) << snail.output;
+  EXPECT_NE(snail.output.find("tentaclesAndRing: 88"), std::string::npos) << snail.output;
+}
+
 TEST(MeshInfo, BadFileExitsWithMessage) {
   test::ScratchDir dir;
   const auto bad = dir.write("bad.veg", "*VERTICES\n1 3 0 0\n1 0 0 zero\n");

@@ -2,7 +2,7 @@
 // meshInfo: reads (or generates) a tetrahedral mesh and prints what it contains.
 //
 //   meshInfo FILE [--json] [--write OUT.veg|OUT.vtu]
-//   meshInfo --generate beam|box [--cells N] [--json] [--write OUT]
+//   meshInfo --generate beam|box|antenna|snail [--cells N] [--json] [--write OUT]
 //
 // Text goes to stdout, reader warnings to stderr; errors print "meshInfo: <message>"
 // on stderr and exit with status 1.
@@ -117,17 +117,22 @@ void printText(const nlohmann::json& j) {
 }
 
 int run(int argc, char** argv) {
-  CLI::App app{"Print the contents of a tetrahedral mesh (.veg, TetGen .node/.ele, Gmsh .msh), "
-               "or generate a beam/box mesh."};
+  CLI::App app{
+      "Print the contents of a tetrahedral mesh (.veg, TetGen .node/.ele, Gmsh .msh), "
+      "or generate a beam, box, antenna or snail mesh."};
   std::string input;
   std::string output;
   std::string generate;
   int cells = 0;
   bool json = false;
   app.add_option("file", input, "mesh file to read (.veg, .node, .ele, .msh)");
-  app.add_option("--generate", generate, "generate instead of reading: beam (makeBeamMesh) or box (makeBoxMesh)")
-      ->check(CLI::IsMember({"beam", "box"}));
-  app.add_option("--cells", cells, "with --generate: beam cells along the length (default 20), or box cells per axis (default 4)")
+  app.add_option("--generate", generate,
+                 "generate instead of reading: beam (makeBeamMesh), box (makeBoxMesh), antenna (makeAntennaMesh) "
+                 "or snail (makeSnailMesh)")
+      ->check(CLI::IsMember({"beam", "box", "antenna", "snail"}));
+  app.add_option("--cells", cells,
+                 "with --generate: beam cells along the length (default 20), box cells per axis (default 4), "
+                 "antenna rod cells (default 8) or snail tentacle cells (default 6)")
       ->check(CLI::Range(1, 1000));
   app.add_flag("--json", json, "print a JSON object instead of text");
   app.add_option("--write", output, "also write the mesh to OUT.veg or OUT.vtu");
@@ -136,24 +141,34 @@ int run(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
-  if (input.empty() == generate.empty()) throw asyncfem::Error("give either a mesh file or --generate beam|box (see --help)");
+  if (input.empty() == generate.empty())
+    throw asyncfem::Error("give either a mesh file or --generate beam|box|antenna|snail (see --help)");
   if (cells != 0 && generate.empty()) throw asyncfem::Error("--cells only applies to --generate");
 
   TetMesh mesh;
   asyncfem::MeshReadReport report;
   std::string source = input;
+  if (!generate.empty()) report.format = "generated";
   if (generate == "beam") {
     asyncfem::BeamSpec spec;
     if (cells > 0) spec.cellsAlongLength = cells;
     mesh = asyncfem::makeBeamMesh(spec);
     source = "generated beam, " + std::to_string(spec.cellsAlongLength) + " cells along the length";
-    report.format = "generated";
   } else if (generate == "box") {
     asyncfem::BoxMeshSpec spec;
     if (cells > 0) spec.cells = Eigen::Vector3i::Constant(cells);
     mesh = asyncfem::makeBoxMesh(spec);
     source = "generated box, " + std::to_string(spec.cells.x()) + " cells per axis";
-    report.format = "generated";
+  } else if (generate == "antenna") {
+    asyncfem::AntennaSpec spec;
+    if (cells > 0) spec.rodCells = cells;
+    mesh = asyncfem::makeAntennaMesh(spec);
+    source = "generated antenna on a block, rod of " + std::to_string(spec.rodCells) + " cells";
+  } else if (generate == "snail") {
+    asyncfem::SnailSpec spec;
+    if (cells > 0) spec.tentacleCells = cells;
+    mesh = asyncfem::makeSnailMesh(spec);
+    source = "generated snail, tentacles of " + std::to_string(spec.tentacleCells) + " cells";
   } else {
     mesh = asyncfem::readMesh(input, {}, &report);
   }

@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/volumetricMesh/generators.hpp>
-
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <array>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
 #include <cmath>
+#include <limits>
+#include <map>
+#include <string>
 
 namespace asyncfem {
 
@@ -21,6 +22,29 @@ double signedVolume(const Eigen::Matrix3Xd& x, const Eigen::Vector4i& t) {
 
 bool inside(const Eigen::Vector3d& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
+}
+
+/// Writes the six tetrahedra of the lattice cell whose low corner is `low` into columns
+/// e .. e + 5 of elements (advancing e), positively oriented. Freudenthal (Kuhn) split: one
+/// tet per permutation of the axes, walking from the cell's low corner to its high corner.
+/// All cells use the same main diagonal, so the triangulations of shared faces match.
+/// vertexId(i, j, k): the mesh vertex at lattice point (i, j, k); x: rest positions.
+template <class VertexId>
+void appendCellTets(const std::array<int, 3>& low, const VertexId& vertexId, const Eigen::Matrix3Xd& x,
+                    Eigen::Matrix4Xi& elements, int& e) {
+  static constexpr std::array<std::array<int, 3>, 6> permutations{
+      {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
+  for (const auto& p : permutations) {
+    std::array<int, 3> c = low;
+    Eigen::Vector4i t;
+    t[0] = vertexId(c[0], c[1], c[2]);
+    for (int s = 0; s < 3; ++s) {
+      ++c[static_cast<std::size_t>(p[static_cast<std::size_t>(s)])];
+      t[s + 1] = vertexId(c[0], c[1], c[2]);
+    }
+    if (signedVolume(x, t) < 0.0) std::swap(t[2], t[3]);
+    elements.col(e++) = t;
+  }
 }
 
 }  // namespace
@@ -40,30 +64,14 @@ TetMesh makeBoxMesh(const BoxMeshSpec& spec) {
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i)
-        x.col(vertexId(i, j, k)) =
-            spec.origin + spec.size.cwiseProduct(Eigen::Vector3d(double(i) / n.x(), double(j) / n.y(), double(k) / n.z()));
+        x.col(vertexId(i, j, k)) = spec.origin + spec.size.cwiseProduct(Eigen::Vector3d(
+                                                     double(i) / n.x(), double(j) / n.y(), double(k) / n.z()));
 
-  // Freudenthal (Kuhn) split: one tet per permutation of the axes, walking from the
-  // cell's low corner to its high corner. All cells use the same main diagonal, so the
-  // triangulations of shared faces match.
-  static constexpr std::array<std::array<int, 3>, 6> permutations{
-      {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
   Eigen::Matrix4Xi elements(4, cellCount * 6);
   int e = 0;
   for (int k = 0; k < n.z(); ++k)
     for (int j = 0; j < n.y(); ++j)
-      for (int i = 0; i < n.x(); ++i)
-        for (const auto& p : permutations) {
-          std::array<int, 3> c{i, j, k};
-          Eigen::Vector4i t;
-          t[0] = vertexId(c[0], c[1], c[2]);
-          for (int s = 0; s < 3; ++s) {
-            ++c[static_cast<std::size_t>(p[static_cast<std::size_t>(s)])];
-            t[s + 1] = vertexId(c[0], c[1], c[2]);
-          }
-          if (signedVolume(x, t) < 0.0) std::swap(t[2], t[3]);
-          elements.col(e++) = t;
-        }
+      for (int i = 0; i < n.x(); ++i) appendCellTets({i, j, k}, vertexId, x, elements, e);
 
   std::vector<Material> materials{spec.material};
   std::vector<int> elementMaterials(static_cast<std::size_t>(elements.cols()), 0);
@@ -108,8 +116,10 @@ TetMesh makeBoxMesh(const BoxMeshSpec& spec) {
 
 TetMesh makeBeamMesh(const BeamSpec& spec) {
   if (spec.cellsAlongLength < 1) throw ValidationError("beam: cellsAlongLength must be >= 1");
-  if (!(spec.tipFraction >= 0.0 && spec.tipFraction < 1.0)) throw ValidationError("beam: tipFraction must be in [0, 1)");
-  if (!(spec.length > 0 && spec.height > 0 && spec.depth > 0)) throw ValidationError("beam: dimensions must be positive");
+  if (!(spec.tipFraction >= 0.0 && spec.tipFraction < 1.0))
+    throw ValidationError("beam: tipFraction must be in [0, 1)");
+  if (!(spec.length > 0 && spec.height > 0 && spec.depth > 0))
+    throw ValidationError("beam: dimensions must be positive");
   const double cell = spec.length / spec.cellsAlongLength;
   BoxMeshSpec box;
   box.size = Eigen::Vector3d(spec.length, spec.height, spec.depth);
@@ -133,6 +143,182 @@ TetMesh makeBeamMesh(const BeamSpec& spec) {
     bodyElements.push_back(e);
   }
   mesh.setElementSet("body", std::move(bodyElements));
+  return mesh;
+}
+
+TetMesh makeCellMesh(const CellMeshSpec& spec) {
+  if (!(spec.cellSize > 0.0) || !std::isfinite(spec.cellSize) || !spec.origin.allFinite()) {
+    throw ValidationError("cell mesh: cellSize must be positive and finite, origin finite");
+  }
+  if (spec.blocks.empty()) throw ValidationError("cell mesh: no blocks");
+  Eigen::Vector3i lo = spec.blocks.front().begin, hi = spec.blocks.front().end;
+  for (const CellBlock& b : spec.blocks) {
+    if (b.name.empty()) throw ValidationError("cell mesh: a block has no name");
+    if ((b.end.array() <= b.begin.array()).any()) {
+      throw ValidationError("cell mesh: block '" + b.name + "' is empty (end must exceed begin on every axis)");
+    }
+    lo = lo.cwiseMin(b.begin);
+    hi = hi.cwiseMax(b.end);
+  }
+  const Eigen::Vector3i cells = hi - lo;
+  const long long latticeCells = static_cast<long long>(cells.x()) * cells.y() * cells.z();
+  if (latticeCells > 50'000'000LL) throw ValidationError("cell mesh: the blocks span more than 5e7 lattice cells");
+
+  // Materials by name, in order of first use; each cell's owner is the last block claiming it.
+  std::vector<Material> materials;
+  std::vector<int> blockMaterial;
+  for (const CellBlock& b : spec.blocks) {
+    auto same =
+        std::find_if(materials.begin(), materials.end(), [&](const Material& m) { return m.name == b.material.name; });
+    if (same != materials.end() && !(*same == b.material)) {
+      throw ValidationError("cell mesh: material '" + b.material.name + "' is given two different values");
+    }
+    if (same == materials.end()) {
+      materials.push_back(b.material);
+      same = materials.end() - 1;
+    }
+    blockMaterial.push_back(static_cast<int>(same - materials.begin()));
+  }
+  std::vector<int> owner(static_cast<std::size_t>(latticeCells), -1);
+  auto cellIndex = [&](int i, int j, int k) {
+    return static_cast<std::size_t>((i - lo.x()) + cells.x() * ((j - lo.y()) + cells.y() * (k - lo.z())));
+  };
+  for (std::size_t b = 0; b < spec.blocks.size(); ++b)
+    for (int k = spec.blocks[b].begin.z(); k < spec.blocks[b].end.z(); ++k)
+      for (int j = spec.blocks[b].begin.y(); j < spec.blocks[b].end.y(); ++j)
+        for (int i = spec.blocks[b].begin.x(); i < spec.blocks[b].end.x(); ++i)
+          owner[cellIndex(i, j, k)] = static_cast<int>(b);
+
+  // Lattice points used by some occupied cell, numbered in lattice order.
+  const Eigen::Vector3i points = cells + Eigen::Vector3i::Ones();
+  auto pointIndex = [&](int i, int j, int k) {
+    return static_cast<std::size_t>((i - lo.x()) + points.x() * ((j - lo.y()) + points.y() * (k - lo.z())));
+  };
+  std::vector<int> vertexOfPoint(static_cast<std::size_t>(points.prod()), -1);
+  int occupied = 0;
+  for (int k = lo.z(); k < hi.z(); ++k)
+    for (int j = lo.y(); j < hi.y(); ++j)
+      for (int i = lo.x(); i < hi.x(); ++i) {
+        if (owner[cellIndex(i, j, k)] < 0) continue;
+        ++occupied;
+        for (int c = 0; c < 8; ++c) vertexOfPoint[pointIndex(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2))] = 0;
+      }
+  std::vector<Eigen::Vector3i> pointOfVertex;
+  for (int k = lo.z(); k <= hi.z(); ++k)
+    for (int j = lo.y(); j <= hi.y(); ++j)
+      for (int i = lo.x(); i <= hi.x(); ++i) {
+        int& v = vertexOfPoint[pointIndex(i, j, k)];
+        if (v < 0) continue;
+        v = static_cast<int>(pointOfVertex.size());
+        pointOfVertex.emplace_back(i, j, k);
+      }
+  Eigen::Matrix3Xd x(3, static_cast<Eigen::Index>(pointOfVertex.size()));
+  for (std::size_t v = 0; v < pointOfVertex.size(); ++v) {
+    x.col(static_cast<Eigen::Index>(v)) = spec.origin + spec.cellSize * pointOfVertex[v].cast<double>();
+  }
+  auto vertexId = [&](int i, int j, int k) { return vertexOfPoint[pointIndex(i, j, k)]; };
+
+  Eigen::Matrix4Xi elements(4, 6 * occupied);
+  std::vector<int> elementMaterials;
+  std::map<std::string, std::vector<int>> setElements;
+  int e = 0;
+  for (int k = lo.z(); k < hi.z(); ++k)
+    for (int j = lo.y(); j < hi.y(); ++j)
+      for (int i = lo.x(); i < hi.x(); ++i) {
+        const int b = owner[cellIndex(i, j, k)];
+        if (b < 0) continue;
+        std::vector<int>& set = setElements[spec.blocks[static_cast<std::size_t>(b)].name];
+        for (int t = 0; t < 6; ++t) {
+          set.push_back(e + t);
+          elementMaterials.push_back(blockMaterial[static_cast<std::size_t>(b)]);
+        }
+        appendCellTets({i, j, k}, vertexId, x, elements, e);
+      }
+
+  TetMesh mesh(std::move(x), std::move(elements), std::move(materials), std::move(elementMaterials));
+  for (auto& [name, members] : setElements) {
+    std::vector<int> vertices;
+    for (int el : members)
+      for (int a = 0; a < 4; ++a) vertices.push_back(mesh.elements()(a, el));
+    mesh.setElementSet(name, std::move(members));
+    mesh.setVertexSet(name, std::move(vertices));
+  }
+  std::vector<int> bottom;
+  for (int v = 0; v < mesh.numVertices(); ++v)
+    if (pointOfVertex[static_cast<std::size_t>(v)].y() == lo.y()) bottom.push_back(v);
+  mesh.setVertexSet("bottom", std::move(bottom));
+
+  for (const CellVertexRing& ring : spec.vertexRings) {
+    if (ring.name.empty() || ring.rings < 0)
+      throw ValidationError("cell mesh: a vertex ring needs a name and rings >= 0");
+    std::vector<Eigen::Vector3i> core;
+    for (const std::string& name : ring.around) {
+      if (mesh.vertexSets().count(name) == 0) {
+        throw ValidationError("cell mesh: vertex ring '" + ring.name + "' around unknown set '" + name + "'");
+      }
+      for (int v : mesh.vertexSet(name)) core.push_back(pointOfVertex[static_cast<std::size_t>(v)]);
+    }
+    std::vector<int> members;
+    for (int v = 0; v < mesh.numVertices(); ++v) {
+      const Eigen::Vector3i& p = pointOfVertex[static_cast<std::size_t>(v)];
+      if (std::any_of(core.begin(), core.end(),
+                      [&](const Eigen::Vector3i& c) { return (c - p).cwiseAbs().maxCoeff() <= ring.rings; })) {
+        members.push_back(v);
+      }
+    }
+    mesh.setVertexSet(ring.name, std::move(members));
+  }
+  return mesh;
+}
+
+namespace {
+
+/// The vertices of `set` with the largest y (the top of an upright appendage).
+std::vector<int> topVertices(const TetMesh& mesh, const std::vector<int>& set) {
+  double top = -std::numeric_limits<double>::infinity();
+  for (int v : set) top = std::max(top, mesh.restPositions()(1, v));
+  std::vector<int> result;
+  for (int v : set)
+    if (mesh.restPositions()(1, v) == top) result.push_back(v);
+  return result;
+}
+
+}  // namespace
+
+TetMesh makeAntennaMesh(const AntennaSpec& spec) {
+  if ((spec.blockCells.array() < 1).any() || spec.rodCells < 1) {
+    throw ValidationError("antenna: blockCells and rodCells must be >= 1");
+  }
+  CellMeshSpec cells;
+  cells.cellSize = spec.cellSize;
+  const Eigen::Vector3i foot(spec.blockCells.x() / 2, spec.blockCells.y(), spec.blockCells.z() / 2);
+  cells.blocks = {{"block", Eigen::Vector3i::Zero(), spec.blockCells, spec.block},
+                  {"rod", foot, foot + Eigen::Vector3i(1, spec.rodCells, 1), spec.rod}};
+  cells.vertexRings = {{"rodAndRing", {"rod"}, 1}};
+  TetMesh mesh = makeCellMesh(cells);
+  mesh.setVertexSet("rodTip", topVertices(mesh, mesh.vertexSet("rod")));
+  return mesh;
+}
+
+TetMesh makeSnailMesh(const SnailSpec& spec) {
+  if (spec.tentacleCells < 1) throw ValidationError("snail: tentacleCells must be >= 1");
+  // Cells (0.05 m each by default): a sole 16 x 1 x 6; a stepped shell on its back half;
+  // a neck and a head on its front; the tentacles stand on the head, three cells apart so
+  // that each keeps its own ring of head vertices around its foot.
+  using V = Eigen::Vector3i;
+  CellMeshSpec cells;
+  cells.cellSize = spec.cellSize;
+  const int top = 4;  // the head's top layer
+  cells.blocks = {{"sole", V(0, 0, 0), V(16, 1, 6), spec.body},
+                  {"shell", V(1, 1, 0), V(9, 5, 6), spec.shell},
+                  {"shell", V(2, 5, 1), V(8, 7, 5), spec.shell},
+                  {"head", V(9, 1, 1), V(16, 3, 5), spec.body},
+                  {"head", V(13, 3, 1), V(16, top, 5), spec.body},
+                  {"tentacles", V(14, top, 1), V(15, top + spec.tentacleCells, 2), spec.tentacles},
+                  {"tentacles", V(14, top, 4), V(15, top + spec.tentacleCells, 5), spec.tentacles}};
+  cells.vertexRings = {{"tentaclesAndRing", {"tentacles"}, 1}};
+  TetMesh mesh = makeCellMesh(cells);
+  mesh.setVertexSet("tentacleTips", topVertices(mesh, mesh.vertexSet("tentacles")));
   return mesh;
 }
 
