@@ -7,6 +7,7 @@
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <utility>
 #include <vector>
 
 namespace asyncfem::testing {
@@ -17,13 +18,9 @@ struct ModalSystem {
 };
 
 inline ModalSystem modalSystem(const TetMesh& mesh, const std::vector<int>& fixedVertices, MassType massType) {
-  const MatrixAssembler assembler(mesh);
-  ModalSystem system;
-  system.stiffness = assembler.createMatrix();
-  assembleLinearStiffness(mesh, assembler, system.stiffness);
-  system.mass = massMatrix(mesh, assembler, massType);
-  system.freeDofs = FreeDofs::fromFixedVertices(mesh.numVertices(), fixedVertices);
-  return system;
+  VibrationMatrices matrices = vibrationMatrices(mesh, massType);
+  return {std::move(matrices.stiffness), std::move(matrices.mass),
+          FreeDofs::fromFixedVertices(mesh.numVertices(), fixedVertices)};
 }
 
 /// Every mode of the system from Eigen's dense GeneralizedSelfAdjointEigenSolver, as a

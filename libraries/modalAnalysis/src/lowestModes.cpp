@@ -88,6 +88,14 @@ double defaultShift(const Eigen::SparseMatrix<double>& stiffness, const Eigen::S
 
 }  // namespace
 
+VibrationMatrices vibrationMatrices(const TetMesh& mesh, MassType massType) {
+  const MatrixAssembler assembler(mesh);
+  VibrationMatrices matrices;
+  matrices.stiffness = linearStiffnessMatrix(mesh, assembler);
+  matrices.mass = massMatrix(mesh, assembler, massType);
+  return matrices;
+}
+
 ModalResult lowestModes(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
                         const FreeDofs& freeDofs, const ModalOptions& options) {
   const int numDofs = freeDofs.numDofs();

@@ -4,10 +4,20 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <limits>
 
 namespace asyncfem {
+
+/// The matrices whose modes describe a scene's small vibrations about the rest shape.
+struct VibrationMatrices {
+  Eigen::SparseMatrix<double> stiffness;  ///< linear FEM K (3n x 3n)
+  Eigen::SparseMatrix<double> mass;       ///< M of the requested type (3n x 3n)
+};
+/// K and M of the mesh with its materials, on one assembler's pattern. For a corotational
+/// scene, K is its tangent at the rest shape (corotational FEM linearises to linear FEM there).
+VibrationMatrices vibrationMatrices(const TetMesh& mesh, MassType massType);
 
 /// Settings of lowestModes().
 struct ModalOptions {
