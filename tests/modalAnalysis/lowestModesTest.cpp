@@ -20,20 +20,13 @@ using testing::modalSystem;
 // A 2 x 0.5 x 0.3 bar of 4 x 2 x 2 cells (45 vertices), clamped at x = 0: 108 free DOFs,
 // small enough for a dense reference, and a rectangular cross-section so that the bending
 // pairs are not degenerate.
-TetMesh smallBar() {
-  BoxMeshSpec spec;
-  spec.size = Eigen::Vector3d(2.0, 0.5, 0.3);
-  spec.cells = Eigen::Vector3i(4, 2, 2);
-  return makeBoxMesh(spec);
-}
+TetMesh smallBar() { return testing::boxMesh(Eigen::Vector3d(2.0, 0.5, 0.3), Eigen::Vector3i(4, 2, 2)); }
 
 TEST(LowestModes, MatchDenseGeneralizedEigendecomposition) {
   const TetMesh mesh = smallBar();
   for (const MassType massType : {MassType::consistent, MassType::lumped}) {
     const auto system = modalSystem(mesh, mesh.vertexSet("xmin"), massType);
-    ModalOptions options;
-    options.count = 10;
-    const ModalResult sparse = lowestModes(system.stiffness, system.mass, system.freeDofs, options);
+    const ModalResult sparse = testing::lowestModesOf(system, 10);
     const ModalResult dense = denseModes(system);
     ASSERT_EQ(sparse.frequencies.size(), 10);
     for (int j = 0; j < 10; ++j) {
@@ -61,9 +54,7 @@ TEST(LowestModes, MatchDenseGeneralizedEigendecomposition) {
 TEST(LowestModes, AreMassOrthonormalResidualFreeAndZeroOnFixedDofs) {
   const TetMesh mesh = smallBar();
   const auto system = modalSystem(mesh, mesh.vertexSet("xmin"), MassType::consistent);
-  ModalOptions options;
-  options.count = 8;
-  const ModalResult result = lowestModes(system.stiffness, system.mass, system.freeDofs, options);
+  const ModalResult result = testing::lowestModesOf(system, 8);
   const Eigen::MatrixXd gram = result.modes.transpose() * (system.mass * result.modes);
   // Lanczos keeps its basis M-orthonormal to round-off (full reorthogonalisation).
   EXPECT_LE((gram - Eigen::MatrixXd::Identity(8, 8)).cwiseAbs().maxCoeff(), 1e-10);
@@ -81,9 +72,7 @@ TEST(LowestModes, AreMassOrthonormalResidualFreeAndZeroOnFixedDofs) {
 TEST(LowestModes, FreeBodyHasSixRigidModes) {
   const TetMesh mesh = smallBar();
   const auto system = modalSystem(mesh, {}, MassType::lumped);
-  ModalOptions options;
-  options.count = 8;
-  const ModalResult result = lowestModes(system.stiffness, system.mass, system.freeDofs, options);
+  const ModalResult result = testing::lowestModesOf(system, 8);
   // Rigid modes have lambda = 0 up to the round-off of K (about eps * lambda_max), so
   // omega ~ 1e-8 omega_max; the first elastic mode of the bar is a few percent of omega_max.
   const double firstElastic = result.frequencies[6];

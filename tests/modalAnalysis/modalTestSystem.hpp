@@ -6,6 +6,7 @@
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <utility>
 #include <vector>
@@ -17,10 +18,25 @@ struct ModalSystem {
   FreeDofs freeDofs;
 };
 
+/// A box mesh of the given size (m) and cells with the default material.
+inline TetMesh boxMesh(const Eigen::Vector3d& size, const Eigen::Vector3i& cells) {
+  BoxMeshSpec spec;
+  spec.size = size;
+  spec.cells = cells;
+  return makeBoxMesh(spec);
+}
+
 inline ModalSystem modalSystem(const TetMesh& mesh, const std::vector<int>& fixedVertices, MassType massType) {
   VibrationMatrices matrices = vibrationMatrices(mesh, massType);
   return {std::move(matrices.stiffness), std::move(matrices.mass),
           FreeDofs::fromFixedVertices(mesh.numVertices(), fixedVertices)};
+}
+
+/// The count lowest modes of the system with the default options.
+inline ModalResult lowestModesOf(const ModalSystem& system, int count) {
+  ModalOptions options;
+  options.count = count;
+  return lowestModes(system.stiffness, system.mass, system.freeDofs, options);
 }
 
 /// Every mode of the system from Eigen's dense GeneralizedSelfAdjointEigenSolver, as a

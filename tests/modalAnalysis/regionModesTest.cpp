@@ -21,11 +21,19 @@ using testing::denseModes;
 using testing::modalSystem;
 
 // 3 x 2 x 2 cells (48 vertices), clamped at x = 0: 108 free DOFs, every mode computed densely.
-TetMesh tinyBox() {
-  BoxMeshSpec spec;
-  spec.size = Eigen::Vector3d(1.5, 1.0, 0.8);
-  spec.cells = Eigen::Vector3i(3, 2, 2);
-  return makeBoxMesh(spec);
+TetMesh tinyBox() { return testing::boxMesh(Eigen::Vector3d(1.5, 1.0, 0.8), Eigen::Vector3i(3, 2, 2)); }
+
+// The count lowest modes of a beam clamped at its root, reported for its "tip" vertex set
+// with m = 8, hL = 1/120 and 30 frames/s; table receives the printed report.
+RegionModeReport tipReport(const TetMesh& mesh, int count, std::string& table) {
+  const auto system = modalSystem(mesh, mesh.vertexSet("root"), MassType::consistent);
+  const ModalResult modes = testing::lowestModesOf(system, count);
+  RegionModeReport report =
+      analyseRegionModes(modes, system.mass, {{"tip", mesh.vertexSet("tip"), 8}}, 1.0 / 120.0, 30.0);
+  std::ostringstream out;
+  printRegionModeReport(out, report);
+  table = out.str();
+  return report;
 }
 
 // Free DOFs of the given vertices (global ids, ascending).
@@ -81,9 +89,7 @@ TEST(RegionModes, SharesOverAllModesSumToTraceIdentity) {
 TEST(RegionModes, RegionSharesAddUpAndTimestepsFollowRatios) {
   const TetMesh mesh = tinyBox();
   const auto system = modalSystem(mesh, mesh.vertexSet("xmin"), MassType::consistent);
-  ModalOptions options;
-  options.count = 6;
-  const ModalResult modes = lowestModes(system.stiffness, system.mass, system.freeDofs, options);
+  const ModalResult modes = testing::lowestModesOf(system, 6);
   // Two regions sharing no element: the x = 1.5 face and the y = 0 face's x = 0 edge are
   // two cells apart, so M^{S1 S2} = 0.
   const std::vector<int> end = mesh.vertexSet("xmax");
@@ -112,46 +118,33 @@ TEST(RegionModes, AsyncKeepsTheModesOfALightSoftTip) {
   spec.cellsAlongLength = 10;
   spec.body = Material{"body", 1000.0, 1e9, 0.3};
   spec.tip = Material{"tip", 10.0, 3e3, 0.3};
-  const TetMesh mesh = makeBeamMesh(spec);
-  const auto system = modalSystem(mesh, mesh.vertexSet("root"), MassType::consistent);
-  ModalOptions options;
-  options.count = 6;
-  const ModalResult modes = lowestModes(system.stiffness, system.mass, system.freeDofs, options);
-  const RegionModeReport report =
-      analyseRegionModes(modes, system.mass, {{"tip", mesh.vertexSet("tip"), 8}}, 1.0 / 120.0, 30.0);
-  std::ostringstream table;
-  printRegionModeReport(table, report);
-  ASSERT_EQ(report.verdict, ModalVerdict::asyncKeepsModes) << table.str();
-  EXPECT_EQ(report.verdictText().rfind("async can keep these modes: 1 (", 0), 0u) << table.str();
+  std::string table;
+  const RegionModeReport report = tipReport(makeBeamMesh(spec), 6, table);
+  ASSERT_EQ(report.verdict, ModalVerdict::asyncKeepsModes) << table;
+  EXPECT_EQ(report.verdictText().rfind("async can keep these modes: 1 (", 0), 0u) << table;
   for (int j : report.keptModes) {
     const ModeInRegions& mode = report.modes[static_cast<std::size_t>(j)];
     EXPECT_GE(mode.fastShare, modalCriteria::minFastShare);
     EXPECT_LT(mode.omega, report.nyquistOmega);
   }
-  EXPECT_NE(table.str().find("async can keep these modes"), std::string::npos);
+  EXPECT_NE(table.find("async can keep these modes"), std::string::npos);
 }
 
 // The default beam (models/beam/beam.veg, tip region, 30 frames/s, hL = 1/120, m = 8): the
 // design note's counter-example. Every visible mode is a bending mode of the whole beam.
 TEST(RegionModes, DefaultBeamHasNoVisibleModeInItsTip) {
-  const TetMesh mesh = readMesh(std::filesystem::path(ASYNCFEM_MODELS_DIR) / "beam" / "beam.veg");
-  const auto system = modalSystem(mesh, mesh.vertexSet("root"), MassType::consistent);
-  ModalOptions options;
-  options.count = 12;
-  const ModalResult modes = lowestModes(system.stiffness, system.mass, system.freeDofs, options);
+  std::string table;
   const RegionModeReport report =
-      analyseRegionModes(modes, system.mass, {{"tip", mesh.vertexSet("tip"), 8}}, 1.0 / 120.0, 30.0);
-  std::ostringstream table;
-  printRegionModeReport(table, report);
-  EXPECT_EQ(report.verdict, ModalVerdict::noVisibleModeInFast) << table.str();
-  EXPECT_FALSE(report.visibleModesTruncated) << table.str();
+      tipReport(readMesh(std::filesystem::path(ASYNCFEM_MODELS_DIR) / "beam" / "beam.veg"), 12, table);
+  EXPECT_EQ(report.verdict, ModalVerdict::noVisibleModeInFast) << table;
+  EXPECT_FALSE(report.visibleModesTruncated) << table;
   for (const ModeInRegions& mode : report.modes) {
     if (mode.visible) {
-      EXPECT_LE(mode.fastShare, 0.26) << table.str();
+      EXPECT_LE(mode.fastShare, 0.26) << table;
     }
   }
-  EXPECT_NE(table.str().find("no mode below the frame Nyquist frequency lives in S: single-rate at hL costs less for "
-                             "the same result"),
+  EXPECT_NE(table.find("no mode below the frame Nyquist frequency lives in S: single-rate at hL costs less for "
+                       "the same result"),
             std::string::npos);
 }
 
