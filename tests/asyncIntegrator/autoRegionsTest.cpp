@@ -4,6 +4,10 @@
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
+#include <filesystem>
+#include <sstream>
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
@@ -94,6 +98,100 @@ TEST(AutoRegions, RelativeModeFindsTheStiffPartAtAnyTimestep) {
     if (targetPerTimestep < 0) targetPerTimestep = proposal.targetOmegaH / hL;
     EXPECT_NEAR(proposal.targetOmegaH / hL, targetPerTimestep, 1e-12 * targetPerTimestep);
   }
+}
+
+// The modal check on the default beam (models/beam/beam.veg, 30 frames/s, hL = 1/120): the
+// stiff, light tip is proposed by the frequency criterion, but every visible mode is a
+// bending mode of the whole beam with at most a quarter of its modal mass in the tip, so
+// the region is withdrawn and the scene runs single-rate at hL.
+TEST(AutoRegions, ModalCheckWithdrawsTheTipOfTheDefaultBeam) {
+  const TetMesh mesh = readMesh(std::filesystem::path(ASYNCFEM_MODELS_DIR) / "beam" / "beam.veg");
+  const FreeDofs freeDofs = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("root"));
+  const VibrationMatrices matrices = vibrationMatrices(mesh, MassType::consistent);
+  AutoRegionOptions options;
+  options.largeTimestep = 1.0 / 120.0;
+  const AutoRegionProposal unchecked = suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
+  ASSERT_EQ(unchecked.regions.size(), 1u);  // modalCheck is off by default
+  EXPECT_FALSE(unchecked.modalReport.has_value());
+
+  options.modalCheck = true;
+  options.frameRate = 30.0;
+  const AutoRegionProposal checked = suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
+  EXPECT_TRUE(checked.regions.empty());
+  ASSERT_EQ(checked.withdrawnRegions.size(), 1u);
+  EXPECT_EQ(checked.withdrawnRegions[0].region.vertices, unchecked.regions[0].region.vertices);
+  ASSERT_TRUE(checked.modalReport.has_value());
+  EXPECT_EQ(checked.modalReport->verdict, ModalVerdict::noVisibleModeInFast);
+  EXPECT_FALSE(checked.modalReport->visibleModesTruncated);
+  // The proposal (no region) is still a valid partition.
+  EXPECT_NO_THROW(RegionPartition(mesh, freeDofs, checked.asyncRegions()));
+}
+
+// The design note's antenna on a block, coarsely: a 0.5 x 0.5 x 0.2 block (rho 1000) with a
+// 0.1 x 0.1 x 0.6 rod (rho 50, same E) standing on it, 0.1 m cells. makeBoxMesh cuts the
+// whole 0.5 x 0.5 x 0.8 box; the elements outside block and rod are dropped here.
+TetMesh antennaOnBlock() {
+  BoxMeshSpec spec;
+  spec.size = Eigen::Vector3d(0.5, 0.5, 0.8);
+  spec.cells = Eigen::Vector3i(5, 5, 8);
+  spec.material = Material{"void", 1.0, 1.0, 0.3};
+  spec.regions.push_back(
+      {"block", Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(2, 2, 0.2), {"block", 1000.0, 1e6, 0.3}});
+  spec.regions.push_back(
+      {"rod", Eigen::Vector3d(0.2, 0.2, 0.2), Eigen::Vector3d(0.3, 0.3, 2), {"rod", 50.0, 1e6, 0.3}});
+  const TetMesh box = makeBoxMesh(spec);
+  std::vector<int> newId(static_cast<std::size_t>(box.numVertices()), -1);
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Eigen::Vector4i> elements;
+  std::vector<int> elementMaterials;
+  for (int e = 0; e < box.numElements(); ++e) {
+    if (box.elementMaterial(e).name == "void") continue;
+    Eigen::Vector4i element;
+    for (int a = 0; a < 4; ++a) {
+      int& id = newId[static_cast<std::size_t>(box.elements()(a, e))];
+      if (id < 0) {
+        id = static_cast<int>(positions.size());
+        positions.push_back(box.restPosition(box.elements()(a, e)));
+      }
+      element[a] = id;
+    }
+    elements.push_back(element);
+    elementMaterials.push_back(box.elementMaterial(e).name == "rod" ? 1 : 0);
+  }
+  Eigen::Matrix3Xd restPositions(3, static_cast<Eigen::Index>(positions.size()));
+  for (std::size_t v = 0; v < positions.size(); ++v) restPositions.col(static_cast<Eigen::Index>(v)) = positions[v];
+  Eigen::Matrix4Xi elementMatrix(4, static_cast<Eigen::Index>(elements.size()));
+  for (std::size_t e = 0; e < elements.size(); ++e) elementMatrix.col(static_cast<Eigen::Index>(e)) = elements[e];
+  return TetMesh(restPositions, elementMatrix, {{"block", 1000.0, 1e6, 0.3}, {"rod", 50.0, 1e6, 0.3}},
+                 elementMaterials);
+}
+
+// The rod's wave speed is 4.5x the block's, so the frequency criterion marks it (plus one
+// ring of block vertices); its bending pair lies below the Nyquist frequency and lives in
+// it, so the modal check keeps the region.
+TEST(AutoRegions, ModalCheckKeepsARegionWhoseModesLiveInIt) {
+  const TetMesh mesh = antennaOnBlock();
+  std::vector<int> bottom;
+  for (int v = 0; v < mesh.numVertices(); ++v)
+    if (mesh.restPosition(v).z() < 1e-12) bottom.push_back(v);
+  const FreeDofs freeDofs = FreeDofs::fromFixedVertices(mesh.numVertices(), bottom);
+  const VibrationMatrices matrices = vibrationMatrices(mesh, MassType::consistent);
+  AutoRegionOptions options;
+  options.largeTimestep = 1.0 / 60.0;
+  options.modalCheck = true;
+  options.frameRate = 30.0;
+  const AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
+  ASSERT_TRUE(proposal.modalReport.has_value());
+  std::ostringstream table;
+  printRegionModeReport(table, *proposal.modalReport);
+  ASSERT_EQ(proposal.regions.size(), 1u) << table.str();
+  EXPECT_TRUE(proposal.withdrawnRegions.empty());
+  EXPECT_NE(proposal.modalReport->verdict, ModalVerdict::noVisibleModeInFast) << table.str();
+  EXPECT_FALSE(proposal.modalReport->visibleModesTruncated) << table.str();
+  for (int v : proposal.regions[0].region.vertices) EXPECT_GE(mesh.restPosition(v).z(), 0.1 - 1e-12);
+
+  options.frameRate = -1.0;
+  EXPECT_THROW(suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass), ValidationError);
 }
 
 }  // namespace

@@ -171,4 +171,45 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   return proposal;
 }
 
+std::vector<ModalRegion> modalRegions(const std::vector<AsyncRegion>& regions) {
+  std::vector<ModalRegion> out;
+  out.reserve(regions.size());
+  for (const AsyncRegion& r : regions) out.push_back({r.name, r.vertices, r.ratio});
+  return out;
+}
+
+AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                                  const Eigen::SparseMatrix<double>& stiffness,
+                                  const Eigen::SparseMatrix<double>& mass) {
+  AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options);
+  if (!options.modalCheck) return proposal;
+  if (!(options.frameRate > 0.0) || !std::isfinite(options.frameRate)) {
+    throw ValidationError("automatic regions: the frame rate of the modal check must be positive");
+  }
+  if (options.modalCount < 1 || options.maxModalCount < options.modalCount) {
+    throw ValidationError("automatic regions: need 1 <= modalCount <= maxModalCount for the modal check");
+  }
+  if (proposal.regions.empty()) return proposal;
+  // Visible modes beyond the computed ones could live in S: compute more while the highest
+  // one is still below the Nyquist frequency.
+  const double nyquist = modalCriteria::nyquistPerFrameRate * options.frameRate;
+  const int largestCount = std::min(options.maxModalCount, freeDofs.numFree() - 1);
+  ModalOptions modal;
+  modal.count = std::min(options.modalCount, largestCount);
+  ModalResult modes = lowestModes(stiffness, mass, freeDofs, modal);
+  proposal.modalSeconds = modes.solveSeconds;
+  while (modes.frequencies[modes.frequencies.size() - 1] < nyquist && modal.count < largestCount) {
+    modal.count = std::min(2 * modal.count, largestCount);
+    modes = lowestModes(stiffness, mass, freeDofs, modal);
+    proposal.modalSeconds += modes.solveSeconds;
+  }
+  proposal.modalReport =
+      analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep, options.frameRate);
+  if (proposal.modalReport->verdict == ModalVerdict::noVisibleModeInFast) {
+    proposal.withdrawnRegions = std::move(proposal.regions);
+    proposal.regions.clear();
+  }
+  return proposal;
+}
+
 }  // namespace asyncfem

@@ -94,12 +94,17 @@ AsyncSceneOptions parseAsyncOptions(const Scene& scene, const TetMesh& mesh, con
     }
     out.automaticRegions = true;
     out.automatic.largeTimestep = scene.integrator.timestep;
+    out.automatic.modalCheck = true;
+    out.automatic.frameRate = scene.frames.rate;
     if (const nlohmann::json* automatic = reader.find("auto")) {
       JsonObjectReader autoReader(*automatic, reader.keyPath("auto"), scene.sourceName);
-      out.automatic.targetOmegaH = autoReader.number("target", out.automatic.targetOmegaH);
-      if (!(out.automatic.targetOmegaH > 0.0)) autoReader.fail("target", "must be > 0");
+      if (autoReader.has("target")) {  // absent: the relative mode
+        out.automatic.targetOmegaH = autoReader.number("target", out.automatic.targetOmegaH);
+        if (!(out.automatic.targetOmegaH > 0.0)) autoReader.fail("target", "must be > 0");
+      }
       out.automatic.growLayers = autoReader.integer("growLayers", out.automatic.growLayers, 0, 100);
       out.automatic.maxRatio = autoReader.integer("maxRatio", out.automatic.maxRatio, 1, 100000);
+      out.automatic.modalCheck = autoReader.boolean("modalCheck", out.automatic.modalCheck);
       autoReader.finish();
     }
   } else if (regions.is_array()) {
@@ -112,7 +117,11 @@ AsyncSceneOptions parseAsyncOptions(const Scene& scene, const TetMesh& mesh, con
                              "expected \"auto\" or an array of regions, got " + JsonObjectReader::describe(regions));
   }
   reader.finish();
-  if (out.automaticRegions) out.regions = suggestRegions(mesh, freeDofs, out.automatic).asyncRegions();
+  if (out.automaticRegions) {
+    // The modal check needs the scene's K (linear, = the corotational rest tangent) and M.
+    const VibrationMatrices matrices = vibrationMatrices(mesh, scene.mass);
+    out.regions = suggestRegions(mesh, freeDofs, out.automatic, matrices.stiffness, matrices.mass).asyncRegions();
+  }
   // Validate the partition here so its errors name the scene key.
   try {
     RegionPartition check(mesh, freeDofs, out.regions);

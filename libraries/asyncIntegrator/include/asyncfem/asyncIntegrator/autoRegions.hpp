@@ -2,11 +2,14 @@
 #pragma once
 
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
+#include <asyncfem/modalAnalysis/regionModes.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
+#include <optional>
 #include <vector>
 
 namespace asyncfem {
@@ -32,6 +35,17 @@ struct AutoRegionOptions {
   /// interface (the dense part of H^{LL*}) small relative to |S|.
   int growLayers = 1;
   int maxRatio = 256;
+  /// Modal check (docs/asynchronous-integrator.md, "Which modes can async keep?"), run by
+  /// the overload of suggestRegions() that takes K and M: the regions are withdrawn when no
+  /// visible mode (omega below pi * frameRate) among the lowest ones has a share of modal
+  /// mass >= modalCriteria::minFastShare in them. Async with such regions keeps nothing
+  /// that single-rate at hL loses, at m times the cost in S. Off by default here; the scene
+  /// path ("regions": "auto") and the suggestRegions utility turn it on.
+  bool modalCheck = false;
+  double frameRate = 30.0;  ///< frames per second, for the visibility test
+  /// Modes computed first; doubled while the highest is still visible, up to maxModalCount.
+  int modalCount = 20;
+  int maxModalCount = 80;
 };
 
 /// One proposed fast region with its statistics.
@@ -47,6 +61,13 @@ struct AutoRegionProposal {
   double largeRegionMaxFrequency = 0.0;  ///< max omega_e over elements touching no fast vertex
   double largeTimestep = 0.0;
   double targetOmegaH = 0.0;  ///< the target in effect (absolute, or from the relative mode)
+  /// Set when the modal check ran (there were regions to check): the report for the regions
+  /// the frequency criterion proposed.
+  std::optional<RegionModeReport> modalReport;
+  /// Regions the frequency criterion proposed and the modal check withdrew (regions is then
+  /// empty: the asynchronous integrator runs single-rate at hL).
+  std::vector<ProposedRegion> withdrawnRegions;
+  double modalSeconds = 0.0;  ///< time of the eigensolves of the modal check
   /// The regions alone, ready for RegionPartition / AsyncBackwardEuler.
   std::vector<AsyncRegion> asyncRegions() const;
 };
@@ -58,6 +79,20 @@ struct AutoRegionProposal {
 /// that would touch are one component) with ratio = ceil(max omega_e hL / target), capped
 /// at maxRatio. Components without free DOFs are dropped. The proposal is a valid
 /// partition for RegionPartition.
+/// Ignores options.modalCheck (it needs K and M: use the overload below).
 AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options);
+
+/// The same proposal, followed by the modal check when options.modalCheck is set:
+/// lowestModes() of stiffness and mass (full 3n x 3n, e.g. vibrationMatrices()) and
+/// analyseRegionModes() of the proposed regions at hL = options.largeTimestep; when its
+/// verdict is ModalVerdict::noVisibleModeInFast the regions move to withdrawnRegions.
+/// The mode counts are clamped to the free DOFs - 1. Throws ValidationError for frameRate <= 0
+/// or counts out of order, and what lowestModes() throws.
+AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                                  const Eigen::SparseMatrix<double>& stiffness,
+                                  const Eigen::SparseMatrix<double>& mass);
+
+/// The regions as the modal report takes them (name, vertices, ratio).
+std::vector<ModalRegion> modalRegions(const std::vector<AsyncRegion>& regions);
 
 }  // namespace asyncfem

@@ -18,7 +18,7 @@ namespace asyncfem {
 struct AsyncSceneOptions {
   AsyncOptions solver;
   bool automaticRegions = false;
-  AutoRegionOptions automatic;             ///< largeTimestep is filled from the scene
+  AutoRegionOptions automatic;             ///< largeTimestep, frameRate from the scene; modalCheck on
   std::vector<AsyncRegion> regions;        ///< explicit regions, resolved on the mesh
 };
 

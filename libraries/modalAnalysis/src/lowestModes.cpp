@@ -1,0 +1,160 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <Spectra/SymGEigsShiftSolver.h>
+
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/modalAnalysis/lowestModes.hpp>
+#include <cmath>
+#include <memory>
+#include <string>
+
+namespace asyncfem {
+
+namespace {
+
+// Spectra's operator for y = (K - sigma M)^{-1} x: set_shift() factors K - sigma M with a
+// SparseSolver, perform_op() back-substitutes.
+class ShiftInvertOperator {
+ public:
+  using Scalar = double;
+
+  ShiftInvertOperator(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
+                      SolverKind kind)
+      : stiffness_(stiffness), mass_(mass), solver_(makeSparseSolver(kind)) {}
+
+  Eigen::Index rows() const { return stiffness_.rows(); }
+  Eigen::Index cols() const { return stiffness_.cols(); }
+
+  void set_shift(double sigma) {  // NOLINT(readability-identifier-naming): Spectra's interface
+    Stopwatch watch;
+    Eigen::SparseMatrix<double> shifted = stiffness_ - sigma * mass_;
+    shifted.makeCompressed();
+    try {
+      solver_->compute(shifted);
+    } catch (const NumericalError& e) {
+      throw NumericalError("modal analysis: cannot factor K - sigma M with sigma = " + std::to_string(sigma) + " (" +
+                           toString(solver_->kind()) +
+                           "): a Cholesky solver needs a shift below the lowest eigenvalue; " + e.what());
+    }
+    factorSeconds_ = watch.stop();
+  }
+
+  void perform_op(const double* in, double* out) const {  // NOLINT(readability-identifier-naming)
+    const Eigen::Map<const Eigen::VectorXd> x(in, rows());
+    solver_->solve(x, scratch_);
+    Eigen::Map<Eigen::VectorXd>(out, rows()) = scratch_.col(0);
+    ++applications_;
+  }
+
+  double factorSeconds() const { return factorSeconds_; }
+  int applications() const { return applications_; }
+
+ private:
+  const Eigen::SparseMatrix<double>& stiffness_;
+  const Eigen::SparseMatrix<double>& mass_;
+  std::unique_ptr<SparseSolver> solver_;  // solve() is not const: the operator is used through const
+  mutable Eigen::MatrixXd scratch_;
+  mutable int applications_ = 0;
+  double factorSeconds_ = 0.0;
+};
+
+// Spectra's operator for y = M x (the B of the generalized problem).
+class MassOperator {
+ public:
+  using Scalar = double;
+
+  explicit MassOperator(const Eigen::SparseMatrix<double>& mass) : mass_(mass) {}
+
+  Eigen::Index rows() const { return mass_.rows(); }
+  Eigen::Index cols() const { return mass_.cols(); }
+
+  void perform_op(const double* in, double* out) const {  // NOLINT(readability-identifier-naming)
+    Eigen::Map<Eigen::VectorXd>(out, rows()).noalias() = mass_ * Eigen::Map<const Eigen::VectorXd>(in, cols());
+  }
+
+ private:
+  const Eigen::SparseMatrix<double>& mass_;
+};
+
+double defaultShift(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass) {
+  double largest = 0.0;
+  for (Eigen::Index i = 0; i < stiffness.rows(); ++i) {
+    const double m = mass.coeff(i, i);
+    if (m > 0.0) largest = std::max(largest, stiffness.coeff(i, i) / m);
+  }
+  return largest > 0.0 ? -1e-8 * largest : -1.0;
+}
+
+}  // namespace
+
+VibrationMatrices vibrationMatrices(const TetMesh& mesh, MassType massType) {
+  const MatrixAssembler assembler(mesh);
+  VibrationMatrices matrices;
+  matrices.stiffness = linearStiffnessMatrix(mesh, assembler);
+  matrices.mass = massMatrix(mesh, assembler, massType);
+  return matrices;
+}
+
+ModalResult lowestModes(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
+                        const FreeDofs& freeDofs, const ModalOptions& options) {
+  const int numDofs = freeDofs.numDofs();
+  if (stiffness.rows() != numDofs || stiffness.cols() != numDofs || mass.rows() != numDofs || mass.cols() != numDofs) {
+    throw ValidationError("modal analysis: K is " + std::to_string(stiffness.rows()) + "x" +
+                          std::to_string(stiffness.cols()) + " and M " + std::to_string(mass.rows()) + "x" +
+                          std::to_string(mass.cols()) + ", expected " + std::to_string(numDofs) + "x" +
+                          std::to_string(numDofs) + " (the DOFs of FreeDofs)");
+  }
+  const int numFree = freeDofs.numFree();
+  if (options.count <= 0 || options.count >= numFree) {
+    throw ValidationError("modal analysis: the number of modes must be in [1, " + std::to_string(numFree - 1) +
+                          "] (fewer than the " + std::to_string(numFree) + " free DOFs), got " +
+                          std::to_string(options.count));
+  }
+  if (!(options.tolerance > 0.0) || options.maxIterations < 1) {
+    throw ValidationError("modal analysis: the tolerance must be > 0 and maxIterations >= 1");
+  }
+  Stopwatch total;
+  const SubmatrixExtractor extractor(stiffness, freeDofs.freeToFull(), freeDofs.freeToFull());
+  const Eigen::SparseMatrix<double> stiffnessFree = extractor.extract(stiffness);
+  const SubmatrixExtractor massExtractor(mass, freeDofs.freeToFull(), freeDofs.freeToFull());
+  const Eigen::SparseMatrix<double> massFree = massExtractor.extract(mass);
+  const double sigma = std::isnan(options.shift) ? defaultShift(stiffnessFree, massFree) : options.shift;
+  if (!std::isfinite(sigma)) throw ValidationError("modal analysis: the shift must be finite");
+
+  ShiftInvertOperator shiftInvert(stiffnessFree, massFree, options.solver);
+  MassOperator massProduct(massFree);
+  // Lanczos basis: at least 2K + 1 vectors (Spectra's advice) and some slack for clusters
+  // such as the six rigid modes, never more than the problem size.
+  const int basisSize = std::min(numFree, std::max(2 * options.count + 1, options.count + 20));
+  using Solver = Spectra::SymGEigsShiftSolver<ShiftInvertOperator, MassOperator, Spectra::GEigsMode::ShiftInvert>;
+  Solver eigs(shiftInvert, massProduct, options.count, basisSize, sigma);  // factors K - sigma M
+  eigs.init();  // Spectra's fixed-seed start vector: results are reproducible
+  const Eigen::Index converged = eigs.compute(Spectra::SortRule::LargestMagn, options.maxIterations, options.tolerance,
+                                              Spectra::SortRule::SmallestAlge);
+  if (eigs.info() != Spectra::CompInfo::Successful) {
+    throw NumericalError("modal analysis: the Lanczos iteration converged for " + std::to_string(converged) + " of " +
+                         std::to_string(options.count) + " modes after " + std::to_string(eigs.num_iterations()) +
+                         " restarts (shift " + std::to_string(sigma) +
+                         "); ask for fewer modes, more iterations or a looser tolerance");
+  }
+
+  ModalResult result;
+  result.shift = sigma;
+  result.eigenvalues = eigs.eigenvalues();
+  result.frequencies = result.eigenvalues.cwiseMax(0.0).cwiseSqrt();
+  const Eigen::MatrixXd freeModes = eigs.eigenvectors();
+  result.modes.setZero(numDofs, options.count);
+  for (int j = 0; j < options.count; ++j) {
+    // Lanczos vectors are M-orthonormal already; normalise again against round-off.
+    const double norm = std::sqrt(freeModes.col(j).dot(massFree * freeModes.col(j)));
+    result.modes.col(j) = freeDofs.expand(freeModes.col(j) / norm);
+  }
+  result.iterations = static_cast<int>(eigs.num_iterations());
+  result.operatorApplications = shiftInvert.applications();
+  result.factorSeconds = shiftInvert.factorSeconds();
+  result.solveSeconds = total.stop();
+  return result;
+}
+
+}  // namespace asyncfem
