@@ -56,7 +56,7 @@ std::string defaultLabel(const Configuration& c) {
       !c.options["regions"].empty() && c.options["regions"][0].contains("ratio")) {
     out << " m=" << c.options["regions"][0]["ratio"].get<int>();
   }
-  for (const char* key : {"schur", "method", "recovery"}) {
+  for (const char* key : {"coupling", "schur", "method", "recovery"}) {
     if (c.options.contains(key)) out << " " << c.options[key].get<std::string>();
   }
   return out.str();
@@ -135,13 +135,13 @@ Configuration parseConfigurationSpec(const std::string& spec, const Scene& scene
         c.timestep = std::stod(value);
       } else if (key == "ratio") {
         ratio = std::stoi(value);
-      } else if (key == "schur" || key == "method" || key == "recovery" || key == "solver") {
+      } else if (key == "coupling" || key == "schur" || key == "method" || key == "recovery" || key == "solver") {
         c.options[key] = value;
       } else if (key == "label") {
         c.label = value;
       } else {
         throw ValidationError("--config \"" + spec + "\": unknown key \"" + key +
-                              "\" (known: spf, dt, ratio, schur, method, recovery, solver, label)");
+                              "\" (known: spf, dt, ratio, coupling, schur, method, recovery, solver, label)");
       }
     } catch (const std::logic_error&) {
       throw ValidationError("--config \"" + spec + "\": bad number in \"" + parts[k] + "\"");
@@ -198,6 +198,8 @@ std::vector<Configuration> defaultConfigurations(const Scene& scene, const Simul
     for (const int spf : {std::max(1, sceneSteps / 2), 2 * sceneSteps}) {
       if (spf != sceneSteps) add("async", spf, sceneRatio, nlohmann::json::object(), false);
     }
+    for (const int ratio : {2, 4, 8, 16, 32})
+      add("async", sceneSteps, ratio, {{"coupling", "paper"}}, ratio == sceneRatio);
     add("async", sceneSteps, sceneRatio, {{"schur", "symmetric"}}, false);
     add("async", sceneSteps, sceneRatio, {{"schur", "lu"}}, false);
     add("async", sceneSteps, sceneRatio, {{"method", "naive"}}, false);

@@ -28,6 +28,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -149,7 +150,7 @@ std::vector<VertexGroup> errorGroups(const Scene& scene, const Simulation& basel
 
 std::string family(const Configuration& c) {
   std::string name = c.integrator;
-  for (const char* key : {"schur", "method"}) {
+  for (const char* key : {"coupling", "schur", "method"}) {
     if (c.options.contains(key)) name += " " + c.options[key].get<std::string>();
   }
   return name;
@@ -318,6 +319,79 @@ void plotVertex(const fs::path& path, const std::vector<RunResult>& results, con
   writePng(path, renderPlot(spec, 1100, 650));
 }
 
+/// How much of one vertex's free vibration a run keeps after the last load window closes:
+/// RMS over those frames of |u_v - c| divided by the reference's, c the reference's mean
+/// position of the vertex over the same frames (the equilibrium it oscillates about). 1 keeps
+/// all of the motion; phase is ignored (what the paper's Figures 4 and 7 show).
+double motionKeptAfterRelease(const Trajectory& run, const Trajectory& reference, const std::vector<double>& times,
+                              double release, int vertex) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (std::size_t k = 0; k < reference.size() && k < times.size(); ++k) {
+    if (times[k] <= release) continue;
+    centre += reference[k].segment<3>(3 * vertex);
+    ++count;
+  }
+  if (count == 0) return std::numeric_limits<double>::quiet_NaN();
+  centre /= count;
+  double runSum = 0.0, referenceSum = 0.0;
+  for (std::size_t k = 0; k < reference.size() && k < run.size() && k < times.size(); ++k) {
+    if (times[k] <= release) continue;
+    runSum += (run[k].segment<3>(3 * vertex) - centre).squaredNorm();
+    referenceSum += (reference[k].segment<3>(3 * vertex) - centre).squaredNorm();
+  }
+  return referenceSum > 0.0 ? std::sqrt(runSum / referenceSum) : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// The table of motion kept at `vertex` after the loads end, for every configuration, and
+/// for each multirate one what single-rate backward Euler keeps at the same wall time and
+/// at the same flops per frame (log-log interpolation between the measured BE runs).
+void printMotionKept(const std::vector<RunResult>& results, const Trajectory& reference, const Scene& scene,
+                     const Simulation& baseline, int vertex) {
+  const PiecewiseConstantLoad load = sceneLoad(scene, baseline);
+  const double release = load.breakpoints.empty() ? 0.0 : load.breakpoints.back();
+  const std::vector<double> times = frameTimes(scene, static_cast<int>(reference.size()));
+  std::map<const RunResult*, double> kept;
+  std::vector<SingleRatePoint> byTime, byFlops;
+  for (const RunResult& r : results) {
+    if (!r.completed) continue;
+    const double value = motionKeptAfterRelease(r.frames, reference, times, release, vertex);
+    kept[&r] = value;
+    if (r.configuration.integrator == "backward-euler" && value > 0.0) {
+      byTime.push_back({r.timestep, r.medianSecondsPerFrame, value});
+      byFlops.push_back({r.timestep, r.flopsPerFrame(), value});
+    }
+  }
+  std::cout << "\n## Motion kept at vertex " << vertex << " after the loads end (t > " << formatDouble(release, 3)
+            << " s)\n\nRMS of the vertex's displacement about its equilibrium, over the frames after the last load "
+               "window, divided by the reference's (phase ignored). BE columns: single-rate backward Euler "
+               "interpolated to the same wall time / flops per frame (* extrapolated).\n\n"
+               "| configuration | time/frame (ms) | kept | BE kept at equal time | ratio | BE kept at equal flops | "
+               "ratio |\n|---|---|---|---|---|---|---|\n";
+  for (const RunResult& r : results) {
+    if (!r.completed) continue;
+    const double value = kept[&r];
+    std::cout << "| " << r.configuration.label << " | " << formatDouble(1e3 * r.medianSecondsPerFrame, 3) << " | "
+              << formatDouble(value, 3) << " |";
+    if (!isMultirate(r.configuration.integrator) || byTime.size() < 2) {
+      std::cout << " | | | |\n";
+      continue;
+    }
+    for (const auto* points : {&byTime, &byFlops}) {
+      const double cost = points == &byTime ? r.medianSecondsPerFrame : r.flopsPerFrame();
+      try {
+        const EqualCostAnswer answer = singleRateAtEqualCost(*points, cost);
+        const std::string mark = answer.extrapolated ? "*" : "";
+        std::cout << " " << formatDouble(answer.error, 3) << mark << " | " << formatDouble(value / answer.error, 3)
+                  << "x" << mark << " |";
+      } catch (const Error& error) {
+        std::cout << " n/a | |";
+      }
+    }
+    std::cout << "\n";
+  }
+}
+
 // The vertex of the first fast region (else of the whole mesh) with the largest reference
 // displacement over the frames.
 int chooseVertex(const Reference& reference, const std::vector<VertexGroup>& groups, int numVertices) {
@@ -450,6 +524,9 @@ int runBenchmark(const CommandLine& options) {
              << ((a.atEqualCost.extrapolated || a.atEqualError.extrapolated) ? 1 : 0) << ",\n";
   }
 
+  const int vertex = options.vertex.value_or(chooseVertex(reference, groups, baseline.mesh->numVertices()));
+  printMotionKept(results, reference.frames, scene, baseline, vertex);
+
   // Plots.
   if (pngSupported()) {
     for (const VertexGroup& g : groups) {
@@ -458,7 +535,6 @@ int runBenchmark(const CommandLine& options) {
       plotPareto(path, results, g.name, sceneName);
       std::cout << "\nWrote " << path.string();
     }
-    const int vertex = options.vertex.value_or(chooseVertex(reference, groups, baseline.mesh->numVertices()));
     const fs::path path = fs::path(options.out) / "vertex-displacement.png";
     plotVertex(path, results, reference, scene, vertex, sceneName);
     std::cout << "\nWrote " << path.string() << " (vertex " << vertex << ")\n";
