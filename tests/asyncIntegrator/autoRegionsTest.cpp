@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "asyncTestSystem.hpp"
+#include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
@@ -9,8 +10,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include <Eigen/Eigenvalues>
-#include <gtest/gtest.h>
+#include "asyncTestSystem.hpp"
 
 namespace asyncfem {
 namespace {

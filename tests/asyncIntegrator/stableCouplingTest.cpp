@@ -400,25 +400,6 @@ TEST(StableCoupling, DefaultBeamDecaysWhereThePaperCouplingGrows) {
   }
 }
 
-// Corotational forces, m = 1: the stable coupling's step equals corotational single-rate
-// backward Euler at hL (1e-9, different factorizations).
-TEST(StableCoupling, CorotationalRatioOneEqualsBackwardEuler) {
-  test::TestSystem ts = test::makeTestSystem(0.2, 1e-3);
-  ts.system.forceModel = std::make_shared<CorotationalLinearFEM>(ts.mesh, TangentKind::simple);
-  ts.u0 *= 100.0;
-  AsyncBackwardEuler async(ts.mesh, ts.system, 2e-3, {{"tip", test::verticesBeyond(ts.mesh, 0.75), 1}},
-                           withCoupling(AsyncCoupling::stable));
-  BackwardEuler single(ts.system, 2e-3);
-  async.setState(ts.u0, ts.v0);
-  single.setState(ts.u0, ts.v0);
-  for (int k = 0; k < 4; ++k) {
-    async.step();
-    single.step();
-  }
-  EXPECT_LT(relativeDifference(async.displacement(), single.displacement()), 1e-9);
-  EXPECT_LT(relativeDifference(async.velocity(), single.velocity()), 1e-9);
-}
-
 // Corotational forces: each large step linearizes the forces at its start, and the energy
 // theorem holds for that quadratic model of the elastic energy (its tangent, the simple
 // one, is positive semi-definite). So a free, undamped run gains at most the linearization

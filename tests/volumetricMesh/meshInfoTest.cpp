@@ -1,16 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // meshInfo end to end: runs the built executable and checks its output and exit status.
-#include "testFiles.hpp"
+#include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <asyncfem/volumetricMesh/readers.hpp>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <string>
 
-#include <sys/wait.h>
+#include "testFiles.hpp"
 
 namespace asyncfem {
 namespace {

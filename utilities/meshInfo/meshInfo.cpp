@@ -6,21 +6,19 @@
 //
 // Text goes to stdout, reader warnings to stderr; errors print "meshInfo: <message>"
 // on stderr and exit with status 1.
-#include <asyncfem/core/threading.hpp>
+#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-
-#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -78,9 +76,11 @@ nlohmann::json describe(const TetMesh& mesh, const std::string& source, const as
   j["mass"] = asyncfem::totalMass(mesh);
   j["boundaryTriangles"] = asyncfem::boundaryTriangles(mesh).size();
   const asyncfem::BoundingBox box = asyncfem::boundingBox(mesh);
-  j["boundingBox"] = {{"min", {box.min.x(), box.min.y(), box.min.z()}}, {"max", {box.max.x(), box.max.y(), box.max.z()}}};
+  j["boundingBox"] = {{"min", {box.min.x(), box.min.y(), box.min.z()}},
+                      {"max", {box.max.x(), box.max.y(), box.max.z()}}};
   const QualitySummary q = summarizeQuality(mesh);
-  j["quality"] = {{"minDihedralAngleDegrees", {{"min", q.minDihedralDegrees}, {"mean", q.meanDihedralDegrees}, {"max", q.maxDihedralDegrees}}},
+  j["quality"] = {{"minDihedralAngleDegrees",
+                   {{"min", q.minDihedralDegrees}, {"mean", q.meanDihedralDegrees}, {"max", q.maxDihedralDegrees}}},
                   {"worstAspectRatio", q.worstAspectRatio}};
   j["reorientedElements"] = report.reorientedElements;
   j["unusedVertices"] = report.unusedVertices;
@@ -187,7 +187,8 @@ int run(int argc, char** argv) {
     } else if (extension == ".vtu") {
       asyncfem::writeVtu(output, mesh);
     } else {
-      throw asyncfem::Error("--write: unknown extension '" + extension + "' for '" + output + "' (expected .veg or .vtu)");
+      throw asyncfem::Error("--write: unknown extension '" + extension + "' for '" + output +
+                            "' (expected .veg or .vtu)");
     }
   }
   return 0;

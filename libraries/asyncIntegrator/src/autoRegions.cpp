@@ -1,11 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
-
-#include <Eigen/Eigenvalues>
-
-#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -65,7 +63,8 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   {
     std::vector<int> fill(offsets.begin(), offsets.end() - 1);
     for (int e = 0; e < ne; ++e)
-      for (int a = 0; a < 4; ++a) incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.elements()(a, e))]++)] = e;
+      for (int a = 0; a < 4; ++a)
+        incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.elements()(a, e))]++)] = e;
   }
 
   std::vector<char> fast(static_cast<std::size_t>(nv), 0);
@@ -90,7 +89,8 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
     for (int v = 0; v < nv; ++v) {
       if (fast[static_cast<std::size_t>(v)]) continue;
       bool enclosed = offsets[static_cast<std::size_t>(v)] < offsets[static_cast<std::size_t>(v) + 1];
-      for (int k = offsets[static_cast<std::size_t>(v)]; enclosed && k < offsets[static_cast<std::size_t>(v) + 1]; ++k) {
+      for (int k = offsets[static_cast<std::size_t>(v)]; enclosed && k < offsets[static_cast<std::size_t>(v) + 1];
+           ++k) {
         const int e = incident[static_cast<std::size_t>(k)];
         for (int a = 0; a < 4; ++a) {
           const int w = mesh.elements()(a, e);
@@ -166,7 +166,8 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   // Interface sizes, from the partition the proposal defines.
   const RegionPartition partition(mesh, freeDofs, proposal.asyncRegions());
   for (int i = 0; i < partition.numRegions(); ++i) {
-    proposal.regions[static_cast<std::size_t>(i)].numInterfaceDofs = static_cast<int>(partition.interfaceDofs(i).size());
+    proposal.regions[static_cast<std::size_t>(i)].numInterfaceDofs =
+        static_cast<int>(partition.interfaceDofs(i).size());
   }
   return proposal;
 }

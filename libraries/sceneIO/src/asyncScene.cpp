@@ -2,7 +2,6 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/asyncScene.hpp>
 #include <asyncfem/sceneIO/jsonReader.hpp>
-
 #include <string>
 
 namespace asyncfem {
@@ -34,7 +33,8 @@ AsyncRegion parseRegion(const Scene& scene, const TetMesh& mesh, const nlohmann:
       JsonObjectReader box((*boxes)[i], reader.elementPath("boxes", i), scene.sourceName);
       const Eigen::Vector3d lo = JsonObjectReader::toVector3(box.required("min"), box.keyPath("min"), scene.sourceName);
       const Eigen::Vector3d hi = JsonObjectReader::toVector3(box.required("max"), box.keyPath("max"), scene.sourceName);
-      if (!((lo.array() <= hi.array()).all())) JsonObjectReader::failAt(scene.sourceName, box.path(), "expected min <= max");
+      if (!((lo.array() <= hi.array()).all()))
+        JsonObjectReader::failAt(scene.sourceName, box.path(), "expected min <= max");
       box.finish();
       selector.boxMin.push_back(lo);
       selector.boxMax.push_back(hi);

@@ -1,13 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <Eigen/Core>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
-#include <Eigen/Core>
-
 #include <functional>
 #include <memory>
 #include <vector>
@@ -68,9 +66,9 @@ struct AsyncOptions {
 /// Called after a large step for every substep r = 1..m_i of fast region i, only when a
 /// caller installed it: time of the substep and the region's displacement and velocity at
 /// it, ordered as partition().regionDofs(i).
-using SubstepObserver = std::function<void(int region, int substep, double time,
-                                           const Eigen::VectorXd& regionDisplacement,
-                                           const Eigen::VectorXd& regionVelocity)>;
+using SubstepObserver =
+    std::function<void(int region, int substep, double time, const Eigen::VectorXd& regionDisplacement,
+                       const Eigen::VectorXd& regionVelocity)>;
 
 /// Asynchronous implicit backward Euler (Zhao, Li & Barbič 2016, with the equations of
 /// docs/asynchronous-integrator.md). Fast regions S_i take m_i backward Euler substeps of
@@ -88,7 +86,7 @@ using SubstepObserver = std::function<void(int region, int substep, double time,
 /// evaluated once per large step and every block is refactored numerically (the paper's
 /// Algorithm 2); symbolic analyses are done once per run.
 class AsyncBackwardEuler final : public Integrator {
-public:
+ public:
   AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions,
                      AsyncOptions options = {});
   ~AsyncBackwardEuler() override;
@@ -121,7 +119,7 @@ public:
   /// non-zeros (machine-independent size of the factors).
   long long factorNonZeros() const;
 
-private:
+ private:
   struct Impl;
   void rebuildBlocks();
   void buildSchurSolver();

@@ -1,14 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/modalAnalysis/regionModes.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
-#include <Eigen/Core>
-#include <Eigen/SparseCore>
-
 #include <optional>
 #include <vector>
 
@@ -51,9 +49,9 @@ struct AutoRegionOptions {
 /// One proposed fast region with its statistics.
 struct ProposedRegion {
   AsyncRegion region;
-  double maxFrequency = 0.0;     ///< max omega_e over its elements (rad/s)
-  int numElements = 0;           ///< elements with every vertex in the region
-  int numInterfaceDofs = 0;      ///< |I| of the region once partitioned
+  double maxFrequency = 0.0;  ///< max omega_e over its elements (rad/s)
+  int numElements = 0;        ///< elements with every vertex in the region
+  int numInterfaceDofs = 0;   ///< |I| of the region once partitioned
 };
 
 struct AutoRegionProposal {

@@ -16,7 +16,7 @@ namespace asyncfem {
 /// Implementations are called once per (large) step, so one virtual call per step is
 /// fine; element loops inside are non-virtual and parallel.
 class ForceModel {
-public:
+ public:
   virtual ~ForceModel() = default;
 
   virtual int numDofs() const = 0;

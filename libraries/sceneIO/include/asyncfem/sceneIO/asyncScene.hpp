@@ -5,9 +5,7 @@
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
-
 #include <nlohmann/json.hpp>
-
 #include <string>
 #include <vector>
 
@@ -18,8 +16,8 @@ namespace asyncfem {
 struct AsyncSceneOptions {
   AsyncOptions solver;
   bool automaticRegions = false;
-  AutoRegionOptions automatic;             ///< largeTimestep, frameRate from the scene; modalCheck on
-  std::vector<AsyncRegion> regions;        ///< explicit regions, resolved on the mesh
+  AutoRegionOptions automatic;       ///< largeTimestep, frameRate from the scene; modalCheck on
+  std::vector<AsyncRegion> regions;  ///< explicit regions, resolved on the mesh
 };
 
 /// Reads `integrator.options` of an async scene and resolves its regions on mesh; errors
