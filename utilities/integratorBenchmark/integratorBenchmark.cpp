@@ -54,6 +54,7 @@ struct CommandLine {
   std::string reference = "auto";
   int maxModalDofs = 5000;
   std::optional<int> vertex;
+  std::vector<double> keptWindow;  ///< [t0, t1] for the motion-kept table; empty: after the last load window
   bool quick = false;
   bool table = false;
   std::string models = "models";
@@ -324,11 +325,11 @@ void plotVertex(const fs::path& path, const std::vector<RunResult>& results, con
 /// position of the vertex over the same frames (the equilibrium it oscillates about). 1 keeps
 /// all of the motion; phase is ignored (what the paper's Figures 4 and 7 show).
 double motionKeptAfterRelease(const Trajectory& run, const Trajectory& reference, const std::vector<double>& times,
-                              double release, int vertex) {
+                              double release, double until, int vertex) {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   int count = 0;
   for (std::size_t k = 0; k < reference.size() && k < times.size(); ++k) {
-    if (times[k] <= release) continue;
+    if (times[k] <= release || times[k] > until) continue;
     centre += reference[k].segment<3>(3 * vertex);
     ++count;
   }
@@ -336,7 +337,7 @@ double motionKeptAfterRelease(const Trajectory& run, const Trajectory& reference
   centre /= count;
   double runSum = 0.0, referenceSum = 0.0;
   for (std::size_t k = 0; k < reference.size() && k < run.size() && k < times.size(); ++k) {
-    if (times[k] <= release) continue;
+    if (times[k] <= release || times[k] > until) continue;
     runSum += (run[k].segment<3>(3 * vertex) - centre).squaredNorm();
     referenceSum += (reference[k].segment<3>(3 * vertex) - centre).squaredNorm();
   }
@@ -347,23 +348,29 @@ double motionKeptAfterRelease(const Trajectory& run, const Trajectory& reference
 /// for each multirate one what single-rate backward Euler keeps at the same wall time and
 /// at the same flops per frame (log-log interpolation between the measured BE runs).
 void printMotionKept(const std::vector<RunResult>& results, const Trajectory& reference, const Scene& scene,
-                     const Simulation& baseline, int vertex) {
+                     const Simulation& baseline, int vertex, const std::vector<double>& window) {
   const PiecewiseConstantLoad load = sceneLoad(scene, baseline);
-  const double release = load.breakpoints.empty() ? 0.0 : load.breakpoints.back();
+  double release = load.breakpoints.empty() ? 0.0 : load.breakpoints.back();
+  double until = std::numeric_limits<double>::infinity();
+  if (window.size() == 2) {
+    release = std::max(release, window[0]);
+    until = window[1];
+  }
   const std::vector<double> times = frameTimes(scene, static_cast<int>(reference.size()));
   std::map<const RunResult*, double> kept;
   std::vector<SingleRatePoint> byTime, byFlops;
   for (const RunResult& r : results) {
     if (!r.completed) continue;
-    const double value = motionKeptAfterRelease(r.frames, reference, times, release, vertex);
+    const double value = motionKeptAfterRelease(r.frames, reference, times, release, until, vertex);
     kept[&r] = value;
     if (r.configuration.integrator == "backward-euler" && value > 0.0) {
       byTime.push_back({r.timestep, r.medianSecondsPerFrame, value});
       byFlops.push_back({r.timestep, r.flopsPerFrame(), value});
     }
   }
-  std::cout << "\n## Motion kept at vertex " << vertex << " after the loads end (t > " << formatDouble(release, 3)
-            << " s)\n\nRMS of the vertex's displacement about its equilibrium, over the frames after the last load "
+  std::cout << "\n## Motion kept at vertex " << vertex << " after the loads end (" << formatDouble(release, 3)
+            << " s < t" << (std::isfinite(until) ? " <= " + formatDouble(until, 3) + " s" : "")
+            << ")\n\nRMS of the vertex's displacement about its equilibrium, over the frames after the last load "
                "window, divided by the reference's (phase ignored). BE columns: single-rate backward Euler "
                "interpolated to the same wall time / flops per frame (* extrapolated).\n\n"
                "| configuration | time/frame (ms) | kept | BE kept at equal time | ratio | BE kept at equal flops | "
@@ -390,6 +397,73 @@ void printMotionKept(const std::vector<RunResult>& results, const Trajectory& re
     }
     std::cout << "\n";
   }
+}
+
+/// The figure of the paper's Figures 4 and 7 for one vertex: the signed displacement
+/// coordinate that moves most in the reference, over time, for the reference, backward
+/// Euler at the largest measured step, the backward Euler run whose wall time per frame is
+/// nearest the multirate run's ("equal cost"), and the multirate run with the scene's own
+/// ratios and no other option (else the first multirate run). Nothing is drawn without a
+/// completed multirate run and two backward Euler runs.
+void plotVertexAgainstEqualCost(const fs::path& path, const std::vector<RunResult>& results, const Reference& reference,
+                                const Scene& scene, int vertex, const std::string& sceneName) {
+  std::string sceneRatios;
+  if (scene.integrator.options.contains("regions") && scene.integrator.options["regions"].is_array()) {
+    for (const nlohmann::json& region : scene.integrator.options["regions"])
+      sceneRatios += (sceneRatios.empty() ? "" : ",") + std::to_string(region.value("ratio", 1));
+  }
+  const RunResult* multirate = nullptr;
+  const RunResult* coarse = nullptr;
+  for (const RunResult& r : results) {
+    if (!r.completed || r.frames.empty()) continue;
+    if (isMultirate(r.configuration.integrator)) {
+      const bool plain = !r.configuration.options.contains("coupling") && !r.configuration.options.contains("schur") &&
+                         !r.configuration.options.contains("method");
+      if (!multirate || (plain && r.ratios == sceneRatios)) multirate = &r;
+    } else if (r.configuration.integrator == "backward-euler" && (!coarse || r.timestep > coarse->timestep)) {
+      coarse = &r;
+    }
+  }
+  if (!multirate || !coarse) return;
+  const RunResult* equalCost = nullptr;
+  for (const RunResult& r : results) {
+    if (!r.completed || r.frames.empty() || r.configuration.integrator != "backward-euler" || &r == coarse) continue;
+    const auto distance = [&](const RunResult& x) {
+      return std::abs(std::log(x.medianSecondsPerFrame / multirate->medianSecondsPerFrame));
+    };
+    if (!equalCost || distance(r) < distance(*equalCost)) equalCost = &r;
+  }
+  if (!equalCost) return;
+  int coordinate = 0;
+  Eigen::Vector3d energy = Eigen::Vector3d::Zero();
+  for (const Eigen::VectorXd& u : reference.frames) energy += u.segment<3>(3 * vertex).cwiseAbs2();
+  energy.maxCoeff(&coordinate);
+  const auto component = [&](const Trajectory& frames) {
+    std::vector<double> values;
+    for (const Eigen::VectorXd& u : frames) values.push_back(u[3 * vertex + coordinate]);
+    return values;
+  };
+  PlotSpec spec;
+  const char* axis = coordinate == 0 ? "x" : coordinate == 1 ? "y" : "z";
+  spec.title = "Vertex " + std::to_string(vertex) + ", " + axis + " displacement: " + sceneName;
+  spec.xLabel = "time (s)";
+  spec.yLabel = std::string("u_") + axis + " of vertex " + std::to_string(vertex);
+  spec.series.push_back({"exact",
+                         frameTimes(scene, static_cast<int>(reference.frames.size())),
+                         component(reference.frames),
+                         {0, 0, 0},
+                         Marker::none,
+                         true});
+  const std::vector<std::pair<const RunResult*, std::string>> runs{
+      {coarse, coarse->configuration.label + " (largest step)"},
+      {equalCost, equalCost->configuration.label + " (nearest wall time)"},
+      {multirate, multirate->configuration.label}};
+  int index = 0;
+  for (const auto& [run, label] : runs) {
+    spec.series.push_back({label, frameTimes(scene, static_cast<int>(run->frames.size())), component(run->frames),
+                           paletteColor(index++), Marker::none, true});
+  }
+  writePng(path, renderPlot(spec, 1100, 650));
 }
 
 // The vertex of the first fast region (else of the whole mesh) with the largest reference
@@ -525,7 +599,9 @@ int runBenchmark(const CommandLine& options) {
   }
 
   const int vertex = options.vertex.value_or(chooseVertex(reference, groups, baseline.mesh->numVertices()));
-  printMotionKept(results, reference.frames, scene, baseline, vertex);
+  printMotionKept(results, reference.frames, scene, baseline, vertex, {});
+  if (!options.keptWindow.empty())
+    printMotionKept(results, reference.frames, scene, baseline, vertex, options.keptWindow);
 
   // Plots.
   if (pngSupported()) {
@@ -538,6 +614,10 @@ int runBenchmark(const CommandLine& options) {
     const fs::path path = fs::path(options.out) / "vertex-displacement.png";
     plotVertex(path, results, reference, scene, vertex, sceneName);
     std::cout << "\nWrote " << path.string() << " (vertex " << vertex << ")\n";
+    const fs::path focus = fs::path(options.out) / "vertex-equal-cost.png";
+    fs::remove(focus);  // an older run's figure must not survive a run that draws none
+    plotVertexAgainstEqualCost(focus, results, reference, scene, vertex, sceneName);
+    if (fs::exists(focus)) std::cout << "Wrote " << focus.string() << "\n";
   } else {
     std::cout << "\nNo plots: this build has no PNG support (configure with ASYNCFEM_WITH_RENDER=ON); CSV only.\n";
   }
@@ -563,6 +643,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"auto", "modal", "trapezoidal"}));
   app.add_option("--max-modal-dofs", options.maxModalDofs, "Largest free-DOF count for the modal reference");
   app.add_option("--vertex", options.vertex, "Vertex of the displacement plot (default: chosen automatically)");
+  app.add_option("--kept-window", options.keptWindow,
+                 "T0 T1: also print the motion-kept table for this time window (s); it always starts after the last "
+                 "load window")
+      ->expected(2);
   app.add_flag("--quick", options.quick, "At most 30 frames and one repeat (smoke test)");
   app.add_flag("--table", options.table, "Print the performance table of every scene in --models");
   app.add_option("--models", options.models, "Folder of scenes for --table (models/*/*.json)");

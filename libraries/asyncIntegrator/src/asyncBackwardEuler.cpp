@@ -66,16 +66,18 @@ SparseMatrix scatterDense(const Eigen::MatrixXd& block, const std::vector<int>& 
   return out;
 }
 
+/// Whether x and y are compressed with identical patterns.
+bool samePattern(const SparseMatrix& x, const SparseMatrix& y) {
+  return x.rows() == y.rows() && x.cols() == y.cols() && x.isCompressed() && y.isCompressed() &&
+         x.nonZeros() == y.nonZeros() &&
+         std::equal(x.outerIndexPtr(), x.outerIndexPtr() + x.outerSize() + 1, y.outerIndexPtr()) &&
+         std::equal(x.innerIndexPtr(), x.innerIndexPtr() + x.nonZeros(), y.innerIndexPtr());
+}
+
 /// out = a A + b B. When A and B share one pattern (blocks cut from M and K, which the
 /// assembler builds on one pattern) only values are written, into out's storage if it
 /// already has that pattern; otherwise Eigen's general sum.
 void combineInto(double a, const SparseMatrix& A, double b, const SparseMatrix& B, SparseMatrix& out) {
-  auto samePattern = [](const SparseMatrix& x, const SparseMatrix& y) {
-    return x.rows() == y.rows() && x.cols() == y.cols() && x.isCompressed() && y.isCompressed() &&
-           x.nonZeros() == y.nonZeros() &&
-           std::equal(x.outerIndexPtr(), x.outerIndexPtr() + x.outerSize() + 1, y.outerIndexPtr()) &&
-           std::equal(x.innerIndexPtr(), x.innerIndexPtr() + x.nonZeros(), y.innerIndexPtr());
-  };
   if (!samePattern(A, B)) {
     out = a * A + b * B;
     out.makeCompressed();
@@ -156,6 +158,10 @@ struct RegionBlocks {
   // Stable coupling: the interface elements and K_I^{II}, their stiffness on I x I (dense).
   std::vector<InterfaceElement> interfaceElements;
   Eigen::MatrixXd interfaceStiffness;
+  // Forward-substitution buffers, and whether M^{SS} and G share one pattern (fused products).
+  Eigen::VectorXd runningStiffness, substepRhs;
+  Eigen::MatrixXd substepSolution;
+  bool massAndGSharePattern = false;
   std::unique_ptr<SparseSolver> solver;
   bool analyzed = false;
   std::vector<Eigen::MatrixXd> z;  // Z_r blocks (dense recovery only)
@@ -171,6 +177,29 @@ Eigen::MatrixXd applyInterfaceRow(const RegionBlocks& rb, bool damped, const Eig
   out += rb.Kis * weightedK;
   if (damped) out += rb.Dis * weightedD;
   return out;
+}
+
+/// mass = M^{SS} x and stiffness += G x, in one pass over the pattern when the two share
+/// it (they are cut from M and K, which share the assembler's pattern), else by Eigen.
+void massAndStiffnessProducts(const RegionBlocks& rb, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::VectorXd& mass,
+                              Eigen::VectorXd& stiffness) {
+  if (!rb.massAndGSharePattern) {
+    mass.noalias() = rb.Mss * x;
+    stiffness.noalias() += rb.G * x;
+    return;
+  }
+  mass.setZero();
+  const int* outer = rb.Mss.outerIndexPtr();
+  const int* inner = rb.Mss.innerIndexPtr();
+  const double* massValues = rb.Mss.valuePtr();
+  const double* stiffValues = rb.G.valuePtr();
+  for (Eigen::Index column = 0; column < rb.Mss.outerSize(); ++column) {
+    const double xc = x[column];
+    for (int k = outer[column]; k < outer[column + 1]; ++k) {
+      mass[inner[k]] += massValues[k] * xc;
+      stiffness[inner[k]] += stiffValues[k] * xc;
+    }
+  }
 }
 
 }  // namespace
@@ -394,6 +423,7 @@ void AsyncBackwardEuler::rebuildBlocks() {
     // A^S = M^{SS} + hS D^{SS} + hS^2 K^{SS}
     combineInto(1.0 + hS * alpha, rb.Mss, hS * hS + hS * beta, rb.Kss, rb.systemMatrix);
     combineInto(0.0, rb.Mss, hS * hS, rb.Kss, rb.G);
+    rb.massAndGSharePattern = samePattern(rb.Mss, rb.G);
     rb.coupling = couplingCoefficients(options.coupling, rb.ratio, hL);
   }
   if (options.coupling == AsyncCoupling::stable) subtractInterfaceStiffness();
@@ -707,16 +737,23 @@ void AsyncBackwardEuler::step() {
     }
     Y = sol.tail(rhsL.size());
   } else {
-    // Forward substitution with H^{SS} (paper's Algorithm 1, indices corrected).
+    // Forward substitution with H^{SS} (Eq. A13): A^S x_r = b_r + M^{SS} x_{r-1} - G sum_{i<r} x_i.
+    // G sum_{i<r} x_i is a running sum; M^{SS} x_{r-1} and G x_{r-1} are taken in one pass
+    // over their shared pattern, into buffers kept across steps (no allocation per substep).
     auto forwardSubstitute = [&](RegionBlocks& rb, const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
-      x.resize(b.rows(), b.cols());
-      Eigen::VectorXd sum = Eigen::VectorXd::Zero(b.rows()), rhs, xr;
+      const Eigen::Index size = b.rows();
+      x.resize(size, b.cols());
+      rb.runningStiffness.setZero(size);
+      rb.substepRhs.resize(size);
       for (int r = 1; r <= rb.ratio; ++r) {
-        rhs = b.col(r - 1);
-        if (r >= 2) rhs += rb.Mss * x.col(r - 2) - rb.G * sum;
-        xr = rb.solver->solve(rhs);
-        x.col(r - 1) = xr;
-        sum += xr;
+        if (r == 1) {
+          rb.substepRhs = b.col(0);
+        } else {
+          massAndStiffnessProducts(rb, x.col(r - 2), rb.substepRhs, rb.runningStiffness);
+          rb.substepRhs += b.col(r - 1) - rb.runningStiffness;
+        }
+        rb.solver->solve(rb.substepRhs, rb.substepSolution);
+        x.col(r - 1) = rb.substepSolution.col(0);
       }
     };
     std::vector<Eigen::MatrixXd> y(static_cast<std::size_t>(numRegions));
