@@ -22,6 +22,8 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/core/threading.hpp>
+#include <asyncfem/modalAnalysis/lowestModes.hpp>
+#include <asyncfem/modalAnalysis/regionModes.hpp>
 #include <asyncfem/sceneIO/asyncScene.hpp>
 #include <cmath>
 #include <cstdio>
@@ -54,7 +56,9 @@ struct CommandLine {
   std::string reference = "auto";
   int maxModalDofs = 5000;
   std::optional<int> vertex;
-  std::vector<double> keptWindow;  ///< [t0, t1] for the motion-kept table; empty: after the last load window
+  std::vector<double> keptWindow;
+  int modes = 0;  ///< > 0: print the modal table of the scene's regions first  ///< [t0, t1] for the motion-kept table;
+                  ///< empty: after the last load window
   bool quick = false;
   bool table = false;
   std::string models = "models";
@@ -466,6 +470,27 @@ void plotVertexAgainstEqualCost(const fs::path& path, const std::vector<RunResul
   writePng(path, renderPlot(spec, 1100, 650));
 }
 
+/// The K lowest modes of the scene (linear K, the scene's mass) with omega hL, omega hS and
+/// the share of each fast region, and the verdict: which modes async can keep here
+/// (docs/asynchronous-integrator.md, "Which modes can async keep?").
+void printSceneModes(const Scene& scene, const Simulation& baseline, int count) {
+  const FreeDofs& freeDofs = baseline.integrator->system().freeDofs;
+  std::vector<AsyncRegion> regions;
+  const nlohmann::json& options = scene.integrator.options;
+  if (isMultirate(scene.integrator.name) && options.is_object() && options.contains("regions") &&
+      options["regions"].is_array()) {
+    regions = parseAsyncOptions(scene, *baseline.mesh, freeDofs, options).regions;
+  }
+  const VibrationMatrices matrices = vibrationMatrices(*baseline.mesh, scene.mass);
+  ModalOptions modal;
+  modal.count = std::min(count, freeDofs.numFree() - 1);
+  const ModalResult modes = lowestModes(matrices.stiffness, matrices.mass, freeDofs, modal);
+  std::cout << "\n## The " << modal.count << " lowest modes and the scene's fast regions (eigensolve "
+            << formatDouble(modes.solveSeconds, 3) << " s)\n\n";
+  printRegionModeReport(std::cout, analyseRegionModes(modes, matrices.mass, modalRegions(regions),
+                                                      scene.integrator.timestep, scene.frames.rate));
+}
+
 // The vertex of the first fast region (else of the whole mesh) with the largest reference
 // displacement over the frames.
 int chooseVertex(const Reference& reference, const std::vector<VertexGroup>& groups, int numVertices) {
@@ -517,6 +542,7 @@ int runBenchmark(const CommandLine& options) {
 
   const Reference reference = computeReference(scene, baseline, configs, frames, options);
   std::cout << "Reference: " << reference.description << "\n";
+  if (options.modes > 0) printSceneModes(scene, baseline, options.modes);
   const std::vector<VertexGroup> groups = errorGroups(scene, baseline, configs);
 
   std::vector<RunResult> results;
@@ -643,6 +669,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"auto", "modal", "trapezoidal"}));
   app.add_option("--max-modal-dofs", options.maxModalDofs, "Largest free-DOF count for the modal reference");
   app.add_option("--vertex", options.vertex, "Vertex of the displacement plot (default: chosen automatically)");
+  app.add_option("--modes", options.modes,
+                 "K: print the K lowest modes with omega*hL, omega*hS and the fast regions' shares, and the verdict")
+      ->check(CLI::PositiveNumber);
   app.add_option("--kept-window", options.keptWindow,
                  "T0 T1: also print the motion-kept table for this time window (s); it always starts after the last "
                  "load window")
