@@ -179,27 +179,36 @@ Eigen::MatrixXd applyInterfaceRow(const RegionBlocks& rb, bool damped, const Eig
   return out;
 }
 
-/// mass = M^{SS} x and stiffness += G x, in one pass over the pattern when the two share
-/// it (they are cut from M and K, which share the assembler's pattern), else by Eigen.
-void massAndStiffnessProducts(const RegionBlocks& rb, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::VectorXd& mass,
-                              Eigen::VectorXd& stiffness) {
-  if (!rb.massAndGSharePattern) {
-    mass.noalias() = rb.Mss * x;
-    stiffness.noalias() += rb.G * x;
-    return;
-  }
-  mass.setZero();
+/// mass = M^{SS} x and stiffness += G x for one column x (contiguous, |S| entries), in one
+/// pass over the pattern the two share (they are cut from M and K, which share the
+/// assembler's pattern).
+void fusedColumnProducts(const RegionBlocks& rb, const double* x, double* mass, double* stiffness) {
   const int* outer = rb.Mss.outerIndexPtr();
   const int* inner = rb.Mss.innerIndexPtr();
   const double* massValues = rb.Mss.valuePtr();
   const double* stiffValues = rb.G.valuePtr();
-  for (Eigen::Index column = 0; column < rb.Mss.outerSize(); ++column) {
+  const Eigen::Index size = rb.Mss.outerSize();
+  std::fill(mass, mass + size, 0.0);
+  for (Eigen::Index column = 0; column < size; ++column) {
     const double xc = x[column];
     for (int k = outer[column]; k < outer[column + 1]; ++k) {
       mass[inner[k]] += massValues[k] * xc;
       stiffness[inner[k]] += stiffValues[k] * xc;
     }
   }
+}
+
+/// mass = M^{SS} x and stiffness += G x, column by column (x, mass, stiffness: |S| x k,
+/// column-major and contiguous), fused when M^{SS} and G share a pattern, else by Eigen.
+void massAndStiffnessProducts(const RegionBlocks& rb, const Eigen::MatrixXd& x, Eigen::MatrixXd& mass,
+                              Eigen::MatrixXd& stiffness) {
+  if (!rb.massAndGSharePattern) {
+    mass.noalias() = rb.Mss * x;
+    stiffness.noalias() += rb.G * x;
+    return;
+  }
+  for (Eigen::Index c = 0; c < x.cols(); ++c)
+    fusedColumnProducts(rb, x.col(c).data(), mass.col(c).data(), stiffness.col(c).data());
 }
 
 }  // namespace
@@ -507,18 +516,19 @@ void AsyncBackwardEuler::rebuildBlocks() {
     const Eigen::MatrixXd Dsi = damped ? Eigen::MatrixXd(rb.Dsi) : Eigen::MatrixXd();
     const CouplingCoefficients& k = rb.coupling;
     const Eigen::Index sizeRows = rb.systemMatrix.rows();
-    Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(sizeRows, q), prev, rhs, x;
+    // As in the step's forward substitution: G sum_{i<r} Z_i as a running sum, M^{SS} Z_{r-1}
+    // and G Z_{r-1} in one pass.
+    Eigen::MatrixXd runningStiffness = Eigen::MatrixXd::Zero(sizeRows, q), massProduct(sizeRows, q), prev, rhs, x;
     Eigen::MatrixXd weightedM = Eigen::MatrixXd::Zero(sizeRows, q), weightedK = weightedM, weightedD;
     if (damped) weightedD = weightedM;
     for (int r = 1; r <= m; ++r) {
       rhs = k.bM[r - 1] * Msi + k.bK[r - 1] * Ksi;
       if (damped) rhs += k.bD[r - 1] * Dsi;
       if (r >= 2) {
-        rhs -= rb.G * sum;
-        rhs += rb.Mss * prev;
+        massAndStiffnessProducts(rb, prev, massProduct, runningStiffness);
+        rhs += massProduct - runningStiffness;
       }
       rb.solver->solve(rhs, x);
-      sum += x;
       if (k.eM[r - 1] != 0.0) weightedM += k.eM[r - 1] * x;
       weightedK += k.eK[r - 1] * x;
       if (damped) weightedD += k.eD[r - 1] * x;
@@ -749,7 +759,12 @@ void AsyncBackwardEuler::step() {
         if (r == 1) {
           rb.substepRhs = b.col(0);
         } else {
-          massAndStiffnessProducts(rb, x.col(r - 2), rb.substepRhs, rb.runningStiffness);
+          if (rb.massAndGSharePattern) {
+            fusedColumnProducts(rb, x.col(r - 2).data(), rb.substepRhs.data(), rb.runningStiffness.data());
+          } else {
+            rb.substepRhs.noalias() = rb.Mss * x.col(r - 2);
+            rb.runningStiffness.noalias() += rb.G * x.col(r - 2);
+          }
           rb.substepRhs += b.col(r - 1) - rb.runningStiffness;
         }
         rb.solver->solve(rb.substepRhs, rb.substepSolution);
