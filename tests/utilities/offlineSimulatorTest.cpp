@@ -556,3 +556,63 @@ TEST_F(OfflineSimulatorTest, EveryShippedSceneRuns) {
 }
 
 }  // namespace
+
+namespace {
+
+/// The (timestep, file) pairs of a .pvd, in order.
+std::vector<std::pair<double, std::string>> pvdEntries(const fs::path& path) {
+  const std::string text = readText(path);
+  std::vector<std::pair<double, std::string>> entries;
+  const std::string timeKey = "timestep=\"";
+  const std::string fileKey = "file=\"";
+  for (std::size_t at = text.find("<DataSet"); at != std::string::npos; at = text.find("<DataSet", at + 1)) {
+    const std::size_t time = text.find(timeKey, at) + timeKey.size();
+    const std::size_t file = text.find(fileKey, at) + fileKey.size();
+    entries.emplace_back(std::stod(text.substr(time, text.find('"', time) - time)),
+                         text.substr(file, text.find('"', file) - file));
+  }
+  return entries;
+}
+
+// Every vtu.every-th frame becomes a binary .vtu, listed in frames.pvd at the time the
+// .afsim record holds; a run stopped early and resumed leaves the same collection as an
+// uninterrupted one; "encoding": "ascii" writes text.
+TEST_F(OfflineSimulatorTest, VtuFramesComeWithAPvdCollection) {
+  auto json = smallScene();
+  json["output"]["vtu"] = {{"folder", "vtu"}, {"every", 2}};
+  const fs::path scene = writeScene(json);
+  const RunResult full = run(quoted(scene) + " --quiet");
+  ASSERT_EQ(full.exitCode, 0) << full.err;
+  const auto entries = pvdEntries(folder_ / "vtu/frames.pvd");
+  asyncfem::SimulationReader reader(folder_ / "out/run.afsim");
+  ASSERT_EQ(entries.size(), 3U);
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const auto frame = static_cast<std::int64_t>(2 * i);
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%05d.vtu", static_cast<int>(frame));
+    EXPECT_EQ(entries[i].second, name);
+    EXPECT_EQ(entries[i].first, reader.readFrame(frame).time);  // printed in the shortest exact form
+    const std::string vtu = readText(folder_ / "vtu" / name);
+    EXPECT_NE(vtu.find("header_type=\"UInt64\""), std::string::npos);
+    EXPECT_NE(vtu.find("<AppendedData encoding=\"raw\">"), std::string::npos);
+  }
+  EXPECT_FALSE(fs::exists(folder_ / "vtu/frames.pvd.tmp"));
+
+  // Stopped after 3 frames: the collection lists the two .vtu files written so far.
+  fs::remove_all(folder_ / "vtu");
+  ASSERT_EQ(run(quoted(scene) + " --quiet --frames 3").exitCode, 0);
+  const auto partial = pvdEntries(folder_ / "vtu/frames.pvd");
+  ASSERT_EQ(partial.size(), 2U);
+  EXPECT_EQ(partial[1].second, "frame_00002.vtu");
+  const RunResult resumed = run(quoted(scene) + " --quiet --resume");
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+  EXPECT_EQ(pvdEntries(folder_ / "vtu/frames.pvd"), entries);
+
+  json["output"]["vtu"]["encoding"] = "ascii";
+  ASSERT_EQ(run(quoted(writeScene(json)) + " --quiet").exitCode, 0);
+  const std::string ascii = readText(folder_ / "vtu/frame_00000.vtu");
+  EXPECT_NE(ascii.find("Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\""), std::string::npos);
+  EXPECT_EQ(ascii.find("AppendedData"), std::string::npos);
+}
+
+}  // namespace

@@ -3,11 +3,13 @@
 #include <asyncfem/volumetricMesh/writers.hpp>
 #include <bit>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <system_error>
 #include <type_traits>
+#include <utility>
 
 #include "detail/textInput.hpp"
 
@@ -288,5 +290,32 @@ void writePvd(const std::filesystem::path& path, const std::vector<PvdEntry>& en
   out << "  </Collection>\n</VTKFile>\n";
   writeAtomically(path, out.str());
 }
+
+VtuSeriesWriter::VtuSeriesWriter(std::filesystem::path folder, VtuEncoding encoding)
+    : folder_(std::move(folder)), encoding_(encoding) {
+  std::error_code ec;
+  std::filesystem::create_directories(folder_, ec);
+  if (ec) throw Error("cannot create the .vtu folder '" + folder_.string() + "': " + ec.message());
+}
+
+std::string VtuSeriesWriter::frameFileName(std::int64_t frame) {
+  char name[40];
+  std::snprintf(name, sizeof(name), "frame_%05lld.vtu", static_cast<long long>(frame));
+  return name;
+}
+
+void VtuSeriesWriter::writeFrame(std::int64_t frame, double time, const TetMesh& mesh,
+                                 const Eigen::VectorXd& displacement) {
+  const std::string name = frameFileName(frame);
+  writeVtu(folder_ / name, mesh, displacement, {}, {}, encoding_);
+  entries_.push_back({time, name});
+  writeCollection();
+}
+
+void VtuSeriesWriter::addExistingFrame(std::int64_t frame, double time) {
+  entries_.push_back({time, frameFileName(frame)});
+}
+
+void VtuSeriesWriter::writeCollection() const { writePvd(collectionPath(), entries_); }
 
 }  // namespace asyncfem

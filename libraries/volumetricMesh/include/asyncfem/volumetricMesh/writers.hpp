@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -63,5 +64,37 @@ struct PvdEntry {
 /// simulated times. Written to PATH.tmp and renamed over PATH, so rewriting it after
 /// every frame always leaves a complete file. asyncfem::Error if it cannot be written.
 void writePvd(const std::filesystem::path& path, const std::vector<PvdEntry>& entries);
+
+/// A frame series for ParaView: FOLDER/frame_NNNNN.vtu per frame (frame index, 5 digits
+/// or more) and FOLDER/frames.pvd listing the frames written so far with their times.
+/// The .pvd is rewritten (atomically) after every frame, so a run stopped at any point
+/// leaves a valid collection of its finished frames.
+class VtuSeriesWriter {
+ public:
+  /// Creates folder (and its parents) if needed; writes nothing else yet.
+  explicit VtuSeriesWriter(std::filesystem::path folder, VtuEncoding encoding = VtuEncoding::binary);
+
+  /// "frame_00042.vtu" for frame 42.
+  static std::string frameFileName(std::int64_t frame);
+
+  /// Writes frame's .vtu (rest positions + displacement, see writeVtu) and the .pvd with
+  /// it appended at time.
+  void writeFrame(std::int64_t frame, double time, const TetMesh& mesh, const Eigen::VectorXd& displacement);
+  /// Lists an already written frame file in the collection (a resumed run's earlier
+  /// frames) without writing it; the .pvd is rewritten at the next writeFrame or
+  /// writeCollection.
+  void addExistingFrame(std::int64_t frame, double time);
+  /// Rewrites the .pvd with the frames listed so far (possibly none).
+  void writeCollection() const;
+
+  const std::filesystem::path& folder() const { return folder_; }
+  std::filesystem::path collectionPath() const { return folder_ / "frames.pvd"; }
+  const std::vector<PvdEntry>& entries() const { return entries_; }
+
+ private:
+  std::filesystem::path folder_;
+  VtuEncoding encoding_;
+  std::vector<PvdEntry> entries_;
+};
 
 }  // namespace asyncfem
