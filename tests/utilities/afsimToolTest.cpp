@@ -2,7 +2,6 @@
 // afsimTool end to end: writes a small .afsim (and mesh) with the libraries, runs the
 // built executable on it and checks what it prints and writes.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <asyncfem/simulationIO/checkpoint.hpp>
@@ -13,28 +12,19 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
+
+#include "runTool.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
+using asyncfem::test::readText;
+using asyncfem::test::RunResult;
+
 const std::string toolPath = std::string(ASYNCFEM_BIN_DIR) + "/afsimTool";
-
-struct RunResult {
-  int exitCode = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string readText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 std::vector<std::string> split(const std::string& text, char separator) {
   std::vector<std::string> parts{""};
@@ -55,11 +45,7 @@ class AfsimToolTest : public ::testing::Test {
   /// A 2 x 1 x 1 box (12 vertices) as box.veg and run.afsim with 5 frames of a known
   /// displacement (u of vertex v, axis a at frame k = sin(k + 3v + a) / 7), frame rate 20.
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    folder_ = fs::temp_directory_path() /
-              ("asyncfem-afsimTool-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
+    folder_ = asyncfem::test::freshTestFolder("afsimTool");
     asyncfem::BoxMeshSpec spec;
     spec.size = Eigen::Vector3d(2, 1, 1);
     spec.cells = Eigen::Vector3i(2, 1, 1);
@@ -81,16 +67,7 @@ class AfsimToolTest : public ::testing::Test {
   }
 
   RunResult run(const std::string& arguments) const {
-    const fs::path out = folder_ / "stdout.txt";
-    const fs::path err = folder_ / "stderr.txt";
-    const std::string command = "cd '" + folder_.string() + "' && '" + toolPath + "' " + arguments + " > '" +
-                                out.string() + "' 2> '" + err.string() + "' < /dev/null";
-    const int status = std::system(command.c_str());
-    RunResult result;
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = readText(out);
-    result.err = readText(err);
-    return result;
+    return asyncfem::test::runTool(toolPath, arguments, folder_, folder_);
   }
 
   fs::path folder_;

@@ -19,34 +19,20 @@
 #include <thread>
 #include <vector>
 
+#include "runTool.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
 const std::string simulatorPath = std::string(ASYNCFEM_BIN_DIR) + "/offlineSimulator";
 
-struct RunResult {
-  int exitCode = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string readText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using asyncfem::test::readText;
+using asyncfem::test::RunResult;
 
 class OfflineSimulatorTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    folder_ = fs::temp_directory_path() /
-              ("asyncfem-offlineSimulator-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
-  }
+  void SetUp() override { folder_ = asyncfem::test::freshTestFolder("offlineSimulator"); }
   void TearDown() override { fs::remove_all(folder_); }
 
   /// A box of 3 x 1 x 1 cells fixed at x = 0, pulled at x = 3 for 0.1 s, backward Euler
@@ -72,16 +58,7 @@ class OfflineSimulatorTest : public ::testing::Test {
   /// Runs the simulator with the shell-quoted arguments; stdout and stderr separately
   /// (both are files, so stderr is not a terminal).
   RunResult run(const std::string& arguments) const {
-    const fs::path out = folder_ / "stdout.txt";
-    const fs::path err = folder_ / "stderr.txt";
-    const std::string command =
-        "'" + simulatorPath + "' " + arguments + " > '" + out.string() + "' 2> '" + err.string() + "' < /dev/null";
-    const int status = std::system(command.c_str());
-    RunResult result;
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = readText(out);
-    result.err = readText(err);
-    return result;
+    return asyncfem::test::runTool(simulatorPath, arguments, folder_);
   }
 
   // Built by appending: GCC 12 warns falsely (-Wrestrict) about "literal" + std::string.
