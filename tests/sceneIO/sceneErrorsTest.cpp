@@ -167,6 +167,8 @@ const ErrorCase cases[] = {
      "scene.json: output.vtu.folder: expected a non-empty path"},
     {"OutputVtuEvery", R"({"output": {"vtu": {"folder": "v", "every": 0}}})",
      "scene.json: output.vtu.every: expected an integer in [1, "},
+    {"OutputVtuEncoding", R"({"output": {"vtu": {"folder": "v", "encoding": "base64"}}})",
+     "scene.json: output.vtu.encoding: unknown value \"base64\" (expected one of \"binary\", \"ascii\")"},
     {"OutputVelocitiesNotBool", R"({"output": {"velocities": "yes"}})",
      "scene.json: output.velocities: expected true or false"},
     {"MeshFileMissing",

@@ -33,6 +33,7 @@ TEST(SceneParse, DefaultsOfAMinimalScene) {
   EXPECT_EQ(scene.frames.count, 60);
   EXPECT_TRUE(scene.output.file.empty());
   EXPECT_TRUE(scene.output.vtuFolder.empty());
+  EXPECT_EQ(scene.output.vtuEncoding, asyncfem::VtuEncoding::binary);
   EXPECT_FALSE(scene.output.velocities);
   EXPECT_FALSE(scene.output.sync);
 }
@@ -53,7 +54,7 @@ TEST(SceneParse, EveryKeyIsRead) {
     "forceModel": {"type": "corotational", "tangent": "exact"},
     "integrator": {"name": "trapezoidal", "timestep": 0.005, "options": {"solver": "umfpack", "anything": 1}},
     "frames": {"rate": 25, "count": 7},
-    "output": {"file": "out/run.afsim", "vtu": {"folder": "out/vtu", "every": 2}, "velocities": true, "sync": true}
+    "output": {"file": "out/run.afsim", "vtu": {"folder": "out/vtu", "every": 2, "encoding": "ascii"}, "velocities": true, "sync": true}
   })");
   const Scene scene = asyncfem::parseScene(json, "scenes", "s.json");
   EXPECT_EQ(scene.description, "all keys");
@@ -94,6 +95,7 @@ TEST(SceneParse, EveryKeyIsRead) {
   EXPECT_EQ(scene.output.file, std::filesystem::path("scenes/out/run.afsim"));
   EXPECT_EQ(scene.output.vtuFolder, std::filesystem::path("scenes/out/vtu"));
   EXPECT_EQ(scene.output.vtuEvery, 2);
+  EXPECT_EQ(scene.output.vtuEncoding, asyncfem::VtuEncoding::ascii);
   EXPECT_TRUE(scene.output.velocities);
   EXPECT_TRUE(scene.output.sync);
 }

@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -305,6 +307,61 @@ TEST_F(SimulationFileTest, AbsurdHeaderFailsFast) {
   writeBytes(path, bytes);
   message = errorOf(path);
   EXPECT_NE(message.find("header checksum mismatch"), std::string::npos) << message;
+}
+
+// docs/simulation-output.md states the record size as "### Frame record (`A + Bn` bytes,
+// or `C + Dn` with velocities)" and the file as a 64-byte header plus records: files
+// the writer produces must have exactly that size, so the page cannot drift from the code.
+TEST_F(SimulationFileTest, FileSizeMatchesTheDocumentedLayout) {
+  const fs::path page = fs::path(ASYNCFEM_MODELS_DIR).parent_path() / "docs" / "simulation-output.md";
+  std::ifstream in(page);
+  ASSERT_TRUE(in) << page;
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string doc = text.str();
+  std::smatch formula;
+  const std::regex heading(R"(### Frame record \(`(\d+) \+ (\d+)n` bytes, or `(\d+) \+ (\d+)n` with velocities\))");
+  ASSERT_TRUE(std::regex_search(doc, formula, heading)) << "record size heading not found in " << page;
+  ASSERT_NE(doc.find("### Header (64 bytes)"), std::string::npos);
+  ASSERT_NE(doc.find("Record `k` starts at byte `64 + k * recordSize`"), std::string::npos);
+  const std::int64_t fixed = std::stoll(formula[1]);
+  const std::int64_t perVertex = std::stoll(formula[2]);
+  const std::int64_t fixedWithVelocities = std::stoll(formula[3]);
+  const std::int64_t perVertexWithVelocities = std::stoll(formula[4]);
+
+  for (const bool velocities : {false, true}) {
+    for (const int n : {1, 7}) {
+      SimulationFileHeader header;
+      header.numVertices = n;
+      header.frameInterval = 0.1;
+      header.hasVelocities = velocities;
+      const fs::path path = file("layout.afsim");
+      constexpr int frames = 3;
+      {
+        SimulationWriter writer(path, header);
+        for (int k = 0; k < frames; ++k) {
+          if (velocities) {
+            writer.appendFrame(0.1 * (k + 1), sample(3 * n, k), sample(3 * n, k + 10));
+          } else {
+            writer.appendFrame(0.1 * (k + 1), sample(3 * n, k));
+          }
+        }
+      }
+      const std::int64_t record =
+          velocities ? fixedWithVelocities + perVertexWithVelocities * n : fixed + perVertex * n;
+      EXPECT_EQ(header.recordBytes(), record) << "n = " << n << ", velocities " << velocities;
+      EXPECT_EQ(static_cast<std::int64_t>(fs::file_size(path)), 64 + frames * record)
+          << "n = " << n << ", velocities " << velocities;
+      // Record k starts at 64 + k * recordSize with its 8-byte index k.
+      std::ifstream raw(path, std::ios::binary);
+      for (std::int64_t k = 0; k < frames; ++k) {
+        raw.seekg(64 + k * record);
+        std::int64_t index = -1;
+        raw.read(reinterpret_cast<char*>(&index), sizeof(index));  // little-endian host
+        EXPECT_EQ(index, k);
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -19,34 +19,20 @@
 #include <thread>
 #include <vector>
 
+#include "runTool.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
 const std::string simulatorPath = std::string(ASYNCFEM_BIN_DIR) + "/offlineSimulator";
 
-struct RunResult {
-  int exitCode = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string readText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using asyncfem::test::readText;
+using asyncfem::test::RunResult;
 
 class OfflineSimulatorTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    folder_ = fs::temp_directory_path() /
-              ("asyncfem-offlineSimulator-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
-  }
+  void SetUp() override { folder_ = asyncfem::test::freshTestFolder("offlineSimulator"); }
   void TearDown() override { fs::remove_all(folder_); }
 
   /// A box of 3 x 1 x 1 cells fixed at x = 0, pulled at x = 3 for 0.1 s, backward Euler
@@ -72,16 +58,7 @@ class OfflineSimulatorTest : public ::testing::Test {
   /// Runs the simulator with the shell-quoted arguments; stdout and stderr separately
   /// (both are files, so stderr is not a terminal).
   RunResult run(const std::string& arguments) const {
-    const fs::path out = folder_ / "stdout.txt";
-    const fs::path err = folder_ / "stderr.txt";
-    const std::string command =
-        "'" + simulatorPath + "' " + arguments + " > '" + out.string() + "' 2> '" + err.string() + "' < /dev/null";
-    const int status = std::system(command.c_str());
-    RunResult result;
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = readText(out);
-    result.err = readText(err);
-    return result;
+    return asyncfem::test::runTool(simulatorPath, arguments, folder_);
   }
 
   // Built by appending: GCC 12 warns falsely (-Wrestrict) about "literal" + std::string.
@@ -553,6 +530,66 @@ TEST_F(OfflineSimulatorTest, EveryShippedSceneRuns) {
     }
   }
   EXPECT_GE(scenes, 4);  // at least the default scene, its single-rate twin and the two benchmark scenes
+}
+
+}  // namespace
+
+namespace {
+
+/// The (timestep, file) pairs of a .pvd, in order.
+std::vector<std::pair<double, std::string>> pvdEntries(const fs::path& path) {
+  const std::string text = readText(path);
+  std::vector<std::pair<double, std::string>> entries;
+  const std::string timeKey = "timestep=\"";
+  const std::string fileKey = "file=\"";
+  for (std::size_t at = text.find("<DataSet"); at != std::string::npos; at = text.find("<DataSet", at + 1)) {
+    const std::size_t time = text.find(timeKey, at) + timeKey.size();
+    const std::size_t file = text.find(fileKey, at) + fileKey.size();
+    entries.emplace_back(std::stod(text.substr(time, text.find('"', time) - time)),
+                         text.substr(file, text.find('"', file) - file));
+  }
+  return entries;
+}
+
+// Every vtu.every-th frame becomes a binary .vtu, listed in frames.pvd at the time the
+// .afsim record holds; a run stopped early and resumed leaves the same collection as an
+// uninterrupted one; "encoding": "ascii" writes text.
+TEST_F(OfflineSimulatorTest, VtuFramesComeWithAPvdCollection) {
+  auto json = smallScene();
+  json["output"]["vtu"] = {{"folder", "vtu"}, {"every", 2}};
+  const fs::path scene = writeScene(json);
+  const RunResult full = run(quoted(scene) + " --quiet");
+  ASSERT_EQ(full.exitCode, 0) << full.err;
+  const auto entries = pvdEntries(folder_ / "vtu/frames.pvd");
+  asyncfem::SimulationReader reader(folder_ / "out/run.afsim");
+  ASSERT_EQ(entries.size(), 3U);
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const auto frame = static_cast<std::int64_t>(2 * i);
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%05d.vtu", static_cast<int>(frame));
+    EXPECT_EQ(entries[i].second, name);
+    EXPECT_EQ(entries[i].first, reader.readFrame(frame).time);  // printed in the shortest exact form
+    const std::string vtu = readText(folder_ / "vtu" / name);
+    EXPECT_NE(vtu.find("header_type=\"UInt64\""), std::string::npos);
+    EXPECT_NE(vtu.find("<AppendedData encoding=\"raw\">"), std::string::npos);
+  }
+  EXPECT_FALSE(fs::exists(folder_ / "vtu/frames.pvd.tmp"));
+
+  // Stopped after 3 frames: the collection lists the two .vtu files written so far.
+  fs::remove_all(folder_ / "vtu");
+  ASSERT_EQ(run(quoted(scene) + " --quiet --frames 3").exitCode, 0);
+  const auto partial = pvdEntries(folder_ / "vtu/frames.pvd");
+  ASSERT_EQ(partial.size(), 2U);
+  EXPECT_EQ(partial[1].second, "frame_00002.vtu");
+  const RunResult resumed = run(quoted(scene) + " --quiet --resume");
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+  EXPECT_EQ(pvdEntries(folder_ / "vtu/frames.pvd"), entries);
+
+  json["output"]["vtu"]["encoding"] = "ascii";
+  ASSERT_EQ(run(quoted(writeScene(json)) + " --quiet").exitCode, 0);
+  const std::string ascii = readText(folder_ / "vtu/frame_00000.vtu");
+  EXPECT_NE(ascii.find("Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\""), std::string::npos);
+  EXPECT_EQ(ascii.find("AppendedData"), std::string::npos);
 }
 
 }  // namespace

@@ -261,10 +261,15 @@ void applyOverrides(const CommandLine& options, asyncfem::Scene& scene) {
   }
 }
 
-std::string vtuName(int frame) {
-  char name[32];
-  std::snprintf(name, sizeof(name), "frame_%05d.vtu", frame);
-  return name;
+/// A resumed run's .pvd lists the .vtu files of its earlier frames too, at the times
+/// stored in the output file's records.
+void listEarlierVtuFrames(const asyncfem::Scene& scene, int firstFrame, asyncfem::VtuSeriesWriter& series) {
+  asyncfem::SimulationReader reader(scene.output.file);
+  for (int k = 0; k < firstFrame && k < reader.numFrames(); k += scene.output.vtuEvery) {
+    if (fs::exists(series.folder() / asyncfem::VtuSeriesWriter::frameFileName(k))) {
+      series.addExistingFrame(k, reader.readFrame(k).time);
+    }
+  }
 }
 
 std::string milliseconds(double seconds, int frames) {
@@ -396,8 +401,9 @@ int run(int argc, char** argv) {
   if (scene.output.file.has_parent_path()) {
     fs::create_directories(scene.output.file.parent_path());
   }
+  std::optional<asyncfem::VtuSeriesWriter> vtuSeries;
   if (!scene.output.vtuFolder.empty()) {
-    fs::create_directories(scene.output.vtuFolder);
+    vtuSeries.emplace(scene.output.vtuFolder, scene.output.vtuEncoding);
   }
   asyncfem::SimulationFileHeader header;
   header.numVertices = simulation.mesh->numVertices();
@@ -418,6 +424,10 @@ int run(int argc, char** argv) {
     // The rest state, so that a run stopped before its first frame can be resumed too.
     asyncfem::writeCheckpoint(checkpointFile, captureCheckpoint(*simulation.integrator, 0, fingerprint),
                               scene.output.sync);
+  }
+  if (vtuSeries) {
+    if (firstFrame > 0) listEarlierVtuFrames(scene, firstFrame, *vtuSeries);
+    vtuSeries->writeCollection();
   }
   std::int64_t checkpointFrames = firstFrame;
   installStopHandlers();
@@ -452,8 +462,8 @@ int run(int argc, char** argv) {
                                     scene.output.sync);
           checkpointFrames = done;
         }
-        if (!scene.output.vtuFolder.empty() && frame % scene.output.vtuEvery == 0) {
-          asyncfem::writeVtu(scene.output.vtuFolder / vtuName(frame), *simulation.mesh, integrator.displacement());
+        if (vtuSeries && frame % scene.output.vtuEvery == 0) {
+          vtuSeries->writeFrame(frame, integrator.time(), *simulation.mesh, integrator.displacement());
         }
       }
       progress.update(frame + 1);

@@ -305,6 +305,9 @@ void parseOutput(JsonObjectReader& top, Scene& scene) {
     JsonObjectReader vtuReader(*vtu, reader.keyPath("vtu"), scene.sourceName);
     scene.output.vtuFolder = resolvePath(scene.baseDirectory, pathString(vtuReader, "folder"));
     scene.output.vtuEvery = vtuReader.integer("every", 1, 1, maxInt);
+    scene.output.vtuEncoding = vtuReader.choice("encoding", "binary", {"binary", "ascii"}) == "ascii"
+                                   ? VtuEncoding::ascii
+                                   : VtuEncoding::binary;
     vtuReader.finish();
   }
   scene.output.velocities = reader.boolean("velocities", false);

@@ -337,6 +337,8 @@ std::vector<std::string> contactStepWarnings(const Scene& scene, const TetMesh& 
 
 }  // namespace
 
+TetMesh buildSceneMesh(const Scene& scene) { return applyMaterialOverrides(scene, loadMesh(scene)); }
+
 Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registry) {
   Simulation simulation;
 
@@ -366,7 +368,7 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
   }
   simulation.stepsPerFrame = static_cast<int>(steps);
 
-  auto mesh = std::make_shared<TetMesh>(applyMaterialOverrides(scene, loadMesh(scene)));
+  auto mesh = std::make_shared<TetMesh>(buildSceneMesh(scene));
   simulation.mesh = mesh;
   simulation.fixedVertices = collectFixedVertices(scene, *mesh);
   const std::vector<VertexLoad> loads = collectLoads(scene, *mesh);

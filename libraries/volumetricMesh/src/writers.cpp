@@ -1,13 +1,17 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "detail/textInput.hpp"
-
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
-
+#include <bit>
+#include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <system_error>
+#include <type_traits>
+#include <utility>
+
+#include "detail/textInput.hpp"
 
 namespace asyncfem {
 
@@ -47,7 +51,9 @@ void writeAtomically(const std::filesystem::path& path, const std::string& text)
 void checkVegName(const std::string& name, const std::string& what) {
   bool ok = !name.empty() && name.front() != '*';
   for (char c : name) ok = ok && c != ',' && c != '#' && c != ' ' && c != '\t' && c != '\n' && c != '\r';
-  if (!ok) throw ValidationError("writeVeg: " + what + " name '" + name + "' cannot be written to .veg (it must be one token without spaces, commas or '#')");
+  if (!ok)
+    throw ValidationError("writeVeg: " + what + " name '" + name +
+                          "' cannot be written to .veg (it must be one token without spaces, commas or '#')");
 }
 
 void writeIdList(std::ostringstream& out, const std::vector<int>& ids) {
@@ -61,17 +67,27 @@ std::string xmlEscape(const std::string& text) {
   std::string escaped;
   for (char c : text) {
     switch (c) {
-      case '&': escaped += "&amp;"; break;
-      case '<': escaped += "&lt;"; break;
-      case '>': escaped += "&gt;"; break;
-      case '"': escaped += "&quot;"; break;
-      default: escaped += c;
+      case '&':
+        escaped += "&amp;";
+        break;
+      case '<':
+        escaped += "&lt;";
+        break;
+      case '>':
+        escaped += "&gt;";
+        break;
+      case '"':
+        escaped += "&quot;";
+        break;
+      default:
+        escaped += c;
     }
   }
   return escaped;
 }
 
-void writeDataArray(std::ostringstream& out, const VtuArray& array, int count, const std::string& where) {
+/// Checks a user array's name, component count and size against count points or cells.
+void checkArray(const VtuArray& array, int count, const std::string& where) {
   if (array.name.empty()) throw ValidationError("writeVtu: a " + where + " array has no name");
   if (array.components != 1 && array.components != 3) {
     throw ValidationError("writeVtu: " + where + " array '" + array.name + "' has " + std::to_string(array.components) +
@@ -79,18 +95,71 @@ void writeDataArray(std::ostringstream& out, const VtuArray& array, int count, c
   }
   const std::size_t expected = static_cast<std::size_t>(array.components) * static_cast<std::size_t>(count);
   if (array.values.size() != expected) {
-    throw ValidationError("writeVtu: " + where + " array '" + array.name + "' has " + std::to_string(array.values.size()) +
-                          " values, expected " + std::to_string(expected));
+    throw ValidationError("writeVtu: " + where + " array '" + array.name + "' has " +
+                          std::to_string(array.values.size()) + " values, expected " + std::to_string(expected));
   }
-  out << "        <DataArray type=\"Float64\" Name=\"" << xmlEscape(array.name) << "\" NumberOfComponents=\""
-      << array.components << "\" format=\"ascii\">\n";
-  for (std::size_t i = 0; i < array.values.size(); i += static_cast<std::size_t>(array.components)) {
-    out << "         ";
-    for (int c = 0; c < array.components; ++c) out << ' ' << detail::formatDouble(array.values[i + static_cast<std::size_t>(c)]);
-    out << '\n';
-  }
-  out << "        </DataArray>\n";
 }
+
+/// The XML of a .vtu and, for the binary encoding, its appended block: each DataArray
+/// either holds its values as text or points (offset) into the appended block, where it
+/// is stored as a UInt64 byte count followed by the raw values.
+class VtuBuilder {
+ public:
+  static_assert(sizeof(int) == 4, "mesh indices are written as VTK Int32");
+
+  explicit VtuBuilder(VtuEncoding encoding) : encoding_(encoding) {}
+
+  std::ostringstream& xml() { return xml_; }
+
+  /// One DataArray of count values (tuples of `components`); name may be empty.
+  template <typename T>
+  void array(const char* type, const std::string& name, int components, const T* values, std::size_t count) {
+    xml_ << "        <DataArray type=\"" << type << '"';
+    if (!name.empty()) xml_ << " Name=\"" << xmlEscape(name) << '"';
+    if (components != 1) xml_ << " NumberOfComponents=\"" << components << '"';
+    if (encoding_ == VtuEncoding::binary) {
+      xml_ << " format=\"appended\" offset=\"" << appended_.size() << "\"/>\n";
+      const std::uint64_t bytes = count * sizeof(T);
+      appendBytes(&bytes, sizeof(bytes));
+      appendBytes(values, bytes);
+      return;
+    }
+    xml_ << " format=\"ascii\">\n";
+    // One tuple per line for vectors, 16 scalars per line otherwise.
+    const std::size_t perLine = components == 1 ? 16 : static_cast<std::size_t>(components);
+    for (std::size_t i = 0; i < count; ++i) {
+      xml_ << (i % perLine == 0 ? "         " : "") << ' ';
+      if constexpr (std::is_floating_point_v<T>) {
+        xml_ << detail::formatDouble(values[i]);
+      } else {
+        xml_ << static_cast<long long>(values[i]);
+      }
+      if (i % perLine == perLine - 1 || i + 1 == count) xml_ << '\n';
+    }
+    xml_ << "        </DataArray>\n";
+  }
+
+  /// The finished file: XML, then (binary) the appended block.
+  std::string finish() {
+    if (encoding_ == VtuEncoding::binary) {
+      xml_ << "  <AppendedData encoding=\"raw\">\n   _";
+      xml_.write(appended_.data(), static_cast<std::streamsize>(appended_.size()));
+      xml_ << "\n  </AppendedData>\n";
+    }
+    xml_ << "</VTKFile>\n";
+    return xml_.str();
+  }
+
+ private:
+  void appendBytes(const void* data, std::size_t bytes) {
+    const auto* begin = static_cast<const char*>(data);
+    appended_.append(begin, begin + bytes);
+  }
+
+  VtuEncoding encoding_;
+  std::ostringstream xml_;
+  std::string appended_;
+};
 
 }  // namespace
 
@@ -99,14 +168,15 @@ void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
   for (const auto& [name, members] : mesh.elementSets()) {
     checkVegName(name, "element set");
     if (name.rfind(kMaterialSetPrefix, 0) == 0) {
-      throw ValidationError("writeVeg: element set name '" + name + "' uses the reserved prefix " + std::string(kMaterialSetPrefix));
+      throw ValidationError("writeVeg: element set name '" + name + "' uses the reserved prefix " +
+                            std::string(kMaterialSetPrefix));
     }
   }
   for (const auto& [name, members] : mesh.vertexSets()) checkVegName(name, "vertex set");
 
   std::ostringstream out;
-  out << "# " << mesh.numVertices() << " vertices, " << mesh.numElements() << " tetrahedra, "
-      << mesh.materials().size() << " materials\n";
+  out << "# " << mesh.numVertices() << " vertices, " << mesh.numElements() << " tetrahedra, " << mesh.materials().size()
+      << " materials\n";
   out << "*VERTICES\n" << mesh.numVertices() << " 3 0 0\n";
   for (int v = 0; v < mesh.numVertices(); ++v) {
     const Eigen::Vector3d x = mesh.restPosition(v);
@@ -134,7 +204,8 @@ void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
   // One *REGION line per material that has elements, naming an existing set with
   // exactly those elements when there is one, otherwise a helper set.
   std::vector<std::vector<int>> materialElements(mesh.materials().size());
-  for (int e = 0; e < mesh.numElements(); ++e) materialElements[static_cast<std::size_t>(mesh.elementMaterialIndex(e))].push_back(e);
+  for (int e = 0; e < mesh.numElements(); ++e)
+    materialElements[static_cast<std::size_t>(mesh.elementMaterialIndex(e))].push_back(e);
   std::string regions;
   for (std::size_t m = 0; m < materialElements.size(); ++m) {
     const std::vector<int>& members = materialElements[m];
@@ -159,48 +230,92 @@ void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
 }
 
 void writeVtu(const std::filesystem::path& path, const TetMesh& mesh, const Eigen::VectorXd& displacement,
-              const std::vector<VtuArray>& pointArrays, const std::vector<VtuArray>& cellArrays) {
+              const std::vector<VtuArray>& pointArrays, const std::vector<VtuArray>& cellArrays, VtuEncoding encoding) {
   if (displacement.size() != 0 && displacement.size() != mesh.numDofs()) {
-    throw ValidationError("writeVtu: displacement has " + std::to_string(displacement.size()) + " entries, expected 0 or " +
-                          std::to_string(mesh.numDofs()));
+    throw ValidationError("writeVtu: displacement has " + std::to_string(displacement.size()) +
+                          " entries, expected 0 or " + std::to_string(mesh.numDofs()));
   }
+  for (const VtuArray& array : pointArrays) checkArray(array, mesh.numVertices(), "point");
+  for (const VtuArray& array : cellArrays) checkArray(array, mesh.numElements(), "cell");
+  const auto numVertices = static_cast<std::size_t>(mesh.numVertices());
+  const auto numElements = static_cast<std::size_t>(mesh.numElements());
+
+  VtuBuilder vtu(encoding);
+  vtu.xml() << "<?xml version=\"1.0\"?>\n"
+            << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\""
+            << (std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian")
+            << "\" header_type=\"UInt64\">\n"
+            << "  <UnstructuredGrid>\n"
+            << "    <Piece NumberOfPoints=\"" << numVertices << "\" NumberOfCells=\"" << numElements << "\">\n";
+  vtu.xml() << "      <PointData" << (displacement.size() != 0 ? " Vectors=\"displacement\"" : "") << ">\n";
+  if (displacement.size() != 0) vtu.array("Float64", "displacement", 3, displacement.data(), 3 * numVertices);
+  for (const VtuArray& array : pointArrays) {
+    vtu.array("Float64", array.name, array.components, array.values.data(), array.values.size());
+  }
+  vtu.xml() << "      </PointData>\n      <CellData>\n";
+  const std::vector<int>& materials = mesh.elementMaterials();
+  vtu.array("Int32", "material", 1, materials.data(), numElements);
+  for (const VtuArray& array : cellArrays) {
+    vtu.array("Float64", array.name, array.components, array.values.data(), array.values.size());
+  }
+  // Rest positions: the displacement array carries the deformation (Warp By Vector),
+  // so it must not be added here as well.
+  vtu.xml() << "      </CellData>\n      <Points>\n";
+  vtu.array("Float64", "", 3, mesh.restPositions().data(), 3 * numVertices);
+  vtu.xml() << "      </Points>\n      <Cells>\n";
+  std::vector<std::int32_t> connectivity(4 * numElements);
+  std::vector<std::int32_t> offsets(numElements);
+  for (std::size_t e = 0; e < numElements; ++e) {
+    const Eigen::Vector4i t = mesh.element(static_cast<int>(e));
+    for (int corner = 0; corner < 4; ++corner) connectivity[4 * e + static_cast<std::size_t>(corner)] = t[corner];
+    offsets[e] = static_cast<std::int32_t>(4 * (e + 1));
+  }
+  constexpr std::uint8_t vtkTetra = 10;
+  const std::vector<std::uint8_t> types(numElements, vtkTetra);
+  vtu.array("Int32", "connectivity", 1, connectivity.data(), connectivity.size());
+  vtu.array("Int32", "offsets", 1, offsets.data(), offsets.size());
+  vtu.array("UInt8", "types", 1, types.data(), types.size());
+  vtu.xml() << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n";
+  writeAtomically(path, vtu.finish());
+}
+
+void writePvd(const std::filesystem::path& path, const std::vector<PvdEntry>& entries) {
   std::ostringstream out;
   out << "<?xml version=\"1.0\"?>\n"
-      << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      << "  <UnstructuredGrid>\n"
-      << "    <Piece NumberOfPoints=\"" << mesh.numVertices() << "\" NumberOfCells=\"" << mesh.numElements() << "\">\n";
-  out << "      <PointData>\n";
-  if (displacement.size() != 0) {
-    VtuArray u{"displacement", 3, std::vector<double>(displacement.data(), displacement.data() + displacement.size())};
-    writeDataArray(out, u, mesh.numVertices(), "point");
+      << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
+  for (const PvdEntry& entry : entries) {
+    out << "    <DataSet timestep=\"" << detail::formatDouble(entry.time) << "\" group=\"\" part=\"0\" file=\""
+        << xmlEscape(entry.file.generic_string()) << "\"/>\n";
   }
-  for (const VtuArray& array : pointArrays) writeDataArray(out, array, mesh.numVertices(), "point");
-  out << "      </PointData>\n      <CellData>\n";
-  out << "        <DataArray type=\"Int32\" Name=\"material\" format=\"ascii\">\n";
-  for (int e = 0; e < mesh.numElements(); ++e) out << (e % 16 == 0 ? "         " : "") << ' ' << mesh.elementMaterialIndex(e) << (e % 16 == 15 || e + 1 == mesh.numElements() ? "\n" : "");
-  out << "        </DataArray>\n";
-  for (const VtuArray& array : cellArrays) writeDataArray(out, array, mesh.numElements(), "cell");
-  out << "      </CellData>\n      <Points>\n"
-      << "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (int v = 0; v < mesh.numVertices(); ++v) {
-    Eigen::Vector3d x = mesh.restPosition(v);
-    if (displacement.size() != 0) x += displacement.segment<3>(3 * v);
-    out << "          " << detail::formatDouble(x.x()) << ' ' << detail::formatDouble(x.y()) << ' '
-        << detail::formatDouble(x.z()) << '\n';
-  }
-  out << "        </DataArray>\n      </Points>\n      <Cells>\n"
-      << "        <DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (int e = 0; e < mesh.numElements(); ++e) {
-    const Eigen::Vector4i t = mesh.element(e);
-    out << "          " << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
-  }
-  out << "        </DataArray>\n        <DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
-  for (int e = 0; e < mesh.numElements(); ++e) out << (e % 16 == 0 ? "         " : "") << ' ' << 4 * (e + 1) << (e % 16 == 15 || e + 1 == mesh.numElements() ? "\n" : "");
-  out << "        </DataArray>\n        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  // VTK_TETRA = 10
-  for (int e = 0; e < mesh.numElements(); ++e) out << (e % 16 == 0 ? "         " : "") << " 10" << (e % 16 == 15 || e + 1 == mesh.numElements() ? "\n" : "");
-  out << "        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  out << "  </Collection>\n</VTKFile>\n";
   writeAtomically(path, out.str());
 }
+
+VtuSeriesWriter::VtuSeriesWriter(std::filesystem::path folder, VtuEncoding encoding)
+    : folder_(std::move(folder)), encoding_(encoding) {
+  std::error_code ec;
+  std::filesystem::create_directories(folder_, ec);
+  if (ec) throw Error("cannot create the .vtu folder '" + folder_.string() + "': " + ec.message());
+}
+
+std::string VtuSeriesWriter::frameFileName(std::int64_t frame) {
+  char name[40];
+  std::snprintf(name, sizeof(name), "frame_%05lld.vtu", static_cast<long long>(frame));
+  return name;
+}
+
+void VtuSeriesWriter::writeFrame(std::int64_t frame, double time, const TetMesh& mesh,
+                                 const Eigen::VectorXd& displacement) {
+  const std::string name = frameFileName(frame);
+  writeVtu(folder_ / name, mesh, displacement, {}, {}, encoding_);
+  entries_.push_back({time, name});
+  writeCollection();
+}
+
+void VtuSeriesWriter::addExistingFrame(std::int64_t frame, double time) {
+  entries_.push_back({time, frameFileName(frame)});
+}
+
+void VtuSeriesWriter::writeCollection() const { writePvd(collectionPath(), entries_); }
 
 }  // namespace asyncfem

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/writers.hpp>
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -114,6 +115,8 @@ struct Scene {
     int vtuEvery = 1;                 ///< write a .vtu every this many frames
     bool velocities = false;          ///< also store velocities in the .afsim file
     bool sync = false;                ///< fsync after every frame
+    /// output.vtu.encoding: how the .vtu files store their arrays
+    VtuEncoding vtuEncoding = VtuEncoding::binary;
   } output;
 };
 

@@ -82,6 +82,11 @@ struct Simulation {
   std::vector<std::string> warnings;
 };
 
+/// The mesh a scene runs on: its file or generator with the material overrides applied,
+/// as buildSimulation builds it, without assembling anything (for tools that only need
+/// positions). Throws asyncfem::ValidationError as buildSimulation does for the mesh.
+TetMesh buildSceneMesh(const Scene& scene);
+
 /// Builds what a scene describes, and only that: the mesh (file or generator) with the
 /// material overrides, the fixed vertices (sets, boxes, .bou), consistent or lumped mass,
 /// a LinearForceModel (constant K) or a CorotationalLinearFEM, Rayleigh alpha and beta,

@@ -1,0 +1,278 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// afsimTool: gets results out of a simulation output file (.afsim).
+//
+//   afsimTool info SIM.afsim
+//   afsimTool csv SIM.afsim --vertices 12,40 [--frames 0:100] [--mesh MESH | --scene SCENE.json] [-o FILE.csv]
+//   afsimTool vtu SIM.afsim (--mesh MESH | --scene SCENE.json) [--frames 10,20] [-o DIR] [--encoding binary|ascii]
+//
+// info prints the header, the frame times, whether every record's checksum matches (else
+// the first bad frame, exit status 1) and the run's checkpoint when one lies next to the
+// file. csv writes one row per frame: index, time and the chosen vertices' displacement
+// (and rest + displacement positions with a mesh). vtu writes DIR/frame_NNNNN.vtu per
+// chosen frame and DIR/frames.pvd. Errors print "afsimTool: <message>" on stderr and exit
+// with status 1. Described in docs/simulation-output.md, section "Getting results out".
+#include <CLI/CLI.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/sceneIO/scene.hpp>
+#include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/simulationIO/checkpoint.hpp>
+#include <asyncfem/simulationIO/frameSelection.hpp>
+#include <asyncfem/simulationIO/simulationFile.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
+#include <asyncfem/volumetricMesh/writers.hpp>
+#include <charconv>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace asyncfem;
+
+struct CommandLine {
+  std::string simulation;
+  std::string vertices;
+  std::string frames;
+  std::optional<std::string> mesh;
+  std::optional<std::string> scene;
+  std::string output;
+  std::string encoding = "binary";
+};
+
+/// The shortest text that reads back to the same double.
+std::string exact(double value) {
+  char text[32];
+  const auto result = std::to_chars(text, text + sizeof(text), value);
+  return {text, result.ptr};
+}
+
+std::string hex(std::uint32_t value) {
+  char text[16];
+  std::snprintf(text, sizeof(text), "0x%08x", value);
+  return text;
+}
+
+/// Opens the file; a missing or unreadable one is named with the reason.
+std::unique_ptr<SimulationReader> openSimulation(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error("cannot open '" + path + "': no such file");
+  if (fs::is_directory(path, ec)) throw Error("cannot open '" + path + "': it is a folder, not an .afsim file");
+  return std::make_unique<SimulationReader>(path);
+}
+
+/// "12,40" -> {12, 40}; every id must be a vertex of the file.
+std::vector<int> parseVertices(const std::string& text, const SimulationReader& reader) {
+  std::vector<int> vertices;
+  std::string item;
+  for (std::size_t i = 0; i <= text.size(); ++i) {
+    if (i < text.size() && text[i] != ',') {
+      item += text[i];
+      continue;
+    }
+    long long id = -1;
+    const auto [end, error] = std::from_chars(item.data(), item.data() + item.size(), id);
+    if (item.empty() || error != std::errc() || end != item.data() + item.size() || id < 0) {
+      throw Error("--vertices " + text + ": \"" + item + "\" is not a vertex id (expected 0-based ids such as 12,40)");
+    }
+    if (id >= reader.numVertices()) {
+      throw Error("--vertices: vertex " + std::to_string(id) + " is out of range: " + reader.path().string() + " has " +
+                  std::to_string(reader.numVertices()) + " vertices (ids 0 to " +
+                  std::to_string(reader.numVertices() - 1) + ")");
+    }
+    vertices.push_back(static_cast<int>(id));
+    item.clear();
+  }
+  return vertices;
+}
+
+/// The mesh from --mesh or --scene (none if neither), checked against the file's vertex count.
+std::optional<TetMesh> loadMesh(const CommandLine& options, const SimulationReader& reader) {
+  if (options.mesh && options.scene) throw Error("give the mesh with --mesh FILE or --scene SCENE.json, not both");
+  std::optional<TetMesh> mesh;
+  std::string name;
+  if (options.mesh) {
+    mesh = readMesh(*options.mesh);
+    name = *options.mesh;
+  } else if (options.scene) {
+    mesh = buildSceneMesh(loadScene(*options.scene));
+    name = *options.scene;
+  } else {
+    return mesh;
+  }
+  if (mesh->numVertices() != reader.numVertices()) {
+    throw Error(reader.path().string() + " has " + std::to_string(reader.numVertices()) + " vertices but the mesh (" +
+                name + ") has " + std::to_string(mesh->numVertices()) + ": the simulation did not run on this mesh");
+  }
+  return mesh;
+}
+
+int info(const CommandLine& options) {
+  const auto reader = openSimulation(options.simulation);
+  const SimulationFileHeader& header = reader->header();
+  std::cout << "file        " << options.simulation << " (" << fs::file_size(options.simulation) << " bytes)\n"
+            << "format      AsyncFEM simulation file, version " << simulationFileVersion << '\n'
+            << "vertices    " << header.numVertices << '\n'
+            << "frames      " << reader->numFrames() << " complete";
+  if (reader->hasTruncatedFrame()) {
+    std::cout << " (+ " << reader->truncatedTrailingBytes() << " bytes of an interrupted frame, ignored)";
+  }
+  std::cout << "\nframe rate  " << exact(header.frameInterval > 0 ? 1.0 / header.frameInterval : 0.0)
+            << " per time unit (interval " << exact(header.frameInterval) << ")\n"
+            << "timestep    " << (header.timestep > 0 ? exact(header.timestep) : std::string("unknown")) << '\n'
+            << "velocities  " << (header.hasVelocities ? "yes" : "no") << '\n'
+            << "record      " << header.recordBytes() << " bytes\n";
+
+  // Every record, so that the times come from the file and a bad checksum is found.
+  SimulationFrame frame;
+  std::optional<std::string> firstBad;
+  double firstTime = 0.0;
+  double lastTime = 0.0;
+  for (std::int64_t k = 0; k < reader->numFrames() && !firstBad; ++k) {
+    try {
+      reader->readFrame(k, frame);
+      if (k == 0) firstTime = frame.time;
+      lastTime = frame.time;
+    } catch (const ParseError& error) {
+      firstBad = error.what();
+    }
+  }
+  if (reader->numFrames() > 0) {
+    std::cout << "times       " << exact(firstTime) << " to " << exact(lastTime) << '\n';
+  }
+  std::cout << "checksums   "
+            << (firstBad ? "BAD: " + *firstBad : "ok (" + std::to_string(reader->numFrames()) + " frames)") << '\n';
+
+  // The .afsim stores no scene; the checkpoint next to it identifies the run.
+  const fs::path checkpointFile = checkpointPathFor(options.simulation);
+  std::cout << "scene       not recorded in the .afsim file";
+  if (fs::exists(checkpointFile)) {
+    try {
+      const SimulationCheckpoint checkpoint = readCheckpoint(checkpointFile);
+      std::cout << "; run fingerprint " << hex(checkpoint.fingerprint) << " (scene, mesh, timestep)\n"
+                << "checkpoint  " << checkpointFile.string() << ": after frame " << checkpoint.frames
+                << ", t = " << exact(checkpoint.time) << ", integrator " << checkpoint.integrator << '\n';
+    } catch (const Error& error) {
+      std::cout << "\ncheckpoint  " << checkpointFile.string() << ": unreadable: " << error.what() << '\n';
+    }
+  } else {
+    std::cout << "\ncheckpoint  none (" << checkpointFile.string() << " does not exist)\n";
+  }
+  if (firstBad) {
+    std::cerr << "afsimTool: " << *firstBad << '\n';
+    return 1;
+  }
+  return 0;
+}
+
+int csv(const CommandLine& options) {
+  const auto reader = openSimulation(options.simulation);
+  const std::vector<int> vertices = parseVertices(options.vertices, *reader);
+  const std::vector<std::int64_t> frames =
+      frames::selectFrames(frames::parseFrameSelection(options.frames), reader->numFrames(), options.simulation);
+  const std::optional<TetMesh> mesh = loadMesh(options, *reader);
+
+  std::ofstream file;
+  if (!options.output.empty()) {
+    const fs::path output(options.output);
+    if (output.has_parent_path()) fs::create_directories(output.parent_path());
+    file.open(output, std::ios::trunc);
+    if (!file) throw Error("cannot write '" + options.output + "'");
+  }
+  std::ostream& out = options.output.empty() ? std::cout : file;
+  out << "frame,time";
+  for (const int v : vertices) {
+    for (const char* axis : {"x", "y", "z"}) out << ",u" << v << '_' << axis;
+    if (mesh) {
+      for (const char* axis : {"x", "y", "z"}) out << ",p" << v << '_' << axis;
+    }
+  }
+  out << '\n';
+  SimulationFrame frame;
+  for (const std::int64_t k : frames) {
+    reader->readFrame(k, frame);
+    out << k << ',' << exact(frame.time);
+    for (const int v : vertices) {
+      const Eigen::Vector3d u = frame.displacement.segment<3>(3 * v);
+      for (int axis = 0; axis < 3; ++axis) out << ',' << exact(u[axis]);
+      if (mesh) {
+        const Eigen::Vector3d position = mesh->restPosition(v) + u;
+        for (int axis = 0; axis < 3; ++axis) out << ',' << exact(position[axis]);
+      }
+    }
+    out << '\n';
+  }
+  out.flush();
+  if (!out) throw Error("cannot write '" + (options.output.empty() ? std::string("stdout") : options.output) + "'");
+  return 0;
+}
+
+int vtu(const CommandLine& options) {
+  const auto reader = openSimulation(options.simulation);
+  if (!options.mesh && !options.scene) throw Error("vtu needs the mesh: give --mesh FILE or --scene SCENE.json");
+  const std::vector<std::int64_t> frames =
+      frames::selectFrames(frames::parseFrameSelection(options.frames), reader->numFrames(), options.simulation);
+  const std::optional<TetMesh> mesh = loadMesh(options, *reader);
+  VtuSeriesWriter series(options.output.empty() ? fs::path("vtu") : fs::path(options.output),
+                         options.encoding == "ascii" ? VtuEncoding::ascii : VtuEncoding::binary);
+  SimulationFrame frame;
+  for (const std::int64_t k : frames) {
+    reader->readFrame(k, frame);
+    series.writeFrame(k, frame.time, *mesh, frame.displacement);
+  }
+  std::cout << "wrote " << frames.size() << " .vtu files and " << series.collectionPath().string() << '\n';
+  return 0;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"Gets results out of an .afsim simulation file (docs/simulation-output.md)."};
+  app.require_subcommand(1);
+  CommandLine options;
+
+  CLI::App* infoCommand = app.add_subcommand("info", "Header, frame times, checksums, the run's checkpoint");
+  infoCommand->add_option("simulation", options.simulation, "The .afsim file")->required();
+
+  CLI::App* csvCommand = app.add_subcommand("csv", "Chosen vertices' displacements (and positions) per frame as CSV");
+  csvCommand->add_option("simulation", options.simulation, "The .afsim file")->required();
+  csvCommand->add_option("--vertices", options.vertices, "0-based vertex ids, comma separated (12,40)")->required();
+  csvCommand->add_option("--frames", options.frames, "Frames, start:stop:step or a comma list (default all)");
+  csvCommand->add_option("--mesh", options.mesh, "The tet mesh: also write positions (rest + displacement)");
+  csvCommand->add_option("--scene", options.scene, "Instead of --mesh: the scene that produced the file");
+  csvCommand->add_option("-o,--output", options.output, "CSV file to write (default: stdout)");
+
+  CLI::App* vtuCommand = app.add_subcommand("vtu", "Chosen frames as .vtu files plus a .pvd collection");
+  vtuCommand->add_option("simulation", options.simulation, "The .afsim file")->required();
+  vtuCommand->add_option("--mesh", options.mesh, "The tet mesh the simulation ran on (.veg, .node/.ele, .msh)");
+  vtuCommand->add_option("--scene", options.scene, "Instead of --mesh: the scene that produced the file");
+  vtuCommand->add_option("--frames", options.frames, "Frames, start:stop:step or a comma list (default all)");
+  vtuCommand->add_option("-o,--output", options.output, "Folder for frame_NNNNN.vtu and frames.pvd (default vtu)");
+  vtuCommand->add_option("--encoding", options.encoding, "binary (raw appended, default) or ascii")
+      ->check(CLI::IsMember({"binary", "ascii"}));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    return app.exit(error);
+  }
+  if (infoCommand->parsed()) return info(options);
+  if (csvCommand->parsed()) return csv(options);
+  return vtu(options);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const asyncfem::Error& e) {
+    std::cerr << "afsimTool: " << e.what() << '\n';
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "afsimTool: unexpected error: " << e.what() << '\n';
+    return 1;
+  }
+}
