@@ -64,6 +64,77 @@ TEST(BuildSimulation, StepsPerFrameToleratesRounding) {
   }
 }
 
+TEST(BuildSimulation, StepsPerFrameGivesTheTimestep) {
+  auto json = smallScene();
+  json["integrator"].erase("timestep");
+  json["integrator"]["stepsPerFrame"] = 4;
+  const Scene scene = asyncfem::parseScene(json, "", "scene.json");
+  EXPECT_EQ(scene.integrator.timestep, 0.1 / 4);  // known before the build, for utilities
+  const Simulation simulation = asyncfem::buildSimulation(scene);
+  EXPECT_EQ(simulation.stepsPerFrame, 4);
+  EXPECT_EQ(simulation.timestep, 0.1 / 4);
+  EXPECT_EQ(simulation.integrator->timestep(), 0.1 / 4);
+}
+
+// A timestep within a relative 1e-9 (timestepDivisorTolerance) of a divisor T / N of the
+// frame interval runs N steps per frame; further away it is refused, with the two nearest
+// divisors in the message.
+TEST(BuildSimulation, TimestepWithinRoundOffOfADivisorIsAccepted) {
+  auto json = smallScene();
+  json["frames"]["rate"] = 30;
+  json["integrator"]["timestep"] = (1.0 / 990.0) * (1.0 + 5e-10);
+  EXPECT_EQ(build(json).stepsPerFrame, 33);
+  json["integrator"]["timestep"] = 0.001010101010;  // 1/990 to ten significant digits
+  EXPECT_EQ(build(json).stepsPerFrame, 33);
+  json["integrator"]["timestep"] = (1.0 / 990.0) * (1.0 + 2e-9);
+  EXPECT_THROW((void)build(json), asyncfem::ValidationError);
+  json["integrator"]["timestep"] = 0.001;
+  try {
+    (void)build(json);
+    FAIL() << "expected a timing error";
+  } catch (const asyncfem::ValidationError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "scene.json: integrator.timestep: 0.001 does not divide the frame interval 1/30 s (frames.rate 30) "
+              "into whole steps: 33.3333333333 steps per frame; the nearest valid timesteps are 1/990 s = "
+              "0.00101010101 s (33 steps per frame) and 1/1020 s = 0.000980392157 s (34 steps per frame); or give "
+              "the steps per frame instead (integrator.stepsPerFrame)");
+  }
+}
+
+// Steps whose load evaluations see a non-zero pull: a window [a, b) acts at the step
+// times t = k h with a <= t < b, a step time within 1e-9 h of b counting as b. Step times
+// are k h (not accumulated), so [0, 0.3] at h = 0.03 and [0, 0.1] at h = 0.01 (where
+// summing h ten times lands above and below b) both hold exactly ten step times: t_0 ..
+// t_9. Backward Euler evaluates f_ext at step ends t_1 .. t_9 (9 steps), symplectic Euler
+// at step starts t_0 .. t_9 (10 steps).
+int pulledSteps(const std::string& integrator, double windowEnd, double h) {
+  int pulled = 0;
+  asyncfem::IntegratorRegistry registry = asyncfem::defaultIntegratorRegistry();
+  registry.add("counting", [&pulled, integrator](const Scene& scene, const asyncfem::TetMesh& mesh,
+                                                 asyncfem::DynamicSystem system, const nlohmann::json& options) {
+    system.externalForce = [&pulled, load = system.externalForce](double time, const Eigen::VectorXd& u,
+                                                                  const Eigen::VectorXd& v, Eigen::VectorXd& forces) {
+      load(time, u, v, forces);
+      pulled += forces.isZero(0.0) ? 0 : 1;
+    };
+    return (*asyncfem::defaultIntegratorRegistry().find(integrator))(scene, mesh, std::move(system), options);
+  });
+  auto json = smallScene();
+  json["integrator"] = {{"name", "counting"}, {"stepsPerFrame", 1}, {"options", {{"force", true}}}};
+  json["frames"]["rate"] = 1.0 / h;
+  json["forces"] = {{{"type", "pull"}, {"set", "xmax"}, {"force", {0, -1, 0}}, {"window", {0.0, windowEnd}}}};
+  const Simulation simulation = asyncfem::buildSimulation(asyncfem::parseScene(json, "", "scene.json"), registry);
+  for (int k = 0; k < 20; ++k) simulation.integrator->step();
+  return pulled;
+}
+
+TEST(BuildSimulation, PullWindowEndingOnAStepTimeHoldsTheSameStepsWhateverTheRoundOff) {
+  EXPECT_EQ(pulledSteps("backward-euler", 0.3, 0.03), 9);
+  EXPECT_EQ(pulledSteps("backward-euler", 0.1, 0.01), 9);
+  EXPECT_EQ(pulledSteps("symplectic-euler", 0.3, 0.03), 10);
+  EXPECT_EQ(pulledSteps("symplectic-euler", 0.1, 0.01), 10);
+}
+
 TEST(BuildSimulation, FileMeshMatchesTheGenerator) {
   const asyncfem::test::ScratchFolder folder;
   asyncfem::BoxMeshSpec spec;

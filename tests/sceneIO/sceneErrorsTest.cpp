@@ -136,7 +136,7 @@ const ErrorCase cases[] = {
      "scene.json: forceModel.tangent: unknown value \"approximate\""},
     {"IntegratorMissing", R"({"integrator": null})", "scene.json: integrator: required key missing"},
     {"TimestepMissing", R"({"integrator": {"timestep": null}})",
-     "scene.json: integrator.timestep: required key missing"},
+     "scene.json: integrator: give either \"timestep\" or \"stepsPerFrame\" (steps per frame of 1 / frames.rate)"},
     {"TimestepNotPositive", R"({"integrator": {"timestep": 0}})",
      "scene.json: integrator.timestep: expected a number > 0"},
     {"IntegratorOptionsNotObject", R"({"integrator": {"options": [1]}})",
@@ -157,9 +157,20 @@ const ErrorCase cases[] = {
      R"({"mesh": {"material": {"youngsModulus": 1e8}}, "integrator": {"name": "central-differences"}})",
      "scene.json: integrator.timestep: ", true},
     {"StepsPerFrameNotInteger", R"({"integrator": {"timestep": 0.03}})",
-     "scene.json: integrator.timestep: 0.03 does not divide the frame interval 1 / frames.rate", true},
+     "scene.json: integrator.timestep: 0.03 does not divide the frame interval 1/10 s (frames.rate 10) into whole "
+     "steps: 3.33333333333 steps per frame; the nearest valid timesteps are 1/30 s = 0.0333333333 s (3 steps per "
+     "frame) and 1/40 s = 0.025 s (4 steps per frame); or give the steps per frame instead "
+     "(integrator.stepsPerFrame)",
+     true},
     {"StepLongerThanFrame", R"({"integrator": {"timestep": 0.2}})",
-     "scene.json: integrator.timestep: 0.2 does not divide the frame interval 1 / frames.rate", true},
+     "scene.json: integrator.timestep: 0.2 does not divide the frame interval 1/10 s (frames.rate 10) into whole "
+     "steps: 0.5 steps per frame; the timestep is longer than a frame; the longest valid timestep is 1/10 s = 0.1 s "
+     "(1 step per frame)",
+     true},
+    {"TimestepAndStepsPerFrame", R"({"integrator": {"stepsPerFrame": 4}})",
+     "scene.json: integrator: give either \"timestep\" or \"stepsPerFrame\""},
+    {"StepsPerFrameNotPositive", R"({"integrator": {"timestep": null, "stepsPerFrame": 0}})",
+     "scene.json: integrator.stepsPerFrame: expected an integer in [1, "},
     {"FramesRate", R"({"frames": {"rate": 0}})", "scene.json: frames.rate: expected a number > 0"},
     {"FramesCount", R"({"frames": {"count": 0}})", "scene.json: frames.count: expected an integer in [1, "},
     {"OutputFileEmpty", R"({"output": {"file": ""}})", "scene.json: output.file: expected a non-empty path"},
@@ -188,6 +199,23 @@ TEST(SceneErrorsFile, InvalidJsonNamesFileAndLine) {
   } catch (const asyncfem::ParseError& error) {
     EXPECT_EQ(error.line(), 3U) << error.what();
     EXPECT_NE(std::string(error.what()).find("broken.json:3: invalid JSON"), std::string::npos) << error.what();
+  }
+}
+
+// A folder or a mesh given where a scene belongs is named as such, not as invalid JSON.
+TEST(SceneErrorsFile, FolderOrMeshInsteadOfASceneIsNamed) {
+  const asyncfem::test::ScratchFolder folder;
+  const auto mesh = folder.write("beam.veg", "*VERTICES\n");
+  for (const auto& [path, expected] :
+       {std::pair{folder.path(), folder.path().string() + ": is a directory, not a scene file"},
+        std::pair{mesh, mesh.string() + ": is a mesh file, not a scene (scenes are JSON; see docs/scene-format.md); "
+                                        "to look at a mesh use meshInfo"}}) {
+    try {
+      (void)asyncfem::loadScene(path);
+      FAIL() << "expected an error for " << path;
+    } catch (const asyncfem::Error& error) {
+      EXPECT_NE(std::string(error.what()).find(expected), std::string::npos) << error.what();
+    }
   }
 }
 

@@ -84,8 +84,21 @@ TEST(TetMesherUtility, BadOptionsAreErrors) {
   EXPECT_EQ(run("--model nosuch -o " + scratch("x.veg").string()).status, 1);
   EXPECT_NE(run("--model nosuch -o " + scratch("x.veg").string()).output.find("known: dinosaur"), std::string::npos);
   EXPECT_EQ(run("--model drop --set bad:1,2 -o " + scratch("x.veg").string()).status, 1);
-  EXPECT_EQ(run("--model drop -o " + scratch("x.txt").string()).status, 1);
-  EXPECT_EQ(run("--spacing -1 --model drop -o " + scratch("x.veg").string()).status, 2);
+  // Usage errors (status 2) are found before any meshing, with readable messages.
+  const auto badExtension = run("--model drop -o " + scratch("x.stl").string());
+  EXPECT_EQ(badExtension.status, 2);
+  EXPECT_NE(badExtension.output.find("tetMesher: --output: cannot write '" + scratch("x.stl").string() +
+                                     "': unknown extension '.stl' (supported: .veg, .vtu)"),
+            std::string::npos)
+      << badExtension.output;
+  EXPECT_EQ(badExtension.output.find("lattice:"), std::string::npos) << badExtension.output;  // no mesh made
+  const auto negative = run("--spacing -1 --model drop -o " + scratch("x.veg").string());
+  EXPECT_EQ(negative.status, 2);
+  EXPECT_NE(negative.output.find("tetMesher: --spacing: must be > 0 (got -1) (see --help)"), std::string::npos)
+      << negative.output;
+  const auto unknown = run("--no-such-option");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_EQ(unknown.output.rfind("tetMesher: ", 0), 0U) << unknown.output;
 }
 
 }  // namespace

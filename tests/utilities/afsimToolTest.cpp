@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "runTool.hpp"
+#include "utilityTest.hpp"
 
 namespace {
 
@@ -38,14 +38,14 @@ std::vector<std::string> split(const std::string& text, char separator) {
   return parts;
 }
 
-class AfsimToolTest : public ::testing::Test {
+class AfsimToolTest : public asyncfem::test::UtilityTest {
  protected:
   static constexpr int frames = 5;
 
   /// A 2 x 1 x 1 box (12 vertices) as box.veg and run.afsim with 5 frames of a known
   /// displacement (u of vertex v, axis a at frame k = sin(k + 3v + a) / 7), frame rate 20.
   void SetUp() override {
-    folder_ = asyncfem::test::freshTestFolder("afsimTool");
+    UtilityTest::SetUp();
     asyncfem::BoxMeshSpec spec;
     spec.size = Eigen::Vector3d(2, 1, 1);
     spec.cells = Eigen::Vector3i(2, 1, 1);
@@ -58,19 +58,17 @@ class AfsimToolTest : public ::testing::Test {
     asyncfem::SimulationWriter writer(folder_ / "run.afsim", header);
     for (int k = 0; k < frames; ++k) writer.appendFrame(0.05 * (k + 1), displacement(k));
   }
-  void TearDown() override { fs::remove_all(folder_); }
-
   Eigen::VectorXd displacement(int frame) const {
     Eigen::VectorXd u(mesh_.numDofs());
     for (Eigen::Index i = 0; i < u.size(); ++i) u[i] = std::sin(static_cast<double>(frame + i)) / 7.0;
     return u;
   }
 
+  /// Runs afsimTool in the test's folder (relative paths are the folder's files).
   RunResult run(const std::string& arguments) const {
-    return asyncfem::test::runTool(toolPath, arguments, folder_, folder_);
+    return runCommand("cd '" + folder_.string() + "' && '" + toolPath + "' " + arguments);
   }
 
-  fs::path folder_;
   asyncfem::TetMesh mesh_;
 };
 

@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "runTool.hpp"
+#include "utilityTest.hpp"
 
 namespace {
 
@@ -30,11 +30,8 @@ const std::string simulatorPath = std::string(ASYNCFEM_BIN_DIR) + "/offlineSimul
 using asyncfem::test::readText;
 using asyncfem::test::RunResult;
 
-class OfflineSimulatorTest : public ::testing::Test {
+class OfflineSimulatorTest : public asyncfem::test::UtilityTest {
  protected:
-  void SetUp() override { folder_ = asyncfem::test::freshTestFolder("offlineSimulator"); }
-  void TearDown() override { fs::remove_all(folder_); }
-
   /// A box of 3 x 1 x 1 cells fixed at x = 0, pulled at x = 3 for 0.1 s, backward Euler
   /// with 5 steps per frame, output "out/run.afsim" next to the scene.
   static nlohmann::json smallScene() {
@@ -57,9 +54,7 @@ class OfflineSimulatorTest : public ::testing::Test {
 
   /// Runs the simulator with the shell-quoted arguments; stdout and stderr separately
   /// (both are files, so stderr is not a terminal).
-  RunResult run(const std::string& arguments) const {
-    return asyncfem::test::runTool(simulatorPath, arguments, folder_);
-  }
+  RunResult run(const std::string& arguments) const { return runCommand("'" + simulatorPath + "' " + arguments); }
 
   // Built by appending: GCC 12 warns falsely (-Wrestrict) about "literal" + std::string.
   static std::string quoted(const fs::path& path) {
@@ -133,8 +128,6 @@ class OfflineSimulatorTest : public ::testing::Test {
     EXPECT_TRUE(expected == actual) << "the resumed run differs from the uninterrupted one";
     EXPECT_TRUE(readText(asyncfem::checkpointPathFor(reference)) == readText(asyncfem::checkpointPathFor(output)));
   }
-
-  fs::path folder_;
 };
 
 TEST_F(OfflineSimulatorTest, WritesTheRequestedFrames) {
@@ -317,6 +310,80 @@ TEST_F(OfflineSimulatorTest, SceneErrorsNameTheKeyAndLeaveOutputAlone) {
   EXPECT_EQ(badOption.err.rfind("offlineSimulator: ", 0), 0U) << badOption.err;
 }
 
+// --dt must divide the frame interval (to a relative 1e-9); the refusal names the frame
+// interval and the two nearest valid timesteps, and --steps-per-frame gives one of them.
+TEST_F(OfflineSimulatorTest, TimestepMustDivideTheFrameOrBeGivenAsStepsPerFrame) {
+  const fs::path scene = writeScene(smallScene());  // frames.rate 20
+  const RunResult refused = run(quoted(scene) + " --dt 0.003");
+  EXPECT_EQ(refused.exitCode, 1);
+  EXPECT_NE(refused.err.find("offlineSimulator: " + scene.string() +
+                             ": integrator.timestep: 0.003 does not divide the frame interval 1/20 s (frames.rate 20) "
+                             "into whole steps: 16.6666666667 steps per frame; the nearest valid timesteps are 1/320 s "
+                             "= 0.003125 s (16 steps per frame) and 1/340 s = 0.00294117647 s (17 steps per frame)"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_FALSE(fs::exists(folder_ / "out/run.afsim"));
+
+  const RunResult bySteps = run(quoted(scene) + " --steps-per-frame 16 --frames 2");
+  EXPECT_EQ(bySteps.exitCode, 0) << bySteps.err;
+  EXPECT_NE(bySteps.out.find("32 steps of h = 0.003125 (16 per frame)"), std::string::npos) << bySteps.out;
+  const RunResult nearDivisor = run(quoted(scene) + " --dt 0.0031250000001 --frames 2");
+  EXPECT_EQ(nearDivisor.exitCode, 0) << nearDivisor.err;
+
+  const RunResult both = run(quoted(scene) + " --dt 0.01 --steps-per-frame 5");
+  EXPECT_EQ(both.exitCode, 2);
+  EXPECT_EQ(both.err.rfind("offlineSimulator: ", 0), 0U) << both.err;
+  const RunResult zero = run(quoted(scene) + " --steps-per-frame 0");
+  EXPECT_EQ(zero.exitCode, 2);
+  EXPECT_NE(zero.err.find("offlineSimulator: --steps-per-frame: must be >= 1 (got 0) (see --help)"), std::string::npos)
+      << zero.err;
+}
+
+// An output that is one of the run's inputs (the scene, the mesh), however it is spelled,
+// is refused before anything is written.
+TEST_F(OfflineSimulatorTest, RefusesToWriteOverItsInputs) {
+  auto json = smallScene();
+  const fs::path mesh = folder_ / "box.veg";
+  const fs::path scene = writeScene(json);
+  const std::string sceneText = readText(scene);
+  const RunResult same = run(quoted(scene) + " --output " + quoted(scene));
+  EXPECT_EQ(same.exitCode, 1);
+  EXPECT_NE(same.err.find("offlineSimulator: the output file " + scene.string() + " is the scene " + scene.string() +
+                          ": writing it would destroy the input"),
+            std::string::npos)
+      << same.err;
+  fs::create_symlink(scene, folder_ / "link.json");
+  const RunResult throughLink = run(quoted(scene) + " --output " + quoted(folder_ / "sub/../link.json"));
+  EXPECT_EQ(throughLink.exitCode, 1);
+  EXPECT_NE(throughLink.err.find("is the scene"), std::string::npos) << throughLink.err;
+  EXPECT_EQ(readText(scene), sceneText);
+
+  // A mesh file: the output may not be it either.
+  const std::string veg =
+      "*VERTICES\n4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n*ELEMENTS\nTET\n1 0 0\n"
+      "1 1 2 3 4\n*MATERIAL m\nENU, 1000, 1e5, 0.4\n*REGION\nallElements, m\n";
+  std::ofstream(mesh) << veg;
+  json["mesh"] = {{"file", "box.veg"}};
+  json["fixed"] = {{"boxes", {{{"min", {0, 0, 0}}, {"max", {0, 0, 0}}}}}};
+  json["forces"] = nlohmann::json::array();
+  const fs::path meshScene = writeScene(json, "mesh.json");
+  const RunResult overMesh = run(quoted(meshScene) + " --output " + quoted(folder_ / "./box.veg"));
+  EXPECT_EQ(overMesh.exitCode, 1);
+  EXPECT_NE(overMesh.err.find("is the mesh " + mesh.string()), std::string::npos) << overMesh.err;
+  EXPECT_EQ(readText(mesh), veg);
+}
+
+// Usage errors print "offlineSimulator: message (see --help)" and exit with status 2.
+TEST_F(OfflineSimulatorTest, UsageErrorsAreReadable) {
+  const fs::path scene = writeScene(smallScene());
+  const RunResult negative = run(quoted(scene) + " --dt -0.5");
+  EXPECT_EQ(negative.exitCode, 2);
+  EXPECT_EQ(negative.err, "offlineSimulator: --dt: must be > 0 (got -0.5) (see --help)\n");
+  const RunResult folder = run(quoted(folder_));
+  EXPECT_EQ(folder.exitCode, 1);
+  EXPECT_NE(folder.err.find("is a directory, not a scene file"), std::string::npos) << folder.err;
+}
+
 TEST_F(OfflineSimulatorTest, KilledRunLeavesEveryFinishedFrameReadable) {
   auto json = smallScene();
   json["mesh"]["cells"] = {6, 2, 2};
@@ -483,10 +550,18 @@ TEST_F(OfflineSimulatorTest, ResumeRefusesWhatItCannotContinueExactly) {
   json["mesh"]["material"]["youngsModulus"] = 2e5;
   const RunResult changed = run(quoted(writeScene(json)) + " --resume --frames 6");
   EXPECT_EQ(changed.exitCode, 1);
-  EXPECT_NE(changed.err.find("different scene, mesh, integrator or timestep"), std::string::npos) << changed.err;
+  EXPECT_NE(changed.err.find("were written by a different run: the scene file or the mesh it builds"),
+            std::string::npos)
+      << changed.err;
+  // Named fields say what differs, there (the stored run) and here.
   const RunResult otherStep = run(quoted(scene) + " --resume --frames 6 --dt 0.005");
   EXPECT_EQ(otherStep.exitCode, 1);
-  EXPECT_NE(otherStep.err.find("different scene, mesh, integrator or timestep"), std::string::npos) << otherStep.err;
+  EXPECT_NE(otherStep.err.find("were written by a different run: timestep (0.01 there, 0.005 here)"), std::string::npos)
+      << otherStep.err;
+  const RunResult otherIntegrator = run(quoted(scene) + " --resume --frames 6 --integrator trapezoidal");
+  EXPECT_EQ(otherIntegrator.exitCode, 1);
+  EXPECT_NE(otherIntegrator.err.find("integrator (backward-euler there, trapezoidal here)"), std::string::npos)
+      << otherIntegrator.err;
   EXPECT_TRUE(readText(output) == threeFrames);
 
   // A corrupted checkpoint is named, and so is a missing one.

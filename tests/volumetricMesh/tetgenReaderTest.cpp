@@ -1,13 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // TetGen .node/.ele: 0- and 1-based numbering, attributes, markers, regions, 10-node tets.
-#include "testFiles.hpp"
+#include <gtest/gtest.h>
 
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
-
-#include <gtest/gtest.h>
-
 #include <string>
+
+#include "testFiles.hpp"
 
 namespace asyncfem {
 namespace {
@@ -61,6 +60,18 @@ TEST(TetGenReader, ZeroBasedWithAttributesMarkersAndRegions) {
   // The .ele name and the bare base name select the same pair.
   EXPECT_EQ(readMesh(dir.path() / "mesh.ele").elements(), mesh.elements());
   EXPECT_EQ(readTetGen(dir.path() / "mesh").elements(), mesh.elements());
+  // readMesh (meshInfo, scenes) takes the base name too (docs/file-formats.md), also
+  // TetGen's own "mesh.1" for mesh.1.node + mesh.1.ele.
+  EXPECT_EQ(readMesh(dir.path() / "mesh").elements(), mesh.elements());
+  dir.write("mesh.1.node", kNodes0);
+  dir.write("mesh.1.ele", kEle0);
+  EXPECT_EQ(readMesh(dir.path() / "mesh.1").elements(), mesh.elements());
+  try {
+    (void)readMesh(dir.path() / "other");
+    FAIL() << "expected an error";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("base name of a TetGen .node/.ele pair"), std::string::npos);
+  }
 }
 
 TEST(TetGenReader, OneBasedWithFractionalRegionAndReorientation) {

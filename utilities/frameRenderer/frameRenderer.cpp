@@ -12,9 +12,9 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <asyncfem/core/threading.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/render/renderer.hpp>
 #include <asyncfem/render/surfaceEmbedding.hpp>
 #include <asyncfem/render/text.hpp>
@@ -39,6 +39,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "commandLine.hpp"
 
 namespace {
 
@@ -230,9 +232,11 @@ int run(int argc, char** argv) {
   app.add_option("--scene", options.scene, "The scene the simulation ran (its mesh and fixed vertices are used)");
   app.add_option("-o,--output", options.output, "Folder for frame_NNNNN.png (created)")->capture_default_str();
   app.add_option("--frames", options.frames, "Frames to draw, start:stop:step (stop exclusive; default all)");
-  app.add_option("--width", options.width, "Image width in pixels")->check(CLI::Range(16, 4096))->capture_default_str();
+  app.add_option("--width", options.width, "Image width in pixels")
+      ->check(asyncfem::cli::inRange(16, 4096))
+      ->capture_default_str();
   app.add_option("--height", options.height, "Image height in pixels")
-      ->check(CLI::Range(16, 4096))
+      ->check(asyncfem::cli::inRange(16, 4096))
       ->capture_default_str();
   app.add_option("--warp", options.warp, "Warping of the linear displacement: none, rotation-strain, modal")
       ->check(CLI::IsMember({"none", "rotation-strain", "modal"}))
@@ -241,7 +245,7 @@ int run(int argc, char** argv) {
   app.add_option("--tint-color", options.tintColor, "Tint colour r,g,b in [0, 1]")
       ->delimiter(',')
       ->expected(3)
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(asyncfem::cli::inRange(0.0, 1.0));
   app.add_option("--fixed-set", options.fixedSets,
                  "With --mesh: vertex sets held fixed in the simulation (rotation-strain warping keeps them)")
       ->delimiter(',');
@@ -262,13 +266,13 @@ int run(int argc, char** argv) {
       ->delimiter(',')
       ->expected(3);
   app.add_option("--fov", options.fieldOfView, "Vertical field of view in degrees")
-      ->check(CLI::Range(1.0, 170.0))
+      ->check(asyncfem::cli::inRange(1.0, 170.0))
       ->capture_default_str();
   app.add_option("--supersampling", options.supersampling, "Antialiasing: render s x s samples per pixel")
-      ->check(CLI::Range(1, 4))
+      ->check(asyncfem::cli::inRange(1, 4))
       ->capture_default_str();
   app.add_option("-j,--threads", options.threads, "Rendering threads (default: the number of cores, at most 8)")
-      ->check(CLI::Range(1, 64));
+      ->check(asyncfem::cli::inRange(1, 64));
   app.add_flag("--progress", options.progress, "Draw the progress bar even when stderr is not a terminal");
   app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
   try {

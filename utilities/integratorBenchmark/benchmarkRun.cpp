@@ -218,6 +218,7 @@ Scene configuredScene(const Scene& scene, const Configuration& configuration, in
   out.integrator.name = configuration.integrator;
   out.integrator.timestep = configuration.stepsPerFrame > 0 ? 1.0 / (scene.frames.rate * configuration.stepsPerFrame)
                                                             : configuration.timestep;
+  out.integrator.stepsPerFrame = configuration.stepsPerFrame > 0 ? configuration.stepsPerFrame : 0;
   out.integrator.options = configuration.options;
   out.frames.count = frames;
   out.output = Scene::OutputSettings{};

@@ -37,6 +37,7 @@
 #include <sstream>
 
 #include "benchmarkRun.hpp"
+#include "commandLine.hpp"
 #include "performanceTable.hpp"
 #include "pngWriter.hpp"
 
@@ -531,6 +532,16 @@ int runBenchmark(const CommandLine& options) {
   if (!options.configsFile.empty()) configs = readConfigurations(options.configsFile, scene);
   for (const std::string& spec : options.configSpecs) configs.push_back(parseConfigurationSpec(spec, scene));
   if (configs.empty()) configs = defaultConfigurations(scene, baseline);
+  // Every configuration is built once before the reference is computed (the expensive
+  // part), so a bad one (unknown integrator or option, a timestep that does not divide
+  // the frame interval) fails at once.
+  for (const Configuration& c : configs) {
+    try {
+      (void)buildSimulation(configuredScene(scene, c, 1));
+    } catch (const Error& error) {
+      throw Error("configuration \"" + c.label + "\": " + error.what());
+    }
+  }
 
   std::cout << "# integratorBenchmark: " << options.scene << "\n\n";
   std::cout << "Machine: " << machineDescription() << "\n";
@@ -662,8 +673,8 @@ int main(int argc, char** argv) {
   app.add_option("--configs", options.configsFile, "JSON file {\"configurations\": [...]}");
   app.add_option("--config", options.configSpecs,
                  "NAME[:spf=N|dt=H][:ratio=M][:schur=..][:method=..][:recovery=..][:label=..] (repeatable)");
-  app.add_option("--frames", options.frames, "Frames per run (default: the scene's)")->check(CLI::PositiveNumber);
-  app.add_option("--repeats", options.repeats, "Timed repeats per configuration")->check(CLI::PositiveNumber);
+  app.add_option("--frames", options.frames, "Frames per run (default: the scene's)")->check(asyncfem::cli::atLeast(1));
+  app.add_option("--repeats", options.repeats, "Timed repeats per configuration")->check(asyncfem::cli::atLeast(1));
   app.add_option("--out", options.out, "Output folder for CSV and PNG files");
   app.add_option("--reference", options.reference, "auto, modal or trapezoidal")
       ->check(CLI::IsMember({"auto", "modal", "trapezoidal"}));
@@ -679,22 +690,15 @@ int main(int argc, char** argv) {
   app.add_flag("--quick", options.quick, "At most 30 frames and one repeat (smoke test)");
   app.add_flag("--table", options.table, "Print the performance table of every scene in --models");
   app.add_option("--models", options.models, "Folder of scenes for --table (models/*/*.json)");
-  app.add_option("--table-frames", options.tableFrames, "Frames per run for --table")->check(CLI::PositiveNumber);
-  try {
-    app.parse(argc, argv);
-    if (!options.table && options.scene.empty())
-      throw CLI::ValidationError("scene", "a scene file is required (or --table)");
-  } catch (const CLI::ParseError& error) {
-    const int code = app.exit(error);
-    return code == 0 ? 0 : 2;
-  }
-  try {
+  app.add_option("--table-frames", options.tableFrames, "Frames per run for --table")->check(asyncfem::cli::atLeast(1));
+  if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "integratorBenchmark")) return *status;
+  return asyncfem::cli::run("integratorBenchmark", [&] {
+    if (!options.table && options.scene.empty()) {
+      throw asyncfem::cli::UsageError("a scene file is required (or --table)");
+    }
     if (options.table) {
       return printPerformanceTable(options.models, options.tableFrames, options.repeats, options.out);
     }
     return runBenchmark(options);
-  } catch (const std::exception& error) {
-    std::cerr << "integratorBenchmark: " << error.what() << "\n";
-    return 1;
-  }
+  });
 }

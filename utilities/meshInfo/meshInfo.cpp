@@ -20,8 +20,11 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "commandLine.hpp"
 
 namespace {
 
@@ -133,13 +136,15 @@ int run(int argc, char** argv) {
   app.add_option("--cells", cells,
                  "with --generate: beam cells along the length (default 20), box cells per axis (default 4), "
                  "antenna rod cells (default 8) or snail tentacle cells (default 6)")
-      ->check(CLI::Range(1, 1000));
+      ->check(asyncfem::cli::inRange(1, 1000));
   app.add_flag("--json", json, "print a JSON object instead of text");
   app.add_option("--write", output, "also write the mesh to OUT.veg or OUT.vtu");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+  if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "meshInfo")) return *status;
+  // Checked before any work, so a typo does not cost a mesh generation or read.
+  const std::string extension = std::filesystem::path(output).extension().string();
+  if (!output.empty() && extension != ".veg" && extension != ".vtu") {
+    throw asyncfem::cli::UsageError("--write: cannot write '" + output + "': unknown extension '" + extension +
+                                    "' (supported: .veg, .vtu)");
   }
   if (input.empty() == generate.empty())
     throw asyncfem::Error("give either a mesh file or --generate beam|box|antenna|snail (see --help)");
@@ -184,11 +189,8 @@ int run(int argc, char** argv) {
     const std::string extension = std::filesystem::path(output).extension().string();
     if (extension == ".veg") {
       asyncfem::writeVeg(output, mesh);
-    } else if (extension == ".vtu") {
-      asyncfem::writeVtu(output, mesh);
     } else {
-      throw asyncfem::Error("--write: unknown extension '" + extension + "' for '" + output +
-                            "' (expected .veg or .vtu)");
+      asyncfem::writeVtu(output, mesh);
     }
   }
   return 0;
@@ -198,13 +200,5 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   asyncfem::preferPassiveThreadWaiting(argv);
-  try {
-    return run(argc, argv);
-  } catch (const asyncfem::Error& e) {
-    std::cerr << "meshInfo: " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "meshInfo: unexpected error: " << e.what() << '\n';
-    return 1;
-  }
+  return asyncfem::cli::run("meshInfo", [&] { return run(argc, argv); });
 }

@@ -42,7 +42,9 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
+#include "commandLine.hpp"
 #include "progress.hpp"
 
 namespace {
@@ -56,6 +58,7 @@ struct CommandLine {
   std::optional<std::string> output;
   std::optional<std::string> integrator;
   std::optional<double> timestep;
+  std::optional<int> stepsPerFrame;
   std::optional<int> frames;
   std::optional<std::string> vtuFolder;
   bool resume = false;
@@ -156,6 +159,51 @@ asyncfem::SimulationCheckpoint captureCheckpoint(const asyncfem::Integrator& int
   return checkpoint;
 }
 
+std::string number(double value) {
+  std::ostringstream out;
+  out.precision(12);
+  out << value;
+  return out.str();
+}
+
+// What differs between the run that wrote an output file and its checkpoint and this one,
+// one "what (there ..., here ...)" per field; the scene and mesh are known only through
+// the run fingerprint, so a fingerprint mismatch with every named field equal reads as a
+// change of the scene or mesh.
+std::vector<std::string> runDifferences(const asyncfem::SimulationCheckpoint& checkpoint,
+                                        const asyncfem::SimulationFileHeader& stored,
+                                        const asyncfem::Integrator& integrator,
+                                        const asyncfem::SimulationFileHeader& header, bool fingerprintDiffers) {
+  std::vector<std::string> differences;
+  const auto differ = [](double a, double b) {
+    return std::bit_cast<std::uint64_t>(a) != std::bit_cast<std::uint64_t>(b);
+  };
+  if (checkpoint.integrator != integrator.name()) {
+    differences.push_back("integrator (" + checkpoint.integrator + " there, " + integrator.name() + " here)");
+  }
+  if (differ(stored.timestep, header.timestep)) {
+    differences.push_back("timestep (" + number(stored.timestep) + " there, " + number(header.timestep) + " here)");
+  }
+  if (differ(stored.frameInterval, header.frameInterval)) {
+    differences.push_back("frame interval 1 / frames.rate (" + number(stored.frameInterval) + " there, " +
+                          number(header.frameInterval) + " here)");
+  }
+  if (stored.numVertices != header.numVertices || checkpoint.displacement.size() != integrator.displacement().size()) {
+    differences.push_back("mesh vertex count (" + std::to_string(stored.numVertices) + " there, " +
+                          std::to_string(header.numVertices) + " here)");
+  }
+  if (stored.hasVelocities != header.hasVelocities) {
+    differences.push_back(std::string("output.velocities (") + (stored.hasVelocities ? "true" : "false") + " there, " +
+                          (header.hasVelocities ? "true" : "false") + " here)");
+  }
+  if (fingerprintDiffers && differences.empty()) {
+    differences.emplace_back(
+        "the scene file or the mesh it builds (a key other than frames.count and output, or the mesh file's vertices, "
+        "elements, materials or fixed vertices)");
+  }
+  return differences;
+}
+
 // Restores the state of the checkpoint next to the output after checking that it belongs
 // to this run and to the frames in the output file; returns the frames to keep.
 std::int64_t restoreFromCheckpoint(const asyncfem::Scene& scene, asyncfem::Simulation& simulation,
@@ -172,24 +220,20 @@ std::int64_t restoreFromCheckpoint(const asyncfem::Scene& scene, asyncfem::Simul
   }
   const asyncfem::SimulationCheckpoint checkpoint = asyncfem::readCheckpoint(checkpointFile);
   asyncfem::Integrator& integrator = *simulation.integrator;
-  if (checkpoint.fingerprint != fingerprint || checkpoint.integrator != integrator.name() ||
-      checkpoint.displacement.size() != integrator.displacement().size()) {
-    throw asyncfem::Error("cannot resume: " + checkpointFile.string() +
-                          " was written by a run with a different scene, mesh, integrator or timestep" + restart);
+  asyncfem::SimulationReader reader(output);
+  const asyncfem::SimulationFileHeader& stored = reader.header();
+  const std::vector<std::string> differences =
+      runDifferences(checkpoint, stored, integrator, header, checkpoint.fingerprint != fingerprint);
+  if (!differences.empty()) {
+    std::string list;
+    for (const std::string& difference : differences) list += (list.empty() ? "" : "; ") + difference;
+    throw asyncfem::Error("cannot resume: " + output.string() + " and " + checkpointFile.string() +
+                          " were written by a different run: " + list + restart);
   }
   if (checkpoint.frames > simulation.numFrames) {
     throw asyncfem::Error("cannot resume: " + output.string() + " already has " + std::to_string(checkpoint.frames) +
                           " finished frames, more than the " + std::to_string(simulation.numFrames) +
                           " requested (frames.count or --frames)");
-  }
-  asyncfem::SimulationReader reader(output);
-  const asyncfem::SimulationFileHeader& stored = reader.header();
-  if (stored.numVertices != header.numVertices || stored.hasVelocities != header.hasVelocities ||
-      std::bit_cast<std::uint64_t>(stored.frameInterval) != std::bit_cast<std::uint64_t>(header.frameInterval) ||
-      std::bit_cast<std::uint64_t>(stored.timestep) != std::bit_cast<std::uint64_t>(header.timestep)) {
-    throw asyncfem::Error("cannot resume: the header of " + output.string() +
-                          " does not match this run (vertex count, frame interval, timestep or output.velocities)" +
-                          restart);
   }
   if (reader.numFrames() < checkpoint.frames) {
     throw asyncfem::Error("cannot resume: " + output.string() + " holds " + std::to_string(reader.numFrames()) +
@@ -249,6 +293,10 @@ void applyOverrides(const CommandLine& options, asyncfem::Scene& scene) {
   }
   if (options.timestep) {
     scene.integrator.timestep = *options.timestep;
+    scene.integrator.stepsPerFrame = 0;
+  }
+  if (options.stepsPerFrame) {
+    scene.integrator.stepsPerFrame = *options.stepsPerFrame;
   }
   if (options.frames) {
     scene.frames.count = *options.frames;
@@ -259,6 +307,20 @@ void applyOverrides(const CommandLine& options, asyncfem::Scene& scene) {
   if (scene.output.file.empty()) {
     throw asyncfem::Error("no output file: set output.file in " + scene.sourceName + " or pass --output FILE");
   }
+  // Every part of the run sees the timestep it will run with (and a bad one fails first).
+  scene.integrator.timestep = asyncfem::resolveFrameTiming(scene).timestep;
+}
+
+// Refuses an output (the .afsim file or its checkpoint) that is one of the run's inputs:
+// truncating it would destroy the scene or mesh before the run could read it again.
+void refuseOutputsOverInputs(const CommandLine& options, const asyncfem::Scene& scene) {
+  std::vector<asyncfem::cli::NamedPath> inputs{{"the scene", options.scene}};
+  if (scene.mesh.source == asyncfem::Scene::MeshSource::file) inputs.push_back({"the mesh", scene.mesh.file});
+  if (scene.fixed.bouFile) inputs.push_back({"the fixed-vertex file", *scene.fixed.bouFile});
+  const std::string advice = "choose another output (--output or output.file)";
+  asyncfem::cli::refuseOutputOverInputs({"the output file", scene.output.file}, inputs, advice);
+  asyncfem::cli::refuseOutputOverInputs({"the checkpoint file", asyncfem::checkpointPathFor(scene.output.file)}, inputs,
+                                        advice);
 }
 
 /// A resumed run's .pvd lists the .vtu files of its earlier frames too, at the times
@@ -299,8 +361,8 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
   if (firstFrame > 0) {
     out << " (resumed after frame " << firstFrame << " of " << simulation.numFrames << ")";
   }
-  out << ", " << steps << " steps of h = " << std::defaultfloat << simulation.timestep << " ("
-      << simulation.stepsPerFrame << " per frame), " << std::fixed
+  out << ", " << steps << " steps of h = " << std::defaultfloat << std::setprecision(9) << simulation.timestep
+      << std::setprecision(3) << " (" << simulation.stepsPerFrame << " per frame), " << std::fixed
       << (setupSeconds + loopSeconds + (couplingCheck ? couplingCheck->estimate.seconds : 0.0)) << " s\n";
   out << "  mesh        " << simulation.mesh->numVertices() << " vertices, " << simulation.mesh->numElements()
       << " elements, " << simulation.fixedVertices.size() << " fixed vertices\n";
@@ -355,8 +417,17 @@ int run(int argc, char** argv) {
   app.add_option("-o,--output", options.output,
                  "Output .afsim file (replaces output.file; truncated at the start of the run)");
   app.add_option("--integrator", options.integrator, "Integrator name (replaces integrator.name)");
-  app.add_option("--dt", options.timestep, "Timestep h (replaces integrator.timestep)")->check(CLI::PositiveNumber);
-  app.add_option("--frames", options.frames, "Number of frames (replaces frames.count)")->check(CLI::PositiveNumber);
+  auto* timestep = app.add_option("--dt", options.timestep,
+                                  "Timestep h (replaces integrator.timestep); must divide the frame interval "
+                                  "1 / frames.rate to a relative 1e-9")
+                       ->check(asyncfem::cli::positive());
+  app.add_option("--steps-per-frame", options.stepsPerFrame,
+                 "Steps per frame N, so h = (1 / frames.rate) / N (replaces integrator.timestep or "
+                 "integrator.stepsPerFrame)")
+      ->check(asyncfem::cli::atLeast(1))
+      ->excludes(timestep);
+  app.add_option("--frames", options.frames, "Number of frames (replaces frames.count)")
+      ->check(asyncfem::cli::atLeast(1));
   app.add_option("--vtu", options.vtuFolder,
                  "Also write FOLDER/frame_NNNNN.vtu per frame (replaces output.vtu.folder)");
   app.add_flag("--resume", options.resume,
@@ -365,25 +436,19 @@ int run(int argc, char** argv) {
   app.add_option("--checkpoint-every", options.checkpointEvery,
                  "Write the checkpoint (OUTPUT.checkpoint) every K frames (default 1); a resumed run recomputes "
                  "the frames after the last one")
-      ->check(CLI::PositiveNumber);
+      ->check(asyncfem::cli::atLeast(1));
   app.add_flag("--progress", options.progress, "Draw the progress bar even when stderr is not a terminal");
   app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
   app.add_flag("--no-stability-check", options.noStabilityCheck,
                "Skip the step-growth estimate (a few dozen steps) made before runs of the asynchronous integrator "
                "with the paper's coupling");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "offlineSimulator: " << e.what() << " (see --help)\n";
-    return 2;
-  }
+  if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "offlineSimulator")) return *status;
 
   asyncfem::Stopwatch setupWatch;
   setupWatch.start();
   asyncfem::Scene scene = asyncfem::loadScene(options.scene);
   applyOverrides(options, scene);
+  refuseOutputsOverInputs(options, scene);
   asyncfem::Simulation simulation = asyncfem::buildSimulation(scene);
   for (const std::string& warning : simulation.warnings) std::cerr << "offlineSimulator: warning: " << warning << "\n";
   const double setupSeconds = setupWatch.stop();
@@ -503,10 +568,5 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   asyncfem::preferPassiveThreadWaiting(argv);
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::cerr << "offlineSimulator: " << e.what() << "\n";
-    return 1;
-  }
+  return asyncfem::cli::run("offlineSimulator", [&] { return run(argc, argv); });
 }

@@ -45,6 +45,8 @@
 #include <thread>
 #include <vector>
 
+#include "commandLine.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -481,7 +483,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Stability stress test of the integrators (docs/benchmarks.md)"};
   Options options;
   app.add_option("--frames", options.frames, "Frames per run (default 100; --full: at least 10000)")
-      ->check(CLI::PositiveNumber);
+      ->check(asyncfem::cli::positive());
   app.add_flag("--full", options.full, "The full grid: 7 stiffness ratios, 6 timestep ratios, >= 10000 frames");
   app.add_option("--cells", options.cells, "Cells of the bar along x, y, z")->expected(3);
   app.add_option("--seed", options.seed, "Seed of the vertex perturbation");
@@ -491,26 +493,17 @@ int main(int argc, char** argv) {
                  "--ratios value (default 2 4 8 16 32 64), plus backward Euler; exit status 3 when a run blows up or "
                  "gains energy after its loads end");
   app.add_option("--jobs", options.jobs, "Runs in parallel (each run is single-threaded work on a small mesh)")
-      ->check(CLI::PositiveNumber);
+      ->check(asyncfem::cli::positive());
   app.add_option("--stiffness-ratios", options.stiffnessRatios, "Only these stiffness ratios")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--ratios", options.ratios, "Only these timestep ratios m")->check(CLI::PositiveNumber);
+      ->check(asyncfem::cli::positive());
+  app.add_option("--ratios", options.ratios, "Only these timestep ratios m")->check(asyncfem::cli::positive());
   app.add_option("--damping", options.dampings, "Only these damping levels")
       ->check(CLI::IsMember({"none", "light", "heavy"}));
   app.add_option("--integrators", options.integrators, "Only these integrators")
       ->check(CLI::IsMember({"async", "async-symmetric", "multirate-uncoupled", "backward-euler"}));
   app.add_option("--meshes", options.meshes, "Only these meshes")->check(CLI::IsMember({"regular", "perturbed"}));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    const int code = app.exit(error);
-    return code == 0 ? 0 : 2;
-  }
+  if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "stabilityStressTest")) return *status;
   options.framesGiven = app.count("--frames") > 0;
-  try {
-    return options.scene.empty() ? run(options) : runScene(options);
-  } catch (const std::exception& error) {
-    std::cerr << "stabilityStressTest: " << error.what() << "\n";
-    return 1;
-  }
+  return asyncfem::cli::run("stabilityStressTest",
+                            [&] { return options.scene.empty() ? run(options) : runScene(options); });
 }

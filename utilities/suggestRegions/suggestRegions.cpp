@@ -18,6 +18,10 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <vector>
+
+#include "commandLine.hpp"
 
 namespace {
 
@@ -49,19 +53,19 @@ int main(int argc, char** argv) {
   std::string massName = "consistent";
   app.add_option("input", input, "scene .json or mesh (.veg, .node/.ele, .msh)")->required();
   app.add_option("--dt", largeTimestep, "large timestep hL (default: the scene's integrator.timestep)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive());
   app.add_option("--target", options.targetOmegaH,
                  "absolute target for omega * h in every region (default: relative mode)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive());
   app.add_option("--relative", options.relativeThreshold,
                  "relative mode: elements above this multiple of the median element frequency become fast")
-      ->check(CLI::Range(1.0001, 1e9))
+      ->check(cli::inRange(1.0001, 1e9))
       ->capture_default_str();
   app.add_option("--grow", options.growLayers, "vertex rings added around each region")
-      ->check(CLI::Range(0, 100))
+      ->check(cli::inRange(0, 100))
       ->capture_default_str();
   app.add_option("--max-ratio", options.maxRatio, "largest ratio m proposed")
-      ->check(CLI::Range(1, 100000))
+      ->check(cli::inRange(1, 100000))
       ->capture_default_str();
   app.add_option("--fixed-set", fixedSets, "vertex set to treat as fixed (mesh input only)");
   app.add_option("--write", writePath, "write the regions as JSON, ready for integrator.options.regions");
@@ -69,18 +73,18 @@ int main(int argc, char** argv) {
   app.add_option("--modes", modeCount,
                  "print the K lowest modes with omega*hL, omega*hS and S share for the scene's regions "
                  "(or the proposal), and whether async can keep any of them")
-      ->check(CLI::Range(1, 100000));
+      ->check(cli::inRange(1, 100000));
   app.add_option("--frame-rate", frameRate, "frames per second for the visibility test (default: the scene's, or 30)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::positive());
   app.add_flag("--no-modal-check", noModalCheck,
                "keep the proposal even when no visible mode lives in it (the check is on by default, as for "
                "\"regions\": \"auto\" in scenes)");
   app.add_option("--mass", massName, "mass matrix for a mesh input (scenes use their own)")
       ->check(CLI::IsMember({"consistent", "lumped"}))
       ->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  if (const std::optional<int> status = cli::parse(app, argc, argv, "suggestRegions")) return *status;
 
-  try {
+  return cli::run("suggestRegions", [&] {
     std::shared_ptr<const TetMesh> mesh;
     FreeDofs freeDofs;
     MassType massType = massName == "lumped" ? MassType::lumped : MassType::consistent;
@@ -88,6 +92,11 @@ int main(int argc, char** argv) {
     bool corotational = false;
     if (std::filesystem::path(input).extension() == ".json") {
       Scene scene = loadScene(input);
+      if (!writePath.empty()) {
+        std::vector<cli::NamedPath> inputs{{"the scene", input}};
+        if (scene.mesh.source == Scene::MeshSource::file) inputs.push_back({"the mesh", scene.mesh.file});
+        cli::refuseOutputOverInputs({"--write", writePath}, inputs, "write the regions to another file");
+      }
       if (largeTimestep <= 0.0) largeTimestep = scene.integrator.timestep;
       if (frameRate <= 0.0) frameRate = scene.frames.rate;
       massType = scene.mass;
@@ -106,6 +115,9 @@ int main(int argc, char** argv) {
         givenRegions = parseAsyncOptions(scene, *mesh, freeDofs, integrator.options).regions;
       }
     } else {
+      if (!writePath.empty()) {
+        cli::refuseOutputOverInputs({"--write", writePath}, {{"the mesh", input}}, "write the regions to another file");
+      }
       if (largeTimestep <= 0.0) throw Error("give the large timestep with --dt for a mesh input");
       MeshReadReport report;
       auto loaded = std::make_shared<TetMesh>(readMesh(input, {}, &report));
@@ -196,9 +208,6 @@ int main(int argc, char** argv) {
       std::filesystem::rename(temporary, target);
       if (!json) std::printf("regions written to %s\n", writePath.c_str());
     }
-  } catch (const std::exception& e) {
-    std::cerr << "suggestRegions: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

@@ -29,6 +29,8 @@
 #include <string>
 #include <vector>
 
+#include "commandLine.hpp"
+
 namespace {
 
 using asyncfem::TetMesh;
@@ -195,10 +197,8 @@ int run(const Options& options) {
   if (output.has_parent_path()) std::filesystem::create_directories(output.parent_path());
   if (output.extension() == ".vtu") {
     asyncfem::writeVtu(output, mesh);
-  } else if (output.extension() == ".veg") {
-    asyncfem::writeVeg(output, mesh);
   } else {
-    throw ValidationError("--output " + options.output + ": expected a .veg or .vtu file");
+    asyncfem::writeVeg(output, mesh);  // the extension was checked in main
   }
   if (!options.quiet) std::printf("wrote %s\n", options.output.c_str());
   return 0;
@@ -215,9 +215,9 @@ int main(int argc, char** argv) {
   app.add_option("--model", options.model, "Built-in example model: dinosaur, flower, dragon, drop");
   app.add_option("-o,--output", options.output, "Output mesh (.veg, or .vtu for ParaView)")->required();
   app.add_option("--spacing", options.spacing, "BCC lattice spacing (length units of the input)")
-      ->check(CLI::PositiveNumber);
+      ->check(asyncfem::cli::positive());
   app.add_option("--cells", options.cells, "Lattice cells across the longest side of the bounding box (default 30)")
-      ->check(CLI::Range(1, 2000));
+      ->check(asyncfem::cli::inRange(1, 2000));
   app.add_option("--set", options.boxSets,
                  "Element and vertex set of the elements whose centroid lies in a box: "
                  "NAME:xmin,ymin,zmin,xmax,ymax,zmax (repeatable)");
@@ -233,16 +233,14 @@ int main(int argc, char** argv) {
   app.add_option("--weld-tolerance", options.weldTolerance,
                  "Merge surface vertices closer than this (default 1e-7 x bounding-box diagonal)");
   app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // --help and --version exit 0; unusable options exit 2 (not CLI11's own codes).
-    return app.exit(e) == 0 ? 0 : 2;
-  }
-  try {
+  if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "tetMesher")) return *status;
+  return asyncfem::cli::run("tetMesher", [&] {
+    // Before any meshing, so a typo does not cost the whole run.
+    const std::string extension = std::filesystem::path(options.output).extension().string();
+    if (extension != ".veg" && extension != ".vtu") {
+      throw asyncfem::cli::UsageError("--output: cannot write '" + options.output + "': unknown extension '" +
+                                      extension + "' (supported: .veg, .vtu)");
+    }
     return run(options);
-  } catch (const std::exception& e) {
-    std::cerr << "tetMesher: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }

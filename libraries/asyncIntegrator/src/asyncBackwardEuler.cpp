@@ -665,7 +665,13 @@ Eigen::VectorXd AsyncBackwardEuler::solveSchur(const Eigen::VectorXd& rhs) {
 void AsyncBackwardEuler::step() {
   Impl& d = *impl_;
   const double hL = timestep();
+  // Step times come from the step index (t0 = k hL, t1 = (k + 1) hL); substep r of a
+  // region is at t0 + r hS, and its last one (r = m) at exactly t1.
   const double t0 = time();
+  const double t1 = stepEndTime();
+  const auto substepTime = [t0, t1](int r, int ratio, double smallStep) {
+    return r == ratio ? t1 : t0 + (r * smallStep);
+  };
   const Eigen::VectorXd& u0 = displacement_;
   const Eigen::VectorXd& v0 = velocity_;
   const bool damped = system_.damped();
@@ -700,9 +706,9 @@ void AsyncBackwardEuler::step() {
       if (options_.substepStatePrediction && system_.externalForce) {
         predicted = u0 + tau * v0;
         externalForce.setZero(u0.size());
-        system_.externalForce(t0 + tau, predicted, v0, externalForce);
+        system_.externalForce(substepTime(r, rb.ratio, rb.smallStep), predicted, v0, externalForce);
       } else {
-        evaluateExternalForce(t0 + tau, externalForce);
+        evaluateExternalForce(substepTime(r, rb.ratio, rb.smallStep), externalForce);
       }
       for (std::size_t k = 0; k < s.size(); ++k) {
         const int dof = s[k];
@@ -711,7 +717,7 @@ void AsyncBackwardEuler::step() {
       }
     }
   }
-  evaluateExternalForce(t0 + hL, externalForce);
+  evaluateExternalForce(t1, externalForce);
   Eigen::VectorXd rhsL(static_cast<Eigen::Index>(large.size()));
   for (std::size_t k = 0; k < large.size(); ++k) {
     const int dof = large[k];
@@ -828,7 +834,7 @@ void AsyncBackwardEuler::step() {
       if (observer_) {
         const Eigen::VectorXd uS = uS0 + rb.smallStep * (double(r) * vS0 + xSum);
         const Eigen::VectorXd vS = vS0 + xi.col(r - 1);
-        observer_(i, r, t0 + r * rb.smallStep, uS, vS);
+        observer_(i, r, substepTime(r, rb.ratio, rb.smallStep), uS, vS);
       }
     }
     const Eigen::VectorXd vS = vS0 + xi.col(rb.ratio - 1);
@@ -844,10 +850,10 @@ void AsyncBackwardEuler::step() {
   }
   stats_.solveSeconds += solve.stop();
 
-  detail::checkFiniteState("async", newU, newV, t0 + hL);
+  detail::checkFiniteState("async", newU, newV, t1);
   displacement_ = std::move(newU);
   velocity_ = std::move(newV);
-  time_ = t0 + hL;
+  advanceTime();
   ++stats_.steps;
   // Solve counts and flops, totalled over the solvers (Z columns included).
   stats_.solvedRightHandSides = 0;

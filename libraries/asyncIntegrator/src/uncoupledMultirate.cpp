@@ -149,7 +149,10 @@ void UncoupledMultirate::rebuild() {
 void UncoupledMultirate::step() {
   Impl& d = *impl_;
   const double hL = timestep();
+  // Step times from the step index (t0 = k hL, t1 = (k + 1) hL); the last substep of a
+  // region (r = m) is at exactly t1.
   const double t0 = time();
+  const double t1 = stepEndTime();
   const Eigen::VectorXd& u0 = displacement_;
   const Eigen::VectorXd& v0 = velocity_;
   const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
@@ -171,11 +174,11 @@ void UncoupledMultirate::step() {
   const int numRegions = partition_.numRegions();
   std::vector<Eigen::VectorXd> externalAtFirstSubstep(static_cast<std::size_t>(numRegions));
   for (int i = 0; i < numRegions; ++i) {
-    evaluateExternalForce(t0 + d.regions[static_cast<std::size_t>(i)].smallStep,
-                          externalAtFirstSubstep[static_cast<std::size_t>(i)]);
+    const RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    evaluateExternalForce(rb.ratio == 1 ? t1 : t0 + rb.smallStep, externalAtFirstSubstep[static_cast<std::size_t>(i)]);
   }
   Eigen::VectorXd externalForce;
-  evaluateExternalForce(t0 + hL, externalForce);
+  evaluateExternalForce(t1, externalForce);
   const std::vector<int>& free = system_.freeDofs.freeToFull();
   Eigen::VectorXd rhs(static_cast<Eigen::Index>(free.size()));
   for (std::size_t k = 0; k < free.size(); ++k) {
@@ -218,7 +221,7 @@ void UncoupledMultirate::step() {
       const Eigen::VectorXd fintS = gather(d.internalForce, s);
       Eigen::VectorXd rhsS, dS, vLr;
       for (int r = 2; r <= m; ++r) {
-        evaluateExternalForce(t0 + r * hS, externalForce);
+        evaluateExternalForce(r == m ? t1 : t0 + (r * hS), externalForce);
         vLr = vL0 + (double(r) / m) * changeL;
         const Eigen::VectorXd uLdiff = (r * hS) * vLr;
         const Eigen::VectorXd uSdiff = uS + hS * vS - uS0;
@@ -241,10 +244,10 @@ void UncoupledMultirate::step() {
   }
   stats_.solveSeconds += solve.stop();
 
-  detail::checkFiniteState("multirate-uncoupled", newU, newV, t0 + hL);
+  detail::checkFiniteState("multirate-uncoupled", newU, newV, t1);
   displacement_ = std::move(newU);
   velocity_ = std::move(newV);
-  time_ = t0 + hL;
+  advanceTime();
   ++stats_.steps;
   stats_.solvedRightHandSides = 0;
   stats_.solveFlops = 0.0;

@@ -73,7 +73,7 @@ void BackwardEuler::stepLinear() {
   detail::restrictTo(dofs, displacement_, u_);
   detail::restrictTo(dofs, velocity_, v_);
   if (system_.externalForce) {
-    evaluateExternalForce(time_ + h, fullForce_);
+    evaluateExternalForce(stepEndTime(), fullForce_);
     detail::restrictTo(dofs, fullForce_, rhs_);
   } else {
     rhs_.setZero(u_.size());
@@ -97,10 +97,10 @@ void BackwardEuler::stepLinear() {
 
   detail::expandTo(dofs, u_, fullU_);
   detail::expandTo(dofs, v_, fullV_);
-  detail::checkFiniteState(fullU_, fullV_, time_ + h, name());
+  detail::checkFiniteState(fullU_, fullV_, stepEndTime(), name());
   displacement_.swap(fullU_);
   velocity_.swap(fullV_);
-  time_ += h;
+  advanceTime();
   ++stats_.steps;
 }
 
@@ -114,7 +114,7 @@ void BackwardEuler::stepNonlinear() {
   detail::restrictTo(dofs, displacement_, u_);
   detail::restrictTo(dofs, velocity_, v_);
   if (system_.externalForce) {
-    evaluateExternalForce(time_ + h, fullForce_);
+    evaluateExternalForce(stepEndTime(), fullForce_);
     detail::restrictTo(dofs, fullForce_, force_);
   } else {
     force_.setZero(u_.size());
@@ -177,10 +177,10 @@ void BackwardEuler::stepNonlinear() {
   u_ += h * v_;
   detail::expandTo(dofs, u_, fullU_);
   detail::expandTo(dofs, v_, fullV_);
-  detail::checkFiniteState(fullU_, fullV_, time_ + h, name());
+  detail::checkFiniteState(fullU_, fullV_, stepEndTime(), name());
   displacement_.swap(fullU_);
   velocity_.swap(fullV_);
-  time_ += h;
+  advanceTime();
   ++stats_.steps;
 }
 

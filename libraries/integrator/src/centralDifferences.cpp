@@ -57,15 +57,15 @@ void CentralDifferences::step() {
   detail::expandTo(dofs, u_, fullU_);
   detail::expandTo(dofs, v_, fullV_);
   Eigen::VectorXd newAcceleration;
-  core_->acceleration(system_, time_ + h, fullU_, fullV_, v_, newAcceleration, stats_);
+  core_->acceleration(system_, stepEndTime(), fullU_, fullV_, v_, newAcceleration, stats_);
   // v_{k+1} = v_{k+1/2} + h/2 a_{k+1}
   v_ += (0.5 * h) * newAcceleration;
   detail::expandTo(dofs, v_, fullV_);
-  detail::checkFiniteState(fullU_, fullV_, time_ + h, name());
+  detail::checkFiniteState(fullU_, fullV_, stepEndTime(), name());
   displacement_.swap(fullU_);
   velocity_.swap(fullV_);
   acceleration_.swap(newAcceleration);
-  time_ += h;
+  advanceTime();
   ++stats_.steps;
 }
 

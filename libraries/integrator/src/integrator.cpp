@@ -40,6 +40,27 @@ void Integrator::setTimestep(double timestep) {
     throw ValidationError("timestep must be positive and finite (got " + std::to_string(timestep) + ")");
   }
   timestep_ = timestep;
+  restartTimeGrid();
+}
+
+void Integrator::restartTimeGrid() {
+  // Keep t = k h exactly when the time is on the grid (a run's start, a checkpoint's time),
+  // so that a resumed run evaluates loads at the very times an uninterrupted one does.
+  const double steps = std::round(time_ / timestep_);
+  if (std::abs(steps) < 1e15 && steps * timestep_ == time_) {
+    timeOrigin_ = 0.0;
+    stepIndex_ = static_cast<long long>(steps);
+  } else {
+    timeOrigin_ = time_;
+    stepIndex_ = 0;
+  }
+}
+
+double Integrator::stepEndTime() const { return timeOrigin_ + (static_cast<double>(stepIndex_ + 1) * timestep_); }
+
+void Integrator::advanceTime() {
+  time_ = stepEndTime();
+  ++stepIndex_;
 }
 
 void Integrator::setState(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, double time) {
@@ -51,6 +72,7 @@ void Integrator::setState(const Eigen::VectorXd& displacement, const Eigen::Vect
   zeroFixed(displacement_);
   zeroFixed(velocity_);
   time_ = time;
+  restartTimeGrid();
   stateChanged();
 }
 

@@ -31,10 +31,10 @@ void SymplecticEuler::step() {
   u_ += h * v_;
   detail::expandTo(dofs, u_, fullU_);
   detail::expandTo(dofs, v_, fullV_);
-  detail::checkFiniteState(fullU_, fullV_, time_ + h, name());
+  detail::checkFiniteState(fullU_, fullV_, stepEndTime(), name());
   displacement_.swap(fullU_);
   velocity_.swap(fullV_);
-  time_ += h;
+  advanceTime();
   ++stats_.steps;
 }
 

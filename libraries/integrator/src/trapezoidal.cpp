@@ -106,7 +106,7 @@ void Trapezoidal::step() {
   detail::restrictTo(dofs, velocity_, v_);
   detail::restrictTo(dofs, acceleration_, a_);
   if (system_.externalForce) {
-    evaluateExternalForce(time_ + h, fullForce_);
+    evaluateExternalForce(stepEndTime(), fullForce_);
     detail::restrictTo(dofs, fullForce_, force_);
   } else {
     force_.setZero(u_.size());
@@ -179,11 +179,11 @@ void Trapezoidal::step() {
   detail::expandTo(dofs, u_, fullU_);
   detail::expandTo(dofs, v_, fullV_);
   detail::expandTo(dofs, newA_, fullA_);
-  detail::checkFiniteState(fullU_, fullV_, time_ + h, name());
+  detail::checkFiniteState(fullU_, fullV_, stepEndTime(), name());
   displacement_.swap(fullU_);
   velocity_.swap(fullV_);
   acceleration_.swap(fullA_);
-  time_ += h;
+  advanceTime();
   ++stats_.steps;
 }
 

@@ -3,6 +3,8 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/jsonReader.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
+#include <cctype>
+#include <cmath>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -14,6 +16,31 @@ namespace {
 using nlohmann::json;
 
 constexpr int maxInt = std::numeric_limits<int>::max();
+constexpr int maxStepsPerFrame = 1000000000;
+
+std::string formatNumber(double value, int precision = 6) {
+  std::ostringstream out;
+  out.precision(precision);
+  out << value;
+  return out.str();
+}
+
+// A duration 1 / (rate * steps) as "1/990 s" when rate is a whole number, else as a decimal.
+std::string describeDuration(double rate, long long steps) {
+  const double denominator = rate * static_cast<double>(steps);
+  if (rate == std::round(rate) && denominator < 1e15) {
+    return "1/" + std::to_string(static_cast<long long>(denominator)) + " s";
+  }
+  return formatNumber(1.0 / denominator, 9) + " s";
+}
+
+// "1/990 s = 0.0010101 (33 steps per frame)"
+std::string describeDivisor(double rate, long long steps) {
+  const std::string exact = describeDuration(rate, steps);
+  const std::string decimal = formatNumber(1.0 / (rate * static_cast<double>(steps)), 9) + " s";
+  return (exact == decimal ? exact : exact + " = " + decimal) + " (" + std::to_string(steps) +
+         (steps == 1 ? " step" : " steps") + " per frame)";
+}
 
 // Relative paths in a scene are relative to the scene file's folder.
 std::filesystem::path resolvePath(const std::filesystem::path& base, const std::string& text) {
@@ -281,8 +308,18 @@ void parseIntegrator(JsonObjectReader& top, Scene& scene) {
   if (scene.integrator.name.empty()) {
     reader.fail("name", "expected a non-empty integrator name");
   }
-  scene.integrator.timestep = reader.requiredNumber("timestep");
-  requirePositive(reader, "timestep", scene.integrator.timestep);
+  const bool hasTimestep = reader.has("timestep");
+  if (hasTimestep == reader.has("stepsPerFrame")) {
+    JsonObjectReader::failAt(scene.sourceName, "integrator",
+                             "give either \"timestep\" or \"stepsPerFrame\" (steps per frame of 1 / frames.rate)");
+  }
+  if (hasTimestep) {
+    scene.integrator.timestep = reader.requiredNumber("timestep");
+    requirePositive(reader, "timestep", scene.integrator.timestep);
+  } else {
+    // The timestep follows once frames.rate is known (parseScene).
+    scene.integrator.stepsPerFrame = reader.integer("stepsPerFrame", 1, 1, maxStepsPerFrame);
+  }
   if (const json* options = reader.find("options")) {
     if (!options->is_object()) {
       reader.fail("options", "expected an object, got " + JsonObjectReader::describe(*options));
@@ -338,11 +375,14 @@ void parseContact(JsonObjectReader& top, Scene& scene) {
     out.planes.push_back(plane);
   }
   if (const nlohmann::json* planes = reader.find("planes")) {
-    if (!planes->is_array()) reader.fail("planes", "expected an array of {\"point\": [x, y, z], \"normal\": [x, y, z]}");
+    if (!planes->is_array())
+      reader.fail("planes", "expected an array of {\"point\": [x, y, z], \"normal\": [x, y, z]}");
     for (std::size_t i = 0; i < planes->size(); ++i) {
       JsonObjectReader planeReader((*planes)[i], reader.elementPath("planes", i), source);
-      const Eigen::Vector3d point = JsonObjectReader::toVector3(planeReader.required("point"), planeReader.keyPath("point"), source);
-      Eigen::Vector3d normal = JsonObjectReader::toVector3(planeReader.required("normal"), planeReader.keyPath("normal"), source);
+      const Eigen::Vector3d point =
+          JsonObjectReader::toVector3(planeReader.required("point"), planeReader.keyPath("point"), source);
+      Eigen::Vector3d normal =
+          JsonObjectReader::toVector3(planeReader.required("normal"), planeReader.keyPath("normal"), source);
       if (!(normal.norm() > 0.0)) planeReader.fail("normal", "expected a non-zero vector");
       planeReader.finish();
       normal.normalize();
@@ -354,7 +394,8 @@ void parseContact(JsonObjectReader& top, Scene& scene) {
     for (std::size_t i = 0; i < spheres->size(); ++i) {
       JsonObjectReader sphereReader((*spheres)[i], reader.elementPath("spheres", i), source);
       ContactSphere sphere;
-      sphere.center = JsonObjectReader::toVector3(sphereReader.required("center"), sphereReader.keyPath("center"), source);
+      sphere.center =
+          JsonObjectReader::toVector3(sphereReader.required("center"), sphereReader.keyPath("center"), source);
       sphere.radius = sphereReader.requiredNumber("radius");
       requirePositive(sphereReader, "radius", sphere.radius);
       sphereReader.finish();
@@ -422,13 +463,70 @@ Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePa
     scene.frames.count = reader.integer("count", scene.frames.count, 1, maxInt);
     reader.finish();
   }
+  if (scene.integrator.stepsPerFrame > 0) {
+    scene.integrator.timestep = (1.0 / scene.frames.rate) / scene.integrator.stepsPerFrame;
+  }
   parseOutput(top, scene);
   top.finish();
   return scene;
 }
 
+FrameTiming resolveFrameTiming(const Scene& scene) {
+  const double rate = scene.frames.rate;
+  if (!(rate > 0.0) || !std::isfinite(rate)) {
+    throwSceneError(scene, "frames.rate", "expected a number > 0");
+  }
+  FrameTiming timing;
+  timing.frameInterval = 1.0 / rate;
+  if (scene.integrator.stepsPerFrame > 0) {
+    timing.stepsPerFrame = scene.integrator.stepsPerFrame;
+    timing.timestep = timing.frameInterval / timing.stepsPerFrame;
+    return timing;
+  }
+  const double h = scene.integrator.timestep;
+  if (!(h > 0.0) || !std::isfinite(h)) {
+    throwSceneError(scene, "integrator.timestep", "expected a number > 0");
+  }
+  const double ratio = timing.frameInterval / h;
+  const double steps = std::round(ratio);
+  // |h - T / N| / (T / N) = |N - ratio| / ratio.
+  if (steps >= 1.0 && steps <= maxStepsPerFrame && std::abs(ratio - steps) <= timestepDivisorTolerance * ratio) {
+    timing.timestep = h;
+    timing.stepsPerFrame = static_cast<int>(steps);
+    return timing;
+  }
+  const std::string interval = describeDuration(rate, 1);
+  std::string message = formatNumber(h, 9) + " does not divide the frame interval " + interval + " (frames.rate " +
+                        formatNumber(rate, 9) + ") into whole steps: " + formatNumber(ratio, 12) + " steps per frame; ";
+  if (ratio > maxStepsPerFrame) {
+    message += "the smallest timestep allowed is " + describeDivisor(rate, maxStepsPerFrame);
+  } else if (ratio < 1.0) {
+    message += "the timestep is longer than a frame; the longest valid timestep is " + describeDivisor(rate, 1);
+  } else {
+    const auto fewer = static_cast<long long>(std::floor(ratio));
+    message +=
+        "the nearest valid timesteps are " + describeDivisor(rate, fewer) + " and " + describeDivisor(rate, fewer + 1);
+  }
+  throwSceneError(scene, "integrator.timestep",
+                  message + "; or give the steps per frame instead (integrator.stepsPerFrame)");
+}
+
 Scene loadScene(const std::filesystem::path& path) {
   const std::string name = path.string();
+  std::error_code ignored;
+  if (std::filesystem::is_directory(path, ignored)) {
+    throw Error(name + ": is a directory, not a scene file (scenes are JSON; see docs/scene-format.md)");
+  }
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* meshExtension : {".veg", ".node", ".ele", ".msh", ".vtu", ".obj", ".stl", ".off", ".ply"}) {
+    if (extension == meshExtension) {
+      throw Error(name +
+                  ": is a mesh file, not a scene (scenes are JSON; see docs/scene-format.md); to look at a mesh use "
+                  "meshInfo");
+    }
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     throw Error(name + ": cannot open the scene file");

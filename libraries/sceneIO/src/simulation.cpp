@@ -226,6 +226,11 @@ struct VertexLoad {
   bool active(double time) const { return leftOpen ? (time > start && time <= end) : (time >= start && time < end); }
 };
 
+// Relative to h: how close to a window bound a step time counts as on it. Round-off in
+// k h and in the substep times t0 + r hS is ~1e-16 relative; 1e-9 is far above it and far
+// below any deliberate offset from a step time.
+constexpr double windowTolerance = 1e-9;
+
 std::vector<VertexLoad> collectLoads(const Scene& scene, const TetMesh& mesh) {
   std::vector<VertexLoad> loads;
   for (std::size_t i = 0; i < scene.forces.size(); ++i) {
@@ -250,8 +255,12 @@ std::vector<VertexLoad> collectLoads(const Scene& scene, const TetMesh& mesh) {
     const double count = static_cast<double>(load.vertices.size());
     if (force.type == Scene::ForceType::pull) {
       load.perVertex = force.vector / count;
-      load.start = force.start;
-      load.end = force.end;
+      // Acts at step times start <= t < end, where a step time within 1e-9 h of a bound
+      // counts as the bound (docs/scene-format.md): step times are k h up to round-off, so
+      // a window ending on a step time excludes that step whatever the round-off.
+      const double tolerance = windowTolerance * scene.integrator.timestep;
+      load.start = force.start - tolerance;
+      load.end = force.end - tolerance;
     } else {
       // An impulse I is a force I / h over a window one step long. Integrators evaluate
       // f_ext at step starts, step ends or both (averaged); the window
@@ -339,8 +348,13 @@ std::vector<std::string> contactStepWarnings(const Scene& scene, const TetMesh& 
 
 TetMesh buildSceneMesh(const Scene& scene) { return applyMaterialOverrides(scene, loadMesh(scene)); }
 
-Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registry) {
+Simulation buildSimulation(const Scene& givenScene, const IntegratorRegistry& registry) {
   Simulation simulation;
+  // The timestep every part below uses is the resolved one (from integrator.stepsPerFrame
+  // when the scene gives it).
+  const FrameTiming timing = resolveFrameTiming(givenScene);
+  Scene scene = givenScene;
+  scene.integrator.timestep = timing.timestep;
 
   // Cheap checks first, so a bad scene fails before the mesh is read and matrices built.
   const IntegratorFactory* factory = registry.find(scene.integrator.name);
@@ -348,25 +362,13 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
     throwSceneError(scene, "integrator.name",
                     "unknown integrator \"" + scene.integrator.name + "\" (known: " + joined(registry.names()) + ")");
   }
-  const double h = scene.integrator.timestep;
-  if (!(h > 0.0) || !std::isfinite(h)) {
-    throwSceneError(scene, "integrator.timestep", "expected a number > 0");
+  if (scene.frames.count < 1) {
+    throwSceneError(scene, "frames.count", "expected a count >= 1");
   }
-  if (!(scene.frames.rate > 0.0) || !std::isfinite(scene.frames.rate) || scene.frames.count < 1) {
-    throwSceneError(scene, "frames", "expected rate > 0 and count >= 1");
-  }
-  simulation.timestep = h;
-  simulation.frameInterval = 1.0 / scene.frames.rate;
+  simulation.timestep = timing.timestep;
+  simulation.frameInterval = timing.frameInterval;
+  simulation.stepsPerFrame = timing.stepsPerFrame;
   simulation.numFrames = scene.frames.count;
-  const double ratio = simulation.frameInterval / h;
-  const double steps = std::round(ratio);
-  if (steps < 1.0 || std::abs(ratio - steps) > 1e-9 * ratio || steps > 1e9) {
-    throwSceneError(scene, "integrator.timestep",
-                    formatNumber(h) + " does not divide the frame interval 1 / frames.rate = " +
-                        formatNumber(simulation.frameInterval) + " into a whole number of steps (ratio " +
-                        formatNumber(ratio) + "); change integrator.timestep or frames.rate");
-  }
-  simulation.stepsPerFrame = static_cast<int>(steps);
 
   auto mesh = std::make_shared<TetMesh>(buildSceneMesh(scene));
   simulation.mesh = mesh;

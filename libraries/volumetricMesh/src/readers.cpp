@@ -1,13 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Format dispatch and the .bou reader; the mesh readers live in detail/*Reader.cpp.
-#include "detail/textInput.hpp"
-
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
-
-#include <algorithm>
 #include <string>
 #include <vector>
+
+#include "detail/textInput.hpp"
 
 namespace asyncfem {
 
@@ -18,8 +17,13 @@ TetMesh readMesh(const std::filesystem::path& path, const MeshReadOptions& optio
     return readTetGen(path, options, report);
   }
   if (detail::equalsIgnoreCase(extension, ".msh")) return readGmsh(path, options, report);
+  // A TetGen base name ("cube" for cube.node + cube.ele; "cube.1" for TetGen's cube.1.*).
+  std::filesystem::path node = path;
+  node += ".node";
+  std::error_code ignored;
+  if (std::filesystem::is_regular_file(node, ignored)) return readTetGen(node, options, report);
   throw Error("cannot read mesh '" + path.string() + "': unknown extension '" + extension +
-              "' (expected .veg, .node, .ele or .msh)");
+              "' (expected .veg, .node, .ele or .msh, or the base name of a TetGen .node/.ele pair)");
 }
 
 std::vector<int> readBou(const std::filesystem::path& path, int numVertices) {

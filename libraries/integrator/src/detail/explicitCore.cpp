@@ -31,7 +31,9 @@ void ExplicitCore::checkTimestep(double timestep, const std::string& methodName)
     message.precision(6);
     message << "timestep " << timestep << " exceeds the estimated stable timestep " << limit << " of " << methodName
             << " (2 / omega_max, omega_max = " << maxFrequency_
-            << " rad/s, undamped bound); reduce the timestep, or use --force (IntegratorOptions::force) to run anyway";
+            << " rad/s, undamped bound); reduce the timestep to at most " << limit
+            << ", or set the option force to run anyway (scene key integrator.options.force: true; "
+               "IntegratorOptions::force)";
     throw ValidationError(message.str());
   }
 }

@@ -69,7 +69,8 @@ class Integrator {
   /// unconditionally stable (implicit methods).
   virtual double stableTimestepEstimate() const;
 
-  /// Sets u and v (size 3n; fixed entries are zeroed) and the time.
+  /// Sets u and v (size 3n; fixed entries are zeroed) and the time. Step times after it
+  /// are t_k = k h when time is such a k h (as a checkpoint's time is), else time + j h.
   void setState(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, double time = 0.0);
   /// What the next step() depends on beyond (u, v, t), for checkpoints: restoring
   /// (u, v, t) with setState() and then this with setInternalState() makes the following
@@ -99,6 +100,13 @@ class Integrator {
  protected:
   /// The external force at time t and the current state (size 3n; zero if none).
   void evaluateExternalForce(double time, Eigen::VectorXd& forces) const;
+  /// The time the current step ends at: t_{k+1} = t_origin + (k + 1) h, computed from the
+  /// step index k so that step times do not accumulate round-off (t_origin = 0 from the
+  /// start of a run; setState() and setTimestep() start a new origin unless the time is
+  /// already a whole number of steps).
+  double stepEndTime() const;
+  /// Ends a step: time() becomes stepEndTime().
+  void advanceTime();
   /// Zeroes the fixed entries of a full vector.
   void zeroFixed(Eigen::VectorXd& full) const;
   /// Called by setState() after the state changed, so that integrators that carry
@@ -112,6 +120,12 @@ class Integrator {
   double time_ = 0.0;
   double timestep_ = 0.0;
   IntegratorStats stats_;
+
+ private:
+  /// Step times are timeOrigin_ + stepIndex_ h (stepEndTime()).
+  void restartTimeGrid();
+  double timeOrigin_ = 0.0;
+  long long stepIndex_ = 0;
 };
 
 }  // namespace asyncfem

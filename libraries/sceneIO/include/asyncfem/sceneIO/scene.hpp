@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include <asyncfem/contact/penaltyContact.hpp>
-
 #include <Eigen/Core>
+#include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
@@ -89,7 +88,7 @@ struct Scene {
   ForceModelKind forceModel = ForceModelKind::linear;
   /// Penalty contact with static obstacles (docs/scene-format.md, "contact").
   struct Contact {
-    std::vector<ContactPlane> planes;    ///< the ground is one of them
+    std::vector<ContactPlane> planes;  ///< the ground is one of them
     std::vector<ContactSphere> spheres;
     PenaltyContactParameters parameters;
     bool enabled() const { return !planes.empty() || !spheres.empty(); }
@@ -98,7 +97,11 @@ struct Scene {
 
   struct IntegratorSettings {
     std::string name = "backward-euler";
-    double timestep = 0.0;  ///< h (> 0)
+    /// h (> 0). With stepsPerFrame it is set from it: (1 / frames.rate) / stepsPerFrame.
+    double timestep = 0.0;
+    /// Steps per frame given instead of the timestep (integrator.stepsPerFrame); 0: the
+    /// timestep was given, and must divide the frame interval (resolveFrameTiming).
+    int stepsPerFrame = 0;
     /// Integrator-specific keys, passed through unparsed to the integrator's factory
     /// (see IntegratorRegistry), which rejects keys it does not know.
     nlohmann::json options = nlohmann::json::object();
@@ -119,6 +122,27 @@ struct Scene {
     VtuEncoding vtuEncoding = VtuEncoding::binary;
   } output;
 };
+
+/// How the integrator's steps fill the frames of a scene.
+struct FrameTiming {
+  double frameInterval = 0.0;  ///< 1 / frames.rate
+  double timestep = 0.0;       ///< h
+  int stepsPerFrame = 0;       ///< frameInterval / h, a whole number
+};
+
+/// The relative distance |h - frameInterval / N| / (frameInterval / N) up to which a
+/// timestep counts as the divisor frameInterval / N of the frame interval: far above the
+/// round-off of a timestep written as 1/990 or with ten significant digits
+/// (0.001010101010), far below the gap 1/N between neighbouring divisors (N <= 1e9).
+inline constexpr double timestepDivisorTolerance = 1e-9;
+
+/// The frame timing of a scene: with integrator.stepsPerFrame N, h = frameInterval / N;
+/// otherwise N = frameInterval / integrator.timestep, which must be a whole number to
+/// timestepDivisorTolerance (h is then used as given). Throws asyncfem::ValidationError
+/// "<scene>: integrator.timestep: ..." naming the frame interval and the two nearest valid
+/// timesteps with their steps per frame when it is not, and "<scene>: frames: ..." for a
+/// bad frames.rate.
+FrameTiming resolveFrameTiming(const Scene& scene);
 
 /// Reads and parses a scene file. Relative paths in it resolve against its folder.
 /// Throws asyncfem::ParseError "FILE:LINE: invalid JSON ..." for malformed JSON, and

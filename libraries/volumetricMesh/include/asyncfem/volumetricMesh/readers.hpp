@@ -2,7 +2,6 @@
 #pragma once
 
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -25,15 +24,16 @@ struct MeshReadOptions {
 
 /// What a reader noticed without failing; utilities print it.
 struct MeshReadReport {
-  std::string format;                   ///< "veg", "tetgen", "gmsh 2.2", "gmsh 4.1"
-  std::vector<std::string> warnings;    ///< e.g. unused vertices, ignored element types
+  std::string format;                 ///< "veg", "tetgen", "gmsh 2.2", "gmsh 4.1"
+  std::vector<std::string> warnings;  ///< e.g. unused vertices, ignored element types
   int reorientedElements = 0;
   int unusedVertices = 0;
-  int ignoredElements = 0;              ///< non-tet elements skipped (Gmsh points/lines/triangles)
+  int ignoredElements = 0;  ///< non-tet elements skipped (Gmsh points/lines/triangles)
 };
 
 /// Reads a tetrahedral mesh, choosing the reader from the extension: .veg; .node/.ele
-/// (TetGen; either file names the pair); .msh (Gmsh 2.2 or 4.1 ASCII).
+/// (TetGen; either file names the pair, and so does their base name: "cube" or "cube.1"
+/// for cube.node + cube.ele or cube.1.node + cube.1.ele); .msh (Gmsh 2.2 or 4.1 ASCII).
 /// Errors: asyncfem::ParseError "FILE:LINE: message" for malformed input,
 /// asyncfem::Error for unreadable files or unknown extensions.
 TetMesh readMesh(const std::filesystem::path& path, const MeshReadOptions& options = {},

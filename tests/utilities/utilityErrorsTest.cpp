@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The error conventions every utility shares (docs/utilities.md): "PROGRAM: message" on
+// stderr, status 2 for usage errors found before any work, 1 for other errors; outputs
+// that are inputs refused. Runs the built executables.
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "utilityTest.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using asyncfem::test::readText;
+using asyncfem::test::RunResult;
+
+class UtilityErrorsTest : public asyncfem::test::UtilityTest {
+ protected:
+  /// Runs PROGRAM (in ASYNCFEM_BIN_DIR) with the arguments, in the scratch folder.
+  RunResult run(const std::string& program, const std::string& arguments) const {
+    return runCommand("cd '" + folder_.string() + "' && '" + std::string(ASYNCFEM_BIN_DIR) + "/" + program + "' " +
+                      arguments);
+  }
+
+  /// A small scene on a generated box (its own folder's scene.json).
+  fs::path writeScene() const {
+    const fs::path path = folder_ / "scene.json";
+    std::ofstream(path) << R"({
+      "mesh": {"generator": "box", "size": [3, 1, 1], "cells": [3, 1, 1]},
+      "fixed": {"sets": ["xmin"]},
+      "integrator": {"name": "backward-euler", "timestep": 0.01},
+      "frames": {"rate": 20, "count": 2}
+    })";
+    return path;
+  }
+};
+
+TEST_F(UtilityErrorsTest, UsageErrorsArePrefixedAndExitWithTwo) {
+  for (const std::string program :
+       {"meshInfo", "suggestRegions", "tetMesher", "offlineSimulator", "integratorBenchmark", "stabilityStressTest"}) {
+    const RunResult r = run(program, "--no-such-option x");
+    EXPECT_EQ(r.exitCode, 2) << program << ": " << r.err;
+    EXPECT_EQ(r.err.rfind(program + ": ", 0), 0U) << r.err;
+    EXPECT_NE(r.err.find("(see --help)"), std::string::npos) << r.err;
+    EXPECT_EQ(run(program, "--help").exitCode, 0) << program;
+  }
+  // Range errors read as a bound, not as CLI11's "not in range 2.2e-308 to 1.797...e+308".
+  const RunResult negative = run("suggestRegions", "scene.json --dt -1");
+  EXPECT_EQ(negative.exitCode, 2);
+  EXPECT_EQ(negative.err, "suggestRegions: --dt: must be > 0 (got -1) (see --help)\n");
+  const RunResult cells = run("meshInfo", "--generate beam --cells 0");
+  EXPECT_EQ(cells.exitCode, 2);
+  EXPECT_EQ(cells.err, "meshInfo: --cells: must be in [1, 1000] (got 0) (see --help)\n");
+}
+
+TEST_F(UtilityErrorsTest, MeshInfoChecksTheOutputExtensionFirst) {
+  const RunResult r = run("meshInfo", "--generate beam --write x.stl");
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(r.err,
+            "meshInfo: --write: cannot write 'x.stl': unknown extension '.stl' (supported: .veg, .vtu) (see "
+            "--help)\n");
+  EXPECT_TRUE(r.out.empty()) << r.out;  // nothing generated or printed
+}
+
+TEST_F(UtilityErrorsTest, MeshInfoReadsATetGenBaseName) {
+  std::ofstream(folder_ / "cube.node") << "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n";
+  std::ofstream(folder_ / "cube.ele") << "1 4 0\n1 1 2 3 4\n";
+  const RunResult r = run("meshInfo", "cube");
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("format: tetgen"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("elements: 1"), std::string::npos) << r.out;
+}
+
+TEST_F(UtilityErrorsTest, SuggestRegionsRefusesToWriteOverItsInput) {
+  const fs::path scene = writeScene();
+  const std::string text = readText(scene);
+  fs::create_symlink(scene, folder_ / "link.json");
+  for (const std::string target : {"scene.json", "./scene.json", "link.json"}) {
+    const RunResult r = run("suggestRegions", "scene.json --write " + target);
+    EXPECT_EQ(r.exitCode, 1) << target;
+    EXPECT_EQ(r.err, "suggestRegions: --write " + target +
+                         " is the scene scene.json: writing it would destroy the "
+                         "input; write the regions to another file\n");
+  }
+  EXPECT_EQ(readText(scene), text);
+}
+
+// Every configuration is checked before the (expensive) reference is computed.
+TEST_F(UtilityErrorsTest, IntegratorBenchmarkRejectsABadConfigurationFirst) {
+  writeScene();
+  const RunResult r = run("integratorBenchmark", "scene.json --quick --out out --config runge-kutta:spf=2");
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.err.find("integratorBenchmark: configuration \"runge-kutta"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("unknown integrator \"runge-kutta\""), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("Reference:"), std::string::npos) << r.out;
+}
+
+}  // namespace
