@@ -36,6 +36,34 @@ bool contains(const std::vector<std::string>& list, const std::string& prefix) {
   return std::any_of(list.begin(), list.end(), [&](const std::string& s) { return s.rfind(prefix, 0) == 0; });
 }
 
+// Options belong to an integrator: switching an async scene to backward Euler drops (and
+// names) the async-only keys, keeps the shared ones, and the scene then builds; switching
+// back and forth with undeclared keys is covered by the registry's declared lists.
+TEST(BuildSimulation, SwitchingIntegratorsDropsTheOptionsTheNewOneDoesNotRead) {
+  nlohmann::json json = smallScene();
+  json["integrator"] = nlohmann::json::parse(R"({"name": "async", "timestep": 0.01, "options": {
+      "coupling": "paper", "schur": "lu",
+      "regions": [{"name": "tip", "ratio": 4, "vertexSets": ["xmax"]}]}})");
+  Scene scene = asyncfem::parseScene(json, "", "scene.json");
+  const asyncfem::IntegratorRegistry registry = asyncfem::defaultIntegratorRegistry();
+  Scene same = scene;
+  EXPECT_TRUE(asyncfem::switchIntegrator(same, registry, "async").empty());
+  EXPECT_EQ(same.integrator.options.size(), 3U);
+  const std::vector<std::string> dropped = asyncfem::switchIntegrator(scene, registry, "backward-euler");
+  EXPECT_EQ(dropped, (std::vector<std::string>{"coupling", "regions", "schur"}));
+  EXPECT_EQ(scene.integrator.name, "backward-euler");
+  EXPECT_TRUE(scene.integrator.options.empty());
+  const Simulation simulation = asyncfem::buildSimulation(scene);
+  EXPECT_EQ(simulation.integrator->name(), "backward-euler");
+  // A shared key carries over: "solver" is read by every single-rate integrator.
+  Scene single = asyncfem::parseScene(smallScene(), "", "scene.json");
+  single.integrator.options = nlohmann::json::parse(R"({"solver": "umfpack", "maxIterations": 3})");
+  EXPECT_TRUE(asyncfem::switchIntegrator(single, registry, "trapezoidal").empty());
+  EXPECT_EQ(single.integrator.options.size(), 2U);
+  EXPECT_EQ(asyncfem::switchIntegrator(single, registry, "async"),
+            (std::vector<std::string>{"maxIterations", "solver"}));
+}
+
 TEST(BuildSimulation, GeneratorMeshAndTiming) {
   const Simulation simulation = build(smallScene());
   EXPECT_EQ(simulation.mesh->numVertices(), 12);

@@ -339,6 +339,24 @@ TEST_F(OfflineSimulatorTest, TimestepMustDivideTheFrameOrBeGivenAsStepsPerFrame)
       << zero.err;
 }
 
+// README's command: an async scene run with --integrator backward-euler drops (and names)
+// the async options and runs; naming the scene's own integrator drops nothing.
+TEST_F(OfflineSimulatorTest, IntegratorSwapDropsTheOptionsItDoesNotRead) {
+  auto json = smallScene();
+  json["integrator"] = nlohmann::json::parse(R"({"name": "async", "timestep": 0.01, "options": {
+      "regions": [{"name": "tip", "ratio": 4, "vertexSets": ["xmax"]}]}})");
+  const fs::path scene = writeScene(json);
+  const RunResult swapped = run(quoted(scene) + " --integrator backward-euler --frames 2");
+  EXPECT_EQ(swapped.exitCode, 0) << swapped.err;
+  EXPECT_NE(swapped.err.find("offlineSimulator: --integrator backward-euler: dropped the scene's integrator.options "
+                             "regions (not read by backward-euler)"),
+            std::string::npos)
+      << swapped.err;
+  const RunResult same = run(quoted(scene) + " --integrator async --frames 2");
+  EXPECT_EQ(same.exitCode, 0) << same.err;
+  EXPECT_EQ(same.err.find("dropped"), std::string::npos) << same.err;
+}
+
 // An output that is one of the run's inputs (the scene, the mesh), however it is spelled,
 // is refused before anything is written.
 TEST_F(OfflineSimulatorTest, RefusesToWriteOverItsInputs) {

@@ -289,7 +289,15 @@ void applyOverrides(const CommandLine& options, asyncfem::Scene& scene) {
     scene.output.file = *options.output;
   }
   if (options.integrator) {
-    scene.integrator.name = *options.integrator;
+    const std::vector<std::string> dropped =
+        asyncfem::switchIntegrator(scene, asyncfem::defaultIntegratorRegistry(), *options.integrator);
+    if (!dropped.empty()) {
+      std::string list;
+      for (const std::string& key : dropped) list += (list.empty() ? "" : ", ") + key;
+      std::cerr << "offlineSimulator: --integrator " << *options.integrator
+                << ": dropped the scene's integrator.options " << list << " (not read by " << *options.integrator
+                << ")\n";
+    }
   }
   if (options.timestep) {
     scene.integrator.timestep = *options.timestep;

@@ -22,8 +22,33 @@
 
 namespace asyncfem {
 
-void IntegratorRegistry::add(const std::string& name, IntegratorFactory factory) {
+void IntegratorRegistry::add(const std::string& name, IntegratorFactory factory, std::vector<std::string> optionKeys) {
   factories_[name] = std::move(factory);
+  optionKeys_[name] = std::move(optionKeys);
+}
+
+const std::vector<std::string>& IntegratorRegistry::optionKeys(const std::string& name) const {
+  static const std::vector<std::string> none;
+  const auto it = optionKeys_.find(name);
+  return it == optionKeys_.end() ? none : it->second;
+}
+
+std::vector<std::string> switchIntegrator(Scene& scene, const IntegratorRegistry& registry, const std::string& name) {
+  std::vector<std::string> dropped;
+  if (name == scene.integrator.name) return dropped;
+  scene.integrator.name = name;
+  const std::vector<std::string>& known = registry.optionKeys(name);
+  if (known.empty() || !scene.integrator.options.is_object()) return dropped;
+  for (auto it = scene.integrator.options.begin(); it != scene.integrator.options.end();) {
+    if (std::find(known.begin(), known.end(), it.key()) == known.end()) {
+      dropped.push_back(it.key());
+      it = scene.integrator.options.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  std::sort(dropped.begin(), dropped.end());
+  return dropped;
 }
 
 const IntegratorFactory* IntegratorRegistry::find(const std::string& name) const {
@@ -291,14 +316,19 @@ std::string formatNumber(double value) {
 
 IntegratorRegistry defaultIntegratorRegistry() {
   IntegratorRegistry registry;
-  registry.add("async", asyncIntegratorFactory());
-  registry.add("multirate-uncoupled", uncoupledMultirateIntegratorFactory());
+  // The keys each reads (docs/scene-format.md): switchIntegrator() drops the others.
+  registry.add("async", asyncIntegratorFactory(),
+               {"coupling", "schur", "method", "recovery", "regionSolver", "substepContact", "regions"});
+  registry.add("multirate-uncoupled", uncoupledMultirateIntegratorFactory(),
+               {"compoundSolver", "regionSolver", "regions"});
   for (const std::string& name : integratorNames()) {
     registry.add(
-        name, [name](const Scene& scene, const TetMesh& /*mesh*/, DynamicSystem system, const nlohmann::json& options) {
+        name,
+        [name](const Scene& scene, const TetMesh& /*mesh*/, DynamicSystem system, const nlohmann::json& options) {
           const IntegratorOptions parsed = parseSingleRateOptions(scene, options);
           return makeIntegrator(name, std::move(system), scene.integrator.timestep, parsed);
-        });
+        },
+        {"solver", "maxIterations", "tolerance", "maxFrequency", "force"});
   }
   return registry;
 }

@@ -30,16 +30,26 @@ using IntegratorFactory = std::function<std::unique_ptr<Integrator>(
 ///     Simulation simulation = buildSimulation(scene, registry);
 class IntegratorRegistry {
  public:
-  /// Adds (or replaces) the factory for name.
-  void add(const std::string& name, IntegratorFactory factory);
+  /// Adds (or replaces) the factory for name, with the keys of integrator.options it reads
+  /// (empty: not declared, so switchIntegrator() keeps every option).
+  void add(const std::string& name, IntegratorFactory factory, std::vector<std::string> optionKeys = {});
   /// The factory for name, or nullptr.
   const IntegratorFactory* find(const std::string& name) const;
+  /// The option keys declared for name (empty if none were, or name is unknown).
+  const std::vector<std::string>& optionKeys(const std::string& name) const;
   /// Registered names, sorted.
   std::vector<std::string> names() const;
 
  private:
   std::map<std::string, IntegratorFactory> factories_;
+  std::map<std::string, std::vector<std::string>> optionKeys_;
 };
+
+/// Makes scene run integrator `name` instead of its own: options belong to an integrator,
+/// so the keys of integrator.options that `name` does not read are removed (when the
+/// registry declares its keys) and returned, sorted; the shared ones stay. A `name` equal
+/// to the scene's integrator changes nothing.
+std::vector<std::string> switchIntegrator(Scene& scene, const IntegratorRegistry& registry, const std::string& name);
 
 /// "backward-euler", "trapezoidal", "central-differences", "symplectic-euler", each
 /// reading the options keys solver, maxIterations, tolerance, maxFrequency, force (see
