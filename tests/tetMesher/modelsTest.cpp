@@ -107,12 +107,19 @@ TEST(ExampleModels, GeneratorReproducesTheShippedMeshes) {
 }
 
 // The lattice-cell models (models/README.md, "Appendage models"), from volumetricMesh's
-// generators: `meshInfo --generate antenna|snail` wrote the shipped files.
+// generators: `meshInfo --generate antenna|snail [--block-cells 20 4 20]` wrote the shipped
+// files.
 TEST(ExampleModels, CellGeneratorsReproduceTheShippedMeshes) {
   const std::filesystem::path models(ASYNCFEM_MODELS_DIR);
   {
     SCOPED_TRACE("antenna");
     expectGeneratorReproduces(makeAntennaMesh(), readVeg(models / "antenna" / "antenna.veg"));
+  }
+  {
+    SCOPED_TRACE("antenna-wide");
+    AntennaSpec wide;
+    wide.blockCells = Eigen::Vector3i(20, 4, 20);
+    expectGeneratorReproduces(makeAntennaMesh(wide), readVeg(models / "antenna" / "antenna-wide.veg"));
   }
   {
     SCOPED_TRACE("snail");

@@ -137,6 +137,12 @@ int run(int argc, char** argv) {
                  "with --generate: beam cells along the length (default 20), box cells per axis (default 4), "
                  "antenna rod cells (default 8) or snail tentacle cells (default 6)")
       ->check(asyncfem::cli::inRange(1, 1000));
+  std::vector<int> blockCells;
+  app.add_option("--block-cells", blockCells,
+                 "with --generate antenna: the block's cells along x, y (up) and z "
+                 "(default 10 4 10)")
+      ->expected(3)
+      ->check(asyncfem::cli::inRange(1, 1000));
   app.add_flag("--json", json, "print a JSON object instead of text");
   app.add_option("--write", output, "also write the mesh to OUT.veg or OUT.vtu");
   if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "meshInfo")) return *status;
@@ -149,6 +155,8 @@ int run(int argc, char** argv) {
   if (input.empty() == generate.empty())
     throw asyncfem::Error("give either a mesh file or --generate beam|box|antenna|snail (see --help)");
   if (cells != 0 && generate.empty()) throw asyncfem::Error("--cells only applies to --generate");
+  if (!blockCells.empty() && generate != "antenna")
+    throw asyncfem::Error("--block-cells only applies to --generate antenna");
 
   TetMesh mesh;
   asyncfem::MeshReadReport report;
@@ -167,6 +175,7 @@ int run(int argc, char** argv) {
   } else if (generate == "antenna") {
     asyncfem::AntennaSpec spec;
     if (cells > 0) spec.rodCells = cells;
+    if (!blockCells.empty()) spec.blockCells = Eigen::Vector3i(blockCells[0], blockCells[1], blockCells[2]);
     mesh = asyncfem::makeAntennaMesh(spec);
     source = "generated antenna on a block, rod of " + std::to_string(spec.rodCells) + " cells";
   } else if (generate == "snail") {
