@@ -325,6 +325,30 @@ TEST(BuildSimulation, MaterialOverridesPerSet) {
   }
 }
 
+// A Vega mesh carries element sets only: a pull, a fixed set and an async region may name
+// one, and mean the vertices of its elements.
+TEST(BuildSimulation, ElementSetsServeWhereVertexSetsDo) {
+  const asyncfem::test::ScratchFolder folder;
+  asyncfem::TetMesh box = *build(smallScene()).mesh;
+  box.setElementSet("shell", {box.numElements() - 1});
+  box.setElementSet("foot", {0});
+  asyncfem::writeVeg(folder.path() / "box.veg", box);
+  nlohmann::json json = smallScene();
+  json["mesh"] = {{"file", "box.veg"}};
+  json["fixed"] = {{"sets", {"foot"}}};
+  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "shell", "force": [0, -8, 0]}])");
+  const Simulation simulation = build(json, folder.path());
+  const std::vector<int> shell = simulation.mesh->setVertices("shell");
+  ASSERT_EQ(shell.size(), 4U);
+  const Eigen::VectorXd force = externalForce(*&simulation, 0.05);
+  double total = 0.0;
+  for (const int v : shell) total += force[3 * v + 1];
+  EXPECT_NEAR(total, -8.0, 1e-12);
+  const std::vector<int> foot = simulation.mesh->setVertices("foot");
+  for (const int v : foot)
+    EXPECT_TRUE(std::binary_search(simulation.fixedVertices.begin(), simulation.fixedVertices.end(), v));
+}
+
 TEST(BuildSimulation, BuildsOnlyWhatTheSceneUses) {
   const Simulation linear = build(smallScene());
   EXPECT_TRUE(linear.integrator->system().forceModel->isLinear());

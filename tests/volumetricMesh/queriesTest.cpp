@@ -1,13 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Mesh queries: volumes, mass, boundary orientation, adjacency, bounding box, quality.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
-
-#include <Eigen/Geometry>
-#include <gtest/gtest.h>
-
-#include <algorithm>
 #include <cmath>
 
 namespace asyncfem {
@@ -35,6 +34,32 @@ TetMesh regularTet() {
 // summing 360 of them adds at most ~360 ulps, about 1e-13 relative, so 1e-12 is a bound
 // with margin that still catches any missing or double-counted element.
 constexpr double kSumTolerance = 1e-12;
+
+// A set of either kind names vertices: a vertex set as it is, an element set as the sorted,
+// unique vertices of its elements (Vega meshes carry element sets only); a vertex set of
+// the same name wins; an unknown name lists the sets of both kinds.
+TEST(MeshQueries, SetVerticesResolvesVertexAndElementSets) {
+  TetMesh mesh = makeBoxMesh(oddBox());
+  mesh.setElementSet("pair", {3, 0});
+  std::vector<int> expected;
+  for (const int e : {0, 3})
+    for (int a = 0; a < 4; ++a) expected.push_back(mesh.element(e)[a]);
+  std::sort(expected.begin(), expected.end());
+  expected.erase(std::unique(expected.begin(), expected.end()), expected.end());
+  EXPECT_EQ(mesh.setVertices("pair"), expected);
+  EXPECT_EQ(mesh.setVertices("xmin"), mesh.vertexSet("xmin"));
+  mesh.setVertexSet("pair", {7});
+  EXPECT_EQ(mesh.setVertices("pair"), std::vector<int>{7});
+  try {
+    (void)mesh.setVertices("nowhere");
+    FAIL() << "expected an error";
+  } catch (const ValidationError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("unknown set 'nowhere'"), std::string::npos) << message;
+    EXPECT_NE(message.find("vertex sets: pair, xmax"), std::string::npos) << message;
+    EXPECT_NE(message.find("element sets: pair"), std::string::npos) << message;
+  }
+}
 
 TEST(MeshQueries, BoxVolumesSumToTheBoxVolume) {
   const BoxMeshSpec spec = oddBox();

@@ -241,7 +241,8 @@ int run(int argc, char** argv) {
   app.add_option("--warp", options.warp, "Warping of the linear displacement: none, rotation-strain, modal")
       ->check(CLI::IsMember({"none", "rotation-strain", "modal"}))
       ->capture_default_str();
-  app.add_option("--tint-set", options.tintSet, "Vertex set drawn in the tint colour (e.g. the fast region)");
+  app.add_option("--tint-set", options.tintSet,
+                 "Set (vertex or element set) drawn in the tint colour (e.g. the fast region)");
   app.add_option("--tint-color", options.tintColor, "Tint colour r,g,b in [0, 1]")
       ->delimiter(',')
       ->expected(3)
@@ -346,7 +347,7 @@ int run(int argc, char** argv) {
   } else {
     auto mesh = std::make_shared<TetMesh>(readMesh(*options.mesh));
     for (const std::string& set : options.fixedSets) {
-      const std::vector<int>& vertices = mesh->vertexSet(set);
+      const std::vector<int> vertices = mesh->setVertices(set);
       shared.fixedVertices.insert(shared.fixedVertices.end(), vertices.begin(), vertices.end());
     }
     shared.mesh = std::move(mesh);
@@ -361,7 +362,7 @@ int run(int argc, char** argv) {
                                       : SurfaceEmbedding::boundary(*shared.mesh);
   RenderStyle style;
   if (options.tintSet) {
-    const std::vector<int>& tinted = shared.mesh->vertexSet(*options.tintSet);
+    const std::vector<int> tinted = shared.mesh->setVertices(*options.tintSet);
     Eigen::Matrix3Xf tetColors = style.surfaceColor.replicate(1, shared.mesh->numVertices());
     const Eigen::Vector3f tint(options.tintColor[0], options.tintColor[1], options.tintColor[2]);
     for (const int v : tinted) {

@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
       for (const std::string& w : report.warnings) std::cerr << "suggestRegions: warning: " << w << "\n";
       std::vector<int> fixed;
       for (const std::string& set : fixedSets) {
-        const std::vector<int>& vertices = loaded->vertexSet(set);
+        const std::vector<int> vertices = loaded->setVertices(set);
         fixed.insert(fixed.end(), vertices.begin(), vertices.end());
       }
       freeDofs = FreeDofs::fromFixedVertices(loaded->numVertices(), fixed);

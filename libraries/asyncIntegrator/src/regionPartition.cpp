@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/core/error.hpp>
-
-#include <algorithm>
 #include <string>
 
 namespace asyncfem {
@@ -19,7 +18,7 @@ void sortUnique(std::vector<int>& ids) {
 std::vector<int> regionVertices(const TetMesh& mesh, const RegionSelector& selector) {
   std::vector<int> vertices;
   for (const std::string& name : selector.vertexSets) {
-    const std::vector<int>& set = mesh.vertexSet(name);
+    const std::vector<int> set = mesh.setVertices(name);
     vertices.insert(vertices.end(), set.begin(), set.end());
   }
   for (const std::string& name : selector.elementSets) {
@@ -105,7 +104,8 @@ RegionPartition::RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, 
       for (int a = 0; a < 4; ++a) {
         const int v = mesh.elements()(a, e);
         if (vertexRegion_[static_cast<std::size_t>(v)] >= 0) continue;
-        for (int c = 0; c < 3; ++c) touchesRegion[static_cast<std::size_t>(fast)][static_cast<std::size_t>(3 * v + c)] = 1;
+        for (int c = 0; c < 3; ++c)
+          touchesRegion[static_cast<std::size_t>(fast)][static_cast<std::size_t>(3 * v + c)] = 1;
       }
     }
   }

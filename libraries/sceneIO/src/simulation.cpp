@@ -123,17 +123,19 @@ std::string knownSets(const std::map<std::string, std::vector<int>>& sets) {
   return names.empty() ? "none" : joined(names);
 }
 
-const std::vector<int>& vertexSetAt(const Scene& scene, const TetMesh& mesh, const std::string& name,
-                                    const std::string& keyPath) {
-  const auto it = mesh.vertexSets().find(name);
-  if (it == mesh.vertexSets().end()) {
+// The vertices of a set of either kind (TetMesh::setVertices), with errors at the key.
+std::vector<int> vertexSetAt(const Scene& scene, const TetMesh& mesh, const std::string& name,
+                             const std::string& keyPath) {
+  if (!mesh.vertexSets().count(name) && !mesh.elementSets().count(name)) {
     throwSceneError(scene, keyPath,
-                    "unknown vertex set \"" + name + "\" (known: " + knownSets(mesh.vertexSets()) + ")");
+                    "unknown set \"" + name + "\" (vertex sets: " + knownSets(mesh.vertexSets()) +
+                        "; element sets: " + knownSets(mesh.elementSets()) + ")");
   }
-  if (it->second.empty()) {
-    throwSceneError(scene, keyPath, "vertex set \"" + name + "\" is empty");
+  std::vector<int> vertices = mesh.setVertices(name);
+  if (vertices.empty()) {
+    throwSceneError(scene, keyPath, "set \"" + name + "\" is empty");
   }
-  return it->second;
+  return vertices;
 }
 
 // Material overrides: new materials for the elements of each set. A material used only

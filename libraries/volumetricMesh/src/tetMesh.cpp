@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
-#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -108,8 +107,8 @@ std::vector<int> TetMesh::elementSet(const std::string& name) const {
   }
   std::string known;
   for (const auto& [n, s] : elementSets_) known += (known.empty() ? "" : ", ") + n;
-  throw ValidationError("unknown element set '" + name + "' (known: allElements" + (known.empty() ? "" : ", ") +
-                        known + ")");
+  throw ValidationError("unknown element set '" + name + "' (known: allElements" + (known.empty() ? "" : ", ") + known +
+                        ")");
 }
 
 const std::vector<int>& TetMesh::vertexSet(const std::string& name) const {
@@ -117,6 +116,26 @@ const std::vector<int>& TetMesh::vertexSet(const std::string& name) const {
   std::string known;
   for (const auto& [n, s] : vertexSets_) known += (known.empty() ? "" : ", ") + n;
   throw ValidationError("unknown vertex set '" + name + "' (known: " + (known.empty() ? "none" : known) + ")");
+}
+
+std::vector<int> TetMesh::setVertices(const std::string& name) const {
+  if (auto it = vertexSets_.find(name); it != vertexSets_.end()) return it->second;
+  if (auto it = elementSets_.find(name); it != elementSets_.end()) {
+    std::vector<int> vertices;
+    vertices.reserve(it->second.size() * 4);
+    for (int e : it->second)
+      for (int a = 0; a < 4; ++a) vertices.push_back(elements_(a, e));
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    return vertices;
+  }
+  const auto list = [](const std::map<std::string, std::vector<int>>& sets) {
+    std::string known;
+    for (const auto& [n, s] : sets) known += (known.empty() ? "" : ", ") + n;
+    return known.empty() ? std::string("none") : known;
+  };
+  throw ValidationError("unknown set '" + name + "' (vertex sets: " + list(vertexSets_) +
+                        "; element sets: " + list(elementSets_) + ")");
 }
 
 void TetMesh::setElementSet(const std::string& name, std::vector<int> elements) {

@@ -2,7 +2,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <map>
 #include <string>
 #include <vector>
@@ -33,7 +32,7 @@ struct Material {
 /// Element orientation (positive signed volume) is the readers' business (see
 /// readers.hpp), not an invariant of this class, so algorithms that need it check.
 class TetMesh {
-public:
+ public:
   TetMesh() = default;
   /// restPositions: 3 x numVertices; elements: 4 x numElements (0-based vertex ids);
   /// elementMaterials: numElements entries, each an index into materials.
@@ -72,6 +71,12 @@ public:
   std::vector<int> elementSet(const std::string& name) const;
   /// The vertex set called name; throws ValidationError naming it if absent.
   const std::vector<int>& vertexSet(const std::string& name) const;
+  /// The vertices a set of either kind names: the vertex set called name if there is one,
+  /// else every vertex of the element set called name (Vega meshes carry element sets
+  /// only), sorted and unique. Throws ValidationError naming it and listing the sets of
+  /// both kinds if neither exists. Every place that takes "a set" (loads, fixed
+  /// vertices, regions, tints) resolves it through here.
+  std::vector<int> setVertices(const std::string& name) const;
   /// Adds or replaces a set; members are sorted and de-duplicated, range-checked.
   void setElementSet(const std::string& name, std::vector<int> elements);
   void setVertexSet(const std::string& name, std::vector<int> vertices);
@@ -79,7 +84,7 @@ public:
   /// Replaces the vertex order of element e (used by readers to fix orientation).
   void setElement(int e, const Eigen::Vector4i& vertices);
 
-private:
+ private:
   void validate() const;
 
   Eigen::Matrix3Xd restPositions_;
