@@ -24,7 +24,8 @@ struct Damping {
 const Damping kDampings[] = {{0.0, 0.0}, {0.3, 2e-3}};
 const AsyncCoupling kCouplings[] = {AsyncCoupling::stable, AsyncCoupling::paper};
 
-const char* name(AsyncCoupling coupling) { return coupling == AsyncCoupling::stable ? "stable" : "paper"; }
+using test::withCoupling;
+const auto name = test::couplingName;
 
 std::unique_ptr<AsyncBackwardEuler> makeAsync(const test::TestSystem& ts, double hL, std::vector<AsyncRegion> regions,
                                               AsyncOptions options = {}) {
@@ -39,9 +40,7 @@ TEST(AsyncIdentities, RatioOneEqualsSingleRate) {
     for (const Damping& damping : kDampings) {
       const test::TestSystem ts = makeTestSystem(damping.alpha, damping.beta);
       const double hL = 2e-3;
-      AsyncOptions options;
-      options.coupling = coupling;
-      auto async = makeAsync(ts, hL, {{"tip", test::verticesBeyond(ts.mesh, 0.75), 1}}, options);
+      auto async = makeAsync(ts, hL, {{"tip", test::verticesBeyond(ts.mesh, 0.75), 1}}, withCoupling(coupling));
       Eigen::VectorXd u = ts.u0, v = ts.v0;
       DenseBackwardEuler reference(ts.system);
       for (int k = 0; k < 3; ++k) {
@@ -59,9 +58,7 @@ TEST(AsyncIdentities, EmptySEqualsSingleRate) {
     for (const Damping& damping : kDampings) {
       const test::TestSystem ts = makeTestSystem(damping.alpha, damping.beta);
       const double hL = 3e-3;
-      AsyncOptions options;
-      options.coupling = coupling;
-      auto async = makeAsync(ts, hL, {}, options);
+      auto async = makeAsync(ts, hL, {}, withCoupling(coupling));
       Eigen::VectorXd u = ts.u0, v = ts.v0;
       DenseBackwardEuler reference(ts.system);
       for (int k = 0; k < 3; ++k) {

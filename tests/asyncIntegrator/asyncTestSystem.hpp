@@ -2,13 +2,11 @@
 // Small linear test systems and a dense single-rate backward Euler reference.
 #pragma once
 
+#include <Eigen/Dense>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
-
-#include <Eigen/Dense>
-
 #include <cmath>
 #include <memory>
 #include <random>
@@ -28,7 +26,8 @@ inline TestSystem makeTestSystem(double alpha, double beta, unsigned seed = 7) {
   spec.size = Eigen::Vector3d(1.0, 0.25, 0.25);
   spec.cells = Eigen::Vector3i(8, 2, 2);
   spec.material = Material{"soft", 1000.0, 1e5, 0.4};
-  spec.regions.push_back({"stiff", Eigen::Vector3d(0.75, -1, -1), Eigen::Vector3d(2, 2, 2), Material{"stiff", 200.0, 5e6, 0.3}});
+  spec.regions.push_back(
+      {"stiff", Eigen::Vector3d(0.75, -1, -1), Eigen::Vector3d(2, 2, 2), Material{"stiff", 200.0, 5e6, 0.3}});
   TestSystem ts{makeBoxMesh(spec), {}, {}, {}};
   MatrixAssembler assembler(ts.mesh);
   ts.system.forceModel = std::make_shared<LinearForceModel>(linearStiffnessMatrix(ts.mesh, assembler));
@@ -61,7 +60,7 @@ inline TestSystem makeTestSystem(double alpha, double beta, unsigned seed = 7) {
 /// Dense single-rate backward Euler on the free DOFs (design note, paper Eq. 5), the
 /// independent reference the asynchronous integrator is checked against.
 class DenseBackwardEuler {
-public:
+ public:
   explicit DenseBackwardEuler(const DynamicSystem& system) : system_(system) {
     const std::vector<int>& free = system.freeDofs.freeToFull();
     const Eigen::MatrixXd M = Eigen::MatrixXd(system.mass);
@@ -94,7 +93,7 @@ public:
     v = dofs.expand(vNew);
   }
 
-private:
+ private:
   const DynamicSystem& system_;
   Eigen::MatrixXd M_, K_, D_;
 };
@@ -103,6 +102,18 @@ private:
 inline double relativeDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   const double scale = std::max({1e-300, a.lpNorm<Eigen::Infinity>(), b.lpNorm<Eigen::Infinity>()});
   return (a - b).lpNorm<Eigen::Infinity>() / scale;
+}
+
+/// Default options with the given coupling.
+inline AsyncOptions withCoupling(AsyncCoupling coupling) {
+  AsyncOptions options;
+  options.coupling = coupling;
+  return options;
+}
+
+/// The scene-file name of a coupling, for test messages.
+inline const char* couplingName(AsyncCoupling coupling) {
+  return coupling == AsyncCoupling::stable ? "stable" : "paper";
 }
 
 /// Vertices of the mesh with rest x >= xMin.

@@ -30,9 +30,8 @@ TEST(NonlinearAsync, RatioOneEqualsCorotationalBackwardEuler) {
       test::TestSystem ts = makeCorotationalSystem(alpha, alpha * 1e-3);
       ts.u0 *= 100.0;  // a visibly nonlinear state (~0.1 displacement on a 1-long bar)
       const double hL = 2e-3;
-      AsyncOptions options;
-      options.coupling = coupling;
-      AsyncBackwardEuler async(ts.mesh, ts.system, hL, {{"tip", test::verticesBeyond(ts.mesh, 0.75), 1}}, options);
+      AsyncBackwardEuler async(ts.mesh, ts.system, hL, {{"tip", test::verticesBeyond(ts.mesh, 0.75), 1}},
+                               test::withCoupling(coupling));
       BackwardEuler single(ts.system, hL);
       async.setState(ts.u0, ts.v0);
       single.setState(ts.u0, ts.v0);
