@@ -1,12 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Every validation error of the region partition names what is wrong.
-#include "asyncTestSystem.hpp"
-
-#include <asyncfem/core/error.hpp>
-
 #include <gtest/gtest.h>
 
+#include <asyncfem/core/error.hpp>
 #include <string>
+
+#include "asyncTestSystem.hpp"
 
 namespace asyncfem {
 namespace {
@@ -37,8 +36,8 @@ TEST(RegionPartition, RejectsOverlapNamingTheVertex) {
 
 TEST(RegionPartition, RejectsElementTouchingTwoFastRegions) {
   const test::TestSystem ts = test::makeTestSystem(0, 0);
-  const std::string message =
-      partitionError(ts, {{"a", test::verticesOnPlanes(ts.mesh, {0.5}), 2}, {"b", test::verticesOnPlanes(ts.mesh, {0.625}), 2}});
+  const std::string message = partitionError(
+      ts, {{"a", test::verticesOnPlanes(ts.mesh, {0.5}), 2}, {"b", test::verticesOnPlanes(ts.mesh, {0.625}), 2}});
   EXPECT_NE(message.find("element "), std::string::npos) << message;
   EXPECT_NE(message.find("'a' and 'b'"), std::string::npos) << message;
 }

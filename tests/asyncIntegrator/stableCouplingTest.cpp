@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#include <asyncfem/core/error.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
@@ -23,13 +24,8 @@ namespace {
 
 using test::relativeDifference;
 
-const char* name(AsyncCoupling coupling) { return coupling == AsyncCoupling::stable ? "stable" : "paper"; }
-
-AsyncOptions withCoupling(AsyncCoupling coupling) {
-  AsyncOptions options;
-  options.coupling = coupling;
-  return options;
-}
+using test::withCoupling;
+const auto name = test::couplingName;
 
 /// One large step of the stable coupling solved from its definition (the per-substep
 /// equations of docs/asynchronous-integrator.md, "Stable coupling", written with positions
@@ -235,6 +231,25 @@ TEST(StableCoupling, PaperCouplingViolatesTheDefinition) {
   Eigen::VectorXd u = ts.u0, v = ts.v0;
   DefinitionStep(ts.mesh, ts.system, regions).step(2e-3, 0.0, u, v);
   EXPECT_GT(relativeDifference(paper.velocity(), v), 1e-4);
+}
+
+// A linear model built from a matrix has no per-element tangent: the stable coupling then
+// takes the interface elements' stiffness from the mesh, after checking that the model's
+// K is the mesh's. A K that is not (here doubled) is refused, naming the way out; the
+// paper coupling, which needs no K_I, still accepts it.
+TEST(StableCoupling, RefusesAMatrixModelThatIsNotTheMeshStiffness) {
+  test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  MatrixAssembler assembler(ts.mesh);
+  ts.system.forceModel = std::make_shared<LinearForceModel>(2.0 * linearStiffnessMatrix(ts.mesh, assembler));
+  const std::vector<AsyncRegion> regions = testPartitions(ts.mesh)[0];
+  try {
+    AsyncBackwardEuler stable(ts.mesh, ts.system, 2e-3, regions, withCoupling(AsyncCoupling::stable));
+    FAIL() << "expected a ValidationError";
+  } catch (const ValidationError& error) {
+    EXPECT_NE(std::string(error.what()).find("differs from the mesh's linear FEM stiffness"), std::string::npos)
+        << error.what();
+  }
+  EXPECT_NO_THROW(AsyncBackwardEuler(ts.mesh, ts.system, 2e-3, regions, withCoupling(AsyncCoupling::paper)));
 }
 
 /// The test system (or a copy with lumped mass / no fixed vertex) with no load.
