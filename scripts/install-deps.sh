@@ -8,7 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libsuitesparse-dev libmetis-dev libopenblas-dev
   nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format-14
 )
 if [[ "${1:-}" != "--no-render" ]]; then
   packages+=(libosmesa6-dev libassimp-dev libpng-dev)

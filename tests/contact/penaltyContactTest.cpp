@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <gtest/gtest.h>
+
 #include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/core/error.hpp>
-
-#include <gtest/gtest.h>
 
 namespace asyncfem {
 namespace {

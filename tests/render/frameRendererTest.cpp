@@ -37,7 +37,7 @@ class FrameRendererTest : public ::testing::Test {
  protected:
   void SetUp() override {
     folder_ = renderTesting::freshFolder(std::string("frameRenderer-") +
-                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
+                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     mesh_ = renderTesting::renderTestBar();
     writeVeg(folder_ / "bar.veg", mesh_);
     // Six frames bending the bar a little more each time.

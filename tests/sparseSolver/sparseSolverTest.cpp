@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/sparseSolver/sparseSolver.hpp>
-
 #include <gtest/gtest.h>
 
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <random>
 #include <string>
 #include <thread>
@@ -95,8 +94,7 @@ TEST(SparseSolver, SolvesSpdSystems) {
     ASSERT_EQ(x.rows(), a.rows());
     ASSERT_EQ(x.cols(), 1);
     EXPECT_LT(relativeResidual(a, x, b), kResidualTolerance) << toString(kind);
-    EXPECT_LT(relativeResidual(a, solver->solve(Eigen::VectorXd(b.col(0))), b), kResidualTolerance)
-        << toString(kind);
+    EXPECT_LT(relativeResidual(a, solver->solve(Eigen::VectorXd(b.col(0))), b), kResidualTolerance) << toString(kind);
   }
 }
 
@@ -194,8 +192,7 @@ TEST(SparseSolver, StatsAreConsistent) {
     EXPECT_LE(stats.factorNonZeros, 2LL * a.rows() * a.rows()) << toString(kind);
     // Eliminating n columns costs at least n flops and the factor's entries bound it below.
     EXPECT_GE(stats.factorFlops, static_cast<double>(a.rows())) << toString(kind);
-    EXPECT_DOUBLE_EQ(stats.solveFlopsPerRhs,
-                     (isCholesky(kind) ? 4.0 : 2.0) * static_cast<double>(stats.factorNonZeros))
+    EXPECT_DOUBLE_EQ(stats.solveFlopsPerRhs, (isCholesky(kind) ? 4.0 : 2.0) * static_cast<double>(stats.factorNonZeros))
         << toString(kind);
     EXPECT_EQ(stats.analyses, 1);
     EXPECT_EQ(stats.factorizations, 1);

@@ -1,21 +1,19 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "testMeshes.hpp"
-
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
-
 #include <gtest/gtest.h>
 #include <omp.h>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
-
 #include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <cmath>
 #include <cstring>
 #include <random>
 #include <string>
 #include <vector>
+
+#include "testMeshes.hpp"
 
 namespace asyncfem {
 namespace {
@@ -31,13 +29,13 @@ bool bitIdentical(const SparseMatrix& a, const SparseMatrix& b) {
 
 // Restores the OpenMP thread count a test changed.
 class ThreadCountGuard {
-public:
+ public:
   ThreadCountGuard() : saved_(omp_get_max_threads()) {}
   ~ThreadCountGuard() { omp_set_num_threads(saved_); }
   ThreadCountGuard(const ThreadCountGuard&) = delete;
   ThreadCountGuard& operator=(const ThreadCountGuard&) = delete;
 
-private:
+ private:
   int saved_;
 };
 

@@ -1,18 +1,16 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "testMeshes.hpp"
-
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
-#include <asyncfem/stiffnessMatrix/dofs.hpp>
-
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCore>
-
 #include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <random>
 #include <string>
 #include <vector>
+
+#include "testMeshes.hpp"
 
 namespace asyncfem {
 namespace {

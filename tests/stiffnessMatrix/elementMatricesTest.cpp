@@ -1,12 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
-
 #include <algorithm>
+#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>
 #include <random>
 

@@ -2,17 +2,15 @@
 // The free-DOF system M + h^2 K of a clamped box, assembled here and solved with every
 // sparse solver kind: the matrices this library builds are what the solvers expect
 // (full storage, sorted, compressed, symmetric positive definite once DOFs are fixed).
-#include "testMeshes.hpp"
-
-#include <asyncfem/sparseSolver/sparseSolver.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
-#include <asyncfem/stiffnessMatrix/dofs.hpp>
-
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCore>
-
+#include <asyncfem/sparseSolver/sparseSolver.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <random>
+
+#include "testMeshes.hpp"
 
 namespace asyncfem {
 namespace {

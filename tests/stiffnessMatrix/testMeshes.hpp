@@ -2,12 +2,10 @@
 // Small meshes shared by the stiffnessMatrix tests.
 #pragma once
 
-#include <asyncfem/volumetricMesh/generators.hpp>
-#include <asyncfem/volumetricMesh/tetMesh.hpp>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
+#include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <random>
 
 namespace asyncfem::test {

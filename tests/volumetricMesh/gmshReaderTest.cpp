@@ -1,13 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Gmsh ASCII 2.2 and 4.1: arbitrary node tags, physical groups, mixed element types.
-#include "testFiles.hpp"
+#include <gtest/gtest.h>
 
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
-
-#include <gtest/gtest.h>
-
 #include <string>
+
+#include "testFiles.hpp"
 
 namespace asyncfem {
 namespace {
@@ -21,39 +20,39 @@ std::string replaced(std::string text, const std::string& from, const std::strin
 
 // Line numbers matter for the error tests below.
 const std::string kMsh22 =
-    "$MeshFormat\n"                       // 1
-    "2.2 0 8\n"                           // 2
-    "$EndMeshFormat\n"                    // 3
-    "$PhysicalNames\n"                    // 4
-    "3\n"                                 // 5
-    "2 3 \"skin\"\n"                      // 6
-    "3 7 \"solid part\"\n"                // 7
-    "3 9 \"unused\"\n"                    // 8
-    "$EndPhysicalNames\n"                 // 9
-    "$Nodes\n"                            // 10
-    "5\n"                                 // 11
-    "10 0 0 0\n"                          // 12
-    "20 1 0 0\n"                          // 13
-    "30 0 1 0\n"                          // 14
-    "40 0 0 1\n"                          // 15
-    "55 1 1 1\n"                          // 16
-    "$EndNodes\n"                         // 17
-    "$Elements\n"                         // 18
-    "5\n"                                 // 19
-    "1 15 2 0 1 10\n"                     // 20 point
-    "2 1 2 0 1 10 20\n"                   // 21 line
-    "3 2 2 3 1 10 20 30\n"                // 22 triangle in physical surface 3
-    "4 4 2 7 1 10 30 20 40\n"             // 23 tet, inverted, physical "solid part"
-    "5 4 2 8 1 20 30 40 55\n"             // 24 tet, physical 8 without a name
-    "$EndElements\n";                     // 25
+    "$MeshFormat\n"            // 1
+    "2.2 0 8\n"                // 2
+    "$EndMeshFormat\n"         // 3
+    "$PhysicalNames\n"         // 4
+    "3\n"                      // 5
+    "2 3 \"skin\"\n"           // 6
+    "3 7 \"solid part\"\n"     // 7
+    "3 9 \"unused\"\n"         // 8
+    "$EndPhysicalNames\n"      // 9
+    "$Nodes\n"                 // 10
+    "5\n"                      // 11
+    "10 0 0 0\n"               // 12
+    "20 1 0 0\n"               // 13
+    "30 0 1 0\n"               // 14
+    "40 0 0 1\n"               // 15
+    "55 1 1 1\n"               // 16
+    "$EndNodes\n"              // 17
+    "$Elements\n"              // 18
+    "5\n"                      // 19
+    "1 15 2 0 1 10\n"          // 20 point
+    "2 1 2 0 1 10 20\n"        // 21 line
+    "3 2 2 3 1 10 20 30\n"     // 22 triangle in physical surface 3
+    "4 4 2 7 1 10 30 20 40\n"  // 23 tet, inverted, physical "solid part"
+    "5 4 2 8 1 20 30 40 55\n"  // 24 tet, physical 8 without a name
+    "$EndElements\n";          // 25
 
 const std::string kMsh41 =
     "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"
     "$PhysicalNames\n2\n2 5 \"skin\"\n3 7 \"solid\"\n$EndPhysicalNames\n"
     "$Entities\n"
     "0 0 1 1\n"
-    "3 0 0 0 1 1 1 1 5 0\n"          // surface 3 in physical 5
-    "1 0 0 0 1 1 1 1 7 1 3\n"        // volume 1 in physical 7, bounded by surface 3
+    "3 0 0 0 1 1 1 1 5 0\n"    // surface 3 in physical 5
+    "1 0 0 0 1 1 1 1 7 1 3\n"  // volume 1 in physical 7, bounded by surface 3
     "$EndEntities\n"
     "$Nodes\n"
     "2 5 10 50\n"

@@ -2,10 +2,10 @@
 // Helpers for the volumetricMesh tests: a scratch folder per test and file writing.
 #pragma once
 
-#include <asyncfem/core/error.hpp>
-
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <asyncfem/core/error.hpp>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -13,18 +13,15 @@
 #include <string>
 #include <string_view>
 
-#include <unistd.h>
-
 namespace asyncfem::test {
 
 /// A fresh folder under the system temp directory, removed when the test ends.
 class ScratchDir {
-public:
+ public:
   ScratchDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = std::filesystem::temp_directory_path() /
-           ("asyncfem-mesh-" + std::string(info->test_suite_name()) + "-" + info->name() + "-" +
-            std::to_string(::getpid()));
+    dir_ = std::filesystem::temp_directory_path() / ("asyncfem-mesh-" + std::string(info->test_suite_name()) + "-" +
+                                                     info->name() + "-" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
   }
@@ -44,7 +41,7 @@ public:
     return p;
   }
 
-private:
+ private:
   std::filesystem::path dir_;
 };
 

@@ -1,13 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Malformed .veg input: one test per documented error, each checking that the message
 // names the file, the line and the offending element, vertex, set or material.
-#include "testFiles.hpp"
-
-#include <asyncfem/volumetricMesh/readers.hpp>
-
 #include <gtest/gtest.h>
 
+#include <asyncfem/volumetricMesh/readers.hpp>
 #include <string>
+
+#include "testFiles.hpp"
 
 namespace asyncfem {
 namespace {
@@ -65,9 +64,7 @@ TEST(VegErrors, ElementVertexZeroIsOutOfRange) {
   expectVegError("1 1 2 3 4", "1 0 2 3 4", 11, {"element 1", "vertex 0"});
 }
 
-TEST(VegErrors, ElementLineMissingAnIndex) {
-  expectVegError("2 2 3 4 5", "2 2 3 4", 12, {"got 4 fields"});
-}
+TEST(VegErrors, ElementLineMissingAnIndex) { expectVegError("2 2 3 4 5", "2 2 3 4", 12, {"got 4 fields"}); }
 
 TEST(VegErrors, ElementUsesVertexTwice) {
   expectVegError("1 1 2 3 4", "1 1 2 1 4", 11, {"element 1", "vertex 1 twice"});
@@ -79,33 +76,23 @@ TEST(VegErrors, LinesOfOnlySeparators) {
   expectVegError("ENU, 7800, 2e11, 0.3", ",,", 14, {"steel", "ENU, density, E, nu"});
 }
 
-TEST(VegErrors, FewerVerticesThanHeader) {
-  expectVegError("5 3 0 0", "7 3 0 0", 2, {"7 vertices", "only 5"});
-}
+TEST(VegErrors, FewerVerticesThanHeader) { expectVegError("5 3 0 0", "7 3 0 0", 2, {"7 vertices", "only 5"}); }
 
 TEST(VegErrors, MoreVertexLinesThanHeader) {
   expectVegError("5 3 0 0", "4 3 0 0", 7, {"4 vertices", "more vertex lines"});
 }
 
-TEST(VegErrors, VertexIndexOutOfRange) {
-  expectVegError("4 0 0 1", "9 0 0 1", 6, {"vertex index 9", "[1, 5]"});
-}
+TEST(VegErrors, VertexIndexOutOfRange) { expectVegError("4 0 0 1", "9 0 0 1", 6, {"vertex index 9", "[1, 5]"}); }
 
 TEST(VegErrors, MoreElementLinesThanHeader) {
   expectVegError("2 4 0", "1 4 0", 12, {"1 elements", "more element lines"});
 }
 
-TEST(VegErrors, FewerElementsThanHeader) {
-  expectVegError("2 4 0", "3 4 0", 10, {"3 elements", "only 2"});
-}
+TEST(VegErrors, FewerElementsThanHeader) { expectVegError("2 4 0", "3 4 0", 10, {"3 elements", "only 2"}); }
 
-TEST(VegErrors, NonNumericCoordinate) {
-  expectVegError("3 0 1 0", "3 0 1.5abc 0", 5, {"vertex 3", "'1.5abc'"});
-}
+TEST(VegErrors, NonNumericCoordinate) { expectVegError("3 0 1 0", "3 0 1.5abc 0", 5, {"vertex 3", "'1.5abc'"}); }
 
-TEST(VegErrors, NonNumericElementIndex) {
-  expectVegError("2 2 3 4 5", "2 2 3x 4 5", 12, {"element 2", "'3x'"});
-}
+TEST(VegErrors, NonNumericElementIndex) { expectVegError("2 2 3 4 5", "2 2 3x 4 5", 12, {"element 2", "'3x'"}); }
 
 TEST(VegErrors, NanCoordinate) { expectVegError("3 0 1 0", "3 0 nan 0", 5, {"vertex 3", "not finite"}); }
 
@@ -128,7 +115,9 @@ TEST(VegErrors, UnknownMaterialInRegion) {
   expectVegError("allElements, steel", "allElements, steal", 16, {"unknown material 'steal'", "steel"});
 }
 
-TEST(VegErrors, UnknownSetInRegion) { expectVegError("allElements, steel", "shell, steel", 16, {"unknown set 'shell'"}); }
+TEST(VegErrors, UnknownSetInRegion) {
+  expectVegError("allElements, steel", "shell, steel", 16, {"unknown set 'shell'"});
+}
 
 TEST(VegErrors, ElementWithoutRegion) {
   test::ScratchDir dir;
@@ -170,7 +159,9 @@ TEST(VegErrors, SetListsElementOutOfRange) {
   expectVegError("*REGION", "*SET s\n1,\n3\n*REGION", 17, {"set 's'", "element 3"});
 }
 
-TEST(VegErrors, SetWithNonNumericMember) { expectVegError("*REGION", "*SET s\n1, two\n*REGION", 16, {"set 's'", "'two'"}); }
+TEST(VegErrors, SetWithNonNumericMember) {
+  expectVegError("*REGION", "*SET s\n1, two\n*REGION", 16, {"set 's'", "'two'"});
+}
 
 TEST(VegErrors, ElementsBeforeVertices) {
   test::ScratchDir dir;

@@ -1,14 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Reading valid .veg files: includes, comments, odd whitespace, line ends, the shipped beam.
-#include "testFiles.hpp"
+#include <gtest/gtest.h>
 
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
-
-#include <gtest/gtest.h>
-
 #include <string>
+
+#include "testFiles.hpp"
 
 namespace asyncfem {
 namespace {
@@ -41,7 +40,7 @@ TEST(VegReader, IncludeInsideSetBody) {
   EXPECT_EQ(mesh.elementSet("second"), std::vector<int>{1});
   EXPECT_EQ(mesh.elementMaterial(0).name, "soft");
   EXPECT_EQ(mesh.elementMaterial(1).name, "hard");
-  EXPECT_EQ(mesh.elementMaterial(0).youngsModulus, 25e5);        // written 25E5
+  EXPECT_EQ(mesh.elementMaterial(0).youngsModulus, 25e5);  // written 25E5
   EXPECT_EQ(mesh.elementMaterial(1).youngsModulus, 1000000000.0);
 }
 
@@ -71,8 +70,7 @@ TEST(VegReader, CrlfAndLoneCrLineEnds) {
   // Line numbers stay right with CRLF: break element 2 (line 12) and look.
   std::string bad = crlf;
   bad.replace(bad.find("2 2 3 4 5"), 9, "2 2 3 4 9");
-  test::expectParseError([&] { readVeg(dir.write("badcrlf.veg", bad)); }, "badcrlf.veg", 12,
-                         {"element 2", "vertex 9"});
+  test::expectParseError([&] { readVeg(dir.write("badcrlf.veg", bad)); }, "badcrlf.veg", 12, {"element 2", "vertex 9"});
 }
 
 TEST(VegReader, DefaultMaterialCoversElementsWithoutRegion) {

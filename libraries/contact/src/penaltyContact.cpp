@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
 #include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/core/error.hpp>
-
-#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -29,7 +28,8 @@ PenaltyContact::PenaltyContact(Eigen::Matrix3Xd restPositions, std::vector<Conta
     planes_[i].offset /= norm;
   }
   for (std::size_t i = 0; i < spheres_.size(); ++i) {
-    if (!(spheres_[i].radius > 0.0)) throw ValidationError("contact: sphere " + std::to_string(i) + " needs a radius > 0");
+    if (!(spheres_[i].radius > 0.0))
+      throw ValidationError("contact: sphere " + std::to_string(i) + " needs a radius > 0");
   }
 }
 
@@ -79,7 +79,8 @@ void PenaltyContact::addForces(const Eigen::VectorXd& displacement, const Eigen:
 
 double PenaltyContact::maxPenetration(const Eigen::VectorXd& displacement) const {
   double worst = 0.0;
-  forEachContact(displacement, nullptr, [&](int, double depth, const Eigen::Vector3d&) { worst = std::max(worst, depth); });
+  forEachContact(displacement, nullptr,
+                 [&](int, double depth, const Eigen::Vector3d&) { worst = std::max(worst, depth); });
   return worst;
 }
 

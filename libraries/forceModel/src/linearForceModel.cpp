@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
-
 #include <string>
 
 namespace asyncfem {
@@ -25,7 +24,8 @@ void LinearForceModel::internalForces(const Eigen::VectorXd& displacement, Eigen
   forces.noalias() = stiffness_ * displacement;
 }
 
-void LinearForceModel::tangentStiffness(const Eigen::VectorXd& /*displacement*/, Eigen::SparseMatrix<double>& stiffness) {
+void LinearForceModel::tangentStiffness(const Eigen::VectorXd& /*displacement*/,
+                                        Eigen::SparseMatrix<double>& stiffness) {
   if (stiffness.nonZeros() == stiffness_.nonZeros() && stiffness.rows() == stiffness_.rows() &&
       stiffness.isCompressed()) {
     std::copy(stiffness_.valuePtr(), stiffness_.valuePtr() + stiffness_.nonZeros(), stiffness.valuePtr());

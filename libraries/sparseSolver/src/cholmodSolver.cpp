@@ -1,13 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // CHOLMOD supernodal Cholesky behind SparseSolver.
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/core/stopwatch.hpp>
-
-#include "detail/solverBase.hpp"
-
 #include <suitesparse/cholmod.h>
 
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
 #include <string>
+
+#include "detail/solverBase.hpp"
 
 namespace asyncfem::detail {
 namespace {
@@ -15,20 +14,27 @@ namespace {
 /// Name of a CHOLMOD ordering code as SparseSolver::ordering() reports it.
 std::string cholmodOrderingName(int ordering) {
   switch (ordering) {
-    case CHOLMOD_METIS: return "metis";
-    case CHOLMOD_NESDIS: return "nesdis";
-    case CHOLMOD_AMD: return "amd";
-    case CHOLMOD_COLAMD: return "colamd";
-    case CHOLMOD_NATURAL: return "natural";
-    case CHOLMOD_GIVEN: return "given";
-    default: return "cholmod-" + std::to_string(ordering);
+    case CHOLMOD_METIS:
+      return "metis";
+    case CHOLMOD_NESDIS:
+      return "nesdis";
+    case CHOLMOD_AMD:
+      return "amd";
+    case CHOLMOD_COLAMD:
+      return "colamd";
+    case CHOLMOD_NATURAL:
+      return "natural";
+    case CHOLMOD_GIVEN:
+      return "given";
+    default:
+      return "cholmod-" + std::to_string(ordering);
   }
 }
 
 /// Owns one cholmod_common (CHOLMOD's per-thread state: parameters, workspace,
 /// statistics). Each solver has its own, so solvers on different threads share nothing.
 class CholmodCommon {
-public:
+ public:
   CholmodCommon() {
     if (!cholmod_start(&common_)) throw Error("cholmod: cholmod_start failed");
     // Libraries never print: CHOLMOD reports through common_.status, which the callers
@@ -43,12 +49,12 @@ public:
   cholmod_common* get() { return &common_; }
   cholmod_common* operator->() { return &common_; }
 
-private:
+ private:
   cholmod_common common_{};
 };
 
 class CholmodSolver final : public SolverBase {
-public:
+ public:
   CholmodSolver() {
     common_->supernodal = CHOLMOD_SUPERNODAL;
     useMetis();
@@ -81,9 +87,8 @@ public:
     if (!factor_ || common_->status < CHOLMOD_OK) {
       if (factor_) cholmod_free_factor(&factor_, common_.get());
       signature_ = PatternSignature{};
-      throw Error("cholmod: symbolic analysis of the " + std::to_string(a.rows()) + " x " +
-                  std::to_string(a.cols()) + " matrix failed (CHOLMOD status " + std::to_string(common_->status) +
-                  ")");
+      throw Error("cholmod: symbolic analysis of the " + std::to_string(a.rows()) + " x " + std::to_string(a.cols()) +
+                  " matrix failed (CHOLMOD status " + std::to_string(common_->status) + ")");
     }
     recordFactorCosts();
     ++stats_.analyses;
@@ -97,8 +102,8 @@ public:
     cholmod_sparse view = upperTriangleView(a);
     const int ok = cholmod_factorize(&view, factor_, common_.get());
     if (!ok || common_->status < CHOLMOD_OK) {
-      throw NumericalError("cholmod: numeric factorization failed (CHOLMOD status " +
-                           std::to_string(common_->status) + ")");
+      throw NumericalError("cholmod: numeric factorization failed (CHOLMOD status " + std::to_string(common_->status) +
+                           ")");
     }
     if (common_->status == CHOLMOD_NOT_POSDEF || factor_->minor < factor_->n) {
       // L->minor is the step (in the permuted order) where a pivot was not positive;
@@ -147,7 +152,7 @@ public:
     stats_.solveSeconds += watch.stop();
   }
 
-private:
+ private:
   /// Asks for METIS only (no comparison with AMD), the ordering the design calls for.
   void useMetis() {
     common_->nmethods = 1;

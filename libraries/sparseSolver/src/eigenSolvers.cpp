@@ -1,14 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Eigen's SimplicialLDLT and SparseLU behind SparseSolver (no SuiteSparse at run time).
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/core/stopwatch.hpp>
-
-#include "detail/solverBase.hpp"
-
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
-
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
 #include <string>
+
+#include "detail/solverBase.hpp"
 
 namespace asyncfem::detail {
 namespace {
@@ -85,7 +83,7 @@ FactorCosts luCosts(const LUFactorization& lu) {
 
 template <class Factorization, SolverKind Kind>
 class EigenSolver final : public SolverBase {
-public:
+ public:
   SolverKind kind() const override { return Kind; }
   std::string ordering() const override {
     if (!signature_.analysed()) return "none";
@@ -116,8 +114,8 @@ public:
     } else {
       if (factorization_.info() != Eigen::Success) {
         // Eigen's message counts columns in its permuted order; say so.
-        throw NumericalError("eigen-lu: matrix is singular (SparseLU, permuted numbering: " +
-                             factorization_.lastErrorMessage() + ")");
+        throw NumericalError(
+            "eigen-lu: matrix is singular (SparseLU, permuted numbering: " + factorization_.lastErrorMessage() + ")");
       }
       costs = luCosts(factorization_);
     }
@@ -139,7 +137,7 @@ public:
     stats_.solveSeconds += watch.stop();
   }
 
-private:
+ private:
   static std::string name() { return Kind == SolverKind::eigenLDLT ? "eigen-ldlt" : "eigen-lu"; }
 
   Factorization factorization_;

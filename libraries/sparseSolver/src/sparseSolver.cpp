@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
+#include <string>
 
 #include "detail/solverBase.hpp"
-
-#include <string>
 
 namespace asyncfem {
 
@@ -15,10 +14,14 @@ constexpr SolverKind kAllKinds[] = {SolverKind::cholmod, SolverKind::umfpack, So
 
 std::string toString(SolverKind kind) {
   switch (kind) {
-    case SolverKind::cholmod: return "cholmod";
-    case SolverKind::umfpack: return "umfpack";
-    case SolverKind::eigenLDLT: return "eigen-ldlt";
-    case SolverKind::eigenLU: return "eigen-lu";
+    case SolverKind::cholmod:
+      return "cholmod";
+    case SolverKind::umfpack:
+      return "umfpack";
+    case SolverKind::eigenLDLT:
+      return "eigen-ldlt";
+    case SolverKind::eigenLU:
+      return "eigen-lu";
   }
   throw Error("toString: invalid SolverKind value " + std::to_string(static_cast<int>(kind)));
 }
@@ -34,10 +37,14 @@ SolverKind parseSolverKind(const std::string& name) {
 
 std::unique_ptr<SparseSolver> makeSparseSolver(SolverKind kind) {
   switch (kind) {
-    case SolverKind::cholmod: return detail::makeCholmodSolver();
-    case SolverKind::umfpack: return detail::makeUmfpackSolver();
-    case SolverKind::eigenLDLT: return detail::makeEigenLDLTSolver();
-    case SolverKind::eigenLU: return detail::makeEigenLUSolver();
+    case SolverKind::cholmod:
+      return detail::makeCholmodSolver();
+    case SolverKind::umfpack:
+      return detail::makeUmfpackSolver();
+    case SolverKind::eigenLDLT:
+      return detail::makeEigenLDLTSolver();
+    case SolverKind::eigenLU:
+      return detail::makeEigenLUSolver();
   }
   throw Error("makeSparseSolver: invalid SolverKind value " + std::to_string(static_cast<int>(kind)));
 }

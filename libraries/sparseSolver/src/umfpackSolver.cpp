@@ -1,14 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // UMFPACK LU behind SparseSolver.
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/core/stopwatch.hpp>
-
-#include "detail/solverBase.hpp"
-
 #include <suitesparse/umfpack.h>
 
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
 #include <string>
 #include <vector>
+
+#include "detail/solverBase.hpp"
 
 namespace asyncfem::detail {
 namespace {
@@ -16,7 +15,7 @@ namespace {
 /// Owns one UMFPACK Symbolic or Numeric object (freed with the matching function).
 template <void (*Free)(void**)>
 class UmfpackHandle {
-public:
+ public:
   UmfpackHandle() = default;
   ~UmfpackHandle() { reset(); }
   UmfpackHandle(const UmfpackHandle&) = delete;
@@ -33,7 +32,7 @@ public:
     return &object_;
   }
 
-private:
+ private:
   void* object_ = nullptr;
 };
 
@@ -41,7 +40,7 @@ using SymbolicHandle = UmfpackHandle<umfpack_di_free_symbolic>;
 using NumericHandle = UmfpackHandle<umfpack_di_free_numeric>;
 
 class UmfpackSolver final : public SolverBase {
-public:
+ public:
   UmfpackSolver() {
     umfpack_di_defaults(control_);
     control_[UMFPACK_PRL] = 0;  // never print
@@ -117,17 +116,22 @@ public:
     stats_.solveSeconds += watch.stop();
   }
 
-private:
+ private:
   /// UMFPACK reports AMD for both of its strategies; the unsymmetric one orders A'A with COLAMD.
   std::string orderingName() const {
     const int used = static_cast<int>(info_[UMFPACK_ORDERING_USED]);
     const bool symmetric = static_cast<int>(info_[UMFPACK_STRATEGY_USED]) == UMFPACK_STRATEGY_SYMMETRIC;
     switch (used) {
-      case UMFPACK_ORDERING_AMD: return symmetric ? "amd" : "colamd";
-      case UMFPACK_ORDERING_METIS: return "metis";
-      case UMFPACK_ORDERING_GIVEN: return "given";
-      case UMFPACK_ORDERING_NONE: return "natural";
-      default: return "umfpack-" + std::to_string(used);
+      case UMFPACK_ORDERING_AMD:
+        return symmetric ? "amd" : "colamd";
+      case UMFPACK_ORDERING_METIS:
+        return "metis";
+      case UMFPACK_ORDERING_GIVEN:
+        return "given";
+      case UMFPACK_ORDERING_NONE:
+        return "natural";
+      default:
+        return "umfpack-" + std::to_string(used);
     }
   }
 

@@ -1,18 +1,17 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
-
-#include "detail/linearStiffness.hpp"
-
 #include <omp.h>
 
 #include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <climits>
 #include <cmath>
 #include <cstring>
 #include <exception>
 #include <numeric>
 #include <string>
+
+#include "detail/linearStiffness.hpp"
 
 namespace asyncfem {
 

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
-
 #include <string>
 
 namespace asyncfem {

@@ -1,11 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Geometry>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
+#include <cmath>
 
 #include "detail/linearStiffness.hpp"
-
-#include <Eigen/Geometry>
-
-#include <cmath>
 
 namespace asyncfem {
 

@@ -1,10 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Dense>
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
-
-#include <Eigen/Dense>
-
-#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -48,7 +46,8 @@ std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh) {
     const Eigen::Vector4i t = mesh.element(e);
     for (int f = 0; f < 4; ++f) {
       std::array<int, 3> key{};
-      for (int a = 0; a < 3; ++a) key[static_cast<std::size_t>(a)] = t[kFaces[static_cast<std::size_t>(f)][static_cast<std::size_t>(a)]];
+      for (int a = 0; a < 3; ++a)
+        key[static_cast<std::size_t>(a)] = t[kFaces[static_cast<std::size_t>(f)][static_cast<std::size_t>(a)]];
       std::sort(key.begin(), key.end());
       faces.push_back({key, e, f});
     }
@@ -88,7 +87,8 @@ VertexElementAdjacency vertexElementAdjacency(const TetMesh& mesh) {
   std::vector<int> fill(adjacency.offsets.begin(), adjacency.offsets.end() - 1);
   // Visiting elements in increasing order leaves each vertex's list ascending.
   for (int e = 0; e < mesh.numElements(); ++e)
-    for (int a = 0; a < 4; ++a) adjacency.elements[static_cast<std::size_t>(fill[static_cast<std::size_t>(elements(a, e))]++)] = e;
+    for (int a = 0; a < 4; ++a)
+      adjacency.elements[static_cast<std::size_t>(fill[static_cast<std::size_t>(elements(a, e))]++)] = e;
   return adjacency;
 }
 
@@ -104,7 +104,8 @@ BoundingBox boundingBox(const TetMesh& mesh, const Eigen::VectorXd& displacement
 }
 
 ElementQuality elementQuality(const TetMesh& mesh, int e) {
-  if (e < 0 || e >= mesh.numElements()) throw ValidationError("elementQuality: element " + std::to_string(e) + " out of range");
+  if (e < 0 || e >= mesh.numElements())
+    throw ValidationError("elementQuality: element " + std::to_string(e) + " out of range");
   const Eigen::Matrix<double, 3, 4> x = mesh.elementRestPositions(e);
   static constexpr std::array<std::array<int, 4>, 6> kEdges{
       {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2}, {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}}};
@@ -133,7 +134,8 @@ ElementQuality elementQuality(const TetMesh& mesh, int e) {
   for (const auto& f : kFaces) area += 0.5 * (x.col(f[1]) - x.col(f[0])).cross(x.col(f[2]) - x.col(f[0])).norm();
   const double volume = std::abs(signedElementVolume(mesh, e));
   const double inradius = area > 0.0 ? 3.0 * volume / area : 0.0;
-  q.aspectRatio = inradius > 0.0 ? longestEdge / (2.0 * std::sqrt(6.0) * inradius) : std::numeric_limits<double>::infinity();
+  q.aspectRatio =
+      inradius > 0.0 ? longestEdge / (2.0 * std::sqrt(6.0) * inradius) : std::numeric_limits<double>::infinity();
   return q;
 }
 

@@ -2,19 +2,17 @@
 // Pattern construction and stiffness assembly on box meshes of ~10k, ~100k and ~1M tets,
 // against a naive triplet (setFromTriplets) assembly measured in the same run: the
 // tripletRatio counter is (triplet assembly time) / (time per iteration).
-#include "benchmarkCommon.hpp"
-
-#include <asyncfem/core/stopwatch.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
-
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
 #include <Eigen/SparseCore>
-
 #include <algorithm>
+#include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <map>
 #include <vector>
+
+#include "benchmarkCommon.hpp"
 
 namespace asyncfem::bench {
 namespace {

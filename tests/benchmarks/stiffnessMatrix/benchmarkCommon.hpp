@@ -2,12 +2,11 @@
 // Shared helpers of the stiffnessMatrix benchmarks: cached box meshes and memory counters.
 #pragma once
 
-#include <asyncfem/volumetricMesh/generators.hpp>
-#include <asyncfem/volumetricMesh/tetMesh.hpp>
-
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 
+#include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <fstream>
 #include <map>
 #include <memory>

@@ -1,16 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // CHOLMOD factorization and one solve of the free system M + h^2 K of a box clamped at
 // x = 0, with one extra solve as the in-run baseline (factor / solve ratio).
-#include "benchmarkCommon.hpp"
+#include <benchmark/benchmark.h>
 
+#include <Eigen/SparseCore>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 
-#include <benchmark/benchmark.h>
-
-#include <Eigen/SparseCore>
+#include "benchmarkCommon.hpp"
 
 namespace asyncfem::bench {
 namespace {

@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
-
-#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,12 +34,11 @@ struct PatternSignature {
 /// Argument checks and bookkeeping shared by every backend: square compressed input,
 /// the analysed pattern, factorize-before-solve, right-hand-side size.
 class SolverBase : public SparseSolver {
-protected:
+ protected:
   /// Throws asyncfem::Error unless `a` is square and compressed.
   static void requireSquareCompressed(const SparseMatrix& a, const std::string& who) {
     if (a.rows() != a.cols()) {
-      throw Error(who + ": matrix is " + std::to_string(a.rows()) + " x " + std::to_string(a.cols()) +
-                  ", not square");
+      throw Error(who + ": matrix is " + std::to_string(a.rows()) + " x " + std::to_string(a.cols()) + ", not square");
     }
     if (!a.isCompressed()) throw Error(who + ": matrix must be compressed (call makeCompressed() first)");
   }
@@ -53,10 +51,11 @@ protected:
     requireSquareCompressed(a, who);
     if (!signature_.analysed()) throw Error(who + ": factorize() called before analyzePattern()");
     if (!signature_.matches(a)) {
-      throw Error(who + ": the matrix pattern (" + std::to_string(a.rows()) + " x " + std::to_string(a.cols()) +
-                  ", " + std::to_string(a.nonZeros()) + " non-zeros) differs from the analysed one (" +
+      throw Error(who + ": the matrix pattern (" + std::to_string(a.rows()) + " x " + std::to_string(a.cols()) + ", " +
+                  std::to_string(a.nonZeros()) + " non-zeros) differs from the analysed one (" +
                   std::to_string(signature_.rows) + " x " + std::to_string(signature_.rows) + ", " +
-                  std::to_string(signature_.inner.size()) + " non-zeros or other indices); call analyzePattern() "
+                  std::to_string(signature_.inner.size()) +
+                  " non-zeros or other indices); call analyzePattern() "
                   "again");
     }
     // A failed factorization leaves no usable factor behind.

@@ -1,18 +1,17 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Gmsh .msh reader, ASCII versions 2.2 and 4.1; see docs/file-formats.md.
-#include "detail/rawMesh.hpp"
-#include "detail/textInput.hpp"
-
-#include <asyncfem/core/error.hpp>
-#include <asyncfem/volumetricMesh/readers.hpp>
-
 #include <algorithm>
 #include <array>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
 #include <map>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
+
+#include "detail/rawMesh.hpp"
+#include "detail/textInput.hpp"
 
 namespace asyncfem {
 
@@ -20,21 +19,22 @@ namespace {
 
 using detail::LineCursor;
 
-constexpr long long kTetrahedron = 4;       // 4-node tetrahedron
-constexpr long long kQuadraticTet = 11;     // 10-node tetrahedron
+constexpr long long kTetrahedron = 4;    // 4-node tetrahedron
+constexpr long long kQuadraticTet = 11;  // 10-node tetrahedron
 // Every element of a volume entity joins each of the entity's physical groups, so the
 // set memberships are (elements) x (groups per entity): a bound on the latter keeps
 // them linear in the file size.
 constexpr std::size_t kMaxPhysicalTagsPerEntity = 64;
 
 class GmshParser {
-public:
+ public:
   explicit GmshParser(const detail::FlatText& flat) : cursor_(flat, false) {}
 
   TetMesh parse(const MeshReadOptions& options, MeshReadReport& report) {
     if (!cursor_.next()) cursor_.failAtEnd("empty file: not a Gmsh mesh");
     if (cursor_.line() != "$MeshFormat") {
-      cursor_.fail("not a Gmsh ASCII file: expected $MeshFormat, got '" + std::string(cursor_.line().substr(0, 40)) + "'");
+      cursor_.fail("not a Gmsh ASCII file: expected $MeshFormat, got '" + std::string(cursor_.line().substr(0, 40)) +
+                   "'");
     }
     readMeshFormat();
     report.format = version41_ ? "gmsh 4.1" : "gmsh 2.2";
@@ -42,7 +42,8 @@ public:
     bool haveElements = false;
     while (cursor_.next()) {
       const std::string_view line = cursor_.line();
-      if (line.front() != '$') cursor_.fail("expected a section such as $Nodes, got '" + std::string(line.substr(0, 40)) + "'");
+      if (line.front() != '$')
+        cursor_.fail("expected a section such as $Nodes, got '" + std::string(line.substr(0, 40)) + "'");
       const std::string section(line.substr(1));
       if (section == "PhysicalNames") {
         readPhysicalNames();
@@ -87,10 +88,11 @@ public:
     return detail::finishMesh(std::move(raw_), cursor_, options, report, detail::MissingMaterialPolicy::FormatDefault);
   }
 
-private:
+ private:
   std::vector<std::string_view> nextRecord(const std::string& what) {
     if (!cursor_.next()) cursor_.failAtEnd("file ends inside " + what);
-    if (cursor_.line().front() == '$') cursor_.fail("section ends early: expected " + what + ", got '" + std::string(cursor_.line()) + "'");
+    if (cursor_.line().front() == '$')
+      cursor_.fail("section ends early: expected " + what + ", got '" + std::string(cursor_.line()) + "'");
     return detail::splitTokens(cursor_.line(), false);
   }
 
@@ -113,17 +115,20 @@ private:
 
   void readMeshFormat() {
     const auto tokens = nextRecord("the $MeshFormat line 'version fileType dataSize'");
-    if (tokens.size() != 3) cursor_.fail("$MeshFormat needs 'version fileType dataSize', got " + std::to_string(tokens.size()) + " fields");
+    if (tokens.size() != 3)
+      cursor_.fail("$MeshFormat needs 'version fileType dataSize', got " + std::to_string(tokens.size()) + " fields");
     if (tokens[1] == "1") {
-      cursor_.fail("binary .msh files are not supported: save the mesh as ASCII (Gmsh: Mesh.Binary = 0, "
-                   "or File > Export without 'Save in binary format')");
+      cursor_.fail(
+          "binary .msh files are not supported: save the mesh as ASCII (Gmsh: Mesh.Binary = 0, "
+          "or File > Export without 'Save in binary format')");
     }
     if (tokens[1] != "0") cursor_.fail("$MeshFormat file type must be 0 (ASCII), got '" + std::string(tokens[1]) + "'");
     if (tokens[0] == "4.1") {
       version41_ = true;
     } else if (tokens[0] != "2.2") {
-      cursor_.fail("unsupported Gmsh format version '" + std::string(tokens[0]) +
-                   "': this reader reads ASCII versions 2.2 and 4.1 (export as 'Version 4 ASCII' or 'Version 2 ASCII')");
+      cursor_.fail(
+          "unsupported Gmsh format version '" + std::string(tokens[0]) +
+          "': this reader reads ASCII versions 2.2 and 4.1 (export as 'Version 4 ASCII' or 'Version 2 ASCII')");
     }
     expectEnd("MeshFormat", "$MeshFormat has more than one line");
   }
@@ -162,7 +167,8 @@ private:
     for (long long i = 0; i < counts[0] + counts[1] + counts[2]; ++i) nextRecord("an entity line");
     for (long long i = 0; i < counts[3]; ++i) {
       const auto tokens = nextRecord("a volume entity line");
-      if (tokens.size() < 8) cursor_.fail("volume entity line needs 'tag minX minY minZ maxX maxY maxZ numPhysicalTags ...'");
+      if (tokens.size() < 8)
+        cursor_.fail("volume entity line needs 'tag minX minY minZ maxX maxY maxZ numPhysicalTags ...'");
       const long long tag = detail::integerAt(cursor_, tokens[0], "volume entity tag");
       for (std::size_t c = 1; c < 7; ++c) detail::doubleAt(cursor_, tokens[c], "volume entity bounding box");
       const long long numPhysicals = detail::integerAt(cursor_, tokens[7], "volume entity physical tag count");
@@ -191,7 +197,8 @@ private:
     if (!nodeIndex_.emplace(tag, index).second) cursor_.fail("duplicate node tag " + std::to_string(tag));
     raw_.vertexFileIds.push_back(tag);
     for (int c = 0; c < 3; ++c) {
-      raw_.positions.push_back(detail::finiteDoubleAt(cursor_, coordinates[c], "node " + std::to_string(tag) + " coordinate"));
+      raw_.positions.push_back(
+          detail::finiteDoubleAt(cursor_, coordinates[c], "node " + std::to_string(tag) + " coordinate"));
     }
   }
 
@@ -204,10 +211,12 @@ private:
     reserveNodes(count);
     for (long long i = 0; i < count; ++i) {
       if (!cursor_.next() || cursor_.line().front() == '$') {
-        cursor_.failAt(headerAt, "$Nodes says " + std::to_string(count) + " nodes, but the section has only " + std::to_string(i));
+        cursor_.failAt(
+            headerAt, "$Nodes says " + std::to_string(count) + " nodes, but the section has only " + std::to_string(i));
       }
       const auto tokens = detail::splitTokens(cursor_.line(), false);
-      if (tokens.size() != 4) cursor_.fail("node line needs 'tag x y z', got " + std::to_string(tokens.size()) + " fields");
+      if (tokens.size() != 4)
+        cursor_.fail("node line needs 'tag x y z', got " + std::to_string(tokens.size()) + " fields");
       addNode(detail::integerAt(cursor_, tokens[0], "node tag"), &tokens[1]);
     }
     expectEnd("Nodes", "$Nodes says " + std::to_string(count) + " nodes, but there are more node lines");
@@ -237,11 +246,13 @@ private:
       if (dim < 0 || dim > 3) cursor_.fail("node block entity dimension must be 0..3, got " + std::to_string(dim));
       if (parametric != 0 && parametric != 1) cursor_.fail("node block parametric flag must be 0 or 1");
       cursor_.checkCountFits(inBlock, 7, "nodes in the block");
-      if (read + inBlock > count) cursor_.failAt(headerAt, "$Nodes says " + std::to_string(count) + " nodes, but its blocks hold more");
+      if (read + inBlock > count)
+        cursor_.failAt(headerAt, "$Nodes says " + std::to_string(count) + " nodes, but its blocks hold more");
       std::vector<long long> tags(static_cast<std::size_t>(inBlock));
       for (auto& tag : tags) {
         const auto tokens = nextRecord("a node tag");
-        if (tokens.size() != 1) cursor_.fail("node block: expected one node tag per line, got " + std::to_string(tokens.size()) + " fields");
+        if (tokens.size() != 1)
+          cursor_.fail("node block: expected one node tag per line, got " + std::to_string(tokens.size()) + " fields");
         tag = detail::integerAt(cursor_, tokens[0], "node tag");
       }
       const std::size_t fields = 3 + static_cast<std::size_t>(parametric ? dim : 0);
@@ -256,7 +267,8 @@ private:
       read += inBlock;
     }
     if (read != count) {
-      cursor_.failAt(headerAt, "$Nodes says " + std::to_string(count) + " nodes, but its blocks hold " + std::to_string(read));
+      cursor_.failAt(headerAt,
+                     "$Nodes says " + std::to_string(count) + " nodes, but its blocks hold " + std::to_string(read));
     }
     expectEnd("Nodes", "$Nodes has more lines than its blocks describe");
   }
@@ -268,7 +280,8 @@ private:
     for (std::size_t a = 0; a < 4; ++a) {
       const long long nodeTag = detail::integerAt(cursor_, nodeTokens[a], name + " node");
       auto it = nodeIndex_.find(nodeTag);
-      if (it == nodeIndex_.end()) cursor_.fail(name + " references node " + std::to_string(nodeTag) + ", which $Nodes does not define");
+      if (it == nodeIndex_.end())
+        cursor_.fail(name + " references node " + std::to_string(nodeTag) + ", which $Nodes does not define");
       for (std::size_t b = 0; b < a; ++b) {
         if (t[b] == it->second) cursor_.fail(name + " uses node " + std::to_string(nodeTag) + " twice");
       }
@@ -294,7 +307,8 @@ private:
     cursor_.checkCountFits(count, 7, "elements");
     for (long long i = 0; i < count; ++i) {
       if (!cursor_.next() || cursor_.line().front() == '$') {
-        cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but the section has only " + std::to_string(i));
+        cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but the section has only " +
+                                     std::to_string(i));
       }
       const auto tokens = detail::splitTokens(cursor_.line(), false);
       if (tokens.size() < 3) cursor_.fail("element line needs 'tag type numTags tags... nodes...'");
@@ -302,7 +316,8 @@ private:
       const long long type = detail::integerAt(cursor_, tokens[1], "element " + std::to_string(tag) + " type");
       const long long numTags = detail::integerAt(cursor_, tokens[2], "element " + std::to_string(tag) + " tag count");
       if (numTags < 0 || static_cast<std::size_t>(numTags) > tokens.size() - 3) {
-        cursor_.fail("element " + std::to_string(tag) + " claims " + std::to_string(numTags) + " tags but the line has fewer fields");
+        cursor_.fail("element " + std::to_string(tag) + " claims " + std::to_string(numTags) +
+                     " tags but the line has fewer fields");
       }
       if (type != kTetrahedron) {
         ignore(type);
@@ -315,7 +330,8 @@ private:
       }
       addTet(tag, &tokens[3 + static_cast<std::size_t>(numTags)]);
       if (numTags >= 1) {
-        const long long physical = detail::integerAt(cursor_, tokens[3], "element " + std::to_string(tag) + " physical tag");
+        const long long physical =
+            detail::integerAt(cursor_, tokens[3], "element " + std::to_string(tag) + " physical tag");
         if (physical != 0) physicalElements_[physical].push_back(static_cast<int>(raw_.elements.size()) - 1);
       }
     }
@@ -325,7 +341,8 @@ private:
   void readElements41() {
     const auto header = nextRecord("'numEntityBlocks numElements minElementTag maxElementTag'");
     const auto headerAt = cursor_.location();
-    if (header.size() != 4) cursor_.fail("$Elements header needs 'numEntityBlocks numElements minElementTag maxElementTag'");
+    if (header.size() != 4)
+      cursor_.fail("$Elements header needs 'numEntityBlocks numElements minElementTag maxElementTag'");
     const long long blocks = detail::integerAt(cursor_, header[0], "element block count");
     const long long count = detail::integerAt(cursor_, header[1], "element count");
     cursor_.checkCountFits(blocks, 7, "element blocks");
@@ -333,13 +350,15 @@ private:
     long long read = 0;
     for (long long b = 0; b < blocks; ++b) {
       const auto block = nextRecord("an element block header 'entityDim entityTag elementType numElementsInBlock'");
-      if (block.size() != 4) cursor_.fail("element block header needs 'entityDim entityTag elementType numElementsInBlock'");
+      if (block.size() != 4)
+        cursor_.fail("element block header needs 'entityDim entityTag elementType numElementsInBlock'");
       const long long dim = detail::integerAt(cursor_, block[0], "element block entity dimension");
       const long long entity = detail::integerAt(cursor_, block[1], "element block entity tag");
       const long long type = detail::integerAt(cursor_, block[2], "element block type");
       const long long inBlock = detail::integerAt(cursor_, block[3], "element block size");
       cursor_.checkCountFits(inBlock, 3, "elements in the block");
-      if (read + inBlock > count) cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but its blocks hold more");
+      if (read + inBlock > count)
+        cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but its blocks hold more");
       const std::vector<long long>* physicals = nullptr;
       if (dim == 3) {
         if (auto it = volumePhysicals_.find(entity); it != volumePhysicals_.end()) physicals = &it->second;
@@ -350,7 +369,9 @@ private:
           ignore(type);
           continue;
         }
-        if (tokens.size() != 5) cursor_.fail("4-node tetrahedron line needs 'tag n1 n2 n3 n4', got " + std::to_string(tokens.size()) + " fields");
+        if (tokens.size() != 5)
+          cursor_.fail("4-node tetrahedron line needs 'tag n1 n2 n3 n4', got " + std::to_string(tokens.size()) +
+                       " fields");
         addTet(detail::integerAt(cursor_, tokens[0], "element tag"), &tokens[1]);
         if (physicals) {
           for (long long p : *physicals) physicalElements_[p].push_back(static_cast<int>(raw_.elements.size()) - 1);
@@ -359,7 +380,8 @@ private:
       read += inBlock;
     }
     if (read != count) {
-      cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but its blocks hold " + std::to_string(read));
+      cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but its blocks hold " +
+                                   std::to_string(read));
     }
     expectEnd("Elements", "$Elements has more lines than its blocks describe");
   }

@@ -1,10 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "detail/rawMesh.hpp"
 
-#include <asyncfem/core/error.hpp>
-
 #include <Eigen/Dense>
-
+#include <asyncfem/core/error.hpp>
 #include <cmath>
 #include <string>
 
@@ -92,7 +90,8 @@ TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions&
     double edgeSum = 0.0;
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b)
-        edgeSum += (positions.col(t[static_cast<std::size_t>(a)]) - positions.col(t[static_cast<std::size_t>(b)])).norm();
+        edgeSum +=
+            (positions.col(t[static_cast<std::size_t>(a)]) - positions.col(t[static_cast<std::size_t>(b)])).norm();
     const double meanEdge = edgeSum / 6.0;
     const std::string name = "element " + std::to_string(raw.elementFileIds[e]);
     // <= so that an element whose vertices all coincide (mean edge 0) is degenerate too.
@@ -102,9 +101,8 @@ TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions&
     }
     if (volume < 0.0) {
       if (!options.reorientInvertedElements) {
-        cursor.failAt(raw.elementLocations[e],
-                      name + " is inverted (signed volume " + formatDouble(volume) +
-                          "); swap two of its vertices or allow reorientation");
+        cursor.failAt(raw.elementLocations[e], name + " is inverted (signed volume " + formatDouble(volume) +
+                                                   "); swap two of its vertices or allow reorientation");
       }
       std::swap(t[2], t[3]);
       ++report.reorientedElements;
@@ -130,7 +128,8 @@ TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions&
   report.unusedVertices = unused;
   if (unused > 0) {
     report.warnings.push_back(std::to_string(unused) + " vertex(es) belong to no element (first: vertex " +
-                              std::to_string(firstUnused) + "); they have no mass or stiffness, so fix them or remove them");
+                              std::to_string(firstUnused) +
+                              "); they have no mass or stiffness, so fix them or remove them");
   }
 
   TetMesh mesh(std::move(positions), std::move(elements), std::move(raw.materials), std::move(raw.elementMaterials));

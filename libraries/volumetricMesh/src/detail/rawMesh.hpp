@@ -1,15 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include "detail/textInput.hpp"
-
+#include <array>
 #include <asyncfem/volumetricMesh/readers.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
-#include <array>
 #include <map>
 #include <string>
 #include <vector>
+
+#include "detail/textInput.hpp"
 
 namespace asyncfem::detail {
 
@@ -17,13 +16,13 @@ namespace asyncfem::detail {
 /// degeneracy, materials, unused vertices). Ids in the file's own numbering are kept so
 /// messages name elements and vertices as the user sees them.
 struct RawMesh {
-  std::vector<double> positions;              ///< x y z per vertex
-  std::vector<long long> vertexFileIds;       ///< id of each vertex in the file
-  std::vector<std::array<int, 4>> elements;   ///< 0-based vertex ids
-  std::vector<Location> elementLocations;     ///< where each element was read
-  std::vector<long long> elementFileIds;      ///< id of each element in the file
+  std::vector<double> positions;             ///< x y z per vertex
+  std::vector<long long> vertexFileIds;      ///< id of each vertex in the file
+  std::vector<std::array<int, 4>> elements;  ///< 0-based vertex ids
+  std::vector<Location> elementLocations;    ///< where each element was read
+  std::vector<long long> elementFileIds;     ///< id of each element in the file
   std::vector<Material> materials;
-  std::vector<int> elementMaterials;          ///< index into materials, -1 for none yet
+  std::vector<int> elementMaterials;  ///< index into materials, -1 for none yet
   std::map<std::string, std::vector<int>> elementSets;
   std::map<std::string, std::vector<int>> vertexSets;
 };

@@ -1,13 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // TetGen .node/.ele reader; see docs/file-formats.md.
-#include "detail/rawMesh.hpp"
-#include "detail/textInput.hpp"
-
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
-
 #include <string>
 #include <vector>
+
+#include "detail/rawMesh.hpp"
+#include "detail/textInput.hpp"
 
 namespace asyncfem {
 
@@ -32,14 +31,18 @@ long long headerField(const LineCursor& cursor, const std::vector<std::string_vi
 long long readNodes(LineCursor& cursor, detail::RawMesh& raw) {
   const auto header = headerTokens(cursor, "<count> 3 <attributes> <boundaryMarker>");
   const auto headerAt = cursor.location();
-  if (header.size() > 4) cursor.fail(".node header needs '<count> 3 <attributes> <boundaryMarker>', got " + std::to_string(header.size()) + " fields");
+  if (header.size() > 4)
+    cursor.fail(".node header needs '<count> 3 <attributes> <boundaryMarker>', got " + std::to_string(header.size()) +
+                " fields");
   const long long count = headerField(cursor, header, 0, 0, ".node vertex count");
   const long long dimension = headerField(cursor, header, 1, 3, ".node dimension");
   const long long attributes = headerField(cursor, header, 2, 0, ".node attribute count");
   const long long markers = headerField(cursor, header, 3, 0, ".node boundary marker flag");
   if (dimension != 3) cursor.fail(".node dimension must be 3, got " + std::to_string(dimension));
-  if (attributes < 0 || attributes > kMaxAttributes) cursor.fail(".node attribute count " + std::to_string(attributes) + " is out of range");
-  if (markers != 0 && markers != 1) cursor.fail(".node boundary marker flag must be 0 or 1, got " + std::to_string(markers));
+  if (attributes < 0 || attributes > kMaxAttributes)
+    cursor.fail(".node attribute count " + std::to_string(attributes) + " is out of range");
+  if (markers != 0 && markers != 1)
+    cursor.fail(".node boundary marker flag must be 0 or 1, got " + std::to_string(markers));
   cursor.checkCountFits(count, 7, "vertices");
   const auto n = static_cast<std::size_t>(count);
   const std::size_t fields = 4 + static_cast<std::size_t>(attributes + markers);
@@ -54,12 +57,14 @@ long long readNodes(LineCursor& cursor, detail::RawMesh& raw) {
     }
     const auto tokens = detail::splitTokens(cursor.line(), false);
     if (tokens.size() != fields) {
-      cursor.fail("vertex line needs " + std::to_string(fields) + " fields (index x y z, " + std::to_string(attributes) +
-                  " attributes, " + std::to_string(markers) + " marker), got " + std::to_string(tokens.size()));
+      cursor.fail("vertex line needs " + std::to_string(fields) + " fields (index x y z, " +
+                  std::to_string(attributes) + " attributes, " + std::to_string(markers) + " marker), got " +
+                  std::to_string(tokens.size()));
     }
     const long long id = detail::integerAt(cursor, tokens[0], "vertex index");
     if (i == 0) {
-      if (id != 0 && id != 1) cursor.fail("the first vertex index must be 0 or 1 (it sets the numbering base), got " + std::to_string(id));
+      if (id != 0 && id != 1)
+        cursor.fail("the first vertex index must be 0 or 1 (it sets the numbering base), got " + std::to_string(id));
       base = id;
     }
     if (id < base || id >= base + count) {
@@ -71,7 +76,8 @@ long long readNodes(LineCursor& cursor, detail::RawMesh& raw) {
     seen[v] = 1;
     raw.vertexFileIds[v] = id;
     for (std::size_t c = 0; c < 3; ++c) {
-      raw.positions[3 * v + c] = detail::finiteDoubleAt(cursor, tokens[c + 1], "vertex " + std::to_string(id) + " coordinate");
+      raw.positions[3 * v + c] =
+          detail::finiteDoubleAt(cursor, tokens[c + 1], "vertex " + std::to_string(id) + " coordinate");
     }
     for (std::size_t a = 4; a < 4 + static_cast<std::size_t>(attributes); ++a) {
       detail::doubleAt(cursor, tokens[a], "vertex " + std::to_string(id) + " attribute");
@@ -87,14 +93,16 @@ long long readNodes(LineCursor& cursor, detail::RawMesh& raw) {
 void readTets(LineCursor& cursor, detail::RawMesh& raw, long long base, MeshReadReport& report) {
   const auto header = headerTokens(cursor, "<count> <4|10> <regionAttribute 0|1>");
   const auto headerAt = cursor.location();
-  if (header.size() > 3) cursor.fail(".ele header needs '<count> <4|10> <0|1>', got " + std::to_string(header.size()) + " fields");
+  if (header.size() > 3)
+    cursor.fail(".ele header needs '<count> <4|10> <0|1>', got " + std::to_string(header.size()) + " fields");
   const long long count = headerField(cursor, header, 0, 0, ".ele element count");
   const long long nodesPerTet = headerField(cursor, header, 1, 4, ".ele nodes per tetrahedron");
   const long long region = headerField(cursor, header, 2, 0, ".ele region attribute flag");
   if (nodesPerTet != 4 && nodesPerTet != 10) {
     cursor.fail(".ele nodes per tetrahedron must be 4 or 10, got " + std::to_string(nodesPerTet));
   }
-  if (region != 0 && region != 1) cursor.fail(".ele region attribute flag must be 0 or 1, got " + std::to_string(region));
+  if (region != 0 && region != 1)
+    cursor.fail(".ele region attribute flag must be 0 or 1, got " + std::to_string(region));
   cursor.checkCountFits(count, 9, "elements");
   const auto n = static_cast<std::size_t>(count);
   const auto numVertices = static_cast<long long>(raw.vertexFileIds.size());
@@ -149,7 +157,8 @@ void readTets(LineCursor& cursor, detail::RawMesh& raw, long long base, MeshRead
     raw.elementLocations[e] = cursor.location();
     raw.elementFileIds[e] = id;
   }
-  if (cursor.next()) cursor.fail(".ele header says " + std::to_string(count) + " elements, but there are more element lines");
+  if (cursor.next())
+    cursor.fail(".ele header says " + std::to_string(count) + " elements, but there are more element lines");
 
   if (nodesPerTet == 10) {
     // Linear elements use only the corners; vertices that only ever were edge nodes
@@ -164,15 +173,18 @@ void readTets(LineCursor& cursor, detail::RawMesh& raw, long long base, MeshRead
       }
       newIndex[v] = kept;
       raw.vertexFileIds[static_cast<std::size_t>(kept)] = raw.vertexFileIds[v];
-      for (std::size_t c = 0; c < 3; ++c) raw.positions[3 * static_cast<std::size_t>(kept) + c] = raw.positions[3 * v + c];
+      for (std::size_t c = 0; c < 3; ++c)
+        raw.positions[3 * static_cast<std::size_t>(kept) + c] = raw.positions[3 * v + c];
       ++kept;
     }
     raw.vertexFileIds.resize(static_cast<std::size_t>(kept));
     raw.positions.resize(3 * static_cast<std::size_t>(kept));
     for (auto& t : raw.elements)
       for (int& v : t) v = newIndex[static_cast<std::size_t>(v)];
-    report.warnings.push_back("10-node (quadratic) tetrahedra: using the 4 corner vertices of each element and "
-                              "dropping the " + std::to_string(dropped) + " edge-only nodes (vertices are renumbered)");
+    report.warnings.push_back(
+        "10-node (quadratic) tetrahedra: using the 4 corner vertices of each element and "
+        "dropping the " +
+        std::to_string(dropped) + " edge-only nodes (vertices are renumbered)");
   }
 }
 

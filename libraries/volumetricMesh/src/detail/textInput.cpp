@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "detail/textInput.hpp"
 
-#include <asyncfem/core/error.hpp>
-
 #include <algorithm>
+#include <asyncfem/core/error.hpp>
 #include <cctype>
 #include <charconv>
 #include <climits>
@@ -39,7 +38,7 @@ std::string_view stripComment(std::string_view line) {
 }
 
 class IncludeLoader {
-public:
+ public:
   IncludeLoader(FlatText& flat, bool expand) : flat_(flat), expand_(expand) {}
 
   /// Appends the file at path (shown as displayName) to the flat text.
@@ -75,8 +74,7 @@ public:
       std::size_t next = 0;
       const std::size_t end = lineEnd(text, pos, next);
       const std::string_view content = trim(stripComment(std::string_view(text).substr(pos, end - pos)));
-      if (startsWithIgnoreCase(content, "*INCLUDE") &&
-          (content.size() == 8 || isSpace(content[8]))) {
+      if (startsWithIgnoreCase(content, "*INCLUDE") && (content.size() == 8 || isSpace(content[8]))) {
         appendChunk(text, chunkStart, pos, fileIndex, chunkFirstLine);
         include(path, content.substr(8), fileIndex, lineNumber);
         chunkStart = next;
@@ -89,7 +87,7 @@ public:
     stack_.pop_back();
   }
 
-private:
+ private:
   void appendChunk(const std::string& text, std::size_t begin, std::size_t end, int file, std::size_t firstLine) {
     if (begin >= end) return;
     flat_.segments.push_back({flat_.text.size(), file, firstLine});
@@ -118,8 +116,7 @@ private:
     if (std::find(stack_.begin(), stack_.end(), canonical) != stack_.end()) {
       std::string chain;
       for (const auto& p : stack_) chain += p.filename().string() + " -> ";
-      throw ParseError(includerName, includerLine,
-                       "*INCLUDE cycle: " + chain + canonical.filename().string());
+      throw ParseError(includerName, includerLine, "*INCLUDE cycle: " + chain + canonical.filename().string());
     }
     load(target, target.string(), includerFile, includerLine);
   }
@@ -207,7 +204,8 @@ void LineCursor::failAtEnd(const std::string& message) const {
 
 void LineCursor::checkCountFits(long long count, std::size_t minBytesPerItem, const std::string& what) const {
   if (count < 0) fail("negative " + what + " count " + std::to_string(count));
-  if (count > INT_MAX) fail(what + " count " + std::to_string(count) + " exceeds the supported maximum " + std::to_string(INT_MAX));
+  if (count > INT_MAX)
+    fail(what + " count " + std::to_string(count) + " exceeds the supported maximum " + std::to_string(INT_MAX));
   const std::size_t fits = bytesRemaining() / minBytesPerItem;
   if (static_cast<unsigned long long>(count) > fits) {
     fail("header says " + std::to_string(count) + " " + what + ", but the rest of the file (" +

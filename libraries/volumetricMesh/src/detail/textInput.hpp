@@ -40,7 +40,7 @@ FlatText loadFlatText(const std::filesystem::path& path, bool expandIncludes);
 /// asked), trims whitespace, accepts LF, CRLF and CR line ends, and builds ParseErrors
 /// "FILE:LINE: message" for the line it is on.
 class LineCursor {
-public:
+ public:
   LineCursor(const FlatText& flat, bool hashComments);
 
   /// Moves to the next non-blank line; false at the end of the input.
@@ -67,7 +67,7 @@ public:
   /// the rest of the input, so a corrupt header cannot make us allocate absurdly.
   void checkCountFits(long long count, std::size_t minBytesPerItem, const std::string& what) const;
 
-private:
+ private:
   const FlatText& flat_;
   bool hashComments_;
   std::size_t pos_ = 0;

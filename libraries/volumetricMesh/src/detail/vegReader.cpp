@@ -1,23 +1,22 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Vega .veg reader (tetrahedral subset); see docs/file-formats.md for what is accepted.
-#include "detail/rawMesh.hpp"
-#include "detail/textInput.hpp"
-
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
-
 #include <map>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "detail/rawMesh.hpp"
+#include "detail/textInput.hpp"
+
 namespace asyncfem {
 
 namespace {
 
-using detail::Location;
 using detail::LineCursor;
+using detail::Location;
 
 /// Sets written by writeVeg only to give each material a *REGION; they are used to
 /// assign materials but not kept as element sets of the mesh.
@@ -46,15 +45,15 @@ std::string nameAfterKeyword(const LineCursor& cursor, std::string_view keyword,
 }
 
 class VegParser {
-public:
+ public:
   explicit VegParser(const detail::FlatText& flat) : cursor_(flat, true) {}
 
   TetMesh parse(const MeshReadOptions& options, MeshReadReport& report) {
     while (cursor_.next()) {
       const std::string_view line = cursor_.line();
       if (!isKeywordLine(line)) {
-        cursor_.fail("expected a keyword (*VERTICES, *ELEMENTS, *MATERIAL, *SET, *REGION), got '" +
-                     std::string(line) + "'");
+        cursor_.fail("expected a keyword (*VERTICES, *ELEMENTS, *MATERIAL, *SET, *REGION), got '" + std::string(line) +
+                     "'");
       }
       const std::vector<std::string_view> tokens = detail::splitTokens(line, false);
       const std::string_view keyword = tokens.front();
@@ -82,7 +81,7 @@ public:
     return detail::finishMesh(std::move(raw_), cursor_, options, report, detail::MissingMaterialPolicy::Error);
   }
 
-private:
+ private:
   /// Reads the count line after *VERTICES / *ELEMENTS (more numbers may follow it).
   std::vector<std::string_view> headerLine(const std::string& keyword, const std::string& expected) {
     if (!cursor_.next() || isKeywordLine(cursor_.line())) {
@@ -98,7 +97,8 @@ private:
     haveVertices_ = true;
     const auto header = headerLine("*VERTICES", "<count> 3 0 0");
     const Location headerAt = cursor_.location();
-    if (header.size() > 4) cursor_.fail("*VERTICES header has " + std::to_string(header.size()) + " fields; expected '<count> 3 0 0'");
+    if (header.size() > 4)
+      cursor_.fail("*VERTICES header has " + std::to_string(header.size()) + " fields; expected '<count> 3 0 0'");
     const long long count = detail::integerAt(cursor_, header[0], "*VERTICES count");
     if (header.size() >= 2 && detail::integerAt(cursor_, header[1], "*VERTICES dimension") != 3) {
       cursor_.fail("*VERTICES dimension must be 3, got " + std::string(header[1]));
@@ -138,7 +138,8 @@ private:
     if (haveElements_) cursor_.fail("second *ELEMENTS section");
     if (!haveVertices_) cursor_.fail("*ELEMENTS before *VERTICES: vertices must come first");
     haveElements_ = true;
-    if (!cursor_.next() || isKeywordLine(cursor_.line())) cursor_.fail("*ELEMENTS needs the element type (TET) on the next line");
+    if (!cursor_.next() || isKeywordLine(cursor_.line()))
+      cursor_.fail("*ELEMENTS needs the element type (TET) on the next line");
     const std::string_view type = cursor_.line();
     long long ignored = 0;
     if (detail::equalsIgnoreCase(type, "CUBIC")) {
@@ -153,7 +154,8 @@ private:
     }
     const auto header = headerLine("*ELEMENTS", "<count> 4 0");
     const Location headerAt = cursor_.location();
-    if (header.size() > 3) cursor_.fail("*ELEMENTS header has " + std::to_string(header.size()) + " fields; expected '<count> 4 0'");
+    if (header.size() > 3)
+      cursor_.fail("*ELEMENTS header has " + std::to_string(header.size()) + " fields; expected '<count> 4 0'");
     const long long count = detail::integerAt(cursor_, header[0], "*ELEMENTS count");
     if (header.size() >= 2 && detail::integerAt(cursor_, header[1], "*ELEMENTS vertices per element") != 4) {
       cursor_.fail("TET elements have 4 vertices, but the header says " + std::string(header[1]));
@@ -311,7 +313,8 @@ private:
       } else {
         std::string known = "allElements";
         for (const auto& [n, s] : raw_.elementSets) known += ", " + n;
-        cursor_.failAt(region.location, "*REGION refers to unknown set '" + region.setName + "' (known: " + known + ")");
+        cursor_.failAt(region.location,
+                       "*REGION refers to unknown set '" + region.setName + "' (known: " + known + ")");
       }
       int material = -1;
       for (std::size_t m = 0; m < raw_.materials.size(); ++m) {

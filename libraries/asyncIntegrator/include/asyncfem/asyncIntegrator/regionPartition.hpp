@@ -1,11 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <Eigen/Core>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
-
-#include <Eigen/Core>
-
 #include <string>
 #include <vector>
 
@@ -25,7 +23,7 @@ struct RegionSelector {
   std::vector<std::string> elementSets;  ///< every vertex of every element of these sets
   std::vector<Eigen::Vector3d> boxMin;   ///< axis-aligned boxes (rest positions inside, inclusive)
   std::vector<Eigen::Vector3d> boxMax;
-  std::vector<int> vertices;             ///< explicit 0-based ids
+  std::vector<int> vertices;  ///< explicit 0-based ids
 };
 /// Union of everything the selector names, sorted and unique. Unknown set names and
 /// out-of-range ids throw asyncfem::ValidationError naming them.
@@ -42,7 +40,7 @@ std::vector<int> regionVertices(const TetMesh& mesh, const RegionSelector& selec
 /// - a region with no free DOF (all its vertices fixed, or empty);
 /// - a vertex id out of range.
 class RegionPartition {
-public:
+ public:
   RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, std::vector<AsyncRegion> regions);
 
   int numRegions() const { return static_cast<int>(regions_.size()); }
@@ -63,7 +61,7 @@ public:
   /// Region of every vertex: i for S_i, -1 for L.
   const std::vector<int>& vertexRegion() const { return vertexRegion_; }
 
-private:
+ private:
   std::vector<AsyncRegion> regions_;
   std::vector<std::vector<int>> regionDofs_;
   std::vector<int> largeDofs_;

@@ -2,7 +2,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <vector>
 
 namespace asyncfem {
@@ -44,7 +43,7 @@ struct PenaltyContactParameters {
 };
 
 class PenaltyContact {
-public:
+ public:
   /// restPositions: 3 x n. Throws asyncfem::ValidationError for a non-positive stiffness,
   /// negative damping/friction, a zero plane normal or a non-positive sphere radius.
   PenaltyContact(Eigen::Matrix3Xd restPositions, std::vector<ContactPlane> planes, std::vector<ContactSphere> spheres,
@@ -62,7 +61,7 @@ public:
 
   const PenaltyContactParameters& parameters() const { return parameters_; }
 
-private:
+ private:
   template <class Visitor>
   void forEachContact(const Eigen::VectorXd& displacement, const std::vector<int>* vertices, Visitor&& visit) const;
 

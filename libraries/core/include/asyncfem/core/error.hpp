@@ -10,21 +10,21 @@ namespace asyncfem {
 /// Base of every exception AsyncFEM throws. The message is complete and meant for
 /// the user: it names the file and line, the element or vertex, or the scene key.
 class Error : public std::runtime_error {
-public:
+ public:
   using std::runtime_error::runtime_error;
 };
 
 /// Malformed input file. what() reads "FILE:LINE: MESSAGE" (LINE is 1-based; 0 when
 /// the problem concerns the whole file, e.g. a missing section).
 class ParseError : public Error {
-public:
+ public:
   ParseError(std::string file, std::size_t line, const std::string& message)
       : Error(format(file, line, message)), file_(std::move(file)), line_(line) {}
 
   const std::string& file() const { return file_; }
   std::size_t line() const { return line_; }
 
-private:
+ private:
   static std::string format(const std::string& file, std::size_t line, const std::string& message) {
     return line > 0 ? file + ":" + std::to_string(line) + ": " + message : file + ": " + message;
   }
@@ -35,14 +35,14 @@ private:
 /// Input that parses but is not valid (degenerate element, unknown set name, bad
 /// region partition, bad scene value, ...).
 class ValidationError : public Error {
-public:
+ public:
   using Error::Error;
 };
 
 /// A computation failed numerically: non-finite state, failed factorization,
 /// energy blow-up. The message names the step/frame and what went wrong.
 class NumericalError : public Error {
-public:
+ public:
   using Error::Error;
 };
 

@@ -7,7 +7,7 @@ namespace asyncfem {
 
 /// Wall-clock stopwatch that accumulates seconds over several start/stop intervals.
 class Stopwatch {
-public:
+ public:
   using Clock = std::chrono::steady_clock;
 
   void start() { startTime_ = Clock::now(); }
@@ -20,20 +20,20 @@ public:
   double totalSeconds() const { return total_; }
   void reset() { total_ = 0.0; }
 
-private:
+ private:
   Clock::time_point startTime_ = Clock::now();
   double total_ = 0.0;
 };
 
 /// Adds the lifetime of the guard to a Stopwatch (RAII timing of a scope).
 class ScopedTimer {
-public:
+ public:
   explicit ScopedTimer(Stopwatch& watch) : watch_(watch) { watch_.start(); }
   ~ScopedTimer() { watch_.stop(); }
   ScopedTimer(const ScopedTimer&) = delete;
   ScopedTimer& operator=(const ScopedTimer&) = delete;
 
-private:
+ private:
   Stopwatch& watch_;
 };
 

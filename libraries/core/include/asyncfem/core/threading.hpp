@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include <cstdlib>
 #include <unistd.h>
+
+#include <cstdlib>
 
 namespace asyncfem {
 

@@ -1,15 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include <asyncfem/forceModel/forceModel.hpp>
-
 #include <Eigen/SparseCore>
+#include <asyncfem/forceModel/forceModel.hpp>
 
 namespace asyncfem {
 
 /// Linear FEM: f_int(u) = K u, K constant, energy u^T K u / 2.
 class LinearForceModel final : public ForceModel {
-public:
+ public:
   /// stiffness: 3n x 3n, full storage (e.g. linearStiffnessMatrix()).
   explicit LinearForceModel(Eigen::SparseMatrix<double> stiffness);
 
@@ -22,7 +21,7 @@ public:
 
   const Eigen::SparseMatrix<double>& stiffness() const { return stiffness_; }
 
-private:
+ private:
   Eigen::SparseMatrix<double> stiffness_;
 };
 

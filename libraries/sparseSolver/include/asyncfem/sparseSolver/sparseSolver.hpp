@@ -3,7 +3,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <memory>
 #include <string>
 
@@ -11,10 +10,10 @@ namespace asyncfem {
 
 /// Which factorization backs a SparseSolver.
 enum class SolverKind {
-  cholmod,     ///< CHOLMOD supernodal Cholesky, METIS ordering (SPD matrices; reads the upper triangle)
-  umfpack,     ///< UMFPACK LU (any square non-singular matrix)
-  eigenLDLT,   ///< Eigen SimplicialLDLT (SPD fallback, no SuiteSparse needed at run time)
-  eigenLU,     ///< Eigen SparseLU (unsymmetric fallback)
+  cholmod,    ///< CHOLMOD supernodal Cholesky, METIS ordering (SPD matrices; reads the upper triangle)
+  umfpack,    ///< UMFPACK LU (any square non-singular matrix)
+  eigenLDLT,  ///< Eigen SimplicialLDLT (SPD fallback, no SuiteSparse needed at run time)
+  eigenLU,    ///< Eigen SparseLU (unsymmetric fallback)
 };
 /// "cholmod", "umfpack", "eigen-ldlt", "eigen-lu".
 std::string toString(SolverKind kind);
@@ -24,9 +23,9 @@ SolverKind parseSolverKind(const std::string& name);
 /// Counters a solver keeps; the machine-independent cost figures come from the
 /// factorization libraries themselves (CHOLMOD's Common->fl and lnz, UMFPACK's Info).
 struct SolverStats {
-  long long factorNonZeros = 0;      ///< non-zeros of L (Cholesky) or L+U (LU)
-  double factorFlops = 0.0;          ///< flops of the last numeric factorization (Eigen kinds: estimated from the factor)
-  double solveFlopsPerRhs = 0.0;     ///< flops of one forward+back substitution (estimate 4*nnz(L) for Cholesky)
+  long long factorNonZeros = 0;   ///< non-zeros of L (Cholesky) or L+U (LU)
+  double factorFlops = 0.0;       ///< flops of the last numeric factorization (Eigen kinds: estimated from the factor)
+  double solveFlopsPerRhs = 0.0;  ///< flops of one forward+back substitution (estimate 4*nnz(L) for Cholesky)
   int analyses = 0;
   int factorizations = 0;
   long long solvedRightHandSides = 0;
@@ -41,7 +40,7 @@ struct SolverStats {
 /// Threads: one solver object is not thread-safe, but distinct objects share no mutable
 /// state (each owns its CHOLMOD common / UMFPACK objects) and may run on distinct threads.
 class SparseSolver {
-public:
+ public:
   virtual ~SparseSolver() = default;
 
   /// Symbolic analysis (ordering, elimination tree) of A's pattern. A later factorize()
@@ -75,7 +74,7 @@ public:
   const SolverStats& stats() const { return stats_; }
   void resetStats() { stats_ = SolverStats{}; }
 
-protected:
+ protected:
   SolverStats stats_;
 };
 

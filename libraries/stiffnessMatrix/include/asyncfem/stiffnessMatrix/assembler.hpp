@@ -1,12 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
-#include <asyncfem/volumetricMesh/tetMesh.hpp>
-
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
+#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <functional>
 #include <vector>
 
@@ -34,7 +32,7 @@ enum class MassType { consistent, lumped };
 /// slot map plus the element and vertex-block arrays (about 85 MB for 1M tets); the
 /// scalar pattern is only materialised in the matrices themselves.
 class MatrixAssembler {
-public:
+ public:
   /// Builds the pattern, slot map and colouring of mesh's connectivity (O(elements),
   /// parallel). Throws asyncfem::Error if the pattern needs more than INT_MAX entries.
   explicit MatrixAssembler(const TetMesh& mesh);
@@ -85,7 +83,7 @@ public:
   /// deterministic like assemble().
   Eigen::VectorXd assembleVector(const ElementVectorFunction& elementVector) const;
 
-private:
+ private:
   friend void assembleLinearStiffness(const TetMesh& mesh, const MatrixAssembler& assembler,
                                       Eigen::SparseMatrix<double>& stiffness);
   friend Eigen::SparseMatrix<double> massMatrix(const TetMesh& mesh, const MatrixAssembler& assembler, MassType type);

@@ -3,7 +3,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <vector>
 
 namespace asyncfem {
@@ -12,7 +11,7 @@ namespace asyncfem {
 /// (3n) and free (numFree) numbering. Fixed DOFs are removed from systems, never
 /// penalised.
 class FreeDofs {
-public:
+ public:
   FreeDofs() = default;
   /// fixedDofs: global DOF ids (any order, duplicates allowed), each in [0, numDofs);
   /// throws ValidationError naming the first DOF out of range.
@@ -37,7 +36,7 @@ public:
   /// (numFree -> numDofs); asyncfem::Error on a size mismatch.
   Eigen::VectorXd expand(const Eigen::VectorXd& free) const;
 
-private:
+ private:
   std::vector<int> freeToFull_;
   std::vector<int> fullToFree_;
 };
@@ -48,7 +47,7 @@ private:
 /// Used to remove fixed DOFs (rows = cols = free DOFs) and to cut the asynchronous
 /// integrator's blocks (K^{SS}, K^{SL}, ...).
 class SubmatrixExtractor {
-public:
+ public:
   SubmatrixExtractor() = default;
   /// Builds the pattern of full(rows, cols) (rows.size() x cols.size()) and the value
   /// map. Throws ValidationError if an index list is not strictly ascending or leaves
@@ -63,7 +62,7 @@ public:
   /// asyncfem::Error otherwise). Parallel, one copy per stored entry.
   void update(const Eigen::SparseMatrix<double>& full, Eigen::SparseMatrix<double>& sub) const;
 
-private:
+ private:
   Eigen::SparseMatrix<double> pattern_;
   std::vector<int> sourceSlots_;  // for every stored entry of pattern_, its index in full.valuePtr()
   // Shape and entry count of the matrix the map was built from (cheap pattern check).

@@ -1,11 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include <asyncfem/volumetricMesh/tetMesh.hpp>
-
 #include <Eigen/Core>
-
 #include <array>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <vector>
 
 namespace asyncfem {
