@@ -15,7 +15,7 @@ mkdir -p out
 ./build/bin/offlineSimulator models/beam/beam.json --output out/beam.afsim
 # Draw every frame (120 at 640 x 360: a few seconds on 2 cores) with the stiff tip tinted,
 # rotation-strain warping and a ground plane (docs/rendering.md).
-./build/bin/frameRenderer out/beam.afsim --scene models/beam/beam.json --output out/frames \
+./build/bin/frameRenderer out/beam.afsim --output out/frames \
   --width 640 --height 360 --warp rotation-strain --tint-set tip --ground
 echo "run-demo: frames are in out/frames/frame_00000.png ... frame_00119.png"
 echo "run-demo: a video: ffmpeg -framerate 30 -i out/frames/frame_%05d.png -pix_fmt yuv420p out/beam.mp4"

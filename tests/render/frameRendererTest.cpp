@@ -99,15 +99,22 @@ TEST_F(FrameRendererTest, SameInputRendersTheSameFileTwice) {
   EXPECT_EQ(readText(folder_ / "c" / "frame_00003.png"), a);
 }
 
-int orangePixels(const Image& image) {
+// Pixels whose colour leans clearly towards one channel.
+template <typename Predicate>
+int countPixels(const Image& image, Predicate leans) {
   int count = 0;
   for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      const std::uint8_t* p = image.pixel(x, y);
-      count += p[0] > p[2] + 40 && p[0] > p[1] + 20 ? 1 : 0;
-    }
+    for (int x = 0; x < image.width; ++x) count += leans(image.pixel(x, y)) ? 1 : 0;
   }
   return count;
+}
+
+int orangePixels(const Image& image) {
+  return countPixels(image, [](const std::uint8_t* p) { return p[0] > p[2] + 40 && p[0] > p[1] + 20; });
+}
+
+int bluePixels(const Image& image) {
+  return countPixels(image, [](const std::uint8_t* p) { return p[2] > p[0] + 40 && p[2] > p[1] + 20; });
 }
 
 TEST_F(FrameRendererTest, TintSetColoursItsRegionOnly) {
@@ -119,6 +126,23 @@ TEST_F(FrameRendererTest, TintSetColoursItsRegionOnly) {
   const RunResult bad = run("run.afsim --mesh bar.veg --frames 5 -q -o x --tint-set nothere");
   EXPECT_EQ(bad.exitCode, 1);
   EXPECT_NE(bad.err.find("nothere"), std::string::npos) << bad.err;
+}
+
+// Several sets: the first in --tint-color (orange by default), the second in the palette's blue.
+TEST_F(FrameRendererTest, SeveralTintSetsGetTheirOwnColours) {
+  const RunResult one = run("run.afsim --mesh bar.veg --frames 5 --width 120 --height 80 -q -o one --tint-set xmax");
+  ASSERT_EQ(one.exitCode, 0) << one.err;
+  const RunResult two =
+      run("run.afsim --mesh bar.veg --frames 5 --width 120 --height 80 -q -o two --tint-set xmax --tint-set xmin");
+  ASSERT_EQ(two.exitCode, 0) << two.err;
+  const Image single = readPng(folder_ / "one" / "frame_00005.png");
+  const Image both = readPng(folder_ / "two" / "frame_00005.png");
+  // The background has some blue pixels of its own: the second set adds more.
+  EXPECT_GT(bluePixels(both), bluePixels(single) + 20);
+  EXPECT_GT(orangePixels(both), 20);
+  const RunResult bad = run("run.afsim --mesh bar.veg --frames 5 -q -o x --tint-set xmax --tint-set nothere");
+  EXPECT_EQ(bad.exitCode, 1);
+  EXPECT_NE(bad.err.find("--tint-set nothere: unknown set"), std::string::npos) << bad.err;
 }
 
 TEST_F(FrameRendererTest, OptionsCombine) {
@@ -225,6 +249,44 @@ TEST_F(FrameRendererTest, SceneGivesTheMesh) {
       run("run.afsim --scene scene.json --frames 0 --width 48 --height 32 -q -o out --warp rotation-strain");
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_TRUE(fs::exists(folder_ / "out" / "frame_00000.png"));
+}
+
+// offlineSimulator records the scene (absolute path and the fingerprint of the mesh and
+// fixed vertices it built) in the .afsim header: frameRenderer then needs neither --scene
+// nor --mesh, builds only the problem (no matrix, no factorization: the summary says so),
+// and refuses when the scene now builds another mesh.
+TEST_F(FrameRendererTest, RecordedSceneGivesTheMeshAndIsChecked) {
+  std::ofstream(folder_ / "scene.json") << R"({
+    "mesh": {"file": "bar.veg"},
+    "fixed": {"sets": ["xmin"]},
+    "gravity": [0, -9.81, 0],
+    "integrator": {"name": "backward-euler", "timestep": 0.05},
+    "frames": {"rate": 10, "count": 3},
+    "output": {"file": "sim.afsim"}
+  })";
+  const std::string simulator = std::string(ASYNCFEM_BIN_DIR) + "/offlineSimulator";
+  const std::string command = "cd '" + folder_.string() + "' && '" + simulator + "' scene.json -q > sim.txt 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << readText(folder_ / "sim.txt");
+  const SimulationReader reader(folder_ / "sim.afsim");
+  EXPECT_EQ(fs::path(reader.header().scenePath), fs::weakly_canonical(folder_ / "scene.json"));
+  const RunResult r = run("sim.afsim --frames 2 --width 48 --height 32 -o out");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(fs::exists(folder_ / "out" / "frame_00002.png"));
+  EXPECT_NE(r.out.find("problem     mesh and fixed vertices of the scene: 0 matrices assembled, no factorization"),
+            std::string::npos)
+      << r.out;
+  // Another boundary: the fingerprint no longer matches.
+  std::ofstream(folder_ / "scene.json") << R"({
+    "mesh": {"file": "bar.veg"},
+    "fixed": {"sets": ["xmax"]},
+    "integrator": {"name": "backward-euler", "timestep": 0.05},
+    "frames": {"rate": 10, "count": 3}
+  })";
+  const RunResult changed = run("sim.afsim --frames 2 -q -o out2");
+  EXPECT_EQ(changed.exitCode, 1);
+  EXPECT_NE(changed.err.find("now builds another mesh or other fixed vertices"), std::string::npos) << changed.err;
+  // --scene still overrides.
+  EXPECT_EQ(run("sim.afsim --scene scene.json --frames 2 -q -o out3").exitCode, 0);
 }
 
 }  // namespace

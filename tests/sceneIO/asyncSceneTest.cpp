@@ -98,7 +98,8 @@ TEST(AsyncScene, ErrorsNameTheKey) {
   };
   const Case cases[] = {
       {R"({"regions": [{"ratio": 0, "vertexSets": ["xmax"]}]})", "integrator.options.regions[0].ratio"},
-      {R"({"regions": [{"ratio": 2, "vertexSets": ["nope"]}]})", "unknown set 'nope' (vertex sets: "},
+      {R"({"regions": [{"ratio": 2, "vertexSets": ["nope"]}]})",
+       "integrator.options.regions[0].vertexSets[0]: unknown set \"nope\" (vertex sets: "},
       {R"({"regions": [{"ratio": 2}]})", "integrator.options.regions[0]: selects no vertex"},
       {R"({"regions": [{"ratio": 2, "vertices": [999]}]})", "integrator.options.regions[0].vertices[0]"},
       {R"({"regions": [{"ratio": 2, "vertexSets": ["xmax"]}, {"ratio": 2, "vertexSets": ["xmax"]}]})",

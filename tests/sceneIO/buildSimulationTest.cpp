@@ -72,8 +72,8 @@ TEST(BuildSimulation, GeneratorMeshAndTiming) {
   EXPECT_EQ(simulation.stepsPerFrame, 10);
   EXPECT_EQ(simulation.numFrames, 3);
   EXPECT_EQ(simulation.integrator->name(), "backward-euler");
-  EXPECT_DOUBLE_EQ(simulation.boundingBoxDiagonal, std::sqrt(6.0));
-  EXPECT_DOUBLE_EQ(simulation.blowUpDisplacement, 1000.0 * std::sqrt(6.0));
+  EXPECT_DOUBLE_EQ(simulation.monitor->boundingBoxDiagonal(), std::sqrt(6.0));
+  EXPECT_DOUBLE_EQ(simulation.monitor->blowUpDisplacement(), 1000.0 * std::sqrt(6.0));
 }
 
 TEST(BuildSimulation, StepsPerFrameToleratesRounding) {
@@ -138,14 +138,14 @@ TEST(BuildSimulation, TimestepWithinRoundOffOfADivisorIsAccepted) {
 int pulledSteps(const std::string& integrator, double windowEnd, double h) {
   int pulled = 0;
   asyncfem::IntegratorRegistry registry = asyncfem::defaultIntegratorRegistry();
-  registry.add("counting", [&pulled, integrator](const Scene& scene, const asyncfem::TetMesh& mesh,
-                                                 asyncfem::DynamicSystem system, const nlohmann::json& options) {
-    system.externalForce = [&pulled, load = system.externalForce](double time, const Eigen::VectorXd& u,
-                                                                  const Eigen::VectorXd& v, Eigen::VectorXd& forces) {
+  registry.add("counting", [&pulled, integrator](asyncfem::IntegratorContext context, const nlohmann::json& options) {
+    context.system.externalForce = [&pulled, load = context.system.externalForce](double time, const Eigen::VectorXd& u,
+                                                                                  const Eigen::VectorXd& v,
+                                                                                  Eigen::VectorXd& forces) {
       load(time, u, v, forces);
       pulled += forces.isZero(0.0) ? 0 : 1;
     };
-    return (*asyncfem::defaultIntegratorRegistry().find(integrator))(scene, mesh, std::move(system), options);
+    return asyncfem::defaultIntegratorRegistry().create(integrator, std::move(context), options);
   });
   auto json = smallScene();
   json["integrator"] = {{"name", "counting"}, {"stepsPerFrame", 1}, {"options", {{"force", true}}}};
@@ -384,15 +384,11 @@ TEST(BuildSimulation, SingleRateOptionsReachTheIntegrator) {
 TEST(BuildSimulation, RegistryAcceptsOtherIntegrators) {
   asyncfem::IntegratorRegistry registry = asyncfem::defaultIntegratorRegistry();
   bool called = false;
-  registry.add("custom", [&called](const Scene& scene, const asyncfem::TetMesh& mesh, asyncfem::DynamicSystem system,
-                                   const nlohmann::json& options) {
+  registry.add("custom", [&called](asyncfem::IntegratorContext context, const nlohmann::json& options) {
     called = true;
-    EXPECT_EQ(mesh.numVertices(), 12);
+    EXPECT_EQ(context.mesh->numVertices(), 12);
     EXPECT_EQ(options.at("regions").size(), 2U);
-    return asyncfem::defaultIntegratorRegistry()
-        .find("backward-euler")
-        ->
-        operator()(scene, mesh, std::move(system), nlohmann::json::object());
+    return asyncfem::defaultIntegratorRegistry().create("backward-euler", std::move(context), nlohmann::json::object());
   });
   auto json = smallScene();
   json["integrator"]["name"] = "custom";

@@ -323,7 +323,7 @@ TEST_F(SimulationFileTest, FileSizeMatchesTheDocumentedLayout) {
   const std::regex heading(R"(### Frame record \(`(\d+) \+ (\d+)n` bytes, or `(\d+) \+ (\d+)n` with velocities\))");
   ASSERT_TRUE(std::regex_search(doc, formula, heading)) << "record size heading not found in " << page;
   ASSERT_NE(doc.find("### Header (64 bytes)"), std::string::npos);
-  ASSERT_NE(doc.find("Record `k` starts at byte `64 + k * recordSize`"), std::string::npos);
+  ASSERT_NE(doc.find("Record `k` starts at byte `H + k * recordSize`"), std::string::npos);
   const std::int64_t fixed = std::stoll(formula[1]);
   const std::int64_t perVertex = std::stoll(formula[2]);
   const std::int64_t fixedWithVelocities = std::stoll(formula[3]);

@@ -205,6 +205,23 @@ TEST_F(OfflineSimulatorTest, WarnsWhenThePaperCouplingGrows) {
   EXPECT_EQ(skipped.out.find("stability"), std::string::npos) << skipped.out;
 }
 
+// The summary lists the regions the run used (name, vertices, interface DOFs, m) and how
+// checkpoints were written (by default every 30 s of wall time, plus the last frame).
+TEST_F(OfflineSimulatorTest, SummaryListsTheRegionsAndTheCheckpoints) {
+  const RunResult r = run(quoted(writeScene(tipBarScene("stable", 8))));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("regions     1 fast region"), std::string::npos) << r.out;
+  // The tip: x >= 0.75 of 8 x 2 x 2 cells, 3 x 3 x 3 lattice planes = 27 vertices; its
+  // interface is the x = 0.625 plane of L, 9 vertices, 27 DOFs.
+  EXPECT_NE(r.out.find("S_1 'tip': 27 vertices, 27 interface DOFs, m = 8"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 checkpoints, every 30 s of wall time and at the end"), std::string::npos) << r.out;
+  const RunResult everyFrame = run(quoted(writeScene(smallScene())) + " --checkpoint-every 1 --checkpoint-seconds 0");
+  ASSERT_EQ(everyFrame.exitCode, 0) << everyFrame.err;
+  EXPECT_NE(everyFrame.out.find("checkpoints, every 1 frame and at the end"), std::string::npos) << everyFrame.out;
+  const RunResult single = run(quoted(writeScene(smallScene())));
+  EXPECT_EQ(single.out.find("regions "), std::string::npos) << single.out;
+}
+
 TEST_F(OfflineSimulatorTest, NoStabilityCheckForTheStableCouplingOrSingleRate) {
   nlohmann::json singleRate = tipBarScene("", 32);
   singleRate["integrator"] = {{"name", "backward-euler"}, {"timestep", 0.1}};

@@ -4,6 +4,7 @@
 // that are inputs refused. Runs the built executables.
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "utilityTest.hpp"
@@ -94,6 +95,43 @@ TEST_F(UtilityErrorsTest, IntegratorBenchmarkRejectsABadConfigurationFirst) {
   EXPECT_NE(r.err.find("integratorBenchmark: configuration \"runge-kutta"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("unknown integrator \"runge-kutta\""), std::string::npos) << r.err;
   EXPECT_EQ(r.out.find("Reference:"), std::string::npos) << r.out;
+}
+
+// suggestRegions proposes what the simulator would run: an async scene's "auto" settings
+// (here maxRatio 2) apply, and a typo inside "auto" is an unknown key there too.
+TEST_F(UtilityErrorsTest, SuggestRegionsHonoursTheScenesAutoSettings) {
+  std::ofstream(folder_ / "scene.json") << R"({
+    "mesh": {"generator": "box", "size": [1, 0.25, 0.25], "cells": [8, 2, 2],
+             "material": {"density": 1000, "youngsModulus": 1e5, "poissonRatio": 0.4},
+             "regions": [{"name": "tip", "min": [0.75, -1, -1], "max": [2, 2, 2],
+                          "material": {"density": 200, "youngsModulus": 5e6, "poissonRatio": 0.3}}]},
+    "fixed": {"sets": ["xmin"]},
+    "integrator": {"name": "async", "timestep": 0.1,
+                   "options": {"regions": "auto", "auto": {"maxRatio": 2, "modalCheck": false}}},
+    "frames": {"rate": 10, "count": 1}
+  })";
+  const RunResult r = run("suggestRegions", "scene.json --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const nlohmann::json proposal = nlohmann::json::parse(r.out);
+  ASSERT_FALSE(proposal.at("regions").empty()) << r.out;
+  for (const auto& region : proposal.at("regions")) EXPECT_LE(region.at("ratio").get<int>(), 2) << r.out;
+  // An explicit option replaces the scene's.
+  const RunResult wider = run("suggestRegions", "scene.json --json --max-ratio 64");
+  ASSERT_EQ(wider.exitCode, 0) << wider.err;
+  EXPECT_GT(nlohmann::json::parse(wider.out).at("regions").at(0).at("ratio").get<int>(), 2) << wider.out;
+
+  std::ofstream(folder_ / "typo.json") << R"({
+    "mesh": {"generator": "box", "size": [1, 0.25, 0.25], "cells": [8, 2, 2]},
+    "fixed": {"sets": ["xmin"]},
+    "integrator": {"name": "async", "timestep": 0.1, "options": {"auto": {"maxRatoi": 2}}},
+    "frames": {"rate": 10, "count": 1}
+  })";
+  const RunResult typo = run("suggestRegions", "typo.json");
+  EXPECT_EQ(typo.exitCode, 1);
+  EXPECT_NE(typo.err.find("typo.json: integrator.options.auto.maxRatoi"), std::string::npos) << typo.err;
+  const RunResult simulator = run("offlineSimulator", "typo.json -o out.afsim");
+  EXPECT_EQ(simulator.exitCode, 1);
+  EXPECT_NE(simulator.err.find("typo.json: integrator.options.auto.maxRatoi"), std::string::npos) << simulator.err;
 }
 
 }  // namespace

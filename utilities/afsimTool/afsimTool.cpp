@@ -22,6 +22,7 @@
 #include <asyncfem/volumetricMesh/writers.hpp>
 #include <charconv>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -101,6 +102,10 @@ std::optional<TetMesh> loadMesh(const CommandLine& options, const SimulationRead
   } else if (options.scene) {
     mesh = buildSceneMesh(loadScene(*options.scene));
     name = *options.scene;
+  } else if (!reader.header().scenePath.empty()) {
+    // The scene the run recorded (checked against its fingerprint).
+    mesh = recordedSceneProblem(reader.header(), reader.path().string())->mesh();
+    name = reader.header().scenePath;
   } else {
     return mesh;
   }
@@ -115,9 +120,13 @@ int info(const CommandLine& options) {
   const auto reader = openSimulation(options.simulation);
   const SimulationFileHeader& header = reader->header();
   std::cout << "file        " << options.simulation << " (" << fs::file_size(options.simulation) << " bytes)\n"
-            << "format      AsyncFEM simulation file, version " << simulationFileVersion << '\n'
-            << "vertices    " << header.numVertices << '\n'
-            << "frames      " << reader->numFrames() << " complete";
+            << "format      AsyncFEM simulation file, version " << (header.scenePath.empty() ? 1 : 2) << '\n';
+  if (!header.scenePath.empty()) {
+    char fingerprint[16];
+    std::snprintf(fingerprint, sizeof(fingerprint), "%08x", header.sceneFingerprint);
+    std::cout << "scene       " << header.scenePath << " (mesh and fixed vertices fingerprint " << fingerprint << ")\n";
+  }
+  std::cout << "vertices    " << header.numVertices << '\n' << "frames      " << reader->numFrames() << " complete";
   if (reader->hasTruncatedFrame()) {
     std::cout << " (+ " << reader->truncatedTrailingBytes() << " bytes of an interrupted frame, ignored)";
   }

@@ -56,7 +56,7 @@ struct CommandLine {
   int width = 640;
   int height = 480;
   std::string warp = "none";
-  std::optional<std::string> tintSet;
+  std::vector<std::string> tintSets;
   std::vector<float> tintColor{0.95F, 0.45F, 0.12F};
   std::vector<std::string> fixedSets;
   std::optional<std::string> renderMesh;
@@ -147,6 +147,7 @@ struct Shared {
   SurfaceEmbedding surface;
   std::optional<Eigen::Matrix3Xf> colors;  // per surface vertex, when a set is tinted
   std::vector<Run> runs;                   // one, or two with --compare
+  int assemblies = 0;                      // matrices the problem assembled (none: only the mesh is needed)
 };
 
 /// A worker's own state: readers of every run and warping objects (neither is
@@ -241,8 +242,9 @@ int run(int argc, char** argv) {
   app.add_option("--warp", options.warp, "Warping of the linear displacement: none, rotation-strain, modal")
       ->check(CLI::IsMember({"none", "rotation-strain", "modal"}))
       ->capture_default_str();
-  app.add_option("--tint-set", options.tintSet,
-                 "Set (vertex or element set) drawn in the tint colour (e.g. the fast region)");
+  app.add_option("--tint-set", options.tintSets,
+                 "Set (vertex or element set) drawn in a tint colour, e.g. a fast region; repeat it for several "
+                 "sets: the first gets --tint-color, the next ones blue, green, purple, ...");
   app.add_option("--tint-color", options.tintColor, "Tint colour r,g,b in [0, 1]")
       ->delimiter(',')
       ->expected(3)
@@ -284,8 +286,10 @@ int run(int argc, char** argv) {
     std::cerr << "frameRenderer: " << e.what() << " (see --help)\n";
     return 2;
   }
-  if (options.mesh.has_value() == options.scene.has_value()) {
-    throw Error("give the mesh with --mesh FILE or --scene SCENE.json (exactly one of them)");
+  if (options.mesh && options.scene) {
+    throw Error(
+        "give the mesh with --mesh FILE or --scene SCENE.json, not both (without either, the scene the "
+        "simulation file records is used)");
   }
   if (options.cameraPosition.empty() != options.cameraTarget.empty()) {
     throw Error("--camera-position and --camera-target go together");
@@ -338,12 +342,16 @@ int run(int argc, char** argv) {
   const std::vector<std::int64_t> frames =
       frames::selectFrames(frames::parseFrameSelection(options.frames), numFrames, framesSource);
 
-  // The mesh, and the vertices held fixed in the simulation.
-  if (options.scene) {
-    const Scene scene = loadScene(*options.scene);
-    Simulation simulation = buildSimulation(scene);
-    shared.mesh = simulation.mesh;
-    shared.fixedVertices = simulation.fixedVertices;
+  // The mesh, and the vertices held fixed in the simulation: from --scene, from the scene
+  // the file records, or from --mesh. Only the problem is built: no matrix, no factorization.
+  if (options.scene || !options.mesh) {
+    const std::shared_ptr<const Problem> problem =
+        options.scene ? buildProblem(loadScene(*options.scene))
+                      : recordedSceneProblem(SimulationReader(shared.runs.front().file).header(),
+                                             shared.runs.front().file.string());
+    shared.mesh = problem->sharedMesh();
+    shared.fixedVertices = problem->fixedVertices();
+    shared.assemblies = problem->assemblies();
   } else {
     auto mesh = std::make_shared<TetMesh>(readMesh(*options.mesh));
     for (const std::string& set : options.fixedSets) {
@@ -352,7 +360,7 @@ int run(int argc, char** argv) {
     }
     shared.mesh = std::move(mesh);
   }
-  const std::string meshName = options.scene ? *options.scene : *options.mesh;
+  const std::string meshName = options.scene ? *options.scene : options.mesh ? *options.mesh : "the recorded scene";
   if (shared.mesh->numVertices() != numVertices) {
     throw Error(shared.runs.front().file.string() + " has " + std::to_string(numVertices) + " vertices but the mesh (" +
                 meshName + ") has " + std::to_string(shared.mesh->numVertices()) +
@@ -361,12 +369,24 @@ int run(int argc, char** argv) {
   shared.surface = options.renderMesh ? SurfaceEmbedding::embed(*shared.mesh, loadSurfaceMesh(*options.renderMesh))
                                       : SurfaceEmbedding::boundary(*shared.mesh);
   RenderStyle style;
-  if (options.tintSet) {
-    const std::vector<int> tinted = shared.mesh->setVertices(*options.tintSet);
+  if (!options.tintSets.empty()) {
+    // The first set in --tint-color, the others in colours far from it and from the surface.
+    static const Eigen::Vector3f palette[] = {
+        {0.25f, 0.45f, 0.95f}, {0.2f, 0.75f, 0.3f}, {0.65f, 0.3f, 0.8f}, {0.95f, 0.8f, 0.15f}, {0.1f, 0.75f, 0.8f}};
     Eigen::Matrix3Xf tetColors = style.surfaceColor.replicate(1, shared.mesh->numVertices());
-    const Eigen::Vector3f tint(options.tintColor[0], options.tintColor[1], options.tintColor[2]);
-    for (const int v : tinted) {
-      tetColors.col(v) = tint;
+    for (std::size_t i = 0; i < options.tintSets.size(); ++i) {
+      VertexSelection selection;
+      selection.sets.push_back(options.tintSets[i]);
+      std::vector<int> tinted;
+      try {
+        tinted = selectVertices(*shared.mesh, selection);
+      } catch (const SelectionError& error) {
+        throw Error("--tint-set " + options.tintSets[i] + ": " + error.what());
+      }
+      const Eigen::Vector3f tint =
+          i == 0 ? Eigen::Vector3f(options.tintColor[0], options.tintColor[1], options.tintColor[2])
+                 : palette[(i - 1) % (sizeof(palette) / sizeof(palette[0]))];
+      for (const int v : tinted) tetColors.col(v) = tint;
     }
     shared.colors = shared.surface.interpolate(tetColors);
   }
@@ -504,7 +524,9 @@ int run(int argc, char** argv) {
       out << " (" << shared.surface.numOutsideVertices() << " outside the tet mesh, up to "
           << shared.surface.maxOutsideDistance() << " away)";
     }
-    out << "\n  warping     " << options.warp << "\n";
+    out << "\n  problem     " << (options.mesh ? "mesh file, no scene" : "mesh and fixed vertices of the scene") << ": "
+        << shared.assemblies << " matrices assembled, no factorization for the simulation\n";
+    out << "  warping     " << options.warp << "\n";
     out << "  camera      " << (options.cameraPosition.empty() ? "fitted to all frames" : "given") << ", bounds "
         << boundsSeconds << " s\n";
     out << "  per frame   " << 1e3 * renderWall / static_cast<double>(frames.size()) << " ms wall on " << threads

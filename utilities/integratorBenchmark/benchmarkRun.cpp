@@ -271,20 +271,14 @@ RunResult runConfiguration(const Scene& scene, const Configuration& configuratio
       result.solvesPerFrame = static_cast<double>(end.solvedRightHandSides - afterWarmUp.solvedRightHandSides) / count;
       result.factorFlopsPerFrame = (end.factorFlops - afterWarmUp.factorFlops) / count;
       result.solveFlopsPerFrame = (end.solveFlops - afterWarmUp.solveFlops) / count;
-      if (const auto* async = dynamic_cast<const AsyncBackwardEuler*>(&integrator)) {
-        result.factorNonZeros = async->factorNonZeros();
-        std::ostringstream ratios;
-        for (int i = 0; i < async->partition().numRegions(); ++i)
-          ratios << (i ? "," : "") << async->partition().ratio(i);
-        result.ratios = ratios.str();
-      } else if (const auto* multirate = dynamic_cast<const UncoupledMultirate*>(&integrator)) {
-        result.factorNonZeros = multirate->factorNonZeros();
-        std::ostringstream ratios;
-        for (int i = 0; i < multirate->partition().numRegions(); ++i) {
-          ratios << (i ? "," : "") << multirate->partition().ratio(i);
-        }
-        result.ratios = ratios.str();
+      result.factorNonZeros = integrator.factorNonZeros();
+      std::ostringstream ratios;
+      bool first = true;
+      for (const RegionSummary& region : integrator.regionSummaries()) {
+        ratios << (first ? "" : ",") << region.ratio;
+        first = false;
       }
+      result.ratios = ratios.str();
     }
     if (failed) break;  // an unstable configuration is not timed again
     if (timedFrames > 0) result.secondsPerFrame.push_back(timedSeconds / timedFrames);

@@ -136,8 +136,7 @@ std::vector<VertexGroup> errorGroups(const Scene& scene, const Simulation& basel
   for (const Configuration& c : configs) {
     if (!isMultirate(c.integrator)) continue;
     const Scene configured = configuredScene(scene, c, 1);
-    const AsyncSceneOptions parsed =
-        parseAsyncOptions(configured, mesh, baseline.integrator->system().freeDofs, c.options);
+    const AsyncSettings parsed = parseAsyncOptions(configured, mesh, baseline.integrator->system().freeDofs, c.options);
     std::vector<bool> fast(static_cast<std::size_t>(mesh.numVertices()), false);
     for (const AsyncRegion& region : parsed.regions) {
       groups.push_back({region.name.empty() ? "S" + std::to_string(groups.size()) : region.name, region.vertices});

@@ -40,7 +40,7 @@ std::string tableRow(const fs::path& path, int frames, int repeats) {
   async.options = scene.integrator.options;
   async.label = "async";
   const Simulation simulation = buildSimulation(configuredScene(scene, async, 1));
-  const AsyncSceneOptions parsed =
+  const AsyncSettings parsed =
       parseAsyncOptions(scene, *simulation.mesh, simulation.integrator->system().freeDofs, scene.integrator.options);
   std::ostringstream sizes, ratios;
   int maxRatio = 1;

@@ -22,6 +22,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/core/threading.hpp>
+#include <asyncfem/runMonitor/runMonitor.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/sceneIO/stepGrowthCheck.hpp>
@@ -30,6 +31,7 @@
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
 #include <bit>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -62,7 +64,8 @@ struct CommandLine {
   std::optional<int> frames;
   std::optional<std::string> vtuFolder;
   bool resume = false;
-  int checkpointEvery = 1;
+  int checkpointEvery = 0;
+  double checkpointSeconds = 30.0;
   bool progress = false;
   bool quiet = false;
   bool noStabilityCheck = false;
@@ -109,99 +112,16 @@ std::string readFile(const fs::path& path) {
   return text.str();
 }
 
-template <typename T>
-std::uint32_t crcOf(const T& value, std::uint32_t crc) {
-  return asyncfem::crc32(&value, sizeof(value), crc);
-}
-
-// Identity of a run, stored in its checkpoint so that --resume refuses to continue a file
-// with different physics: the scene file without frames.count and output (which a resumed
-// run may change), the integrator and timestep after command-line overrides, and the mesh
-// as built (rest positions, elements, materials, fixed vertices).
-std::uint32_t runFingerprint(const fs::path& sceneFile, const asyncfem::Scene& scene,
-                             const asyncfem::Simulation& simulation) {
-  // Scenes may carry // comments, as loadScene accepts them.
+// The scene file as the run fingerprint sees it: without frames.count and output, which
+// a resumed run may change. Scenes may carry // comments, as loadScene accepts them.
+std::string fingerprintText(const fs::path& sceneFile) {
   nlohmann::json json = nlohmann::json::parse(readFile(sceneFile), nullptr, /*allow_exceptions=*/true,
                                               /*ignore_comments=*/true);
   if (json.is_object()) {
     json.erase("output");
     if (json.contains("frames") && json["frames"].is_object()) json["frames"].erase("count");
   }
-  const std::string text = json.dump();
-  std::uint32_t crc = asyncfem::crc32(text.data(), text.size());
-  crc = asyncfem::crc32(scene.integrator.name.data(), scene.integrator.name.size(), crc);
-  crc = crcOf(std::bit_cast<std::uint64_t>(simulation.timestep), crc);
-  crc = crcOf(std::bit_cast<std::uint64_t>(simulation.frameInterval), crc);
-  const asyncfem::TetMesh& mesh = *simulation.mesh;
-  crc = asyncfem::crc32(mesh.restPositions().data(),
-                        sizeof(double) * static_cast<std::size_t>(mesh.restPositions().size()), crc);
-  crc = asyncfem::crc32(mesh.elements().data(), sizeof(int) * static_cast<std::size_t>(mesh.elements().size()), crc);
-  crc = asyncfem::crc32(mesh.elementMaterials().data(), sizeof(int) * mesh.elementMaterials().size(), crc);
-  for (const asyncfem::Material& material : mesh.materials()) {
-    crc = crcOf(std::bit_cast<std::uint64_t>(material.density), crc);
-    crc = crcOf(std::bit_cast<std::uint64_t>(material.youngsModulus), crc);
-    crc = crcOf(std::bit_cast<std::uint64_t>(material.poissonRatio), crc);
-  }
-  crc = asyncfem::crc32(simulation.fixedVertices.data(), sizeof(int) * simulation.fixedVertices.size(), crc);
-  return crc;
-}
-
-asyncfem::SimulationCheckpoint captureCheckpoint(const asyncfem::Integrator& integrator, std::int64_t frames,
-                                                 std::uint32_t fingerprint) {
-  asyncfem::SimulationCheckpoint checkpoint;
-  checkpoint.frames = frames;
-  checkpoint.time = integrator.time();
-  checkpoint.fingerprint = fingerprint;
-  checkpoint.integrator = integrator.name();
-  checkpoint.displacement = integrator.displacement();
-  checkpoint.velocity = integrator.velocity();
-  checkpoint.internalState = integrator.internalState();
-  return checkpoint;
-}
-
-std::string number(double value) {
-  std::ostringstream out;
-  out.precision(12);
-  out << value;
-  return out.str();
-}
-
-// What differs between the run that wrote an output file and its checkpoint and this one,
-// one "what (there ..., here ...)" per field; the scene and mesh are known only through
-// the run fingerprint, so a fingerprint mismatch with every named field equal reads as a
-// change of the scene or mesh.
-std::vector<std::string> runDifferences(const asyncfem::SimulationCheckpoint& checkpoint,
-                                        const asyncfem::SimulationFileHeader& stored,
-                                        const asyncfem::Integrator& integrator,
-                                        const asyncfem::SimulationFileHeader& header, bool fingerprintDiffers) {
-  std::vector<std::string> differences;
-  const auto differ = [](double a, double b) {
-    return std::bit_cast<std::uint64_t>(a) != std::bit_cast<std::uint64_t>(b);
-  };
-  if (checkpoint.integrator != integrator.name()) {
-    differences.push_back("integrator (" + checkpoint.integrator + " there, " + integrator.name() + " here)");
-  }
-  if (differ(stored.timestep, header.timestep)) {
-    differences.push_back("timestep (" + number(stored.timestep) + " there, " + number(header.timestep) + " here)");
-  }
-  if (differ(stored.frameInterval, header.frameInterval)) {
-    differences.push_back("frame interval 1 / frames.rate (" + number(stored.frameInterval) + " there, " +
-                          number(header.frameInterval) + " here)");
-  }
-  if (stored.numVertices != header.numVertices || checkpoint.displacement.size() != integrator.displacement().size()) {
-    differences.push_back("mesh vertex count (" + std::to_string(stored.numVertices) + " there, " +
-                          std::to_string(header.numVertices) + " here)");
-  }
-  if (stored.hasVelocities != header.hasVelocities) {
-    differences.push_back(std::string("output.velocities (") + (stored.hasVelocities ? "true" : "false") + " there, " +
-                          (header.hasVelocities ? "true" : "false") + " here)");
-  }
-  if (fingerprintDiffers && differences.empty()) {
-    differences.emplace_back(
-        "the scene file or the mesh it builds (a key other than frames.count and output, or the mesh file's vertices, "
-        "elements, materials or fixed vertices)");
-  }
-  return differences;
+  return json.dump();
 }
 
 // Restores the state of the checkpoint next to the output after checking that it belongs
@@ -223,7 +143,7 @@ std::int64_t restoreFromCheckpoint(const asyncfem::Scene& scene, asyncfem::Simul
   asyncfem::SimulationReader reader(output);
   const asyncfem::SimulationFileHeader& stored = reader.header();
   const std::vector<std::string> differences =
-      runDifferences(checkpoint, stored, integrator, header, checkpoint.fingerprint != fingerprint);
+      asyncfem::runDifferences(checkpoint, stored, integrator, header, checkpoint.fingerprint != fingerprint);
   if (!differences.empty()) {
     std::string list;
     for (const std::string& difference : differences) list += (list.empty() ? "" : "; ") + difference;
@@ -351,7 +271,8 @@ std::string milliseconds(double seconds, int frames) {
 void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simulation,
                   const asyncfem::IntegratorStats& before, double setupSeconds, double loopSeconds,
                   double outputSeconds, std::int64_t outputBytes, int firstFrame,
-                  const std::optional<asyncfem::PaperCouplingCheck>& couplingCheck) {
+                  const std::optional<asyncfem::PaperCouplingCheck>& couplingCheck,
+                  const asyncfem::CheckpointSchedule& schedule, int checkpointsWritten) {
   const asyncfem::IntegratorStats& after = simulation.integrator->stats();
   // Frames computed by this run (a resumed run starts at firstFrame).
   const int frames = std::max(simulation.numFrames - firstFrame, 1);
@@ -381,6 +302,16 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
                                                                   : "corotational (simple tangent)"))
       << ", " << (scene.mass == asyncfem::MassType::lumped ? "lumped" : "consistent") << " mass, integrator "
       << simulation.integrator->name() << "\n";
+  const std::vector<asyncfem::RegionSummary> regions = simulation.integrator->regionSummaries();
+  if (!regions.empty()) {
+    out << "  regions     " << regions.size() << " fast region" << (regions.size() == 1 ? "" : "s") << " (the rest, L, "
+        << "steps at h):\n";
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+      const asyncfem::RegionSummary& region = regions[i];
+      out << "    S_" << (i + 1) << " '" << region.name << "': " << region.vertices << " vertices, "
+          << region.interfaceDofs << " interface DOFs, m = " << region.ratio << " (h / " << region.ratio << ")\n";
+    }
+  }
   out << "  setup       " << setupSeconds << " s (mesh, matrices, first factorization: " << before.factorizationSeconds
       << " s)\n";
   if (couplingCheck) {
@@ -407,8 +338,14 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
   for (const std::string& item : simulation.skipped) {
     out << "    - " << item << "\n";
   }
+  out << "  checks      finite state and blow-up after every step; energy "
+      << (simulation.monitor->energyEvaluations() > 0 ? std::to_string(simulation.monitor->energyEvaluations()) +
+                                                            " evaluations (once per frame after the loads)"
+                                                      : std::string("not evaluated (see skipped)"))
+      << "\n";
   out << "  output      " << scene.output.file.string() << " (" << simulation.numFrames << " frames, " << outputBytes
-      << " bytes; checkpoint " << asyncfem::checkpointPathFor(scene.output.file).string() << ")";
+      << " bytes; " << checkpointsWritten << " checkpoints, " << schedule.describe() << " and at the end, in "
+      << asyncfem::checkpointPathFor(scene.output.file).string() << ")";
   if (!scene.output.vtuFolder.empty()) {
     out << ", .vtu files in " << scene.output.vtuFolder.string();
   }
@@ -442,9 +379,13 @@ int run(int argc, char** argv) {
                "Continue the output file from its last checkpoint instead of starting over; the result is "
                "bit-identical to an uninterrupted run (frames.count / --frames may be raised)");
   app.add_option("--checkpoint-every", options.checkpointEvery,
-                 "Write the checkpoint (OUTPUT.checkpoint) every K frames (default 1); a resumed run recomputes "
-                 "the frames after the last one")
+                 "Also write the checkpoint (OUTPUT.checkpoint) every K frames (default: by time only); a resumed "
+                 "run recomputes the frames after the last checkpoint")
       ->check(asyncfem::cli::atLeast(1));
+  app.add_option("--checkpoint-seconds", options.checkpointSeconds,
+                 "Write the checkpoint when this many seconds of wall time have passed since the last one "
+                 "(default 30; 0: only by --checkpoint-every); the last frame and an interrupted run always get one")
+      ->check(asyncfem::cli::atLeast(0.0));
   app.add_flag("--progress", options.progress, "Draw the progress bar even when stderr is not a terminal");
   app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
   app.add_flag("--no-stability-check", options.noStabilityCheck,
@@ -483,8 +424,14 @@ int run(int argc, char** argv) {
   header.frameInterval = simulation.frameInterval;
   header.timestep = simulation.timestep;
   header.hasVelocities = scene.output.velocities;
+  // The scene, so that frameRenderer and afsimTool find the mesh by themselves.
+  header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
+  header.sceneFingerprint = asyncfem::problemFingerprint(*simulation.problem);
   const asyncfem::SimulationWriter::Options writerOptions{scene.output.sync};
-  const std::uint32_t fingerprint = runFingerprint(options.scene, scene, simulation);
+  const std::uint32_t fingerprint =
+      asyncfem::runFingerprint(fingerprintText(options.scene), scene.integrator.name, simulation.timestep,
+                               simulation.frameInterval, *simulation.problem);
+  const asyncfem::CheckpointSchedule schedule{options.checkpointEvery, options.checkpointSeconds};
   const fs::path checkpointFile = asyncfem::checkpointPathFor(scene.output.file);
 
   int firstFrame = 0;
@@ -495,7 +442,7 @@ int run(int argc, char** argv) {
   } else {
     writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, header, writerOptions);
     // The rest state, so that a run stopped before its first frame can be resumed too.
-    asyncfem::writeCheckpoint(checkpointFile, captureCheckpoint(*simulation.integrator, 0, fingerprint),
+    asyncfem::writeCheckpoint(checkpointFile, asyncfem::captureCheckpoint(*simulation.integrator, 0, fingerprint),
                               scene.output.sync);
   }
   if (vtuSeries) {
@@ -503,6 +450,11 @@ int run(int argc, char** argv) {
     vtuSeries->writeCollection();
   }
   std::int64_t checkpointFrames = firstFrame;
+  int checkpointsWritten = 0;
+  auto lastCheckpoint = std::chrono::steady_clock::now();
+  const auto secondsSince = [](std::chrono::steady_clock::time_point then) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - then).count();
+  };
   installStopHandlers();
 
   ProgressStyle style = ProgressStyle::lines;
@@ -530,10 +482,12 @@ int run(int argc, char** argv) {
         }
         // After the record, so that the checkpoint never runs ahead of the file.
         const int done = frame + 1;
-        if (done % options.checkpointEvery == 0 || done == simulation.numFrames || stopSignal != 0) {
-          asyncfem::writeCheckpoint(checkpointFile, captureCheckpoint(integrator, done, fingerprint),
+        if (schedule.due(done, secondsSince(lastCheckpoint)) || done == simulation.numFrames || stopSignal != 0) {
+          asyncfem::writeCheckpoint(checkpointFile, asyncfem::captureCheckpoint(integrator, done, fingerprint),
                                     scene.output.sync);
           checkpointFrames = done;
+          ++checkpointsWritten;
+          lastCheckpoint = std::chrono::steady_clock::now();
         }
         if (vtuSeries && frame % scene.output.vtuEvery == 0) {
           vtuSeries->writeFrame(frame, integrator.time(), *simulation.mesh, integrator.displacement());
@@ -551,8 +505,9 @@ int run(int argc, char** argv) {
   progress.finish();
   if (stopSignal != 0 && checkpointFrames != writer->numFrames()) {
     // The signal came after the last frame's checkpoint decision.
-    asyncfem::writeCheckpoint(
-        checkpointFile, captureCheckpoint(*simulation.integrator, writer->numFrames(), fingerprint), scene.output.sync);
+    asyncfem::writeCheckpoint(checkpointFile,
+                              asyncfem::captureCheckpoint(*simulation.integrator, writer->numFrames(), fingerprint),
+                              scene.output.sync);
     checkpointFrames = writer->numFrames();
   }
   writer->close();
@@ -567,7 +522,7 @@ int run(int argc, char** argv) {
   if (!options.quiet) {
     const auto bytes = static_cast<std::int64_t>(fs::file_size(scene.output.file));
     printSummary(scene, simulation, statsAfterSetup, setupSeconds, loopSeconds, outputWatch.totalSeconds(), bytes,
-                 firstFrame, couplingCheck);
+                 firstFrame, couplingCheck, schedule, checkpointsWritten);
   }
   return 0;
 }

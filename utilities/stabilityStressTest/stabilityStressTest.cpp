@@ -192,7 +192,7 @@ Outcome runSimulation(Simulation& simulation, int frames, double freeFrom, doubl
       outcome.energyMeasured = true;
       // Total energy, with the potential of the loads that stay constant (gravity, endless pulls).
       const double potential =
-          simulation.constantLoad.size() > 0 ? simulation.constantLoad.dot(integrator.displacement()) : 0.0;
+          simulation.problem->loads()->constantPart(simulation.problem->numDofs()).dot(integrator.displacement());
       const double energy = integrator.mechanicalEnergy() - potential;
       if (referenceEnergy < 0.0) referenceEnergy = energy;
       if (referenceEnergy > 0.0) outcome.energyGrowth = std::max(outcome.energyGrowth, energy / referenceEnergy);
@@ -441,7 +441,7 @@ int runScene(const Options& options) {
         const Scene scene = sceneFor(jobs[index]);
         Simulation simulation = buildSimulation(scene);
         const StepGrowthEstimate stepGrowth = estimateSceneStepGrowth(scene, simulation);
-        Outcome outcome = runSimulation(simulation, frames, simulation.energyCheckFrom);
+        Outcome outcome = runSimulation(simulation, frames, simulation.monitor->energyCheckFrom());
         outcome.stepGrowth = stepGrowth;
         return outcome;
       },

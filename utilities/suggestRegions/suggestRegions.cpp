@@ -90,6 +90,7 @@ int main(int argc, char** argv) {
     MassType massType = massName == "lumped" ? MassType::lumped : MassType::consistent;
     std::vector<AsyncRegion> givenRegions;  // a scene's explicit regions
     bool corotational = false;
+    std::optional<AutoRegionOptions> sceneAuto;  // an async scene with "regions": "auto"
     if (std::filesystem::path(input).extension() == ".json") {
       Scene scene = loadScene(input);
       if (!writePath.empty()) {
@@ -102,17 +103,21 @@ int main(int argc, char** argv) {
       massType = scene.mass;
       corotational = scene.forceModel == Scene::ForceModelKind::corotational;
       const Scene::IntegratorSettings integrator = scene.integrator;
-      // Only the mesh and the constraints are needed: build with a single-rate integrator.
-      scene.integrator.name = "backward-euler";
-      scene.integrator.options = nlohmann::json::object();
-      Simulation simulation = buildSimulation(scene);
-      mesh = simulation.mesh;
-      freeDofs = simulation.integrator->system().freeDofs;
+      // Only the mesh and the constraints are needed: the problem, nothing assembled.
+      const std::shared_ptr<const Problem> problem = buildProblem(scene);
+      mesh = problem->sharedMesh();
+      freeDofs = problem->freeDofs();
       const nlohmann::json* regions = integrator.options.is_object() && integrator.options.contains("regions")
                                           ? &integrator.options["regions"]
                                           : nullptr;
       if (integrator.name == "async" && regions && regions->is_array()) {
         givenRegions = parseAsyncOptions(scene, *mesh, freeDofs, integrator.options).regions;
+      } else if (integrator.name == "async") {
+        // What the simulator would run: the scene's own auto settings (command-line
+        // options given explicitly replace them).
+        Scene timed = scene;
+        timed.integrator.timestep = largeTimestep;
+        sceneAuto = parseAutoRegionOptions(integratorContext(timed), integrator.options);
       }
     } else {
       if (!writePath.empty()) {
@@ -131,9 +136,25 @@ int main(int argc, char** argv) {
       mesh = loaded;
     }
     if (frameRate <= 0.0) frameRate = 30.0;
+    if (sceneAuto) {
+      const AutoRegionOptions given = options;
+      options = *sceneAuto;
+      if (app.count("--target") > 0) options.targetOmegaH = given.targetOmegaH;
+      if (app.count("--relative") > 0) options.relativeThreshold = given.relativeThreshold;
+      if (app.count("--grow") > 0) options.growLayers = given.growLayers;
+      if (app.count("--max-ratio") > 0) options.maxRatio = given.maxRatio;
+      if (noModalCheck) options.modalCheck = false;
+    } else {
+      options.modalCheck = !noModalCheck;
+    }
     options.largeTimestep = largeTimestep;
-    options.modalCheck = !noModalCheck;
     options.frameRate = frameRate;
+    if (sceneAuto && !json) {
+      std::printf("settings: the scene's \"regions\": \"auto\" (integrator.options.auto%s), as the simulator runs it\n",
+                  app.count("--target") + app.count("--relative") + app.count("--grow") + app.count("--max-ratio") > 0
+                      ? ", with the options given here"
+                      : "");
+    }
     const VibrationMatrices matrices = vibrationMatrices(*mesh, massType);
     const AutoRegionProposal proposal = suggestRegions(*mesh, freeDofs, options, matrices.stiffness, matrices.mass);
     AutoRegionProposal withdrawn;

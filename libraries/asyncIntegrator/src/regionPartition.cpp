@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/volumetricMesh/vertexSelection.hpp>
 #include <string>
 
 namespace asyncfem {
@@ -16,38 +17,26 @@ void sortUnique(std::vector<int>& ids) {
 }  // namespace
 
 std::vector<int> regionVertices(const TetMesh& mesh, const RegionSelector& selector) {
-  std::vector<int> vertices;
-  for (const std::string& name : selector.vertexSets) {
-    const std::vector<int> set = mesh.setVertices(name);
-    vertices.insert(vertices.end(), set.begin(), set.end());
-  }
-  for (const std::string& name : selector.elementSets) {
-    for (int e : mesh.elementSet(name))
-      for (int a = 0; a < 4; ++a) vertices.push_back(mesh.elements()(a, e));
-  }
   if (selector.boxMin.size() != selector.boxMax.size()) {
     throw ValidationError("region selector: every box needs both a min and a max corner");
   }
-  for (std::size_t b = 0; b < selector.boxMin.size(); ++b) {
-    const Eigen::Vector3d& lo = selector.boxMin[b];
-    const Eigen::Vector3d& hi = selector.boxMax[b];
-    if (!((lo.array() <= hi.array()).all())) {
-      throw ValidationError("region selector: box " + std::to_string(b) + " has min > max");
+  // The one vertex-selection resolver of volumetricMesh; sets of either kind.
+  VertexSelection selection;
+  selection.sets = selector.vertexSets;
+  selection.sets.insert(selection.sets.end(), selector.elementSets.begin(), selector.elementSets.end());
+  for (std::size_t b = 0; b < selector.boxMin.size(); ++b)
+    selection.boxes.push_back({selector.boxMin[b], selector.boxMax[b]});
+  selection.vertices = selector.vertices;
+  try {
+    return selectVertices(mesh, selection);
+  } catch (const SelectionError& error) {
+    // Name the selector's own list: its vertex sets come first in selection.sets.
+    const int vertexSets = static_cast<int>(selector.vertexSets.size());
+    if (error.part() == "sets" && error.index() >= vertexSets) {
+      throw SelectionError("elementSets", error.index() - vertexSets, error.what());
     }
-    for (int v = 0; v < mesh.numVertices(); ++v) {
-      const Eigen::Vector3d p = mesh.restPosition(v);
-      if ((p.array() >= lo.array()).all() && (p.array() <= hi.array()).all()) vertices.push_back(v);
-    }
+    throw SelectionError(error.part() == "sets" ? "vertexSets" : error.part(), error.index(), error.what());
   }
-  for (int v : selector.vertices) {
-    if (v < 0 || v >= mesh.numVertices()) {
-      throw ValidationError("region selector: vertex " + std::to_string(v) + " outside [0, " +
-                            std::to_string(mesh.numVertices()) + ")");
-    }
-    vertices.push_back(v);
-  }
-  sortUnique(vertices);
-  return vertices;
 }
 
 RegionPartition::RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, std::vector<AsyncRegion> regions)
@@ -134,6 +123,19 @@ RegionPartition::RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, 
                             "' has no free degree of freedom (empty, or every vertex fixed)");
     }
   }
+}
+
+std::vector<RegionSummary> summarizeRegions(const RegionPartition& partition) {
+  std::vector<int> vertexCount(static_cast<std::size_t>(partition.numRegions()), 0);
+  for (const int region : partition.vertexRegion()) {
+    if (region >= 0) ++vertexCount[static_cast<std::size_t>(region)];
+  }
+  std::vector<RegionSummary> summaries;
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    summaries.push_back({partition.region(i).name, vertexCount[static_cast<std::size_t>(i)],
+                         static_cast<int>(partition.interfaceDofs(i).size()), partition.ratio(i)});
+  }
+  return summaries;
 }
 
 }  // namespace asyncfem

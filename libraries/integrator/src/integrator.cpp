@@ -37,7 +37,7 @@ double Integrator::stableTimestepEstimate() const { return std::numeric_limits<d
 
 void Integrator::setTimestep(double timestep) {
   if (!(timestep > 0.0) || !std::isfinite(timestep)) {
-    throw ValidationError("timestep must be positive and finite (got " + std::to_string(timestep) + ")");
+    throw TimestepError("timestep must be positive and finite (got " + std::to_string(timestep) + ")");
   }
   timestep_ = timestep;
   restartTimeGrid();

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/sceneIO/jsonReader.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
+#include <asyncfem/settings/jsonReader.hpp>
 #include <cctype>
 #include <cmath>
 #include <fstream>

@@ -1,5 +1,4 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/stepGrowthCheck.hpp>
 #include <sstream>
@@ -8,24 +7,25 @@ namespace asyncfem {
 
 StepGrowthEstimate estimateSceneStepGrowth(const Scene& scene, const Simulation& simulation,
                                            const StepGrowthOptions& options, const IntegratorRegistry& registry) {
-  const IntegratorFactory* factory = registry.find(scene.integrator.name);
-  if (factory == nullptr)
-    throw Error(scene.sourceName + ": integrator.name: unknown integrator " + scene.integrator.name);
-  const std::unique_ptr<Integrator> integrator = (*factory)(
-      scene, *simulation.mesh, homogeneousLinearSystem(simulation.integrator->system()), scene.integrator.options);
+  IntegratorContext context = integratorContext(scene);
+  context.timestep = simulation.timestep;
+  context.mesh = simulation.mesh;
+  context.system = homogeneousLinearSystem(simulation.integrator->system());
+  const std::unique_ptr<Integrator> integrator =
+      registry.create(scene.integrator.name, std::move(context), scene.integrator.options);
   return estimateStepGrowth(*integrator, options);
 }
 
 std::optional<PaperCouplingCheck> checkPaperCoupling(const Scene& scene, const Simulation& simulation,
                                                      const IntegratorRegistry& registry) {
-  const auto* async = dynamic_cast<const AsyncBackwardEuler*>(simulation.integrator.get());
-  if (async == nullptr || async->options().coupling != AsyncCoupling::paper) return std::nullopt;
+  if (!simulation.integrator->mayGainEnergy()) return std::nullopt;
   PaperCouplingCheck check;
   check.estimate = estimateSceneStepGrowth(scene, simulation, {}, registry);
   std::ostringstream regions;
-  for (int i = 0; i < async->partition().numRegions(); ++i) {
-    regions << (i > 0 ? ", " : "") << async->partition().region(i).name << " (m = " << async->partition().ratio(i)
-            << ")";
+  bool first = true;
+  for (const RegionSummary& region : simulation.integrator->regionSummaries()) {
+    regions << (first ? "" : ", ") << region.name << " (m = " << region.ratio << ")";
+    first = false;
   }
   check.regions = regions.str();
   if (check.estimate.spectralRadius > 1.0 + kStepGrowthWarningTolerance) {

@@ -51,15 +51,19 @@ SimulationReader::SimulationReader(const std::filesystem::path& path) : path_(pa
         "truncated header: " + std::to_string(got) + " bytes, expected " + std::to_string(simulationHeaderBytes));
   }
   const std::uint32_t version = detail::getU32(bytes + detail::offsetVersion);
-  if (version != simulationFileVersion) {
+  if (version != 1 && version != 2) {
     throw ParseError(name, 0,
-                     "unsupported format version " + std::to_string(version) + " (this build reads " +
+                     "unsupported format version " + std::to_string(version) + " (this build reads 1 to " +
                          std::to_string(simulationFileVersion) + ")");
   }
   const std::uint32_t headerBytes = detail::getU32(bytes + detail::offsetHeaderBytes);
-  if (headerBytes != simulationHeaderBytes) {
+  const std::uint32_t maxHeaderBytes = simulationHeaderBytes + 16 + maxSimulationScenePath + 8;
+  if (version == 1
+          ? headerBytes != simulationHeaderBytes
+          : (headerBytes < simulationHeaderBytes + 24 || headerBytes > maxHeaderBytes || headerBytes % 8 != 0)) {
     throw ParseError(
-        name, 0, "header size " + std::to_string(headerBytes) + ", expected " + std::to_string(simulationHeaderBytes));
+        name, 0,
+        "header size " + std::to_string(headerBytes) + " is not valid for format version " + std::to_string(version));
   }
   const std::uint32_t storedCrc = detail::getU32(bytes + detail::offsetHeaderCrc);
   const std::uint32_t actualCrc = crc32(bytes, detail::offsetHeaderCrc);
@@ -95,7 +99,26 @@ SimulationReader::SimulationReader(const std::filesystem::path& path) : path_(pa
                          std::to_string(numVertices) + " vertices (expected " + std::to_string(header_.recordBytes()) +
                          ")");
   }
+  if (version == 2) readSceneBlock(headerBytes);
   refresh();
+}
+
+void SimulationReader::readSceneBlock(std::uint32_t headerBytes) {
+  const std::string name = path_.string();
+  std::vector<unsigned char> block(headerBytes - simulationHeaderBytes, 0);
+  if (std::fread(block.data(), 1, block.size(), file_.get()) != block.size()) {
+    throw ParseError(name, 0, "truncated scene block in the header (" + std::to_string(headerBytes) + " bytes)");
+  }
+  const std::size_t crcAt = block.size() - 8;
+  if (detail::getU32(block.data() + crcAt) != crc32(block.data(), crcAt)) {
+    throw ParseError(name, 0, "scene block checksum mismatch: the header is corrupted");
+  }
+  const std::uint32_t length = detail::getU32(block.data() + 4);
+  if (length == 0 || length > maxSimulationScenePath || 8 + ((length + 7) / 8 * 8) != crcAt) {
+    throw ParseError(name, 0, "scene block has a path length " + std::to_string(length) + " that does not fit it");
+  }
+  header_.sceneFingerprint = detail::getU32(block.data());
+  header_.scenePath.assign(reinterpret_cast<const char*>(block.data() + 8), length);
 }
 
 SimulationReader::~SimulationReader() = default;
@@ -105,10 +128,10 @@ void SimulationReader::refresh() {
     throw Error(path_.string() + ": cannot seek: " + std::strerror(errno));
   }
   const auto size = static_cast<std::int64_t>(::ftello(file_.get()));
-  if (size < simulationHeaderBytes) {
+  if (size < header_.headerBytes()) {
     throw ParseError(path_.string(), 0, "the file shrank below its header while being read");
   }
-  const std::int64_t payload = size - simulationHeaderBytes;
+  const std::int64_t payload = size - header_.headerBytes();
   numFrames_ = payload / header_.recordBytes();
   trailingBytes_ = payload % header_.recordBytes();
 }
@@ -126,7 +149,7 @@ void SimulationReader::readFrame(std::int64_t k, SimulationFrame& out) {
   }
   const auto recordBytes = static_cast<std::size_t>(header_.recordBytes());
   buffer_.resize(recordBytes);
-  const std::int64_t offset = simulationHeaderBytes + (k * header_.recordBytes());
+  const std::int64_t offset = header_.headerBytes() + (k * header_.recordBytes());
   if (::fseeko(file_.get(), static_cast<off_t>(offset), SEEK_SET) != 0 ||
       std::fread(buffer_.data(), 1, recordBytes, file_.get()) != recordBytes) {
     throw ParseError(path_.string(), 0, "frame " + std::to_string(k) + ": cannot read the record");

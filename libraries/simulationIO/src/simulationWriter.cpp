@@ -9,10 +9,17 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "detail/byteOrder.hpp"
 
 namespace asyncfem {
+
+std::int64_t SimulationFileHeader::headerBytes() const {
+  if (scenePath.empty()) return simulationHeaderBytes;
+  const auto padded = static_cast<std::int64_t>((scenePath.size() + 7) / 8 * 8);
+  return simulationHeaderBytes + 8 + padded + 8;
+}
 
 std::int64_t SimulationFileHeader::recordBytes() const {
   const std::int64_t arrays = hasVelocities ? 2 : 1;
@@ -34,19 +41,32 @@ void checkHeader(const std::string& name, const SimulationFileHeader& header) {
       header.timestep < 0.0) {
     throw Error(name + ": frame interval and timestep must be finite and >= 0");
   }
+  if (header.scenePath.size() > maxSimulationScenePath) {
+    throw Error(name + ": the scene path is longer than " + std::to_string(maxSimulationScenePath) + " bytes");
+  }
 }
 
-void encodeHeader(const SimulationFileHeader& header, unsigned char (&bytes)[simulationHeaderBytes]) {
-  std::memset(bytes, 0, sizeof(bytes));
+std::vector<unsigned char> encodeHeader(const SimulationFileHeader& header) {
+  std::vector<unsigned char> block(static_cast<std::size_t>(header.headerBytes()), 0);
+  unsigned char* bytes = block.data();
   std::memcpy(bytes, detail::simulationMagic, sizeof(detail::simulationMagic));
-  detail::putU32(bytes + detail::offsetVersion, simulationFileVersion);
-  detail::putU32(bytes + detail::offsetHeaderBytes, static_cast<std::uint32_t>(simulationHeaderBytes));
+  detail::putU32(bytes + detail::offsetVersion, header.scenePath.empty() ? 1U : 2U);
+  detail::putU32(bytes + detail::offsetHeaderBytes, static_cast<std::uint32_t>(header.headerBytes()));
   detail::putU64(bytes + detail::offsetNumVertices, static_cast<std::uint64_t>(header.numVertices));
   detail::putF64(bytes + detail::offsetFrameInterval, header.frameInterval);
   detail::putF64(bytes + detail::offsetTimestep, header.timestep);
   detail::putU64(bytes + detail::offsetFlags, header.hasVelocities ? detail::flagVelocities : 0);
   detail::putU64(bytes + detail::offsetRecordBytes, static_cast<std::uint64_t>(header.recordBytes()));
   detail::putU32(bytes + detail::offsetHeaderCrc, crc32(bytes, detail::offsetHeaderCrc));
+  if (!header.scenePath.empty()) {
+    unsigned char* scene = bytes + simulationHeaderBytes;
+    detail::putU32(scene, header.sceneFingerprint);
+    detail::putU32(scene + 4, static_cast<std::uint32_t>(header.scenePath.size()));
+    std::memcpy(scene + 8, header.scenePath.data(), header.scenePath.size());
+    const std::size_t crcAt = block.size() - 8;
+    detail::putU32(bytes + crcAt, crc32(scene, crcAt - simulationHeaderBytes));
+  }
+  return block;
 }
 
 }  // namespace
@@ -64,9 +84,8 @@ SimulationWriter::SimulationWriter(const std::filesystem::path& path, const Simu
     throw Error(name + ": cannot create: " + systemMessage());
   }
 
-  unsigned char bytes[simulationHeaderBytes];
-  encodeHeader(header, bytes);
-  if (std::fwrite(bytes, 1, sizeof(bytes), file_.get()) != sizeof(bytes) || std::fflush(file_.get()) != 0) {
+  const std::vector<unsigned char> bytes = encodeHeader(header);
+  if (std::fwrite(bytes.data(), 1, bytes.size(), file_.get()) != bytes.size() || std::fflush(file_.get()) != 0) {
     throw Error(name + ": cannot write the header: " + systemMessage());
   }
   buffer_.resize(static_cast<std::size_t>(header.recordBytes()));
@@ -81,25 +100,23 @@ SimulationWriter::SimulationWriter(const std::filesystem::path& path, const Simu
   if (!file_) {
     throw Error(name + ": cannot open to continue it: " + systemMessage());
   }
-  unsigned char expected[simulationHeaderBytes];
-  encodeHeader(header, expected);
-  unsigned char stored[simulationHeaderBytes] = {};
-  if (std::fread(stored, 1, sizeof(stored), file_.get()) != sizeof(stored) ||
-      std::memcmp(stored, expected, sizeof(stored)) != 0) {
+  const std::vector<unsigned char> expected = encodeHeader(header);
+  std::vector<unsigned char> stored(expected.size(), 0);
+  if (std::fread(stored.data(), 1, stored.size(), file_.get()) != stored.size() || stored != expected) {
     throw Error(name +
                 ": cannot continue it: its header differs from this run's (vertex count, frame interval, "
-                "timestep or velocity output changed)");
+                "timestep, velocity output or scene changed)");
   }
   if (::fseeko(file_.get(), 0, SEEK_END) != 0) {
     throw Error(name + ": cannot seek: " + systemMessage());
   }
   const auto size = static_cast<std::int64_t>(::ftello(file_.get()));
-  const std::int64_t complete = (size - simulationHeaderBytes) / header.recordBytes();
+  const std::int64_t complete = (size - header.headerBytes()) / header.recordBytes();
   if (keepFrames < 0 || keepFrames > complete) {
     throw Error(name + ": cannot continue after frame " + std::to_string(keepFrames) + ": the file holds only " +
                 std::to_string(complete) + " complete frames");
   }
-  const std::int64_t keepBytes = simulationHeaderBytes + (keepFrames * header.recordBytes());
+  const std::int64_t keepBytes = header.headerBytes() + (keepFrames * header.recordBytes());
   if (std::fflush(file_.get()) != 0 || ::ftruncate(::fileno(file_.get()), static_cast<off_t>(keepBytes)) != 0 ||
       ::fseeko(file_.get(), static_cast<off_t>(keepBytes), SEEK_SET) != 0) {
     throw Error(name + ": cannot cut the file after frame " + std::to_string(keepFrames) + ": " + systemMessage());

@@ -34,7 +34,7 @@ void ExplicitCore::checkTimestep(double timestep, const std::string& methodName)
             << " rad/s, undamped bound); reduce the timestep to at most " << limit
             << ", or set the option force to run anyway (scene key integrator.options.force: true; "
                "IntegratorOptions::force)";
-    throw ValidationError(message.str());
+    throw TimestepError(message.str());
   }
 }
 

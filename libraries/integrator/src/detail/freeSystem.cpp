@@ -62,9 +62,10 @@ void checkFinite(const Eigen::VectorXd& vector, const char* what, double time, c
     if (!std::isfinite(vector[i])) {
       const int dof = static_cast<int>(i);
       throw NumericalError(integratorName + ": non-finite " + what + " (" + std::to_string(vector[i]) +
-                           ") in the step to time " + std::to_string(time) + " at DOF " + std::to_string(dof) +
-                           " (vertex " + std::to_string(dof / 3) + ", coordinate " + coordinateName(dof % 3) +
-                           "); the state was left at the start of the step");
+                               ") in the step to time " + std::to_string(time) + " at DOF " + std::to_string(dof) +
+                               " (vertex " + std::to_string(dof / 3) + ", coordinate " + coordinateName(dof % 3) +
+                               "); the state was left at the start of the step",
+                           NumericalErrorLocation{time, -1, -1, dof, dof / 3, -1, {}});
     }
   }
 }

@@ -117,7 +117,10 @@ class AsyncBackwardEuler final : public Integrator {
   double solveFloorSeconds(int repeats = 5);
   /// Sum over the factorizations this integrator owns of the solver libraries' factor
   /// non-zeros (machine-independent size of the factors).
-  long long factorNonZeros() const;
+  long long factorNonZeros() const override;
+  std::vector<RegionSummary> regionSummaries() const override { return summarizeRegions(partition_); }
+  int regionOfVertex(int vertex) const override { return partition_.regionOfVertex(vertex); }
+  bool mayGainEnergy() const override { return options_.coupling == AsyncCoupling::paper; }
 
  private:
   struct Impl;

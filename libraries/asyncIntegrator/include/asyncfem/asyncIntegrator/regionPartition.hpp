@@ -2,8 +2,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <asyncfem/volumetricMesh/vertexSelection.hpp>
 #include <string>
 #include <vector>
 
@@ -25,8 +27,10 @@ struct RegionSelector {
   std::vector<Eigen::Vector3d> boxMax;
   std::vector<int> vertices;  ///< explicit 0-based ids
 };
-/// Union of everything the selector names, sorted and unique. Unknown set names and
-/// out-of-range ids throw asyncfem::ValidationError naming them.
+/// Union of everything the selector names, sorted and unique, through the mesh's one
+/// resolver (selectVertices). Unknown set names, empty sets, boxes selecting nothing and
+/// out-of-range ids throw asyncfem::SelectionError whose part is the selector's list
+/// ("vertexSets", "elementSets", "boxes", "vertices") and index its position there.
 std::vector<int> regionVertices(const TetMesh& mesh, const RegionSelector& selector);
 
 /// A validated partition of the free DOFs into fast regions S_1..S_n and the rest L,
@@ -60,6 +64,12 @@ class RegionPartition {
   const std::vector<int>& interfaceElements() const { return interfaceElements_; }
   /// Region of every vertex: i for S_i, -1 for L.
   const std::vector<int>& vertexRegion() const { return vertexRegion_; }
+  /// vertexRegion()[vertex], or -1 for a vertex out of range.
+  int regionOfVertex(int vertex) const {
+    return vertex >= 0 && vertex < static_cast<int>(vertexRegion_.size())
+               ? vertexRegion_[static_cast<std::size_t>(vertex)]
+               : -1;
+  }
 
  private:
   std::vector<AsyncRegion> regions_;
@@ -70,5 +80,8 @@ class RegionPartition {
   std::vector<int> interfaceElements_;
   std::vector<int> vertexRegion_;
 };
+
+/// One RegionSummary per fast region of partition (name, vertices, interface DOFs, m).
+std::vector<RegionSummary> summarizeRegions(const RegionPartition& partition);
 
 }  // namespace asyncfem

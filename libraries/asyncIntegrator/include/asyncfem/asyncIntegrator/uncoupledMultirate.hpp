@@ -74,7 +74,9 @@ class UncoupledMultirate final : public Integrator {
   const RegionPartition& partition() const { return partition_; }
   const UncoupledMultirateOptions& options() const { return options_; }
   /// Sum over the factorizations this integrator owns of the factor non-zeros.
-  long long factorNonZeros() const;
+  long long factorNonZeros() const override;
+  std::vector<RegionSummary> regionSummaries() const override { return summarizeRegions(partition_); }
+  int regionOfVertex(int vertex) const override { return partition_.regionOfVertex(vertex); }
 
  private:
   struct Impl;

@@ -49,6 +49,14 @@ struct IntegratorStats {
   std::vector<std::string> skipped;  ///< work the configuration made unnecessary, for the run summary
 };
 
+/// One fast region of a multirate integrator, as run summaries and messages show it.
+struct RegionSummary {
+  std::string name;
+  int vertices = 0;       ///< vertices of the region
+  int interfaceDofs = 0;  ///< free DOFs of L coupled to the region's elements
+  int ratio = 1;          ///< substeps per large step, m
+};
+
 /// One time integrator: owns the state (u, v, t) of a DynamicSystem and advances it by
 /// step(). The linear solves are done by a SparseSolver the integrator owns, so
 /// integrators and solvers can be swapped independently.
@@ -91,6 +99,21 @@ class Integrator {
   double timestep() const { return timestep_; }
   /// Changes h; implicit integrators refactor lazily at the next step.
   virtual void setTimestep(double timestep);
+
+  /// Multirate integrators: their fast regions, in region order; empty for single-rate
+  /// ones. Lets drivers describe any integrator without knowing its type.
+  virtual std::vector<RegionSummary> regionSummaries() const { return {}; }
+  /// Multirate integrators: the index (into regionSummaries()) of the fast region holding
+  /// vertex, or -1 when it lies in the large-step region L; single-rate: always -1.
+  virtual int regionOfVertex(int vertex) const {
+    (void)vertex;
+    return -1;
+  }
+  /// Non-zeros of the factors the integrator keeps, for cost reports (0: not reported).
+  virtual long long factorNonZeros() const { return 0; }
+  /// True when this configuration may gain energy from step to step (the asynchronous
+  /// integrator with the paper's coupling): drivers then estimate the step growth first.
+  virtual bool mayGainEnergy() const { return false; }
 
   const DynamicSystem& system() const { return system_; }
   /// Kinetic energy v^T M v / 2 plus the force model's elastic energy.

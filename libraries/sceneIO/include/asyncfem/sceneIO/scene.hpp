@@ -5,6 +5,7 @@
 #include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/vertexSelection.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
 #include <filesystem>
 #include <limits>
@@ -40,10 +41,7 @@ struct Scene {
 
   /// Axis-aligned box [min, max] (inclusive) selecting the vertices whose rest position
   /// lies in it.
-  struct Box {
-    Eigen::Vector3d min = Eigen::Vector3d::Zero();
-    Eigen::Vector3d max = Eigen::Vector3d::Zero();
-  };
+  using Box = VertexBox;
 
   /// Fixed vertices: the union of vertex sets, boxes and a Vega .bou file (1-based ids).
   struct Fixed {

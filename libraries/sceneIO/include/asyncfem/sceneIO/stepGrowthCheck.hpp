@@ -35,8 +35,8 @@ struct PaperCouplingCheck {
   std::string warning;
 };
 
-/// When simulation runs AsyncBackwardEuler with AsyncCoupling::paper (as the constructed
-/// integrator's options() say, so a scene without the key gets the parser's default):
+/// When simulation's integrator may gain energy (Integrator::mayGainEnergy(): the
+/// asynchronous integrator with the paper's coupling, as constructed):
 /// estimateSceneStepGrowth() and the warning. std::nullopt for every other integrator or
 /// coupling, without any work.
 std::optional<PaperCouplingCheck> checkPaperCoupling(const Scene& scene, const Simulation& simulation,

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace asyncfem {
@@ -24,20 +25,40 @@ namespace asyncfem {
 ///         48     8  record size in bytes (u64, derived from n and flags; checked)
 ///         56     4  reserved (0)
 ///         60     4  CRC-32 of bytes 0..59
+///
+/// Version 2 (written when the run names its scene) adds a scene block after byte 64, and
+/// the header size at offset 12 covers it; frame records start after it:
+///
+///         64     4  scene fingerprint (u32, runMonitor's problemFingerprint of the run)
+///         68     4  length L of the scene path (u32, 1 to 4096)
+///         72     L  the scene file's absolute path, UTF-8, zero-padded to a multiple of 8
+///     72+P(L)    4  CRC-32 of bytes 64 .. 72+P(L)-1
+///     76+P(L)    4  reserved (0)
 struct SimulationFileHeader {
   std::int64_t numVertices = 0;
   double frameInterval = 0.0;
   double timestep = 0.0;
   bool hasVelocities = false;
+  /// The scene the run came from (version 2; empty: none recorded, version 1), and the
+  /// fingerprint of the mesh and fixed vertices it built, so that a reader can find the
+  /// mesh by itself and tell when the scene has changed since.
+  std::string scenePath;
+  std::uint32_t sceneFingerprint = 0;
+
+  /// Bytes before the first record: 64, or 64 + the scene block.
+  std::int64_t headerBytes() const;
 
   /// Bytes of one frame record: index (8) + time (8) + 3n doubles of displacement
   /// (+ 3n of velocity) + CRC-32 (4) + 4 reserved bytes.
   std::int64_t recordBytes() const;
 };
 
-/// Current format version, and the size of the header in bytes.
-inline constexpr std::uint32_t simulationFileVersion = 1;
+/// Newest format version (2: with a scene block; files without one are written as
+/// version 1, byte for byte as before), and the size of the fixed header in bytes.
+inline constexpr std::uint32_t simulationFileVersion = 2;
 inline constexpr std::int64_t simulationHeaderBytes = 64;
+/// Longest scene path a header may carry.
+inline constexpr std::size_t maxSimulationScenePath = 4096;
 /// Largest vertex count a header may claim: 3n must fit in an int (Eigen index), so a
 /// corrupt header can never trigger a giant allocation.
 inline constexpr std::int64_t maxSimulationFileVertices = 715827882;  // floor((2^31 - 1) / 3)
@@ -153,6 +174,7 @@ class SimulationReader {
   struct FileCloser {
     void operator()(std::FILE* file) const;
   };
+  void readSceneBlock(std::uint32_t headerBytes);
 
   std::filesystem::path path_;
   std::unique_ptr<std::FILE, FileCloser> file_;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/sceneIO/jsonReader.hpp>
+#include <asyncfem/settings/jsonReader.hpp>
 #include <cmath>
 #include <sstream>
 

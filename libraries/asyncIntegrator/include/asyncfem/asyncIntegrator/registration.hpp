@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/integrator/registry.hpp>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+/// What the options object of an "async" (or "multirate-uncoupled") integrator says
+/// (docs/scene-format.md, section "Asynchronous integrator"), with its regions resolved
+/// on the context's mesh.
+struct AsyncSettings {
+  AsyncOptions solver;
+  bool automaticRegions = false;
+  AutoRegionOptions automatic;       ///< largeTimestep and frameRate from the context; modalCheck on
+  std::vector<AsyncRegion> regions;  ///< explicit regions, or those the automatic proposal kept
+  /// The automatic proposal (regions "auto"), for reports: what was proposed, withdrawn, why.
+  std::optional<AutoRegionProposal> proposal;
+};
+
+/// The option keys "async" reads.
+const std::vector<std::string>& asyncOptionKeys();
+
+/// The automatic-region settings an "async" options object gives: hL and the frame rate
+/// from the context, modal check on, then its "auto" object (target, growLayers,
+/// maxRatio, modalCheck; other keys are errors naming them). What "regions": "auto" runs
+/// with, for tools that propose regions the way the simulator would.
+AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const nlohmann::json& options);
+
+/// Reads options (a JSON object) as "async" does; errors name the key under
+/// context.optionsPath ("integrator.options.regions[1].ratio: ..."). Regions "auto" (the
+/// default) runs suggestRegions() with the modal check on the context's mesh and mass type.
+AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohmann::json& options);
+
+/// Adds "async" (AsyncBackwardEuler) and "multirate-uncoupled" (UncoupledMultirate).
+void registerMultirateIntegrators(IntegratorRegistry& registry);
+
+}  // namespace asyncfem

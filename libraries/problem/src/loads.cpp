@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/problem/loads.hpp>
+#include <cmath>
+
+namespace asyncfem {
+
+void Loads::addConstant(const Eigen::VectorXd& force) {
+  if (constant_.size() == 0) {
+    constant_ = force;
+  } else if (constant_.size() == force.size()) {
+    constant_ += force;
+  } else {
+    throw ValidationError("Loads::addConstant: size " + std::to_string(force.size()) + " differs from " +
+                          std::to_string(constant_.size()));
+  }
+}
+
+void Loads::addWindow(VertexLoad load) {
+  if (load.vertices.empty() || load.perVertex.isZero(0.0)) return;  // acts on nothing
+  if (!(load.start <= load.end)) throw ValidationError("Loads::addWindow: start after end");
+  windows_.push_back(std::move(load));
+}
+
+void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                  Eigen::VectorXd& forces) const {
+  if (constant_.size() > 0) forces += constant_;
+  for (const VertexLoad& load : windows_) {
+    if (!load.active(time)) continue;
+    for (const int v : load.vertices) forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
+  }
+  if (contact_) contact_->addForces(displacement, velocity, forces);
+}
+
+std::vector<double> Loads::breakpoints() const {
+  std::vector<double> times;
+  for (const VertexLoad& load : windows_) {
+    if (std::isfinite(load.start)) times.push_back(load.start);
+    if (std::isfinite(load.end)) times.push_back(load.end);
+  }
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  return times;
+}
+
+double Loads::lastChange() const {
+  if (contact_) return std::numeric_limits<double>::infinity();
+  const std::vector<double> times = breakpoints();
+  return times.empty() ? 0.0 : std::max(0.0, times.back());
+}
+
+Eigen::VectorXd Loads::constantPart(Eigen::Index numDofs) const {
+  Eigen::VectorXd constant = constant_.size() > 0 ? constant_ : Eigen::VectorXd::Zero(numDofs);
+  for (const VertexLoad& load : windows_) {
+    if (std::isfinite(load.end)) continue;
+    for (const int v : load.vertices) constant.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
+  }
+  return constant;
+}
+
+}  // namespace asyncfem

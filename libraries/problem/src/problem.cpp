@@ -1,0 +1,111 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/forceModel/linearForceModel.hpp>
+#include <asyncfem/problem/problem.hpp>
+
+namespace asyncfem {
+
+Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVertices, ProblemSettings settings,
+                 std::vector<VertexLoad> windows, std::shared_ptr<const PenaltyContact> contact)
+    : mesh_(std::move(mesh)),
+      fixedVertices_(std::move(fixedVertices)),
+      settings_(std::move(settings)),
+      windows_(std::move(windows)),
+      contact_(std::move(contact)) {
+  if (!mesh_) throw ValidationError("problem: no mesh");
+  const int n = mesh_->numVertices();
+  std::sort(fixedVertices_.begin(), fixedVertices_.end());
+  fixedVertices_.erase(std::unique(fixedVertices_.begin(), fixedVertices_.end()), fixedVertices_.end());
+  for (const int v : fixedVertices_) {
+    if (v < 0 || v >= n) {
+      throw ValidationError("problem: fixed vertex " + std::to_string(v) + " out of range [0, " + std::to_string(n) +
+                            ")");
+    }
+  }
+  if (!fixedVertices_.empty() && static_cast<int>(fixedVertices_.size()) == n) {
+    throw ValidationError("problem: every vertex is fixed: nothing would move");
+  }
+  for (const VertexLoad& load : windows_) {
+    for (const int v : load.vertices) {
+      if (v < 0 || v >= n) {
+        throw ValidationError("problem: load vertex " + std::to_string(v) + " out of range [0, " + std::to_string(n) +
+                              ")");
+      }
+    }
+  }
+  freeDofs_ = FreeDofs::fromFixedVertices(n, fixedVertices_);
+}
+
+const std::shared_ptr<const MatrixAssembler>& Problem::assembler() const {
+  if (!assembler_) assembler_ = std::make_shared<const MatrixAssembler>(*mesh_);
+  return assembler_;
+}
+
+const Eigen::SparseMatrix<double>& Problem::massMatrix() const {
+  if (!haveMass_) {
+    mass_ = asyncfem::massMatrix(*mesh_, *assembler(), settings_.mass);
+    haveMass_ = true;
+    ++assemblies_;
+  }
+  return mass_;
+}
+
+const Eigen::SparseMatrix<double>& Problem::stiffnessMatrix() const {
+  if (!haveStiffness_) {
+    stiffness_ = linearStiffnessMatrix(*mesh_, *assembler());
+    haveStiffness_ = true;
+    ++assemblies_;
+  }
+  return stiffness_;
+}
+
+const std::shared_ptr<const Loads>& Problem::loads() const {
+  if (!loads_) {
+    auto loads = std::make_shared<Loads>();
+    if (!settings_.gravity.isZero(0.0)) {
+      loads->addConstant(massMatrix() * settings_.gravity.replicate(mesh_->numVertices(), 1));
+    }
+    for (const VertexLoad& load : windows_) loads->addWindow(load);
+    loads->setContact(contact_);
+    loads_ = std::move(loads);
+  }
+  return loads_;
+}
+
+std::shared_ptr<ForceModel> Problem::makeForceModel() const {
+  if (settings_.forceModel == ForceModelType::linear) return std::make_shared<LinearForceModel>(stiffnessMatrix());
+  return std::make_shared<CorotationalLinearFEM>(*mesh_, assembler(), settings_.tangent);
+}
+
+DynamicSystem Problem::dynamicSystem() const {
+  DynamicSystem system;
+  system.forceModel = makeForceModel();
+  system.mass = massMatrix();
+  system.freeDofs = freeDofs_;
+  system.rayleighMass = settings_.rayleighAlpha;
+  system.rayleighStiffness = settings_.rayleighBeta;
+  std::shared_ptr<const Loads> external = loads();
+  if (!external->empty()) {
+    system.externalForce = [external](double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                      Eigen::VectorXd& forces) {
+      external->addTo(time, displacement, velocity, forces);
+    };
+  }
+  return system;
+}
+
+std::vector<std::string> Problem::skipped() const {
+  std::vector<std::string> skipped;
+  if (settings_.forceModel == ForceModelType::linear) {
+    skipped.emplace_back("corotational rotations and per-step tangent (linear force model)");
+  }
+  if (settings_.gravity.isZero(0.0)) skipped.emplace_back("gravity load (gravity is zero)");
+  if (!contact_) skipped.emplace_back("contact (no obstacles)");
+  if (settings_.gravity.isZero(0.0) && windows_.empty() && !contact_) {
+    skipped.emplace_back("external force evaluation (no gravity, no loads)");
+  }
+  return skipped;
+}
+
+}  // namespace asyncfem

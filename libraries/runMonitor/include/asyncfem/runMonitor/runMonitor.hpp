@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/integrator/integrator.hpp>
+#include <asyncfem/problem/problem.hpp>
+#include <asyncfem/simulationIO/checkpoint.hpp>
+#include <asyncfem/simulationIO/simulationFile.hpp>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+/// Watches a run for numerical failure, so that no unstable state is ever stored:
+/// - after every step, u and v finite and max |u| <= blowUpFactor x the rest bounding-box
+///   diagonal;
+/// - after every frame, once no load changes any more (Loads::lastChange(); never with
+///   contact), the total energy E = kinetic + elastic - constant loads . u has not grown
+///   by more than 9 times its size at the start of that free phase (a stable integrator
+///   keeps or dissipates it; explicit ones let it oscillate by far less).
+/// Failures throw asyncfem::NumericalError whose location() carries the frame, step,
+/// time, vertex and region, and whose message says the same in words.
+class RunMonitor {
+ public:
+  struct Settings {
+    double blowUpFactor = 1000.0;
+    bool energyCheck = true;
+  };
+  RunMonitor(const Problem& problem, double timestep, Settings settings);
+  RunMonitor(const Problem& problem, double timestep) : RunMonitor(problem, timestep, Settings{}) {}
+
+  /// Runs stepsPerFrame steps of integrator with the checks; frame is the 0-based frame
+  /// index used in messages and locations.
+  void advanceFrame(Integrator& integrator, long long frame, int stepsPerFrame);
+
+  /// "vertex 17 in fast region S_1 'tip' (vertex set 'tip')", for messages.
+  std::string describeVertex(const Integrator& integrator, int vertex) const;
+
+  double blowUpDisplacement() const { return blowUpDisplacement_; }
+  double boundingBoxDiagonal() const { return boundingBoxDiagonal_; }
+  /// Time from which the energy check runs (infinity: never, e.g. with contact).
+  double energyCheckFrom() const { return energyCheckFrom_; }
+  /// Energy evaluations made so far (one per frame in the free phase).
+  long long energyEvaluations() const { return energyEvaluations_; }
+  /// Checks the settings or the problem made unnecessary, for run summaries.
+  std::vector<std::string> skipped() const;
+
+ private:
+  NumericalErrorLocation locate(const Integrator& integrator, long long frame, long long step, double time,
+                                int vertex) const;
+
+  const TetMesh* mesh_;
+  Settings settings_;
+  double timestep_;
+  double boundingBoxDiagonal_ = 0.0;
+  double blowUpDisplacement_ = 0.0;
+  double energyCheckFrom_ = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd constantLoad_;
+  bool haveFreeEnergy_ = false;
+  double freeEnergy_ = 0.0, freeEnergyScale_ = 0.0, freeEnergyTime_ = 0.0;
+  long long energyEvaluations_ = 0;
+};
+
+/// When a run writes its checkpoint: every `everyFrames` frames (0: not by frames) and/or
+/// when `everySeconds` of wall time have passed since the last one (0: not by time); a
+/// run's last frame and an interrupted run always get one. Default: every 30 s, so that a
+/// checkpoint never costs a noticeable share of a run whose frames are cheap.
+struct CheckpointSchedule {
+  int everyFrames = 0;
+  double everySeconds = 30.0;
+
+  /// Whether to write after the frame that makes framesDone finished frames, given the
+  /// wall-clock seconds since the last checkpoint.
+  bool due(long long framesDone, double secondsSinceLast) const {
+    return (everyFrames > 0 && framesDone % everyFrames == 0) ||
+           (everySeconds > 0.0 && secondsSinceLast >= everySeconds);
+  }
+  /// "every 30 s of wall time", "every 5 frames", "every 2 frames or 30 s".
+  std::string describe() const;
+};
+
+/// Identity of a run, stored in its checkpoint so that a resumed run refuses a file
+/// written with other physics: sceneText (the scene as JSON text, without the keys a
+/// resumed run may change), the integrator name, h, the frame interval, and the problem
+/// as built (rest positions, elements, materials, fixed vertices).
+std::uint32_t runFingerprint(const std::string& sceneText, const std::string& integratorName, double timestep,
+                             double frameInterval, const Problem& problem);
+
+/// Fingerprint of what a reader of a run's frames needs from its problem: rest positions,
+/// elements and fixed vertices (CRC-32). Stored in the .afsim header next to the scene path.
+std::uint32_t problemFingerprint(const Problem& problem);
+
+/// The checkpoint of integrator's state after `frames` finished frames.
+SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_t frames, std::uint32_t fingerprint);
+
+/// What differs between the run that wrote an output (its header `stored` and its
+/// checkpoint) and this one (`integrator`, `header`), one "what (there ..., here ...)"
+/// per field; when only the fingerprint differs, a sentence naming the scene or mesh.
+std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, const SimulationFileHeader& stored,
+                                        const Integrator& integrator, const SimulationFileHeader& header,
+                                        bool fingerprintDiffers);
+
+}  // namespace asyncfem

@@ -1,0 +1,259 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/runMonitor/runMonitor.hpp>
+#include <asyncfem/simulationIO/crc32.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+#include <bit>
+#include <cmath>
+#include <sstream>
+
+namespace asyncfem {
+
+namespace {
+
+std::string formatNumber(double value, int precision = 6) {
+  std::ostringstream out;
+  out.precision(precision);
+  out << value;
+  return out.str();
+}
+
+template <typename T>
+std::uint32_t crcOf(const T& value, std::uint32_t crc) {
+  return crc32(&value, sizeof(value), crc);
+}
+
+}  // namespace
+
+RunMonitor::RunMonitor(const Problem& problem, double timestep, Settings settings)
+    : mesh_(&problem.mesh()), settings_(settings), timestep_(timestep) {
+  const BoundingBox box = boundingBox(problem.mesh());
+  boundingBoxDiagonal_ = (box.max - box.min).norm();
+  blowUpDisplacement_ = settings_.blowUpFactor * boundingBoxDiagonal_;
+  if (settings_.energyCheck && !problem.hasContact()) {
+    const Loads& loads = *problem.loads();
+    energyCheckFrom_ = loads.lastChange();
+    constantLoad_ = loads.constantPart(problem.numDofs());
+  }
+}
+
+std::vector<std::string> RunMonitor::skipped() const {
+  std::vector<std::string> skipped;
+  if (!settings_.energyCheck) {
+    skipped.emplace_back("energy blow-up check (switched off)");
+  } else if (!std::isfinite(energyCheckFrom_)) {
+    skipped.emplace_back("energy blow-up check (contact forces do work)");
+  }
+  return skipped;
+}
+
+std::string RunMonitor::describeVertex(const Integrator& integrator, int vertex) const {
+  std::ostringstream out;
+  out << "vertex " << vertex;
+  const std::vector<RegionSummary> regions = integrator.regionSummaries();
+  if (!regions.empty()) {
+    const int region = integrator.regionOfVertex(vertex);
+    if (region >= 0 && region < static_cast<int>(regions.size())) {
+      out << " in fast region S_" << (region + 1) << " '" << regions[static_cast<std::size_t>(region)].name << "'";
+    } else {
+      out << " in the large-step region L";
+    }
+  } else {
+    out << " of the mesh";
+  }
+  for (const auto& [name, members] : mesh_->vertexSets()) {
+    if (std::binary_search(members.begin(), members.end(), vertex)) {
+      out << " (vertex set '" << name << "')";
+      break;
+    }
+  }
+  return out.str();
+}
+
+NumericalErrorLocation RunMonitor::locate(const Integrator& integrator, long long frame, long long step, double time,
+                                          int vertex) const {
+  NumericalErrorLocation location;
+  location.frame = frame;
+  location.step = step;
+  location.time = time;
+  location.vertex = vertex;
+  if (vertex >= 0) {
+    location.region = integrator.regionOfVertex(vertex);
+    const std::vector<RegionSummary> regions = integrator.regionSummaries();
+    if (location.region >= 0 && location.region < static_cast<int>(regions.size())) {
+      location.regionName = regions[static_cast<std::size_t>(location.region)].name;
+    }
+  }
+  return location;
+}
+
+void RunMonitor::advanceFrame(Integrator& integrator, long long frame, int stepsPerFrame) {
+  for (int s = 0; s < stepsPerFrame; ++s) {
+    const long long step = (frame * stepsPerFrame) + s + 1;
+    // The time the step ends at, taken before the step (which advances time() on success).
+    const double stepEnd = integrator.time() + integrator.timestep();
+    const std::string where =
+        "frame " + std::to_string(frame) + " (step " + std::to_string(step) + ", t = " + formatNumber(stepEnd) + ")";
+    try {
+      integrator.step();
+    } catch (const NumericalError& error) {
+      // Keep what the integrator knew (DOF, vertex) and add frame, step and region.
+      NumericalErrorLocation location = error.location();
+      const NumericalErrorLocation here = locate(integrator, frame, step, stepEnd, location.vertex);
+      location.frame = here.frame;
+      location.step = here.step;
+      if (!location.hasTime()) location.time = here.time;
+      location.region = here.region;
+      location.regionName = here.regionName;
+      const std::string vertex =
+          location.vertex >= 0 ? " [" + describeVertex(integrator, location.vertex) + "]" : std::string();
+      throw NumericalError(where + ": " + error.what() + vertex, location);
+    }
+    const Eigen::VectorXd& u = integrator.displacement();
+    const Eigen::VectorXd& v = integrator.velocity();
+    Eigen::Index firstNonFinite = -1;
+    Eigen::Index largest = 0;
+    double maxDisplacement = 0.0;
+    for (Eigen::Index i = 0; i < u.size(); ++i) {
+      if (!std::isfinite(u[i]) || !std::isfinite(v[i])) {
+        firstNonFinite = i;
+        break;
+      }
+      if (std::abs(u[i]) > maxDisplacement) {
+        maxDisplacement = std::abs(u[i]);
+        largest = i;
+      }
+    }
+    if (firstNonFinite >= 0) {
+      const int vertex = static_cast<int>(firstNonFinite / 3);
+      NumericalErrorLocation location = locate(integrator, frame, step, stepEnd, vertex);
+      location.dof = static_cast<int>(firstNonFinite);
+      throw NumericalError(where + ": the state is not finite (NaN or infinity), first at " +
+                               describeVertex(integrator, vertex) + "; the simulation is unstable",
+                           location);
+    }
+    if (maxDisplacement > blowUpDisplacement_) {
+      const int vertex = static_cast<int>(largest / 3);
+      NumericalErrorLocation location = locate(integrator, frame, step, stepEnd, vertex);
+      location.dof = static_cast<int>(largest);
+      throw NumericalError(where + ": blow-up: max |u| = " + formatNumber(maxDisplacement) + " at " +
+                               describeVertex(integrator, vertex) + " exceeds " + formatNumber(settings_.blowUpFactor) +
+                               " x the bounding-box diagonal (" + formatNumber(boundingBoxDiagonal_) +
+                               "); the simulation is unstable",
+                           location);
+    }
+  }
+  if (integrator.time() < energyCheckFrom_ + (0.5 * timestep_)) return;
+  const Eigen::VectorXd& u = integrator.displacement();
+  const double mechanical = integrator.mechanicalEnergy();
+  ++energyEvaluations_;
+  const double energy = mechanical - constantLoad_.dot(u);
+  if (!haveFreeEnergy_) {
+    haveFreeEnergy_ = true;
+    freeEnergy_ = energy;
+    freeEnergyScale_ = std::max(mechanical, std::abs(energy));
+    freeEnergyTime_ = integrator.time();
+    return;
+  }
+  if (energy - freeEnergy_ > 9.0 * freeEnergyScale_) {
+    Eigen::Index largest = 0;
+    u.cwiseAbs().maxCoeff(&largest);
+    const int vertex = static_cast<int>(largest / 3);
+    std::ostringstream out;
+    out << "frame " << frame << " (t = " << formatNumber(integrator.time())
+        << "): energy blow-up: with no load changing since t = " << formatNumber(energyCheckFrom_)
+        << ", the total energy (kinetic + elastic - constant loads . u) grew from " << formatNumber(freeEnergy_)
+        << " at t = " << formatNumber(freeEnergyTime_) << " to " << formatNumber(energy)
+        << "; largest |u| = " << formatNumber(std::abs(u[largest])) << " at " << describeVertex(integrator, vertex)
+        << "; the simulation is unstable";
+    NumericalErrorLocation location = locate(integrator, frame, -1, integrator.time(), vertex);
+    location.dof = static_cast<int>(largest);
+    throw NumericalError(out.str(), location);
+  }
+}
+
+std::string CheckpointSchedule::describe() const {
+  std::ostringstream out;
+  if (everyFrames > 0) out << "every " << everyFrames << (everyFrames == 1 ? " frame" : " frames");
+  if (everyFrames > 0 && everySeconds > 0.0) out << " or ";
+  if (everySeconds > 0.0) out << (everyFrames > 0 ? "" : "every ") << everySeconds << " s of wall time";
+  if (everyFrames <= 0 && everySeconds <= 0.0) out << "at the end only";
+  return out.str();
+}
+
+std::uint32_t runFingerprint(const std::string& sceneText, const std::string& integratorName, double timestep,
+                             double frameInterval, const Problem& problem) {
+  std::uint32_t crc = crc32(sceneText.data(), sceneText.size());
+  crc = crc32(integratorName.data(), integratorName.size(), crc);
+  crc = crcOf(std::bit_cast<std::uint64_t>(timestep), crc);
+  crc = crcOf(std::bit_cast<std::uint64_t>(frameInterval), crc);
+  const TetMesh& mesh = problem.mesh();
+  crc = crc32(mesh.restPositions().data(), sizeof(double) * static_cast<std::size_t>(mesh.restPositions().size()), crc);
+  crc = crc32(mesh.elements().data(), sizeof(int) * static_cast<std::size_t>(mesh.elements().size()), crc);
+  crc = crc32(mesh.elementMaterials().data(), sizeof(int) * mesh.elementMaterials().size(), crc);
+  for (const Material& material : mesh.materials()) {
+    crc = crcOf(std::bit_cast<std::uint64_t>(material.density), crc);
+    crc = crcOf(std::bit_cast<std::uint64_t>(material.youngsModulus), crc);
+    crc = crcOf(std::bit_cast<std::uint64_t>(material.poissonRatio), crc);
+  }
+  const std::vector<int>& fixed = problem.fixedVertices();
+  return crc32(fixed.data(), sizeof(int) * fixed.size(), crc);
+}
+
+std::uint32_t problemFingerprint(const Problem& problem) {
+  const TetMesh& mesh = problem.mesh();
+  std::uint32_t crc =
+      crc32(mesh.restPositions().data(), sizeof(double) * static_cast<std::size_t>(mesh.restPositions().size()));
+  crc = crc32(mesh.elements().data(), sizeof(int) * static_cast<std::size_t>(mesh.elements().size()), crc);
+  const std::vector<int>& fixed = problem.fixedVertices();
+  return crc32(fixed.data(), sizeof(int) * fixed.size(), crc);
+}
+
+SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_t frames, std::uint32_t fingerprint) {
+  SimulationCheckpoint checkpoint;
+  checkpoint.frames = frames;
+  checkpoint.time = integrator.time();
+  checkpoint.fingerprint = fingerprint;
+  checkpoint.integrator = integrator.name();
+  checkpoint.displacement = integrator.displacement();
+  checkpoint.velocity = integrator.velocity();
+  checkpoint.internalState = integrator.internalState();
+  return checkpoint;
+}
+
+std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, const SimulationFileHeader& stored,
+                                        const Integrator& integrator, const SimulationFileHeader& header,
+                                        bool fingerprintDiffers) {
+  std::vector<std::string> differences;
+  const auto differ = [](double a, double b) {
+    return std::bit_cast<std::uint64_t>(a) != std::bit_cast<std::uint64_t>(b);
+  };
+  const auto number = [](double value) { return formatNumber(value, 12); };
+  if (checkpoint.integrator != integrator.name()) {
+    differences.push_back("integrator (" + checkpoint.integrator + " there, " + integrator.name() + " here)");
+  }
+  if (differ(stored.timestep, header.timestep)) {
+    differences.push_back("timestep (" + number(stored.timestep) + " there, " + number(header.timestep) + " here)");
+  }
+  if (differ(stored.frameInterval, header.frameInterval)) {
+    differences.push_back("frame interval 1 / frames.rate (" + number(stored.frameInterval) + " there, " +
+                          number(header.frameInterval) + " here)");
+  }
+  if (stored.numVertices != header.numVertices || checkpoint.displacement.size() != integrator.displacement().size()) {
+    differences.push_back("mesh vertex count (" + std::to_string(stored.numVertices) + " there, " +
+                          std::to_string(header.numVertices) + " here)");
+  }
+  if (stored.hasVelocities != header.hasVelocities) {
+    differences.push_back(std::string("output.velocities (") + (stored.hasVelocities ? "true" : "false") + " there, " +
+                          (header.hasVelocities ? "true" : "false") + " here)");
+  }
+  if (fingerprintDiffers && differences.empty()) {
+    differences.emplace_back(
+        "the scene file or the mesh it builds (a key other than frames.count and output, or the mesh file's vertices, "
+        "elements, materials or fixed vertices)");
+  }
+  return differences;
+}
+
+}  // namespace asyncfem

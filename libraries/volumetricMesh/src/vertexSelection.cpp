@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
+#include <asyncfem/volumetricMesh/readers.hpp>
+#include <asyncfem/volumetricMesh/vertexSelection.hpp>
+#include <map>
+
+namespace asyncfem {
+
+namespace {
+
+template <typename Sets>
+std::string setNames(const Sets& sets) {
+  std::string names;
+  for (const auto& [name, members] : sets) names += (names.empty() ? "" : ", ") + name;
+  return names.empty() ? "none" : names;
+}
+
+}  // namespace
+
+std::vector<int> selectVertices(const TetMesh& mesh, const VertexSelection& selection) {
+  std::vector<int> selected;
+  for (std::size_t i = 0; i < selection.sets.size(); ++i) {
+    const std::string& name = selection.sets[i];
+    if (!mesh.vertexSets().count(name) && !mesh.elementSets().count(name)) {
+      throw SelectionError("sets", static_cast<int>(i),
+                           "unknown set \"" + name + "\" (vertex sets: " + setNames(mesh.vertexSets()) +
+                               "; element sets: " + setNames(mesh.elementSets()) + ")");
+    }
+    const std::vector<int> members = mesh.setVertices(name);
+    if (members.empty()) throw SelectionError("sets", static_cast<int>(i), "set \"" + name + "\" is empty");
+    selected.insert(selected.end(), members.begin(), members.end());
+  }
+  for (std::size_t b = 0; b < selection.boxes.size(); ++b) {
+    const VertexBox& box = selection.boxes[b];
+    if (!(box.min.array() <= box.max.array()).all()) {
+      throw SelectionError("boxes", static_cast<int>(b), "expected min <= max");
+    }
+    std::size_t count = 0;
+    for (int v = 0; v < mesh.numVertices(); ++v) {
+      const Eigen::Vector3d x = mesh.restPosition(v);
+      if ((x.array() >= box.min.array()).all() && (x.array() <= box.max.array()).all()) {
+        selected.push_back(v);
+        ++count;
+      }
+    }
+    if (count == 0) throw SelectionError("boxes", static_cast<int>(b), "selects no vertex");
+  }
+  for (std::size_t k = 0; k < selection.vertices.size(); ++k) {
+    const int v = selection.vertices[k];
+    if (v < 0 || v >= mesh.numVertices()) {
+      throw SelectionError("vertices", static_cast<int>(k),
+                           "vertex " + std::to_string(v) + " out of range [0, " + std::to_string(mesh.numVertices()) +
+                               ") (ids are 0-based)");
+    }
+    selected.push_back(v);
+  }
+  if (selection.bouFile) {
+    std::vector<int> fromFile;
+    try {
+      fromFile = readBou(*selection.bouFile, mesh.numVertices());
+    } catch (const Error& error) {
+      throw SelectionError("bou", -1, error.what());
+    }
+    selected.insert(selected.end(), fromFile.begin(), fromFile.end());
+  }
+  std::sort(selected.begin(), selected.end());
+  selected.erase(std::unique(selected.begin(), selected.end()), selected.end());
+  return selected;
+}
+
+}  // namespace asyncfem

@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <gtest/gtest.h>
+
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/problem/loads.hpp>
+#include <limits>
+
+namespace asyncfem {
+namespace {
+
+constexpr double inf = std::numeric_limits<double>::infinity();
+
+VertexLoad pull(std::vector<int> vertices, Eigen::Vector3d force, double start, double end) {
+  VertexLoad load;
+  load.vertices = std::move(vertices);
+  load.perVertex = force;
+  load.start = start;
+  load.end = end;
+  return load;
+}
+
+TEST(Loads, EvaluatesConstantAndWindowsAtTheirTimes) {
+  Loads loads;
+  loads.addConstant(Eigen::VectorXd::Constant(9, 1.0));
+  loads.addWindow(pull({0, 2}, Eigen::Vector3d(1, 2, 3), 0.1, 0.3));
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(9);
+  Eigen::VectorXd before = zero, during = zero, atEnd = zero;
+  loads.addTo(0.05, zero, zero, before);
+  loads.addTo(0.1, zero, zero, during);  // the start is inside [start, end)
+  loads.addTo(0.3, zero, zero, atEnd);   // the end is not
+  EXPECT_EQ(before, Eigen::VectorXd::Constant(9, 1.0));
+  EXPECT_EQ(atEnd, Eigen::VectorXd::Constant(9, 1.0));
+  EXPECT_EQ(during.segment<3>(0), Eigen::Vector3d(2, 3, 4));
+  EXPECT_EQ(during.segment<3>(3), Eigen::Vector3d(1, 1, 1));
+  EXPECT_EQ(during.segment<3>(6), Eigen::Vector3d(2, 3, 4));
+}
+
+TEST(Loads, ImpulseWindowsAreOpenOnTheLeft) {
+  VertexLoad impulse = pull({1}, Eigen::Vector3d(5, 0, 0), 0.5, 1.5);
+  impulse.leftOpen = true;
+  EXPECT_FALSE(impulse.active(0.5));
+  EXPECT_TRUE(impulse.active(1.0));
+  EXPECT_TRUE(impulse.active(1.5));
+}
+
+TEST(Loads, BreakpointsLastChangeAndConstantPart) {
+  Loads loads;
+  loads.addConstant(Eigen::VectorXd::Constant(6, 2.0));
+  loads.addWindow(pull({0}, Eigen::Vector3d(1, 0, 0), 0.2, 0.4));
+  loads.addWindow(pull({1}, Eigen::Vector3d(0, 1, 0), 0.3, inf));  // never ends: constant after 0.3
+  EXPECT_EQ(loads.breakpoints(), (std::vector<double>{0.2, 0.3, 0.4}));
+  EXPECT_DOUBLE_EQ(loads.lastChange(), 0.4);
+  Eigen::VectorXd expected = Eigen::VectorXd::Constant(6, 2.0);
+  expected[4] += 1.0;
+  EXPECT_EQ(loads.constantPart(6), expected);
+  // The constant part is what acts at any time after the last change.
+  Eigen::VectorXd late = Eigen::VectorXd::Zero(6);
+  loads.addTo(10.0, late, late, late);
+  EXPECT_EQ(late, expected);
+}
+
+TEST(Loads, ZeroOrEmptyWindowsAreDroppedAndBadWindowsRefused) {
+  Loads loads;
+  loads.addWindow(pull({0}, Eigen::Vector3d::Zero(), 0.0, 1.0));
+  loads.addWindow(pull({}, Eigen::Vector3d(1, 0, 0), 0.0, 1.0));
+  EXPECT_TRUE(loads.empty());
+  EXPECT_THROW(loads.addWindow(pull({0}, Eigen::Vector3d(1, 0, 0), 2.0, 1.0)), ValidationError);
+  loads.addConstant(Eigen::VectorXd::Zero(6));
+  EXPECT_THROW(loads.addConstant(Eigen::VectorXd::Zero(9)), ValidationError);
+}
+
+TEST(Loads, ContactMakesTheLastChangeInfinite) {
+  Loads loads;
+  Eigen::Matrix3Xd rest(3, 1);
+  rest << 0, 0, 1;
+  ContactPlane ground;
+  loads.setContact(std::make_shared<PenaltyContact>(rest, std::vector<ContactPlane>{ground},
+                                                    std::vector<ContactSphere>{}, PenaltyContactParameters{}));
+  EXPECT_EQ(loads.lastChange(), inf);
+  EXPECT_FALSE(loads.empty());
+}
+
+}  // namespace
+}  // namespace asyncfem

@@ -1,0 +1,82 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/integrator/factory.hpp>
+#include <asyncfem/problem/problem.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
+
+namespace asyncfem {
+namespace {
+
+std::shared_ptr<const TetMesh> beam() {
+  BeamSpec spec;
+  spec.cellsAlongLength = 6;
+  return std::make_shared<const TetMesh>(makeBeamMesh(spec));
+}
+
+TEST(Problem, BuildsNothingUntilAsked) {
+  const auto mesh = beam();
+  ProblemSettings settings;
+  settings.gravity = Eigen::Vector3d(0, -9.81, 0);
+  const Problem problem(mesh, mesh->vertexSets().at("root"), settings);
+  // The mesh, the boundary and the free DOFs cost no matrix.
+  EXPECT_EQ(problem.freeDofs().numFixed(), 3 * static_cast<int>(mesh->vertexSets().at("root").size()));
+  EXPECT_EQ(problem.assemblies(), 0);
+  // Gravity M g needs M: asking for the loads assembles it, once.
+  const auto& loads = problem.loads();
+  EXPECT_EQ(problem.assemblies(), 1);
+  (void)problem.massMatrix();
+  EXPECT_EQ(problem.assemblies(), 1);
+  // M g sums to the total weight on each axis (mass = density x volume; 1e-9 relative:
+  // round-off of the element sums).
+  const Eigen::VectorXd g = loads->constantPart(problem.numDofs());
+  double weight = 0.0;
+  for (Eigen::Index i = 1; i < g.size(); i += 3) weight += g[i];
+  double mass = 0.0;
+  for (Eigen::Index i = 0; i < problem.massMatrix().outerSize(); i += 3) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(problem.massMatrix(), i); it; ++it) {
+      if (it.row() % 3 == 0) mass += it.value();
+    }
+  }
+  EXPECT_NEAR(weight, -9.81 * mass, 1e-9 * 9.81 * mass);
+}
+
+TEST(Problem, DynamicSystemRunsAnIntegratorUnderTheLoads) {
+  const auto mesh = beam();
+  VertexLoad pull;
+  pull.vertices = mesh->vertexSets().at("tip");
+  pull.perVertex = Eigen::Vector3d(0, 10.0, 0);
+  const Problem problem(mesh, mesh->vertexSets().at("root"), ProblemSettings{}, {pull});
+  auto integrator = makeIntegrator("backward-euler", problem.dynamicSystem(), 0.01);
+  EXPECT_EQ(problem.assemblies(), 2);  // M and K
+  for (int i = 0; i < 5; ++i) integrator->step();
+  // The pull lifts the tip; the root stays where it is.
+  EXPECT_GT(integrator->displacement()[3 * pull.vertices.front() + 1], 0.0);
+  EXPECT_EQ(integrator->displacement()[3 * mesh->vertexSets().at("root").front() + 1], 0.0);
+}
+
+TEST(Problem, RefusesBadBoundaries) {
+  const auto mesh = beam();
+  std::vector<int> all(static_cast<std::size_t>(mesh->numVertices()));
+  for (int v = 0; v < mesh->numVertices(); ++v) all[static_cast<std::size_t>(v)] = v;
+  EXPECT_THROW(Problem(mesh, all, ProblemSettings{}), ValidationError);
+  EXPECT_THROW(Problem(mesh, {mesh->numVertices()}, ProblemSettings{}), ValidationError);
+  VertexLoad load;
+  load.vertices = {-1};
+  load.perVertex = Eigen::Vector3d::UnitX();
+  EXPECT_THROW(Problem(mesh, {}, ProblemSettings{}, {load}), ValidationError);
+}
+
+TEST(Problem, SkippedWorkIsListed) {
+  const auto mesh = beam();
+  const Problem problem(mesh, {}, ProblemSettings{});
+  const std::vector<std::string> skipped = problem.skipped();
+  EXPECT_NE(std::find(skipped.begin(), skipped.end(), "gravity load (gravity is zero)"), skipped.end());
+  EXPECT_TRUE(problem.loads()->empty());
+  EXPECT_FALSE(problem.dynamicSystem().externalForce);
+}
+
+}  // namespace
+}  // namespace asyncfem
