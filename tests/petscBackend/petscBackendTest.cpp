@@ -75,7 +75,8 @@ PetscSimulationSettings beamSettings(const TetMesh& mesh, PetscIntegratorKind in
 /// The single-process reference: the integrator library's BackwardEuler or Trapezoidal
 /// with CHOLMOD on the same mesh, fixed vertices and gravity M g.
 std::vector<Eigen::VectorXd> computeCholmodTrajectory(const TetMesh& mesh, PetscIntegratorKind integrator,
-                                                      PetscForceModelKind model) {
+                                                      PetscForceModelKind model, double alpha = 0.0,
+                                                      double beta = 0.0) {
   auto assembler = std::make_shared<const MatrixAssembler>(mesh);
   DynamicSystem system;
   if (model == PetscForceModelKind::linear) {
@@ -85,6 +86,8 @@ std::vector<Eigen::VectorXd> computeCholmodTrajectory(const TetMesh& mesh, Petsc
   }
   system.mass = massMatrix(mesh, *assembler, MassType::consistent);
   system.freeDofs = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("xmin"));
+  system.rayleighMass = alpha;
+  system.rayleighStiffness = beta;
   const Eigen::VectorXd gravityForce = system.mass * kGravity.replicate(mesh.numVertices(), 1);
   system.externalForce = [gravityForce](double, const Eigen::VectorXd&, const Eigen::VectorXd&,
                                         Eigen::VectorXd& forces) { forces += gravityForce; };
@@ -214,6 +217,28 @@ TEST(PetscBackend, CorotationalDiffersFromLinear) {
             1e3 * comparisonTolerance(mesh, PetscSolverKind::cgGamg));
 }
 
+// Rayleigh damping D = alpha M + beta K(u_k) enters both integrators as in the
+// single-process ones (same tolerances as above; the damping only lowers kappa's effect).
+TEST(PetscBackend, DampedTrajectoriesMatchCholmod) {
+  const TetMesh mesh = beamMesh();
+  const double alpha = 0.5;
+  const double beta = 2e-3;
+  for (const auto& [integrator, model, solver] :
+       {std::make_tuple(PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear, PetscSolverKind::cgGamg),
+        std::make_tuple(PetscIntegratorKind::trapezoidal, PetscForceModelKind::corotational, PetscSolverKind::mumps)}) {
+    PetscSimulationSettings settings = beamSettings(mesh, integrator, model, solver);
+    settings.rayleighMass = alpha;
+    settings.rayleighStiffness = beta;
+    const PetscTrajectory petsc = runPetscSimulation(mesh, settings, kSteps);
+    if (worldRank() != 0) continue;
+    const std::vector<Eigen::VectorXd> reference = computeCholmodTrajectory(mesh, integrator, model, alpha, beta);
+    // The damping changes the motion by far more than the tolerance (it is exercised).
+    EXPECT_GT(trajectoryDifference(cholmodTrajectory(mesh, integrator, model), reference), 1e-4);
+    EXPECT_LE(trajectoryDifference(petsc.displacements, reference), comparisonTolerance(mesh, solver))
+        << toString(integrator) << " " << toString(model);
+  }
+}
+
 // PETSc options given in the settings reach the solver (and only this simulation's).
 TEST(PetscBackend, OptionsDatabasePassesThrough) {
   const TetMesh mesh = beamMesh();
@@ -321,6 +346,40 @@ TEST(PetscBackendFailure, NonFiniteForceIsReported) {
     EXPECT_NE(std::string(error.what()).find("(vertex " + std::to_string(vertex) + ", coordinate 1)"),
               std::string::npos)
         << error.what();
+  }
+}
+
+// The last rank holds a different (coarser) mesh: every rank stops with the same error
+// before any collective call sized by the mesh. Needs two ranks to mean anything.
+TEST(PetscBackendFailure, DifferentMeshOnOneRankStopsEveryRank) {
+  if (worldSize() < 2) GTEST_SKIP() << "needs at least 2 ranks (ctest PetscBackend.np2, .np3)";
+  BoxMeshSpec spec;
+  spec.size = Eigen::Vector3d(1.0, 0.2, 0.2);
+  spec.cells = worldRank() == worldSize() - 1 ? Eigen::Vector3i(11, 3, 3) : Eigen::Vector3i(12, 3, 3);
+  const TetMesh mesh = makeBoxMesh(spec);
+  try {
+    PetscSimulation simulation(mesh, beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear,
+                                                  PetscSolverKind::mumps));
+    ADD_FAILURE() << "no exception on rank " << worldRank();
+  } catch (const ValidationError& error) {
+    EXPECT_NE(std::string(error.what()).find("the ranks hold different meshes"), std::string::npos) << error.what();
+  }
+}
+
+// A PETSc error (an unknown KSP type from the options) becomes an asyncfem::Error that
+// carries PETSc's own message.
+TEST(PetscBackendFailure, PetscErrorsBecomeExceptions) {
+  const TetMesh mesh = beamMesh();
+  PetscSimulationSettings settings =
+      beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear, PetscSolverKind::cgGamg);
+  settings.solver.options = "-ksp_type no_such_method";
+  try {
+    PetscSimulation simulation(mesh, settings);
+    ADD_FAILURE() << "no exception on rank " << worldRank();
+  } catch (const Error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("PETSc: KSPSetFromOptions failed"), std::string::npos) << message;
+    EXPECT_NE(message.find("no_such_method"), std::string::npos) << message;
   }
 }
 
