@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libmetis-dev libopenblas-dev
   nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format-14
+  libpetsc-real-dev openmpi-bin
 )
 if [[ "${1:-}" != "--no-render" ]]; then
   packages+=(libosmesa6-dev libassimp-dev libpng-dev)

@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "detail/distributedLayout.hpp"
+
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <climits>
+#include <string>
+
+namespace asyncfem::detail {
+
+namespace {
+std::size_t at(PetscInt i) { return static_cast<std::size_t>(i); }
+}  // namespace
+
+DistributedLayout buildDistributedLayout(const TetMesh& mesh, const std::vector<int>& fixedVertices,
+                                         const std::vector<int>& elementPart, int rank, int numRanks) {
+  DistributedLayout layout;
+  layout.rank = rank;
+  layout.numRanks = numRanks;
+  const int numVertices = mesh.numVertices();
+  const int numElements = mesh.numElements();
+  const Eigen::Matrix4Xi& elements = mesh.elements();
+
+  std::vector<bool> fixed(static_cast<std::size_t>(numVertices), false);
+  for (int v : fixedVertices) {
+    if (v < 0 || v >= numVertices) {
+      throw ValidationError("PETSc backend: fixed vertex " + std::to_string(v) + " is out of range [0, " +
+                            std::to_string(numVertices) + ")");
+    }
+    fixed[static_cast<std::size_t>(v)] = true;
+  }
+
+  // Owner = lowest part among the vertex's elements; vertex -> element adjacency (CSR).
+  std::vector<int> owner(static_cast<std::size_t>(numVertices), INT_MAX);
+  std::vector<int> adjacencyStart(static_cast<std::size_t>(numVertices) + 1, 0);
+  layout.elementsPerRank.assign(static_cast<std::size_t>(numRanks), 0);
+  for (int e = 0; e < numElements; ++e) {
+    const int part = elementPart[static_cast<std::size_t>(e)];
+    ++layout.elementsPerRank[static_cast<std::size_t>(part)];
+    if (part == rank) layout.localElements.push_back(e);
+    for (int a = 0; a < 4; ++a) {
+      const auto v = static_cast<std::size_t>(elements(a, e));
+      owner[v] = std::min(owner[v], part);
+      ++adjacencyStart[v + 1];
+    }
+  }
+  for (int v = 0; v < numVertices; ++v) {
+    const auto i = static_cast<std::size_t>(v);
+    adjacencyStart[i + 1] += adjacencyStart[i];
+    if (owner[i] == INT_MAX && !fixed[i]) {
+      throw ValidationError("PETSc backend: vertex " + std::to_string(v) +
+                            " belongs to no element and is not fixed (its rows of M and K would be zero)");
+    }
+  }
+  std::vector<int> adjacency(static_cast<std::size_t>(adjacencyStart.back()));
+  {
+    std::vector<int> fill(adjacencyStart.begin(), adjacencyStart.end() - 1);
+    for (int e = 0; e < numElements; ++e) {
+      for (int a = 0; a < 4; ++a)
+        adjacency[static_cast<std::size_t>(fill[static_cast<std::size_t>(elements(a, e))]++)] = e;
+    }
+  }
+
+  // Blocks rank by rank, ascending vertex id within a rank.
+  layout.vertexBlock.assign(static_cast<std::size_t>(numVertices), -1);
+  layout.blockStart.assign(static_cast<std::size_t>(numRanks) + 1, 0);
+  for (int v = 0; v < numVertices; ++v) {
+    const auto i = static_cast<std::size_t>(v);
+    if (!fixed[i]) ++layout.blockStart[static_cast<std::size_t>(owner[i]) + 1];
+  }
+  for (int r = 0; r < numRanks; ++r) layout.blockStart[at(r) + 1] += layout.blockStart[at(r)];
+  layout.numBlocks = layout.blockStart.back();
+  layout.blockVertex.resize(at(layout.numBlocks));
+  {
+    std::vector<PetscInt> next(layout.blockStart.begin(), layout.blockStart.end() - 1);
+    for (int v = 0; v < numVertices; ++v) {
+      const auto i = static_cast<std::size_t>(v);
+      if (fixed[i]) continue;
+      const PetscInt block = next[static_cast<std::size_t>(owner[i])]++;
+      layout.vertexBlock[i] = block;
+      layout.blockVertex[at(block)] = v;
+    }
+  }
+  layout.firstBlock = layout.blockStart[at(rank)];
+  layout.ownedBlocks = layout.blockStart[at(rank) + 1] - layout.firstBlock;
+  const auto isOwned = [&](PetscInt block) {
+    return block >= layout.firstBlock && block < layout.firstBlock + layout.ownedBlocks;
+  };
+
+  // Ghosts: free vertices of local elements owned by another rank.
+  std::vector<PetscInt> ghostBlocks;
+  for (int e : layout.localElements) {
+    for (int a = 0; a < 4; ++a) {
+      const PetscInt block = layout.vertexBlock[static_cast<std::size_t>(elements(a, e))];
+      if (block >= 0 && !isOwned(block)) ghostBlocks.push_back(block);
+    }
+  }
+  std::sort(ghostBlocks.begin(), ghostBlocks.end());
+  ghostBlocks.erase(std::unique(ghostBlocks.begin(), ghostBlocks.end()), ghostBlocks.end());
+  for (PetscInt block : ghostBlocks) {
+    for (PetscInt c = 0; c < 3; ++c) layout.ghostDofs.push_back((3 * block) + c);
+  }
+  const auto localBlock = [&](PetscInt block) -> PetscInt {
+    if (isOwned(block)) return block - layout.firstBlock;
+    const auto it = std::lower_bound(ghostBlocks.begin(), ghostBlocks.end(), block);
+    return layout.ownedBlocks + static_cast<PetscInt>(it - ghostBlocks.begin());
+  };
+  layout.elementDofs.resize(layout.localElements.size());
+  layout.elementLocalDofs.resize(layout.localElements.size());
+  for (std::size_t k = 0; k < layout.localElements.size(); ++k) {
+    const int e = layout.localElements[k];
+    for (int a = 0; a < 4; ++a) {
+      const PetscInt block = layout.vertexBlock[static_cast<std::size_t>(elements(a, e))];
+      const PetscInt local = block >= 0 ? localBlock(block) : -1;
+      for (int c = 0; c < 3; ++c) {
+        const auto slot = static_cast<std::size_t>((3 * a) + c);
+        layout.elementDofs[k][slot] = block >= 0 ? (3 * block) + c : -1;
+        layout.elementLocalDofs[k][slot] = block >= 0 ? (3 * local) + c : -1;
+      }
+    }
+  }
+
+  // Exact preallocation: the blocks of row vertex v are the free vertices of all
+  // elements around v, whatever rank assembles them.
+  layout.diagonalBlocks.assign(at(layout.ownedBlocks), 0);
+  layout.offDiagonalBlocks.assign(at(layout.ownedBlocks), 0);
+  std::vector<int> stamp(static_cast<std::size_t>(numVertices), -1);
+  for (PetscInt row = 0; row < layout.ownedBlocks; ++row) {
+    const int v = layout.blockVertex[at(layout.firstBlock + row)];
+    const auto vi = static_cast<std::size_t>(v);
+    const auto countColumn = [&](int w) {
+      const auto wi = static_cast<std::size_t>(w);
+      if (stamp[wi] == v) return;
+      stamp[wi] = v;
+      const PetscInt block = layout.vertexBlock[wi];
+      if (block < 0) return;
+      (isOwned(block) ? layout.diagonalBlocks : layout.offDiagonalBlocks)[at(row)] += 1;
+    };
+    countColumn(v);  // the diagonal block is always stored
+    for (int k = adjacencyStart[vi]; k < adjacencyStart[vi + 1]; ++k) {
+      const int e = adjacency[static_cast<std::size_t>(k)];
+      for (int a = 0; a < 4; ++a) countColumn(elements(a, e));
+    }
+  }
+  return layout;
+}
+
+}  // namespace asyncfem::detail

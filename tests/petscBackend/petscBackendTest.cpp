@@ -1,0 +1,463 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The PETSc backend against the single-process CHOLMOD integrators, across 1, 2 and 3
+// ranks (ctest runs this executable under mpiexec -n 1, 2, 3), and its failure paths.
+// Every test is collective: all ranks run it; trajectories live on rank 0, so the
+// comparisons run there, after every collective call of the test.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
+#include <asyncfem/forceModel/linearForceModel.hpp>
+#include <asyncfem/integrator/backwardEuler.hpp>
+#include <asyncfem/integrator/trapezoidal.hpp>
+#include <asyncfem/petscBackend/partition.hpp>
+#include <asyncfem/petscBackend/petscRuntime.hpp>
+#include <asyncfem/petscBackend/petscSimulation.hpp>
+#include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace asyncfem::test {
+namespace {
+
+int worldRank() {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  return rank;
+}
+
+int worldSize() {
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  return size;
+}
+
+constexpr double kTimestep = 0.02;
+constexpr int kSteps = 15;
+constexpr double kSolverTolerance = 1e-10;  // relative residual of the iterative solves
+
+/// A 1 x 0.2 x 0.2 cantilever (12 x 3 x 3 cubes, 648 tets, 208 vertices) of soft rubber,
+/// x = 0 face fixed, sagging under gravity: tip deflection of ~0.1 in 0.5 s, rotations
+/// large enough that corotational and linear FEM differ visibly.
+TetMesh beamMesh() {
+  BoxMeshSpec spec;
+  spec.size = Eigen::Vector3d(1.0, 0.2, 0.2);
+  spec.cells = Eigen::Vector3i(12, 3, 3);
+  spec.material = Material{"rubber", 1000.0, 1e6, 0.45};
+  return makeBoxMesh(spec);
+}
+
+const Eigen::Vector3d kGravity(0.0, -9.81, 0.0);
+
+PetscSimulationSettings beamSettings(const TetMesh& mesh, PetscIntegratorKind integrator, PetscForceModelKind model,
+                                     PetscSolverKind solver) {
+  PetscSimulationSettings settings;
+  settings.integrator = integrator;
+  settings.forceModel = model;
+  settings.timestep = kTimestep;
+  settings.fixedVertices = mesh.vertexSet("xmin");
+  settings.gravity = kGravity;
+  settings.solver.kind = solver;
+  settings.solver.relativeTolerance = kSolverTolerance;
+  return settings;
+}
+
+/// The single-process reference: the integrator library's BackwardEuler or Trapezoidal
+/// with CHOLMOD on the same mesh, fixed vertices and gravity M g.
+std::vector<Eigen::VectorXd> computeCholmodTrajectory(const TetMesh& mesh, PetscIntegratorKind integrator,
+                                                      PetscForceModelKind model, double alpha = 0.0,
+                                                      double beta = 0.0) {
+  auto assembler = std::make_shared<const MatrixAssembler>(mesh);
+  DynamicSystem system;
+  if (model == PetscForceModelKind::linear) {
+    system.forceModel = std::make_shared<LinearForceModel>(linearStiffnessMatrix(mesh, *assembler));
+  } else {
+    system.forceModel = std::make_shared<CorotationalLinearFEM>(mesh, assembler, TangentKind::simple);
+  }
+  system.mass = massMatrix(mesh, *assembler, MassType::consistent);
+  system.freeDofs = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("xmin"));
+  system.rayleighMass = alpha;
+  system.rayleighStiffness = beta;
+  const Eigen::VectorXd gravityForce = system.mass * kGravity.replicate(mesh.numVertices(), 1);
+  system.externalForce = [gravityForce](double, const Eigen::VectorXd&, const Eigen::VectorXd&,
+                                        Eigen::VectorXd& forces) { forces += gravityForce; };
+  std::unique_ptr<Integrator> reference;
+  if (integrator == PetscIntegratorKind::backwardEuler) {
+    reference = std::make_unique<BackwardEuler>(system, kTimestep);
+  } else {
+    reference = std::make_unique<Trapezoidal>(system, kTimestep);
+  }
+  std::vector<Eigen::VectorXd> trajectory;
+  for (int k = 0; k < kSteps; ++k) {
+    reference->step();
+    trajectory.push_back(reference->displacement());
+  }
+  return trajectory;
+}
+
+/// The same, computed once per integrator and model (rank 0 computes while the other
+/// ranks wait, so the tests stay short under MPI).
+const std::vector<Eigen::VectorXd>& cholmodTrajectory(const TetMesh& mesh, PetscIntegratorKind integrator,
+                                                      PetscForceModelKind model) {
+  static std::map<std::pair<PetscIntegratorKind, PetscForceModelKind>, std::vector<Eigen::VectorXd>> cache;
+  const auto key = std::make_pair(integrator, model);
+  auto it = cache.find(key);
+  if (it == cache.end()) it = cache.emplace(key, computeCholmodTrajectory(mesh, integrator, model)).first;
+  return it->second;
+}
+
+/// Condition number of the free backward-Euler matrix M + h^2 K at rest (dense, 624
+/// DOFs): the factor between a solve's relative residual and its relative error.
+double systemConditionNumber(const TetMesh& mesh) {
+  MatrixAssembler assembler(mesh);
+  const FreeDofs dofs = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("xmin"));
+  const Eigen::SparseMatrix<double> full = massMatrix(mesh, assembler, MassType::consistent) +
+                                           (kTimestep * kTimestep) * linearStiffnessMatrix(mesh, assembler);
+  const auto n = static_cast<Eigen::Index>(dofs.numFree());
+  const Eigen::MatrixXd dense(full);
+  Eigen::MatrixXd free(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index j = 0; j < n; ++j) free(i, j) = dense(dofs.freeToFull()[i], dofs.freeToFull()[j]);
+  }
+  const Eigen::VectorXd eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(free).eigenvalues();
+  return eigenvalues.maxCoeff() / eigenvalues.minCoeff();
+}
+
+/// Largest |a_k - b_k|_inf over the steps, relative to the largest |b_k|_inf.
+double trajectoryDifference(const std::vector<Eigen::VectorXd>& a, const std::vector<Eigen::VectorXd>& b) {
+  double difference = 0.0;
+  double scale = 0.0;
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    difference = std::max(difference, (a[k] - b[k]).lpNorm<Eigen::Infinity>());
+    scale = std::max(scale, b[k].lpNorm<Eigen::Infinity>());
+  }
+  return difference / std::max(scale, 1e-300);
+}
+
+/// Tolerance of a PETSc trajectory against CHOLMOD's. An iterative solve stops at a
+/// relative residual of 1e-10, so each step's increment has a relative error of at most
+/// kappa * 1e-10 (kappa ~ 4.5e3 here, the condition number of the system matrix); the
+/// displacement accumulates h times these increments, whose summed size is about the
+/// final displacement for this sagging beam, and a factor 10 covers that sum, the
+/// mixing of 2- and max-norms and the corotated tangent's condition number differing
+/// from the one at rest: 10 kappa 1e-10 ~ 5e-6. Direct solves are exact up to rounding,
+/// kappa * 1e-15 per solve with the same factor: ~5e-11.
+double comparisonTolerance(const TetMesh& mesh, PetscSolverKind solver) {
+  static const double kappa = systemConditionNumber(mesh);
+  const double perStep = solver == PetscSolverKind::mumps ? 1e-15 : kSolverTolerance;
+  return 10.0 * kappa * perStep;
+}
+
+class PetscVersusCholmod
+    : public ::testing::TestWithParam<std::tuple<PetscIntegratorKind, PetscForceModelKind, PetscSolverKind>> {};
+
+TEST_P(PetscVersusCholmod, TrajectoryMatchesToSolverTolerance) {
+  const auto [integrator, model, solver] = GetParam();
+  const TetMesh mesh = beamMesh();
+  const PetscTrajectory petsc = runPetscSimulation(mesh, beamSettings(mesh, integrator, model, solver), kSteps);
+  EXPECT_EQ(petsc.stats.ranks, worldSize());
+  EXPECT_EQ(petsc.stats.steps, kSteps);
+  if (worldRank() != 0) {
+    EXPECT_TRUE(petsc.displacements.empty());
+    return;
+  }
+  const std::vector<Eigen::VectorXd>& reference = cholmodTrajectory(mesh, integrator, model);
+  ASSERT_EQ(petsc.displacements.size(), reference.size());
+  const double tolerance = comparisonTolerance(mesh, solver);
+  ASSERT_LT(tolerance, 1e-4) << "the condition number makes the comparison meaningless";
+  // The motion is not trivial: the tip sags by more than 1% of the length.
+  ASSERT_GT(reference.back().lpNorm<Eigen::Infinity>(), 1e-2);
+  EXPECT_LE(trajectoryDifference(petsc.displacements, reference), tolerance)
+      << toString(integrator) << " " << toString(model) << " " << toString(solver) << " on " << worldSize()
+      << " ranks, " << petsc.stats.solverIterations << " iterations";
+}
+
+std::string caseName(const ::testing::TestParamInfo<PetscVersusCholmod::ParamType>& info) {
+  std::string name = toString(std::get<1>(info.param)) + "_" + toString(std::get<2>(info.param));
+  std::replace(name.begin(), name.end(), '-', '_');
+  return name;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BackwardEuler, PetscVersusCholmod,
+    ::testing::Combine(::testing::Values(PetscIntegratorKind::backwardEuler),
+                       ::testing::Values(PetscForceModelKind::linear, PetscForceModelKind::corotational),
+                       ::testing::Values(PetscSolverKind::cgGamg, PetscSolverKind::cgHypre, PetscSolverKind::mumps)),
+    caseName);
+INSTANTIATE_TEST_SUITE_P(Trapezoidal, PetscVersusCholmod,
+                         ::testing::Combine(::testing::Values(PetscIntegratorKind::trapezoidal),
+                                            ::testing::Values(PetscForceModelKind::linear,
+                                                              PetscForceModelKind::corotational),
+                                            ::testing::Values(PetscSolverKind::cgGamg, PetscSolverKind::mumps)),
+                         caseName);
+
+// Corotational and linear trajectories differ here by far more than the comparison
+// tolerance, so the corotational comparison above could not pass with the wrong model.
+TEST(PetscBackend, CorotationalDiffersFromLinear) {
+  const TetMesh mesh = beamMesh();
+  const PetscTrajectory linear = runPetscSimulation(
+      mesh, beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear, PetscSolverKind::mumps),
+      kSteps);
+  const PetscTrajectory corotational = runPetscSimulation(
+      mesh,
+      beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::corotational, PetscSolverKind::mumps),
+      kSteps);
+  if (worldRank() != 0) return;
+  EXPECT_GT(trajectoryDifference(corotational.displacements, linear.displacements),
+            1e3 * comparisonTolerance(mesh, PetscSolverKind::cgGamg));
+}
+
+// Rayleigh damping D = alpha M + beta K(u_k) enters both integrators as in the
+// single-process ones (same tolerances as above; the damping only lowers kappa's effect).
+TEST(PetscBackend, DampedTrajectoriesMatchCholmod) {
+  const TetMesh mesh = beamMesh();
+  const double alpha = 0.5;
+  const double beta = 2e-3;
+  for (const auto& [integrator, model, solver] :
+       {std::make_tuple(PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear, PetscSolverKind::cgGamg),
+        std::make_tuple(PetscIntegratorKind::trapezoidal, PetscForceModelKind::corotational, PetscSolverKind::mumps)}) {
+    PetscSimulationSettings settings = beamSettings(mesh, integrator, model, solver);
+    settings.rayleighMass = alpha;
+    settings.rayleighStiffness = beta;
+    const PetscTrajectory petsc = runPetscSimulation(mesh, settings, kSteps);
+    if (worldRank() != 0) continue;
+    const std::vector<Eigen::VectorXd> reference = computeCholmodTrajectory(mesh, integrator, model, alpha, beta);
+    // The damping changes the motion by far more than the tolerance (it is exercised).
+    EXPECT_GT(trajectoryDifference(cholmodTrajectory(mesh, integrator, model), reference), 1e-4);
+    EXPECT_LE(trajectoryDifference(petsc.displacements, reference), comparisonTolerance(mesh, solver))
+        << toString(integrator) << " " << toString(model);
+  }
+}
+
+// PETSc options given in the settings reach the solver (and only this simulation's).
+TEST(PetscBackend, OptionsDatabasePassesThrough) {
+  const TetMesh mesh = beamMesh();
+  PetscSimulationSettings settings =
+      beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear, PetscSolverKind::cgGamg);
+  settings.solver.options = "-ksp_type minres -pc_type jacobi";
+  const PetscTrajectory minres = runPetscSimulation(mesh, settings, kSteps);
+  EXPECT_EQ(minres.stats.kspType, "minres");
+  EXPECT_EQ(minres.stats.pcType, "jacobi");
+  settings.solver.options.clear();
+  const PetscTrajectory gamg = runPetscSimulation(mesh, settings, 1);
+  EXPECT_EQ(gamg.stats.kspType, "cg");
+  EXPECT_EQ(gamg.stats.pcType, "gamg");
+  if (worldRank() != 0) return;
+  const std::vector<Eigen::VectorXd>& reference =
+      cholmodTrajectory(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear);
+  EXPECT_LE(trajectoryDifference(minres.displacements, reference), comparisonTolerance(mesh, PetscSolverKind::cgGamg));
+}
+
+// The METIS partition covers every element with balanced, non-empty parts (METIS's
+// default imbalance allowance is 3%; 5% leaves room for rounding on 648 elements).
+TEST(PetscBackend, PartitionIsBalanced) {
+  const TetMesh mesh = beamMesh();
+  for (int parts : {1, 2, 3}) {
+    const std::vector<int> partition = partitionElements(mesh, parts);
+    ASSERT_EQ(static_cast<int>(partition.size()), mesh.numElements());
+    std::vector<int> sizes(static_cast<std::size_t>(parts), 0);
+    for (int p : partition) {
+      ASSERT_GE(p, 0);
+      ASSERT_LT(p, parts);
+      ++sizes[static_cast<std::size_t>(p)];
+    }
+    const double average = static_cast<double>(mesh.numElements()) / parts;
+    EXPECT_LE(*std::max_element(sizes.begin(), sizes.end()), 1.05 * average + 1.0) << parts << " parts";
+    EXPECT_GT(*std::min_element(sizes.begin(), sizes.end()), 0) << parts << " parts";
+  }
+  EXPECT_THROW(partitionElements(mesh, 0), ValidationError);
+}
+
+// A flat element (four coplanar vertices of the x = 1 face) is detected by the one rank
+// that assembles it; every rank must throw, naming that rank and the element, instead
+// of the other ranks waiting in the matrix assembly (ctest's timeout guards the hang).
+TEST(PetscBackendFailure, DegenerateElementOnOneRankStopsEveryRank) {
+  const TetMesh good = beamMesh();
+  const std::vector<int>& face = good.vertexSet("xmax");
+  Eigen::Matrix4Xi elements(4, good.numElements() + 1);
+  elements.leftCols(good.numElements()) = good.elements();
+  elements.col(good.numElements()) << face[0], face[1], face[4], face[5];
+  std::vector<int> materials(static_cast<std::size_t>(good.numElements()) + 1, 0);
+  TetMesh mesh(good.restPositions(), elements, good.materials(), materials);
+  mesh.setVertexSet("xmin", good.vertexSet("xmin"));
+  const int flat = good.numElements();
+  const int owner = partitionElements(mesh, worldSize())[static_cast<std::size_t>(flat)];
+  try {
+    runPetscSimulation(
+        mesh,
+        beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear, PetscSolverKind::mumps), 2);
+    ADD_FAILURE() << "no exception on rank " << worldRank();
+  } catch (const ValidationError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("rank " + std::to_string(owner) + ":"), std::string::npos) << message;
+    EXPECT_NE(message.find("element " + std::to_string(flat) + " is degenerate"), std::string::npos) << message;
+  }
+}
+
+// A force callback that fails on the last rank only, at the third step: every rank
+// gets the error (same type, the failing rank named), and the backend stays usable.
+TEST(PetscBackendFailure, CallbackThrowingOnOneRankStopsEveryRank) {
+  const TetMesh mesh = beamMesh();
+  PetscSimulationSettings settings = beamSettings(mesh, PetscIntegratorKind::backwardEuler,
+                                                  PetscForceModelKind::corotational, PetscSolverKind::cgGamg);
+  const int failing = worldSize() - 1;
+  settings.timeDependentForce = [failing](double time, Eigen::VectorXd&) {
+    if (worldRank() == failing && time > 2.5 * kTimestep) throw NumericalError("injected failure");
+  };
+  PetscSimulation simulation(mesh, settings);
+  simulation.step();
+  simulation.step();
+  try {
+    simulation.step();
+    ADD_FAILURE() << "no exception on rank " << worldRank();
+  } catch (const NumericalError& error) {
+    EXPECT_EQ(std::string(error.what()), "rank " + std::to_string(failing) + ": injected failure");
+  }
+  // Still usable afterwards: the collective calls are in step on every rank.
+  const PetscTrajectory after = runPetscSimulation(
+      mesh, beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear, PetscSolverKind::mumps),
+      1);
+  EXPECT_EQ(after.stats.steps, 1);
+}
+
+// A non-finite external force is reported on every rank with the vertex and time.
+TEST(PetscBackendFailure, NonFiniteForceIsReported) {
+  const TetMesh mesh = beamMesh();
+  PetscSimulationSettings settings =
+      beamSettings(mesh, PetscIntegratorKind::trapezoidal, PetscForceModelKind::linear, PetscSolverKind::mumps);
+  const int vertex = mesh.vertexSet("xmax").front();
+  settings.timeDependentForce = [vertex](double time, Eigen::VectorXd& forces) {
+    if (time > 1.5 * kTimestep) forces[(3 * vertex) + 1] = std::nan("");
+  };
+  try {
+    runPetscSimulation(mesh, settings, 3);
+    ADD_FAILURE() << "no exception on rank " << worldRank();
+  } catch (const NumericalError& error) {
+    EXPECT_NE(std::string(error.what()).find("(vertex " + std::to_string(vertex) + ", coordinate 1)"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
+// The last rank holds a different (coarser) mesh: every rank stops with the same error
+// before any collective call sized by the mesh. Needs two ranks to mean anything.
+TEST(PetscBackendFailure, DifferentMeshOnOneRankStopsEveryRank) {
+  if (worldSize() < 2) GTEST_SKIP() << "needs at least 2 ranks (ctest PetscBackend.np2, .np3)";
+  BoxMeshSpec spec;
+  spec.size = Eigen::Vector3d(1.0, 0.2, 0.2);
+  spec.cells = worldRank() == worldSize() - 1 ? Eigen::Vector3i(11, 3, 3) : Eigen::Vector3i(12, 3, 3);
+  const TetMesh mesh = makeBoxMesh(spec);
+  try {
+    PetscSimulation simulation(mesh, beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear,
+                                                  PetscSolverKind::mumps));
+    ADD_FAILURE() << "no exception on rank " << worldRank();
+  } catch (const ValidationError& error) {
+    EXPECT_NE(std::string(error.what()).find("the ranks hold different meshes"), std::string::npos) << error.what();
+  }
+}
+
+// A PETSc error (an unknown KSP type from the options) becomes an asyncfem::Error that
+// carries PETSc's own message.
+TEST(PetscBackendFailure, PetscErrorsBecomeExceptions) {
+  const TetMesh mesh = beamMesh();
+  PetscSimulationSettings settings =
+      beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear, PetscSolverKind::cgGamg);
+  settings.solver.options = "-ksp_type no_such_method";
+  try {
+    PetscSimulation simulation(mesh, settings);
+    ADD_FAILURE() << "no exception on rank " << worldRank();
+  } catch (const Error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("PETSc: KSPSetFromOptions failed"), std::string::npos) << message;
+    EXPECT_NE(message.find("no_such_method"), std::string::npos) << message;
+  }
+}
+
+// Bad settings: clear errors on every rank.
+TEST(PetscBackendFailure, BadSettingsAreRejected) {
+  const TetMesh mesh = beamMesh();
+  PetscSimulationSettings settings =
+      beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::linear, PetscSolverKind::mumps);
+  settings.fixedVertices.push_back(mesh.numVertices());
+  EXPECT_THROW(PetscSimulation(mesh, settings), ValidationError);
+  settings.fixedVertices.pop_back();
+  settings.timestep = -1.0;
+  EXPECT_THROW(PetscSimulation(mesh, settings), ValidationError);
+  EXPECT_THROW(parsePetscSolverKind("lu"), ValidationError);
+  EXPECT_EQ(parsePetscSolverKind("cg-hypre"), PetscSolverKind::cgHypre);
+}
+
+// Partition agreement across separate runs: with ASYNCFEM_PETSC_TRAJECTORY_DIR set, each
+// run (np = 1, 2, 3) stores its corotational trajectory; the ctest PetscBackend.PartitionsAgree
+// then compares them (PetscPartitions.Agree, with ASYNCFEM_PETSC_COMPARE_DIR).
+std::string trajectoryFile(const std::string& directory, int ranks) {
+  return directory + "/petsc-trajectory-np" + std::to_string(ranks) + ".bin";
+}
+
+TEST(PetscPartitions, StoreTrajectory) {
+  const TetMesh mesh = beamMesh();
+  const PetscTrajectory trajectory = runPetscSimulation(
+      mesh,
+      beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::corotational, PetscSolverKind::mumps),
+      kSteps);
+  const char* directory = std::getenv("ASYNCFEM_PETSC_TRAJECTORY_DIR");
+  if (worldRank() != 0 || directory == nullptr) return;
+  std::ofstream out(trajectoryFile(directory, worldSize()), std::ios::binary);
+  for (const Eigen::VectorXd& u : trajectory.displacements) {
+    out.write(reinterpret_cast<const char*>(u.data()), static_cast<std::streamsize>(u.size() * sizeof(double)));
+  }
+  ASSERT_TRUE(out.good());
+}
+
+// Direct solves on 1, 2 and 3 ranks differ only by the rounding of differently ordered
+// factorizations and sums: kappa * eps per step, the direct tolerance above.
+TEST(PetscPartitions, Agree) {
+  const char* directory = std::getenv("ASYNCFEM_PETSC_COMPARE_DIR");
+  ASSERT_NE(directory, nullptr) << "run through ctest (PetscBackend.PartitionsAgree)";
+  const TetMesh mesh = beamMesh();
+  std::vector<std::vector<Eigen::VectorXd>> runs;
+  for (int ranks : {1, 2, 3}) {
+    std::ifstream in(trajectoryFile(directory, ranks), std::ios::binary);
+    ASSERT_TRUE(in.good()) << trajectoryFile(directory, ranks);
+    std::vector<Eigen::VectorXd> trajectory(kSteps, Eigen::VectorXd(mesh.numDofs()));
+    for (Eigen::VectorXd& u : trajectory) {
+      in.read(reinterpret_cast<char*>(u.data()), static_cast<std::streamsize>(u.size() * sizeof(double)));
+    }
+    ASSERT_TRUE(in.good()) << "short file " << trajectoryFile(directory, ranks);
+    runs.push_back(std::move(trajectory));
+  }
+  const double tolerance = comparisonTolerance(mesh, PetscSolverKind::mumps);
+  EXPECT_LE(trajectoryDifference(runs[1], runs[0]), tolerance) << "2 ranks vs 1";
+  EXPECT_LE(trajectoryDifference(runs[2], runs[0]), tolerance) << "3 ranks vs 1";
+  EXPECT_GT(runs[0].back().lpNorm<Eigen::Infinity>(), 1e-2);
+}
+
+}  // namespace
+}  // namespace asyncfem::test
+
+// PETSc is initialized once for all tests; only rank 0 prints gtest's report, and the
+// exit status is the worst of all ranks, so a failure on any rank fails the ctest.
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  int status = 1;
+  {
+    asyncfem::PetscRuntime runtime(&argc, &argv);
+    if (runtime.rank() != 0) {
+      delete ::testing::UnitTest::GetInstance()->listeners().Release(
+          ::testing::UnitTest::GetInstance()->listeners().default_result_printer());
+    }
+    const int local = RUN_ALL_TESTS();
+    MPI_Allreduce(&local, &status, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  }
+  return status;
+}
