@@ -98,8 +98,16 @@ void printQuality(const TetMesh& mesh, const asyncfem::StuffingReport& stuffing,
   }
   std::printf("mesh: %d vertices, %d tetrahedra, %d boundary triangles, %d connected component%s\n", mesh.numVertices(),
               mesh.numElements(), check.boundaryTriangles, check.components, check.components == 1 ? "" : "s");
-  std::printf("quality: dihedral angles min %.2f, max %.2f degrees; worst aspect ratio %.3f\n",
-              quality.minDihedralDegrees, quality.maxDihedralDegrees, quality.worstAspectRatio);
+  std::printf(
+      "quality: dihedral angles min %.2f, max %.2f degrees (guaranteed 10.78 to 164.74); worst aspect ratio "
+      "%.3f\n",
+      quality.minDihedralDegrees, quality.maxDihedralDegrees, quality.worstAspectRatio);
+  if (check.pinchedBoundaryEdges > 0) {
+    std::printf(
+        "pinches: %d boundary edges where two sheets of the surface touch (parts or gaps thinner than the "
+        "spacing); valid, but a smaller --spacing resolves them\n",
+        check.pinchedBoundaryEdges);
+  }
   std::printf("checks: no inverted or degenerate element, every vertex used, boundary closed and outward\n");
 }
 
