@@ -80,6 +80,55 @@ TEST(TetMesherUtility, OpenSurfaceIsAnErrorUnlessRepaired) {
   EXPECT_GT(readVeg(veg).numElements(), 100);
 }
 
+TEST(TetMesherUtility, ReportsFidelityAndRefusesInputItCannotMeshFaithfully) {
+  // A closed sphere: volume and Hausdorff distance are reported, the latter below a spacing
+  // (boundary vertices lie on the surface; the 24 x 12 polyhedron's facets are within
+  // ~0.03 of the mesh boundary's, and the spacing is 0.15).
+  const auto sphereObj = scratch("sphere.obj");
+  std::ofstream(sphereObj) << test::toObj(test::uvSphere(Eigen::Vector3d::Zero(), 1.0, 24, 12));
+  const RunResult sphere = run(sphereObj.string() + " --spacing 0.15 -o " + scratch("sphere.veg").string());
+  ASSERT_EQ(sphere.status, 0) << sphere.output;
+  EXPECT_NE(sphere.output.find("volume: mesh"), std::string::npos) << sphere.output;
+  const std::size_t at = sphere.output.find("(", sphere.output.find("fidelity: Hausdorff distance"));
+  ASSERT_NE(at, std::string::npos) << sphere.output;
+  EXPECT_LT(std::stod(sphere.output.substr(at + 1)), 1.0) << sphere.output;  // in spacings
+
+  // Half a sphere is open far beyond repair: the winding number would invent the whole cap.
+  TriangleSurface half = test::uvSphere(Eigen::Vector3d::Zero(), 1.0, 24, 12);
+  Eigen::Matrix3Xi upper(3, 0);
+  for (int t = 0; t < half.numTriangles(); ++t) {
+    if (half.vertices.col(half.triangles(0, t)).z() + half.vertices.col(half.triangles(1, t)).z() +
+            half.vertices.col(half.triangles(2, t)).z() >
+        0.0) {
+      upper.conservativeResize(3, upper.cols() + 1);
+      upper.col(upper.cols() - 1) = half.triangles.col(t);
+    }
+  }
+  half.triangles = upper;
+  half.triangleParts.assign(static_cast<std::size_t>(upper.cols()), 0);
+  const auto halfObj = scratch("half.obj");
+  std::ofstream(halfObj) << test::toObj(half);
+  const RunResult open = run(halfObj.string() + " --repair --spacing 0.15 -o " + scratch("half.veg").string());
+  EXPECT_EQ(open.status, 1) << open.output;
+  EXPECT_NE(open.output.find("open beyond repair"), std::string::npos) << open.output;
+  EXPECT_NE(open.output.find("near ("), std::string::npos) << open.output;
+  EXPECT_NE(open.output.find("input triangle, #"), std::string::npos) << open.output;
+
+  // Two closed spheres overlapping: each is a manifold, together they intersect; the
+  // pseudonormal sign is wrong inside the overlap, so this is an error naming the place,
+  // and --repair meshes the union.
+  const auto overlapObj = scratch("overlap.obj");
+  std::ofstream(overlapObj) << test::toObj(
+      test::concatenate(test::uvSphere(Eigen::Vector3d(-0.4, 0, 0), 1.0, 24, 12), "a",
+                        test::uvSphere(Eigen::Vector3d(0.4, 0, 0), 1.0, 24, 12), "b"));
+  const RunResult overlap = run(overlapObj.string() + " --spacing 0.15 -o " + scratch("overlap.veg").string());
+  EXPECT_EQ(overlap.status, 1) << overlap.output;
+  EXPECT_NE(overlap.output.find("intersects or overlaps itself"), std::string::npos) << overlap.output;
+  EXPECT_NE(overlap.output.find("nearest triangle #"), std::string::npos) << overlap.output;
+  const RunResult united = run(overlapObj.string() + " --repair --spacing 0.15 -o " + scratch("overlap.veg").string());
+  EXPECT_EQ(united.status, 0) << united.output;
+}
+
 TEST(TetMesherUtility, BadOptionsAreErrors) {
   EXPECT_EQ(run("--model nosuch -o " + scratch("x.veg").string()).status, 1);
   EXPECT_NE(run("--model nosuch -o " + scratch("x.veg").string()).output.find("known: dinosaur"), std::string::npos);

@@ -462,8 +462,13 @@ TetMesh stuffIsosurface(const ImplicitFunction& f, const Eigen::AlignedBox3d& bo
     StencilBuilder builder(lattice, signs, warped, cuts);
     const long long latticeTets = fillAll(builder);
     if (builder.elements.empty()) {
-      throw ValidationError("stuffIsosurface: no element: the solid is empty at spacing " + std::to_string(spacing) +
-                            " (is f negative inside, and is the spacing small enough for the shape?)");
+      std::ostringstream message;
+      message << "stuffIsosurface: no element: no lattice vertex lies inside the solid at spacing " << spacing;
+      if (*std::min_element(values.begin(), values.end()) >= 0.0)
+        message << " (f >= 0 at every one: the solid is thinner than the lattice everywhere, or empty, or f is not "
+                   "negative inside); try a spacing below "
+                << 0.5 * spacing;
+      throw ValidationError(message.str());
     }
     Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(builder.positions.size()));
     for (std::size_t v = 0; v < builder.positions.size(); ++v)
