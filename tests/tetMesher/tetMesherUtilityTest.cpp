@@ -129,6 +129,36 @@ TEST(TetMesherUtility, ReportsFidelityAndRefusesInputItCannotMeshFaithfully) {
   EXPECT_EQ(united.status, 0) << united.output;
 }
 
+TEST(TetMesherUtility, AShellAroundACoreBecomesATwoMaterialMeshInOneCommand) {
+  // Two nested closed spheres in OBJ groups "shell" (radius 1) and "core" (radius 0.5): the
+  // winding number meshes the union, the core's elements are those its own triangles enclose.
+  const auto obj = scratch("shell.obj");
+  std::ofstream(obj) << test::toObj(test::concatenate(test::uvSphere(Eigen::Vector3d::Zero(), 1.0, 32, 16), "shell",
+                                                      test::uvSphere(Eigen::Vector3d::Zero(), 0.5, 24, 12), "core"));
+  const auto veg = scratch("shell.veg");
+  const double spacing = 0.1;
+  const RunResult result = run(obj.string() + " --repair --spacing 0.1 --group-sets --material core:3000,1e8,0.3 " +
+                               "--material shell:1000,1e5,0.45 -o " + veg.string());
+  ASSERT_EQ(result.status, 0) << result.output;
+  const TetMesh mesh = readVeg(veg);
+  ASSERT_FALSE(mesh.elementSet("core").empty());
+  ASSERT_FALSE(mesh.elementSet("shell").empty());
+  EXPECT_EQ(mesh.elementSet("core").size() + mesh.elementSet("shell").size(),
+            static_cast<std::size_t>(mesh.numElements()));
+  // Every element is in the material of its side of the inner sphere, up to one element
+  // size (a centroid lies within about a spacing of the sphere it is assigned by).
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const double r = mesh.elementRestPositions(e).rowwise().mean().norm();
+    const std::string& material = mesh.elementMaterial(e).name;
+    if (r < 0.5 - spacing) EXPECT_EQ(material, "core") << "element " << e << " at radius " << r;
+    if (r > 0.5 + spacing) EXPECT_EQ(material, "shell") << "element " << e << " at radius " << r;
+  }
+  // Material ids of the file work the same way (toObj writes no materials: one default).
+  const RunResult materials = run(obj.string() + " --repair --spacing 0.2 --material-sets -o " + veg.string());
+  EXPECT_EQ(materials.status, 0) << materials.output;
+  EXPECT_NE(materials.output.find("set "), std::string::npos) << materials.output;
+}
+
 TEST(TetMesherUtility, BadOptionsAreErrors) {
   EXPECT_EQ(run("--model nosuch -o " + scratch("x.veg").string()).status, 1);
   EXPECT_NE(run("--model nosuch -o " + scratch("x.veg").string()).output.find("known: dinosaur"), std::string::npos);

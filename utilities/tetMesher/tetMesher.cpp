@@ -10,6 +10,7 @@
 // The report goes to stdout; errors print "tetMesher: <message>" on stderr and exit 1
 // (2 for unusable command-line options). docs/tet-mesher.md describes everything.
 #include <CLI/CLI.hpp>
+#include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/threading.hpp>
 #include <asyncfem/tetMesher/elementSets.hpp>
@@ -28,6 +29,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "commandLine.hpp"
@@ -105,14 +107,7 @@ int dropDegenerateTriangles(asyncfem::TriangleSurface& surface) {
   for (int t = 0; t < surface.numTriangles(); ++t)
     if (!zeroArea(surface, t)) keep.push_back(t);
   const int dropped = surface.numTriangles() - static_cast<int>(keep.size());
-  Eigen::Matrix3Xi triangles(3, static_cast<Eigen::Index>(keep.size()));
-  std::vector<int> parts;
-  for (std::size_t i = 0; i < keep.size(); ++i) {
-    triangles.col(static_cast<Eigen::Index>(i)) = surface.triangles.col(keep[i]);
-    parts.push_back(surface.triangleParts[static_cast<std::size_t>(keep[i])]);
-  }
-  surface.triangles = triangles;
-  surface.triangleParts = parts;
+  asyncfem::selectTriangles(surface, keep);
   return dropped;
 }
 
@@ -124,6 +119,8 @@ struct Options {
   int cells = 0;
   std::vector<std::string> boxSets;
   bool partSets = false;
+  bool materialSets = false;
+  bool groupSets = false;
   std::vector<std::string> materials;
   std::string defaultMaterial;
   bool repair = false;
@@ -219,14 +216,15 @@ int run(const Options& options) {
       const Eigen::Vector3d at = surface.vertices.col(surface.triangles(0, first));
       if (mode == asyncfem::SignMode::Pseudonormal) {
         throw ValidationError(options.input + ": " + std::to_string(topology.degenerateTriangles) +
-                              " triangles have zero area, e.g. triangle #" + std::to_string(first) + " at " +
-                              describe(at) +
+                              " triangles have zero area, e.g. triangle #" +
+                              std::to_string(asyncfem::inputTriangleIndex(surface, first)) + " at " + describe(at) +
                               "; their normals are undefined, so inside and outside cannot be told there (remove "
                               "them, or mesh with --repair, which ignores them)");
       }
       const int dropped = dropDegenerateTriangles(surface);
       if (!options.quiet) {
-        std::printf("repair: %d zero-area triangles ignored (e.g. #%d at %s)\n", dropped, first, describe(at).c_str());
+        std::printf("repair: %d zero-area triangles ignored (e.g. #%d at %s)\n", dropped,
+                    asyncfem::inputTriangleIndex(surface, first), describe(at).c_str());
       }
     }
     if (topology.signedVolume < 0.0) {
@@ -265,9 +263,12 @@ int run(const Options& options) {
           "%s (triangle #%d)\n",
           deviation.hausdorff(), deviation.hausdorff() / spacing, deviation.meshToSurface,
           describe(deviation.meshToSurfaceAt).c_str(), deviation.surfaceToMesh,
-          describe(deviation.surfaceToMeshAt).c_str(), deviation.surfaceToMeshTriangle);
+          describe(deviation.surfaceToMeshAt).c_str(),
+          asyncfem::inputTriangleIndex(distance->surface(), deviation.surfaceToMeshTriangle));
     }
-    if (options.partSets) asyncfem::addNearestPartSets(mesh, *distance);
+    if (options.partSets) asyncfem::addSurfaceLabelSets(mesh, *distance, asyncfem::SurfaceLabel::Part);
+    if (options.materialSets) asyncfem::addSurfaceLabelSets(mesh, *distance, asyncfem::SurfaceLabel::Material);
+    if (options.groupSets) asyncfem::addSurfaceLabelSets(mesh, *distance, asyncfem::SurfaceLabel::Group);
   }
   for (const std::string& text : options.boxSets) {
     const auto [name, numbers] = splitName(text, "--set");
@@ -316,8 +317,17 @@ int main(int argc, char** argv) {
   app.add_option("--set", options.boxSets,
                  "Element and vertex set of the elements whose centroid lies in a box: "
                  "NAME:xmin,ymin,zmin,xmax,ymax,zmax (repeatable)");
-  app.add_flag("--part-sets", options.partSets,
-               "One set per named surface part (assimp mesh/node name): the elements nearest that part");
+  // Surface label sets (addSurfaceLabelSets): by assimp part, file material or named group.
+  const std::array<std::tuple<const char*, bool*, const char*>, 3> labelSets{{
+      {"--part-sets", &options.partSets, "named surface part (assimp mesh/node name)"},
+      {"--material-sets", &options.materialSets, "material of the surface file"},
+      {"--group-sets", &options.groupSets, "named group of the surface file (OBJ g/o, glTF/FBX nodes)"},
+  }};
+  for (const auto& [flag, target, what] : labelSets) {
+    app.add_flag(flag, *target,
+                 std::string("One set per ") + what +
+                     ", named after it: the elements inside its triangles (innermost first), else nearest to them");
+  }
   app.add_option("--material", options.materials,
                  "Material of a set: SET:density,youngsModulus,poissonRatio (repeatable)");
   app.add_option("--default-material", options.defaultMaterial,

@@ -109,7 +109,8 @@ double requireRepairableHoles(const TetMesh& mesh, const SignedDistance& distanc
   out << source << ": open beyond repair: " << 100.0 * fraction
       << "% of the mesh boundary is more than a spacing from every input triangle (limit " << 100.0 * maxFraction
       << "%): the winding number spans large openings, the widest near " << point(farthestAt) << ", " << farthest
-      << " from the nearest input triangle, #" << triangle << "; close the surface around that place";
+      << " from the nearest input triangle, #" << inputTriangleIndex(distance.surface(), triangle)
+      << "; close the surface around that place";
   throw ValidationError(out.str());
 }
 
@@ -127,7 +128,8 @@ void requireNoSelfOverlap(const TetMesh& mesh, const SignedDistance& distance, c
       std::ostringstream out;
       out.precision(4);
       out << source << ": the surface intersects or overlaps itself: the point " << point(x)
-          << " is enclosed with winding number " << w << " (nearest triangle #" << triangle
+          << " is enclosed with winding number " << w << " (nearest triangle #"
+          << inputTriangleIndex(distance.surface(), triangle)
           << "); remove the overlap, or mesh the union of the shells with --repair (generalized winding number)";
       throw ValidationError(out.str());
     }

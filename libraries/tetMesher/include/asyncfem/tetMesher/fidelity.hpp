@@ -17,7 +17,7 @@ struct SurfaceDeviation {
   Eigen::Vector3d meshToSurfaceAt = Eigen::Vector3d::Zero();
   double surfaceToMesh = 0.0;  ///< max over the input surface of the distance to the boundary
   Eigen::Vector3d surfaceToMeshAt = Eigen::Vector3d::Zero();
-  int surfaceToMeshTriangle = -1;  ///< input triangle holding surfaceToMeshAt
+  int surfaceToMeshTriangle = -1;  ///< triangle of distance.surface() holding surfaceToMeshAt
   double hausdorff() const { return meshToSurface > surfaceToMesh ? meshToSurface : surfaceToMesh; }
 };
 
