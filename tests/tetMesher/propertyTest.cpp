@@ -11,10 +11,12 @@
 #include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
 #include <asyncfem/tetMesher/meshChecks.hpp>
 #include <asyncfem/tetMesher/signedDistance.hpp>
+#include <asyncfem/tetMesher/triangleSurface.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <numbers>
 #include <random>
 #include <string>
@@ -175,6 +177,40 @@ TEST(StuffingProperties, OpenSurfacesThroughTheWindingNumber) {
     EXPECT_NEAR(totalVolume(mesh), exact, 0.05 * exact) << "trial " << trial;
   }
   extremes.print("open surfaces");
+}
+
+TEST(StuffingProperties, RealSurfacesFromAssimpTestModels) {
+  // Debian's assimp-testmodels, when installed (not a build dependency): closed and open
+  // real surfaces, each at several spacings; closed ones must also keep their volume.
+  const std::filesystem::path models("/usr/share/assimp/models");
+  if (!surfaceReaderAvailable() || !std::filesystem::is_directory(models))
+    GTEST_SKIP() << "assimp-testmodels not installed (apt-get install assimp-testmodels)";
+  Extremes extremes;
+  for (const char* relative : {"Collada/duck.dae", "3DS/fels.3ds", "FBX/huesitos.fbx", "OBJ/WusonOBJ.obj",
+                               "OBJ/spider.obj", "glTF/CesiumMilkTruck/CesiumMilkTruck.gltf"}) {
+    const std::filesystem::path path = models / relative;
+    if (!std::filesystem::exists(path)) continue;
+    TriangleSurface surface = readSurface(path);
+    const Eigen::AlignedBox3d bounds = surface.bounds();
+    weldVertices(surface, 1e-7 * bounds.diagonal().norm());
+    const SurfaceTopology topology = surfaceTopology(surface);
+    if (topology.signedVolume < 0.0) flipOrientation(surface);
+    const bool closed = topology.closed();
+    const SignedDistance distance(surface, closed ? SignMode::Pseudonormal : SignMode::WindingNumber);
+    for (int cells : {9, 16}) {
+      const double spacing = bounds.sizes().maxCoeff() / cells;
+      const Eigen::AlignedBox3d box(bounds.min().array() - spacing, bounds.max().array() + spacing);
+      const TetMesh mesh = expectValid(distance.function(), box, spacing,
+                                       std::string(relative) + " cells " + std::to_string(cells), extremes);
+      // A closed surface at 16 cells: within 5% of its volume (the inscribed boundary loses
+      // about h^2 times the curvature over the area; 2% is met at 30 cells, see the benchmark).
+      if (closed && cells == 16) {
+        const double enclosed = std::abs(topology.signedVolume);
+        EXPECT_NEAR(totalVolume(mesh), enclosed, 0.05 * enclosed) << relative;
+      }
+    }
+  }
+  extremes.print("assimp test models");
 }
 
 }  // namespace
