@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/implicit.hpp>
 #include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
 #include <asyncfem/tetMesher/meshChecks.hpp>
@@ -177,6 +178,34 @@ TEST(StuffingProperties, OpenSurfacesThroughTheWindingNumber) {
     EXPECT_NEAR(totalVolume(mesh), exact, 0.05 * exact) << "trial " << trial;
   }
   extremes.print("open surfaces");
+}
+
+TEST(StuffingProperties, EverySpacingFromTheCoarsestWorks) {
+  // An open, non-smooth input (a sphere with holes, through the winding number) at every
+  // spacing from its diameter down to 1/16 of it: each run either meshes validly or, when too coarse
+  // for any lattice vertex to be inside, says so; once one spacing works, every finer one
+  // works too.
+  TriangleSurface sphere = test::uvSphere(Vector3d(0.01, -0.02, 0.03), 1.0, 20, 10);
+  std::vector<int> keep;
+  for (int t = 0; t < sphere.numTriangles(); ++t)
+    if (t % 17 != 3) keep.push_back(t);
+  selectTriangles(sphere, keep);
+  const SignedDistance distance(sphere, SignMode::WindingNumber);
+  const Eigen::AlignedBox3d box(Vector3d::Constant(-1.1), Vector3d::Constant(1.1));
+  Extremes extremes;
+  bool worked = false;
+  for (int cells = 1; cells <= 16; ++cells) {
+    const double spacing = 2.0 / cells;
+    try {
+      expectValid(distance.function(), box, spacing, "cells " + std::to_string(cells), extremes);
+      worked = true;
+    } catch (const ValidationError& e) {
+      EXPECT_FALSE(worked) << "cells " << cells << " failed after a coarser spacing worked: " << e.what();
+      EXPECT_NE(std::string(e.what()).find("no lattice vertex lies inside"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(worked);
+  extremes.print("spacing sweep");
 }
 
 TEST(StuffingProperties, RealSurfacesFromAssimpTestModels) {
