@@ -185,7 +185,15 @@ int run(const Options& options) {
     if (options.cells > 0) throw ValidationError("--cells applies to surfaces; give --spacing for a model");
     if (spacing <= 0.0) spacing = asyncfem::exampleModelShape(model).spacing;
     mesh = asyncfem::makeExampleModel(model, spacing, &stuffing);
-    if (!options.quiet) std::printf("model: %s\n", options.model.c_str());
+    if (!options.quiet) {
+      const asyncfem::ImplicitModel shape = asyncfem::exampleModelShape(model);
+      Eigen::Vector3d at = Eigen::Vector3d::Zero();
+      const double deviation =
+          asyncfem::implicitDeviation(mesh, asyncfem::implicitUnionOfParts(shape.parts, shape.blend), &at);
+      std::printf("model: %s\n", options.model.c_str());
+      std::printf("fidelity: mesh boundary to surface at most %.4g (%.2f spacings, |f| sampled) at %s\n", deviation,
+                  deviation / spacing, describe(at).c_str());
+    }
   } else {
     asyncfem::TriangleSurface surface = asyncfem::readSurface(options.input);
     requireFiniteVertices(surface, options.input);
