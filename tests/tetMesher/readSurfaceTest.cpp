@@ -86,3 +86,40 @@ TEST(ReadSurface, MissingOrEmptyFilesAreErrors) {
 
 }  // namespace
 }  // namespace asyncfem
+
+namespace asyncfem {
+namespace {
+
+TEST(ReadSurface, ObjGroupsAndMaterialsLabelTriangles) {
+  // Two tetrahedra in groups "left" and "right"; "left" has two materials.
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 3 0 0\nv 4 0 0\nv 3 1 0\nv 3 0 1\n"
+      "g left\nusemtl red\nf 1 3 2\nf 1 2 4\nusemtl blue\nf 1 4 3\nf 2 3 4\n"
+      "g right\nusemtl blue\nf 5 7 6\nf 5 6 8\nf 5 8 7\nf 6 7 8\n";
+  TriangleSurface surface = readSurface(writeTemp("groups.obj", obj));
+  weldVertices(surface, 1e-9);
+  ASSERT_EQ(surface.numTriangles(), 8);
+  ASSERT_EQ(surface.triangleGroups.size(), 8u);
+  ASSERT_EQ(surface.triangleMaterials.size(), 8u);
+  auto count = [](const std::vector<int>& labels, const std::vector<std::string>& names, const std::string& name) {
+    int n = 0;
+    for (int label : labels) n += names[static_cast<std::size_t>(label)] == name ? 1 : 0;
+    return n;
+  };
+  EXPECT_EQ(count(surface.triangleGroups, surface.groupNames, "left"), 4);
+  EXPECT_EQ(count(surface.triangleGroups, surface.groupNames, "right"), 4);
+  EXPECT_EQ(count(surface.triangleMaterials, surface.materialNames, "red"), 2);
+  EXPECT_EQ(count(surface.triangleMaterials, surface.materialNames, "blue"), 6);
+  // Group sets by containment: every element of a tetrahedron goes to its group.
+  const SignedDistance distance(surface, SignMode::WindingNumber);
+  TetMesh mesh = stuffIsosurface(distance.function(), surface.bounds(), 0.1);
+  const std::vector<int> counts = addSurfaceLabelSets(mesh, distance, SurfaceLabel::Group);
+  int total = 0;
+  for (int c : counts) total += c;
+  EXPECT_EQ(total, mesh.numElements());
+  for (int e : mesh.elementSet("left")) EXPECT_LT(mesh.elementRestPositions(e).row(0).mean(), 2.0) << e;
+  for (int e : mesh.elementSet("right")) EXPECT_GT(mesh.elementRestPositions(e).row(0).mean(), 2.0) << e;
+}
+
+}  // namespace
+}  // namespace asyncfem

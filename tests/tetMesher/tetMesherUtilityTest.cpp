@@ -80,6 +80,85 @@ TEST(TetMesherUtility, OpenSurfaceIsAnErrorUnlessRepaired) {
   EXPECT_GT(readVeg(veg).numElements(), 100);
 }
 
+TEST(TetMesherUtility, ReportsFidelityAndRefusesInputItCannotMeshFaithfully) {
+  // A closed sphere: volume and Hausdorff distance are reported, the latter below a spacing
+  // (boundary vertices lie on the surface; the 24 x 12 polyhedron's facets are within
+  // ~0.03 of the mesh boundary's, and the spacing is 0.15).
+  const auto sphereObj = scratch("sphere.obj");
+  std::ofstream(sphereObj) << test::toObj(test::uvSphere(Eigen::Vector3d::Zero(), 1.0, 24, 12));
+  const RunResult sphere = run(sphereObj.string() + " --spacing 0.15 -o " + scratch("sphere.veg").string());
+  ASSERT_EQ(sphere.status, 0) << sphere.output;
+  EXPECT_NE(sphere.output.find("volume: mesh"), std::string::npos) << sphere.output;
+  const std::size_t at = sphere.output.find("(", sphere.output.find("fidelity: Hausdorff distance"));
+  ASSERT_NE(at, std::string::npos) << sphere.output;
+  EXPECT_LT(std::stod(sphere.output.substr(at + 1)), 1.0) << sphere.output;  // in spacings
+
+  // Half a sphere is open far beyond repair: the winding number would invent the whole cap.
+  TriangleSurface half = test::uvSphere(Eigen::Vector3d::Zero(), 1.0, 24, 12);
+  Eigen::Matrix3Xi upper(3, 0);
+  for (int t = 0; t < half.numTriangles(); ++t) {
+    if (half.vertices.col(half.triangles(0, t)).z() + half.vertices.col(half.triangles(1, t)).z() +
+            half.vertices.col(half.triangles(2, t)).z() >
+        0.0) {
+      upper.conservativeResize(3, upper.cols() + 1);
+      upper.col(upper.cols() - 1) = half.triangles.col(t);
+    }
+  }
+  half.triangles = upper;
+  half.triangleParts.assign(static_cast<std::size_t>(upper.cols()), 0);
+  const auto halfObj = scratch("half.obj");
+  std::ofstream(halfObj) << test::toObj(half);
+  const RunResult open = run(halfObj.string() + " --repair --spacing 0.15 -o " + scratch("half.veg").string());
+  EXPECT_EQ(open.status, 1) << open.output;
+  EXPECT_NE(open.output.find("open beyond repair"), std::string::npos) << open.output;
+  EXPECT_NE(open.output.find("near ("), std::string::npos) << open.output;
+  EXPECT_NE(open.output.find("input triangle, #"), std::string::npos) << open.output;
+
+  // Two closed spheres overlapping: each is a manifold, together they intersect; the
+  // pseudonormal sign is wrong inside the overlap, so this is an error naming the place,
+  // and --repair meshes the union.
+  const auto overlapObj = scratch("overlap.obj");
+  std::ofstream(overlapObj) << test::toObj(
+      test::concatenate(test::uvSphere(Eigen::Vector3d(-0.4, 0, 0), 1.0, 24, 12), "a",
+                        test::uvSphere(Eigen::Vector3d(0.4, 0, 0), 1.0, 24, 12), "b"));
+  const RunResult overlap = run(overlapObj.string() + " --spacing 0.15 -o " + scratch("overlap.veg").string());
+  EXPECT_EQ(overlap.status, 1) << overlap.output;
+  EXPECT_NE(overlap.output.find("intersects or overlaps itself"), std::string::npos) << overlap.output;
+  EXPECT_NE(overlap.output.find("nearest triangle #"), std::string::npos) << overlap.output;
+  const RunResult united = run(overlapObj.string() + " --repair --spacing 0.15 -o " + scratch("overlap.veg").string());
+  EXPECT_EQ(united.status, 0) << united.output;
+}
+
+TEST(TetMesherUtility, AShellAroundACoreBecomesATwoMaterialMeshInOneCommand) {
+  // Two nested closed spheres in OBJ groups "shell" (radius 1) and "core" (radius 0.5): the
+  // winding number meshes the union, the core's elements are those its own triangles enclose.
+  const auto obj = scratch("shell.obj");
+  std::ofstream(obj) << test::toObj(test::concatenate(test::uvSphere(Eigen::Vector3d::Zero(), 1.0, 32, 16), "shell",
+                                                      test::uvSphere(Eigen::Vector3d::Zero(), 0.5, 24, 12), "core"));
+  const auto veg = scratch("shell.veg");
+  const double spacing = 0.1;
+  const RunResult result = run(obj.string() + " --repair --spacing 0.1 --group-sets --material core:3000,1e8,0.3 " +
+                               "--material shell:1000,1e5,0.45 -o " + veg.string());
+  ASSERT_EQ(result.status, 0) << result.output;
+  const TetMesh mesh = readVeg(veg);
+  ASSERT_FALSE(mesh.elementSet("core").empty());
+  ASSERT_FALSE(mesh.elementSet("shell").empty());
+  EXPECT_EQ(mesh.elementSet("core").size() + mesh.elementSet("shell").size(),
+            static_cast<std::size_t>(mesh.numElements()));
+  // Every element is in the material of its side of the inner sphere, up to one element
+  // size (a centroid lies within about a spacing of the sphere it is assigned by).
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const double r = mesh.elementRestPositions(e).rowwise().mean().norm();
+    const std::string& material = mesh.elementMaterial(e).name;
+    if (r < 0.5 - spacing) EXPECT_EQ(material, "core") << "element " << e << " at radius " << r;
+    if (r > 0.5 + spacing) EXPECT_EQ(material, "shell") << "element " << e << " at radius " << r;
+  }
+  // Material ids of the file work the same way (toObj writes no materials: one default).
+  const RunResult materials = run(obj.string() + " --repair --spacing 0.2 --material-sets -o " + veg.string());
+  EXPECT_EQ(materials.status, 0) << materials.output;
+  EXPECT_NE(materials.output.find("set "), std::string::npos) << materials.output;
+}
+
 TEST(TetMesherUtility, BadOptionsAreErrors) {
   EXPECT_EQ(run("--model nosuch -o " + scratch("x.veg").string()).status, 1);
   EXPECT_NE(run("--model nosuch -o " + scratch("x.veg").string()).output.find("known: dinosaur"), std::string::npos);

@@ -10,10 +10,12 @@
 // The report goes to stdout; errors print "tetMesher: <message>" on stderr and exit 1
 // (2 for unusable command-line options). docs/tet-mesher.md describes everything.
 #include <CLI/CLI.hpp>
+#include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/threading.hpp>
 #include <asyncfem/tetMesher/elementSets.hpp>
 #include <asyncfem/tetMesher/exampleModels.hpp>
+#include <asyncfem/tetMesher/fidelity.hpp>
 #include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
 #include <asyncfem/tetMesher/meshChecks.hpp>
 #include <asyncfem/tetMesher/signedDistance.hpp>
@@ -27,6 +29,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "commandLine.hpp"
@@ -70,6 +73,44 @@ std::pair<std::string, std::string> splitName(const std::string& text, const std
   return {text.substr(0, colon), text.substr(colon + 1)};
 }
 
+std::string describe(const Eigen::Vector3d& x) {
+  char text[96];
+  std::snprintf(text, sizeof(text), "(%.6g, %.6g, %.6g)", x.x(), x.y(), x.z());
+  return text;
+}
+
+void requireFiniteVertices(const asyncfem::TriangleSurface& surface, const std::string& source) {
+  for (int v = 0; v < surface.numVertices(); ++v) {
+    if (!surface.vertices.col(v).allFinite()) {
+      throw ValidationError(source + ": vertex #" + std::to_string(v) + " has a non-finite coordinate");
+    }
+  }
+}
+
+bool zeroArea(const asyncfem::TriangleSurface& surface, int t) {
+  const Eigen::Vector3d a = surface.vertices.col(surface.triangles(0, t));
+  return (surface.vertices.col(surface.triangles(1, t)) - a)
+             .cross(surface.vertices.col(surface.triangles(2, t)) - a)
+             .norm() == 0.0;
+}
+
+int firstDegenerateTriangle(const asyncfem::TriangleSurface& surface) {
+  for (int t = 0; t < surface.numTriangles(); ++t)
+    if (zeroArea(surface, t)) return t;
+  return -1;
+}
+
+/// Removes zero-area triangles (they enclose nothing and add no winding number); returns
+/// how many.
+int dropDegenerateTriangles(asyncfem::TriangleSurface& surface) {
+  std::vector<int> keep;
+  for (int t = 0; t < surface.numTriangles(); ++t)
+    if (!zeroArea(surface, t)) keep.push_back(t);
+  const int dropped = surface.numTriangles() - static_cast<int>(keep.size());
+  asyncfem::selectTriangles(surface, keep);
+  return dropped;
+}
+
 struct Options {
   std::string input;
   std::string model;
@@ -78,9 +119,12 @@ struct Options {
   int cells = 0;
   std::vector<std::string> boxSets;
   bool partSets = false;
+  bool materialSets = false;
+  bool groupSets = false;
   std::vector<std::string> materials;
   std::string defaultMaterial;
   bool repair = false;
+  double maxHole = 0.2;
   double weldTolerance = -1.0;
   bool quiet = false;
 };
@@ -98,8 +142,16 @@ void printQuality(const TetMesh& mesh, const asyncfem::StuffingReport& stuffing,
   }
   std::printf("mesh: %d vertices, %d tetrahedra, %d boundary triangles, %d connected component%s\n", mesh.numVertices(),
               mesh.numElements(), check.boundaryTriangles, check.components, check.components == 1 ? "" : "s");
-  std::printf("quality: dihedral angles min %.2f, max %.2f degrees; worst aspect ratio %.3f\n",
-              quality.minDihedralDegrees, quality.maxDihedralDegrees, quality.worstAspectRatio);
+  std::printf(
+      "quality: dihedral angles min %.2f, max %.2f degrees (guaranteed 10.78 to 164.74); worst aspect ratio "
+      "%.3f\n",
+      quality.minDihedralDegrees, quality.maxDihedralDegrees, quality.worstAspectRatio);
+  if (check.pinchedBoundaryEdges > 0) {
+    std::printf(
+        "pinches: %d boundary edges where two sheets of the surface touch (parts or gaps thinner than the "
+        "spacing); valid, but a smaller --spacing resolves them\n",
+        check.pinchedBoundaryEdges);
+  }
   std::printf("checks: no inverted or degenerate element, every vertex used, boundary closed and outward\n");
 }
 
@@ -133,9 +185,18 @@ int run(const Options& options) {
     if (options.cells > 0) throw ValidationError("--cells applies to surfaces; give --spacing for a model");
     if (spacing <= 0.0) spacing = asyncfem::exampleModelShape(model).spacing;
     mesh = asyncfem::makeExampleModel(model, spacing, &stuffing);
-    if (!options.quiet) std::printf("model: %s\n", options.model.c_str());
+    if (!options.quiet) {
+      const asyncfem::ImplicitModel shape = asyncfem::exampleModelShape(model);
+      Eigen::Vector3d at = Eigen::Vector3d::Zero();
+      const double deviation =
+          asyncfem::implicitDeviation(mesh, asyncfem::implicitUnionOfParts(shape.parts, shape.blend), &at);
+      std::printf("model: %s\n", options.model.c_str());
+      std::printf("fidelity: mesh boundary to surface at most %.4g (%.2f spacings, |f| sampled) at %s\n", deviation,
+                  deviation / spacing, describe(at).c_str());
+    }
   } else {
     asyncfem::TriangleSurface surface = asyncfem::readSurface(options.input);
+    requireFiniteVertices(surface, options.input);
     const int inputVertices = surface.numVertices();
     const Eigen::AlignedBox3d inputBounds = surface.bounds();
     const double diagonal = inputBounds.diagonal().norm();
@@ -148,14 +209,30 @@ int run(const Options& options) {
                   options.input.c_str(), surface.numTriangles(), surface.numVertices(), welded, inputVertices,
                   tolerance, surface.partNames.size(), surface.partNames.size() == 1 ? "" : "s");
     }
+    if (options.repair) mode = asyncfem::SignMode::WindingNumber;
     if (!topology.closed()) {
       if (!options.repair) asyncfem::requireClosedSurface(surface, options.input);
-      mode = asyncfem::SignMode::WindingNumber;
       if (!options.quiet) {
         std::printf(
             "repair: the surface is not closed (%d open, %d non-manifold, %d inconsistently oriented edges, "
             "e.g. %s); inside/outside from the generalized winding number\n",
             topology.boundaryEdges, topology.nonManifoldEdges, topology.misorientedEdges, topology.example.c_str());
+      }
+    }
+    if (topology.degenerateTriangles > 0) {
+      const int first = firstDegenerateTriangle(surface);
+      const Eigen::Vector3d at = surface.vertices.col(surface.triangles(0, first));
+      if (mode == asyncfem::SignMode::Pseudonormal) {
+        throw ValidationError(options.input + ": " + std::to_string(topology.degenerateTriangles) +
+                              " triangles have zero area, e.g. triangle #" +
+                              std::to_string(asyncfem::inputTriangleIndex(surface, first)) + " at " + describe(at) +
+                              "; their normals are undefined, so inside and outside cannot be told there (remove "
+                              "them, or mesh with --repair, which ignores them)");
+      }
+      const int dropped = dropDegenerateTriangles(surface);
+      if (!options.quiet) {
+        std::printf("repair: %d zero-area triangles ignored (e.g. #%d at %s)\n", dropped,
+                    asyncfem::inputTriangleIndex(surface, first), describe(at).c_str());
       }
     }
     if (topology.signedVolume < 0.0) {
@@ -167,12 +244,39 @@ int run(const Options& options) {
     distance.emplace(std::move(surface), mode);
     const Eigen::AlignedBox3d bounds(inputBounds.min().array() - spacing, inputBounds.max().array() + spacing);
     mesh = asyncfem::stuffIsosurface(distance->function(), bounds, spacing, mesherOptions, &stuffing);
-    if (!options.quiet && enclosed > 0.0) {
-      const double volume = asyncfem::totalVolume(mesh);
-      std::printf("volume: mesh %.6g, surface %.6g (%+.2f%%)\n", volume, enclosed,
-                  100.0 * (volume - enclosed) / enclosed);
+    const asyncfem::SurfaceDeviation deviation = asyncfem::surfaceDeviation(mesh, *distance);
+    if (mode == asyncfem::SignMode::WindingNumber) {
+      const double invented =
+          asyncfem::requireRepairableHoles(mesh, *distance, spacing, options.maxHole, options.input);
+      if (!options.quiet) {
+        std::printf("repair: %.2f%% of the boundary spans openings of the input (more than a spacing from it)\n",
+                    100.0 * invented);
+      }
+    } else {
+      asyncfem::requireNoSelfOverlap(mesh, *distance, options.input);
     }
-    if (options.partSets) asyncfem::addNearestPartSets(mesh, *distance);
+    if (!options.quiet) {
+      const double volume = asyncfem::totalVolume(mesh);
+      if (mode == asyncfem::SignMode::Pseudonormal && enclosed > 0.0) {
+        std::printf("volume: mesh %.6g, surface %.6g (%+.2f%%)\n", volume, enclosed,
+                    100.0 * (volume - enclosed) / enclosed);
+      } else {
+        std::printf(
+            "volume: mesh %.6g (the open surface encloses no definite volume; its divergence-theorem "
+            "value is %.6g)\n",
+            volume, enclosed);
+      }
+      std::printf(
+          "fidelity: Hausdorff distance %.4g (%.2f spacings): mesh to surface %.4g at %s, surface to mesh %.4g at "
+          "%s (triangle #%d)\n",
+          deviation.hausdorff(), deviation.hausdorff() / spacing, deviation.meshToSurface,
+          describe(deviation.meshToSurfaceAt).c_str(), deviation.surfaceToMesh,
+          describe(deviation.surfaceToMeshAt).c_str(),
+          asyncfem::inputTriangleIndex(distance->surface(), deviation.surfaceToMeshTriangle));
+    }
+    if (options.partSets) asyncfem::addSurfaceLabelSets(mesh, *distance, asyncfem::SurfaceLabel::Part);
+    if (options.materialSets) asyncfem::addSurfaceLabelSets(mesh, *distance, asyncfem::SurfaceLabel::Material);
+    if (options.groupSets) asyncfem::addSurfaceLabelSets(mesh, *distance, asyncfem::SurfaceLabel::Group);
   }
   for (const std::string& text : options.boxSets) {
     const auto [name, numbers] = splitName(text, "--set");
@@ -221,8 +325,17 @@ int main(int argc, char** argv) {
   app.add_option("--set", options.boxSets,
                  "Element and vertex set of the elements whose centroid lies in a box: "
                  "NAME:xmin,ymin,zmin,xmax,ymax,zmax (repeatable)");
-  app.add_flag("--part-sets", options.partSets,
-               "One set per named surface part (assimp mesh/node name): the elements nearest that part");
+  // Surface label sets (addSurfaceLabelSets): by assimp part, file material or named group.
+  const std::array<std::tuple<const char*, bool*, const char*>, 3> labelSets{{
+      {"--part-sets", &options.partSets, "named surface part (assimp mesh/node name)"},
+      {"--material-sets", &options.materialSets, "material of the surface file"},
+      {"--group-sets", &options.groupSets, "named group of the surface file (OBJ g/o, glTF/FBX nodes)"},
+  }};
+  for (const auto& [flag, target, what] : labelSets) {
+    app.add_flag(flag, *target,
+                 std::string("One set per ") + what +
+                     ", named after it: the elements inside its triangles (innermost first), else nearest to them");
+  }
   app.add_option("--material", options.materials,
                  "Material of a set: SET:density,youngsModulus,poissonRatio (repeatable)");
   app.add_option("--default-material", options.defaultMaterial,
@@ -230,6 +343,10 @@ int main(int argc, char** argv) {
                  "(default 1000,1e6,0.45)");
   app.add_flag("--repair", options.repair,
                "Mesh a surface with holes or non-manifold edges using the generalized winding number");
+  app.add_option("--max-hole", options.maxHole,
+                 "With --repair: the largest share of the mesh boundary that may span openings of the input "
+                 "(farther than a spacing from it; default 0.2); more is an error naming the place")
+      ->check(asyncfem::cli::positive());
   app.add_option("--weld-tolerance", options.weldTolerance,
                  "Merge surface vertices closer than this (default 1e-7 x bounding-box diagonal)");
   app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");

@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
+#include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/elementSets.hpp>
+#include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 
 namespace asyncfem {
 
@@ -76,6 +79,69 @@ std::vector<int> addNearestPartSets(TetMesh& mesh, const SignedDistance& distanc
   for (std::size_t p = 0; p < members.size(); ++p) {
     counts.push_back(static_cast<int>(members[p].size()));
     if (!members[p].empty()) setElementAndVertexSet(mesh, surface.partNames[p], std::move(members[p]));
+  }
+  return counts;
+}
+
+std::vector<int> addSurfaceLabelSets(TetMesh& mesh, const SignedDistance& distance, SurfaceLabel kind) {
+  const TriangleSurface& surface = distance.surface();
+  const std::vector<int>* labels = nullptr;
+  const std::vector<std::string>* names = nullptr;
+  const char* what = "";
+  switch (kind) {
+    case SurfaceLabel::Part:
+      labels = &surface.triangleParts, names = &surface.partNames, what = "parts";
+      break;
+    case SurfaceLabel::Material:
+      labels = &surface.triangleMaterials, names = &surface.materialNames, what = "materials";
+      break;
+    case SurfaceLabel::Group:
+      labels = &surface.triangleGroups, names = &surface.groupNames, what = "named groups";
+      break;
+  }
+  if (labels->size() != static_cast<std::size_t>(surface.numTriangles()) || names->empty()) {
+    throw ValidationError(std::string("the surface has no ") + what + " to make element sets from");
+  }
+  // Every label's triangles as a surface of their own, for its winding number.
+  struct Label {
+    std::unique_ptr<SignedDistance> distance;
+    Eigen::AlignedBox3d box;
+    double volume = 0.0;
+  };
+  std::vector<Label> byLabel(names->size());
+  for (std::size_t l = 0; l < names->size(); ++l) {
+    std::vector<int> keep;
+    for (int t = 0; t < surface.numTriangles(); ++t)
+      if ((*labels)[static_cast<std::size_t>(t)] == static_cast<int>(l)) keep.push_back(t);
+    if (keep.empty()) continue;
+    TriangleSurface own = surface;
+    selectTriangles(own, keep);
+    byLabel[l].box = own.bounds();
+    byLabel[l].volume = std::abs(surfaceTopology(own).signedVolume);
+    byLabel[l].distance = std::make_unique<SignedDistance>(std::move(own), SignMode::WindingNumber);
+  }
+  std::vector<std::vector<int>> members(names->size());
+  const Eigen::Matrix3Xd centroids = elementCentroids(mesh);
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const Eigen::Vector3d x = centroids.col(e);
+    int best = -1;
+    for (std::size_t l = 0; l < byLabel.size(); ++l) {
+      const Label& label = byLabel[l];
+      if (!label.distance || !label.box.contains(x)) continue;
+      if (std::abs(label.distance->windingNumber(x)) <= 0.5) continue;
+      if (best < 0 || label.volume < byLabel[static_cast<std::size_t>(best)].volume) best = static_cast<int>(l);
+    }
+    if (best < 0) {
+      int triangle = -1;
+      distance.distance(x, &triangle);
+      best = (*labels)[static_cast<std::size_t>(triangle)];
+    }
+    members[static_cast<std::size_t>(best)].push_back(e);
+  }
+  std::vector<int> counts;
+  for (std::size_t l = 0; l < members.size(); ++l) {
+    counts.push_back(static_cast<int>(members[l].size()));
+    if (!members[l].empty()) setElementAndVertexSet(mesh, (*names)[l], std::move(members[l]));
   }
   return counts;
 }

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -35,6 +36,19 @@ struct BccLattice {
   }
   long long red(int i, int j, int k) const {
     return numBlack() + i + static_cast<long long>(cells.x()) * (j + static_cast<long long>(cells.y()) * k);
+  }
+  /// Twice the lattice coordinates: black (2i, 2j, 2k), red (2i+1, 2j+1, 2k+1).
+  Eigen::Vector3i doubled(long long id) const {
+    if (!isRed(id)) {
+      const long long nx = cells.x() + 1, ny = cells.y() + 1;
+      return 2 * Eigen::Vector3i(static_cast<int>(id % nx), static_cast<int>((id / nx) % ny),
+                                 static_cast<int>(id / (nx * ny)));
+    }
+    const long long r = id - numBlack();
+    const long long nx = cells.x(), ny = cells.y();
+    return 2 * Eigen::Vector3i(static_cast<int>(r % nx), static_cast<int>((r / nx) % ny),
+                               static_cast<int>(r / (nx * ny))) +
+           Eigen::Vector3i::Ones();
   }
   Eigen::Vector3d position(long long id) const {
     if (!isRed(id)) {
@@ -107,7 +121,8 @@ class StencilBuilder {
                  const std::unordered_map<std::uint64_t, Eigen::Vector3d>& cuts)
       : lattice_(lattice), signs_(signs), warped_(warped), cuts_(cuts) {}
 
-  /// Fills the part of lattice tetrahedron (b0, b1, r0, r1) where f <= 0.
+  /// Fills the part of lattice tetrahedron `tet` where f <= 0 with the stencil of its sign
+  /// pattern (Labelle & Shewchuk 2007, Figure 4; - inside, 0 on the surface, + outside).
   void fill(const std::array<long long, 4>& tet) {
     std::array<long long, 4> neg{}, zero{}, pos{};
     int numNeg = 0, numZero = 0, numPos = 0;
@@ -120,67 +135,66 @@ class StencilBuilder {
       else
         pos[static_cast<std::size_t>(numPos++)] = v;
     }
-    // No inside vertex: nothing to fill. This includes tetrahedra whose four vertices were
-    // all warped onto the surface; keeping those would break the angle bound (they can be
-    // nearly flat slivers lying along the surface).
+    // No inside vertex: nothing to fill. This includes tetrahedra whose four vertices all lie
+    // on the surface, which the stencils discard.
     if (numNeg == 0) return;
     if (numPos == 0) {
       emit(lat(tet[0]), lat(tet[1]), lat(tet[2]), lat(tet[3]));
       return;
     }
-    if (numPos == 1) {
-      const long long p = pos[0];
-      if (numNeg == 3) {
-        // Corner cut off: a prism between the three inside vertices and their cut points.
-        const std::array<long long, 3> o{neg[0], neg[1], neg[2]};
-        std::array<int, 3> a{}, b{};
-        std::array<Diagonal, 3> diagonals{};
-        for (int i = 0; i < 3; ++i) {
-          a[static_cast<std::size_t>(i)] = lat(o[static_cast<std::size_t>(i)]);
-          b[static_cast<std::size_t>(i)] = cut(p, o[static_cast<std::size_t>(i)]);
-        }
-        for (int i = 0; i < 3; ++i) {
-          const bool fromFirst =
-              diagonalFromFirst(o[static_cast<std::size_t>(i)], o[static_cast<std::size_t>((i + 1) % 3)]);
-          diagonals[static_cast<std::size_t>(i)] = fromFirst ? Diagonal::Forward : Diagonal::Backward;
-        }
-        emitPrism(a, b, diagonals);
-      } else if (numNeg == 2) {
-        // Pyramid: apex at the surface vertex, base quad in the face (p, n0, n1).
-        const long long n0 = neg[0], n1 = neg[1];
-        const int apex = lat(zero[0]);
-        const int A = lat(n0), B = lat(n1), cA = cut(p, n0), cB = cut(p, n1);
-        if (diagonalFromFirst(n0, n1)) {
-          emit(apex, A, B, cB);
-          emit(apex, A, cB, cA);
-        } else {
-          emit(apex, A, B, cA);
-          emit(apex, B, cB, cA);
-        }
+    if (numNeg == 1) {
+      // One inside vertex: a single tetrahedron from it, the surface vertices and the cut
+      // points on its edges to the outside vertices.
+      const long long n = neg[0];
+      std::array<int, 4> t{lat(n), 0, 0, 0};
+      int k = 1;
+      for (int i = 0; i < numZero; ++i) t[static_cast<std::size_t>(k++)] = lat(zero[static_cast<std::size_t>(i)]);
+      for (int i = 0; i < numPos; ++i) t[static_cast<std::size_t>(k++)] = cut(n, pos[static_cast<std::size_t>(i)]);
+      emit(t[0], t[1], t[2], t[3]);
+      return;
+    }
+    if (numNeg == 2 && numZero == 1) {
+      // Pyramid: apex at the surface vertex, base quadrilateral in the face (p, n0, n1).
+      const long long n0 = neg[0], n1 = neg[1], p = pos[0];
+      const int apex = lat(zero[0]);
+      const int A = lat(n0), B = lat(n1), cA = cut(p, n0), cB = cut(p, n1);
+      if (diagonalAtFirst(n0, n1, p)) {
+        emit(apex, A, B, cB);
+        emit(apex, A, cB, cA);
       } else {
-        emit(lat(neg[0]), lat(zero[0]), lat(zero[1]), cut(p, neg[0]));
+        emit(apex, A, B, cA);
+        emit(apex, B, cB, cA);
       }
       return;
     }
-    if (numPos == 2) {
-      const long long p0 = pos[0], p1 = pos[1];
-      if (numNeg == 2) {
-        // Wedge around the inside edge (n0, n1): a prism whose triangles hold n0 and n1.
-        const long long n0 = neg[0], n1 = neg[1];
-        const std::array<int, 3> a{lat(n0), cut(p0, n0), cut(p1, n0)};
-        const std::array<int, 3> b{lat(n1), cut(p0, n1), cut(p1, n1)};
-        const bool fromFirst = diagonalFromFirst(n0, n1);
-        std::array<Diagonal, 3> diagonals{fromFirst ? Diagonal::Forward : Diagonal::Backward, Diagonal::Free,
-                                          fromFirst ? Diagonal::Backward : Diagonal::Forward};
-        emitPrism(a, b, diagonals);
-      } else {
-        const long long n = neg[0];
-        emit(lat(n), lat(zero[0]), cut(p0, n), cut(p1, n));
-      }
+    if (numNeg == 2) {
+      // Two inside, two outside: a prism around the inside edge (n0, n1) whose two lattice
+      // quadrilaterals follow the face rule; the third (inside the lattice tetrahedron) is
+      // split so that the prism falls into three tetrahedra.
+      const long long n0 = neg[0], n1 = neg[1], p0 = pos[0], p1 = pos[1];
+      const std::array<int, 3> a{lat(n0), cut(p0, n0), cut(p1, n0)};
+      const std::array<int, 3> b{lat(n1), cut(p0, n1), cut(p1, n1)};
+      // Quad 0 is (a0, a1, b1, b0) in face (p0, n0, n1): Forward is a0 - b1 = n0 - c(p0, n1).
+      // Quad 2 is (a2, a0, b0, b2) in face (p1, n0, n1): Forward is a2 - b0 = c(p1, n0) - n1.
+      const Diagonal quad0 = diagonalAtFirst(n0, n1, p0) ? Diagonal::Forward : Diagonal::Backward;
+      const Diagonal quad2 = diagonalAtFirst(n0, n1, p1) ? Diagonal::Backward : Diagonal::Forward;
+      emitPrism(a, b, {quad0, Diagonal::Free, quad2});
       return;
     }
-    const long long n = neg[0];
-    emit(lat(n), cut(pos[0], n), cut(pos[1], n), cut(pos[2], n));
+    // Three inside, one outside: the corner at p is cut off, leaving a prism between the
+    // inside face and the three cut points; each quadrilateral lies in a lattice face.
+    const long long p = pos[0];
+    const std::array<long long, 3> o{neg[0], neg[1], neg[2]};
+    std::array<int, 3> a{}, b{};
+    std::array<Diagonal, 3> diagonals{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      a[i] = lat(o[i]);
+      b[i] = cut(p, o[i]);
+    }
+    // Quad i is (a_i, a_{i+1}, b_{i+1}, b_i): Forward is a_i - b_{i+1} = o_i - c(p, o_{i+1}).
+    for (std::size_t i = 0; i < 3; ++i)
+      diagonals[i] = diagonalAtFirst(o[i], o[(i + 1) % 3], p) ? Diagonal::Forward : Diagonal::Backward;
+    emitPrism(a, b, diagonals);
   }
 
   std::vector<Eigen::Vector3d> positions;
@@ -220,16 +234,25 @@ class StencilBuilder {
     return it->second;
   }
 
-  /// The quadrilateral (A, B, c(P,B), c(P,A)) that a face (P, A, B) with A, B inside and P
-  /// outside leaves is split either by the diagonal A - c(P,B) (returns true) or by
-  /// B - c(P,A). The choice depends only on A and B, so the two lattice tetrahedra sharing
-  /// the face agree. For a short (black-red) edge the diagonal leaves the red vertex, so
-  /// in a corner-cut prism (one outside vertex) the two short-edge quads share a vertex and
-  /// the prism always splits into three tetrahedra; for a long edge the lower id decides.
-  bool diagonalFromFirst(long long A, long long B) const {
-    const bool redA = lattice_.isRed(A), redB = lattice_.isRed(B);
-    if (redA != redB) return redA;
-    return A < B;
+  /// The quadrilateral (A, B, c(P,B), c(P,A)) that a lattice face (P, A, B) with A, B
+  /// inside and P outside leaves is split either by the diagonal A - c(P,B) (returns true)
+  /// or by B - c(P,A). Every lattice face has one long edge (axis-parallel: black-black or
+  /// red-red) and two short ones. If the long edge runs from P, its cut point takes the
+  /// diagonal; if it is A - B, the paper's parity rule decides: with c the cut point on
+  /// B - P, count the coordinates in which A exceeds c; A - c is the diagonal when that
+  /// count is even on a red long edge or odd on a black one. The rule depends only on the
+  /// face (swapping A and B flips the count's parity), so the two lattice tetrahedra
+  /// sharing the face agree, and it is what the angle bound of the paper assumes.
+  bool diagonalAtFirst(long long A, long long B, long long P) const {
+    const Eigen::Vector3i a = lattice_.doubled(A), b = lattice_.doubled(B), p = lattice_.doubled(P);
+    const bool redA = lattice_.isRed(A), redB = lattice_.isRed(B), redP = lattice_.isRed(P);
+    if (redP == redA) return false;  // long edge P - A: c(P,A) takes the diagonal to B
+    if (redP == redB) return true;   // long edge P - B: c(P,B) takes the diagonal to A
+    // Long edge A - B. c lies strictly inside B - P, so each coordinate of A - c has the
+    // sign of 2A - B - P (doubled lattice coordinates, never zero).
+    const Eigen::Vector3i d = 2 * a - b - p;
+    const int exceeds = (d.x() > 0) + (d.y() > 0) + (d.z() > 0);
+    return (exceeds + (redA ? 0 : 1)) % 2 == 0;
   }
 
   void emit(int a, int b, int c, int d) {
@@ -439,8 +462,13 @@ TetMesh stuffIsosurface(const ImplicitFunction& f, const Eigen::AlignedBox3d& bo
     StencilBuilder builder(lattice, signs, warped, cuts);
     const long long latticeTets = fillAll(builder);
     if (builder.elements.empty()) {
-      throw ValidationError("stuffIsosurface: no element: the solid is empty at spacing " + std::to_string(spacing) +
-                            " (is f negative inside, and is the spacing small enough for the shape?)");
+      std::ostringstream message;
+      message << "stuffIsosurface: no element: no lattice vertex lies inside the solid at spacing " << spacing;
+      if (*std::min_element(values.begin(), values.end()) >= 0.0)
+        message << " (f >= 0 at every one: the solid is thinner than the lattice everywhere, or empty, or f is not "
+                   "negative inside); try a spacing below "
+                << 0.5 * spacing;
+      throw ValidationError(message.str());
     }
     Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(builder.positions.size()));
     for (std::size_t v = 0; v < builder.positions.size(); ++v)
@@ -468,6 +496,27 @@ TetMesh stuffIsosurface(const ImplicitFunction& f, const Eigen::AlignedBox3d& bo
       }
       continue;
     }
+    const MeshQuality quality = meshQuality(mesh);
+    if (options.minDihedralDegrees > 0.0 && unwarped == 0 && quality.minDihedralDegrees < options.minDihedralDegrees) {
+      // Not the input's fault: the stencils guarantee 10.78 degrees for any function.
+      const std::vector<ElementQuality> qualities = elementQualities(mesh);
+      int worst = 0;
+      for (int e = 1; e < mesh.numElements(); ++e)
+        if (qualities[static_cast<std::size_t>(e)].minDihedralAngle <
+            qualities[static_cast<std::size_t>(worst)].minDihedralAngle)
+          worst = e;
+      const Eigen::Vector3d centre = mesh.elementRestPositions(worst).rowwise().mean();
+      std::ostringstream message;
+      message << "stuffIsosurface: internal error: element " << worst << " near (" << centre.x() << ", " << centre.y()
+              << ", " << centre.z() << ") has a dihedral angle of " << quality.minDihedralDegrees
+              << " degrees, below the guaranteed " << options.minDihedralDegrees << " (spacing " << spacing
+              << ", alphaLong " << options.alphaLong << ", alphaShort " << options.alphaShort
+              << "; the bound holds for the default alphas); the mesh was not returned";
+      throw Error(message.str());
+    }
+    if (options.check) {
+      validateTetMesh(mesh, "stuffIsosurface (spacing " + std::to_string(spacing) + ")");
+    }
     if (report != nullptr) {
       report->latticeVertices = numLattice;
       report->latticeTetrahedra = latticeTets;
@@ -476,10 +525,9 @@ TetMesh stuffIsosurface(const ImplicitFunction& f, const Eigen::AlignedBox3d& bo
       report->unwarpedVertices = unwarped;
       report->elements = mesh.numElements();
       report->vertices = mesh.numVertices();
-    }
-    if (options.check) {
-      validateTetMesh(mesh, "stuffIsosurface (spacing " + std::to_string(spacing) +
-                                "; a failure here usually means parts of the solid thinner than about two spacings)");
+      report->minDihedralDegrees = quality.minDihedralDegrees;
+      report->maxDihedralDegrees = quality.maxDihedralDegrees;
+      report->pinchedBoundaryEdges = static_cast<int>(nonManifoldBoundaryEdges(mesh).size());
     }
     return mesh;
   }

@@ -99,6 +99,10 @@ MeshCheckReport checkTetMesh(const TetMesh& mesh) {
     if (count == 1) {
       ++report.openBoundaryEdges;
       note(where + " belongs to one boundary triangle (open boundary)");
+    } else if (count > 2 && use[0] == use[1]) {
+      // Two (or more) sheets of the boundary touching along this edge: the solid is pinched
+      // there, which the elements represent correctly (every sheet is closed and outward).
+      ++report.pinchedBoundaryEdges;
     } else if (count > 2) {
       ++report.nonManifoldBoundaryEdges;
       note(where + " belongs to " + std::to_string(count) + " boundary triangles (non-manifold)");

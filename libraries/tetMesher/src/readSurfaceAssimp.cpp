@@ -25,23 +25,38 @@ struct Collector {
   const aiScene* scene = nullptr;
   std::vector<Eigen::Vector3d> vertices;
   std::vector<Eigen::Vector3i> triangles;
-  std::vector<int> parts;
-  std::vector<std::string> partNames;
-  std::map<std::string, int> partIndex;
+  std::vector<int> parts, materials, groups;
+  /// Names and their indices, for parts, materials and groups.
+  struct Names {
+    std::vector<std::string> names;
+    std::map<std::string, int> index;
+    int operator()(const std::string& name) {
+      const auto [it, inserted] = index.try_emplace(name, static_cast<int>(names.size()));
+      if (inserted) names.push_back(name);
+      return it->second;
+    }
+  };
+  Names partNames, materialNames, groupNames;
 
-  int part(const std::string& name) {
-    const auto [it, inserted] = partIndex.try_emplace(name, static_cast<int>(partNames.size()));
-    if (inserted) partNames.push_back(name);
-    return it->second;
-  }
-
-  void visit(const aiNode* node, const Eigen::Matrix4d& parentTransform) {
+  void visit(const aiNode* node, const Eigen::Matrix4d& parentTransform, const std::string& parentGroup) {
     const Eigen::Matrix4d transform = parentTransform * toEigen(node->mTransformation);
+    // The group is the node's own name (OBJ g/o, glTF and FBX nodes); unnamed nodes belong
+    // to their parent's group.
+    const bool named = node != scene->mRootNode && node->mName.length > 0;
+    const std::string group = named ? std::string(node->mName.C_Str()) : parentGroup;
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
       const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
       std::string name = mesh->mName.length > 0 ? std::string(mesh->mName.C_Str()) : std::string(node->mName.C_Str());
       if (name.empty()) name = "part" + std::to_string(node->mMeshes[i]);
-      const int partId = part(name);
+      const int partId = partNames(name);
+      aiString materialName;
+      std::string material = "material" + std::to_string(mesh->mMaterialIndex);
+      if (mesh->mMaterialIndex < scene->mNumMaterials &&
+          scene->mMaterials[mesh->mMaterialIndex]->Get(AI_MATKEY_NAME, materialName) == AI_SUCCESS &&
+          materialName.length > 0)
+        material = materialName.C_Str();
+      const int materialId = materialNames(material);
+      const int groupId = groupNames(group.empty() ? "group" : group);
       const int offset = static_cast<int>(vertices.size());
       for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
         const aiVector3D& p = mesh->mVertices[v];
@@ -54,9 +69,11 @@ struct Collector {
         triangles.emplace_back(offset + static_cast<int>(face.mIndices[0]), offset + static_cast<int>(face.mIndices[1]),
                                offset + static_cast<int>(face.mIndices[2]));
         parts.push_back(partId);
+        materials.push_back(materialId);
+        groups.push_back(groupId);
       }
     }
-    for (unsigned c = 0; c < node->mNumChildren; ++c) visit(node->mChildren[c], transform);
+    for (unsigned c = 0; c < node->mNumChildren; ++c) visit(node->mChildren[c], transform, group);
   }
 };
 
@@ -75,7 +92,8 @@ TriangleSurface readSurface(const std::filesystem::path& path) {
   }
   Collector collector;
   collector.scene = scene;
-  collector.visit(scene->mRootNode, Eigen::Matrix4d::Identity());
+  // The root node carries the file's name, not a group: its own meshes form group "root".
+  collector.visit(scene->mRootNode, Eigen::Matrix4d::Identity(), "root");
   if (collector.triangles.empty()) throw ValidationError(path.string() + ": the file holds no triangles");
   TriangleSurface surface;
   surface.vertices.resize(3, static_cast<Eigen::Index>(collector.vertices.size()));
@@ -85,7 +103,11 @@ TriangleSurface readSurface(const std::filesystem::path& path) {
   for (std::size_t t = 0; t < collector.triangles.size(); ++t)
     surface.triangles.col(static_cast<Eigen::Index>(t)) = collector.triangles[t];
   surface.triangleParts = std::move(collector.parts);
-  surface.partNames = std::move(collector.partNames);
+  surface.partNames = std::move(collector.partNames.names);
+  surface.triangleMaterials = std::move(collector.materials);
+  surface.materialNames = std::move(collector.materialNames.names);
+  surface.triangleGroups = std::move(collector.groups);
+  surface.groupNames = std::move(collector.groupNames.names);
   return surface;
 }
 

@@ -77,8 +77,7 @@ int weldVertices(TriangleSurface& surface, double tolerance) {
   Eigen::Matrix3Xd vertices(3, static_cast<Eigen::Index>(kept.size()));
   for (std::size_t i = 0; i < kept.size(); ++i)
     vertices.col(static_cast<Eigen::Index>(i)) = surface.vertices.col(kept[i]);
-  std::vector<Eigen::Vector3i> triangles;
-  std::vector<int> parts;
+  std::vector<int> keep;
   for (int t = 0; t < surface.numTriangles(); ++t) {
     Eigen::Vector3i tri;
     for (int c = 0; c < 3; ++c) {
@@ -88,16 +87,41 @@ int weldVertices(TriangleSurface& surface, double tolerance) {
                               " out of range");
       tri[c] = representative[static_cast<std::size_t>(v)];
     }
+    surface.triangles.col(t) = tri;
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
-    triangles.push_back(tri);
-    parts.push_back(surface.triangleParts.empty() ? 0 : surface.triangleParts[static_cast<std::size_t>(t)]);
+    keep.push_back(t);
   }
   surface.vertices = std::move(vertices);
-  surface.triangles.resize(3, static_cast<Eigen::Index>(triangles.size()));
-  for (std::size_t t = 0; t < triangles.size(); ++t) surface.triangles.col(static_cast<Eigen::Index>(t)) = triangles[t];
-  surface.triangleParts = std::move(parts);
+  if (surface.triangleParts.empty()) surface.triangleParts.assign(static_cast<std::size_t>(surface.numTriangles()), 0);
+  selectTriangles(surface, keep);
   if (surface.partNames.empty()) surface.partNames.push_back("surface");
   return n - static_cast<int>(kept.size());
+}
+
+void selectTriangles(TriangleSurface& surface, const std::vector<int>& keep) {
+  if (surface.inputTriangles.empty()) {
+    surface.inputTriangles.resize(static_cast<std::size_t>(surface.numTriangles()));
+    for (int t = 0; t < surface.numTriangles(); ++t) surface.inputTriangles[static_cast<std::size_t>(t)] = t;
+  }
+  auto select = [&keep](std::vector<int>& labels) {
+    if (labels.empty()) return;
+    std::vector<int> kept;
+    kept.reserve(keep.size());
+    for (int t : keep) kept.push_back(labels[static_cast<std::size_t>(t)]);
+    labels = std::move(kept);
+  };
+  Eigen::Matrix3Xi triangles(3, static_cast<Eigen::Index>(keep.size()));
+  for (std::size_t i = 0; i < keep.size(); ++i)
+    triangles.col(static_cast<Eigen::Index>(i)) = surface.triangles.col(keep[i]);
+  surface.triangles = std::move(triangles);
+  select(surface.triangleParts);
+  select(surface.triangleMaterials);
+  select(surface.triangleGroups);
+  select(surface.inputTriangles);
+}
+
+int inputTriangleIndex(const TriangleSurface& surface, int t) {
+  return surface.inputTriangles.empty() || t < 0 ? t : surface.inputTriangles[static_cast<std::size_t>(t)];
 }
 
 SurfaceTopology surfaceTopology(const TriangleSurface& surface) {

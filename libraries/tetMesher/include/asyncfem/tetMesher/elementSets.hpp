@@ -31,6 +31,22 @@ std::vector<int> addImplicitPartSets(TetMesh& mesh, const std::vector<ImplicitPa
 /// Returns the number of elements per part (indexed like surface().partNames).
 std::vector<int> addNearestPartSets(TetMesh& mesh, const SignedDistance& distance);
 
+/// Which triangle labels of a surface addSurfaceLabelSets groups elements by.
+enum class SurfaceLabel {
+  Part,      ///< triangleParts / partNames (assimp meshes)
+  Material,  ///< triangleMaterials / materialNames (the file's materials)
+  Group,     ///< triangleGroups / groupNames (OBJ g/o, glTF/FBX nodes)
+};
+
+/// One element (and vertex) set per label of distance.surface(), named after the label:
+/// an element goes to the innermost label whose triangles enclose its centroid (generalized
+/// winding number of that label's triangles above 1/2; among several, the one enclosing the
+/// least volume, so that a part nested in another, such as a core inside a shell, keeps its
+/// own elements); elements enclosed by no label (open labels) go to the label of the nearest
+/// triangle. Labels that receive no element get no set. Returns the element count per label
+/// (indexed like the names). ValidationError if the surface has no such labels.
+std::vector<int> addSurfaceLabelSets(TetMesh& mesh, const SignedDistance& distance, SurfaceLabel kind);
+
 /// Gives every element of element set `set` the material (added to the mesh, or replacing
 /// the material of the same name). ValidationError if the set does not exist.
 void assignSetMaterial(TetMesh& mesh, const std::string& set, const Material& material);

@@ -12,10 +12,11 @@ struct MesherOptions {
   /// Warping thresholds of Labelle & Shewchuk 2007 (Section 5): a lattice vertex closer than
   /// alphaLong (axis-parallel edges, length h) or alphaShort (diagonal edges, length
   /// h sqrt(3)/2) times the edge length to a cut point on one of its edges is moved onto
-  /// that cut point. With these values the paper proves dihedral angles in
-  /// [10.78, 164.74] degrees for its stencils; this implementation splits quadrilaterals by
-  /// its own face-consistent rule and was measured at [9.1, 158.5] degrees over hundreds of
-  /// random shapes (docs/tet-mesher.md), which is what the tests assert (>= 9, <= 165).
+  /// that cut point. With these values and the paper's stencils and parity rule (which this
+  /// implementation follows) every dihedral angle lies in [10.78, 164.74] degrees, whatever
+  /// the function: the proof uses only the signs at the lattice vertices and the cut points'
+  /// positions on their edges, so it also holds for winding-number and other non-distance
+  /// functions. Other alphas void the guarantee (and minDihedralDegrees must be lowered).
   double alphaLong = 0.24999;
   double alphaShort = 0.41189;
   /// Iterations of the bracketed root finder that places a cut point on a lattice edge
@@ -28,9 +29,15 @@ struct MesherOptions {
   bool parallel = true;
   /// Where warped vertices pinch two sheets of the boundary together along an edge (parts
   /// thinner than the lattice resolves), move those vertices back to the lattice and
-  /// rebuild, so that the boundary stays a manifold. The angle bound does not hold next to
-  /// such vertices (StuffingReport::unwarpedVertices counts them).
-  bool repairPinches = true;
+  /// rebuild, so that the boundary has no pinched edge. Off by default: next to such
+  /// vertices the angle bound does not hold (minDihedralDegrees is not enforced on a mesh
+  /// with such vertices). A pinched boundary is a valid mesh
+  /// (checkTetMesh counts pinchedBoundaryEdges); a finer spacing resolves the thin part.
+  bool repairPinches = false;
+  /// The smallest dihedral angle (degrees) a returned mesh may have. The stuffing bound is
+  /// 10.78; an element below this limit means a bug, and stuffIsosurface throws an Error
+  /// naming the element and where it is rather than return the mesh. 0 disables it.
+  double minDihedralDegrees = 10.0;
   /// Run validateTetMesh on the result and throw if a check fails.
   bool check = true;
   /// Largest number of lattice vertices accepted (guards against a spacing far too small).
@@ -46,6 +53,9 @@ struct StuffingReport {
   int unwarpedVertices = 0;  ///< warped vertices moved back to undo boundary pinches
   int elements = 0;
   int vertices = 0;
+  int pinchedBoundaryEdges = 0;     ///< see MeshCheckReport::pinchedBoundaryEdges
+  double minDihedralDegrees = 0.0;  ///< of the returned mesh
+  double maxDihedralDegrees = 0.0;
 };
 
 /// Tetrahedral mesh of the solid {x : f(x) < 0} inside bounds, by isosurface stuffing
@@ -58,14 +68,14 @@ struct StuffingReport {
 /// 3. A vertex closer to a cut point on one of its edges than alpha times that edge's
 ///    length is warped onto the closest such cut point and its value set to zero; cut
 ///    points on edges of warped vertices are dropped.
-/// 4. Each BCC tetrahedron is filled by a stencil chosen by the signs (-, 0, +) of its
+/// 4. Each BCC tetrahedron is filled by the paper's stencil for the signs (-, 0, +) of its
 ///    vertices: whole tetrahedra, single tetrahedra cut from a corner, pyramids (two
-///    tetrahedra) and prisms (three). Quadrilaterals in lattice faces are split by a rule
-///    that depends only on the face, so neighbours agree.
+///    tetrahedra) and prisms (three). Quadrilaterals in lattice faces are split by the
+///    paper's rule (long edge, else parity), which depends only on the face.
 /// The elements are positively oriented, all get options.material; no sets are created.
 /// With options.check the result is validated (validateTetMesh) and a ValidationError
-/// names the first failed check. ValidationError for a spacing <= 0, an empty or
-/// oversized lattice, or an empty result.
+/// names the first failed check; an element below options.minDihedralDegrees is an Error. ValidationError for a spacing
+/// <= 0, an empty or oversized lattice, or an empty result.
 TetMesh stuffIsosurface(const ImplicitFunction& f, const Eigen::AlignedBox3d& bounds, double spacing,
                         const MesherOptions& options = {}, StuffingReport* report = nullptr);
 

@@ -22,7 +22,12 @@ struct MeshCheckReport {
   int unusedVertices = 0;
   int boundaryTriangles = 0;
   int openBoundaryEdges = 0;         ///< boundary edges in one boundary triangle
-  int nonManifoldBoundaryEdges = 0;  ///< boundary edges in three or more boundary triangles
+  int nonManifoldBoundaryEdges = 0;  ///< boundary edges in three or more boundary triangles,
+                                     ///< not traversed equally often in both directions
+  /// Boundary edges in four (or any even number of) boundary triangles, traversed equally
+  /// often in both directions: sheets of a closed, outward boundary touching along the edge
+  /// (a solid pinched there, such as two parts meeting at an edge). Not a failure.
+  int pinchedBoundaryEdges = 0;
   int misorientedBoundaryEdges = 0;  ///< edges whose two boundary triangles run the same way
   int components = 0;                ///< connected components (elements sharing a face)
   double elementVolume = 0.0;        ///< sum of signed element volumes
@@ -33,8 +38,8 @@ struct MeshCheckReport {
 };
 
 /// Checks that the mesh is usable: no inverted or degenerate element, every vertex used,
-/// the boundary surface closed (every boundary edge in exactly two boundary triangles) and
-/// consistently oriented (each such edge traversed once in each direction), and the volume
+/// the boundary surface closed and consistently oriented (every boundary edge traversed
+/// equally often in each direction: once each way, or in pinches several times), and the volume
 /// enclosed by the outward boundary (divergence theorem) equal to the element volume to a
 /// relative 1e-9. Counts connected components but does not require one.
 MeshCheckReport checkTetMesh(const TetMesh& mesh);

@@ -18,6 +18,16 @@ struct TriangleSurface {
   Eigen::Matrix3Xi triangles;
   std::vector<int> triangleParts;
   std::vector<std::string> partNames;
+  /// Optional labels of every triangle (empty when the source has none): its material
+  /// (index into materialNames, the file's material names) and its named group (index into
+  /// groupNames: the OBJ `g`/`o` group or glTF/FBX node holding it).
+  std::vector<int> triangleMaterials;
+  std::vector<std::string> materialNames;
+  std::vector<int> triangleGroups;
+  std::vector<std::string> groupNames;
+  /// Optional: each triangle's index in the source file (kept through weldVertices and
+  /// selectTriangles, so that messages can name the input's triangle).
+  std::vector<int> inputTriangles;
 
   int numVertices() const { return static_cast<int>(vertices.cols()); }
   int numTriangles() const { return static_cast<int>(triangles.cols()); }
@@ -29,6 +39,12 @@ struct TriangleSurface {
 /// corners). Files exported with split normals or texture seams need this before their
 /// edges can be matched. Returns the number of vertices removed.
 int weldVertices(TriangleSurface& surface, double tolerance);
+
+/// Keeps the triangles listed (in that order), with their parts, labels and input indices.
+void selectTriangles(TriangleSurface& surface, const std::vector<int>& keep);
+
+/// The source file's index of triangle t (t itself when inputTriangles is empty).
+int inputTriangleIndex(const TriangleSurface& surface, int t);
 
 /// Edge topology of a welded surface.
 struct SurfaceTopology {
