@@ -48,7 +48,7 @@ SmallStrainModuli mooneyRivlinSmallStrainModuli(const MooneyRivlinParameters& pa
             << " are not a stable material: need finite values with mu10 + mu01 > 0 and v1 > 0";
     throw ValidationError(message.str());
   }
-  return {9.0 * bulk * shear / ((3.0 * bulk) + shear), ((3.0 * bulk) - (2.0 * shear)) / (2.0 * ((3.0 * bulk) + shear))};
+  return {parameters.equivalentYoungsModulus(), parameters.equivalentPoissonRatio()};
 }
 
 }  // namespace asyncfem

@@ -21,6 +21,19 @@ struct MooneyRivlinParameters {
   double mu10 = 0.0;
   double v1 = 0.0;
 
+  /// The small-strain Young's modulus E = 9 K G / (3 K + G) and Poisson ratio
+  /// nu = (3 K - 2 G) / (2 (3 K + G)) of G and K above; meaningful for G > 0, K > 0.
+  double equivalentYoungsModulus() const {
+    const double shear = 2.0 * (mu10 + mu01);
+    const double bulk = 2.0 * v1;
+    return 9.0 * bulk * shear / ((3.0 * bulk) + shear);
+  }
+  double equivalentPoissonRatio() const {
+    const double shear = 2.0 * (mu10 + mu01);
+    const double bulk = 2.0 * v1;
+    return ((3.0 * bulk) - (2.0 * shear)) / (2.0 * ((3.0 * bulk) + shear));
+  }
+
   bool operator==(const MooneyRivlinParameters&) const = default;
 };
 
