@@ -106,6 +106,28 @@ TEST(HyperelasticInversion, ExtensionIsContinuousAtTheThreshold) {
   }
 }
 
+TEST(HyperelasticInversion, VegaClampEvaluatesAtTheClampedStretches) {
+  // Vega's mode: below the threshold the stretch is replaced by the threshold, so the
+  // energy density (and stress) equal those at the threshold whatever the stretch.
+  const TetMesh mesh = test::unitTet();
+  HyperelasticOptions options;
+  options.inversionThreshold = 0.2;
+  options.inversionHandling = InversionHandling::vegaClamp;
+  const IsotropicHyperelasticFEM vega(mesh, HyperelasticMaterialKind::neoHookean, options);
+  const double atThreshold = vega.energyDensity(0, {1.1, 0.9, 0.2});
+  EXPECT_EQ(vega.energyDensity(0, {1.1, 0.9, -0.3}), atThreshold);
+  EXPECT_EQ(vega.energyDensity(0, {1.1, 0.9, 0.05}), atThreshold);
+  // The consistent extension differs there (it adds g (s - c)).
+  options.inversionHandling = InversionHandling::extrapolate;
+  const IsotropicHyperelasticFEM extended(mesh, HyperelasticMaterialKind::neoHookean, options);
+  EXPECT_GT(std::abs(extended.energyDensity(0, {1.1, 0.9, -0.3}) - atThreshold), 1e-3 * std::abs(atThreshold));
+  // Forces stay finite for an inverted element.
+  const Eigen::VectorXd u = test::homogeneousDisplacement(mesh, withStretches({1.05, 0.9, -0.3}));
+  options.inversionHandling = InversionHandling::vegaClamp;
+  IsotropicHyperelasticFEM vegaModel(mesh, HyperelasticMaterialKind::neoHookean, options);
+  EXPECT_TRUE(test::forces(vegaModel, u).allFinite());
+}
+
 TEST(HyperelasticInversion, PositiveDefiniteTangentOptionClampsEigenvalues) {
   const TetMesh mesh = test::unitTet();
   HyperelasticOptions options;
