@@ -130,8 +130,8 @@ TEST(VegErrors, ElementWithoutRegion) {
 TEST(VegErrors, CubicElementsAreRejected) { expectVegError("TET", "CUBIC", 9, {"CUBIC", "only TET"}); }
 
 TEST(VegErrors, UnknownMaterialKeyword) {
-  expectVegError("ENU, 7800, 2e11, 0.3", "MOONEYRIVLIN, 1000, 1e5, 2e5, 1e7", 14, {"MOONEYRIVLIN", "steel"});
-  expectVegError("ENU, 7800, 2e11, 0.3", "ORTHOTROPIC_N1, 1, 2, 3", 14, {"ORTHOTROPIC_N1"});
+  // MOONEYRIVLIN is read since Mooney-Rivlin materials exist (mooneyRivlinTest.cpp).
+  expectVegError("ENU, 7800, 2e11, 0.3", "ORTHOTROPIC_N1, 1, 2, 3", 14, {"ORTHOTROPIC_N1", "steel"});
 }
 
 TEST(VegErrors, MaterialOutOfRange) {

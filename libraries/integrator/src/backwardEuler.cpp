@@ -2,6 +2,8 @@
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "detail/freeSystem.hpp"
@@ -137,6 +139,16 @@ void BackwardEuler::stepNonlinear() {
   free.solve(rhs_, dv_, stats_);
   int iterations = 1;
   lastRelativeResidual_ = -1.0;
+  lastLineSearchHalvings_ = 0;
+  const bool lineSearch = options_.lineSearch && options_.maxIterations > 1;
+  const bool dampingAtIterate = options_.rayleighStiffnessAtIterate && beta != 0.0;
+  if (lineSearch) {
+    // The linearized step starts from dv = 0 with the slope estimated by its own
+    // right-hand side (the linearization of -R(0)).
+    Eigen::VectorXd start = Eigen::VectorXd::Zero(dv_.size());
+    const Eigen::VectorXd step = dv_;
+    dv_ = start + backtrack(start, step, incrementalPotential(start), -rhs_.dot(step)) * step;
+  }
 
   if (options_.maxIterations > 1) {
     const double scale = rhsNorm > 0.0 ? rhsNorm : 1.0;
@@ -146,27 +158,34 @@ void BackwardEuler::stepNonlinear() {
       newDisplacement = u_ + h * newVelocity;
       detail::expandTo(dofs, newDisplacement, fullU_);
       const bool mayIterate = iterations < options_.maxIterations;
-      if (mayIterate) {
+      if (mayIterate || dampingAtIterate) {
         free.evaluateForcesAndTangent(system_, fullU_, free.iterateStiffness, stats_);
       } else {
         free.evaluateForces(system_, fullU_, stats_);
       }
       detail::restrictTo(dofs, free.fullForces(), internal);
+      // D = alpha M + beta K(u_k), or beta K(u_{k+1}^{(i)}) with rayleighStiffnessAtIterate.
+      const Eigen::SparseMatrix<double>& dampingStiffness = dampingAtIterate ? free.iterateStiffness : free.stiffness;
       {
-        // R = M dv - h ( f_ext - f_int(u_{k+1}) - D v_{k+1} ),  D = alpha M + beta K(u_k)
+        // R = M dv - h ( f_ext - f_int(u_{k+1}) - D v_{k+1} )
         TimeInto timer(stats_.forceSeconds);
         residual = free.mass * dv_;
         residual.noalias() -= h * (force_ - internal);
         if (alpha != 0.0) residual.noalias() += (h * alpha) * (free.mass * newVelocity);
-        if (beta != 0.0) residual.noalias() += (h * beta) * (free.stiffness * newVelocity);
+        if (beta != 0.0) residual.noalias() += (h * beta) * (dampingStiffness * newVelocity);
       }
       lastRelativeResidual_ = residual.norm() / scale;
       if (lastRelativeResidual_ <= options_.tolerance || !mayIterate) break;
-      // J = (1 + h alpha) M + h beta K(u_k) + h^2 K(u_{k+1}^{(i)})
-      free.assemble({1.0 + (h * alpha), h * beta, h * h}, {&free.mass, &free.stiffness, &free.iterateStiffness},
+      // J = (1 + h alpha) M + h beta K_D + h^2 K(u_{k+1}^{(i)}), K_D the damping stiffness
+      free.assemble({1.0 + (h * alpha), h * beta, h * h}, {&free.mass, &dampingStiffness, &free.iterateStiffness},
                     stats_);
       free.factorize(stats_);
       free.solve(-residual, correction, stats_);
+      // With D at the iterate R is not the potential's gradient, so Phi is no merit
+      // function for these updates: they are taken in full, as Vega FEM does.
+      if (lineSearch && !dampingAtIterate) {
+        correction *= backtrack(dv_, correction, incrementalPotential(dv_), residual.dot(correction));
+      }
       dv_ += correction;
       ++iterations;
     }
@@ -182,6 +201,52 @@ void BackwardEuler::stepNonlinear() {
   velocity_.swap(fullV_);
   advanceTime();
   ++stats_.steps;
+}
+
+double BackwardEuler::incrementalPotential(const Eigen::VectorXd& dv) {
+  // Phi(dv) = 1/2 dv^T M dv + E(u_k + h (v_k + dv)) - h f_ext^T dv + h dv^T D (v_k + dv / 2),
+  // D = alpha M + beta K(u_k): its gradient is the residual R(dv) of the step equations.
+  const double h = timestep_;
+  const double alpha = system_.rayleighMass;
+  const double beta = system_.rayleighStiffness;
+  work_ = u_ + h * (v_ + dv);
+  detail::expandTo(system_.freeDofs, work_, fullU_);
+  double energy = 0.0;
+  {
+    TimeInto timer(stats_.forceSeconds);
+    energy = system_.forceModel->elasticEnergy(fullU_);
+  }
+  work_ = v_ + 0.5 * dv;
+  double damping = 0.0;
+  if (alpha != 0.0) damping += alpha * dv.dot(free_->mass * work_);
+  if (beta != 0.0) damping += beta * dv.dot(free_->stiffness * work_);
+  return (0.5 * dv.dot(free_->mass * dv)) + energy - (h * force_.dot(dv)) + (h * damping);
+}
+
+double BackwardEuler::backtrack(const Eigen::VectorXd& dv, const Eigen::VectorXd& step, double potential,
+                                double slope) {
+  // Armijo: accept t once Phi(dv + t step) <= Phi(dv) + 1e-4 t slope, halving t up to
+  // kMaxHalvings times; differences below 1e-12 |Phi| are rounding and count as no
+  // increase. If no t passes, the one with the lowest potential is taken, so the
+  // potential never rises by more than rounding.
+  constexpr int kMaxHalvings = 12;
+  const double roundingAllowance = 1e-12 * std::abs(potential);
+  double t = 1.0;
+  double bestT = 1.0;
+  double bestPotential = std::numeric_limits<double>::infinity();
+  for (int halving = 0; halving <= kMaxHalvings; ++halving) {
+    const double trial = incrementalPotential(dv + t * step);
+    if (std::isfinite(trial) && trial <= potential + (1e-4 * t * std::min(slope, 0.0)) + roundingAllowance) {
+      return t;
+    }
+    if (std::isfinite(trial) && trial < bestPotential) {
+      bestPotential = trial;
+      bestT = t;
+    }
+    ++lastLineSearchHalvings_;
+    t *= 0.5;
+  }
+  return bestPotential < std::numeric_limits<double>::infinity() ? bestT : t;
 }
 
 }  // namespace asyncfem

@@ -189,8 +189,16 @@ void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
     out << e + 1 << ' ' << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << ' ' << t[3] + 1 << '\n';
   }
   for (const Material& m : mesh.materials()) {
-    out << "\n*MATERIAL " << m.name << "\nENU, " << detail::formatDouble(m.density) << ", "
-        << detail::formatDouble(m.youngsModulus) << ", " << detail::formatDouble(m.poissonRatio) << '\n';
+    out << "\n*MATERIAL " << m.name << '\n';
+    if (m.mooneyRivlin) {
+      // E and nu are not written: the reader derives them from mu01, mu10, v1.
+      out << "MOONEYRIVLIN, " << detail::formatDouble(m.density) << ", " << detail::formatDouble(m.mooneyRivlin->mu01)
+          << ", " << detail::formatDouble(m.mooneyRivlin->mu10) << ", " << detail::formatDouble(m.mooneyRivlin->v1)
+          << '\n';
+    } else {
+      out << "ENU, " << detail::formatDouble(m.density) << ", " << detail::formatDouble(m.youngsModulus) << ", "
+          << detail::formatDouble(m.poissonRatio) << '\n';
+    }
   }
   for (const auto& [name, members] : mesh.elementSets()) {
     out << "\n*SET " << name << '\n';

@@ -219,14 +219,18 @@ class VegParser {
 
   void readMaterial(const std::string& name) {
     if (!materialNames_.insert(name).second) cursor_.fail("material '" + name + "' is defined twice");
-    if (!cursor_.next() || isKeywordLine(cursor_.line())) {
-      cursor_.fail("*MATERIAL " + name + " needs a line 'ENU, density, E, nu'");
-    }
+    const std::string expected = "a line 'ENU, density, E, nu' or 'MOONEYRIVLIN, density, mu01, mu10, v1'";
+    if (!cursor_.next() || isKeywordLine(cursor_.line())) cursor_.fail("*MATERIAL " + name + " needs " + expected);
     const auto tokens = detail::splitTokens(cursor_.line(), true);
-    if (tokens.empty()) cursor_.fail("*MATERIAL " + name + " needs a line 'ENU, density, E, nu'");
-    if (!detail::equalsIgnoreCase(tokens.front(), "ENU")) {
+    if (tokens.empty()) cursor_.fail("*MATERIAL " + name + " needs " + expected);
+    const bool mooneyRivlin = detail::equalsIgnoreCase(tokens.front(), "MOONEYRIVLIN");
+    if (!mooneyRivlin && !detail::equalsIgnoreCase(tokens.front(), "ENU")) {
       cursor_.fail("material '" + name + "': unsupported material keyword '" + std::string(tokens.front()) +
-                   "' (only isotropic 'ENU, density, E, nu' is supported)");
+                   "' (supported: 'ENU, density, E, nu' and 'MOONEYRIVLIN, density, mu01, mu10, v1')");
+    }
+    if (mooneyRivlin) {
+      readMooneyRivlinMaterial(name, tokens);
+      return;
     }
     if (tokens.size() != 4) {
       cursor_.fail("material '" + name + "': ENU needs exactly 3 numbers (density, E, nu), got " +
@@ -237,6 +241,37 @@ class VegParser {
     m.density = detail::finiteDoubleAt(cursor_, tokens[1], "material '" + name + "' density");
     m.youngsModulus = detail::finiteDoubleAt(cursor_, tokens[2], "material '" + name + "' Young's modulus");
     m.poissonRatio = detail::finiteDoubleAt(cursor_, tokens[3], "material '" + name + "' Poisson's ratio");
+    detail::checkMaterialAt(cursor_, m);
+    raw_.materials.push_back(std::move(m));
+  }
+
+  // Vega's compressible Mooney-Rivlin material; E and nu are set to its small-strain
+  // equivalents so that linear and corotational models still apply.
+  template <class Tokens>
+  void readMooneyRivlinMaterial(const std::string& name, const Tokens& tokens) {
+    if (tokens.size() != 5) {
+      cursor_.fail("material '" + name + "': MOONEYRIVLIN needs exactly 4 numbers (density, mu01, mu10, v1), got " +
+                   std::to_string(tokens.size() - 1));
+    }
+    Material m;
+    m.name = name;
+    m.density = detail::finiteDoubleAt(cursor_, tokens[1], "material '" + name + "' density");
+    MooneyRivlinParameters parameters;
+    parameters.mu01 = detail::finiteDoubleAt(cursor_, tokens[2], "material '" + name + "' mu01");
+    parameters.mu10 = detail::finiteDoubleAt(cursor_, tokens[3], "material '" + name + "' mu10");
+    parameters.v1 = detail::finiteDoubleAt(cursor_, tokens[4], "material '" + name + "' v1");
+    if (!(parameters.mu01 + parameters.mu10 > 0.0)) {
+      cursor_.fail("material '" + name +
+                   "': MOONEYRIVLIN needs mu01 + mu10 > 0 (the shear modulus is 2 (mu01 + mu10)), got " +
+                   detail::formatDouble(parameters.mu01 + parameters.mu10));
+    }
+    if (!(parameters.v1 > 0.0)) {
+      cursor_.fail("material '" + name + "': MOONEYRIVLIN needs v1 > 0 (the bulk modulus is 2 v1), got " +
+                   detail::formatDouble(parameters.v1));
+    }
+    m.youngsModulus = parameters.equivalentYoungsModulus();
+    m.poissonRatio = parameters.equivalentPoissonRatio();
+    m.mooneyRivlin = parameters;
     detail::checkMaterialAt(cursor_, m);
     raw_.materials.push_back(std::move(m));
   }

@@ -41,6 +41,20 @@ class FreeSystem;
 /// The first iteration is the linearized step above; iteration i > 1 solves
 /// J dv_delta = -R and stops once |R|_2 <= tolerance * |b_0|_2, b_0 the right-hand side
 /// of the linearized step (the residual of the linearized equations at dv = 0).
+///
+/// Line search (options.lineSearch, used when maxIterations > 1): R is the gradient of
+/// the incremental potential
+///     Phi(dv) = 1/2 dv^T M dv + E(u_k + h (v_k + dv)) - h f_ext^T dv + h dv^T D (v_k + dv/2),
+/// E the force model's elastic energy, so every update (the linearized step included) is
+/// scaled by t = 1, 1/2, 1/4, ... until Phi decreases enough (Armijo, 1e-4 of the
+/// predicted decrease): a step too large for Newton's model is shortened instead of
+/// diverging. Each trial costs one energy evaluation.
+///
+/// Rayleigh damping under Newton: by default D keeps K(u_k) of the step start (the step
+/// equations stay a potential's gradient). options.rayleighStiffnessAtIterate uses
+/// D = alpha M + beta K(u_{k+1}^{(i)}) in R and J at every iterate, as Vega FEM does; the
+/// line search then acts on the linearized first update only (the later ones solve
+/// equations that are no potential's gradient and are taken in full, as in Vega).
 class BackwardEuler final : public Integrator {
  public:
   /// system: validated; h > 0. Factors at once for linear force models.
@@ -58,11 +72,18 @@ class BackwardEuler final : public Integrator {
   /// evaluated (linear models and maxIterations = 1 never evaluate it: the linearized
   /// step is taken as is).
   double lastRelativeResidual() const { return lastRelativeResidual_; }
+  /// Step halvings the line search made during the last step (0: every full Newton
+  /// update was accepted, or no line search).
+  int lastLineSearchHalvings() const { return lastLineSearchHalvings_; }
 
  private:
   void stepLinear();
   void stepNonlinear();
   void assembleAndFactor();
+  // Incremental potential Phi(dv) of the current step (see the class comment).
+  double incrementalPotential(const Eigen::VectorXd& dv);
+  // Step length t in (0, 1] along step from dv by backtracking on Phi.
+  double backtrack(const Eigen::VectorXd& dv, const Eigen::VectorXd& step, double potential, double slope);
 
   IntegratorOptions options_;
   std::unique_ptr<detail::FreeSystem> free_;
@@ -70,6 +91,7 @@ class BackwardEuler final : public Integrator {
   bool factorizationStale_ = true;
   int lastIterations_ = 0;
   double lastRelativeResidual_ = -1.0;
+  int lastLineSearchHalvings_ = 0;
   // Scratch on the free DOFs, kept to avoid per-step allocation.
   Eigen::VectorXd u_, v_, force_, rhs_, dv_, work_;
   Eigen::VectorXd fullForce_, fullU_, fullV_;

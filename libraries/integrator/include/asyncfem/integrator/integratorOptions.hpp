@@ -20,6 +20,15 @@ struct IntegratorOptions {
   int maxIterations = 1;
   /// Relative Newton tolerance (see maxIterations).
   double tolerance = 1e-8;
+  /// Backward Euler with maxIterations > 1: backtrack every Newton update (the
+  /// linearized first one included) until the incremental potential decreases, so that a
+  /// large step cannot diverge (see BackwardEuler). No effect with maxIterations = 1,
+  /// which keeps the linearized step exactly.
+  bool lineSearch = true;
+  /// Backward Euler Newton iterations: evaluate the Rayleigh term beta K at every iterate,
+  /// D = alpha M + beta K(u_{k+1}^(i)), as Vega FEM does. Off (the default): D keeps
+  /// K(u_k) of the step start, so the step equations are the gradient of a potential.
+  bool rayleighStiffnessAtIterate = false;
 
   /// Explicit methods: an upper bound of the highest angular frequency omega_max
   /// (rad / time unit) of the free system, e.g. from estimateMaxFrequency(mesh, massType).

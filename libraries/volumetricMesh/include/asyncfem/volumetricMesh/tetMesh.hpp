@@ -3,18 +3,64 @@
 
 #include <Eigen/Core>
 #include <map>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace asyncfem {
 
+/// Parameters of Vega FEM's compressible Mooney-Rivlin material (all in stress units,
+/// e.g. Pa), strain energy density per rest volume
+///     W = mu01 (I2bar - 3) + mu10 (I1bar - 3) + v1 (J - 1)^2,
+/// with I1bar = I1 / J^(2/3), I2bar = I2 / J^(4/3) the isochoric invariants of
+/// C = F^T F and J = det F. Small strains: shear modulus G = 2 (mu10 + mu01), bulk
+/// modulus K = 2 v1.
+struct MooneyRivlinParameters {
+  double mu01 = 0.0;
+  double mu10 = 0.0;
+  double v1 = 0.0;
+
+  /// The small-strain Young's modulus E = 9 K G / (3 K + G) and Poisson ratio
+  /// nu = (3 K - 2 G) / (2 (3 K + G)) of G and K above; meaningful for G > 0, K > 0.
+  double equivalentYoungsModulus() const {
+    const double shear = 2.0 * (mu10 + mu01);
+    const double bulk = 2.0 * v1;
+    return 9.0 * bulk * shear / ((3.0 * bulk) + shear);
+  }
+  double equivalentPoissonRatio() const {
+    const double shear = 2.0 * (mu10 + mu01);
+    const double bulk = 2.0 * v1;
+    return ((3.0 * bulk) - (2.0 * shear)) / (2.0 * ((3.0 * bulk) + shear));
+  }
+
+  bool operator==(const MooneyRivlinParameters&) const = default;
+};
+
 /// Isotropic linear-elastic material. SI units are conventional but not required;
 /// the toolkit only needs them consistent.
 struct Material {
+  Material() = default;
+  /// Positional form, Material{name, density, E, nu} (and optionally the Mooney-Rivlin
+  /// block); a constructor rather than aggregate initialisation so that the optional
+  /// block can be left out without compiler warnings.
+  Material(std::string materialName, double materialDensity, double materialYoungsModulus, double materialPoissonRatio,
+           std::optional<MooneyRivlinParameters> mooneyRivlinParameters = std::nullopt)
+      : name(std::move(materialName)),
+        density(materialDensity),
+        youngsModulus(materialYoungsModulus),
+        poissonRatio(materialPoissonRatio),
+        mooneyRivlin(mooneyRivlinParameters) {}
+
   std::string name;
   double density = 1000.0;     ///< rho, mass per volume (kg/m^3)
   double youngsModulus = 1e6;  ///< E (Pa)
   double poissonRatio = 0.45;  ///< nu, in (-1, 0.5)
+  /// Set for materials given as Mooney-Rivlin (.veg MOONEYRIVLIN lines); then E and nu
+  /// hold the small-strain equivalent (from G and K above) so that linear and
+  /// corotational models still apply, and the hyperelastic Mooney-Rivlin model reads
+  /// these parameters.
+  std::optional<MooneyRivlinParameters> mooneyRivlin;
 
   bool operator==(const Material&) const = default;
 };

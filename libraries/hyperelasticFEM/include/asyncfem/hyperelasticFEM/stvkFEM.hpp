@@ -1,0 +1,40 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <asyncfem/hyperelasticFEM/elementForceModel.hpp>
+#include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
+#include <memory>
+#include <vector>
+
+namespace asyncfem {
+
+/// Saint Venant-Kirchhoff FEM on linear tetrahedra in the Green-strain form, the model
+/// of Vega FEM's StVKForceModel (which precomputes polynomial integrals of the same
+/// quantities). Per element, with F = sum_a x_a g_a^T, E = (F^T F - I) / 2 and the Lame
+/// parameters of the element's material (vegaLameParameters(E, nu)):
+///   - energy |V| (lambda/2 (tr E)^2 + mu tr(E^2));
+///   - second Piola-Kirchhoff stress S = lambda tr(E) I + 2 mu E, first P = F S;
+///   - force on vertex a: |V| P g_a;
+///   - tangent block (a, b): |V| [ (g_a . S g_b) I + lambda h_a h_b^T
+///     + mu (g_a . g_b) F F^T + mu h_b h_a^T ], h_a = F g_a (exact derivative, symmetric).
+/// At F = I the tangent is linear FEM's element stiffness. StVK softens under strong
+/// compression and has no resistance to inversion; use IsotropicHyperelasticFEM with an
+/// inversion threshold when elements may invert.
+class StVKFEM final : public ElementForceModel {
+ public:
+  /// Throws ValidationError naming the lowest degenerate element; assembler as in
+  /// ElementForceModel (null: built here).
+  explicit StVKFEM(const TetMesh& mesh, std::shared_ptr<const MatrixAssembler> assembler = nullptr);
+
+  /// Lame parameters of element e.
+  const LameParameters& elementLame(int e) const { return lame_[static_cast<std::size_t>(e)]; }
+
+ protected:
+  void computeElement(int element, const Eigen::Matrix3d& deformationGradient, double* energy, ElementVector* force,
+                      ElementMatrix* tangent) const override;
+
+ private:
+  std::vector<LameParameters> lame_;
+};
+
+}  // namespace asyncfem
