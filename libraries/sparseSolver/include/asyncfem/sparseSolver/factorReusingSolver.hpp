@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <asyncfem/sparseSolver/sparseSolver.hpp>
+#include <memory>
+
+namespace asyncfem {
+
+/// When FactorReusingSolver refactors and how accurately it solves.
+struct FactorReuseOptions {
+  /// PCG stops once |b - A x|_2 <= relativeTolerance |b|_2.
+  double relativeTolerance = 1e-8;
+  /// A solve that has not converged after this many PCG iterations is abandoned: the
+  /// current matrix is factored and the system solved with the new factor (exactly).
+  int maxIterations = 25;
+  /// After a converged solve that took more than this many iterations, the next
+  /// setMatrix() refactors.
+  int refactorAfterIterations = 8;
+  /// ... and also when the count exceeds growthFactor times the count of the first solve
+  /// with the current factor's stale values (<= 0: off), at least 2 iterations.
+  double growthFactor = 3.0;
+};
+
+/// Counters of a FactorReusingSolver since construction (or resetStats()).
+struct FactorReuseStats {
+  long long solves = 0;
+  long long exactSolves = 0;          ///< solves with a factor of the current values (no iteration)
+  long long pcgIterations = 0;        ///< sum over the PCG solves (one product with A each)
+  long long refactorizations = 0;     ///< numeric factorizations, the first one included
+  long long abandonedSolves = 0;      ///< PCG runs that hit maxIterations (then solved exactly)
+  int lastIterations = 0;             ///< PCG iterations of the last solve (0: exact)
+  double lastRelativeResidual = 0.0;  ///< |b - A x| / |b| of the last PCG solve (0 when exact)
+};
+
+/// Solves a sequence of systems A_k x = b_k whose matrices (one sparsity pattern, SPD,
+/// e.g. the backward Euler matrices M + h D + h^2 K(u_k) of a corotational model) change
+/// slowly: the last numeric factorization of some earlier A_j is kept as the
+/// preconditioner P = A_j^{-1} of a conjugate-gradient solve with A_k, until the
+/// iteration count says that A_k has moved too far (FactorReuseOptions), when A_k is
+/// factored again. A solve right after a factorization is one back-substitution.
+///
+/// Each PCG iteration costs one sparse product with A and one back-substitution with
+/// the kept factor, against one numeric factorization (typically 10-20 back-substitutions
+/// on 3D meshes) for the exact path, so a step costs a few back-substitutions while the
+/// factor stays a good preconditioner. The solution meets the relative residual
+/// tolerance; it is not the exact solve's to rounding (the difference is at most
+/// cond(A) times the tolerance, relatively). Deterministic: the same sequence of inputs
+/// gives the same results.
+class FactorReusingSolver {
+ public:
+  /// direct: the factorization used (cholmod for SPD matrices). Throws asyncfem::Error on
+  /// options out of range (tolerance not in [0, 1), maxIterations < 1).
+  explicit FactorReusingSolver(SolverKind direct = SolverKind::cholmod, const FactorReuseOptions& options = {});
+  ~FactorReusingSolver();
+  FactorReusingSolver(const FactorReusingSolver&) = delete;
+  FactorReusingSolver& operator=(const FactorReusingSolver&) = delete;
+
+  /// The matrix of the following solves (square, compressed; must stay alive and
+  /// unchanged until then). Analyses its pattern the first time or when it changes, and
+  /// factors it when there is no factor yet or the policy asked for a refactorization.
+  void setMatrix(const Eigen::SparseMatrix<double>& matrix);
+  /// x = A^{-1} b to the relative tolerance (exactly when the factor is A's own). Throws
+  /// asyncfem::Error before setMatrix() or on a size mismatch; NumericalError when the
+  /// factorization fails (A not positive definite for Cholesky).
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
+  /// Makes the next setMatrix() factor its matrix.
+  void requestRefactorization() { refactorPending_ = true; }
+
+  const FactorReuseOptions& options() const { return options_; }
+  const FactorReuseStats& stats() const { return stats_; }
+  /// The direct solver's own counters (factor non-zeros, flops, times).
+  const SolverStats& directStats() const { return direct_->stats(); }
+  void resetStats() { stats_ = FactorReuseStats{}; }
+
+ private:
+  void refactor();
+  void applyPreconditioner(const Eigen::VectorXd& rhs, Eigen::VectorXd& out);
+
+  FactorReuseOptions options_;
+  FactorReuseStats stats_;
+  std::unique_ptr<SparseSolver> direct_;
+  const Eigen::SparseMatrix<double>* matrix_ = nullptr;
+  bool analysed_ = false;
+  bool factorIsCurrent_ = false;  // the factor is that of matrix_'s current values
+  bool refactorPending_ = true;
+  int firstStaleIterations_ = 0;  // iterations of the first PCG solve with this factor
+  Eigen::MatrixXd preconditioned_;
+  Eigen::VectorXd residual_, direction_, product_, z_;
+};
+
+}  // namespace asyncfem
