@@ -3,6 +3,7 @@
 
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/integrator/integratorOptions.hpp>
+#include <asyncfem/sparseSolver/factorReusingSolver.hpp>
 #include <memory>
 #include <string>
 
@@ -41,6 +42,12 @@ class FreeSystem;
 /// The first iteration is the linearized step above; iteration i > 1 solves
 /// J dv_delta = -R and stops once |R|_2 <= tolerance * |b_0|_2, b_0 the right-hand side
 /// of the linearized step (the residual of the linearized equations at dv = 0).
+///
+/// options.reuseFactor (nonlinear models): the system matrix is still assembled at every
+/// step, but solved by a FactorReusingSolver: PCG to options.pcgTolerance preconditioned
+/// by the last numeric factor, refactoring when the iteration count says the factor is
+/// stale. Its counters are factorReuseStats(); refactorizations are also counted in
+/// stats().factorizations.
 class BackwardEuler final : public Integrator {
  public:
   /// system: validated; h > 0. Factors at once for linear force models.
@@ -58,14 +65,22 @@ class BackwardEuler final : public Integrator {
   /// evaluated (linear models and maxIterations = 1 never evaluate it: the linearized
   /// step is taken as is).
   double lastRelativeResidual() const { return lastRelativeResidual_; }
+  /// PCG and refactorization counters when options().reuseFactor is in effect, else null.
+  const FactorReuseStats* factorReuseStats() const;
 
  private:
   void stepLinear();
   void stepNonlinear();
   void assembleAndFactor();
+  // With options_.reuseFactor: hands the assembled system matrix to reuse_ (refactoring
+  // only when it asks to) and solves with it; the time goes to the same stats fields.
+  void assembleForReuse();
+  void updateReusedMatrix();
+  void solveWithReuse(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
 
   IntegratorOptions options_;
   std::unique_ptr<detail::FreeSystem> free_;
+  std::unique_ptr<FactorReusingSolver> reuse_;  // options_.reuseFactor, nonlinear models only
   bool linear_ = false;
   bool factorizationStale_ = true;
   int lastIterations_ = 0;

@@ -21,6 +21,17 @@ struct IntegratorOptions {
   /// Relative Newton tolerance (see maxIterations).
   double tolerance = 1e-8;
 
+  /// Backward Euler, nonlinear force models: instead of refactoring the system matrix at
+  /// every step, keep the last numeric factor as the preconditioner of a PCG solve to
+  /// pcgTolerance (relative residual) and refactor when PCG needs more than
+  /// pcgRefactorIterations iterations (FactorReusingSolver). false (the default): the
+  /// exact path, one factorization and back-substitution per linear solve.
+  bool reuseFactor = false;
+  /// Relative residual tolerance of those PCG solves (reuseFactor only), in (0, 1).
+  double pcgTolerance = 1e-8;
+  /// Iterations of a PCG solve above which the next step refactors (reuseFactor only).
+  int pcgRefactorIterations = 8;
+
   /// Explicit methods: an upper bound of the highest angular frequency omega_max
   /// (rad / time unit) of the free system, e.g. from estimateMaxFrequency(mesh, massType).
   /// <= 0: the integrator estimates it from the matrices (see stableTimestep.hpp).
