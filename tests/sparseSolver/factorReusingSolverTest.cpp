@@ -50,6 +50,7 @@ Eigen::VectorXd randomVector(Eigen::Index n, unsigned seed) {
 TEST(FactorReusingSolver, FirstSolveIsExactAndLaterOnesMeetTheTolerance) {
   FactorReuseOptions options;
   options.relativeTolerance = 1e-10;
+  options.amortize = false;  // keep the first factor throughout
   FactorReusingSolver solver(SolverKind::cholmod, options);
   SparseMatrix a = driftingMatrix(8, 0.0);
   solver.setMatrix(a);
@@ -94,6 +95,31 @@ TEST(FactorReusingSolver, GrowingIterationCountsTriggerARefactorization) {
   EXPECT_LT(refactorizationsSeen, 12);  // but not every step
 }
 
+TEST(FactorReusingSolver, AmortisationRefactorsWhenFactorizationsAreCheap) {
+  const Eigen::VectorXd b = randomVector(512, 4);
+  Eigen::VectorXd x;
+  std::vector<long long> refactorizations;
+  // A factorization that costs as much as 1 PCG iteration is redone after every PCG
+  // solve (any iteration count exceeds the average); one that costs 1e4 is never redone
+  // over 8 small drifts (the iteration counts stay far below the average).
+  for (const double cost : {1.0, 1e4}) {
+    FactorReuseOptions options;
+    options.relativeTolerance = 1e-10;
+    options.factorCostInIterations = cost;
+    FactorReusingSolver solver(SolverKind::cholmod, options);
+    for (int step = 0; step < 8; ++step) {
+      const SparseMatrix a = driftingMatrix(8, 0.005 * step);
+      solver.setMatrix(a);
+      solver.solve(b, x);
+      EXPECT_LE((a * x - b).norm(), options.relativeTolerance * b.norm());
+    }
+    EXPECT_EQ(solver.stats().factorCostInIterations, cost);
+    refactorizations.push_back(solver.stats().refactorizations);
+  }
+  EXPECT_EQ(refactorizations[0], 4);  // factor, PCG, factor, PCG, ...
+  EXPECT_EQ(refactorizations[1], 1);
+}
+
 TEST(FactorReusingSolver, AnAbandonedSolveFallsBackToAnExactOne) {
   FactorReuseOptions options;
   options.relativeTolerance = 1e-14;
@@ -113,8 +139,8 @@ TEST(FactorReusingSolver, AnAbandonedSolveFallsBackToAnExactOne) {
 }
 
 TEST(FactorReusingSolver, MisuseIsReportedClearly) {
-  EXPECT_THROW(FactorReusingSolver(SolverKind::cholmod, FactorReuseOptions{1.5, 10, 8, 3.0}), Error);
-  EXPECT_THROW(FactorReusingSolver(SolverKind::cholmod, FactorReuseOptions{1e-8, 0, 8, 3.0}), Error);
+  EXPECT_THROW(FactorReusingSolver(SolverKind::cholmod, FactorReuseOptions{1.5, 10, 8, 3.0, 0.0, true}), Error);
+  EXPECT_THROW(FactorReusingSolver(SolverKind::cholmod, FactorReuseOptions{1e-8, 0, 8, 3.0, 0.0, true}), Error);
   FactorReusingSolver solver;
   Eigen::VectorXd x;
   try {

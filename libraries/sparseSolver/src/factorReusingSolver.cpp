@@ -40,6 +40,15 @@ void FactorReusingSolver::refactor() {
   factorIsCurrent_ = true;
   refactorPending_ = false;
   firstStaleIterations_ = 0;
+  double factorCost = options_.factorCostInIterations;
+  if (!(factorCost > 0.0)) {
+    const SolverStats& direct = direct_->stats();
+    factorCost = direct.solveFlopsPerRhs > 0.0 ? direct.factorFlops / (6.0 * direct.solveFlopsPerRhs) : 10.0;
+  }
+  stats_.factorCostInIterations = factorCost;
+  // The factorization and the exact solve that follows it (one substitution).
+  cycleCost_ = factorCost + 1.0;
+  cycleSolves_ = 0;
 }
 
 void FactorReusingSolver::applyPreconditioner(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
@@ -56,6 +65,7 @@ void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& sol
   ++stats_.solves;
   if (factorIsCurrent_) {
     applyPreconditioner(rhs, solution);
+    ++cycleSolves_;
     ++stats_.exactSolves;
     stats_.lastIterations = 0;
     stats_.lastRelativeResidual = 0.0;
@@ -99,6 +109,7 @@ void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& sol
     ++stats_.abandonedSolves;
     refactor();
     applyPreconditioner(rhs, solution);
+    ++cycleSolves_;
     stats_.lastRelativeResidual = 0.0;
     return;
   }
@@ -108,7 +119,11 @@ void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& sol
   const bool grew = options_.growthFactor > 0.0 &&
                     static_cast<double>(iterations) >
                         std::max(2.0, options_.growthFactor * static_cast<double>(firstStaleIterations_));
-  if (tooMany || grew) refactorPending_ = true;
+  cycleCost_ += iterations;
+  ++cycleSolves_;
+  const bool pays =
+      options_.amortize && static_cast<double>(iterations) > cycleCost_ / static_cast<double>(cycleSolves_);
+  if (tooMany || grew || pays) refactorPending_ = true;
 }
 
 }  // namespace asyncfem
