@@ -120,6 +120,34 @@ TEST(FactorReusingSolver, AmortisationRefactorsWhenFactorizationsAreCheap) {
   EXPECT_EQ(refactorizations[1], 1);
 }
 
+TEST(FactorReusingSolver, AGoodInitialGuessSavesIterationsAndABadOneIsIgnored) {
+  FactorReuseOptions options;
+  options.relativeTolerance = 1e-10;
+  options.amortize = false;
+  FactorReusingSolver solver(SolverKind::cholmod, options);
+  const SparseMatrix first = driftingMatrix(8, 0.0);
+  const Eigen::VectorXd b = randomVector(first.rows(), 5);
+  Eigen::VectorXd exact;
+  solver.setMatrix(first);
+  solver.solve(b, exact);
+  const SparseMatrix second = driftingMatrix(8, 0.02);
+  solver.setMatrix(second);
+  Eigen::VectorXd fromZero;
+  solver.solve(b, fromZero);
+  const int iterationsFromZero = solver.stats().lastIterations;
+  // The first system's solution is close to the second's: fewer iterations, same tolerance.
+  Eigen::VectorXd fromGuess = exact;
+  solver.solve(b, fromGuess, fromGuess);
+  EXPECT_LT(solver.stats().lastIterations, iterationsFromZero);
+  EXPECT_LE((second * fromGuess - b).norm(), options.relativeTolerance * b.norm());
+  // A guess worse than 0 (residual above |b|) is not used: the count is that from 0.
+  const Eigen::VectorXd bad = -10.0 * exact;
+  Eigen::VectorXd fromBad;
+  solver.solve(b, bad, fromBad);
+  EXPECT_EQ(solver.stats().lastIterations, iterationsFromZero);
+  EXPECT_LE((second * fromBad - b).norm(), options.relativeTolerance * b.norm());
+}
+
 TEST(FactorReusingSolver, AnAbandonedSolveFallsBackToAnExactOne) {
   FactorReuseOptions options;
   options.relativeTolerance = 1e-14;

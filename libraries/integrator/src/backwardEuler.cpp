@@ -92,7 +92,9 @@ void BackwardEuler::solveWithReuse(const Eigen::VectorXd& rhs, Eigen::VectorXd& 
   const long long before = reuse_->stats().refactorizations;
   {
     TimeInto timer(stats_.solveSeconds);
-    reuse_->solve(rhs, solution);
+    // solution still holds the previous solve's result (dv of the previous step): a
+    // starting point PCG takes when it is closer than 0.
+    reuse_->solve(rhs, solution, solution);
   }
   stats_.factorizations += reuse_->stats().refactorizations - before;
   ++stats_.solvedRightHandSides;

@@ -57,6 +57,11 @@ void FactorReusingSolver::applyPreconditioner(const Eigen::VectorXd& rhs, Eigen:
 }
 
 void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  solve(rhs, Eigen::VectorXd(), solution);
+}
+
+void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, const Eigen::VectorXd& initialGuess,
+                                Eigen::VectorXd& solution) {
   if (matrix_ == nullptr) throw Error("FactorReusingSolver::solve: called before setMatrix()");
   if (rhs.size() != matrix_->rows()) {
     throw Error("FactorReusingSolver::solve: right-hand side has " + std::to_string(rhs.size()) +
@@ -71,23 +76,35 @@ void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& sol
     stats_.lastRelativeResidual = 0.0;
     return;
   }
-  // Preconditioned conjugate gradients from x = 0 (Saad, Iterative Methods, Alg. 9.1).
+  // Preconditioned conjugate gradients (Saad, Iterative Methods, Alg. 9.1) from x = 0 or
+  // from the initial guess.
   const Eigen::SparseMatrix<double>& a = *matrix_;
   const double rhsNorm = rhs.norm();
-  solution.setZero(rhs.size());
   if (rhsNorm == 0.0) {
+    solution.setZero(rhs.size());
     stats_.lastIterations = 0;
     stats_.lastRelativeResidual = 0.0;
     return;
   }
   const double target = options_.relativeTolerance * rhsNorm;
   residual_ = rhs;
+  bool fromGuess = false;
+  if (initialGuess.size() == rhs.size()) {
+    product_.noalias() = a * initialGuess;
+    fromGuess = (rhs - product_).norm() < rhsNorm;
+  }
+  if (fromGuess) {
+    if (&solution != &initialGuess) solution = initialGuess;
+    residual_ -= product_;
+  } else {
+    solution.setZero(rhs.size());
+  }
   applyPreconditioner(residual_, z_);
   direction_ = z_;
   double residualDotZ = residual_.dot(z_);
   int iterations = 0;
-  double residualNorm = rhsNorm;
-  while (iterations < options_.maxIterations) {
+  double residualNorm = residual_.norm();
+  while (residualNorm > target && iterations < options_.maxIterations) {
     product_.noalias() = a * direction_;
     const double curvature = direction_.dot(product_);
     if (!(curvature > 0.0) || !std::isfinite(curvature)) break;  // not SPD along p: solve exactly below

@@ -25,7 +25,10 @@ struct IntegratorOptions {
   /// every step, keep the last numeric factor as the preconditioner of a PCG solve to
   /// pcgTolerance (relative residual) and refactor when PCG needs more than
   /// pcgRefactorIterations iterations (FactorReusingSolver). false (the default): the
-  /// exact path, one factorization and back-substitution per linear solve.
+  /// exact path, one factorization and back-substitution per linear solve. With
+  /// reuseFactor the results depend on which earlier matrix was factored and on the
+  /// previous step's solution (the PCG start), so a run resumed from a checkpoint agrees
+  /// with an uninterrupted one to about pcgTolerance, not bit for bit.
   bool reuseFactor = false;
   /// Relative residual tolerance of those PCG solves (reuseFactor only), in (0, 1).
   double pcgTolerance = 1e-8;

@@ -78,6 +78,10 @@ class FactorReusingSolver {
   /// asyncfem::Error before setMatrix() or on a size mismatch; NumericalError when the
   /// factorization fails (A not positive definite for Cholesky).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
+  /// Same, with PCG starting from initialGuess (e.g. the previous step's solution, when
+  /// consecutive systems have similar solutions) when its residual is below |b|;
+  /// otherwise from 0. initialGuess may alias solution.
+  void solve(const Eigen::VectorXd& rhs, const Eigen::VectorXd& initialGuess, Eigen::VectorXd& solution);
   /// Makes the next setMatrix() factor its matrix.
   void requestRefactorization() { refactorPending_ = true; }
 
