@@ -81,17 +81,27 @@ constexpr double kConvergedStep = 1e-9;
 // exact tangent; closer to a point where R is not differentiable the SVD is more robust.
 constexpr double kRelativePairSumMargin = 1e-3;
 
-// A starting rotation computed from F only: the identity when F is within about 10
-// degrees of symmetric (|axial(F - F^T)| <= tr(F) / 4), else the rotation whose first
-// two columns are F's first two columns orthonormalised.
+// A starting rotation computed from F only: the identity when F is within about 0.3
+// degrees of symmetric (|axial(F - F^T)| <= tr(F) / 100), else the rotation whose first
+// two columns are those of F (or of one Newton-Schulz step from F) orthonormalised.
 Eigen::Matrix3d deterministicStart(const Eigen::Matrix3d& f) {
   const Eigen::Vector3d skew(f(2, 1) - f(1, 2), f(0, 2) - f(2, 0), f(1, 0) - f(0, 1));
   const double trace = f.trace();
-  if (trace > 0.0 && skew.norm() <= 0.25 * trace) return Eigen::Matrix3d::Identity();
-  const double norm0 = f.col(0).norm();
+  if (trace > 0.0 && skew.norm() <= 0.01 * trace) return Eigen::Matrix3d::Identity();
+  // Near a rotation (|F^T F - I| < 1/2, strains below ~20%) one Newton-Schulz step
+  // X = F (3 I - F^T F) / 2 removes the stretch to second order before the columns are
+  // orthonormalised, so the Newton iteration starts a step closer.
+  const Eigen::Matrix3d gram = f.transpose() * f;
+  Eigen::Matrix3d x = f;
+  if ((gram - Eigen::Matrix3d::Identity()).squaredNorm() < 0.25) {
+    Eigen::Matrix3d factor = -0.5 * gram;
+    factor.diagonal().array() += 1.5;
+    x = f * factor;
+  }
+  const double norm0 = x.col(0).norm();
   if (!(norm0 > 0.0)) return Eigen::Matrix3d::Identity();
-  const Eigen::Vector3d r0 = f.col(0) / norm0;
-  Eigen::Vector3d r1 = f.col(1) - (r0.dot(f.col(1)) * r0);
+  const Eigen::Vector3d r0 = x.col(0) / norm0;
+  Eigen::Vector3d r1 = x.col(1) - (r0.dot(x.col(1)) * r0);
   const double norm1 = r1.norm();
   if (!(norm1 > 1e-8 * norm0)) return Eigen::Matrix3d::Identity();
   r1 /= norm1;

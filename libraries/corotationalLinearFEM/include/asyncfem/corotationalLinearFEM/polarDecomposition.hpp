@@ -85,8 +85,9 @@ struct PolarRotation {
 /// Start: warmStart when given (e.g. the element's rotation at its previous evaluation;
 /// 1-3 steps for smooth motion) unless tr(S) I - S is not positive definite there;
 /// otherwise a deterministic guess from F alone (the
-/// identity for F within about 10 degrees of symmetric, else the Gram-Schmidt rotation
-/// of F's columns), so the result depends only on F. F = I (to rounding) gives exactly
+/// identity for F within about 0.3 degrees of symmetric, else the Gram-Schmidt rotation
+/// of the columns of F, or of one Newton-Schulz step X = F (3 I - F^T F) / 2 when F is
+/// near a rotation), so the result depends only on F. F = I (to rounding) gives exactly
 /// the identity. Costs about 0.1 us per Newton step against about 1 us for the SVD.
 /// When withDifferentialOperator is set, (tr(S) I - S)^{-1} is returned at the final R;
 /// it equals rotationDifferentialOperator(polarDecomposition(F)) to rounding (the
