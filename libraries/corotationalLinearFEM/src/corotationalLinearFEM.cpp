@@ -5,6 +5,7 @@
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/corotationalLinearFEM/polarDecomposition.hpp>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -21,22 +22,6 @@ Eigen::Matrix3d crossMatrix(const Eigen::Vector3d& p) {
   Eigen::Matrix3d m;
   m << 0.0, -p[2], p[1], p[2], 0.0, -p[0], -p[1], p[0], 0.0;
   return m;
-}
-
-/// The element's corotated displacement v = R^T x - X (3x4, one column per vertex).
-ElementPositions corotatedDisplacement(const Eigen::Matrix3d& rotation, const ElementPositions& current,
-                                       const ElementPositions& rest) {
-  ElementPositions v = rotation.transpose() * current;
-  v -= rest;
-  return v;
-}
-
-/// f_e = R K_e v (12), v = R^T x - X.
-void elementForce(const ElementMatrix& stiffness, const Eigen::Matrix3d& rotation, const ElementPositions& current,
-                  const ElementPositions& rest, ElementVector& out) {
-  const ElementPositions v = corotatedDisplacement(rotation, current, rest);
-  const ElementVector kv = stiffness * Eigen::Map<const ElementVector>(v.data());
-  Eigen::Map<ElementPositions>(out.data()).noalias() = rotation * Eigen::Map<const ElementPositions>(kv.data());
 }
 
 /// R K_e R^T, block (a, b) = R K_ab R^T.
@@ -125,6 +110,9 @@ CorotationalLinearFEM::CorotationalLinearFEM(const TetMesh& mesh, std::shared_pt
   elementStiffness_.resize(count);
   rotations_.assign(count, Eigen::Matrix3d::Identity());
   elementEnergies_.assign(count, 0.0);
+  lameVolume_.resize(count);
+  rotatedGradients_.resize(count);
+  elementForces_.resize(count);
   std::vector<double> signedVolumes(count);
   std::vector<double> longestEdges(count);
 #pragma omp parallel for schedule(static)
@@ -139,6 +127,7 @@ CorotationalLinearFEM::CorotationalLinearFEM(const TetMesh& mesh, std::shared_pt
     longestEdges[i] = std::sqrt(longestSquared);
     const Material& material = mesh.elementMaterial(e);
     elementStiffness_[i] = linearElementStiffness(x, material.youngsModulus, material.poissonRatio);
+    lameVolume_[i] = lameParameters(material.youngsModulus, material.poissonRatio) * std::abs(signedVolumes[i]);
   }
   // Checked after the loop, in element order, so the error names the lowest element
   // whatever the thread count.
@@ -152,6 +141,27 @@ CorotationalLinearFEM::CorotationalLinearFEM(const TetMesh& mesh, std::shared_pt
       throw ValidationError(message.str());
     }
   }
+  // Scatter offsets into the assembler's pattern and the vertex -> element incidences of
+  // the per-vertex assembly pass.
+  blockSlots_.resize(count * 16);
+  columnLengths_.resize(count * 4);
+  for (int e = 0; e < numElements; ++e) {
+    for (int b = 0; b < 4; ++b) {
+      for (int a = 0; a < 4; ++a)
+        blockSlots_[(toIndex(e) * 16) + toIndex((4 * b) + a)] = assembler_->slot(e, 3 * a, 3 * b);
+      columnLengths_[(toIndex(e) * 4) + toIndex(b)] =
+          assembler_->slot(e, 0, (3 * b) + 1) - assembler_->slot(e, 0, 3 * b);
+    }
+  }
+  const int numVertices = mesh.numVertices();
+  incidenceOffsets_.assign(toIndex(numVertices) + 1, 0);
+  for (Index k = 0; k < count * 4; ++k) ++incidenceOffsets_[toIndex(elements_.data()[k]) + 1];
+  for (Index v = 0; v < toIndex(numVertices); ++v) incidenceOffsets_[v + 1] += incidenceOffsets_[v];
+  incidences_.resize(count * 4);
+  std::vector<int> fill(incidenceOffsets_.begin(), incidenceOffsets_.end() - 1);
+  for (int k = 0; k < numElements * 4; ++k) incidences_[toIndex(fill[toIndex(elements_.data()[k])]++)] = k;
+  const Eigen::SparseMatrix<double> pattern = assembler_->createMatrix();
+  patternOuter_.assign(pattern.outerIndexPtr(), pattern.outerIndexPtr() + pattern.outerSize() + 1);
 }
 
 Eigen::SparseMatrix<double> CorotationalLinearFEM::createStiffnessMatrix() const { return assembler_->createMatrix(); }
@@ -169,24 +179,116 @@ ElementPositions CorotationalLinearFEM::currentPositions(int e, const Eigen::Vec
   return x;
 }
 
-void CorotationalLinearFEM::updateRotations(const Eigen::VectorXd& displacement, bool needDifferentialOperator) {
+bool CorotationalLinearFEM::cacheHolds(const Eigen::VectorXd& displacement) const {
+  return cacheValid_ && cachedDisplacement_.size() == displacement.size() &&
+         std::memcmp(cachedDisplacement_.data(), displacement.data(),
+                     sizeof(double) * static_cast<std::size_t>(displacement.size())) == 0;
+}
+
+void CorotationalLinearFEM::evaluateElements(const Eigen::VectorXd& displacement, bool needDifferentialOperator) {
+  if ((cacheHolds(displacement)) && (!needDifferentialOperator || cacheHasDifferentialOperators_)) {
+    ++rotationStats_.reusedEvaluations;
+    return;
+  }
   const int numElements = this->numElements();
   if (needDifferentialOperator) differentialOperators_.resize(toIndex(numElements));
-#pragma omp parallel for schedule(static)
+  // The rotations of the previous evaluation, if there is one, are the warm start.
+  const bool warmStart = rotationStart_ == RotationStart::previousEvaluation && cacheValid_;
+  long long newtonSteps = 0;
+  long long fallbacks = 0;
+#pragma omp parallel for schedule(static) reduction(+ : newtonSteps, fallbacks)
   for (int e = 0; e < numElements; ++e) {
     const Index i = toIndex(e);
-    const Eigen::Matrix3d deformationGradient = currentPositions(e, displacement) * shapeGradients_[i].transpose();
-    const PolarDecomposition polar = polarDecomposition(deformationGradient);
-    rotations_[i] = polar.rotation;
-    if (needDifferentialOperator) differentialOperators_[i] = rotationDifferentialOperator(polar);
+    const Eigen::Matrix<double, 3, 4>& g = shapeGradients_[i];
+    // F = I + sum_a u_a g_a^T: the same as sum_a x_a g_a^T (sum_a X_a g_a^T = I), without
+    // the cancellation of positions far from the origin.
+    ElementPositions elementDisplacement;
+    for (int a = 0; a < 4; ++a) {
+      elementDisplacement.col(a) = displacement.segment<3>(3 * static_cast<Eigen::Index>(elements_(a, e)));
+    }
+    Eigen::Matrix3d deformationGradient = elementDisplacement * g.transpose();
+    deformationGradient.diagonal().array() += 1.0;
+    const PolarRotation polar =
+        polarRotation(deformationGradient, warmStart ? &rotations_[i] : nullptr, needDifferentialOperator);
+    newtonSteps += polar.newtonSteps;
+    fallbacks += polar.usedDecomposition ? 1 : 0;
+    const Eigen::Matrix3d& rotation = polar.rotation;
+    rotations_[i] = rotation;
+    if (needDifferentialOperator) differentialOperators_[i] = polar.differentialOperator;
+    // Corotated strain eps = sym(R^T F) - I and V sigma = lambda V tr(eps) I + 2 mu V eps.
+    const Eigen::Matrix3d corotated = rotation.transpose() * deformationGradient;
+    Eigen::Matrix3d strain = 0.5 * (corotated + corotated.transpose());
+    strain.diagonal().array() -= 1.0;
+    const double lambdaVolume = lameVolume_[i][0];
+    const double muVolume = lameVolume_[i][1];
+    const double trace = strain.trace();
+    Eigen::Matrix3d stressVolume = (2.0 * muVolume) * strain;
+    stressVolume.diagonal().array() += lambdaVolume * trace;
+    elementEnergies_[i] = (muVolume * strain.squaredNorm()) + (0.5 * lambdaVolume * trace * trace);
+    const Eigen::Matrix3d rotatedStress = rotation * stressVolume;
+    elementForces_[i].noalias() = rotatedStress * g;
+    rotatedGradients_[i].noalias() = rotation * g;
+  }
+  rotationStats_.extractions += numElements;
+  rotationStats_.newtonSteps += newtonSteps;
+  rotationStats_.decompositionFallbacks += fallbacks;
+  // Summed serially in element order: the total does not depend on the thread count.
+  double energy = 0.0;
+  for (const double elementEnergy : elementEnergies_) energy += elementEnergy;
+  cachedEnergy_ = energy;
+  cachedDisplacement_ = displacement;
+  cacheValid_ = true;
+  cacheHasDifferentialOperators_ = needDifferentialOperator;
+}
+
+void CorotationalLinearFEM::assembleForces(Eigen::VectorXd& forces) const {
+  const int numVertices = numDofs_ / 3;
+  forces.resize(numDofs_);
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < numVertices; ++v) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int p = incidenceOffsets_[toIndex(v)]; p < incidenceOffsets_[toIndex(v) + 1]; ++p) {
+      const int incidence = incidences_[toIndex(p)];
+      sum += elementForces_[toIndex(incidence / 4)].col(incidence % 4);
+    }
+    forces.segment<3>(3 * static_cast<Eigen::Index>(v)) = sum;
   }
 }
 
-void CorotationalLinearFEM::assembleForces(const Eigen::VectorXd& displacement, Eigen::VectorXd& forces) const {
-  forces = assembler_->assembleVector([&](int e, ElementVector& out) {
-    const Index i = toIndex(e);
-    elementForce(elementStiffness_[i], rotations_[i], currentPositions(e, displacement), restPositions_[i], out);
-  });
+void CorotationalLinearFEM::assembleSimpleTangent(Eigen::SparseMatrix<double>& stiffness) const {
+  const int numVertices = numDofs_ / 3;
+  const int* outer = stiffness.outerIndexPtr();
+  double* values = stiffness.valuePtr();
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < numVertices; ++v) {
+    // The three columns of vertex v are contiguous and written by this iteration only.
+    std::fill(values + outer[3 * v], values + outer[(3 * v) + 3], 0.0);
+    for (int p = incidenceOffsets_[toIndex(v)]; p < incidenceOffsets_[toIndex(v) + 1]; ++p) {
+      const int incidence = incidences_[toIndex(p)];
+      const Index e = toIndex(incidence / 4);
+      const int b = incidence % 4;
+      const Eigen::Matrix<double, 3, 4>& h = rotatedGradients_[e];
+      const double lambdaVolume = lameVolume_[e][0];
+      const double muVolume = lameVolume_[e][1];
+      const Eigen::Vector3d hb = h.col(b);
+      const int columnLength = columnLengths_[(e * 4) + toIndex(b)];
+      const int* slots = blockSlots_.data() + (e * 16) + toIndex(4 * b);
+      // Block (a, b) = lambda V h_a h_b^T + mu V h_b h_a^T + mu V (h_a . h_b) I; its
+      // column j is lambda V h_b[j] h_a + mu V h_a[j] h_b + mu V (h_a . h_b) e_j.
+      const Eigen::Vector3d lambdaHb = lambdaVolume * hb;
+      const Eigen::Vector4d dots = muVolume * (h.transpose() * hb);
+      for (int a = 0; a < 4; ++a) {
+        const Eigen::Vector3d ha = h.col(a);
+        const Eigen::Vector3d muHa = muVolume * ha;
+        double* block = values + slots[a];
+        for (int j = 0; j < 3; ++j) {
+          Eigen::Map<Eigen::Vector3d> column(block + (j * columnLength));
+          column += (lambdaHb[j] * ha) + (muHa[j] * hb);
+          column[j] += dots[a];
+        }
+      }
+    }
+  }
 }
 
 void CorotationalLinearFEM::assembleTangent(const Eigen::VectorXd& displacement,
@@ -196,12 +298,12 @@ void CorotationalLinearFEM::assembleTangent(const Eigen::VectorXd& displacement,
     stiffness = assembler_->createMatrix();
   }
   if (tangentKind_ == TangentKind::simple) {
-    assembler_->assemble(
-        [&](int e, ElementMatrix& out) {
-          const Index i = toIndex(e);
-          simpleElementTangent(elementStiffness_[i], rotations_[i], out);
-        },
-        stiffness);
+    if (!std::equal(patternOuter_.begin(), patternOuter_.end(), stiffness.outerIndexPtr())) {
+      throw Error("CorotationalLinearFEM::tangentStiffness: the " + std::to_string(stiffness.rows()) + " x " +
+                  std::to_string(stiffness.cols()) +
+                  " matrix does not have the assembler's pattern; create it with createStiffnessMatrix()");
+    }
+    assembleSimpleTangent(stiffness);
   } else {
     assembler_->assemble(
         [&](int e, ElementMatrix& out) {
@@ -215,22 +317,22 @@ void CorotationalLinearFEM::assembleTangent(const Eigen::VectorXd& displacement,
 
 void CorotationalLinearFEM::internalForces(const Eigen::VectorXd& displacement, Eigen::VectorXd& forces) {
   checkDisplacement(displacement, "internalForces");
-  updateRotations(displacement, false);
-  assembleForces(displacement, forces);
+  evaluateElements(displacement, false);
+  assembleForces(forces);
 }
 
 void CorotationalLinearFEM::tangentStiffness(const Eigen::VectorXd& displacement,
                                              Eigen::SparseMatrix<double>& stiffness) {
   checkDisplacement(displacement, "tangentStiffness");
-  updateRotations(displacement, tangentKind_ == TangentKind::exact);
+  evaluateElements(displacement, tangentKind_ == TangentKind::exact);
   assembleTangent(displacement, stiffness);
 }
 
 void CorotationalLinearFEM::forcesAndTangent(const Eigen::VectorXd& displacement, Eigen::VectorXd& forces,
                                              Eigen::SparseMatrix<double>& stiffness) {
   checkDisplacement(displacement, "forcesAndTangent");
-  updateRotations(displacement, tangentKind_ == TangentKind::exact);
-  assembleForces(displacement, forces);
+  evaluateElements(displacement, tangentKind_ == TangentKind::exact);
+  assembleForces(forces);
   assembleTangent(displacement, stiffness);
 }
 
@@ -255,20 +357,13 @@ bool CorotationalLinearFEM::elementTangent(const Eigen::VectorXd& displacement, 
 
 double CorotationalLinearFEM::elasticEnergy(const Eigen::VectorXd& displacement) {
   checkDisplacement(displacement, "elasticEnergy");
-  updateRotations(displacement, false);
-  const int numElements = this->numElements();
-#pragma omp parallel for schedule(static)
-  for (int e = 0; e < numElements; ++e) {
-    const Index i = toIndex(e);
-    const ElementPositions v =
-        corotatedDisplacement(rotations_[i], currentPositions(e, displacement), restPositions_[i]);
-    const Eigen::Map<const ElementVector> stacked(v.data());
-    elementEnergies_[i] = 0.5 * stacked.dot(elementStiffness_[i] * stacked);
-  }
-  // Summed serially in element order: the total does not depend on the thread count.
-  double energy = 0.0;
-  for (const double elementEnergy : elementEnergies_) energy += elementEnergy;
-  return energy;
+  evaluateElements(displacement, false);
+  return cachedEnergy_;
+}
+
+double CorotationalLinearFEM::energyOfLastEvaluation() const {
+  if (!cacheValid_) throw Error("CorotationalLinearFEM::energyOfLastEvaluation: no evaluation has been made yet");
+  return cachedEnergy_;
 }
 
 }  // namespace asyncfem

@@ -22,7 +22,22 @@ BackwardEuler::BackwardEuler(DynamicSystem system, double timestep, const Integr
     throw ValidationError("backward Euler needs a Newton tolerance >= 0 (got " + std::to_string(options_.tolerance) +
                           ")");
   }
+  if (options_.reuseFactor && !(options_.pcgTolerance > 0.0 && options_.pcgTolerance < 1.0)) {
+    throw ValidationError("backward Euler needs a PCG tolerance in (0, 1) (got " +
+                          std::to_string(options_.pcgTolerance) + ")");
+  }
+  if (options_.reuseFactor && options_.pcgRefactorIterations < 1) {
+    throw ValidationError("backward Euler needs pcgRefactorIterations >= 1 (got " +
+                          std::to_string(options_.pcgRefactorIterations) + ")");
+  }
   linear_ = system_.forceModel->isLinear();
+  if (options_.reuseFactor && !linear_) {
+    FactorReuseOptions reuseOptions;
+    reuseOptions.relativeTolerance = options_.pcgTolerance;
+    reuseOptions.refactorAfterIterations = options_.pcgRefactorIterations;
+    reuseOptions.maxIterations = std::max(25, 3 * options_.pcgRefactorIterations);
+    reuse_ = std::make_unique<FactorReusingSolver>(options_.solver, reuseOptions);
+  }
   {
     TimeInto timer(stats_.assemblySeconds);
     free_ = std::make_unique<detail::FreeSystem>(system_, options_.solver);
@@ -55,6 +70,36 @@ void BackwardEuler::assembleAndFactor() {
                   {&free_->mass, &free_->stiffness}, stats_);
   free_->factorize(stats_);
   factorizationStale_ = false;
+}
+
+const FactorReuseStats* BackwardEuler::factorReuseStats() const { return reuse_ ? &reuse_->stats() : nullptr; }
+
+void BackwardEuler::assembleForReuse() {
+  const double h = timestep_;
+  free_->assemble({1.0 + (h * system_.rayleighMass), (h * system_.rayleighStiffness) + (h * h)},
+                  {&free_->mass, &free_->stiffness}, stats_);
+  updateReusedMatrix();
+}
+
+void BackwardEuler::updateReusedMatrix() {
+  const long long before = reuse_->stats().refactorizations;
+  {
+    TimeInto timer(stats_.factorizationSeconds);
+    reuse_->setMatrix(free_->systemMatrix);
+  }
+  stats_.factorizations += reuse_->stats().refactorizations - before;
+}
+
+void BackwardEuler::solveWithReuse(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  const long long before = reuse_->stats().refactorizations;
+  {
+    TimeInto timer(stats_.solveSeconds);
+    // solution still holds the previous solve's result (dv of the previous step): a
+    // starting point PCG takes when it is closer than 0.
+    reuse_->solve(rhs, solution, solution);
+  }
+  stats_.factorizations += reuse_->stats().refactorizations - before;
+  ++stats_.solvedRightHandSides;
 }
 
 void BackwardEuler::step() {
@@ -126,7 +171,11 @@ void BackwardEuler::stepNonlinear() {
   free.evaluateForcesAndTangent(system_, displacement_, free.stiffness, stats_);
   Eigen::VectorXd internal;
   detail::restrictTo(dofs, free.fullForces(), internal);
-  assembleAndFactor();
+  if (reuse_) {
+    assembleForReuse();
+  } else {
+    assembleAndFactor();
+  }
   {
     TimeInto timer(stats_.forceSeconds);
     rhs_ = force_ - internal;
@@ -136,7 +185,11 @@ void BackwardEuler::stepNonlinear() {
     rhs_ *= h;
   }
   const double rhsNorm = rhs_.norm();
-  free.solve(rhs_, dv_, stats_);
+  if (reuse_) {
+    solveWithReuse(rhs_, dv_);
+  } else {
+    free.solve(rhs_, dv_, stats_);
+  }
   int iterations = 1;
   lastRelativeResidual_ = -1.0;
   lastLineSearchHalvings_ = 0;
@@ -179,8 +232,13 @@ void BackwardEuler::stepNonlinear() {
       // J = (1 + h alpha) M + h beta K_D + h^2 K(u_{k+1}^{(i)}), K_D the damping stiffness
       free.assemble({1.0 + (h * alpha), h * beta, h * h}, {&free.mass, &dampingStiffness, &free.iterateStiffness},
                     stats_);
-      free.factorize(stats_);
-      free.solve(-residual, correction, stats_);
+      if (reuse_) {
+        updateReusedMatrix();
+        solveWithReuse(-residual, correction);
+      } else {
+        free.factorize(stats_);
+        free.solve(-residual, correction, stats_);
+      }
       // With D at the iterate R is not the potential's gradient, so Phi is no merit
       // function for these updates: they are taken in full, as Vega FEM does.
       if (lineSearch && !dampingAtIterate) {

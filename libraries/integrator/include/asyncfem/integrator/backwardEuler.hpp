@@ -3,6 +3,7 @@
 
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/integrator/integratorOptions.hpp>
+#include <asyncfem/sparseSolver/factorReusingSolver.hpp>
 #include <memory>
 #include <string>
 
@@ -55,6 +56,12 @@ class FreeSystem;
 /// D = alpha M + beta K(u_{k+1}^{(i)}) in R and J at every iterate, as Vega FEM does; the
 /// line search then acts on the linearized first update only (the later ones solve
 /// equations that are no potential's gradient and are taken in full, as in Vega).
+///
+/// options.reuseFactor (nonlinear models): the system matrix is still assembled at every
+/// step, but solved by a FactorReusingSolver: PCG to options.pcgTolerance preconditioned
+/// by the last numeric factor, refactoring when the iteration count says the factor is
+/// stale. Its counters are factorReuseStats(); refactorizations are also counted in
+/// stats().factorizations.
 class BackwardEuler final : public Integrator {
  public:
   /// system: validated; h > 0. Factors at once for linear force models.
@@ -75,6 +82,8 @@ class BackwardEuler final : public Integrator {
   /// Step halvings the line search made during the last step (0: every full Newton
   /// update was accepted, or no line search).
   int lastLineSearchHalvings() const { return lastLineSearchHalvings_; }
+  /// PCG and refactorization counters when options().reuseFactor is in effect, else null.
+  const FactorReuseStats* factorReuseStats() const;
 
  private:
   void stepLinear();
@@ -84,9 +93,15 @@ class BackwardEuler final : public Integrator {
   double incrementalPotential(const Eigen::VectorXd& dv);
   // Step length t in (0, 1] along step from dv by backtracking on Phi.
   double backtrack(const Eigen::VectorXd& dv, const Eigen::VectorXd& step, double potential, double slope);
+  // With options_.reuseFactor: hands the assembled system matrix to reuse_ (refactoring
+  // only when it asks to) and solves with it; the time goes to the same stats fields.
+  void assembleForReuse();
+  void updateReusedMatrix();
+  void solveWithReuse(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
 
   IntegratorOptions options_;
   std::unique_ptr<detail::FreeSystem> free_;
+  std::unique_ptr<FactorReusingSolver> reuse_;  // options_.reuseFactor, nonlinear models only
   bool linear_ = false;
   bool factorizationStale_ = true;
   int lastIterations_ = 0;

@@ -30,6 +30,20 @@ struct IntegratorOptions {
   /// K(u_k) of the step start, so the step equations are the gradient of a potential.
   bool rayleighStiffnessAtIterate = false;
 
+  /// Backward Euler, nonlinear force models: instead of refactoring the system matrix at
+  /// every step, keep the last numeric factor as the preconditioner of a PCG solve to
+  /// pcgTolerance (relative residual) and refactor when PCG needs more than
+  /// pcgRefactorIterations iterations (FactorReusingSolver). false (the default): the
+  /// exact path, one factorization and back-substitution per linear solve. With
+  /// reuseFactor the results depend on which earlier matrix was factored and on the
+  /// previous step's solution (the PCG start), so a run resumed from a checkpoint agrees
+  /// with an uninterrupted one to about pcgTolerance, not bit for bit.
+  bool reuseFactor = false;
+  /// Relative residual tolerance of those PCG solves (reuseFactor only), in (0, 1).
+  double pcgTolerance = 1e-8;
+  /// Iterations of a PCG solve above which the next step refactors (reuseFactor only).
+  int pcgRefactorIterations = 8;
+
   /// Explicit methods: an upper bound of the highest angular frequency omega_max
   /// (rad / time unit) of the free system, e.g. from estimateMaxFrequency(mesh, massType).
   /// <= 0: the integrator estimates it from the matrices (see stableTimestep.hpp).

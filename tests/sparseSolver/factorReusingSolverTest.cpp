@@ -1,0 +1,186 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <gtest/gtest.h>
+
+#include <Eigen/SparseCore>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/sparseSolver/factorReusingSolver.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+namespace {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+// 3D 7-point Laplacian on a k^3 grid plus a diagonal: SPD, full storage; the diagonal
+// entries vary with `variation` so that a sequence of matrices drifts away from the first.
+SparseMatrix driftingMatrix(int k, double variation) {
+  const int n = k * k * k;
+  std::vector<Eigen::Triplet<double>> entries;
+  const auto index = [k](int x, int y, int z) { return x + (k * (y + (k * z))); };
+  for (int z = 0; z < k; ++z) {
+    for (int y = 0; y < k; ++y) {
+      for (int x = 0; x < k; ++x) {
+        const int i = index(x, y, z);
+        entries.emplace_back(i, i, 6.5 + (variation * ((i % 7) - 3)));
+        if (x + 1 < k)
+          entries.emplace_back(i, index(x + 1, y, z), -1.0), entries.emplace_back(index(x + 1, y, z), i, -1.0);
+        if (y + 1 < k)
+          entries.emplace_back(i, index(x, y + 1, z), -1.0), entries.emplace_back(index(x, y + 1, z), i, -1.0);
+        if (z + 1 < k)
+          entries.emplace_back(i, index(x, y, z + 1), -1.0), entries.emplace_back(index(x, y, z + 1), i, -1.0);
+      }
+    }
+  }
+  SparseMatrix a(n, n);
+  a.setFromTriplets(entries.begin(), entries.end());
+  a.makeCompressed();
+  return a;
+}
+
+Eigen::VectorXd randomVector(Eigen::Index n, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> entry(-1.0, 1.0);
+  Eigen::VectorXd v(n);
+  for (Eigen::Index i = 0; i < n; ++i) v[i] = entry(random);
+  return v;
+}
+
+TEST(FactorReusingSolver, FirstSolveIsExactAndLaterOnesMeetTheTolerance) {
+  FactorReuseOptions options;
+  options.relativeTolerance = 1e-10;
+  options.amortize = false;  // keep the first factor throughout
+  FactorReusingSolver solver(SolverKind::cholmod, options);
+  SparseMatrix a = driftingMatrix(8, 0.0);
+  solver.setMatrix(a);
+  const Eigen::VectorXd b = randomVector(a.rows(), 1);
+  Eigen::VectorXd x;
+  solver.solve(b, x);
+  // A direct Cholesky solve of this well-conditioned (cond < 10) matrix: rounding only.
+  EXPECT_LE((a * x - b).norm(), 1e-13 * b.norm());
+  EXPECT_EQ(solver.stats().exactSolves, 1);
+  EXPECT_EQ(solver.stats().refactorizations, 1);
+  // Drift the values by a few percent per step: PCG with the first factor.
+  for (int step = 1; step <= 4; ++step) {
+    a = driftingMatrix(8, 0.01 * step);
+    solver.setMatrix(a);
+    solver.solve(b, x);
+    EXPECT_LE((a * x - b).norm(), options.relativeTolerance * b.norm()) << "step " << step;
+    EXPECT_GT(solver.stats().lastIterations, 0);
+  }
+  EXPECT_EQ(solver.stats().refactorizations, 1);
+  EXPECT_GT(solver.stats().pcgIterations, 4);
+}
+
+TEST(FactorReusingSolver, GrowingIterationCountsTriggerARefactorization) {
+  FactorReuseOptions options;
+  options.relativeTolerance = 1e-10;
+  options.refactorAfterIterations = 4;
+  FactorReusingSolver solver(SolverKind::cholmod, options);
+  const Eigen::VectorXd b = randomVector(512, 2);
+  Eigen::VectorXd x;
+  long long refactorizationsSeen = 0;
+  for (int step = 0; step < 12; ++step) {
+    // The diagonal drifts by up to 0.45 (of 6.5) over the run, keeping A SPD (its
+    // smallest eigenvalue is above 0.5 - 0.45): the first factor soon needs many iterations.
+    const SparseMatrix a = driftingMatrix(8, 0.0125 * step);
+    solver.setMatrix(a);
+    solver.solve(b, x);
+    EXPECT_LE((a * x - b).norm(), options.relativeTolerance * b.norm()) << "step " << step;
+    EXPECT_LE(solver.stats().lastIterations, options.maxIterations);
+    refactorizationsSeen = solver.stats().refactorizations;
+  }
+  EXPECT_GT(refactorizationsSeen, 1);   // it did refactor
+  EXPECT_LT(refactorizationsSeen, 12);  // but not every step
+}
+
+TEST(FactorReusingSolver, AmortisationRefactorsWhenFactorizationsAreCheap) {
+  const Eigen::VectorXd b = randomVector(512, 4);
+  Eigen::VectorXd x;
+  std::vector<long long> refactorizations;
+  // A factorization that costs as much as 1 PCG iteration is redone after every PCG
+  // solve (any iteration count exceeds the average); one that costs 1e4 is never redone
+  // over 8 small drifts (the iteration counts stay far below the average).
+  for (const double cost : {1.0, 1e4}) {
+    FactorReuseOptions options;
+    options.relativeTolerance = 1e-10;
+    options.factorCostInIterations = cost;
+    FactorReusingSolver solver(SolverKind::cholmod, options);
+    for (int step = 0; step < 8; ++step) {
+      const SparseMatrix a = driftingMatrix(8, 0.005 * step);
+      solver.setMatrix(a);
+      solver.solve(b, x);
+      EXPECT_LE((a * x - b).norm(), options.relativeTolerance * b.norm());
+    }
+    EXPECT_EQ(solver.stats().factorCostInIterations, cost);
+    refactorizations.push_back(solver.stats().refactorizations);
+  }
+  EXPECT_EQ(refactorizations[0], 4);  // factor, PCG, factor, PCG, ...
+  EXPECT_EQ(refactorizations[1], 1);
+}
+
+TEST(FactorReusingSolver, AGoodInitialGuessSavesIterationsAndABadOneIsIgnored) {
+  FactorReuseOptions options;
+  options.relativeTolerance = 1e-10;
+  options.amortize = false;
+  FactorReusingSolver solver(SolverKind::cholmod, options);
+  const SparseMatrix first = driftingMatrix(8, 0.0);
+  const Eigen::VectorXd b = randomVector(first.rows(), 5);
+  Eigen::VectorXd exact;
+  solver.setMatrix(first);
+  solver.solve(b, exact);
+  const SparseMatrix second = driftingMatrix(8, 0.02);
+  solver.setMatrix(second);
+  Eigen::VectorXd fromZero;
+  solver.solve(b, fromZero);
+  const int iterationsFromZero = solver.stats().lastIterations;
+  // The first system's solution is close to the second's: fewer iterations, same tolerance.
+  Eigen::VectorXd fromGuess = exact;
+  solver.solve(b, fromGuess, fromGuess);
+  EXPECT_LT(solver.stats().lastIterations, iterationsFromZero);
+  EXPECT_LE((second * fromGuess - b).norm(), options.relativeTolerance * b.norm());
+  // A guess worse than 0 (residual above |b|) is not used: the count is that from 0.
+  const Eigen::VectorXd bad = -10.0 * exact;
+  Eigen::VectorXd fromBad;
+  solver.solve(b, bad, fromBad);
+  EXPECT_EQ(solver.stats().lastIterations, iterationsFromZero);
+  EXPECT_LE((second * fromBad - b).norm(), options.relativeTolerance * b.norm());
+}
+
+TEST(FactorReusingSolver, AnAbandonedSolveFallsBackToAnExactOne) {
+  FactorReuseOptions options;
+  options.relativeTolerance = 1e-14;
+  options.maxIterations = 1;  // one iteration can never reach 1e-14 on a changed matrix
+  FactorReusingSolver solver(SolverKind::cholmod, options);
+  const SparseMatrix first = driftingMatrix(6, 0.0);
+  solver.setMatrix(first);
+  const Eigen::VectorXd b = randomVector(first.rows(), 3);
+  Eigen::VectorXd x;
+  solver.solve(b, x);
+  const SparseMatrix second = driftingMatrix(6, 0.1);
+  solver.setMatrix(second);
+  solver.solve(b, x);
+  EXPECT_EQ(solver.stats().abandonedSolves, 1);
+  EXPECT_EQ(solver.stats().refactorizations, 2);
+  EXPECT_LE((second * x - b).norm(), 1e-13 * b.norm());  // exact solve: rounding only
+}
+
+TEST(FactorReusingSolver, MisuseIsReportedClearly) {
+  EXPECT_THROW(FactorReusingSolver(SolverKind::cholmod, FactorReuseOptions{1.5, 10, 8, 3.0, 0.0, true}), Error);
+  EXPECT_THROW(FactorReusingSolver(SolverKind::cholmod, FactorReuseOptions{1e-8, 0, 8, 3.0, 0.0, true}), Error);
+  FactorReusingSolver solver;
+  Eigen::VectorXd x;
+  try {
+    solver.solve(Eigen::VectorXd::Ones(3), x);
+    FAIL() << "no exception";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("before setMatrix"), std::string::npos) << error.what();
+  }
+  const SparseMatrix a = driftingMatrix(3, 0.0);
+  solver.setMatrix(a);
+  EXPECT_THROW(solver.solve(Eigen::VectorXd::Ones(5), x), Error);
+}
+
+}  // namespace
+}  // namespace asyncfem
