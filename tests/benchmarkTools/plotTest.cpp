@@ -25,8 +25,9 @@ TEST(Plot, TextUsesTheBitmapFont) {
   drawText(image, 0, 0, "1", 1, Rgb8{0, 0, 0});
   // '1' has glyph rows 0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E: 1 + 2 + 1 + 1 + 1 + 1 + 3 = 10 dots.
   EXPECT_EQ(countNonWhite(image), 10);
-  // Three 5-dot glyphs and two 1-dot gaps, at scale 2.
+  // Three 5-dot glyphs and two 1-dot gaps, at scale 2; the pen moves one more gap.
   EXPECT_EQ(textWidth("abc", 2), 34);
+  EXPECT_EQ(textAdvance("abc", 2), 36);
   Image upper(40, 10, white), lower(40, 10, white);
   drawText(upper, 0, 0, "AZ", 1, Rgb8{0, 0, 0});
   drawText(lower, 0, 0, "az", 1, Rgb8{0, 0, 0});

@@ -138,7 +138,7 @@ Image renderPlot(const PlotSpec& spec, int width, int height) {
   Image image(width, height, Rgb8{255, 255, 255});
   const Rgb8 black{0, 0, 0}, grid{225, 225, 225};
   int legendWidth = 0;
-  for (const PlotSeries& s : spec.series) legendWidth = std::max(legendWidth, textWidth(s.label, 1));
+  for (const PlotSeries& s : spec.series) legendWidth = std::max(legendWidth, textAdvance(s.label, 1));
   legendWidth = legendWidth > 0 ? legendWidth + 40 : 0;
   const int left = 80, right = width - 20 - legendWidth, top = 50, bottom = height - 60;
   if (right - left < 50 || bottom - top < 50) throw Error("renderPlot: image too small for the plot and its legend");
@@ -166,20 +166,20 @@ Image renderPlot(const PlotSpec& spec, int width, int height) {
     const int x = left + static_cast<int>(std::lround((t - ax.lo) / (ax.hi - ax.lo) * (right - left)));
     drawLine(image, x, top, x, bottom, grid);
     drawLine(image, x, bottom, x, bottom + 5, black);
-    drawText(image, x - textWidth(label, 1) / 2, bottom + 10, label, 1, black);
+    drawText(image, x - textAdvance(label, 1) / 2, bottom + 10, label, 1, black);
   }
   for (const auto& [t, label] : ticks(ay)) {
     const int y = bottom - static_cast<int>(std::lround((t - ay.lo) / (ay.hi - ay.lo) * (bottom - top)));
     drawLine(image, left, y, right, y, grid);
     drawLine(image, left - 5, y, left, y, black);
-    drawText(image, left - 8 - textWidth(label, 1), y - 3, label, 1, black);
+    drawText(image, left - 8 - textAdvance(label, 1), y - 3, label, 1, black);
   }
   drawLine(image, left, top, left, bottom, black);
   drawLine(image, left, bottom, right, bottom, black);
   drawLine(image, left, top, right, top, black);
   drawLine(image, right, top, right, bottom, black);
-  drawText(image, (left + right - textWidth(spec.title, 2)) / 2, 14, spec.title, 2, black);
-  drawText(image, (left + right - textWidth(spec.xLabel, 1)) / 2, bottom + 30, spec.xLabel, 1, black);
+  drawText(image, (left + right - textAdvance(spec.title, 2)) / 2, 14, spec.title, 2, black);
+  drawText(image, (left + right - textAdvance(spec.xLabel, 1)) / 2, bottom + 30, spec.xLabel, 1, black);
   drawText(image, 8, top - 16, spec.yLabel, 1, black);
 
   // Series, clipped to the plot area by skipping points outside it.

@@ -103,6 +103,8 @@ int textWidth(const std::string& text, int scale) {
   return ((static_cast<int>(text.size()) * (glyphWidth + 1)) - 1) * scale;
 }
 
+int textAdvance(const std::string& text, int scale) { return static_cast<int>(text.size()) * (glyphWidth + 1) * scale; }
+
 void drawText(Image& image, int x, int y, const std::string& text, int scale, const Eigen::Vector3f& color) {
   drawText(image, x, y, text, scale, toRgb8(color));
 }

@@ -18,6 +18,10 @@ inline constexpr int glyphHeight = 7;
 /// from the first glyph's left edge to the last glyph's right edge, without the spacing
 /// column after it (0 for empty text).
 int textWidth(const std::string& text, int scale);
+/// How far text moves the pen at the given scale: 6 dots per character, the spacing
+/// column after the last glyph included (textWidth + scale for non-empty text). Layouts
+/// that place text on a character grid (the benchmark plots) measure with this.
+int textAdvance(const std::string& text, int scale);
 /// Draws text with its top-left corner at (x, y), clipped to the image; glyph k starts at
 /// x + 6 k scale.
 void drawText(Image& image, int x, int y, const std::string& text, int scale, Rgb8 color);
