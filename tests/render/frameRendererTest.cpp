@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
-#include <asyncfem/render/image.hpp>
+#include <asyncfem/image/png.hpp>
 #include <asyncfem/render/surfaceMesh.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
@@ -81,6 +81,9 @@ TEST_F(FrameRendererTest, WritesTheSelectedFramesAtTheRequestedSize) {
   }
   EXPECT_FALSE(fs::exists(folder_ / "out" / "frame_00001.png"));
   EXPECT_FALSE(fs::exists(folder_ / "out" / "frame_00006.png"));
+  // stderr is a file here: progress comes as plain lines, the last one at 100%.
+  EXPECT_NE(r.err.find("frameRenderer: frame 3/3 (100%), elapsed "), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
 }
 
 TEST_F(FrameRendererTest, SameInputRendersTheSameFileTwice) {

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Image, PNG files, the bitmap font and side-by-side composition.
+// The image library: Image, lines, PNG files, the bitmap font and side-by-side composition.
 #include <gtest/gtest.h>
 
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/render/image.hpp>
-#include <asyncfem/render/text.hpp>
+#include <asyncfem/image/png.hpp>
+#include <asyncfem/image/text.hpp>
 #include <fstream>
 
 #include "renderTestHelpers.hpp"
@@ -24,6 +24,44 @@ Image gradient(int width, int height) {
     }
   }
   return image;
+}
+
+TEST(Image, ColoursConvertToBytesByRounding) {
+  // 0.5 * 255 = 127.5 rounds away from zero; out-of-range components clamp.
+  EXPECT_EQ(toRgb8(Eigen::Vector3f(0.5F, -1.0F, 2.0F)), (Rgb8{128, 0, 255}));
+  const Image a(3, 2, Eigen::Vector3f(0.2F, 0.4F, 0.6F));
+  const Image b(3, 2, Rgb8{51, 102, 153});
+  EXPECT_TRUE(a == b);
+  EXPECT_EQ(a.at(2, 1), (Rgb8{51, 102, 153}));
+  EXPECT_THROW(Image(-1, 4), Error);
+}
+
+TEST(Image, LinesCoverBothEndsAndClip) {
+  Image image(10, 10, Rgb8{255, 255, 255});
+  const Rgb8 black{0, 0, 0};
+  drawLine(image, 1, 1, 8, 1, black);
+  for (int x = 0; x < 10; ++x) {
+    EXPECT_EQ(image.at(x, 1) == black, x >= 1 && x <= 8) << x;
+  }
+  // A diagonal with a 2-pixel pen: the pen covers [x, x + 1] x [y, y + 1] at each step.
+  Image thick(10, 10, Rgb8{255, 255, 255});
+  drawLine(thick, 2, 2, 5, 5, black, 2);
+  int lit = 0;
+  for (int y = 0; y < 10; ++y) {
+    for (int x = 0; x < 10; ++x) {
+      lit += thick.at(x, y) == black ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(lit, 4 + (3 * 3));  // the first 2 x 2 square, then 3 new pixels per step
+  // Far outside the image: nothing drawn, nothing written out of bounds.
+  Image clipped(4, 4, Rgb8{255, 255, 255});
+  drawLine(clipped, -1000000, -5, 1000000, -5, black, 3);
+  EXPECT_TRUE(clipped == Image(4, 4, Rgb8{255, 255, 255}));
+}
+
+TEST(Png, ThisBuildHasPngSupport) {
+  // Rendering needs libpng (the top-level CMakeLists requires it with ASYNCFEM_WITH_RENDER).
+  EXPECT_TRUE(pngSupported());
 }
 
 TEST(Png, RoundTripIsExact) {
@@ -89,6 +127,15 @@ TEST(Text, GlyphsDrawInsideTheirCell) {
   drawText(other, 0, 0, "SINGL", 1, Eigen::Vector3f::Ones());
   EXPECT_TRUE(upper == lower);
   EXPECT_FALSE(upper == other);
+  // Brackets, caret and bar have glyphs; a character without one draws as a hollow box.
+  for (const char* defined : {"[", "]", "^", "|"}) {
+    Image drawn(6, 8);
+    Image box(6, 8);
+    drawText(drawn, 0, 0, defined, 1, Rgb8{255, 255, 255});
+    drawText(box, 0, 0, "~", 1, Rgb8{255, 255, 255});
+    EXPECT_FALSE(drawn == box) << defined;
+    EXPECT_FALSE(drawn == Image(6, 8)) << defined;
+  }
 }
 
 TEST(Text, SideBySideKeepsBothImagesUnderTheirBars) {

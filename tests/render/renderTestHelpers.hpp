@@ -5,7 +5,7 @@
 #include <unistd.h>
 
 #include <Eigen/Core>
-#include <asyncfem/render/image.hpp>
+#include <asyncfem/image/image.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <cstdlib>
 #include <filesystem>

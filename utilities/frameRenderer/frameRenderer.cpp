@@ -8,16 +8,16 @@
 // Writes DIR/frame_NNNNN.png (NNNNN = the frame's index in the file). Progress on stderr,
 // a summary on stdout. Errors print "frameRenderer: <message>" on stderr and exit with
 // status 1 (2 for unusable command-line options). Reference: docs/rendering.md.
-#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/core/threading.hpp>
+#include <asyncfem/image/png.hpp>
+#include <asyncfem/image/text.hpp>
 #include <asyncfem/render/renderer.hpp>
 #include <asyncfem/render/surfaceEmbedding.hpp>
-#include <asyncfem/render/text.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/simulationIO/frameSelection.hpp>
@@ -26,7 +26,6 @@
 #include <asyncfem/volumetricMesh/readers.hpp>
 #include <asyncfem/warping/warping.hpp>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -41,6 +40,7 @@
 #include <vector>
 
 #include "commandLine.hpp"
+#include "progress.hpp"
 
 namespace {
 
@@ -75,62 +75,6 @@ struct CommandLine {
 };
 
 Eigen::Vector3d toVector(const std::vector<double>& values) { return {values[0], values[1], values[2]}; }
-
-// ---------------------------------------------------------------------------------------
-// Progress on stderr: a bar redrawn in place on a terminal (or with --progress), plain
-// lines every 10% otherwise, nothing with --quiet.
-
-class Progress {
- public:
-  enum class Style { none, bar, lines };
-  Progress(Style style, std::size_t total) : style_(style), total_(std::max<std::size_t>(total, 1)) {}
-
-  void update(std::size_t done) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (style_ == Style::none) {
-      return;
-    }
-    const auto now = std::chrono::steady_clock::now();
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    const double eta = done > 0 ? elapsed * static_cast<double>(total_ - done) / static_cast<double>(done) : 0.0;
-    const int percent = static_cast<int>((100 * done) / total_);
-    if (style_ == Style::bar) {
-      if (done < total_ && drawn_ && now - last_ < std::chrono::milliseconds(50)) {
-        return;
-      }
-      constexpr int width = 30;
-      const auto filled = static_cast<std::size_t>((width * done) / total_);
-      const std::string bar = std::string(filled, '#') + std::string(width - filled, '.');
-      std::fprintf(stderr, "\r[%s] %zu/%zu frames %3d%%  elapsed %.1f s  ETA %.1f s   ", bar.c_str(), done, total_,
-                   percent, elapsed, eta);
-      std::fflush(stderr);
-      drawn_ = true;
-      last_ = now;
-      return;
-    }
-    if (percent / 10 > lastPercent_ / 10 || done == total_) {
-      std::fprintf(stderr, "frameRenderer: frame %zu/%zu (%d%%), elapsed %.1f s, ETA %.1f s\n", done, total_, percent,
-                   elapsed, eta);
-      lastPercent_ = percent;
-    }
-  }
-  void finish() {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (style_ == Style::bar && drawn_) {
-      std::fputc('\n', stderr);
-      drawn_ = false;
-    }
-  }
-
- private:
-  Style style_;
-  std::size_t total_;
-  std::mutex mutex_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-  std::chrono::steady_clock::time_point last_ = start_;
-  int lastPercent_ = 0;
-  bool drawn_ = false;
-};
 
 // ---------------------------------------------------------------------------------------
 // What every worker shares (read-only) and what each owns.
@@ -448,14 +392,9 @@ int run(int argc, char** argv) {
   }
 
   fs::create_directories(options.output);
-  Progress::Style progressStyle = Progress::Style::lines;
-  if (options.quiet) {
-    progressStyle = Progress::Style::none;
-  } else if (options.progress || ::isatty(STDERR_FILENO) != 0) {
-    progressStyle = Progress::Style::bar;
-  }
-  Progress progress(progressStyle, frames.size());
-  std::atomic<std::size_t> done{0};
+  cli::ProgressReporter progress("frameRenderer", cli::chooseProgressStyle(options.quiet, options.progress),
+                                 static_cast<int>(frames.size()));
+  std::atomic<int> done{0};
   // One renderer (OSMesa context) per thread and panel; panels may differ in width by one.
   std::vector<std::vector<std::unique_ptr<OffscreenRenderer>>> renderers(static_cast<std::size_t>(threads));
   std::vector<double> renderSeconds(static_cast<std::size_t>(threads), 0.0);

@@ -9,6 +9,7 @@
 #include <asyncfem/integrator/stableTimestep.hpp>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -122,7 +123,7 @@ Configuration parseConfigurationSpec(const std::string& spec, const Scene& scene
   Configuration c;
   c.integrator = parts[0];
   c.plotTrajectory = true;
-  int ratio = 0;
+  std::optional<int> ratio;
   for (std::size_t k = 1; k < parts.size(); ++k) {
     const std::size_t eq = parts[k].find('=');
     if (eq == std::string::npos)
@@ -131,8 +132,11 @@ Configuration parseConfigurationSpec(const std::string& spec, const Scene& scene
     try {
       if (key == "spf") {
         c.stepsPerFrame = std::stoi(value);
+        if (c.stepsPerFrame < 1)
+          throw ValidationError("--config \"" + spec + "\": spf must be >= 1 (got " + value + ")");
       } else if (key == "dt") {
         c.timestep = std::stod(value);
+        if (!(c.timestep > 0.0)) throw ValidationError("--config \"" + spec + "\": dt must be > 0 (got " + value + ")");
       } else if (key == "ratio") {
         ratio = std::stoi(value);
       } else if (key == "coupling" || key == "schur" || key == "method" || key == "recovery" || key == "solver") {
@@ -155,7 +159,8 @@ Configuration parseConfigurationSpec(const std::string& spec, const Scene& scene
     }
   }
   completeOptions(c, scene);
-  if (ratio > 0) setRatio(c.options, ratio, "--config \"" + spec + "\"");
+  // Any given ratio goes to the regions, so that the scene check rejects one out of range.
+  if (ratio) setRatio(c.options, *ratio, "--config \"" + spec + "\".ratio");
   if (c.label.empty()) c.label = defaultLabel(c);
   return c;
 }

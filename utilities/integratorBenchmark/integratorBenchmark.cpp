@@ -22,6 +22,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/core/threading.hpp>
+#include <asyncfem/image/png.hpp>
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
 #include <asyncfem/modalAnalysis/regionModes.hpp>
 #include <asyncfem/sceneIO/asyncScene.hpp>
@@ -39,7 +40,6 @@
 #include "benchmarkRun.hpp"
 #include "commandLine.hpp"
 #include "performanceTable.hpp"
-#include "pngWriter.hpp"
 
 namespace {
 
@@ -301,7 +301,7 @@ void plotPareto(const fs::path& path, const std::vector<RunResult>& results, con
   }
   // Points keep the configuration order (backward Euler: increasing steps per frame), so
   // the connected single-rate curve follows the timestep even where timing noise reorders it.
-  writePng(path, renderPlot(spec, 1100, 650));
+  writePng(path, renderPlot(spec, 1100, 650), PngCompression::standard);
 }
 
 void plotVertex(const fs::path& path, const std::vector<RunResult>& results, const Reference& reference,
@@ -321,7 +321,7 @@ void plotVertex(const fs::path& path, const std::vector<RunResult>& results, con
         {r.configuration.label, t, vertexDisplacementNorms(r.frames, vertex), paletteColor(index), Marker::none, true});
     ++index;
   }
-  writePng(path, renderPlot(spec, 1100, 650));
+  writePng(path, renderPlot(spec, 1100, 650), PngCompression::standard);
 }
 
 /// How much of one vertex's free vibration a run keeps after the last load window closes:
@@ -467,7 +467,7 @@ void plotVertexAgainstEqualCost(const fs::path& path, const std::vector<RunResul
     spec.series.push_back({label, frameTimes(scene, static_cast<int>(run->frames.size())), component(run->frames),
                            paletteColor(index++), Marker::none, true});
   }
-  writePng(path, renderPlot(spec, 1100, 650));
+  writePng(path, renderPlot(spec, 1100, 650), PngCompression::standard);
 }
 
 /// The K lowest modes of the scene (linear K, the scene's mass) with omega hL, omega hS and
@@ -655,7 +655,7 @@ int runBenchmark(const CommandLine& options) {
     plotVertexAgainstEqualCost(focus, results, reference, scene, vertex, sceneName);
     if (fs::exists(focus)) std::cout << "Wrote " << focus.string() << "\n";
   } else {
-    std::cout << "\nNo plots: this build has no PNG support (configure with ASYNCFEM_WITH_RENDER=ON); CSV only.\n";
+    std::cout << "\nNo plots: this build has no PNG support (libpng was not found when it was configured); CSV only.\n";
   }
   std::cout << "Wrote " << (fs::path(options.out) / "results.csv").string() << " and "
             << (fs::path(options.out) / "equal-cost-error.csv").string() << "\n";

@@ -3,8 +3,8 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <asyncfem/image/image.hpp>
 #include <asyncfem/render/camera.hpp>
-#include <asyncfem/render/image.hpp>
 #include <memory>
 #include <optional>
 #include <vector>

@@ -1,16 +1,21 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "progress.hpp"
 
+#include <unistd.h>
+
 #include <cmath>
+#include <utility>
 
-namespace asyncfem::offline {
+namespace asyncfem::cli {
 
-ProgressReporter::ProgressReporter(ProgressStyle style, int totalFrames, int firstFrame, std::FILE* out)
-    : style_(style), totalFrames_(totalFrames > 0 ? totalFrames : 1), firstFrame_(firstFrame), out_(out) {
-  lastPercentPrinted_ = static_cast<int>(std::floor(100.0 * firstFrame_ / totalFrames_));
+ProgressStyle chooseProgressStyle(bool quiet, bool forceBar) {
+  if (quiet) {
+    return ProgressStyle::none;
+  }
+  return forceBar || ::isatty(STDERR_FILENO) != 0 ? ProgressStyle::bar : ProgressStyle::lines;
 }
 
-std::string ProgressReporter::formatSeconds(double seconds) {
+std::string formatDuration(double seconds) {
   char text[32];
   if (seconds < 60.0) {
     std::snprintf(text, sizeof(text), "%.1f s", seconds);
@@ -24,10 +29,23 @@ std::string ProgressReporter::formatSeconds(double seconds) {
   return text;
 }
 
+ProgressReporter::ProgressReporter(std::string program, ProgressStyle style, int totalFrames, int firstFrame,
+                                   std::FILE* out)
+    : program_(std::move(program)),
+      style_(style),
+      totalFrames_(totalFrames > 0 ? totalFrames : 1),
+      firstFrame_(firstFrame),
+      out_(out),
+      latest_(firstFrame) {
+  lastPercentPrinted_ = static_cast<int>(std::floor(100.0 * firstFrame_ / totalFrames_));
+}
+
 void ProgressReporter::update(int framesDone) {
-  if (style_ == ProgressStyle::none) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (style_ == ProgressStyle::none || framesDone < latest_) {
     return;
   }
+  latest_ = framesDone;
   const Clock::time_point now = Clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   const double fraction = static_cast<double>(framesDone) / totalFrames_;
@@ -45,7 +63,7 @@ void ProgressReporter::update(int framesDone) {
     std::string bar(static_cast<std::size_t>(filled), '#');
     bar.append(static_cast<std::size_t>(width - filled), '.');
     std::fprintf(out_, "\r[%s] %d/%d frames %3d%%  elapsed %s  ETA %s   ", bar.c_str(), framesDone, totalFrames_,
-                 percent, formatSeconds(elapsed).c_str(), formatSeconds(remaining).c_str());
+                 percent, formatDuration(elapsed).c_str(), formatDuration(remaining).c_str());
     std::fflush(out_);
     barDrawn_ = true;
     lastPrint_ = now;
@@ -60,14 +78,15 @@ void ProgressReporter::update(int framesDone) {
   if (framesDone == totalFrames_ && lastPercentPrinted_ == 100) {
     return;
   }
-  std::fprintf(out_, "offlineSimulator: frame %d/%d (%d%%), elapsed %s, ETA %s\n", framesDone, totalFrames_, percent,
-               formatSeconds(elapsed).c_str(), formatSeconds(remaining).c_str());
+  std::fprintf(out_, "%s: frame %d/%d (%d%%), elapsed %s, ETA %s\n", program_.c_str(), framesDone, totalFrames_,
+               percent, formatDuration(elapsed).c_str(), formatDuration(remaining).c_str());
   std::fflush(out_);
   lastPercentPrinted_ = percent;
   lastPrint_ = now;
 }
 
 void ProgressReporter::finish() {
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (style_ == ProgressStyle::bar && barDrawn_) {
     std::fputc('\n', out_);
     std::fflush(out_);
@@ -75,4 +94,4 @@ void ProgressReporter::finish() {
   }
 }
 
-}  // namespace asyncfem::offline
+}  // namespace asyncfem::cli

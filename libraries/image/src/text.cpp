@@ -2,7 +2,7 @@
 #include <algorithm>
 #include <array>
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/render/text.hpp>
+#include <asyncfem/image/text.hpp>
 #include <cctype>
 #include <string>
 
@@ -66,6 +66,8 @@ constexpr Glyph glyphs[] = {
     {'/', {0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00}},   // ..... ....# ...#. ..#.. .#... #.... .....
     {'(', {0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02}},   // ...#. ..#.. .#... .#... .#... ..#.. ...#.
     {')', {0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08}},   // .#... ..#.. ...#. ...#. ...#. ..#.. .#...
+    {'[', {0x0E, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0E}},   // .###. .#... .#... .#... .#... .#... .###.
+    {']', {0x0E, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0E}},   // .###. ...#. ...#. ...#. ...#. ...#. .###.
     {'%', {0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03}},   // ##... ##..# ...#. ..#.. .#... #..## ...##
     {'#', {0x0A, 0x0A, 0x1F, 0x0A, 0x1F, 0x0A, 0x0A}},   // .#.#. .#.#. ##### .#.#. ##### .#.#. .#.#.
     {'\'', {0x04, 0x04, 0x08, 0x00, 0x00, 0x00, 0x00}},  // ..#.. ..#.. .#... ..... ..... ..... .....
@@ -75,6 +77,8 @@ constexpr Glyph glyphs[] = {
     {'<', {0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02}},   // ...#. ..#.. .#... #.... .#... ..#.. ...#.
     {'>', {0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08}},   // .#... ..#.. ...#. ....# ...#. ..#.. .#...
     {'*', {0x00, 0x04, 0x15, 0x0E, 0x15, 0x04, 0x00}},   // ..... ..#.. #.#.# .###. #.#.# ..#.. .....
+    {'^', {0x04, 0x0A, 0x11, 0x00, 0x00, 0x00, 0x00}},   // ..#.. .#.#. #...# ..... ..... ..... .....
+    {'|', {0x04, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04}},   // ..#.. ..#.. ..#.. ..#.. ..#.. ..#.. ..#..
 };
 
 /// Drawn for characters without a glyph: a hollow box.
@@ -99,7 +103,13 @@ int textWidth(const std::string& text, int scale) {
   return ((static_cast<int>(text.size()) * (glyphWidth + 1)) - 1) * scale;
 }
 
+int textAdvance(const std::string& text, int scale) { return static_cast<int>(text.size()) * (glyphWidth + 1) * scale; }
+
 void drawText(Image& image, int x, int y, const std::string& text, int scale, const Eigen::Vector3f& color) {
+  drawText(image, x, y, text, scale, toRgb8(color));
+}
+
+void drawText(Image& image, int x, int y, const std::string& text, int scale, Rgb8 color) {
   for (std::size_t i = 0; i < text.size(); ++i) {
     const auto& rows = glyphRows(text[i]);
     const int left = x + (static_cast<int>(i) * (glyphWidth + 1) * scale);
