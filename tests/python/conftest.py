@@ -8,8 +8,8 @@ import pytest
 
 import asyncfem as af
 
-SOURCE_DIR = pathlib.Path(os.environ.get("ASYNCFEM_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
-BINARY_DIR = pathlib.Path(os.environ.get("ASYNCFEM_BINARY_DIR", SOURCE_DIR / "build"))
+SOURCE_DIR = pathlib.Path(os.environ.get("ASYNCFEM_SOURCE_DIR", pathlib.Path(__file__).parents[2])).resolve()
+BINARY_DIR = pathlib.Path(os.environ.get("ASYNCFEM_BINARY_DIR", SOURCE_DIR / "build")).resolve()
 BEAM = SOURCE_DIR / "models" / "beam" / "beam.veg"
 
 

@@ -4,7 +4,7 @@
 
 #include <bindings.hpp>
 
-PYBIND11_MODULE(asyncfem, module) {
+PYBIND11_MODULE(_asyncfem, module) {
   namespace python = asyncfem::python;
   module.doc() =
       "AsyncFEM: tetrahedral FEM meshes, matrices, sparse solvers, force models, single-rate and "
