@@ -31,7 +31,7 @@ def test_default_scene(tmp_path):
 
 def test_async_vs_single_rate(tmp_path):
     output = tmp_path / "tip.png"
-    text = run("async_vs_single_rate.py", "--seconds", 0.1, "--output", output, cwd=tmp_path)
+    text = run("async_vs_single_rate.py", "--seconds", 0.05, "--output", output, cwd=tmp_path)
     assert text.count("s wall") == 3
     if af.has_render:
         image = af.read_png(output)
