@@ -18,7 +18,7 @@ parser.add_argument("--frames", type=int, default=120, help="frames at 30 per se
 parser.add_argument("--output", default="beam.afsim")
 args = parser.parse_args()
 
-# The scene in ten lines.
+# The scene itself: about ten lines.
 mesh = af.read_mesh(MODELS / "beam" / "beam.veg")
 assembler = af.MatrixAssembler(mesh)
 pull = np.zeros(mesh.num_dofs)
