@@ -61,3 +61,32 @@ def test_async_with_ratio_one_is_backward_euler(beam):
     reference.step(5)
     scale = np.abs(reference.displacement).max()
     np.testing.assert_allclose(one.displacement, reference.displacement, rtol=0, atol=1e-9 * scale)
+
+
+def test_suggested_regions(beam):
+    """The stiff, light tip of the generated beam is proposed as a fast region (its element
+    frequencies are about sqrt(50e6/200 / (1e6/1000)) = 16 times the body's)."""
+    free = af.FreeDofs.from_fixed_vertices(beam.num_vertices, beam.vertex_set("root"))
+    frequencies = af.element_max_frequencies(beam)
+    tip_elements = beam.element_set("tip")
+    assert frequencies[tip_elements].min() > 10 * np.delete(frequencies, tip_elements).max()
+    options = af.AutoRegionOptions()
+    options.large_timestep = 1 / 120
+    proposal = af.suggest_regions(beam, free, options)
+    assert len(proposal.regions) == 1 and not proposal.has_modal_report
+    proposed = proposal.regions[0]
+    assert set(beam.set_vertices("tip")) <= set(proposed.region.vertices) and proposed.region.ratio > 1
+    assert proposed.max_frequency == frequencies[tip_elements].max() and proposed.num_elements >= len(tip_elements)
+    assert proposal.large_timestep == options.large_timestep and proposal.target_omega_h > 0
+    assert proposal.large_region_max_frequency < proposed.max_frequency
+    assert proposal.async_regions()[0].ratio == proposed.region.ratio
+    assert proposal.withdrawn_regions == [] and proposal.modal_seconds == 0.0
+    for field in ("relative_threshold", "grow_layers", "max_ratio", "frame_rate", "modal_count", "max_modal_count"):
+        assert getattr(options, field) > 0
+    options.modal_check = True
+    assembler = af.MatrixAssembler(beam)
+    checked = af.suggest_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler),
+                                 af.mass_matrix(beam, assembler))
+    assert checked.has_modal_report and checked.modal_seconds > 0
+    with pytest.raises(ValueError, match="give both"):
+        af.suggest_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler))

@@ -3,6 +3,7 @@
 // implicit backward Euler integrator.
 
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <integrators.hpp>
 
 namespace asyncfem::python {
@@ -149,6 +150,51 @@ void bindAsync(py::module_& module) {
       .def("solve_floor_seconds", &AsyncBackwardEuler::solveFloorSeconds, py::arg("repeats") = 5,
            py::call_guard<py::gil_scoped_release>())
       .def_property_readonly("factor_non_zeros", &AsyncBackwardEuler::factorNonZeros);
+
+  // Automatic regions (what a scene's "regions": "auto" and suggestRegions use).
+  module.def("element_max_frequencies", &elementMaxFrequencies, py::arg("mesh"),
+             py::call_guard<py::gil_scoped_release>(), "omega_e per element (rad/s), lumped element mass");
+  py::class_<AutoRegionOptions>(module, "AutoRegionOptions")
+      .def(py::init<>())
+      .def_readwrite("large_timestep", &AutoRegionOptions::largeTimestep, "hL (s)")
+      .def_readwrite("target_omega_h", &AutoRegionOptions::targetOmegaH)
+      .def_readwrite("relative_threshold", &AutoRegionOptions::relativeThreshold)
+      .def_readwrite("grow_layers", &AutoRegionOptions::growLayers)
+      .def_readwrite("max_ratio", &AutoRegionOptions::maxRatio)
+      .def_readwrite("modal_check", &AutoRegionOptions::modalCheck)
+      .def_readwrite("frame_rate", &AutoRegionOptions::frameRate)
+      .def_readwrite("modal_count", &AutoRegionOptions::modalCount)
+      .def_readwrite("max_modal_count", &AutoRegionOptions::maxModalCount);
+  py::class_<ProposedRegion>(module, "ProposedRegion")
+      .def_readonly("region", &ProposedRegion::region)
+      .def_readonly("max_frequency", &ProposedRegion::maxFrequency)
+      .def_readonly("num_elements", &ProposedRegion::numElements)
+      .def_readonly("num_interface_dofs", &ProposedRegion::numInterfaceDofs);
+  py::class_<AutoRegionProposal>(module, "AutoRegionProposal")
+      .def_readonly("regions", &AutoRegionProposal::regions)
+      .def_readonly("withdrawn_regions", &AutoRegionProposal::withdrawnRegions)
+      .def_readonly("large_region_max_frequency", &AutoRegionProposal::largeRegionMaxFrequency)
+      .def_readonly("large_timestep", &AutoRegionProposal::largeTimestep)
+      .def_readonly("target_omega_h", &AutoRegionProposal::targetOmegaH)
+      .def_readonly("modal_seconds", &AutoRegionProposal::modalSeconds)
+      .def_property_readonly("has_modal_report",
+                             [](const AutoRegionProposal& proposal) { return proposal.modalReport.has_value(); })
+      .def("async_regions", &AutoRegionProposal::asyncRegions, "the proposed regions, ready for AsyncBackwardEuler");
+  module.def(
+      "suggest_regions",
+      [](const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+         const std::optional<Eigen::SparseMatrix<double>>& stiffness,
+         const std::optional<Eigen::SparseMatrix<double>>& mass) {
+        if (stiffness.has_value() != mass.has_value()) {
+          throw py::value_error("stiffness, mass: give both (for the modal check) or neither");
+        }
+        py::gil_scoped_release release;
+        return stiffness ? suggestRegions(mesh, freeDofs, options, *stiffness, *mass)
+                         : suggestRegions(mesh, freeDofs, options);
+      },
+      py::arg("mesh"), py::arg("free_dofs"), py::arg("options") = AutoRegionOptions{},
+      py::arg("stiffness") = py::none(), py::arg("mass") = py::none(),
+      "fast regions and ratios from the element frequencies (modal check with K and M, full 3n matrices)");
 }
 
 }  // namespace asyncfem::python
