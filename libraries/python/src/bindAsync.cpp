@@ -1,0 +1,200 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// libraries/asyncIntegrator: fast regions, their partition, options and the asynchronous
+// implicit backward Euler integrator.
+
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <integrators.hpp>
+
+namespace asyncfem::python {
+
+namespace {
+
+SubstepObserver observerFromPython(const py::object& callable) {
+  if (callable.is_none()) return {};
+  if (!PyCallable_Check(callable.ptr())) {
+    throw py::value_error("observer: expected a callable f(region, substep, time, u_region, v_region)");
+  }
+  auto function = std::make_shared<PythonReference>(callable);
+  return [function](int region, int substep, double time, const Eigen::VectorXd& u, const Eigen::VectorXd& v) {
+    py::gil_scoped_acquire gil;
+    function->get()(region, substep, time, Eigen::VectorXd(u), Eigen::VectorXd(v));
+  };
+}
+
+}  // namespace
+
+void bindAsync(py::module_& module) {
+  py::class_<AsyncRegion>(module, "AsyncRegion", "A fast region S_i: vertices stepped at hL / ratio")
+      .def(py::init([](std::string name, const py::handle& vertices, int ratio) {
+             return AsyncRegion{std::move(name), indexListArgument(vertices, "vertices"), ratio};
+           }),
+           py::arg("name"), py::arg("vertices"), py::arg("ratio"))
+      .def_readwrite("name", &AsyncRegion::name)
+      .def_property(
+          "vertices", [](const AsyncRegion& region) { return intArray(region.vertices); },
+          [](AsyncRegion& region, const py::handle& vertices) {
+            region.vertices = indexListArgument(vertices, "vertices");
+          })
+      .def_readwrite("ratio", &AsyncRegion::ratio);
+
+  module.def(
+      "region_vertices",
+      [](const TetMesh& mesh, std::vector<std::string> vertexSets, std::vector<std::string> elementSets,
+         const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& boxes, const py::handle& vertices) {
+        RegionSelector selector;
+        selector.vertexSets = std::move(vertexSets);
+        selector.elementSets = std::move(elementSets);
+        for (const auto& [min, max] : boxes) {
+          selector.boxMin.push_back(min);
+          selector.boxMax.push_back(max);
+        }
+        selector.vertices = indexListArgument(vertices, "vertices");
+        return intArray(regionVertices(mesh, selector));
+      },
+      py::arg("mesh"), py::arg("vertex_sets") = std::vector<std::string>{},
+      py::arg("element_sets") = std::vector<std::string>{},
+      py::arg("boxes") = std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>{},
+      py::arg("vertices") = std::vector<int>{},
+      "sorted union of the vertex sets, the vertices of the element sets, the vertices inside the (min, max) "
+      "boxes and the ids");
+
+  py::class_<RegionPartition>(module, "RegionPartition", "Free DOFs split into fast regions S_i and the rest L")
+      .def(py::init([](const TetMesh& mesh, const FreeDofs& freeDofs, std::vector<AsyncRegion> regions) {
+             return RegionPartition(mesh, freeDofs, std::move(regions));
+           }),
+           py::arg("mesh"), py::arg("free_dofs"), py::arg("regions"))
+      .def_property_readonly("num_regions", &RegionPartition::numRegions)
+      .def(
+          "region",
+          [](const RegionPartition& partition, int i) {
+            checkIndex(i, partition.numRegions(), "region");
+            return partition.region(i);
+          },
+          py::arg("index"))
+      .def(
+          "region_dofs",
+          [](const RegionPartition& partition, int i) {
+            checkIndex(i, partition.numRegions(), "region");
+            return intArray(partition.regionDofs(i));
+          },
+          py::arg("index"))
+      .def(
+          "interface_dofs",
+          [](const RegionPartition& partition, int i) {
+            checkIndex(i, partition.numRegions(), "region");
+            return intArray(partition.interfaceDofs(i));
+          },
+          py::arg("index"))
+      .def_property_readonly("large_dofs", [](const RegionPartition& p) { return intArray(p.largeDofs()); })
+      .def_property_readonly("interface_elements",
+                             [](const RegionPartition& p) { return intArray(p.interfaceElements()); })
+      .def_property_readonly(
+          "vertex_region", [](const RegionPartition& p) { return intArray(p.vertexRegion()); },
+          "region of every vertex: i for S_i, -1 for L");
+
+  py::enum_<SchurMode>(module, "SchurMode")
+      .value("low_rank", SchurMode::lowRank)
+      .value("lu", SchurMode::lu)
+      .value("symmetric", SchurMode::symmetric);
+  py::enum_<AsyncSolveMethod>(module, "AsyncSolveMethod")
+      .value("structured", AsyncSolveMethod::structured)
+      .value("naive", AsyncSolveMethod::naive);
+  py::enum_<RecoveryMode>(module, "RecoveryMode")
+      .value("automatic", RecoveryMode::automatic)
+      .value("substitution", RecoveryMode::substitution)
+      .value("dense_z", RecoveryMode::denseZ);
+  py::enum_<AsyncCoupling>(module, "AsyncCoupling")
+      .value("stable", AsyncCoupling::stable)
+      .value("paper", AsyncCoupling::paper);
+  py::class_<AsyncOptions>(module, "AsyncOptions")
+      .def(py::init([](AsyncCoupling coupling, SchurMode schur, AsyncSolveMethod method, RecoveryMode recovery,
+                       SolverKind regionSolver, bool prediction) {
+             return AsyncOptions{coupling, schur, method, recovery, regionSolver, prediction};
+           }),
+           py::arg("coupling") = AsyncCoupling::stable, py::arg("schur") = SchurMode::lowRank,
+           py::arg("method") = AsyncSolveMethod::structured, py::arg("recovery") = RecoveryMode::automatic,
+           py::arg("region_solver") = SolverKind::cholmod, py::arg("substep_state_prediction") = false)
+      .def_readwrite("coupling", &AsyncOptions::coupling)
+      .def_readwrite("schur", &AsyncOptions::schur)
+      .def_readwrite("method", &AsyncOptions::method)
+      .def_readwrite("recovery", &AsyncOptions::recovery)
+      .def_readwrite("region_solver", &AsyncOptions::regionSolver)
+      .def_readwrite("substep_state_prediction", &AsyncOptions::substepStatePrediction);
+
+  py::class_<AsyncBackwardEuler, Integrator>(
+      module, "AsyncBackwardEuler",
+      "Asynchronous implicit backward Euler: fast regions take ratio substeps per large step, coupled implicitly")
+      .def(py::init([](const TetMesh& mesh, const PythonDynamicSystem& system, double largeTimestep,
+                       std::vector<AsyncRegion> regions, AsyncOptions options) {
+             DynamicSystem copy = checkedSystem(system);
+             py::gil_scoped_release release;
+             return std::make_unique<AsyncBackwardEuler>(mesh, std::move(copy), largeTimestep, std::move(regions),
+                                                         options);
+           }),
+           py::arg("mesh"), py::arg("system"), py::arg("large_timestep"), py::arg("regions"),
+           py::arg("options") = AsyncOptions{})
+      .def_property_readonly("partition", &AsyncBackwardEuler::partition, py::return_value_policy::reference_internal)
+      .def_property_readonly("options", &AsyncBackwardEuler::options)
+      .def(
+          "set_substep_observer",
+          [](AsyncBackwardEuler& integrator, const py::object& callable) {
+            integrator.setSubstepObserver(observerFromPython(callable));
+          },
+          py::arg("observer"),
+          "callable(region, substep, time, u_region, v_region) after each large step for every substep "
+          "(None removes it)")
+      .def_property_readonly("schur_asymmetry", &AsyncBackwardEuler::schurAsymmetry)
+      .def_property_readonly("z_column_seconds", &AsyncBackwardEuler::zColumnSeconds)
+      .def_property_readonly("schur_mode_used", &AsyncBackwardEuler::schurModeUsed)
+      .def("solve_floor_seconds", &AsyncBackwardEuler::solveFloorSeconds, py::arg("repeats") = 5,
+           py::call_guard<py::gil_scoped_release>())
+      .def_property_readonly("factor_non_zeros", &AsyncBackwardEuler::factorNonZeros);
+
+  // Automatic regions (what a scene's "regions": "auto" and suggestRegions use).
+  module.def("element_max_frequencies", &elementMaxFrequencies, py::arg("mesh"),
+             py::call_guard<py::gil_scoped_release>(), "omega_e per element (rad/s), lumped element mass");
+  py::class_<AutoRegionOptions>(module, "AutoRegionOptions")
+      .def(py::init<>())
+      .def_readwrite("large_timestep", &AutoRegionOptions::largeTimestep, "hL (s)")
+      .def_readwrite("target_omega_h", &AutoRegionOptions::targetOmegaH)
+      .def_readwrite("relative_threshold", &AutoRegionOptions::relativeThreshold)
+      .def_readwrite("grow_layers", &AutoRegionOptions::growLayers)
+      .def_readwrite("max_ratio", &AutoRegionOptions::maxRatio)
+      .def_readwrite("modal_check", &AutoRegionOptions::modalCheck)
+      .def_readwrite("frame_rate", &AutoRegionOptions::frameRate)
+      .def_readwrite("modal_count", &AutoRegionOptions::modalCount)
+      .def_readwrite("max_modal_count", &AutoRegionOptions::maxModalCount);
+  py::class_<ProposedRegion>(module, "ProposedRegion")
+      .def_readonly("region", &ProposedRegion::region)
+      .def_readonly("max_frequency", &ProposedRegion::maxFrequency)
+      .def_readonly("num_elements", &ProposedRegion::numElements)
+      .def_readonly("num_interface_dofs", &ProposedRegion::numInterfaceDofs);
+  py::class_<AutoRegionProposal>(module, "AutoRegionProposal")
+      .def_readonly("regions", &AutoRegionProposal::regions)
+      .def_readonly("withdrawn_regions", &AutoRegionProposal::withdrawnRegions)
+      .def_readonly("large_region_max_frequency", &AutoRegionProposal::largeRegionMaxFrequency)
+      .def_readonly("large_timestep", &AutoRegionProposal::largeTimestep)
+      .def_readonly("target_omega_h", &AutoRegionProposal::targetOmegaH)
+      .def_readonly("modal_seconds", &AutoRegionProposal::modalSeconds)
+      .def_property_readonly("has_modal_report",
+                             [](const AutoRegionProposal& proposal) { return proposal.modalReport.has_value(); })
+      .def("async_regions", &AutoRegionProposal::asyncRegions, "the proposed regions, ready for AsyncBackwardEuler");
+  module.def(
+      "suggest_regions",
+      [](const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+         const std::optional<Eigen::SparseMatrix<double>>& stiffness,
+         const std::optional<Eigen::SparseMatrix<double>>& mass) {
+        if (stiffness.has_value() != mass.has_value()) {
+          throw py::value_error("stiffness, mass: give both (for the modal check) or neither");
+        }
+        py::gil_scoped_release release;
+        return stiffness ? suggestRegions(mesh, freeDofs, options, *stiffness, *mass)
+                         : suggestRegions(mesh, freeDofs, options);
+      },
+      py::arg("mesh"), py::arg("free_dofs"), py::arg("options") = AutoRegionOptions{},
+      py::arg("stiffness") = py::none(), py::arg("mass") = py::none(),
+      "fast regions and ratios from the element frequencies (modal check with K and M, full 3n matrices)");
+}
+
+}  // namespace asyncfem::python

@@ -1,0 +1,414 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// libraries/volumetricMesh: TetMesh, materials, sets, readers, writers, generators, queries.
+
+#include <pybind11/operators.h>
+
+#include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <asyncfem/volumetricMesh/writers.hpp>
+#include <bindings.hpp>
+
+namespace asyncfem::python {
+
+namespace {
+
+using Release = py::call_guard<py::gil_scoped_release>;
+
+TetMesh makeMesh(const py::handle& positions, const py::handle& elements, std::vector<Material> materials,
+                 const py::handle& elementMaterials) {
+  const auto points = matrixArgument(positions, "positions", -1, 3);
+  const auto tets = indexMatrixArgument(elements, "elements", -1, 4);
+  std::vector<int> materialIndices;
+  if (elementMaterials.is_none()) {
+    materialIndices.assign(static_cast<std::size_t>(tets.shape(0)), 0);
+  } else {
+    materialIndices = indexListArgument(elementMaterials, "element_materials");
+  }
+  if (static_cast<py::ssize_t>(materialIndices.size()) != tets.shape(0)) {
+    throw py::value_error("element_materials: expected " + std::to_string(tets.shape(0)) +
+                          " entries (one per element), got " + std::to_string(materialIndices.size()));
+  }
+  // (n, 3) C order is the 3 x n column-major layout TetMesh stores.
+  Eigen::Matrix3Xd rest = Eigen::Map<const Eigen::Matrix3Xd>(points.data(), 3, points.shape(0));
+  Eigen::Matrix4Xi connectivity = Eigen::Map<const Eigen::Matrix4Xi>(tets.data(), 4, tets.shape(0));
+  return {std::move(rest), std::move(connectivity), std::move(materials), std::move(materialIndices)};
+}
+
+py::dict setsDict(const std::map<std::string, std::vector<int>>& sets) {
+  py::dict result;
+  for (const auto& [name, members] : sets) result[py::str(name)] = intArray(members);
+  return result;
+}
+
+void checkVertex(const TetMesh& mesh, int vertex) { checkIndex(vertex, mesh.numVertices(), "vertex"); }
+void checkElement(const TetMesh& mesh, int element) { checkIndex(element, mesh.numElements(), "element"); }
+
+VtuArray vtuArray(const std::string& name, const py::handle& value, int count, const char* what) {
+  const std::string label = std::string(what) + "[" + name + "]";
+  py::array array = py::module_::import("numpy").attr("asarray")(value);
+  VtuArray result;
+  result.name = name;
+  if (array.ndim() == 2) {
+    const auto checked = matrixArgument(value, label.c_str(), count, 3);
+    result.components = 3;
+    result.values.assign(checked.data(), checked.data() + checked.size());
+  } else {
+    const auto checked = vectorArgument(value, label.c_str(), count);
+    result.values.assign(checked.data(), checked.data() + checked.size());
+  }
+  return result;
+}
+
+std::vector<VtuArray> vtuArrays(const py::dict& arrays, int count, const char* what) {
+  std::vector<VtuArray> result;
+  for (const auto& [key, value] : arrays) {
+    result.push_back(vtuArray(py::str(key).cast<std::string>(), value, count, what));
+  }
+  return result;
+}
+
+}  // namespace
+
+void bindMesh(py::module_& module) {
+  py::class_<Material>(module, "Material", "Isotropic linear-elastic material (SI units by convention).")
+      .def(py::init([](std::string name, double density, double youngsModulus, double poissonRatio) {
+             return Material{std::move(name), density, youngsModulus, poissonRatio};
+           }),
+           py::arg("name") = "default", py::arg("density") = 1000.0, py::arg("youngs_modulus") = 1e6,
+           py::arg("poisson_ratio") = 0.45)
+      .def_readwrite("name", &Material::name)
+      .def_readwrite("density", &Material::density, "rho (kg/m^3)")
+      .def_readwrite("youngs_modulus", &Material::youngsModulus, "E (Pa)")
+      .def_readwrite("poisson_ratio", &Material::poissonRatio, "nu, in (-1, 0.5)")
+      .def(py::self == py::self)  // NOLINT(misc-redundant-expression)
+      .def("__repr__", [](const Material& m) {
+        return "Material(name='" + m.name + "', density=" + py::repr(py::float_(m.density)).cast<std::string>() +
+               ", youngs_modulus=" + py::repr(py::float_(m.youngsModulus)).cast<std::string>() +
+               ", poisson_ratio=" + py::repr(py::float_(m.poissonRatio)).cast<std::string>() + ")";
+      });
+
+  py::class_<TetMesh>(module, "TetMesh",
+                      "Linear tetrahedral mesh with a material per element and named vertex and element sets.")
+      .def(py::init(&makeMesh), py::arg("positions"), py::arg("elements"),
+           py::arg("materials") = std::vector<Material>{Material{}}, py::arg("element_materials") = py::none(),
+           "positions: (n, 3) float64 rest positions; elements: (m, 4) integer vertex ids; materials: list of "
+           "Material; element_materials: m indices into materials (default: all 0).")
+      .def_property_readonly("num_vertices", &TetMesh::numVertices)
+      .def_property_readonly("num_elements", &TetMesh::numElements)
+      .def_property_readonly("num_dofs", &TetMesh::numDofs, "3 * num_vertices")
+      .def_property_readonly(
+          "rest_positions",
+          [](py::object self) { return transposedView(self.cast<const TetMesh&>().restPositions(), self); },
+          "(n, 3) read-only view of the rest positions (no copy)")
+      .def_property_readonly(
+          "elements", [](py::object self) { return transposedView(self.cast<const TetMesh&>().elements(), self); },
+          "(m, 4) read-only int32 view of the connectivity (no copy)")
+      .def(
+          "rest_position",
+          [](const TetMesh& mesh, int v) {
+            checkVertex(mesh, v);
+            return Eigen::Vector3d(mesh.restPosition(v));
+          },
+          py::arg("vertex"))
+      .def(
+          "element",
+          [](const TetMesh& mesh, int e) {
+            checkElement(mesh, e);
+            return Eigen::Vector4i(mesh.element(e));
+          },
+          py::arg("element"))
+      .def(
+          "element_rest_positions",
+          [](const TetMesh& mesh, int e) {
+            checkElement(mesh, e);
+            return Eigen::Matrix<double, 3, 4>(mesh.elementRestPositions(e));
+          },
+          py::arg("element"), "3 x 4: the rest positions of the element's vertices as columns")
+      .def_property_readonly("materials", &TetMesh::materials)
+      .def_property_readonly("element_materials", [](const TetMesh& mesh) { return intArray(mesh.elementMaterials()); })
+      .def(
+          "element_material",
+          [](const TetMesh& mesh, int e) {
+            checkElement(mesh, e);
+            return mesh.elementMaterial(e);
+          },
+          py::arg("element"))
+      .def("find_material", &TetMesh::findMaterial, py::arg("name"), "index of the material, or -1")
+      .def("add_material", &TetMesh::addMaterial, py::arg("material"),
+           "adds (or replaces the one with the same name) and returns its index")
+      .def("assign_material", &TetMesh::assignMaterial, py::arg("element_set"), py::arg("material_index"))
+      .def_property_readonly("element_sets", [](const TetMesh& mesh) { return setsDict(mesh.elementSets()); })
+      .def_property_readonly("vertex_sets", [](const TetMesh& mesh) { return setsDict(mesh.vertexSets()); })
+      .def(
+          "element_set", [](const TetMesh& mesh, const std::string& name) { return intArray(mesh.elementSet(name)); },
+          py::arg("name"))
+      .def(
+          "vertex_set", [](const TetMesh& mesh, const std::string& name) { return intArray(mesh.vertexSet(name)); },
+          py::arg("name"))
+      .def(
+          "set_vertices", [](const TetMesh& mesh, const std::string& name) { return intArray(mesh.setVertices(name)); },
+          py::arg("name"), "the vertex set called name, else the vertices of the element set called name")
+      .def(
+          "set_element_set",
+          [](TetMesh& mesh, const std::string& name, const py::handle& members) {
+            mesh.setElementSet(name, indexListArgument(members, "elements"));
+          },
+          py::arg("name"), py::arg("elements"))
+      .def(
+          "set_vertex_set",
+          [](TetMesh& mesh, const std::string& name, const py::handle& members) {
+            mesh.setVertexSet(name, indexListArgument(members, "vertices"));
+          },
+          py::arg("name"), py::arg("vertices"))
+      .def(
+          "set_element",
+          [](TetMesh& mesh, int e, const Eigen::Vector4i& vertices) {
+            checkElement(mesh, e);
+            mesh.setElement(e, vertices);
+          },
+          py::arg("element"), py::arg("vertices"))
+      .def("__repr__", [](const TetMesh& mesh) {
+        return "TetMesh(" + std::to_string(mesh.numVertices()) + " vertices, " + std::to_string(mesh.numElements()) +
+               " elements, " + std::to_string(mesh.materials().size()) + " materials)";
+      });
+
+  // Readers.
+  py::class_<MeshReadOptions>(module, "MeshReadOptions")
+      .def(py::init([](std::optional<Material> defaultMaterial, bool reorient, double tolerance) {
+             return MeshReadOptions{std::move(defaultMaterial), reorient, tolerance};
+           }),
+           py::arg("default_material") = py::none(), py::arg("reorient_inverted_elements") = true,
+           py::arg("degenerate_volume_tolerance") = 1e-12)
+      .def_readwrite("default_material", &MeshReadOptions::defaultMaterial)
+      .def_readwrite("reorient_inverted_elements", &MeshReadOptions::reorientInvertedElements)
+      .def_readwrite("degenerate_volume_tolerance", &MeshReadOptions::degenerateVolumeTolerance);
+  py::class_<MeshReadReport>(module, "MeshReadReport")
+      .def(py::init<>())
+      .def_readonly("format", &MeshReadReport::format)
+      .def_readonly("warnings", &MeshReadReport::warnings)
+      .def_readonly("reoriented_elements", &MeshReadReport::reorientedElements)
+      .def_readonly("unused_vertices", &MeshReadReport::unusedVertices)
+      .def_readonly("ignored_elements", &MeshReadReport::ignoredElements);
+  using Reader = TetMesh (*)(const std::filesystem::path&, const MeshReadOptions&, MeshReadReport*);
+  const auto addReader = [&module](const char* name, Reader reader, const char* doc) {
+    module.def(
+        name,
+        [reader](const std::filesystem::path& path, const MeshReadOptions& options, bool withReport) -> py::object {
+          MeshReadReport report;
+          TetMesh mesh;
+          {
+            py::gil_scoped_release release;
+            mesh = reader(path, options, &report);
+          }
+          if (withReport) return py::make_tuple(std::move(mesh), std::move(report));
+          return py::cast(std::move(mesh));
+        },
+        py::arg("path"), py::arg("options") = MeshReadOptions{}, py::arg("with_report") = false, doc);
+  };
+  addReader("read_mesh", &readMesh,
+            "Reads .veg, TetGen .node/.ele (or their base name) or Gmsh .msh 2.2/4.1 by extension. With "
+            "with_report=True returns (mesh, MeshReadReport). ParseError names the file and line.");
+  addReader("read_veg", &readVeg, "Reads a Vega .veg file.");
+  addReader("read_tetgen", &readTetGen, "Reads a TetGen .node/.ele pair.");
+  addReader("read_gmsh", &readGmsh, "Reads a Gmsh .msh (ASCII 2.2 or 4.1) file.");
+  module.def(
+      "read_bou",
+      [](const std::filesystem::path& path, int numVertices) { return intArray(readBou(path, numVertices)); },
+      py::arg("path"), py::arg("num_vertices"), "Vega .bou: sorted unique 0-based vertex ids");
+
+  // Writers.
+  py::enum_<VtuEncoding>(module, "VtuEncoding").value("binary", VtuEncoding::binary).value("ascii", VtuEncoding::ascii);
+  module.def("write_veg", &writeVeg, py::arg("path"), py::arg("mesh"), Release(),
+             "Vega .veg that read_veg reads back exactly");
+  module.def(
+      "write_vtu",
+      [](const std::filesystem::path& path, const TetMesh& mesh, const py::object& displacement,
+         const py::dict& pointArrays, const py::dict& cellArrays, VtuEncoding encoding) {
+        const Eigen::VectorXd u =
+            displacement.is_none() ? Eigen::VectorXd() : toVector(displacement, "displacement", mesh.numDofs());
+        const auto points = vtuArrays(pointArrays, mesh.numVertices(), "point_arrays");
+        const auto cells = vtuArrays(cellArrays, mesh.numElements(), "cell_arrays");
+        py::gil_scoped_release release;
+        writeVtu(path, mesh, u, points, cells, encoding);
+      },
+      py::arg("path"), py::arg("mesh"), py::arg("displacement") = py::none(), py::arg("point_arrays") = py::dict(),
+      py::arg("cell_arrays") = py::dict(), py::arg("encoding") = VtuEncoding::binary,
+      "VTK XML .vtu at the rest positions with point array 'displacement' (3n) and the given arrays: "
+      "name -> (n,) or (n, 3) per point, (m,) or (m, 3) per cell.");
+  module.def(
+      "write_pvd",
+      [](const std::filesystem::path& path, const std::vector<std::pair<double, std::filesystem::path>>& entries) {
+        std::vector<PvdEntry> list;
+        for (const auto& [time, file] : entries) list.push_back(PvdEntry{time, file});
+        writePvd(path, list);
+      },
+      py::arg("path"), py::arg("entries"), "ParaView collection from a list of (time, file)");
+  py::class_<VtuSeriesWriter>(module, "VtuSeriesWriter",
+                              "FOLDER/frame_NNNNN.vtu per frame and FOLDER/frames.pvd, rewritten after each frame")
+      .def(py::init<std::filesystem::path, VtuEncoding>(), py::arg("folder"), py::arg("encoding") = VtuEncoding::binary)
+      .def(
+          "write_frame",
+          [](VtuSeriesWriter& writer, std::int64_t frame, double time, const TetMesh& mesh,
+             const py::handle& displacement) {
+            const Eigen::VectorXd u = toVector(displacement, "displacement", mesh.numDofs());
+            py::gil_scoped_release release;
+            writer.writeFrame(frame, time, mesh, u);
+          },
+          py::arg("frame"), py::arg("time"), py::arg("mesh"), py::arg("displacement"))
+      .def("add_existing_frame", &VtuSeriesWriter::addExistingFrame, py::arg("frame"), py::arg("time"))
+      .def("write_collection", &VtuSeriesWriter::writeCollection)
+      .def_property_readonly("folder", &VtuSeriesWriter::folder)
+      .def_property_readonly("collection_path", &VtuSeriesWriter::collectionPath)
+      .def_static("frame_file_name", &VtuSeriesWriter::frameFileName, py::arg("frame"));
+
+  // Generators.
+  py::class_<BoxRegion>(module, "BoxRegion")
+      .def(py::init([](std::string name, const Eigen::Vector3d& min, const Eigen::Vector3d& max, Material material) {
+             return BoxRegion{std::move(name), min, max, std::move(material)};
+           }),
+           py::arg("name"), py::arg("min"), py::arg("max"), py::arg("material"))
+      .def_readwrite("name", &BoxRegion::name)
+      .def_readwrite("min", &BoxRegion::min)
+      .def_readwrite("max", &BoxRegion::max)
+      .def_readwrite("material", &BoxRegion::material);
+  py::class_<BoxMeshSpec>(module, "BoxMeshSpec")
+      .def(py::init<>())
+      .def_readwrite("origin", &BoxMeshSpec::origin)
+      .def_readwrite("size", &BoxMeshSpec::size)
+      .def_readwrite("cells", &BoxMeshSpec::cells)
+      .def_readwrite("material", &BoxMeshSpec::material)
+      .def_readwrite("regions", &BoxMeshSpec::regions);
+  module.def("make_box_mesh", &makeBoxMesh, py::arg("spec"), Release(),
+             "box cut into cubes of six tets; vertex sets xmin..zmax, plus the regions' sets");
+  py::class_<BeamSpec>(module, "BeamSpec")
+      .def(py::init<>())
+      .def_readwrite("length", &BeamSpec::length)
+      .def_readwrite("height", &BeamSpec::height)
+      .def_readwrite("depth", &BeamSpec::depth)
+      .def_readwrite("cells_along_length", &BeamSpec::cellsAlongLength)
+      .def_readwrite("tip_fraction", &BeamSpec::tipFraction)
+      .def_readwrite("body", &BeamSpec::body)
+      .def_readwrite("tip", &BeamSpec::tip);
+  module.def("make_beam_mesh", &makeBeamMesh, py::arg("spec") = BeamSpec{}, Release(),
+             "cantilever along +x: sets 'root' (x = 0), 'tip' (stiff, light last tip_fraction)");
+  py::class_<CellBlock>(module, "CellBlock")
+      .def(py::init([](std::string name, const Eigen::Vector3i& begin, const Eigen::Vector3i& end, Material material) {
+             return CellBlock{std::move(name), begin, end, std::move(material)};
+           }),
+           py::arg("name"), py::arg("begin"), py::arg("end"), py::arg("material"))
+      .def_readwrite("name", &CellBlock::name)
+      .def_readwrite("begin", &CellBlock::begin)
+      .def_readwrite("end", &CellBlock::end)
+      .def_readwrite("material", &CellBlock::material);
+  py::class_<CellVertexRing>(module, "CellVertexRing")
+      .def(py::init([](std::string name, std::vector<std::string> around, int rings) {
+             return CellVertexRing{std::move(name), std::move(around), rings};
+           }),
+           py::arg("name"), py::arg("around"), py::arg("rings") = 1)
+      .def_readwrite("name", &CellVertexRing::name)
+      .def_readwrite("around", &CellVertexRing::around)
+      .def_readwrite("rings", &CellVertexRing::rings);
+  py::class_<CellMeshSpec>(module, "CellMeshSpec")
+      .def(py::init<>())
+      .def_readwrite("origin", &CellMeshSpec::origin)
+      .def_readwrite("cell_size", &CellMeshSpec::cellSize)
+      .def_readwrite("blocks", &CellMeshSpec::blocks)
+      .def_readwrite("vertex_rings", &CellMeshSpec::vertexRings);
+  module.def("make_cell_mesh", &makeCellMesh, py::arg("spec"), Release(), "union of lattice cells, conforming");
+  py::class_<AntennaSpec>(module, "AntennaSpec")
+      .def(py::init<>())
+      .def_readwrite("cell_size", &AntennaSpec::cellSize)
+      .def_readwrite("block_cells", &AntennaSpec::blockCells)
+      .def_readwrite("rod_cells", &AntennaSpec::rodCells)
+      .def_readwrite("block", &AntennaSpec::block)
+      .def_readwrite("rod", &AntennaSpec::rod);
+  module.def("make_antenna_mesh", &makeAntennaMesh, py::arg("spec") = AntennaSpec{}, Release());
+  py::class_<SnailSpec>(module, "SnailSpec")
+      .def(py::init<>())
+      .def_readwrite("cell_size", &SnailSpec::cellSize)
+      .def_readwrite("tentacle_cells", &SnailSpec::tentacleCells)
+      .def_readwrite("body", &SnailSpec::body)
+      .def_readwrite("shell", &SnailSpec::shell)
+      .def_readwrite("tentacles", &SnailSpec::tentacles);
+  module.def("make_snail_mesh", &makeSnailMesh, py::arg("spec") = SnailSpec{}, Release());
+
+  // Queries.
+  module.def(
+      "signed_element_volume",
+      [](const TetMesh& mesh, int e) {
+        checkElement(mesh, e);
+        return signedElementVolume(mesh, e);
+      },
+      py::arg("mesh"), py::arg("element"));
+  module.def("element_volumes", &elementVolumes, py::arg("mesh"), Release(), "|V| per element");
+  module.def("total_volume", &totalVolume, py::arg("mesh"), Release());
+  module.def("total_mass", &totalMass, py::arg("mesh"), Release());
+  module.def(
+      "boundary_triangles",
+      [](const TetMesh& mesh) {
+        std::vector<std::array<int, 3>> triangles;
+        {
+          py::gil_scoped_release release;
+          triangles = boundaryTriangles(mesh);
+        }
+        return triangleArray(triangles);
+      },
+      py::arg("mesh"), "(k, 3) int32, outward oriented");
+  module.def(
+      "vertex_element_adjacency",
+      [](const TetMesh& mesh) {
+        const VertexElementAdjacency adjacency = vertexElementAdjacency(mesh);
+        return py::make_tuple(intArray(adjacency.offsets), intArray(adjacency.elements));
+      },
+      py::arg("mesh"), "(offsets, elements): the elements of vertex v are elements[offsets[v]:offsets[v+1]]");
+  py::class_<BoundingBox>(module, "BoundingBox")
+      .def(py::init([](const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
+             return BoundingBox{min, max};
+           }),
+           py::arg("min"), py::arg("max"))
+      .def_readwrite("min", &BoundingBox::min)
+      .def_readwrite("max", &BoundingBox::max);
+  module.def(
+      "bounding_box",
+      [](const TetMesh& mesh, const py::object& displacement) {
+        return boundingBox(
+            mesh, displacement.is_none() ? Eigen::VectorXd() : toVector(displacement, "displacement", mesh.numDofs()));
+      },
+      py::arg("mesh"), py::arg("displacement") = py::none());
+  py::class_<ElementQuality>(module, "ElementQuality")
+      .def_readonly("min_dihedral_angle", &ElementQuality::minDihedralAngle, "radians")
+      .def_readonly("max_dihedral_angle", &ElementQuality::maxDihedralAngle, "radians")
+      .def_readonly("aspect_ratio", &ElementQuality::aspectRatio, "1 for the regular tetrahedron");
+  module.def(
+      "element_quality",
+      [](const TetMesh& mesh, int e) {
+        checkElement(mesh, e);
+        return elementQuality(mesh, e);
+      },
+      py::arg("mesh"), py::arg("element"));
+  module.def(
+      "element_qualities",
+      [](const TetMesh& mesh) {
+        const std::vector<ElementQuality> qualities = elementQualities(mesh);
+        py::array_t<double> minAngle(static_cast<py::ssize_t>(qualities.size()));
+        py::array_t<double> maxAngle(static_cast<py::ssize_t>(qualities.size()));
+        py::array_t<double> aspect(static_cast<py::ssize_t>(qualities.size()));
+        for (std::size_t i = 0; i < qualities.size(); ++i) {
+          minAngle.mutable_data()[i] = qualities[i].minDihedralAngle;
+          maxAngle.mutable_data()[i] = qualities[i].maxDihedralAngle;
+          aspect.mutable_data()[i] = qualities[i].aspectRatio;
+        }
+        py::dict result;
+        result["min_dihedral_angle"] = minAngle;
+        result["max_dihedral_angle"] = maxAngle;
+        result["aspect_ratio"] = aspect;
+        return result;
+      },
+      py::arg("mesh"), "dict of per-element arrays: min_dihedral_angle, max_dihedral_angle, aspect_ratio");
+  module.def(
+      "unused_vertices", [](const TetMesh& mesh) { return intArray(unusedVertices(mesh)); }, py::arg("mesh"));
+}
+
+}  // namespace asyncfem::python

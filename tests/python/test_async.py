@@ -1,0 +1,92 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""The asynchronous integrator from Python: regions, options, observer, statistics."""
+import numpy as np
+import pytest
+
+import asyncfem as af
+from conftest import downward_pull, linear_system
+
+
+@pytest.fixture(scope="module")
+def beam():
+    spec = af.BeamSpec()
+    spec.cells_along_length = 8
+    return af.make_beam_mesh(spec)
+
+
+def test_regions_and_partition(beam):
+    tip = af.region_vertices(beam, element_sets=["tip"])
+    np.testing.assert_array_equal(tip, np.unique(beam.elements[beam.element_set("tip")]))
+    assert set(af.region_vertices(beam, vertices=[3, 1], boxes=[([-1, -1, -1], [0.0, 1, 1])])) >= {1, 3}
+    free = af.FreeDofs.from_fixed_vertices(beam.num_vertices, beam.vertex_set("root"))
+    partition = af.RegionPartition(beam, free, [af.AsyncRegion("tip", tip, 4)])
+    assert partition.num_regions == 1 and partition.region(0).ratio == 4
+    assert len(partition.region_dofs(0)) == 3 * len(tip)
+    assert len(partition.interface_dofs(0)) > 0 and len(partition.interface_elements) > 0
+    assert (partition.vertex_region[tip] == 0).all()
+    with pytest.raises(af.ValidationError):
+        af.RegionPartition(beam, free, [af.AsyncRegion("tip", tip, 0)])
+
+
+@pytest.mark.parametrize("coupling", [af.AsyncCoupling.stable, af.AsyncCoupling.paper])
+def test_async_steps_and_observer(beam, coupling):
+    system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))
+    tip = af.region_vertices(beam, element_sets=["tip"])
+    options = af.AsyncOptions(coupling=coupling, schur=af.SchurMode.low_rank)
+    integrator = af.AsyncBackwardEuler(beam, system, 0.01, [af.AsyncRegion("tip", tip, 4)], options)
+    seen = []
+    integrator.set_substep_observer(lambda region, substep, time, u, v: seen.append((region, substep, time, u.size)))
+    integrator.step(3)
+    assert integrator.name == "async" and integrator.stats.steps == 3
+    assert [s[1] for s in seen] == [1, 2, 3, 4] * 3
+    assert seen[-1][2] == pytest.approx(0.03, rel=1e-14)
+    assert seen[0][3] == len(integrator.partition.region_dofs(0))
+    assert integrator.schur_mode_used == af.SchurMode.low_rank
+    assert integrator.factor_non_zeros > 0 and integrator.schur_asymmetry >= 0.0
+    assert integrator.solve_floor_seconds(1) > 0.0
+    assert (integrator.displacement.reshape(-1, 3)[tip, 1] < 0).all()
+    integrator.set_substep_observer(None)
+    integrator.step()
+    assert len(seen) == 12
+
+
+def test_async_with_ratio_one_is_backward_euler(beam):
+    """m = 1 everywhere: async reduces to backward Euler (same equations); round-off of the
+    block solve against one factorization, so compared to 1e-9 of the motion."""
+    system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))
+    tip = af.region_vertices(beam, element_sets=["tip"])
+    one = af.AsyncBackwardEuler(beam, system, 0.01, [af.AsyncRegion("tip", tip, 1)])
+    reference = af.BackwardEuler(system, 0.01)
+    one.step(5)
+    reference.step(5)
+    scale = np.abs(reference.displacement).max()
+    np.testing.assert_allclose(one.displacement, reference.displacement, rtol=0, atol=1e-9 * scale)
+
+
+def test_suggested_regions(beam):
+    """The stiff, light tip of the generated beam is proposed as a fast region (its element
+    frequencies are about sqrt(50e6/200 / (1e6/1000)) = 16 times the body's)."""
+    free = af.FreeDofs.from_fixed_vertices(beam.num_vertices, beam.vertex_set("root"))
+    frequencies = af.element_max_frequencies(beam)
+    tip_elements = beam.element_set("tip")
+    assert frequencies[tip_elements].min() > 10 * np.delete(frequencies, tip_elements).max()
+    options = af.AutoRegionOptions()
+    options.large_timestep = 1 / 120
+    proposal = af.suggest_regions(beam, free, options)
+    assert len(proposal.regions) == 1 and not proposal.has_modal_report
+    proposed = proposal.regions[0]
+    assert set(beam.set_vertices("tip")) <= set(proposed.region.vertices) and proposed.region.ratio > 1
+    assert proposed.max_frequency == frequencies[tip_elements].max() and proposed.num_elements >= len(tip_elements)
+    assert proposal.large_timestep == options.large_timestep and proposal.target_omega_h > 0
+    assert proposal.large_region_max_frequency < proposed.max_frequency
+    assert proposal.async_regions()[0].ratio == proposed.region.ratio
+    assert proposal.withdrawn_regions == [] and proposal.modal_seconds == 0.0
+    for field in ("relative_threshold", "grow_layers", "max_ratio", "frame_rate", "modal_count", "max_modal_count"):
+        assert getattr(options, field) > 0
+    options.modal_check = True
+    assembler = af.MatrixAssembler(beam)
+    checked = af.suggest_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler),
+                                 af.mass_matrix(beam, assembler))
+    assert checked.has_modal_report and checked.modal_seconds > 0
+    with pytest.raises(ValueError, match="give both"):
+        af.suggest_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler))
