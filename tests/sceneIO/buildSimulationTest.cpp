@@ -441,3 +441,51 @@ TEST(AdvanceFrame, UnstableExplicitRunNamesTheFrame) {
 }
 
 }  // namespace
+
+namespace {
+
+std::string sceneError(const nlohmann::json& json) {
+  try {
+    build(json);
+  } catch (const asyncfem::Error& error) {
+    return error.what();
+  }
+  return "no error";
+}
+
+// forceModel.type names the hyperelastic materials too: the scene runs them with Newton
+// iterations (line search on by default) and they sag under gravity like the linear
+// model at small strain; their keys are refused on the other models.
+TEST(BuildSimulation, HyperelasticForceModelsRunFromTheScene) {
+  auto json = smallScene();
+  json["gravity"] = {0, -9.81, 0};
+  json["integrator"]["options"] = {{"maxIterations", 5}, {"tolerance", 1e-8}};
+  Simulation linear = build(json);
+  for (int k = 0; k < 10; ++k) linear.integrator->step();
+  for (const char* type : {"stvk", "neo-hookean"}) {
+    json["forceModel"] = {{"type", type}, {"inversionThreshold", 0.2}};
+    Simulation simulation = build(json);
+    EXPECT_EQ(asyncfem::toString(simulation.problem->settings().forceModel), type);
+    for (int k = 0; k < 10; ++k) simulation.integrator->step();
+    // Same direction and, at this strain (|u| / size ~1e-3 or less), within 10 % of the
+    // linear model's sag: the materials agree with linear FEM to first order.
+    const Eigen::VectorXd& u = simulation.integrator->displacement();
+    const Eigen::VectorXd& v = linear.integrator->displacement();
+    ASSERT_GT(v.cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_LT((u - v).cwiseAbs().maxCoeff(), 0.1 * v.cwiseAbs().maxCoeff()) << type;
+  }
+  json["forceModel"] = {{"type", "corotational"}, {"enforceSPD", true}};
+  EXPECT_NE(sceneError(json).find("forceModel.enforceSPD: only the hyperelastic force models"), std::string::npos)
+      << sceneError(json);
+  json["forceModel"] = {{"type", "neo-hookean"}, {"inversionThreshold", 1.5}};
+  EXPECT_NE(sceneError(json).find("forceModel.inversionThreshold: expected a principal stretch in (0, 1)"),
+            std::string::npos)
+      << sceneError(json);
+  json["forceModel"] = {{"type", "neo-hookean"}, {"mooneyRivlin", {{"mu01", 1}}}};
+  EXPECT_NE(sceneError(json).find("forceModel.mooneyRivlin: only with"), std::string::npos) << sceneError(json);
+  json["forceModel"] = {{"type", "neo-hookean"}};
+  json["integrator"]["options"] = {{"pcgTolerance", 2.0}};
+  EXPECT_NE(sceneError(json).find("integrator.options.pcgTolerance"), std::string::npos) << sceneError(json);
+}
+
+}  // namespace

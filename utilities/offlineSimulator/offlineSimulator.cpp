@@ -295,11 +295,10 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
       << (setupSeconds + loopSeconds + (couplingCheck ? couplingCheck->estimate.seconds : 0.0)) << " s\n";
   out << "  mesh        " << simulation.mesh->numVertices() << " vertices, " << simulation.mesh->numElements()
       << " elements, " << simulation.fixedVertices.size() << " fixed vertices\n";
-  out << "  model       "
-      << (scene.forceModel == asyncfem::Scene::ForceModelKind::linear
-              ? "linear"
-              : (scene.tangent == asyncfem::Scene::Tangent::exact ? "corotational (exact tangent)"
-                                                                  : "corotational (simple tangent)"))
+  out << "  model       " << asyncfem::toString(simulation.problem->settings().forceModel)
+      << (scene.forceModel != asyncfem::Scene::ForceModelKind::corotational ? ""
+          : scene.tangent == asyncfem::Scene::Tangent::exact                ? " (exact tangent)"
+                                                                            : " (simple tangent)")
       << ", " << (scene.mass == asyncfem::MassType::lumped ? "lumped" : "consistent") << " mass, integrator "
       << simulation.integrator->name() << "\n";
   const std::vector<asyncfem::RegionSummary> regions = simulation.integrator->regionSummaries();

@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
       if (largeTimestep <= 0.0) largeTimestep = scene.integrator.timestep;
       if (frameRate <= 0.0) frameRate = scene.frames.rate;
       massType = scene.mass;
-      corotational = scene.forceModel == Scene::ForceModelKind::corotational;
+      corotational = scene.forceModel != Scene::ForceModelKind::linear;
       const Scene::IntegratorSettings integrator = scene.integrator;
       // Only the mesh and the constraints are needed: the problem, nothing assembled.
       const std::shared_ptr<const Problem> problem = buildProblem(scene);
@@ -209,7 +209,7 @@ int main(int argc, char** argv) {
       out << "\nmodes of " << (given ? "the scene's regions" : "the proposed regions") << ": " << modal.count
           << " lowest of K phi = omega^2 M phi (" << freeDofs.numFree() << " free DOFs, linear K, "
           << (massType == MassType::lumped ? "lumped" : "consistent") << " M"
-          << (corotational ? "; corotational scene: K is its rest tangent" : "") << ")\n";
+          << (corotational ? "; nonlinear scene: K is its rest tangent" : "") << ")\n";
       char line[160];
       std::snprintf(line, sizeof line,
                     "eigensolve: %.3g s (factorization %.3g s, %d solves, %d restarts, shift %.3g)\n",

@@ -8,7 +8,7 @@
 namespace asyncfem {
 
 std::string modalReferenceUnsupportedReason(const Scene& scene, const Simulation& simulation, int maxFreeDofs) {
-  if (scene.forceModel != Scene::ForceModelKind::linear) return "corotational (nonlinear) force model";
+  if (scene.forceModel != Scene::ForceModelKind::linear) return "nonlinear force model";
   if (scene.contact.enabled()) return "contact forces depend on the state";
   const int numFree = simulation.integrator->system().freeDofs.numFree();
   if (numFree > maxFreeDofs) {

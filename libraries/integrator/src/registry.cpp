@@ -71,7 +71,9 @@ std::vector<std::string> IntegratorRegistry::dropForeignOptions(const std::strin
 }
 
 const std::vector<std::string>& singleRateOptionKeys() {
-  static const std::vector<std::string> keys{"solver", "maxIterations", "tolerance", "maxFrequency", "force"};
+  static const std::vector<std::string> keys{
+      "solver",      "maxIterations", "tolerance",    "lineSearch", "rayleighStiffnessAtIterate",
+      "reuseFactor", "pcgTolerance",  "maxFrequency", "force"};
   return keys;
 }
 
@@ -89,6 +91,12 @@ IntegratorOptions parseIntegratorOptions(const nlohmann::json& options, const st
   result.maxIterations = reader.integer("maxIterations", result.maxIterations, 1, 1000);
   result.tolerance = reader.number("tolerance", result.tolerance);
   if (!(result.tolerance > 0.0)) reader.fail("tolerance", "expected a number > 0");
+  result.lineSearch = reader.boolean("lineSearch", result.lineSearch);
+  result.rayleighStiffnessAtIterate = reader.boolean("rayleighStiffnessAtIterate", result.rayleighStiffnessAtIterate);
+  result.reuseFactor = reader.boolean("reuseFactor", result.reuseFactor);
+  result.pcgTolerance = reader.number("pcgTolerance", result.pcgTolerance);
+  if (!(result.pcgTolerance > 0.0 && result.pcgTolerance < 1.0))
+    reader.fail("pcgTolerance", "expected a number in (0, 1)");
   result.maxFrequency = reader.number("maxFrequency", result.maxFrequency);
   if (result.maxFrequency < 0.0) reader.fail("maxFrequency", "expected a number >= 0 (0: estimate it)");
   result.force = reader.boolean("force", result.force);

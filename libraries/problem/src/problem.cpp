@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
+#include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <asyncfem/problem/problem.hpp>
 
 namespace asyncfem {
@@ -73,9 +74,38 @@ const std::shared_ptr<const Loads>& Problem::loads() const {
   return loads_;
 }
 
+std::string toString(ForceModelType type) {
+  switch (type) {
+    case ForceModelType::linear:
+      return "linear";
+    case ForceModelType::corotational:
+      return "corotational";
+    case ForceModelType::stvk:
+      return toString(HyperelasticMaterialKind::stvk);
+    case ForceModelType::neoHookean:
+      return toString(HyperelasticMaterialKind::neoHookean);
+    case ForceModelType::mooneyRivlin:
+      return toString(HyperelasticMaterialKind::mooneyRivlin);
+  }
+  return "unknown";
+}
+
 std::shared_ptr<ForceModel> Problem::makeForceModel() const {
-  if (settings_.forceModel == ForceModelType::linear) return std::make_shared<LinearForceModel>(stiffnessMatrix());
-  return std::make_shared<CorotationalLinearFEM>(*mesh_, assembler(), settings_.tangent);
+  switch (settings_.forceModel) {
+    case ForceModelType::linear:
+      return std::make_shared<LinearForceModel>(stiffnessMatrix());
+    case ForceModelType::corotational:
+      return std::make_shared<CorotationalLinearFEM>(*mesh_, assembler(), settings_.tangent);
+    case ForceModelType::stvk:
+      return makeHyperelasticForceModel(*mesh_, HyperelasticMaterialKind::stvk, settings_.hyperelastic, assembler());
+    case ForceModelType::neoHookean:
+      return makeHyperelasticForceModel(*mesh_, HyperelasticMaterialKind::neoHookean, settings_.hyperelastic,
+                                        assembler());
+    case ForceModelType::mooneyRivlin:
+      return makeHyperelasticForceModel(*mesh_, HyperelasticMaterialKind::mooneyRivlin, settings_.hyperelastic,
+                                        assembler());
+  }
+  throw ValidationError("problem: unknown force model type");
 }
 
 DynamicSystem Problem::dynamicSystem() const {
@@ -98,7 +128,7 @@ DynamicSystem Problem::dynamicSystem() const {
 std::vector<std::string> Problem::skipped() const {
   std::vector<std::string> skipped;
   if (settings_.forceModel == ForceModelType::linear) {
-    skipped.emplace_back("corotational rotations and per-step tangent (linear force model)");
+    skipped.emplace_back("per-step forces and tangent (linear force model: K factored once)");
   }
   if (settings_.gravity.isZero(0.0)) skipped.emplace_back("gravity load (gravity is zero)");
   if (!contact_) skipped.emplace_back("contact (no obstacles)");

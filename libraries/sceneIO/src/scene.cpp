@@ -443,14 +443,60 @@ Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePa
   }
   if (const nlohmann::json* forceModel = top.find("forceModel")) {
     JsonObjectReader reader(*forceModel, "forceModel", sourceName);
-    const std::string type = reader.choice("type", "linear", {"linear", "corotational"});
-    scene.forceModel = type == "linear" ? Scene::ForceModelKind::linear : Scene::ForceModelKind::corotational;
+    const std::string type =
+        reader.choice("type", "linear", {"linear", "corotational", "stvk", "neo-hookean", "mooney-rivlin"});
+    scene.forceModel = type == "linear"         ? Scene::ForceModelKind::linear
+                       : type == "corotational" ? Scene::ForceModelKind::corotational
+                       : type == "stvk"         ? Scene::ForceModelKind::stvk
+                       : type == "neo-hookean"  ? Scene::ForceModelKind::neoHookean
+                                                : Scene::ForceModelKind::mooneyRivlin;
     if (reader.has("tangent")) {
-      if (scene.forceModel == Scene::ForceModelKind::linear) {
+      if (scene.forceModel != Scene::ForceModelKind::corotational) {
         reader.fail("tangent", "only the corotational force model has a tangent choice");
       }
       scene.tangent = reader.choice("tangent", "simple", {"simple", "exact"}) == "exact" ? Scene::Tangent::exact
                                                                                          : Scene::Tangent::simple;
+    }
+    const bool hyperelastic =
+        scene.forceModel != Scene::ForceModelKind::linear && scene.forceModel != Scene::ForceModelKind::corotational;
+    for (const char* key : {"inversionThreshold", "inversionHandling", "compressionResistance", "enforceSPD",
+                            "stvkFormulation", "mooneyRivlin"}) {
+      if (reader.has(key) && !hyperelastic) {
+        reader.fail(key, "only the hyperelastic force models (stvk, neo-hookean, mooney-rivlin) read it");
+      }
+    }
+    HyperelasticOptions& h = scene.hyperelastic;
+    if (reader.has("inversionThreshold")) {
+      h.inversionThreshold = reader.number("inversionThreshold", 0.0);
+      if (!(h.inversionThreshold > 0.0 && h.inversionThreshold < 1.0)) {
+        reader.fail("inversionThreshold", "expected a principal stretch in (0, 1)");
+      }
+    }
+    h.inversionHandling =
+        reader.choice("inversionHandling", "extrapolate", {"extrapolate", "vega-clamp"}) == "vega-clamp"
+            ? InversionHandling::vegaClamp
+            : InversionHandling::extrapolate;
+    if (reader.has("compressionResistance")) {
+      h.enableCompressionResistance = true;
+      h.compressionResistance = reader.number("compressionResistance", h.compressionResistance);
+      if (!(h.compressionResistance >= 0.0)) reader.fail("compressionResistance", "expected a number >= 0");
+    }
+    h.enforceSPD = reader.boolean("enforceSPD", h.enforceSPD);
+    h.stvkFormulation =
+        reader.choice("stvkFormulation", "green-strain", {"green-strain", "principal-stretches"}) == "green-strain"
+            ? StVKFormulation::greenStrain
+            : StVKFormulation::principalStretches;
+    if (const nlohmann::json* mooney = reader.find("mooneyRivlin")) {
+      if (scene.forceModel != Scene::ForceModelKind::mooneyRivlin) {
+        reader.fail("mooneyRivlin", "only with \"type\": \"mooney-rivlin\"");
+      }
+      JsonObjectReader m(*mooney, reader.keyPath("mooneyRivlin"), sourceName);
+      MooneyRivlinParameters parameters;
+      parameters.mu01 = m.number("mu01", parameters.mu01);
+      parameters.mu10 = m.number("mu10", parameters.mu10);
+      parameters.v1 = m.number("v1", parameters.v1);
+      m.finish();
+      h.mooneyRivlin = parameters;
     }
     reader.finish();
   }

@@ -74,7 +74,8 @@ class IntegratorRegistry {
 };
 
 /// The option keys every single-rate integrator reads (IntegratorOptions): solver,
-/// maxIterations, tolerance, maxFrequency, force.
+/// maxIterations, tolerance, lineSearch, rayleighStiffnessAtIterate, reuseFactor,
+/// pcgTolerance, maxFrequency, force.
 const std::vector<std::string>& singleRateOptionKeys();
 /// Reads those keys of options (a JSON object; unknown keys are errors naming them).
 IntegratorOptions parseIntegratorOptions(const nlohmann::json& options, const std::string& optionsPath,

@@ -5,6 +5,7 @@
 #include <Eigen/SparseCore>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/forceModel/forceModel.hpp>
+#include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/problem/loads.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
@@ -16,14 +17,19 @@
 
 namespace asyncfem {
 
-/// The elastic force model of a problem.
-enum class ForceModelType { linear, corotational };
+/// The elastic force model of a problem: linear and corotational FEM, and the
+/// hyperelastic materials of library hyperelasticFEM.
+enum class ForceModelType { linear, corotational, stvk, neoHookean, mooneyRivlin };
+
+/// "linear", "corotational", "stvk", "neo-hookean", "mooney-rivlin".
+std::string toString(ForceModelType type);
 
 /// The physics of a problem beyond its mesh, boundary and loads.
 struct ProblemSettings {
   MassType mass = MassType::consistent;
   ForceModelType forceModel = ForceModelType::linear;
   TangentKind tangent = TangentKind::simple;  ///< corotational only
+  HyperelasticOptions hyperelastic;           ///< stvk, neo-hookean, mooney-rivlin only
   double rayleighAlpha = 0.0;                 ///< D = alpha M + beta K
   double rayleighBeta = 0.0;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< acceleration (length / time^2)

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <asyncfem/contact/penaltyContact.hpp>
+#include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/vertexSelection.hpp>
@@ -65,7 +66,8 @@ struct Scene {
     double time = 0.0;  ///< impulse: when it is delivered
   };
 
-  enum class ForceModelKind { linear, corotational };
+  /// linear and corotational FEM, and the hyperelastic materials of library hyperelasticFEM.
+  enum class ForceModelKind { linear, corotational, stvk, neoHookean, mooneyRivlin };
   enum class Tangent { simple, exact };
 
   /// Name of the scene for messages: the file name as given to loadScene, or the
@@ -92,6 +94,9 @@ struct Scene {
     bool enabled() const { return !planes.empty() || !spheres.empty(); }
   } contact;
   Tangent tangent = Tangent::simple;  ///< corotational only
+  /// Hyperelastic kinds only: inversion threshold, compression resistance, SPD tangent,
+  /// StVK formulation, Mooney-Rivlin parameters (docs/scene-format.md, "forceModel").
+  HyperelasticOptions hyperelastic;
 
   struct IntegratorSettings {
     std::string name = "backward-euler";
