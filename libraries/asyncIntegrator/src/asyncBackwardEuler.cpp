@@ -172,9 +172,10 @@ struct RegionBlocks {
   Eigen::MatrixXd zLast, zSum;  // Z_m and sum_r Z_r, |S| x q (dense recovery only)
   Eigen::MatrixXd correction;   // C_i = H^{IS} Z, q x q
   // Per-step buffers, sized once: no allocation in a steady-state step.
-  Eigen::MatrixXd rhs;       // |S| x m, column r - 1 = b_r
-  Eigen::MatrixXd external;  // |S| x m, f_ext on S at the substeps
-  Eigen::MatrixXd y, x;      // forward substitutions of b and of b - H^{SL} Y
+  Eigen::MatrixXd rhs;                   // |S| x m, column r - 1 = b_r
+  Eigen::MatrixXd external;              // |S| x m, f_ext on S at the substeps
+  Eigen::MatrixXd y, x;                  // forward substitutions of b and of b - H^{SL} Y
+  Eigen::MatrixXd probe, probeSolution;  // H^{SL} y and its forward substitution (applySchur)
   Eigen::VectorXd runningStiffness, substepRhs, combined;
   Eigen::MatrixXd substepSolution;
   Eigen::VectorXd weightedM, weightedD, weightedK, interfaceRow;  // Eq. (A7) on y
@@ -259,6 +260,9 @@ struct AsyncBackwardEuler::Impl {
   std::vector<double> forceTimes;
   std::vector<Eigen::VectorXd> forceValues;
   std::size_t forcesUsed = 0;
+  // Lagged Schur factor (AsyncOptions::laggedSchur).
+  bool lagSchur = false, schurStale = false, schurBuilt = false, refreshNext = false;
+  Eigen::VectorXd schurProduct, schurResidual, schurCorrection, schurDirection;
 };
 
 namespace {
@@ -534,17 +538,29 @@ void AsyncBackwardEuler::rebuildBlocks() {
   factor.start();
   for (RegionBlocks& rb : d.regions) detail::factorizeCounted(*rb.solver, rb.systemMatrix, rb.analyzed, stats);
   stats.factorizationSeconds += factor.stop();
+  if (d.lagSchur) {
+    d.schurStale = true;  // Z and H^{LL*} kept from the last full rebuild (step() iterates)
+    return;
+  }
+  fullSchurRebuild();
+}
+
+// Z, the Schur corrections and the H^{LL*} factor from the current blocks.
+void AsyncBackwardEuler::fullSchurRebuild() {
+  Impl& d = *impl_;
+  IntegratorStats& stats = stats_;
+  Stopwatch factor;
   factor.start();
-  computeCorrections(damped);
+  computeCorrections(system_.damped());
   const double zSeconds = factor.stop();
   zColumnSeconds_ += zSeconds;
   stats.factorizationSeconds += zSeconds;
   (runStats_.rebuilds == 0 && runStats_.steps == 0 ? runStats_.setupZSeconds : runStats_.rebuildZSeconds) += zSeconds;
-  schurAsymmetry = 0.0;
+  schurAsymmetry_ = 0.0;
   for (const RegionBlocks& rb : d.regions) {
     const double norm = rb.correction.norm();
     if (norm > 0.0) {
-      schurAsymmetry = std::max(schurAsymmetry, (rb.correction - rb.correction.transpose()).norm() / norm);
+      schurAsymmetry_ = std::max(schurAsymmetry_, (rb.correction - rb.correction.transpose()).norm() / norm);
     }
   }
   factor.start();
@@ -552,6 +568,8 @@ void AsyncBackwardEuler::rebuildBlocks() {
   const double schurSeconds = factor.stop();
   stats.factorizationSeconds += schurSeconds;
   if (runStats_.rebuilds == 0 && runStats_.steps == 0) runStats_.setupSchurSeconds += schurSeconds;
+  d.schurStale = false;
+  d.schurBuilt = true;
 }
 
 namespace {
@@ -908,6 +926,9 @@ void AsyncBackwardEuler::step() {
   if (!d.linear || !d.built) {
     Stopwatch rebuild;
     const bool first = runStats_.rebuilds == 0 && runStats_.steps == 0;
+    d.lagSchur = options_.laggedSchur && !d.linear && d.schurBuilt && !d.refreshNext &&
+                 options_.method == AsyncSolveMethod::structured;
+    d.refreshNext = false;
     rebuildBlocks();
     d.built = true;
     const double seconds = rebuild.stop();
@@ -1077,7 +1098,13 @@ void AsyncBackwardEuler::step() {
     }
     if (large.empty()) {
       d.Y.resize(0);
-    } else {
+    } else if (!d.schurStale) {
+      solveSchur(d.rhsSchur, d.Y);
+    } else if (!iterativeSchur(d.rhsSchur, d.Y)) {
+      // The old factor no longer preconditions well enough: rebuild now (exact solve).
+      Stopwatch rebuild;
+      fullSchurRebuild();
+      runStats_.rebuildSeconds += rebuild.stop();
       solveSchur(d.rhsSchur, d.Y);
     }
     // Recovery per region (in parallel): X_m and sum_r X_r from the stored Z_m, sum_r Z_r,
@@ -1092,7 +1119,7 @@ void AsyncBackwardEuler::step() {
       }
       rb.yInterface.resize(static_cast<Eigen::Index>(pos.size()));
       for (std::size_t k = 0; k < pos.size(); ++k) rb.yInterface[static_cast<Eigen::Index>(k)] = d.Y[pos[k]];
-      if (rb.useDenseZ && !observer_) {
+      if (rb.useDenseZ && !observer_ && !d.schurStale) {
         rb.xLast = rb.y.col(rb.ratio - 1);
         rb.xLast.noalias() -= rb.zLast * rb.yInterface;
         rb.xSum = rb.y.rowwise().sum();
@@ -1164,6 +1191,94 @@ void AsyncBackwardEuler::step() {
   }
   ++runStats_.steps;
   runStats_.stepSeconds += whole.stop() - (runStats_.setupSeconds + runStats_.rebuildSeconds - rebuildBefore);
+}
+
+// out = H^{LL*} y for the current blocks: A-hat^L y minus, per region, the interface rows
+// of H^{LS} (H^{SS})^{-1} H^{SL} y (one forward substitution per region).
+void AsyncBackwardEuler::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out) {
+  Impl& d = *impl_;
+  const bool damped = system_.damped();
+  out.resize(y.size());
+  out.noalias() = d.largeSystem * y;
+  const int numRegions = partition_.numRegions();
+  parallelTasks(numRegions, threadBudget(options_.threads), [&](int i) {
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    const std::vector<int>& pos = partition_.interfacePositions(i);
+    if (pos.empty()) return;
+    rb.yInterface.resize(static_cast<Eigen::Index>(pos.size()));
+    for (std::size_t k = 0; k < pos.size(); ++k) rb.yInterface[static_cast<Eigen::Index>(k)] = y[pos[k]];
+    const CouplingCoefficients& k = rb.coupling;
+    rb.massY.noalias() = rb.Msi * rb.yInterface;
+    rb.stiffY.noalias() = rb.Ksi * rb.yInterface;
+    if (damped) rb.dampY.noalias() = rb.Dsi * rb.yInterface;
+    rb.probe.resize(rb.massY.size(), rb.ratio);
+    for (int r = 1; r <= rb.ratio; ++r) {
+      rb.probe.col(r - 1) = k.bM[r - 1] * rb.massY + k.bK[r - 1] * rb.stiffY;
+      if (damped) rb.probe.col(r - 1) += k.bD[r - 1] * rb.dampY;
+    }
+    forwardSubstitute(rb, rb.probe, rb.probeSolution);
+    weightedColumnSum(rb.probeSolution, k.eM, rb.weightedM);
+    weightedColumnSum(rb.probeSolution, k.eK, rb.weightedK);
+    rb.interfaceRow.noalias() = rb.Mis * rb.weightedM;
+    rb.interfaceRow.noalias() += rb.Kis * rb.weightedK;
+    if (damped) {
+      weightedColumnSum(rb.probeSolution, k.eD, rb.weightedD);
+      rb.interfaceRow.noalias() += rb.Dis * rb.weightedD;
+    }
+  });
+  for (int i = 0; i < numRegions; ++i) {
+    const std::vector<int>& pos = partition_.interfacePositions(i);
+    const RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    for (std::size_t k = 0; k < pos.size(); ++k) out[pos[k]] -= rb.interfaceRow[static_cast<Eigen::Index>(k)];
+  }
+}
+
+// H^{LL*} Y = rhs with the factor of the last full rebuild as preconditioner
+// (AsyncOptions::laggedSchur): conjugate gradients for the stable coupling, whose H^{LL*}
+// is symmetric, iterative refinement for the paper's. Returns false when it did not reach
+// the tolerance.
+bool AsyncBackwardEuler::iterativeSchur(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  Impl& d = *impl_;
+  const double scale = rhs.norm();
+  solveSchur(rhs, solution);
+  if (scale == 0.0) return true;
+  const bool conjugate = options_.coupling == AsyncCoupling::stable;
+  applySchur(solution, d.schurProduct);
+  d.schurResidual = rhs - d.schurProduct;  // r
+  Eigen::VectorXd& direction = d.schurDirection;
+  double rz = 0.0;
+  for (int iteration = 1; iteration <= options_.laggedSchurIterations; ++iteration) {
+    const double residual = d.schurResidual.norm() / scale;
+    if (!std::isfinite(residual)) return false;
+    if (residual <= options_.laggedSchurTolerance) {
+      ++runStats_.laggedSteps;
+      runStats_.largestSchurResidual = std::max(runStats_.largestSchurResidual, residual);
+      d.refreshNext = iteration > options_.laggedSchurIterations / 2;  // slow: the next step rebuilds
+      return true;
+    }
+    ++runStats_.schurIterations;
+    solveSchur(d.schurResidual, d.schurCorrection);  // z = P^{-1} r
+    if (!conjugate) {
+      solution += d.schurCorrection;
+      applySchur(solution, d.schurProduct);
+      d.schurResidual = rhs - d.schurProduct;
+      continue;
+    }
+    const double rzNew = d.schurResidual.dot(d.schurCorrection);
+    if (iteration == 1) {
+      direction = d.schurCorrection;
+    } else {
+      direction = d.schurCorrection + (rzNew / rz) * direction;
+    }
+    rz = rzNew;
+    applySchur(direction, d.schurProduct);
+    const double curvature = direction.dot(d.schurProduct);
+    if (!(curvature > 0.0)) return false;
+    const double step = rz / curvature;
+    solution += step * direction;
+    d.schurResidual -= step * d.schurProduct;
+  }
+  return false;
 }
 
 double AsyncBackwardEuler::solveFloorSeconds(int repeats) {

@@ -537,13 +537,25 @@ struct SteadyRow {
 /// set-up against single-rate steps at hL. With `only`, one configuration and no table
 /// (for callgrind). Corotational: the async large step (rebuild included) against m
 /// corotational single-rate steps at hS.
-void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotational, const std::string& only) {
+void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotational, const std::string& only,
+                 bool collectFirst, bool laggedSchur) {
   std::vector<SteadyRow> rows;
   for (const std::string& spec : scenes) {
     const Scene scene = steadyScene(spec, corotational);
     Simulation simulation = buildSimulation(scene);
     auto* async = dynamic_cast<AsyncBackwardEuler*>(simulation.integrator.get());
     if (async == nullptr) throw ValidationError(spec + ": the scene's integrator is not async");
+    std::unique_ptr<AsyncBackwardEuler> lagged;
+    if (laggedSchur) {
+      // The same scene with AsyncOptions::laggedSchur (not a scene key).
+      AsyncOptions options = async->options();
+      options.laggedSchur = true;
+      std::vector<AsyncRegion> regions;
+      for (int i = 0; i < async->partition().numRegions(); ++i) regions.push_back(async->partition().region(i));
+      lagged =
+          std::make_unique<AsyncBackwardEuler>(*simulation.mesh, async->system(), async->timestep(), regions, options);
+      async = lagged.get();
+    }
     SteadyRow row;
     row.name = scene.sourceName;
     row.vertices = simulation.mesh->numVertices();
@@ -555,19 +567,23 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
     }
     row.interfaceDofs = async->runStats().interfaceDofs;
     const DynamicSystem system = async->system();
+    // Collected for callgrind: the first step (set-up included) with --first, else the
+    // timed steady steps.
     const auto measure = [&](Integrator& integrator, double* setup) {
       Stopwatch first;
+      if (!only.empty() && collectFirst) ASYNCFEM_COLLECT_ON();
       integrator.step();
+      if (!only.empty() && collectFirst) ASYNCFEM_COLLECT_OFF();
       if (setup) *setup = first.stop();
       integrator.step();
       std::vector<double> samples;
-      if (!only.empty()) ASYNCFEM_COLLECT_ON();
+      if (!only.empty() && !collectFirst) ASYNCFEM_COLLECT_ON();
       for (int k = 0; k < steps; ++k) {
         Stopwatch watch;
         integrator.step();
         samples.push_back(watch.stop());
       }
-      if (!only.empty()) ASYNCFEM_COLLECT_OFF();
+      if (!only.empty() && !collectFirst) ASYNCFEM_COLLECT_OFF();
       return median(samples);
     };
     if (only.empty() || only == "async") {
@@ -577,16 +593,23 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
       row.setup = async->runStats().setupSeconds;
     }
     if (only.empty() || only == "single") {
+      // Single-rate factors in its constructor: its set-up is construction + first step.
+      Stopwatch construction;
+      if (!only.empty() && collectFirst) ASYNCFEM_COLLECT_ON();
       auto single = makeIntegrator("backward-euler", system, row.hL);
+      if (!only.empty() && collectFirst) ASYNCFEM_COLLECT_OFF();
+      const double constructionSeconds = construction.stop();
       row.singleStep = measure(*single, &row.singleSetup);
+      row.singleSetup += constructionSeconds;
     }
-    if (only.empty() && corotational) {
+    if ((only.empty() && corotational) || only == "single-hs") {
       auto small = makeIntegrator("backward-euler", system, row.hL / row.ratio);
       row.singleStepHS = measure(*small, nullptr) * row.ratio;
     }
     if (!only.empty()) {
-      std::printf("%s: %s, %d steady steps collected: %.3f ms per step (median)\n", row.name.c_str(), only.c_str(),
-                  steps, 1e3 * (only == "async" ? row.asyncStep : row.singleStep));
+      const double perStep = only == "async" ? row.asyncStep : only == "single" ? row.singleStep : row.singleStepHS;
+      std::printf("%s: %s, %d steps collected, m = %d: %.3f ms per step (median; single-hs: per m steps)\n",
+                  row.name.c_str(), only.c_str(), steps, row.ratio, 1e3 * perStep);
       continue;
     }
     rows.push_back(row);
@@ -604,6 +627,7 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
                   1e3 * r.asyncStep, 1e3 * r.singleStep, r.asyncStep / r.singleStep, 1e3 * r.setup,
                   r.setup / r.singleStep);
   } else {
+    std::printf("%s", laggedSchur ? "With AsyncOptions::laggedSchur.\n\n" : "");
     std::printf(
         "| scene | vertices | S vertices (%%) | interface DOFs | m | async ms/large step | single-rate hL ms/step | "
         "single-rate hS ms per hL | async / single-rate hS | async set-up ms "
@@ -627,13 +651,15 @@ int main(int argc, char** argv) {
   double hL = 5e-3;
   std::vector<std::string> scenes;
   std::string only;
-  bool corotational = false;
+  bool corotational = false, collectFirst = false, laggedSchur = false;
   app.add_option("--study", study, "growth | ratio | schur | corotational | contact | steady | all")
       ->check(CLI::IsMember({"growth", "ratio", "schur", "corotational", "contact", "steady", "all"}));
   app.add_option("--scenes", scenes, "steady study: scene files, or dragon:SPACING:SET:M:HL");
   app.add_option("--only", only, "steady study: time one configuration only (for callgrind)")
-      ->check(CLI::IsMember({"async", "single"}));
+      ->check(CLI::IsMember({"async", "single", "single-hs"}));
   app.add_flag("--corotational", corotational, "steady study: corotational forces");
+  app.add_flag("--lagged-schur", laggedSchur, "steady study: AsyncOptions::laggedSchur (nonlinear forces)");
+  app.add_flag("--first", collectFirst, "with --only: collect the first step (set-up included) instead");
   app.add_option("--cells", cells, "cells along the bar for the growth and schur studies")->check(CLI::Range(2, 400));
   app.add_option("--ratio-cells", ratioCells, "cells along the bar for the ratio study")->check(CLI::Range(2, 400));
   app.add_option("--m", ratio, "substeps per large step (growth, schur)")->check(CLI::Range(1, 1000));
@@ -651,7 +677,7 @@ int main(int argc, char** argv) {
     if (study == "schur" || study == "all") schurStudy(cells, ratio, hL, steps);
     if (study == "corotational" || study == "all") corotationalStudy(ratioCells, ratio, 1.0 / 120.0);
     if (study == "contact" || study == "all") contactStudy(ratioCells, ratio, 1.0 / 120.0);
-    if (study == "steady") steadyStudy(scenes, steps, corotational, only);
+    if (study == "steady") steadyStudy(scenes, steps, corotational, only, collectFirst, laggedSchur);
   } catch (const asyncfem::Error& e) {
     std::fprintf(stderr, "benchmarkAsync: %s\n", e.what());
     return 1;

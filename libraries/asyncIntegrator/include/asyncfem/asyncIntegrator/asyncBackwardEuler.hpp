@@ -71,6 +71,18 @@ struct AsyncOptions {
   /// Threads for the set-up and per-large-step rebuild (columns of Z in blocks, one A^S
   /// factor copy per block) and for the regions of a step: 0 = OpenMP's maximum.
   int threads = 0;
+  /// Nonlinear forces only. false (default): every large step recomputes Z and refactors
+  /// H^{LL*} (the paper's Algorithm 2). true: the factor of H^{LL*} from the last full
+  /// rebuild is kept as a preconditioner and the Schur system of the current tangent is
+  /// solved by preconditioned iterative refinement (each iteration: one forward substitution
+  /// per region and one solve with the old factor) to a relative residual of
+  /// laggedSchurTolerance; when that takes more than laggedSchurIterations iterations the
+  /// step does the full rebuild instead, and so does the next one after a slow
+  /// convergence. A^S is refactored every step either way. The step then solves the
+  /// coupled system to the tolerance instead of to round-off.
+  bool laggedSchur = false;
+  int laggedSchurIterations = 8;
+  double laggedSchurTolerance = 1e-10;
 };
 
 /// Where an asynchronous run's time went, set-up apart from the steady-state steps (the
@@ -89,11 +101,14 @@ struct AsyncRunStats {
   /// Everything else step() spends (forces, right-hand sides, solves, state update).
   double stepSeconds = 0.0;
   long long steps = 0;
-  int fastDofs = 0;        ///< sum_i |S_i|
-  int interfaceDofs = 0;   ///< sum_i |I_i|
-  int largeDofs = 0;       ///< |L|
-  int zThreads = 1;        ///< threads (A^S factor copies) the last Z computation used
-  long long zColumns = 0;  ///< right-hand sides of one Z computation: sum_i m_i |I_i|
+  int fastDofs = 0;                   ///< sum_i |S_i|
+  int interfaceDofs = 0;              ///< sum_i |I_i|
+  int largeDofs = 0;                  ///< |L|
+  int zThreads = 1;                   ///< threads (A^S factor copies) the last Z computation used
+  long long zColumns = 0;             ///< right-hand sides of one Z computation: sum_i m_i |I_i|
+  long long laggedSteps = 0;          ///< steps solved with the lagged H^{LL*} (AsyncOptions::laggedSchur)
+  long long schurIterations = 0;      ///< iterative refinement iterations over those steps
+  double largestSchurResidual = 0.0;  ///< largest final relative residual of those steps
   /// Mean seconds of a steady-state large step (stepSeconds / steps), and with rebuilds.
   double meanStepSeconds() const { return steps > 0 ? stepSeconds / static_cast<double>(steps) : 0.0; }
   double meanStepWithRebuildSeconds() const {
@@ -167,6 +182,9 @@ class AsyncBackwardEuler final : public Integrator {
   void subtractInterfaceStiffness();
   void solveSchur(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
   void computeCorrections(bool damped);
+  void fullSchurRebuild();
+  void applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out);
+  bool iterativeSchur(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
   RegionPartition partition_;
   AsyncOptions options_;
   SubstepObserver observer_;
