@@ -442,7 +442,6 @@ void AsyncBackwardEuler::rebuildBlocks() {
   const AsyncOptions& options = options_;
   const double largeStep = timestep();
   IntegratorStats& stats = stats_;
-  double& schurAsymmetry = schurAsymmetry_;
   const double alpha = system.rayleighMass, beta = system.rayleighStiffness;
   const bool damped = system.damped();
   const double hL = largeStep;
