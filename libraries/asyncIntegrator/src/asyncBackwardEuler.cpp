@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Asynchronous implicit backward Euler. Equation numbers (A1)-(A12) refer to
 // docs/asynchronous-integrator.md, section "Method".
+#include <omp.h>
+
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <algorithm>
@@ -11,6 +13,7 @@
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>
+#include <exception>
 #include <string>
 
 #include "detail/multirateSupport.hpp"
@@ -52,18 +55,14 @@ double* findEntry(SparseMatrix& matrix, int row, int column) {
   return matrix.valuePtr() + (it - matrix.innerIndexPtr());
 }
 
-/// A dense q x q block scattered into a |L| x |L| sparse matrix at the listed positions,
-/// every entry stored (so the pattern never depends on values).
-SparseMatrix scatterDense(const Eigen::MatrixXd& block, const std::vector<int>& positions, int size) {
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(block.size()));
-  for (Eigen::Index c = 0; c < block.cols(); ++c)
-    for (Eigen::Index r = 0; r < block.rows(); ++r)
-      triplets.emplace_back(positions[static_cast<std::size_t>(r)], positions[static_cast<std::size_t>(c)],
-                            block(r, c));
-  SparseMatrix out(size, size);
-  out.setFromTriplets(triplets.begin(), triplets.end());
-  return out;
+/// Column c of a compressed matrix dotted with x (row c of K x when K is symmetric).
+double columnDot(const SparseMatrix& matrix, int column, const Eigen::VectorXd& x) {
+  const int* inner = matrix.innerIndexPtr();
+  const double* values = matrix.valuePtr();
+  double sum = 0.0;
+  for (int k = matrix.outerIndexPtr()[column]; k < matrix.outerIndexPtr()[column + 1]; ++k)
+    sum += values[k] * x[inner[k]];
+  return sum;
 }
 
 /// Whether x and y are compressed with identical patterns.
@@ -158,57 +157,61 @@ struct RegionBlocks {
   // Stable coupling: the interface elements and K_I^{II}, their stiffness on I x I (dense).
   std::vector<InterfaceElement> interfaceElements;
   Eigen::MatrixXd interfaceStiffness;
-  // Forward-substitution buffers, and whether M^{SS} and G share one pattern (fused products).
-  Eigen::VectorXd runningStiffness, substepRhs;
-  Eigen::MatrixXd substepSolution;
-  bool massAndGSharePattern = false;
+  SparseMatrix GT;  // G^T, for products with many columns held row-wise
+  // The previous substep's solve gives M^{SS} x_{r-1} for free: A^S = (1 + hS alpha) M^{SS}
+  // + (1 + beta / hS) G, so M^{SS} x_{r-1} = (rhs_{r-1} - (1 + beta / hS) G x_{r-1}) / (1 +
+  // hS alpha), and substep r's right-hand side b_r + M^{SS} x_{r-1} - G sum_{i<r} x_i needs
+  // one product with G: rhsWeight rhs_{r-1} + b_r - G (stepWeight x_{r-1} + sum_{i<r} x_i).
+  double rhsWeight = 1.0, stepWeight = 1.0;
   std::unique_ptr<SparseSolver> solver;
   bool analyzed = false;
-  std::vector<Eigen::MatrixXd> z;  // Z_r blocks (dense recovery only)
+  // Copies of the A^S factor for the column blocks of Z computed on other threads.
+  std::vector<std::unique_ptr<SparseSolver>> helperSolvers;
+  std::vector<char> helperAnalyzed;
   bool useDenseZ = false;
-  Eigen::MatrixXd correction;  // C_i = H^{IS} Z, q x q
+  Eigen::MatrixXd zLast, zSum;  // Z_m and sum_r Z_r, |S| x q (dense recovery only)
+  Eigen::MatrixXd correction;   // C_i = H^{IS} Z, q x q
+  // Per-step buffers, sized once: no allocation in a steady-state step.
+  Eigen::MatrixXd rhs;                   // |S| x m, column r - 1 = b_r
+  Eigen::MatrixXd external;              // |S| x m, f_ext on S at the substeps
+  Eigen::MatrixXd y, x;                  // forward substitutions of b and of b - H^{SL} Y
+  Eigen::MatrixXd probe, probeSolution;  // H^{SL} y and its forward substitution (applySchur)
+  Eigen::VectorXd runningStiffness, substepRhs, combined;
+  Eigen::MatrixXd substepSolution;
+  Eigen::VectorXd weightedM, weightedD, weightedK, interfaceRow;  // Eq. (A7) on y
+  Eigen::VectorXd yInterface, massY, stiffY, dampY;
+  Eigen::VectorXd ySum, xLast, xSum;
+  bool substituted = false;  // x holds every substep (observer, substitution recovery)
+  std::exception_ptr failure;
 };
 
-/// H^{IS} x for x_1..x_m the columns of x (|S| x m or, for Z, blocks side by side): sum_i
-/// E_i x_i = M^{IS} (x eM) + D^{IS} (x eD) + K^{IS} (x eK), Eq. (A7).
-Eigen::MatrixXd applyInterfaceRow(const RegionBlocks& rb, bool damped, const Eigen::MatrixXd& weightedM,
-                                  const Eigen::MatrixXd& weightedD, const Eigen::MatrixXd& weightedK) {
-  Eigen::MatrixXd out = rb.Mis * weightedM;
-  out += rb.Kis * weightedK;
-  if (damped) out += rb.Dis * weightedD;
-  return out;
+/// The weighted sums sum_r w_r x_r of Eq. (A7) for the columns x_1..x_m of x.
+void weightedColumnSum(const Eigen::MatrixXd& x, const Eigen::VectorXd& weights, Eigen::VectorXd& out) {
+  out.noalias() = x * weights;
 }
 
-/// mass = M^{SS} x and stiffness += G x for one column x (contiguous, |S| entries), in one
-/// pass over the pattern the two share (they are cut from M and K, which share the
-/// assembler's pattern).
-void fusedColumnProducts(const RegionBlocks& rb, const double* x, double* mass, double* stiffness) {
-  const int* outer = rb.Mss.outerIndexPtr();
-  const int* inner = rb.Mss.innerIndexPtr();
-  const double* massValues = rb.Mss.valuePtr();
-  const double* stiffValues = rb.G.valuePtr();
-  const Eigen::Index size = rb.Mss.outerSize();
-  std::fill(mass, mass + size, 0.0);
+/// out -= G t for one column t (|S| entries), scattered column by column.
+void subtractStiffnessProduct(const RegionBlocks& rb, const double* t, double* out) {
+  const int* outer = rb.G.outerIndexPtr();
+  const int* inner = rb.G.innerIndexPtr();
+  const double* values = rb.G.valuePtr();
+  const Eigen::Index size = rb.G.outerSize();
   for (Eigen::Index column = 0; column < size; ++column) {
-    const double xc = x[column];
-    for (int k = outer[column]; k < outer[column + 1]; ++k) {
-      mass[inner[k]] += massValues[k] * xc;
-      stiffness[inner[k]] += stiffValues[k] * xc;
-    }
+    const double tc = t[column];
+    for (int k = outer[column]; k < outer[column + 1]; ++k) out[inner[k]] -= values[k] * tc;
   }
 }
 
-/// mass = M^{SS} x and stiffness += G x, column by column (x, mass, stiffness: |S| x k,
-/// column-major and contiguous), fused when M^{SS} and G share a pattern, else by Eigen.
-void massAndStiffnessProducts(const RegionBlocks& rb, const Eigen::MatrixXd& x, Eigen::MatrixXd& mass,
-                              Eigen::MatrixXd& stiffness) {
-  if (!rb.massAndGSharePattern) {
-    mass.noalias() = rb.Mss * x;
-    stiffness.noalias() += rb.G * x;
-    return;
-  }
-  for (Eigen::Index c = 0; c < x.cols(); ++c)
-    fusedColumnProducts(rb, x.col(c).data(), mass.col(c).data(), stiffness.col(c).data());
+/// The same for many columns held row-wise: outT = (G t)^T for tT = t^T (k x |S|), column c
+/// of outT a sum of length-k vector updates over column c of G^T (row c of G), which
+/// vectorize across the k columns.
+void rowWiseStiffnessProduct(const RegionBlocks& rb, const Eigen::MatrixXd& tT, Eigen::MatrixXd& outT) {
+  const int* outer = rb.GT.outerIndexPtr();
+  const int* inner = rb.GT.innerIndexPtr();
+  const double* values = rb.GT.valuePtr();
+  outT.setZero();
+  for (Eigen::Index c = 0; c < rb.GT.outerSize(); ++c)
+    for (int k = outer[c]; k < outer[c + 1]; ++k) outT.col(c) += values[k] * tT.col(inner[k]);
 }
 
 }  // namespace
@@ -228,6 +231,11 @@ struct AsyncBackwardEuler::Impl {
   SparseMatrix schur;                         // H^{LL*} (or its symmetric part)
   std::unique_ptr<SparseSolver> schurSolver;  // of H^{LL*} (lu, symmetric) or of A^L (lowRank)
   bool schurAnalyzed = false;
+  // H^{LL*} on a fixed pattern (A^L's plus every region's dense I_i x I_i block), so a
+  // rebuild only writes values: where each A^L entry and each block entry sits in it.
+  bool schurPatternBuilt = false;
+  std::vector<int> schurFromLarge;
+  std::vector<std::vector<int>> schurFromBlock;
   // Low-rank form of H^{LL*} = A^L - U C U^T.
   std::vector<int> interfaceUnion;                   // positions in L of every region's interface DOFs
   Eigen::MatrixXd unionCorrection;                   // C, q x q
@@ -238,6 +246,23 @@ struct AsyncBackwardEuler::Impl {
   std::unique_ptr<SparseSolver> naiveSolver;
   bool naiveAnalyzed = false;
   std::vector<int> naiveOffsets;  // first row of region i's X_1; last entry = first row of Y
+  // Per-step buffers (full 3n, or |L|).
+  Eigen::VectorXd stiffVelocity, massVelocity, stateForce, predicted, newU, newV, work;
+  // Linear forces with a symmetric K (checked at the first build): f_int(u_0) = K u_0 and
+  // K v_0 are taken row by row (row i = column i) on the DOFs that need them, and L's rows
+  // need only K (u_0 + (beta + hL) v_0), as in single-rate backward Euler.
+  bool symmetricStiffness = false;
+  bool symmetryChecked = false;
+  Eigen::VectorXd rhsL, rhsSchur, Y, lowRankRhs;
+  Eigen::MatrixXd schurSolution;
+  // External forces at the distinct times of one large step (shared by regions whose
+  // substeps fall on the same times), valid for one step.
+  std::vector<double> forceTimes;
+  std::vector<Eigen::VectorXd> forceValues;
+  std::size_t forcesUsed = 0;
+  // Lagged Schur factor (AsyncOptions::laggedSchur).
+  bool lagSchur = false, schurStale = false, schurBuilt = false, refreshNext = false;
+  Eigen::VectorXd schurProduct, schurResidual, schurCorrection, schurDirection;
 };
 
 namespace {
@@ -388,6 +413,11 @@ AsyncBackwardEuler::AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system
     d.perElementTangent = findInterfaceElements(mesh, partition_, system_, d.regions);
   }
   d.naiveSolver = makeSparseSolver(SolverKind::umfpack);
+  runStats_.largeDofs = static_cast<int>(large.size());
+  for (int i = 0; i < partition_.numRegions(); ++i) {
+    runStats_.fastDofs += static_cast<int>(partition_.regionDofs(i).size());
+    runStats_.interfaceDofs += static_cast<int>(partition_.interfaceDofs(i).size());
+  }
   if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
   if (d.linear)
     stats_.skipped.push_back("per-step refactorization (linear forces: blocks, Z and H^{LL*} factored once)");
@@ -412,7 +442,6 @@ void AsyncBackwardEuler::rebuildBlocks() {
   const AsyncOptions& options = options_;
   const double largeStep = timestep();
   IntegratorStats& stats = stats_;
-  double& schurAsymmetry = schurAsymmetry_;
   const double alpha = system.rayleighMass, beta = system.rayleighStiffness;
   const bool damped = system.damped();
   const double hL = largeStep;
@@ -442,10 +471,17 @@ void AsyncBackwardEuler::rebuildBlocks() {
     // A^S = M^{SS} + hS D^{SS} + hS^2 K^{SS}
     combineInto(1.0 + hS * alpha, rb.Mss, hS * hS + hS * beta, rb.Kss, rb.systemMatrix);
     combineInto(0.0, rb.Mss, hS * hS, rb.Kss, rb.G);
-    rb.massAndGSharePattern = samePattern(rb.Mss, rb.G);
+    rb.GT = rb.G.transpose();
+    rb.rhsWeight = 1.0 / (1.0 + hS * alpha);
+    rb.stepWeight = (1.0 + beta / hS) / (1.0 + hS * alpha);
     rb.coupling = couplingCoefficients(options.coupling, rb.ratio, hL);
   }
   if (options.coupling == AsyncCoupling::stable) subtractInterfaceStiffness();
+  if (d.linear && !d.symmetryChecked) {
+    const SparseMatrix transposed = d.stiffness.transpose();
+    d.symmetricStiffness = (d.stiffness - transposed).norm() <= 1e-13 * d.stiffness.norm();
+    d.symmetryChecked = true;
+  }
   stats.assemblySeconds += assembly.stop();
 
   if (options.method == AsyncSolveMethod::naive) {
@@ -499,64 +535,188 @@ void AsyncBackwardEuler::rebuildBlocks() {
   // Structured: factor every A^S, compute Z = (H^{SS})^{-1} H^{SI} by forward
   // substitution with |I| right-hand sides, and the Schur corrections C_i = H^{IS} Z.
   factor.start();
-  schurAsymmetry = 0.0;
-  for (RegionBlocks& rb : d.regions) {
-    detail::factorizeCounted(*rb.solver, rb.systemMatrix, rb.analyzed, stats);
-    const int m = rb.ratio;
-    const Eigen::Index q = rb.Msi.cols();
-    const double sizeS = static_cast<double>(rb.systemMatrix.rows());
-    rb.z.clear();
-    // Recovery: X = y - Z Y_I (2 m |S| q flops, m |S| q doubles) or a second forward
-    // substitution (m solves and 2m sparse products). Automatic picks the cheaper in flops
-    // while Z fits in kMaxDenseZEntries.
-    const double denseFlops = 2.0 * m * sizeS * static_cast<double>(q);
-    const double substitutionFlops =
-        m * (rb.solver->stats().solveFlopsPerRhs + 4.0 * static_cast<double>(rb.Kss.nonZeros()));
-    rb.useDenseZ = options.recovery == RecoveryMode::denseZ ||
-                   (options.recovery == RecoveryMode::automatic && denseFlops <= substitutionFlops &&
-                    m * sizeS * static_cast<double>(q) <= kMaxDenseZEntries);
-    if (q == 0) {
-      rb.correction.resize(0, 0);
-      continue;
-    }
-    // Z: one multi-right-hand-side solve per substep (|I| columns at once: BLAS-3 work
-    // in the supernodal solve, threaded by the BLAS).
-    Stopwatch zWatch;
-    const Eigen::MatrixXd Msi = Eigen::MatrixXd(rb.Msi), Ksi = Eigen::MatrixXd(rb.Ksi);
-    const Eigen::MatrixXd Dsi = damped ? Eigen::MatrixXd(rb.Dsi) : Eigen::MatrixXd();
-    const CouplingCoefficients& k = rb.coupling;
-    const Eigen::Index sizeRows = rb.systemMatrix.rows();
-    // As in the step's forward substitution: G sum_{i<r} Z_i as a running sum, M^{SS} Z_{r-1}
-    // and G Z_{r-1} in one pass.
-    Eigen::MatrixXd runningStiffness = Eigen::MatrixXd::Zero(sizeRows, q), massProduct(sizeRows, q), prev, rhs, x;
-    Eigen::MatrixXd weightedM = Eigen::MatrixXd::Zero(sizeRows, q), weightedK = weightedM, weightedD;
-    if (damped) weightedD = weightedM;
-    for (int r = 1; r <= m; ++r) {
-      rhs = k.bM[r - 1] * Msi + k.bK[r - 1] * Ksi;
-      if (damped) rhs += k.bD[r - 1] * Dsi;
-      if (r >= 2) {
-        massAndStiffnessProducts(rb, prev, massProduct, runningStiffness);
-        rhs += massProduct - runningStiffness;
-      }
-      rb.solver->solve(rhs, x);
-      if (k.eM[r - 1] != 0.0) weightedM += k.eM[r - 1] * x;
-      weightedK += k.eK[r - 1] * x;
-      if (damped) weightedD += k.eD[r - 1] * x;
-      prev = x;
-      if (rb.useDenseZ) rb.z.push_back(x);
-    }
-    // C_i = H^{IS} Z = sum_r E_r Z_r (Eq. A7).
-    rb.correction = applyInterfaceRow(rb, damped, weightedM, weightedD, weightedK);
-    zColumnSeconds_ += zWatch.stop();
+  for (RegionBlocks& rb : d.regions) detail::factorizeCounted(*rb.solver, rb.systemMatrix, rb.analyzed, stats);
+  stats.factorizationSeconds += factor.stop();
+  if (d.lagSchur) {
+    d.schurStale = true;  // Z and H^{LL*} kept from the last full rebuild (step() iterates)
+    return;
+  }
+  fullSchurRebuild();
+}
+
+// Z, the Schur corrections and the H^{LL*} factor from the current blocks.
+void AsyncBackwardEuler::fullSchurRebuild() {
+  Impl& d = *impl_;
+  IntegratorStats& stats = stats_;
+  Stopwatch factor;
+  factor.start();
+  computeCorrections(system_.damped());
+  const double zSeconds = factor.stop();
+  zColumnSeconds_ += zSeconds;
+  stats.factorizationSeconds += zSeconds;
+  (runStats_.rebuilds == 0 && runStats_.steps == 0 ? runStats_.setupZSeconds : runStats_.rebuildZSeconds) += zSeconds;
+  schurAsymmetry_ = 0.0;
+  for (const RegionBlocks& rb : d.regions) {
     const double norm = rb.correction.norm();
     if (norm > 0.0) {
-      schurAsymmetry = std::max(schurAsymmetry, (rb.correction - rb.correction.transpose()).norm() / norm);
+      schurAsymmetry_ = std::max(schurAsymmetry_, (rb.correction - rb.correction.transpose()).norm() / norm);
     }
   }
-  stats.factorizationSeconds += factor.stop();
   factor.start();
   buildSchurSolver();
-  stats.factorizationSeconds += factor.stop();
+  const double schurSeconds = factor.stop();
+  stats.factorizationSeconds += schurSeconds;
+  if (runStats_.rebuilds == 0 && runStats_.steps == 0) runStats_.setupSchurSeconds += schurSeconds;
+  d.schurStale = false;
+  d.schurBuilt = true;
+}
+
+namespace {
+
+/// Fewest Z columns worth a thread of their own (below, the copy of the A^S factor costs
+/// more than the columns it takes over).
+constexpr Eigen::Index kMinZColumnsPerThread = 24;
+
+/// Columns [first, first + width) of Z = (H^{SS})^{-1} H^{SI} by forward substitution with
+/// `solver` (a factor of A^S), and from them the same columns of C_i = H^{IS} Z (Eq. A7),
+/// and of Z_m and sum_r Z_r when the region recovers X densely.
+void correctionColumns(RegionBlocks& rb, SparseSolver& solver, bool damped, Eigen::Index first, Eigen::Index width) {
+  const Eigen::Index size = rb.systemMatrix.rows();
+  const CouplingCoefficients& k = rb.coupling;
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(size, width), x, combinedT(width, size), productT(width, size);
+  Eigen::MatrixXd runningT = Eigen::MatrixXd::Zero(width, size);  // (sum_{i<r} Z_i)^T
+  Eigen::MatrixXd weightedM = Eigen::MatrixXd::Zero(size, width), weightedK = weightedM, weightedD, sum;
+  if (damped) weightedD = weightedM;
+  if (rb.useDenseZ) sum = weightedM;
+  // rhs += scale * block(:, first .. first + width), for a sparse block of H^{SI}.
+  const auto addColumns = [&](const SparseMatrix& block, double scale) {
+    if (scale == 0.0) return;
+    for (Eigen::Index c = 0; c < width; ++c)
+      for (SparseMatrix::InnerIterator it(block, first + c); it; ++it) rhs(it.row(), c) += scale * it.value();
+  };
+  for (int r = 1; r <= rb.ratio; ++r) {
+    // Row r of H^{SS} Z = H^{SI}: A^S Z_r = B_r + M^{SS} Z_{r-1} - G sum_{i<r} Z_i, with
+    // M^{SS} Z_{r-1} from the previous right-hand side (see RegionBlocks::rhsWeight).
+    if (r >= 2) {
+      runningT += x.transpose();
+      combinedT = runningT;
+      combinedT += rb.stepWeight * x.transpose();
+      rowWiseStiffnessProduct(rb, combinedT, productT);
+      rhs *= rb.rhsWeight;
+      rhs -= productT.transpose();
+    }
+    addColumns(rb.Msi, k.bM[r - 1]);
+    addColumns(rb.Ksi, k.bK[r - 1]);
+    if (damped) addColumns(rb.Dsi, k.bD[r - 1]);
+    solver.solve(rhs, x);
+    if (k.eM[r - 1] != 0.0) weightedM += k.eM[r - 1] * x;
+    weightedK += k.eK[r - 1] * x;
+    if (damped) weightedD += k.eD[r - 1] * x;
+    if (rb.useDenseZ) sum += x;
+  }
+  if (rb.useDenseZ) {
+    rb.zLast.middleCols(first, width) = x;
+    rb.zSum.middleCols(first, width) = sum;
+  }
+  Eigen::MatrixXd columns = rb.Mis * weightedM;
+  columns += rb.Kis * weightedK;
+  if (damped) columns += rb.Dis * weightedD;
+  rb.correction.middleCols(first, width) = columns;
+}
+
+int threadBudget(int requested) { return requested > 0 ? requested : std::max(1, omp_get_max_threads()); }
+
+/// Runs body(t) for t = 0..count-1 on up to `threads` OpenMP threads and rethrows the first
+/// exception a task threw (an exception must not leave an OpenMP region).
+template <class Body>
+void parallelTasks(int count, int threads, const Body& body) {
+  std::vector<std::exception_ptr> failures(static_cast<std::size_t>(std::max(count, 0)));
+#pragma omp parallel for schedule(dynamic) num_threads(std::max(1, std::min(threads, count))) if (count > 1)
+  for (int t = 0; t < count; ++t) {
+    try {
+      body(t);
+    } catch (...) {
+      failures[static_cast<std::size_t>(t)] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace
+
+// Z and the Schur corrections of every region. The columns of Z are independent: each
+// region's are split into blocks of at least kMinZColumnsPerThread, one per thread, each
+// block solved (many right-hand sides at once: BLAS-3 work in the supernodal solve) with
+// its own copy of the A^S factor, since one solver object is not thread-safe.
+void AsyncBackwardEuler::computeCorrections(bool damped) {
+  Impl& d = *impl_;
+  const int threads = threadBudget(options_.threads);
+  struct Task {
+    int region = 0;
+    int block = 0;  // 0: the region's own solver, j > 0: helperSolvers[j - 1]
+    Eigen::Index first = 0, width = 0;
+  };
+  std::vector<Task> tasks;
+  std::vector<std::pair<int, int>> helpers;  // (region, helper) factorizations to run
+  long long zColumns = 0;
+  int usedThreads = 1;
+  for (std::size_t i = 0; i < d.regions.size(); ++i) {
+    RegionBlocks& rb = d.regions[i];
+    const int m = rb.ratio;
+    const Eigen::Index q = rb.Msi.cols();
+    const Eigen::Index sizeS = rb.systemMatrix.rows();
+    // Recovery: the end state needs X_m = y_m - Z_m Y_I and sum_r X_r = sum_r y_r -
+    // (sum_r Z_r) Y_I (4 |S| q flops, 2 |S| q doubles), or a second forward substitution
+    // (m solves and 2m sparse products). Automatic picks the cheaper in flops while the two
+    // blocks fit in kMaxDenseZEntries.
+    const double denseFlops = 4.0 * static_cast<double>(sizeS) * static_cast<double>(q);
+    const double substitutionFlops =
+        m * (rb.solver->stats().solveFlopsPerRhs + 4.0 * static_cast<double>(rb.Kss.nonZeros()));
+    rb.useDenseZ = options_.recovery == RecoveryMode::denseZ ||
+                   (options_.recovery == RecoveryMode::automatic && denseFlops <= substitutionFlops &&
+                    2.0 * static_cast<double>(sizeS) * static_cast<double>(q) <= kMaxDenseZEntries);
+    rb.correction.resize(q, q);
+    if (rb.useDenseZ) {
+      rb.zLast.resize(sizeS, q);
+      rb.zSum.resize(sizeS, q);
+    } else {
+      rb.zLast.resize(0, 0);
+      rb.zSum.resize(0, 0);
+    }
+    if (q == 0) continue;
+    zColumns += static_cast<long long>(m) * q;
+    const int blocks =
+        static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(threads, q / kMinZColumnsPerThread)));
+    usedThreads = std::max(usedThreads, blocks);
+    while (static_cast<int>(rb.helperSolvers.size()) < blocks - 1) {
+      rb.helperSolvers.push_back(makeSparseSolver(options_.regionSolver));
+      rb.helperAnalyzed.push_back(0);
+    }
+    for (int j = 1; j < blocks; ++j) helpers.emplace_back(static_cast<int>(i), j - 1);
+    for (int j = 0; j < blocks; ++j) {
+      const Eigen::Index first = q * j / blocks, last = q * (j + 1) / blocks;
+      tasks.push_back({static_cast<int>(i), j, first, last - first});
+    }
+  }
+  parallelTasks(static_cast<int>(helpers.size()), threads, [&](int t) {
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(helpers[static_cast<std::size_t>(t)].first)];
+    const auto j = static_cast<std::size_t>(helpers[static_cast<std::size_t>(t)].second);
+    if (!rb.helperAnalyzed[j]) {
+      rb.helperSolvers[j]->analyzePattern(rb.systemMatrix);
+      rb.helperAnalyzed[j] = 1;
+    }
+    rb.helperSolvers[j]->factorize(rb.systemMatrix);
+  });
+  stats_.factorizations += static_cast<long long>(helpers.size());
+  parallelTasks(static_cast<int>(tasks.size()), threads, [&](int t) {
+    const Task& task = tasks[static_cast<std::size_t>(t)];
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(task.region)];
+    SparseSolver& solver = task.block == 0 ? *rb.solver : *rb.helperSolvers[static_cast<std::size_t>(task.block - 1)];
+    correctionColumns(rb, solver, damped, task.first, task.width);
+  });
+  runStats_.zThreads = usedThreads;
+  runStats_.zColumns = zColumns;
 }
 
 // Stable coupling: A^L becomes Â^L = A^L - sum_i (1 - theta_i) hL^2 K_{I_i}^{II} (Eq. A11),
@@ -612,6 +772,12 @@ void AsyncBackwardEuler::buildSchurSolver() {
   const Eigen::Index q = static_cast<Eigen::Index>(all.size());
 
   SchurMode mode = options_.schur;
+  if (mode == SchurMode::lowRank && options_.coupling == AsyncCoupling::stable) {
+    // The stable coupling's H^{LL*} is symmetric (to round-off): its own Cholesky factor
+    // is exact and costs one sparse solve per step, where the low-rank form adds a dense
+    // |L| x q product per step and q solves with A^L per rebuild.
+    mode = schurAsymmetry_ <= 1e-10 ? SchurMode::symmetric : SchurMode::lu;
+  }
   if (mode == SchurMode::lowRank && static_cast<double>(numLarge) * static_cast<double>(q) > kMaxLowRankEntries) {
     mode = SchurMode::lu;  // A^{-1} U would not fit: factor H^{LL*} itself
   }
@@ -649,31 +815,95 @@ void AsyncBackwardEuler::buildSchurSolver() {
     return;
   }
 
+  // H^{LL*} = A^L - sum_i C_i on the I_i x I_i blocks, on a pattern built once (every
+  // block entry stored, so a rebuild writes values only and the analysis is kept).
   Stopwatch assembly;
-  d.schur = d.largeSystem;
+  if (!d.schurPatternBuilt) {
+    std::vector<Eigen::Triplet<double>> triplets;
+    triplets.reserve(static_cast<std::size_t>(d.largeSystem.nonZeros()));
+    appendTriplets(d.largeSystem, 1.0, 0, 0, triplets);
+    for (int i = 0; i < partition_.numRegions(); ++i) {
+      const std::vector<int>& pos = partition_.interfacePositions(i);
+      for (int column : pos)
+        for (int row : pos) triplets.emplace_back(row, column, 0.0);
+    }
+    d.schur.resize(numLarge, numLarge);
+    d.schur.setFromTriplets(triplets.begin(), triplets.end());
+    d.schur.makeCompressed();
+    d.schurFromLarge.resize(static_cast<std::size_t>(d.largeSystem.nonZeros()));
+    for (int c = 0; c < numLarge; ++c)
+      for (int k = d.largeSystem.outerIndexPtr()[c]; k < d.largeSystem.outerIndexPtr()[c + 1]; ++k)
+        d.schurFromLarge[static_cast<std::size_t>(k)] =
+            static_cast<int>(findEntry(d.schur, d.largeSystem.innerIndexPtr()[k], c) - d.schur.valuePtr());
+    d.schurFromBlock.assign(static_cast<std::size_t>(partition_.numRegions()), {});
+    for (int i = 0; i < partition_.numRegions(); ++i) {
+      const std::vector<int>& pos = partition_.interfacePositions(i);
+      std::vector<int>& index = d.schurFromBlock[static_cast<std::size_t>(i)];
+      index.reserve(pos.size() * pos.size());
+      for (int column : pos)
+        for (int row : pos) index.push_back(static_cast<int>(findEntry(d.schur, row, column) - d.schur.valuePtr()));
+    }
+    d.schurPatternBuilt = true;
+  }
+  double* values = d.schur.valuePtr();
+  std::fill(values, values + d.schur.nonZeros(), 0.0);
+  for (std::size_t k = 0; k < d.schurFromLarge.size(); ++k) values[d.schurFromLarge[k]] += d.largeSystem.valuePtr()[k];
   for (int i = 0; i < partition_.numRegions(); ++i) {
     const Eigen::MatrixXd& c = d.regions[static_cast<std::size_t>(i)].correction;
-    if (c.size() == 0) continue;
-    const Eigen::MatrixXd applied = mode == SchurMode::symmetric ? Eigen::MatrixXd(0.5 * (c + c.transpose())) : c;
-    d.schur -= scatterDense(applied, partition_.interfacePositions(i), numLarge);
+    const std::vector<int>& index = d.schurFromBlock[static_cast<std::size_t>(i)];
+    const Eigen::Index qi = c.rows();
+    for (Eigen::Index b = 0; b < qi; ++b)
+      for (Eigen::Index a = 0; a < qi; ++a) {
+        const double entry = mode == SchurMode::symmetric ? 0.5 * (c(a, b) + c(b, a)) : c(a, b);
+        values[index[static_cast<std::size_t>(b * qi + a)]] -= entry;
+      }
   }
-  d.schur.makeCompressed();
   stats_.assemblySeconds += assembly.stop();
   detail::factorizeCounted(*d.schurSolver, d.schur, d.schurAnalyzed, stats_);
 }
 
-Eigen::VectorXd AsyncBackwardEuler::solveSchur(const Eigen::VectorXd& rhs) {
+void AsyncBackwardEuler::solveSchur(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
   Impl& d = *impl_;
-  Eigen::VectorXd y = d.schurSolver->solve(rhs);
-  if (schurModeUsed_ != SchurMode::lowRank || d.interfaceUnion.empty()) return y;
-  const Eigen::VectorXd yInterface = gather(y, d.interfaceUnion);
+  d.schurSolver->solve(rhs, d.schurSolution);
+  solution = d.schurSolution.col(0);
+  if (schurModeUsed_ != SchurMode::lowRank || d.interfaceUnion.empty()) return;
+  const Eigen::VectorXd yInterface = gather(solution, d.interfaceUnion);
   const Eigen::VectorXd z = d.capacitance.solve(yInterface);
-  y.noalias() += d.lowRankBasis * (d.unionCorrection * z);
-  return y;
+  solution.noalias() += d.lowRankBasis * (d.unionCorrection * z);
 }
+
+namespace {
+
+/// Forward substitution with H^{SS} (Eq. A13): A^S x_r = b_r + M^{SS} x_{r-1} - G sum_{i<r} x_i,
+/// into x (|S| x m). G sum_{i<r} x_i is a running sum; M^{SS} x_{r-1} and G x_{r-1} are
+/// taken in one pass over their shared pattern, into the region's buffers.
+void forwardSubstitute(RegionBlocks& rb, const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
+  const Eigen::Index size = b.rows();
+  x.resize(size, b.cols());
+  rb.runningStiffness.setZero(size);  // w = sum_{i<r} x_i
+  rb.combined.resize(size);
+  for (int r = 1; r <= rb.ratio; ++r) {
+    if (r == 1) {
+      rb.substepRhs = b.col(0);
+    } else {
+      // rhs_r = rhsWeight rhs_{r-1} + b_r - G (stepWeight x_{r-1} + w) (RegionBlocks::rhsWeight).
+      rb.runningStiffness += x.col(r - 2);
+      rb.combined = rb.runningStiffness + rb.stepWeight * x.col(r - 2);
+      rb.substepRhs *= rb.rhsWeight;
+      rb.substepRhs += b.col(r - 1);
+      subtractStiffnessProduct(rb, rb.combined.data(), rb.substepRhs.data());
+    }
+    rb.solver->solve(rb.substepRhs, rb.substepSolution);
+    x.col(r - 1) = rb.substepSolution.col(0);
+  }
+}
+
+}  // namespace
 
 void AsyncBackwardEuler::step() {
   Impl& d = *impl_;
+  Stopwatch whole;
+  const double rebuildBefore = runStats_.setupSeconds + runStats_.rebuildSeconds;
   const double hL = timestep();
   // Step times come from the step index (t0 = k hL, t1 = (k + 1) hL); substep r of a
   // region is at t0 + r hS, and its last one (r = m) at exactly t1.
@@ -686,183 +916,267 @@ void AsyncBackwardEuler::step() {
   const Eigen::VectorXd& v0 = velocity_;
   const bool damped = system_.damped();
   const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
+  const int threads = threadBudget(options_.threads);
 
-  detail::evaluateForces(system_, d.linear, d.built, u0, d.internalForce, d.stiffness, stats_);
+  if (!d.linear || !d.built || !d.symmetricStiffness) {
+    detail::evaluateForces(system_, d.linear, d.built, u0, d.internalForce, d.stiffness, stats_);
+  }
   Stopwatch solve;
   if (!d.linear || !d.built) {
+    Stopwatch rebuild;
+    const bool first = runStats_.rebuilds == 0 && runStats_.steps == 0;
+    d.lagSchur = options_.laggedSchur && !d.linear && d.schurBuilt && !d.refreshNext &&
+                 options_.method == AsyncSolveMethod::structured;
+    d.refreshNext = false;
     rebuildBlocks();
     d.built = true;
+    const double seconds = rebuild.stop();
+    if (first) {
+      runStats_.setupSeconds += seconds;
+    } else {
+      runStats_.rebuildSeconds += seconds;
+      ++runStats_.rebuilds;
+    }
   }
 
   solve.start();
-  // Right-hand sides (design note): b_r = h (f_ext(t) - f_int(u_0) - (D + t K) v_0), t = r hS.
-  const Eigen::VectorXd stiffVelocity = d.stiffness * v0;
-  Eigen::VectorXd dampVelocity;
-  if (damped) dampVelocity = alpha * (system_.mass * v0) + beta * stiffVelocity;
-  // The state-dependent part, once per large step: f_int(u_0) + D v_0 (full vector).
-  Eigen::VectorXd stateForce = d.internalForce;
-  if (damped) stateForce += dampVelocity;
-  Eigen::VectorXd externalForce, predicted;
   const std::vector<int>& large = partition_.largeDofs();
   const int numRegions = partition_.numRegions();
-  std::vector<Eigen::MatrixXd> rhsS(static_cast<std::size_t>(numRegions));  // |S| x m, column r-1 = b_r
+  // Right-hand sides (A4): b_r = hS (f_ext(t) - f_int(u_0) - (D + t K) v_0), t = r hS.
+  const bool rowProducts = d.linear && d.symmetricStiffness;
+  if (damped && alpha != 0.0) {
+    d.massVelocity.resize(u0.size());
+    d.massVelocity.noalias() = system_.mass * v0;
+  }
+  if (!rowProducts) {
+    d.stiffVelocity.resize(u0.size());
+    d.stiffVelocity.noalias() = d.stiffness * v0;
+    // The state-dependent part, once per large step: f_int(u_0) + D v_0.
+    d.stateForce = d.internalForce;
+    if (damped) {
+      if (alpha != 0.0) d.stateForce += alpha * d.massVelocity;
+      d.stateForce += beta * d.stiffVelocity;
+    }
+  } else {
+    d.work = u0 + (beta + hL) * v0;
+  }
+  // External forces, evaluated in this thread (the callback need not be thread-safe): once
+  // per distinct time of the step, shared by regions whose substeps fall on it; with the
+  // substep state prediction, once per substep and region.
+  d.forcesUsed = 0;
+  const auto forceAt = [&](double time, const Eigen::VectorXd& u) -> const Eigen::VectorXd& {
+    if (&u == &u0) {
+      for (std::size_t k = 0; k < d.forcesUsed; ++k)
+        if (d.forceTimes[k] == time) return d.forceValues[k];
+    }
+    if (d.forcesUsed == d.forceValues.size()) {
+      d.forceValues.emplace_back();
+      d.forceTimes.push_back(0.0);
+    }
+    Eigen::VectorXd& f = d.forceValues[d.forcesUsed];
+    d.forceTimes[d.forcesUsed] = &u == &u0 ? time : std::nan("");  // predicted states are never shared
+    ++d.forcesUsed;
+    f.setZero(u0.size());
+    system_.externalForce(time, u, v0, f);
+    return f;
+  };
+  const bool hasExternal = static_cast<bool>(system_.externalForce);
   for (int i = 0; i < numRegions; ++i) {
-    const RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& s = partition_.regionDofs(i);
-    Eigen::MatrixXd& b = rhsS[static_cast<std::size_t>(i)];
-    b.resize(static_cast<Eigen::Index>(s.size()), rb.ratio);
+    const auto sizeS = static_cast<Eigen::Index>(s.size());
+    rb.external.resize(sizeS, rb.ratio);
+    if (!hasExternal) {
+      rb.external.setZero();
+      continue;
+    }
     for (int r = 1; r <= rb.ratio; ++r) {
-      const double tau = r * rb.smallStep;
-      if (options_.substepStatePrediction && system_.externalForce) {
-        predicted = u0 + tau * v0;
-        externalForce.setZero(u0.size());
-        system_.externalForce(substepTime(r, rb.ratio, rb.smallStep), predicted, v0, externalForce);
+      const double time = substepTime(r, rb.ratio, rb.smallStep);
+      const Eigen::VectorXd* f = nullptr;
+      if (options_.substepStatePrediction) {
+        d.predicted = u0 + (r * rb.smallStep) * v0;
+        f = &forceAt(time, d.predicted);
       } else {
-        evaluateExternalForce(substepTime(r, rb.ratio, rb.smallStep), externalForce);
+        f = &forceAt(time, u0);
       }
-      for (std::size_t k = 0; k < s.size(); ++k) {
-        const int dof = s[k];
-        b(static_cast<Eigen::Index>(k), r - 1) =
-            rb.smallStep * (externalForce[dof] - stateForce[dof] - tau * stiffVelocity[dof]);
-      }
+      for (Eigen::Index k = 0; k < sizeS; ++k) rb.external(k, r - 1) = (*f)[s[static_cast<std::size_t>(k)]];
     }
   }
-  evaluateExternalForce(t1, externalForce);
-  Eigen::VectorXd rhsL(static_cast<Eigen::Index>(large.size()));
+  const Eigen::VectorXd* externalL = hasExternal ? &forceAt(t1, u0) : nullptr;
+  d.rhsL.resize(static_cast<Eigen::Index>(large.size()));
   for (std::size_t k = 0; k < large.size(); ++k) {
     const int dof = large[k];
-    rhsL[static_cast<Eigen::Index>(k)] = hL * (externalForce[dof] - stateForce[dof] - hL * stiffVelocity[dof]);
+    const double external = externalL ? (*externalL)[dof] : 0.0;
+    // hL (f_ext - f_int(u_0) - D v_0) - hL^2 K v_0; linear: hL (f_ext - alpha M v_0 - K (u_0 + (beta + hL) v_0)).
+    const double state =
+        rowProducts ? columnDot(d.stiffness, dof, d.work) + (damped && alpha != 0.0 ? alpha * d.massVelocity[dof] : 0.0)
+                    : d.stateForce[dof] + hL * d.stiffVelocity[dof];
+    d.rhsL[static_cast<Eigen::Index>(k)] = hL * (external - state);
   }
   // Stable coupling: b^L += (1 - theta) hL^2 (K^{IS} v^S_0 + K_I^{II} v^I_0) (Eq. A12).
   for (int i = 0; i < numRegions && options_.coupling == AsyncCoupling::stable; ++i) {
-    const RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& pos = partition_.interfacePositions(i);
     if (pos.empty()) continue;
-    const Eigen::VectorXd correction =
-        rb.coupling.interfaceWeight * (rb.Kis * gather(v0, partition_.regionDofs(i)) +
-                                       rb.interfaceStiffness * gather(v0, partition_.interfaceDofs(i)));
-    for (std::size_t k = 0; k < pos.size(); ++k) rhsL[pos[k]] += correction[static_cast<Eigen::Index>(k)];
+    const std::vector<int>& s = partition_.regionDofs(i);
+    const std::vector<int>& iface = partition_.interfaceDofs(i);
+    rb.xSum.resize(static_cast<Eigen::Index>(s.size()));  // scratch: v^S_0
+    for (std::size_t k = 0; k < s.size(); ++k) rb.xSum[static_cast<Eigen::Index>(k)] = v0[s[k]];
+    rb.yInterface.resize(static_cast<Eigen::Index>(iface.size()));  // scratch: v^I_0
+    for (std::size_t k = 0; k < iface.size(); ++k) rb.yInterface[static_cast<Eigen::Index>(k)] = v0[iface[k]];
+    rb.interfaceRow.resize(static_cast<Eigen::Index>(pos.size()));
+    rb.interfaceRow.noalias() = rb.Kis * rb.xSum;
+    rb.interfaceRow.noalias() += rb.interfaceStiffness * rb.yInterface;
+    for (std::size_t k = 0; k < pos.size(); ++k)
+      d.rhsL[pos[k]] += rb.coupling.interfaceWeight * rb.interfaceRow[static_cast<Eigen::Index>(k)];
   }
+  // Every region's b^S (|S| x m) from its DOFs only.
+  parallelTasks(numRegions, threads, [&](int i) {
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    const std::vector<int>& s = partition_.regionDofs(i);
+    rb.rhs.resize(static_cast<Eigen::Index>(s.size()), rb.ratio);
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      const int dof = s[k];
+      const auto row = static_cast<Eigen::Index>(k);
+      double state = 0.0, stiffVelocity = 0.0;  // (f_int(u_0) + D v_0)_dof and (K v_0)_dof
+      if (rowProducts) {
+        stiffVelocity = columnDot(d.stiffness, dof, v0);
+        state = columnDot(d.stiffness, dof, u0) + beta * stiffVelocity +
+                (damped && alpha != 0.0 ? alpha * d.massVelocity[dof] : 0.0);
+      } else {
+        stiffVelocity = d.stiffVelocity[dof];
+        state = d.stateForce[dof];
+      }
+      for (int r = 1; r <= rb.ratio; ++r) {
+        const double tau = r * rb.smallStep;
+        rb.rhs(row, r - 1) = rb.smallStep * (rb.external(row, r - 1) - state - tau * stiffVelocity);
+      }
+    }
+  });
 
-  // Solve for X (per region, |S| x m) and Y.
-  std::vector<Eigen::MatrixXd> X(static_cast<std::size_t>(numRegions));
-  Eigen::VectorXd Y;
   if (options_.method == AsyncSolveMethod::naive) {
     Eigen::VectorXd rhs(d.naiveSystem.rows());
     for (int i = 0; i < numRegions; ++i) {
-      const Eigen::MatrixXd& b = rhsS[static_cast<std::size_t>(i)];
+      const Eigen::MatrixXd& b = d.regions[static_cast<std::size_t>(i)].rhs;
       rhs.segment(d.naiveOffsets[static_cast<std::size_t>(i)], b.size()) =
           Eigen::Map<const Eigen::VectorXd>(b.data(), b.size());
     }
-    rhs.tail(rhsL.size()) = rhsL;
+    rhs.tail(d.rhsL.size()) = d.rhsL;
     const Eigen::VectorXd sol = d.naiveSolver->solve(rhs);
     for (int i = 0; i < numRegions; ++i) {
-      const Eigen::MatrixXd& b = rhsS[static_cast<std::size_t>(i)];
-      X[static_cast<std::size_t>(i)] = Eigen::Map<const Eigen::MatrixXd>(
-          sol.data() + d.naiveOffsets[static_cast<std::size_t>(i)], b.rows(), b.cols());
+      RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+      rb.x = Eigen::Map<const Eigen::MatrixXd>(sol.data() + d.naiveOffsets[static_cast<std::size_t>(i)], rb.rhs.rows(),
+                                               rb.rhs.cols());
+      rb.substituted = true;
     }
-    Y = sol.tail(rhsL.size());
+    d.Y = sol.tail(d.rhsL.size());
   } else {
-    // Forward substitution with H^{SS} (Eq. A13): A^S x_r = b_r + M^{SS} x_{r-1} - G sum_{i<r} x_i.
-    // G sum_{i<r} x_i is a running sum; M^{SS} x_{r-1} and G x_{r-1} are taken in one pass
-    // over their shared pattern, into buffers kept across steps (no allocation per substep).
-    auto forwardSubstitute = [&](RegionBlocks& rb, const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
-      const Eigen::Index size = b.rows();
-      x.resize(size, b.cols());
-      rb.runningStiffness.setZero(size);
-      rb.substepRhs.resize(size);
-      for (int r = 1; r <= rb.ratio; ++r) {
-        if (r == 1) {
-          rb.substepRhs = b.col(0);
-        } else {
-          if (rb.massAndGSharePattern) {
-            fusedColumnProducts(rb, x.col(r - 2).data(), rb.substepRhs.data(), rb.runningStiffness.data());
-          } else {
-            rb.substepRhs.noalias() = rb.Mss * x.col(r - 2);
-            rb.runningStiffness.noalias() += rb.G * x.col(r - 2);
-          }
-          rb.substepRhs += b.col(r - 1) - rb.runningStiffness;
-        }
-        rb.solver->solve(rb.substepRhs, rb.substepSolution);
-        x.col(r - 1) = rb.substepSolution.col(0);
-      }
-    };
-    std::vector<Eigen::MatrixXd> y(static_cast<std::size_t>(numRegions));
-    Eigen::VectorXd rhsSchur = rhsL;
-    for (int i = 0; i < numRegions; ++i) {
+    // Forward substitution y = (H^{SS})^{-1} b^S per region (in parallel: each region owns
+    // its solver), and the region's term of b^{L*} = b^L - H^{LS} y on its interface rows:
+    // sum_r E_r y_r = M^{IS} (y eM) + D^{IS} (y eD) + K^{IS} (y eK) (Eq. A7).
+    parallelTasks(numRegions, threads, [&](int i) {
       RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
-      Eigen::MatrixXd& yi = y[static_cast<std::size_t>(i)];
-      forwardSubstitute(rb, rhsS[static_cast<std::size_t>(i)], yi);
-      if (rb.Mis.rows() == 0) continue;
-      // b^{L*} = b^L - H^{LS} y = b^L - sum_r E_r y_r on the interface rows (Eq. A7).
+      forwardSubstitute(rb, rb.rhs, rb.y);
+      if (rb.Mis.rows() == 0) return;
       const CouplingCoefficients& k = rb.coupling;
-      const Eigen::VectorXd coupling =
-          applyInterfaceRow(rb, damped, yi * k.eM, damped ? Eigen::VectorXd(yi * k.eD) : Eigen::VectorXd(), yi * k.eK);
-      const std::vector<int>& pos = partition_.interfacePositions(i);
-      for (std::size_t k = 0; k < pos.size(); ++k) rhsSchur[pos[k]] -= coupling[static_cast<Eigen::Index>(k)];
-    }
-    Y = large.empty() ? Eigen::VectorXd() : solveSchur(rhsSchur);
+      weightedColumnSum(rb.y, k.eM, rb.weightedM);
+      weightedColumnSum(rb.y, k.eK, rb.weightedK);
+      rb.interfaceRow.resize(rb.Mis.rows());
+      rb.interfaceRow.noalias() = rb.Mis * rb.weightedM;
+      rb.interfaceRow.noalias() += rb.Kis * rb.weightedK;
+      if (damped) {
+        weightedColumnSum(rb.y, k.eD, rb.weightedD);
+        rb.interfaceRow.noalias() += rb.Dis * rb.weightedD;
+      }
+    });
+    d.rhsSchur = d.rhsL;
     for (int i = 0; i < numRegions; ++i) {
+      const RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+      const std::vector<int>& pos = partition_.interfacePositions(i);
+      for (std::size_t k = 0; k < pos.size(); ++k) d.rhsSchur[pos[k]] -= rb.interfaceRow[static_cast<Eigen::Index>(k)];
+    }
+    if (large.empty()) {
+      d.Y.resize(0);
+    } else if (!d.schurStale) {
+      solveSchur(d.rhsSchur, d.Y);
+    } else if (!iterativeSchur(d.rhsSchur, d.Y)) {
+      // The old factor no longer preconditions well enough: rebuild now (exact solve).
+      Stopwatch rebuild;
+      fullSchurRebuild();
+      runStats_.rebuildSeconds += rebuild.stop();
+      solveSchur(d.rhsSchur, d.Y);
+    }
+    // Recovery per region (in parallel): X_m and sum_r X_r from the stored Z_m, sum_r Z_r,
+    // or every X_r by a second forward substitution with b^S - H^{SL} Y.
+    parallelTasks(numRegions, threads, [&](int i) {
       RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
-      Eigen::MatrixXd& xi = X[static_cast<std::size_t>(i)];
       const std::vector<int>& pos = partition_.interfacePositions(i);
       if (pos.empty()) {
-        xi = y[static_cast<std::size_t>(i)];
-        continue;
+        std::swap(rb.x, rb.y);
+        rb.substituted = true;
+        return;
       }
-      Eigen::VectorXd yInterface(static_cast<Eigen::Index>(pos.size()));
-      for (std::size_t k = 0; k < pos.size(); ++k) yInterface[static_cast<Eigen::Index>(k)] = Y[pos[k]];
-      if (rb.useDenseZ) {
-        xi = y[static_cast<std::size_t>(i)];
-        for (int r = 1; r <= rb.ratio; ++r) xi.col(r - 1) -= rb.z[static_cast<std::size_t>(r - 1)] * yInterface;
-      } else {
-        // X = (H^{SS})^{-1} (b^S - H^{SL} Y), block r of H^{SL} Y = B_r Y_I.
-        const CouplingCoefficients& k = rb.coupling;
-        const Eigen::VectorXd mY = rb.Msi * yInterface, kY = rb.Ksi * yInterface;
-        Eigen::VectorXd dY;
-        if (damped) dY = rb.Dsi * yInterface;
-        Eigen::MatrixXd b = rhsS[static_cast<std::size_t>(i)];
-        for (int r = 1; r <= rb.ratio; ++r) {
-          b.col(r - 1) -= k.bM[r - 1] * mY + k.bK[r - 1] * kY;
-          if (damped) b.col(r - 1) -= k.bD[r - 1] * dY;
-        }
-        forwardSubstitute(rb, b, xi);
+      rb.yInterface.resize(static_cast<Eigen::Index>(pos.size()));
+      for (std::size_t k = 0; k < pos.size(); ++k) rb.yInterface[static_cast<Eigen::Index>(k)] = d.Y[pos[k]];
+      if (rb.useDenseZ && !observer_ && !d.schurStale) {
+        rb.xLast = rb.y.col(rb.ratio - 1);
+        rb.xLast.noalias() -= rb.zLast * rb.yInterface;
+        rb.xSum = rb.y.rowwise().sum();
+        rb.xSum.noalias() -= rb.zSum * rb.yInterface;
+        rb.substituted = false;
+        return;
       }
-    }
+      // X = (H^{SS})^{-1} (b^S - H^{SL} Y), block r of H^{SL} Y = B_r Y_I.
+      const CouplingCoefficients& k = rb.coupling;
+      rb.massY.noalias() = rb.Msi * rb.yInterface;
+      rb.stiffY.noalias() = rb.Ksi * rb.yInterface;
+      if (damped) rb.dampY.noalias() = rb.Dsi * rb.yInterface;
+      for (int r = 1; r <= rb.ratio; ++r) {
+        rb.rhs.col(r - 1) -= k.bM[r - 1] * rb.massY + k.bK[r - 1] * rb.stiffY;
+        if (damped) rb.rhs.col(r - 1) -= k.bD[r - 1] * rb.dampY;
+      }
+      forwardSubstitute(rb, rb.rhs, rb.x);
+      rb.substituted = true;
+    });
   }
 
   // New state: v^S_r = v^S_0 + X_r, u^S_m = u^S_0 + hS sum_r v^S_r; v^L = v^L_0 + Y, u^L = u^L_0 + hL v^L.
-  Eigen::VectorXd newU = u0, newV = v0;
+  d.newU = u0;
+  d.newV = v0;
   for (int i = 0; i < numRegions; ++i) {
-    const RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& s = partition_.regionDofs(i);
-    const Eigen::MatrixXd& xi = X[static_cast<std::size_t>(i)];
-    const Eigen::VectorXd vS0 = gather(v0, s), uS0 = gather(u0, s);
-    Eigen::VectorXd xSum = Eigen::VectorXd::Zero(xi.rows());
-    for (int r = 1; r <= rb.ratio; ++r) {
-      xSum += xi.col(r - 1);
-      if (observer_) {
-        const Eigen::VectorXd uS = uS0 + rb.smallStep * (double(r) * vS0 + xSum);
-        const Eigen::VectorXd vS = vS0 + xi.col(r - 1);
-        observer_(i, r, substepTime(r, rb.ratio, rb.smallStep), uS, vS);
-      }
+    const int m = rb.ratio;
+    if (rb.substituted) {
+      rb.xLast = rb.x.col(m - 1);
+      rb.xSum = rb.x.rowwise().sum();
     }
-    const Eigen::VectorXd vS = vS0 + xi.col(rb.ratio - 1);
-    const Eigen::VectorXd uS = uS0 + rb.smallStep * (double(rb.ratio) * vS0 + xSum);
     for (std::size_t k = 0; k < s.size(); ++k) {
-      newV[s[k]] = vS[static_cast<Eigen::Index>(k)];
-      newU[s[k]] = uS[static_cast<Eigen::Index>(k)];
+      const auto row = static_cast<Eigen::Index>(k);
+      d.newV[s[k]] = v0[s[k]] + rb.xLast[row];
+      d.newU[s[k]] = u0[s[k]] + rb.smallStep * (m * v0[s[k]] + rb.xSum[row]);
+    }
+    if (observer_) {
+      // Substep states, only for an installed observer (x then holds every substep).
+      const Eigen::VectorXd vS0 = gather(v0, s), uS0 = gather(u0, s);
+      Eigen::VectorXd running = Eigen::VectorXd::Zero(rb.x.rows());
+      for (int r = 1; r <= m; ++r) {
+        running += rb.x.col(r - 1);
+        const Eigen::VectorXd uS = uS0 + rb.smallStep * (double(r) * vS0 + running);
+        const Eigen::VectorXd vS = vS0 + rb.x.col(r - 1);
+        observer_(i, r, substepTime(r, m, rb.smallStep), uS, vS);
+      }
     }
   }
   for (std::size_t k = 0; k < large.size(); ++k) {
-    newV[large[k]] = v0[large[k]] + Y[static_cast<Eigen::Index>(k)];
-    newU[large[k]] = u0[large[k]] + hL * newV[large[k]];
+    d.newV[large[k]] = v0[large[k]] + d.Y[static_cast<Eigen::Index>(k)];
+    d.newU[large[k]] = u0[large[k]] + hL * d.newV[large[k]];
   }
   stats_.solveSeconds += solve.stop();
 
-  detail::checkFiniteState("async", newU, newV, t1);
-  displacement_ = std::move(newU);
-  velocity_ = std::move(newV);
+  detail::checkFiniteState("async", d.newU, d.newV, t1);
+  std::swap(displacement_, d.newU);
+  std::swap(velocity_, d.newV);
   advanceTime();
   ++stats_.steps;
   // Solve counts and flops, totalled over the solvers (Z columns included).
@@ -870,7 +1184,100 @@ void AsyncBackwardEuler::step() {
   stats_.solveFlops = 0.0;
   detail::addSolveCounts(*d.naiveSolver, stats_);
   if (d.schurSolver) detail::addSolveCounts(*d.schurSolver, stats_);
-  for (const RegionBlocks& rb : d.regions) detail::addSolveCounts(*rb.solver, stats_);
+  for (const RegionBlocks& rb : d.regions) {
+    detail::addSolveCounts(*rb.solver, stats_);
+    for (const auto& helper : rb.helperSolvers) detail::addSolveCounts(*helper, stats_);
+  }
+  ++runStats_.steps;
+  runStats_.stepSeconds += whole.stop() - (runStats_.setupSeconds + runStats_.rebuildSeconds - rebuildBefore);
+}
+
+// out = H^{LL*} y for the current blocks: A-hat^L y minus, per region, the interface rows
+// of H^{LS} (H^{SS})^{-1} H^{SL} y (one forward substitution per region).
+void AsyncBackwardEuler::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out) {
+  Impl& d = *impl_;
+  const bool damped = system_.damped();
+  out.resize(y.size());
+  out.noalias() = d.largeSystem * y;
+  const int numRegions = partition_.numRegions();
+  parallelTasks(numRegions, threadBudget(options_.threads), [&](int i) {
+    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    const std::vector<int>& pos = partition_.interfacePositions(i);
+    if (pos.empty()) return;
+    rb.yInterface.resize(static_cast<Eigen::Index>(pos.size()));
+    for (std::size_t k = 0; k < pos.size(); ++k) rb.yInterface[static_cast<Eigen::Index>(k)] = y[pos[k]];
+    const CouplingCoefficients& k = rb.coupling;
+    rb.massY.noalias() = rb.Msi * rb.yInterface;
+    rb.stiffY.noalias() = rb.Ksi * rb.yInterface;
+    if (damped) rb.dampY.noalias() = rb.Dsi * rb.yInterface;
+    rb.probe.resize(rb.massY.size(), rb.ratio);
+    for (int r = 1; r <= rb.ratio; ++r) {
+      rb.probe.col(r - 1) = k.bM[r - 1] * rb.massY + k.bK[r - 1] * rb.stiffY;
+      if (damped) rb.probe.col(r - 1) += k.bD[r - 1] * rb.dampY;
+    }
+    forwardSubstitute(rb, rb.probe, rb.probeSolution);
+    weightedColumnSum(rb.probeSolution, k.eM, rb.weightedM);
+    weightedColumnSum(rb.probeSolution, k.eK, rb.weightedK);
+    rb.interfaceRow.noalias() = rb.Mis * rb.weightedM;
+    rb.interfaceRow.noalias() += rb.Kis * rb.weightedK;
+    if (damped) {
+      weightedColumnSum(rb.probeSolution, k.eD, rb.weightedD);
+      rb.interfaceRow.noalias() += rb.Dis * rb.weightedD;
+    }
+  });
+  for (int i = 0; i < numRegions; ++i) {
+    const std::vector<int>& pos = partition_.interfacePositions(i);
+    const RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+    for (std::size_t k = 0; k < pos.size(); ++k) out[pos[k]] -= rb.interfaceRow[static_cast<Eigen::Index>(k)];
+  }
+}
+
+// H^{LL*} Y = rhs with the factor of the last full rebuild as preconditioner
+// (AsyncOptions::laggedSchur): conjugate gradients for the stable coupling, whose H^{LL*}
+// is symmetric, iterative refinement for the paper's. Returns false when it did not reach
+// the tolerance.
+bool AsyncBackwardEuler::iterativeSchur(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  Impl& d = *impl_;
+  const double scale = rhs.norm();
+  solveSchur(rhs, solution);
+  if (scale == 0.0) return true;
+  const bool conjugate = options_.coupling == AsyncCoupling::stable;
+  applySchur(solution, d.schurProduct);
+  d.schurResidual = rhs - d.schurProduct;  // r
+  Eigen::VectorXd& direction = d.schurDirection;
+  double rz = 0.0;
+  for (int iteration = 1; iteration <= options_.laggedSchurIterations; ++iteration) {
+    const double residual = d.schurResidual.norm() / scale;
+    if (!std::isfinite(residual)) return false;
+    if (residual <= options_.laggedSchurTolerance) {
+      ++runStats_.laggedSteps;
+      runStats_.largestSchurResidual = std::max(runStats_.largestSchurResidual, residual);
+      d.refreshNext = iteration > options_.laggedSchurIterations / 2;  // slow: the next step rebuilds
+      return true;
+    }
+    ++runStats_.schurIterations;
+    solveSchur(d.schurResidual, d.schurCorrection);  // z = P^{-1} r
+    if (!conjugate) {
+      solution += d.schurCorrection;
+      applySchur(solution, d.schurProduct);
+      d.schurResidual = rhs - d.schurProduct;
+      continue;
+    }
+    const double rzNew = d.schurResidual.dot(d.schurCorrection);
+    if (iteration == 1) {
+      direction = d.schurCorrection;
+    } else {
+      direction = d.schurCorrection + (rzNew / rz) * direction;
+    }
+    rz = rzNew;
+    applySchur(direction, d.schurProduct);
+    const double curvature = direction.dot(d.schurProduct);
+    if (!(curvature > 0.0)) return false;
+    const double step = rz / curvature;
+    solution += step * direction;
+    d.schurResidual -= step * d.schurProduct;
+  }
+  return false;
 }
 
 double AsyncBackwardEuler::solveFloorSeconds(int repeats) {
@@ -883,7 +1290,8 @@ double AsyncBackwardEuler::solveFloorSeconds(int repeats) {
       d.naiveSolver->solve(Eigen::VectorXd::Random(d.naiveSystem.rows()));
     } else {
       for (RegionBlocks& rb : d.regions) {
-        const int solves = rb.useDenseZ ? rb.ratio : 2 * rb.ratio;
+        const bool dense = rb.useDenseZ || rb.Msi.cols() == 0;
+        const int solves = dense ? rb.ratio : 2 * rb.ratio;
         const Eigen::VectorXd rhs = Eigen::VectorXd::Random(rb.systemMatrix.rows());
         for (int r = 0; r < solves; ++r) rb.solver->solve(rhs);
       }

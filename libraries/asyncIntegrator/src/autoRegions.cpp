@@ -5,6 +5,8 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>
+#include <cstdio>
+#include <iterator>
 #include <numeric>
 #include <string>
 
@@ -163,13 +165,133 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
     r.region.name = "auto" + std::to_string(proposal.regions.size() + 1);
     proposal.regions.push_back(std::move(r));
   }
+  // Cap: keep the regions that need the largest ratios (then the largest ones); every
+  // region costs its own factor, Z and interface block.
+  if (static_cast<int>(proposal.regions.size()) > std::max(options.maxRegions, 0)) {
+    std::stable_sort(proposal.regions.begin(), proposal.regions.end(),
+                     [](const ProposedRegion& a, const ProposedRegion& b) {
+                       if (a.region.ratio != b.region.ratio) return a.region.ratio > b.region.ratio;
+                       return a.region.vertices.size() > b.region.vertices.size();
+                     });
+    const auto keep = static_cast<std::ptrdiff_t>(std::max(options.maxRegions, 0));
+    proposal.cappedRegions.assign(std::make_move_iterator(proposal.regions.begin() + keep),
+                                  std::make_move_iterator(proposal.regions.end()));
+    proposal.regions.erase(proposal.regions.begin() + keep, proposal.regions.end());
+    for (std::size_t i = 0; i < proposal.regions.size(); ++i)
+      proposal.regions[i].region.name = "auto" + std::to_string(i + 1);
+  }
   // Interface sizes, from the partition the proposal defines.
   const RegionPartition partition(mesh, freeDofs, proposal.asyncRegions());
   for (int i = 0; i < partition.numRegions(); ++i) {
     proposal.regions[static_cast<std::size_t>(i)].numInterfaceDofs =
         static_cast<int>(partition.interfaceDofs(i).size());
   }
+  if (options.costCheck && !proposal.regions.empty()) {
+    proposal.cost = estimateAsyncCost(mesh, freeDofs, proposal.asyncRegions(), options.nonlinear, options.costMargin);
+    if (!proposal.cost.asyncCheaper) {
+      proposal.costWithdrawnRegions = std::move(proposal.regions);
+      proposal.regions.clear();
+    }
+  }
   return proposal;
+}
+
+namespace {
+
+/// Estimated non-zeros of a Cholesky factor of the stiffness-like matrix of n DOFs of a 3D
+/// tet mesh whose own pattern has `entries` non-zeros (nested dissection: ~ n^{4/3}).
+double factorEntries(double n, double entries) {
+  constexpr double kFactorFill = 3.0;
+  return std::max(0.5 * (entries + n), kFactorFill * std::pow(std::max(n, 0.0), 4.0 / 3.0));
+}
+double solveFlops(double factor) { return 4.0 * factor; }
+double factorFlops(double factor, double n) { return n > 0.0 ? 2.0 * factor * factor / n : 0.0; }
+
+}  // namespace
+
+AutoRegionCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs, const std::vector<AsyncRegion>& regions,
+                                 bool nonlinear, double costMargin) {
+  AutoRegionCost cost;
+  cost.evaluated = true;
+  const RegionPartition partition(mesh, freeDofs, regions);
+  const int nv = mesh.numVertices();
+  // Free DOFs per vertex, and the stiffness pattern's non-zeros inside each region and in L
+  // (3 x 3 blocks of vertex pairs that share an element, the diagonal included).
+  std::vector<int> freeOf(static_cast<std::size_t>(nv), 0);
+  for (int v = 0; v < nv; ++v)
+    for (int c = 0; c < 3; ++c) freeOf[static_cast<std::size_t>(v)] += freeDofs.isFixed(3 * v + c) ? 0 : 1;
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(static_cast<std::size_t>(6 * mesh.numElements()));
+  for (int e = 0; e < mesh.numElements(); ++e)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) {
+        const int x = mesh.elements()(a, e), y = mesh.elements()(b, e);
+        edges.emplace_back(std::min(x, y), std::max(x, y));
+      }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  const std::vector<int>& regionOf = partition.vertexRegion();
+  const int numRegions = partition.numRegions();
+  std::vector<double> entries(static_cast<std::size_t>(numRegions) + 1, 0.0);  // last: L
+  const auto slot = [&](int v) {
+    const int r = regionOf[static_cast<std::size_t>(v)];
+    return static_cast<std::size_t>(r < 0 ? numRegions : r);
+  };
+  double allEntries = 0.0;
+  for (int v = 0; v < nv; ++v) {
+    const double block = double(freeOf[static_cast<std::size_t>(v)]) * freeOf[static_cast<std::size_t>(v)];
+    entries[slot(v)] += block;
+    allEntries += block;
+  }
+  for (const auto& [x, y] : edges) {
+    const double block = 2.0 * freeOf[static_cast<std::size_t>(x)] * freeOf[static_cast<std::size_t>(y)];
+    allEntries += block;
+    if (slot(x) == slot(y)) entries[slot(x)] += block;
+  }
+  const double n = freeDofs.numFree();
+  const double nL = static_cast<double>(partition.largeDofs().size());
+  cost.freeDofs = freeDofs.numFree();
+  cost.largeDofs = static_cast<int>(nL);
+  // Single-rate: one back-substitution (plus the K v and f_int products) per step;
+  // nonlinear: a numeric factorization too.
+  const double fullFactor = factorEntries(n, allEntries);
+  const double singleStep = solveFlops(fullFactor) + 4.0 * allEntries + (nonlinear ? factorFlops(fullFactor, n) : 0.0);
+  int maxRatio = 1;
+  for (int i = 0; i < numRegions; ++i) maxRatio = std::max(maxRatio, partition.ratio(i));
+  cost.singleRateSubsteps = maxRatio;
+  cost.singleRateFlops = maxRatio * singleStep;
+  cost.singleRateSetupFlops = factorFlops(fullFactor, n);
+  // Async: H^{LL*} is A^L plus a dense I_i x I_i block per region (q_i^2 / 2 more factor
+  // entries); per region m_i forward-substitution solves, and the recovery (a second
+  // forward substitution or the dense 4 |S| q products, whichever is cheaper).
+  double interfaceBlock = 0.0, zSolves = 0.0, regionFactorFlops = 0.0, regionSteps = 0.0;
+  for (int i = 0; i < numRegions; ++i) {
+    const double s = static_cast<double>(partition.regionDofs(i).size());
+    const double q = static_cast<double>(partition.interfaceDofs(i).size());
+    const double m = partition.ratio(i);
+    cost.interfaceDofs += static_cast<int>(q);
+    const double factor = factorEntries(s, entries[static_cast<std::size_t>(i)]);
+    const double substitution = m * (solveFlops(factor) + 4.0 * entries[static_cast<std::size_t>(i)]);
+    regionSteps += substitution + std::min(substitution, 4.0 * s * q);
+    interfaceBlock += 0.5 * q * q;
+    zSolves += m * q * (solveFlops(factor) + 4.0 * entries[static_cast<std::size_t>(i)]);
+    regionFactorFlops += factorFlops(factor, s);
+  }
+  const double schurFactor = factorEntries(nL, entries.back()) + interfaceBlock;
+  const double asyncSetup = regionFactorFlops + zSolves + factorFlops(schurFactor, std::max(nL, 1.0));
+  cost.asyncSetupFlops = asyncSetup;
+  cost.asyncFlops = solveFlops(schurFactor) + regionSteps + 4.0 * allEntries + (nonlinear ? asyncSetup : 0.0);
+  cost.asyncCheaper = cost.asyncFlops < costMargin * cost.singleRateFlops;
+  char line[400];
+  std::snprintf(line, sizeof line,
+                "%s: async %.3g Mflop per large step (%d regions, %d interface DOFs, |L| = %d) against %.3g Mflop for "
+                "%d single-rate step%s at hL/%d (ratio %.2f); set-up %.3g against %.3g Mflop",
+                cost.asyncCheaper ? "async regions kept" : "regions withdrawn, single-rate", 1e-6 * cost.asyncFlops,
+                numRegions, cost.interfaceDofs, cost.largeDofs, 1e-6 * cost.singleRateFlops, maxRatio,
+                maxRatio == 1 ? "" : "s", maxRatio, cost.ratio(), 1e-6 * cost.asyncSetupFlops,
+                1e-6 * cost.singleRateSetupFlops);
+  cost.decision = line;
+  return cost;
 }
 
 std::vector<ModalRegion> modalRegions(const std::vector<AsyncRegion>& regions) {

@@ -10,6 +10,14 @@
 //   benchmarkAsync --study corotational
 //                                   nonlinear async vs corotational single-rate at equal cost:
 //                                   retained motion of S (the paper's Figure 8) and time split
+//   benchmarkAsync --study steady --scenes A.json B.json ... [--dragon-spacing H]
+//                                   per scene: set-up, steady-state async step against one
+//                                   single-rate step at hL, and (--corotational) the async
+//                                   frame against corotational single-rate at hS
+//   benchmarkAsync --study steady --only async|single --scenes A.json --steps N
+//                                   one configuration only, for callgrind: the steady steps
+//                                   are the only ones collected (run under
+//                                   valgrind --tool=callgrind --collect-atstart=no)
 #include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -21,8 +29,12 @@
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/integrator/factory.hpp>
+#include <asyncfem/sceneIO/scene.hpp>
+#include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/tetMesher/exampleModels.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/writers.hpp>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -30,6 +42,15 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>
+#define ASYNCFEM_COLLECT_ON() CALLGRIND_TOGGLE_COLLECT
+#define ASYNCFEM_COLLECT_OFF() CALLGRIND_TOGGLE_COLLECT
+#else
+#define ASYNCFEM_COLLECT_ON()
+#define ASYNCFEM_COLLECT_OFF()
+#endif
 
 namespace {
 
@@ -475,6 +496,155 @@ void contactStudy(int cells, int ratio, double hL) {
       initialEnergy, s.contactStiffness, lightest * hL, median * hL, lightest * hL / ratio, median * hL / ratio);
 }
 
+/// A scene for the steady-state study: a file, or "dragon:H:SET:M:HL", the procedural
+/// dragon meshed at spacing H (models/README.md) with the vertex set SET as its one fast
+/// region at ratio M and the large step HL, everything else as models/dragon/dragon.json.
+Scene steadyScene(const std::string& spec, bool corotational) {
+  Scene scene;
+  if (spec.rfind("dragon:", 0) == 0) {
+    std::vector<std::string> parts;
+    std::size_t from = 0;
+    for (std::size_t at; (at = spec.find(':', from)) != std::string::npos; from = at + 1)
+      parts.push_back(spec.substr(from, at - from));
+    parts.push_back(spec.substr(from));
+    if (parts.size() != 5) throw ValidationError("--scenes: expected dragon:SPACING:SET:M:HL, got " + spec);
+    const double spacing = std::stod(parts[1]);
+    const std::string path = "/tmp/benchmarkAsync-dragon-" + parts[1] + ".veg";
+    if (!std::ifstream(path)) writeVeg(path, makeExampleModel(ExampleModel::Dragon, spacing));
+    scene = loadScene("models/dragon/dragon.json");
+    scene.mesh.file = path;
+    scene.integrator.timestep = std::stod(parts[4]);
+    scene.integrator.options["regions"] =
+        nlohmann::json::array({{{"name", parts[2]}, {"ratio", std::stoi(parts[3])}, {"vertexSets", {parts[2]}}}});
+    scene.frames.rate = 1.0 / scene.integrator.timestep;
+    scene.sourceName = "dragon (spacing " + parts[1] + ", S = " + parts[2] + ")";
+  } else {
+    scene = loadScene(spec);
+  }
+  if (corotational) scene.forceModel = Scene::ForceModelKind::corotational;
+  return scene;
+}
+
+struct SteadyRow {
+  std::string name;
+  int vertices = 0, fastVertices = 0, interfaceDofs = 0, ratio = 1;
+  double hL = 0;
+  double setupZ = 0, setupSchur = 0;
+  double setup = 0, asyncStep = 0, asyncMeanStep = 0, singleSetup = 0, singleStep = 0, singleStepHS = 0;
+};
+
+/// Steady state: per scene, the async step (median wall, and the integrator's own mean of
+/// its steady steps) against one single-rate backward Euler step at hL on the same system;
+/// set-up against single-rate steps at hL. With `only`, one configuration and no table
+/// (for callgrind). Corotational: the async large step (rebuild included) against m
+/// corotational single-rate steps at hS.
+void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotational, const std::string& only,
+                 bool collectFirst, bool laggedSchur) {
+  std::vector<SteadyRow> rows;
+  for (const std::string& spec : scenes) {
+    const Scene scene = steadyScene(spec, corotational);
+    Simulation simulation = buildSimulation(scene);
+    auto* async = dynamic_cast<AsyncBackwardEuler*>(simulation.integrator.get());
+    if (async == nullptr) throw ValidationError(spec + ": the scene's integrator is not async");
+    std::unique_ptr<AsyncBackwardEuler> lagged;
+    if (laggedSchur) {
+      // The same scene with AsyncOptions::laggedSchur (not a scene key).
+      AsyncOptions options = async->options();
+      options.laggedSchur = true;
+      std::vector<AsyncRegion> regions;
+      for (int i = 0; i < async->partition().numRegions(); ++i) regions.push_back(async->partition().region(i));
+      lagged =
+          std::make_unique<AsyncBackwardEuler>(*simulation.mesh, async->system(), async->timestep(), regions, options);
+      async = lagged.get();
+    }
+    SteadyRow row;
+    row.name = scene.sourceName;
+    row.vertices = simulation.mesh->numVertices();
+    row.hL = async->timestep();
+    const RegionPartition& partition = async->partition();
+    for (int i = 0; i < partition.numRegions(); ++i) {
+      row.fastVertices += static_cast<int>(partition.region(i).vertices.size());
+      row.ratio = std::max(row.ratio, partition.ratio(i));
+    }
+    row.interfaceDofs = async->runStats().interfaceDofs;
+    const DynamicSystem system = async->system();
+    // Collected for callgrind: the first step (set-up included) with --first, else the
+    // timed steady steps.
+    const auto measure = [&](Integrator& integrator, double* setup) {
+      Stopwatch first;
+      if (!only.empty() && collectFirst) ASYNCFEM_COLLECT_ON();
+      integrator.step();
+      if (!only.empty() && collectFirst) ASYNCFEM_COLLECT_OFF();
+      if (setup) *setup = first.stop();
+      integrator.step();
+      std::vector<double> samples;
+      if (!only.empty() && !collectFirst) ASYNCFEM_COLLECT_ON();
+      for (int k = 0; k < steps; ++k) {
+        Stopwatch watch;
+        integrator.step();
+        samples.push_back(watch.stop());
+      }
+      if (!only.empty() && !collectFirst) ASYNCFEM_COLLECT_OFF();
+      return median(samples);
+    };
+    if (only.empty() || only == "async") {
+      row.asyncStep = measure(*async, &row.setup);
+      row.asyncMeanStep =
+          corotational ? async->runStats().meanStepWithRebuildSeconds() : async->runStats().meanStepSeconds();
+      row.setup = async->runStats().setupSeconds;
+      row.setupZ = async->runStats().setupZSeconds;
+      row.setupSchur = async->runStats().setupSchurSeconds;
+    }
+    if (only.empty() || only == "single") {
+      // Single-rate factors in its constructor: its set-up is construction + first step.
+      Stopwatch construction;
+      if (!only.empty() && collectFirst) ASYNCFEM_COLLECT_ON();
+      auto single = makeIntegrator("backward-euler", system, row.hL);
+      if (!only.empty() && collectFirst) ASYNCFEM_COLLECT_OFF();
+      const double constructionSeconds = construction.stop();
+      row.singleStep = measure(*single, &row.singleSetup);
+      row.singleSetup += constructionSeconds;
+    }
+    if ((only.empty() && corotational) || only == "single-hs") {
+      auto small = makeIntegrator("backward-euler", system, row.hL / row.ratio);
+      row.singleStepHS = measure(*small, nullptr) * row.ratio;
+    }
+    if (!only.empty()) {
+      const double perStep = only == "async" ? row.asyncStep : only == "single" ? row.singleStep : row.singleStepHS;
+      std::printf("%s: %s, %d steps collected, m = %d: %.3f ms per step (median; single-hs: per m steps)\n",
+                  row.name.c_str(), only.c_str(), steps, row.ratio, 1e3 * perStep);
+      continue;
+    }
+    rows.push_back(row);
+  }
+  if (!only.empty()) return;
+  std::printf("### Steady state: async against single-rate backward Euler (%s forces, %d timed steps)\n\n",
+              corotational ? "corotational" : "linear", steps);
+  if (!corotational) {
+    std::printf(
+        "| scene | vertices | S vertices (%%) | interface DOFs | m | hL | async ms/step | single-rate hL ms/step | "
+        "ratio | async set-up ms (Z, H^{LL*}) | single-rate set-up ms | set-up / single-rate step |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (const SteadyRow& r : rows)
+      std::printf("| %s | %d | %d (%.1f%%) | %d | %d | %.4g | %.3f | %.3f | %.2f | %.1f (%.1f, %.1f) | %.1f | %.1f |\n",
+                  r.name.c_str(), r.vertices, r.fastVertices, 100.0 * r.fastVertices / r.vertices, r.interfaceDofs,
+                  r.ratio, r.hL, 1e3 * r.asyncStep, 1e3 * r.singleStep, r.asyncStep / r.singleStep, 1e3 * r.setup,
+                  1e3 * r.setupZ, 1e3 * r.setupSchur, 1e3 * r.singleSetup, r.setup / r.singleStep);
+  } else {
+    std::printf("%s", laggedSchur ? "With AsyncOptions::laggedSchur.\n\n" : "");
+    std::printf(
+        "| scene | vertices | S vertices (%%) | interface DOFs | m | async ms/large step | single-rate hL ms/step | "
+        "single-rate hS ms per hL | async / single-rate hS | async set-up ms "
+        "|\n|---|---|---|---|---|---|---|---|---|---|\n");
+    for (const SteadyRow& r : rows)
+      std::printf("| %s | %d | %d (%.1f%%) | %d | %d | %.3f | %.3f | %.3f | %.2f | %.1f |\n", r.name.c_str(),
+                  r.vertices, r.fastVertices, 100.0 * r.fastVertices / r.vertices, r.interfaceDofs, r.ratio,
+                  1e3 * r.asyncStep, 1e3 * r.singleStep, 1e3 * r.singleStepHS, r.asyncStep / r.singleStepHS,
+                  1e3 * r.setup);
+  }
+  std::printf("\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -483,8 +653,17 @@ int main(int argc, char** argv) {
   std::string study = "all";
   int cells = 40, ratioCells = 20, ratio = 8, steps = 20, maxNaiveRatio = 64;
   double hL = 5e-3;
-  app.add_option("--study", study, "growth | ratio | schur | corotational | contact | all")
-      ->check(CLI::IsMember({"growth", "ratio", "schur", "corotational", "contact", "all"}));
+  std::vector<std::string> scenes;
+  std::string only;
+  bool corotational = false, collectFirst = false, laggedSchur = false;
+  app.add_option("--study", study, "growth | ratio | schur | corotational | contact | steady | all")
+      ->check(CLI::IsMember({"growth", "ratio", "schur", "corotational", "contact", "steady", "all"}));
+  app.add_option("--scenes", scenes, "steady study: scene files, or dragon:SPACING:SET:M:HL");
+  app.add_option("--only", only, "steady study: time one configuration only (for callgrind)")
+      ->check(CLI::IsMember({"async", "single", "single-hs"}));
+  app.add_flag("--corotational", corotational, "steady study: corotational forces");
+  app.add_flag("--lagged-schur", laggedSchur, "steady study: AsyncOptions::laggedSchur (nonlinear forces)");
+  app.add_flag("--first", collectFirst, "with --only: collect the first step (set-up included) instead");
   app.add_option("--cells", cells, "cells along the bar for the growth and schur studies")->check(CLI::Range(2, 400));
   app.add_option("--ratio-cells", ratioCells, "cells along the bar for the ratio study")->check(CLI::Range(2, 400));
   app.add_option("--m", ratio, "substeps per large step (growth, schur)")->check(CLI::Range(1, 1000));
@@ -502,6 +681,7 @@ int main(int argc, char** argv) {
     if (study == "schur" || study == "all") schurStudy(cells, ratio, hL, steps);
     if (study == "corotational" || study == "all") corotationalStudy(ratioCells, ratio, 1.0 / 120.0);
     if (study == "contact" || study == "all") contactStudy(ratioCells, ratio, 1.0 / 120.0);
+    if (study == "steady") steadyStudy(scenes, steps, corotational, only, collectFirst, laggedSchur);
   } catch (const asyncfem::Error& e) {
     std::fprintf(stderr, "benchmarkAsync: %s\n", e.what());
     return 1;

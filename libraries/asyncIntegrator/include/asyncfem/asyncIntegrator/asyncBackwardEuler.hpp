@@ -14,10 +14,13 @@ namespace asyncfem {
 
 /// How H^{LL*} = A^L - sum_i H^{L S_i} (H^{S_i S_i})^{-1} H^{S_i L} is factored.
 enum class SchurMode {
-  /// Exact, and the default: H^{LL*} = A^L - U C U^T differs from the SPD A^L only by the
-  /// dense interface block C, so A^L is factored by Cholesky and C enters through a q x q
-  /// capacitance matrix (q = interface DOFs; W = (A^L)^{-1} U, |L| x q, is stored). Falls
-  /// back to lu when W would exceed 512 MiB.
+  /// Exact, and the default. For the stable coupling, whose H^{LL*} is symmetric, this is
+  /// a Cholesky factor of H^{LL*} itself (what `symmetric` does; one sparse solve per step;
+  /// lu if the corrections are measurably unsymmetric, above 1e-10). For the paper's
+  /// coupling: H^{LL*} = A^L - U C U^T differs from the SPD A^L only by the dense interface
+  /// block C, so A^L is factored by Cholesky and C enters through a q x q capacitance
+  /// matrix (q = interface DOFs; W = (A^L)^{-1} U, |L| x q, is stored). Falls back to lu
+  /// when W would exceed 512 MiB.
   lowRank,
   lu,  ///< exact: unsymmetric LU (UMFPACK) of H^{LL*} itself, as in the paper
   /// Cholesky of the symmetric part of H^{LL*}, as in the paper: approximate for the paper
@@ -33,7 +36,11 @@ enum class AsyncSolveMethod {
 enum class RecoveryMode {
   automatic,     ///< per region, whichever of the two below needs fewer flops (Z up to 128 MiB)
   substitution,  ///< a second forward substitution (m_i sparse solves per region)
-  denseZ,        ///< X = y - Z Y_I with Z = (H^{SS})^{-1} H^{SI} stored densely (m_i |S_i| x |I_i|)
+  /// The end-of-step state needs only X_m and sum_r X_r: X_m = y_m - Z_m Y_I and
+  /// sum_r X_r = sum_r y_r - (sum_r Z_r) Y_I, with Z_m and sum_r Z_r stored densely
+  /// (2 |S_i| x |I_i|), 4 |S_i| |I_i| flops per step whatever m_i. With a substep observer
+  /// installed the substeps are recovered by substitution.
+  denseZ,
 };
 
 /// How a fast region and L exchange forces inside a large step (docs/asynchronous-integrator.md,
@@ -61,6 +68,52 @@ struct AsyncOptions {
   /// substep (an explicit prediction: the substep states themselves are unknowns of the
   /// implicit solve).
   bool substepStatePrediction = false;
+  /// Threads for the set-up and per-large-step rebuild (columns of Z in blocks, one A^S
+  /// factor copy per block) and for the regions of a step: 0 = OpenMP's maximum.
+  int threads = 0;
+  /// Nonlinear forces only. false (default): every large step recomputes Z and refactors
+  /// H^{LL*} (the paper's Algorithm 2). true: the factor of H^{LL*} from the last full
+  /// rebuild is kept as a preconditioner and the Schur system of the current tangent is
+  /// solved by preconditioned iterative refinement (each iteration: one forward substitution
+  /// per region and one solve with the old factor) to a relative residual of
+  /// laggedSchurTolerance; when that takes more than laggedSchurIterations iterations the
+  /// step does the full rebuild instead, and so does the next one after a slow
+  /// convergence. A^S is refactored every step either way. The step then solves the
+  /// coupled system to the tolerance instead of to round-off.
+  bool laggedSchur = false;
+  int laggedSchurIterations = 8;
+  double laggedSchurTolerance = 1e-10;
+};
+
+/// Where an asynchronous run's time went, set-up apart from the steady-state steps (the
+/// IntegratorStats of stats() hold the same time split by kind of work).
+struct AsyncRunStats {
+  /// First build (blocks, A^{S_i} factors, Z, the Schur corrections C_i, the H^{LL*}
+  /// factor): the cost before the first step can be taken. Linear forces: paid once per
+  /// timestep; nonlinear: the first step's rebuild.
+  double setupSeconds = 0.0;
+  double setupZSeconds = 0.0;      ///< of setupSeconds: Z columns and C_i
+  double setupSchurSeconds = 0.0;  ///< of setupSeconds: assembling and factoring H^{LL*} (or A^L)
+  /// Per-large-step rebuilds after the first (nonlinear forces: refactor A^S, Z, H^{LL*}).
+  double rebuildSeconds = 0.0;
+  double rebuildZSeconds = 0.0;  ///< of rebuildSeconds: Z columns and C_i
+  long long rebuilds = 0;
+  /// Everything else step() spends (forces, right-hand sides, solves, state update).
+  double stepSeconds = 0.0;
+  long long steps = 0;
+  int fastDofs = 0;                   ///< sum_i |S_i|
+  int interfaceDofs = 0;              ///< sum_i |I_i|
+  int largeDofs = 0;                  ///< |L|
+  int zThreads = 1;                   ///< threads (A^S factor copies) the last Z computation used
+  long long zColumns = 0;             ///< right-hand sides of one Z computation: sum_i m_i |I_i|
+  long long laggedSteps = 0;          ///< steps solved with the lagged H^{LL*} (AsyncOptions::laggedSchur)
+  long long schurIterations = 0;      ///< iterative refinement iterations over those steps
+  double largestSchurResidual = 0.0;  ///< largest final relative residual of those steps
+  /// Mean seconds of a steady-state large step (stepSeconds / steps), and with rebuilds.
+  double meanStepSeconds() const { return steps > 0 ? stepSeconds / static_cast<double>(steps) : 0.0; }
+  double meanStepWithRebuildSeconds() const {
+    return steps > 0 ? (stepSeconds + rebuildSeconds) / static_cast<double>(steps) : 0.0;
+  }
 };
 
 /// Called after a large step for every substep r = 1..m_i of fast region i, only when a
@@ -106,8 +159,11 @@ class AsyncBackwardEuler final : public Integrator {
   /// stats().factorizationSeconds): the part of a refactorization the paper's Algorithm 2
   /// adds over single-rate.
   double zColumnSeconds() const { return zColumnSeconds_; }
-  /// The Schur mode in effect (lowRank may fall back to lu for very large interfaces).
+  /// The Schur mode in effect (lowRank is symmetric for the stable coupling, and may fall
+  /// back to lu for very large interfaces).
   SchurMode schurModeUsed() const { return schurModeUsed_; }
+  /// Set-up, rebuild and steady-state step times, and the sizes that set them.
+  const AsyncRunStats& runStats() const { return runStats_; }
 
   /// Seconds per large step of the sparse triangular solves alone, with the current
   /// factors and random right-hand sides (median of `repeats`): per region 2 m_i solves
@@ -127,13 +183,18 @@ class AsyncBackwardEuler final : public Integrator {
   void rebuildBlocks();
   void buildSchurSolver();
   void subtractInterfaceStiffness();
-  Eigen::VectorXd solveSchur(const Eigen::VectorXd& rhs);
+  void solveSchur(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
+  void computeCorrections(bool damped);
+  void fullSchurRebuild();
+  void applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out);
+  bool iterativeSchur(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
   RegionPartition partition_;
   AsyncOptions options_;
   SubstepObserver observer_;
   double schurAsymmetry_ = 0.0;
   double zColumnSeconds_ = 0.0;
   SchurMode schurModeUsed_ = SchurMode::lowRank;
+  AsyncRunStats runStats_;
   std::unique_ptr<Impl> impl_;
 };
 

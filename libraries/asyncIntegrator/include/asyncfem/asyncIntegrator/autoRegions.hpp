@@ -44,6 +44,40 @@ struct AutoRegionOptions {
   /// Modes computed first; doubled while the highest is still visible, up to maxModalCount.
   int modalCount = 20;
   int maxModalCount = 80;
+  /// At most this many regions: beyond it the regions needing the smallest ratio (then the
+  /// smallest) move to AutoRegionProposal::cappedRegions and run at hL.
+  int maxRegions = 4;
+  /// Cost check (AutoRegionCost): the regions are withdrawn unless the estimated cost of an
+  /// asynchronous large step is below costMargin times the cost of the single-rate steps
+  /// that would meet the target everywhere (hL / max ratio) over the same time.
+  bool costCheck = true;
+  double costMargin = 1.0;
+  /// Nonlinear (corotational) forces: both sides also refactor every step (the async
+  /// rebuild: A^S, the Z columns, H^{LL*}).
+  bool nonlinear = false;
+};
+
+/// The cost model of the proposal, in estimated flops (the counts the benchmarks report:
+/// sparse solves from factor sizes, dense interface work from interface sizes). A factor
+/// of a 3D mesh's N DOFs is estimated at kFactorFill N^{4/3} non-zeros (nested
+/// dissection; fitted to CHOLMOD's factors of the shipped meshes), a solve at 4 per factor
+/// non-zero, a numeric factorization at 2 nnz^2 / N.
+struct AutoRegionCost {
+  bool evaluated = false;
+  int freeDofs = 0;
+  int largeDofs = 0;      ///< |L| once the regions are taken out
+  int interfaceDofs = 0;  ///< sum_i |I_i|
+  /// Single-rate steps per large step at the step the target needs everywhere: the
+  /// largest ratio of the proposal (1 when nothing is proposed).
+  int singleRateSubsteps = 1;
+  double singleRateFlops = 0.0;       ///< per large step: singleRateSubsteps steps at hL / that
+  double asyncFlops = 0.0;            ///< per large step, steady state (nonlinear: rebuild included)
+  double singleRateSetupFlops = 0.0;  ///< before the first step (factorization)
+  double asyncSetupFlops = 0.0;       ///< before the first step (A^S factors, Z, H^{LL*} factor)
+  bool asyncCheaper = false;
+  /// One line for a run summary: the numbers and what was decided.
+  std::string decision;
+  double ratio() const { return singleRateFlops > 0.0 ? asyncFlops / singleRateFlops : 0.0; }
 };
 
 /// One proposed fast region with its statistics.
@@ -66,6 +100,12 @@ struct AutoRegionProposal {
   /// empty: the asynchronous integrator runs single-rate at hL).
   std::vector<ProposedRegion> withdrawnRegions;
   double modalSeconds = 0.0;  ///< time of the eigensolves of the modal check
+  /// The cost check (options.costCheck) of the regions after the cap, and the regions it
+  /// withdrew (regions is then empty: single-rate at hL).
+  AutoRegionCost cost;
+  std::vector<ProposedRegion> costWithdrawnRegions;
+  /// Regions beyond options.maxRegions, dropped (they run at hL).
+  std::vector<ProposedRegion> cappedRegions;
   /// The regions alone, ready for RegionPartition / AsyncBackwardEuler.
   std::vector<AsyncRegion> asyncRegions() const;
 };
@@ -75,10 +115,17 @@ struct AutoRegionProposal {
 /// growLayers rings, enclosed L vertices (all neighbours fast) filled in, and each
 /// connected component becomes one region (so regions never share an element: components
 /// that would touch are one component) with ratio = ceil(max omega_e hL / target), capped
-/// at maxRatio. Components without free DOFs are dropped. The proposal is a valid
-/// partition for RegionPartition.
+/// at maxRatio. Components without free DOFs are dropped. At most options.maxRegions are
+/// kept (cappedRegions), then the cost check (AutoRegionCost) withdraws them all unless
+/// async is estimated cheaper than single-rate at the step they would otherwise need. The
+/// proposal is a valid partition for RegionPartition.
 /// Ignores options.modalCheck (it needs K and M: use the overload below).
 AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options);
+
+/// The cost model alone, for any regions (e.g. a scene's own): flops per large step of
+/// async with these regions against single-rate at hL / (largest ratio).
+AutoRegionCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs, const std::vector<AsyncRegion>& regions,
+                                 bool nonlinear = false, double costMargin = 1.0);
 
 /// The same proposal, followed by the modal check when options.modalCheck is set:
 /// lowestModes() of stiffness and mass (full 3n x 3n, e.g. vibrationMatrices()) and
