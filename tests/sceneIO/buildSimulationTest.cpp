@@ -463,7 +463,8 @@ TEST(BuildSimulation, HyperelasticForceModelsRunFromTheScene) {
   Simulation linear = build(json);
   for (int k = 0; k < 10; ++k) linear.integrator->step();
   for (const char* type : {"stvk", "neo-hookean"}) {
-    json["forceModel"] = {{"type", type}, {"inversionThreshold", 0.2}};
+    json["forceModel"] = {{"type", type}};
+    if (std::string(type) == "neo-hookean") json["forceModel"]["inversionThreshold"] = 0.2;
     Simulation simulation = build(json);
     EXPECT_EQ(asyncfem::toString(simulation.problem->settings().forceModel), type);
     for (int k = 0; k < 10; ++k) simulation.integrator->step();
@@ -480,6 +481,9 @@ TEST(BuildSimulation, HyperelasticForceModelsRunFromTheScene) {
   json["forceModel"] = {{"type", "neo-hookean"}, {"inversionThreshold", 1.5}};
   EXPECT_NE(sceneError(json).find("forceModel.inversionThreshold: expected a principal stretch in (0, 1)"),
             std::string::npos)
+      << sceneError(json);
+  json["forceModel"] = {{"type", "stvk"}, {"enforceSPD", true}};
+  EXPECT_NE(sceneError(json).find("forceModel.enforceSPD: the Green-strain StVK"), std::string::npos)
       << sceneError(json);
   json["forceModel"] = {{"type", "neo-hookean"}, {"mooneyRivlin", {{"mu01", 1}}}};
   EXPECT_NE(sceneError(json).find("forceModel.mooneyRivlin: only with"), std::string::npos) << sceneError(json);

@@ -311,6 +311,7 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
           << region.interfaceDofs << " interface DOFs, m = " << region.ratio << " (h / " << region.ratio << ")\n";
     }
   }
+  for (const std::string& line : simulation.integrator->runReport()) out << "  integrator  " << line << "\n";
   out << "  setup       " << setupSeconds << " s (mesh, matrices, first factorization: " << before.factorizationSeconds
       << " s)\n";
   if (couplingCheck) {

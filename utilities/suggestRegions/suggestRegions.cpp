@@ -187,6 +187,7 @@ int main(int argc, char** argv) {
                       list == &proposal.withdrawnRegions ? "  (withdrawn by the modal check)" : "");
         }
       }
+      if (proposal.cost.evaluated) std::printf("cost check: %s\n", proposal.cost.decision.c_str());
       if (proposal.modalReport) {
         std::printf("modal check (%zu lowest modes, %.3g s): %s\n", proposal.modalReport->modes.size(),
                     proposal.modalSeconds, proposal.modalReport->verdictText().c_str());

@@ -68,6 +68,8 @@ AsyncRegion parseRegion(const std::string& sourceName, const TetMesh& mesh, cons
 AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const nlohmann::json& options) {
   AutoRegionOptions automatic;
   automatic.largeTimestep = context.timestep;
+  // Nonlinear forces refactor every step on both sides: the cost check counts that.
+  automatic.nonlinear = context.system.forceModel && !context.system.forceModel->isLinear();
   automatic.modalCheck = true;
   if (context.frameRate > 0.0) automatic.frameRate = context.frameRate;
   if (!options.is_object() || !options.contains("auto")) return automatic;
@@ -80,13 +82,17 @@ AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const
   automatic.growLayers = reader.integer("growLayers", automatic.growLayers, 0, 100);
   automatic.maxRatio = reader.integer("maxRatio", automatic.maxRatio, 1, 100000);
   automatic.modalCheck = reader.boolean("modalCheck", automatic.modalCheck);
+  automatic.maxRegions = reader.integer("maxRegions", automatic.maxRegions, 1, 1000);
+  automatic.costCheck = reader.boolean("costCheck", automatic.costCheck);
+  automatic.costMargin = reader.number("costMargin", automatic.costMargin);
+  if (!(automatic.costMargin > 0.0)) reader.fail("costMargin", "must be > 0");
   reader.finish();
   return automatic;
 }
 
 const std::vector<std::string>& asyncOptionKeys() {
-  static const std::vector<std::string> keys{"coupling",     "schur",          "method",  "recovery",
-                                             "regionSolver", "substepContact", "regions", "auto"};
+  static const std::vector<std::string> keys{"coupling",       "schur",       "method",  "recovery", "regionSolver",
+                                             "substepContact", "laggedSchur", "threads", "regions",  "auto"};
   return keys;
 }
 
@@ -110,6 +116,8 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
       reader.choice("regionSolver", "cholmod", {"cholmod", "umfpack", "eigen-ldlt", "eigen-lu"});
   out.solver.regionSolver = parseSolverKind(regionSolver);
   out.solver.substepStatePrediction = reader.boolean("substepContact", false);
+  out.solver.laggedSchur = reader.boolean("laggedSchur", out.solver.laggedSchur);
+  out.solver.threads = reader.integer("threads", out.solver.threads, 0, 1024);
   if (out.solver.substepStatePrediction && !context.hasContact) {
     reader.fail("substepContact", "only meaningful with a \"contact\" section");
   }

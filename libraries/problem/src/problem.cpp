@@ -128,7 +128,7 @@ DynamicSystem Problem::dynamicSystem() const {
 std::vector<std::string> Problem::skipped() const {
   std::vector<std::string> skipped;
   if (settings_.forceModel == ForceModelType::linear) {
-    skipped.emplace_back("per-step forces and tangent (linear force model: K factored once)");
+    skipped.emplace_back("corotational rotations and per-step tangent (linear force model)");
   }
   if (settings_.gravity.isZero(0.0)) skipped.emplace_back("gravity load (gravity is zero)");
   if (!contact_) skipped.emplace_back("contact (no obstacles)");

@@ -117,15 +117,32 @@ void bindIntegrators(py::module_& module) {
       .def("validate", [](const PythonDynamicSystem& s) { (void)checkedSystem(s); });
 
   py::class_<IntegratorOptions>(module, "IntegratorOptions")
-      .def(py::init([](SolverKind solver, int maxIterations, double tolerance, double maxFrequency, bool force) {
-             return IntegratorOptions{solver, maxIterations, tolerance, maxFrequency, force};
+      .def(py::init([](SolverKind solver, int maxIterations, double tolerance, double maxFrequency, bool force,
+                       bool lineSearch, bool rayleighStiffnessAtIterate, bool reuseFactor, double pcgTolerance) {
+             IntegratorOptions options;  // by name: the struct gains fields over time
+             options.solver = solver;
+             options.maxIterations = maxIterations;
+             options.tolerance = tolerance;
+             options.maxFrequency = maxFrequency;
+             options.force = force;
+             options.lineSearch = lineSearch;
+             options.rayleighStiffnessAtIterate = rayleighStiffnessAtIterate;
+             options.reuseFactor = reuseFactor;
+             options.pcgTolerance = pcgTolerance;
+             return options;
            }),
            py::arg("solver") = SolverKind::cholmod, py::arg("max_iterations") = 1, py::arg("tolerance") = 1e-8,
-           py::arg("max_frequency") = 0.0, py::arg("force") = false)
+           py::arg("max_frequency") = 0.0, py::arg("force") = false, py::arg("line_search") = true,
+           py::arg("rayleigh_stiffness_at_iterate") = false, py::arg("reuse_factor") = false,
+           py::arg("pcg_tolerance") = 1e-8)
       .def_readwrite("solver", &IntegratorOptions::solver)
       .def_readwrite("max_iterations", &IntegratorOptions::maxIterations)
       .def_readwrite("tolerance", &IntegratorOptions::tolerance)
       .def_readwrite("max_frequency", &IntegratorOptions::maxFrequency)
+      .def_readwrite("line_search", &IntegratorOptions::lineSearch)
+      .def_readwrite("rayleigh_stiffness_at_iterate", &IntegratorOptions::rayleighStiffnessAtIterate)
+      .def_readwrite("reuse_factor", &IntegratorOptions::reuseFactor)
+      .def_readwrite("pcg_tolerance", &IntegratorOptions::pcgTolerance)
       .def_readwrite("force", &IntegratorOptions::force);
 
   py::class_<IntegratorStats>(module, "IntegratorStats")

@@ -2,8 +2,9 @@
 // libraries/render (built with ASYNCFEM_WITH_RENDER): off-screen frames as NumPy
 // (height, width, 3) uint8 arrays, PNG in and out.
 
+#include <asyncfem/image/image.hpp>
+#include <asyncfem/image/png.hpp>
 #include <asyncfem/render/camera.hpp>
-#include <asyncfem/render/image.hpp>
 #include <asyncfem/render/renderer.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <bindings.hpp>

@@ -486,6 +486,15 @@ Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePa
         reader.choice("stvkFormulation", "green-strain", {"green-strain", "principal-stretches"}) == "green-strain"
             ? StVKFormulation::greenStrain
             : StVKFormulation::principalStretches;
+    if (scene.forceModel == Scene::ForceModelKind::stvk && h.stvkFormulation == StVKFormulation::greenStrain) {
+      for (const char* key : {"inversionThreshold", "compressionResistance", "enforceSPD"}) {
+        if (reader.has(key)) {
+          reader.fail(key,
+                      "the Green-strain StVK has no inversion handling: set \"stvkFormulation\": "
+                      "\"principal-stretches\" to use it");
+        }
+      }
+    }
     if (const nlohmann::json* mooney = reader.find("mooneyRivlin")) {
       if (scene.forceModel != Scene::ForceModelKind::mooneyRivlin) {
         reader.fail("mooneyRivlin", "only with \"type\": \"mooney-rivlin\"");

@@ -164,6 +164,8 @@ class AsyncBackwardEuler final : public Integrator {
   SchurMode schurModeUsed() const { return schurModeUsed_; }
   /// Set-up, rebuild and steady-state step times, and the sizes that set them.
   const AsyncRunStats& runStats() const { return runStats_; }
+  /// Set-up, rebuild and steady-step times and the lagged-Schur counts of runStats().
+  std::vector<std::string> runReport() const override;
 
   /// Seconds per large step of the sparse triangular solves alone, with the current
   /// factors and random right-hand sides (median of `repeats`): per region 2 m_i solves

@@ -111,6 +111,9 @@ class Integrator {
   }
   /// Non-zeros of the factors the integrator keeps, for cost reports (0: not reported).
   virtual long long factorNonZeros() const { return 0; }
+  /// Lines the integrator adds to run summaries (set-up against steady-state cost,
+  /// iterations, ...), each without a trailing newline; empty by default.
+  virtual std::vector<std::string> runReport() const { return {}; }
   /// True when this configuration may gain energy from step to step (the asynchronous
   /// integrator with the paper's coupling): drivers then estimate the step growth first.
   virtual bool mayGainEnergy() const { return false; }
