@@ -1,17 +1,126 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Scene files through today's sceneIO API (loadScene, buildSimulation, advanceFrame), kept
-// in this one file on purpose: the scene layer is being redesigned, and this is the only
-// place the module touches it.
+// The problem layer (Problem, VertexLoad, ProblemSettings: library problem) and scene files
+// (sceneIO: load_problem, scene_mesh, run_scene).
 
+#include <algorithm>
+#include <asyncfem/problem/problem.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <bindings.hpp>
+#include <integrators.hpp>
+#include <limits>
 #include <optional>
 
 namespace asyncfem::python {
 
+namespace {
+
+ForceModelType parseForceModelType(const std::string& name) {
+  for (const ForceModelType type : {ForceModelType::linear, ForceModelType::corotational, ForceModelType::stvk,
+                                    ForceModelType::neoHookean, ForceModelType::mooneyRivlin}) {
+    if (toString(type) == name) return type;
+  }
+  throw py::value_error("force_model: expected one of linear, corotational, stvk, neo-hookean, mooney-rivlin, got " +
+                        name);
+}
+
+void bindProblem(py::module_& module) {
+  py::class_<VertexLoad>(module, "VertexLoad",
+                         "The same force on each of a list of vertices while a window [start, end) is open")
+      .def(py::init(
+               [](const py::handle& vertices, const py::handle& perVertex, double start, double end, bool leftOpen) {
+                 VertexLoad load;
+                 load.vertices = indexListArgument(vertices, "vertices");
+                 std::sort(load.vertices.begin(), load.vertices.end());
+                 load.vertices.erase(std::unique(load.vertices.begin(), load.vertices.end()), load.vertices.end());
+                 load.perVertex = toVector(perVertex, "per_vertex", 3);
+                 load.start = start;
+                 load.end = end;
+                 load.leftOpen = leftOpen;
+                 return load;
+               }),
+           py::arg("vertices"), py::arg("per_vertex"), py::arg("start") = 0.0,
+           py::arg("end") = std::numeric_limits<double>::infinity(), py::arg("left_open") = false)
+      .def_readonly("vertices", &VertexLoad::vertices)
+      .def_property_readonly("per_vertex", [](const VertexLoad& l) { return Eigen::Vector3d(l.perVertex); })
+      .def_readonly("start", &VertexLoad::start)
+      .def_readonly("end", &VertexLoad::end)
+      .def_readonly("left_open", &VertexLoad::leftOpen)
+      .def("active", &VertexLoad::active, py::arg("time"));
+
+  py::class_<ProblemSettings>(module, "ProblemSettings", "Physics of a problem beyond its mesh, boundary and loads")
+      .def(py::init(
+               [](MassType mass, const std::string& forceModel, double alpha, double beta, const py::handle& gravity) {
+                 ProblemSettings settings;
+                 settings.mass = mass;
+                 settings.forceModel = parseForceModelType(forceModel);
+                 settings.rayleighAlpha = alpha;
+                 settings.rayleighBeta = beta;
+                 settings.gravity = toVector(gravity, "gravity", 3);
+                 return settings;
+               }),
+           py::arg("mass") = MassType::consistent, py::arg("force_model") = "linear", py::arg("rayleigh_alpha") = 0.0,
+           py::arg("rayleigh_beta") = 0.0, py::arg("gravity") = Eigen::Vector3d::Zero().eval())
+      .def_property_readonly("force_model", [](const ProblemSettings& s) { return toString(s.forceModel); })
+      .def_readonly("mass", &ProblemSettings::mass)
+      .def_readonly("rayleigh_alpha", &ProblemSettings::rayleighAlpha)
+      .def_readonly("rayleigh_beta", &ProblemSettings::rayleighBeta)
+      .def_property_readonly("gravity", [](const ProblemSettings& s) { return Eigen::Vector3d(s.gravity); });
+
+  py::class_<Problem, std::shared_ptr<Problem>>(
+      module, "Problem",
+      "Mesh, fixed vertices, physics and loads; matrices are assembled on request (assemblies counts them)")
+      .def(py::init([](const TetMesh& mesh, const py::handle& fixed, const ProblemSettings& settings,
+                       std::vector<VertexLoad> loads) {
+             return std::make_shared<Problem>(std::make_shared<const TetMesh>(mesh),
+                                              indexListArgument(fixed, "fixed_vertices"), settings, std::move(loads));
+           }),
+           py::arg("mesh"), py::arg("fixed_vertices"), py::arg("settings") = ProblemSettings{},
+           py::arg("loads") = std::vector<VertexLoad>{})
+      .def_property_readonly("mesh", [](const Problem& p) { return p.mesh(); })
+      .def_property_readonly("fixed_vertices", &Problem::fixedVertices)
+      .def_property_readonly("free_dofs", &Problem::freeDofs)
+      .def_property_readonly("settings", &Problem::settings)
+      .def_property_readonly("loads", &Problem::windows)
+      .def_property_readonly("assemblies", &Problem::assemblies)
+      .def("mass_matrix", &Problem::massMatrix, py::call_guard<py::gil_scoped_release>())
+      .def("stiffness_matrix", &Problem::stiffnessMatrix, py::call_guard<py::gil_scoped_release>())
+      .def("breakpoints", [](const Problem& p) { return p.loads()->breakpoints(); })
+      .def("last_change", [](const Problem& p) { return p.loads()->lastChange(); })
+      .def("constant_load", [](const Problem& p) { return Eigen::VectorXd(p.loads()->constantPart(p.numDofs())); })
+      .def(
+          "external_force",
+          [](const Problem& p, double time) {
+            const Eigen::VectorXd zero = Eigen::VectorXd::Zero(p.numDofs());
+            Eigen::VectorXd force = zero;
+            p.loads()->addTo(time, zero, zero, force);
+            return force;
+          },
+          py::arg("time"), "f_ext(t) at rest (3n)")
+      .def(
+          "dynamic_system",
+          [](const Problem& p) {
+            PythonDynamicSystem system;
+            system.system = p.dynamicSystem();
+            return system;
+          },
+          "The DynamicSystem integrators take (assembles M and K on first use)")
+      .def("skipped", &Problem::skipped);
+
+  module.def(
+      "load_problem",
+      [](const std::filesystem::path& path) {
+        py::gil_scoped_release release;
+        return std::const_pointer_cast<Problem>(buildProblem(loadScene(path)));
+      },
+      py::arg("path"), "The problem a scene file describes (mesh, boundary, physics, loads), nothing assembled");
+}
+
+}  // namespace
+
 void bindScene(py::module_& module) {
+  bindProblem(module);
   module.def(
       "scene_mesh",
       [](const std::filesystem::path& path) {
