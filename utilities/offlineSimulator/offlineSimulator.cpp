@@ -46,6 +46,11 @@
 #include <string>
 #include <vector>
 
+#if ASYNCFEM_OFFLINE_WITH_PETSC
+#include <asyncfem/petscBackend/petscRuntime.hpp>
+#include <asyncfem/petscBackend/petscSimulation.hpp>
+#endif
+
 #include "commandLine.hpp"
 #include "progress.hpp"
 
@@ -69,6 +74,9 @@ struct CommandLine {
   bool progress = false;
   bool quiet = false;
   bool noStabilityCheck = false;
+  std::string backend = "local";
+  std::string petscSolver = "cg-gamg";
+  std::string petscOptions;
 };
 
 // The signal that asked the run to stop (0: none). A signal handler can only set a flag
@@ -353,6 +361,105 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
   std::cout << out.str() << std::flush;
 }
 
+#if ASYNCFEM_OFFLINE_WITH_PETSC
+// --backend petsc: the scene's problem on the PETSc backend (every rank builds the problem,
+// rank 0 writes the frames). Supports what that backend integrates: linear and
+// corotational backward Euler and trapezoidal, loads that depend on time only.
+int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::Scene& scene) {
+  const std::string prefix = "--backend petsc: ";
+  if (options.resume) throw asyncfem::Error(prefix + "--resume is not supported (this backend writes no checkpoint)");
+  if (scene.contact.enabled()) {
+    throw asyncfem::Error(prefix + scene.sourceName + ": contact: not supported (its forces depend on the state)");
+  }
+  if (!scene.output.vtuFolder.empty() || scene.output.velocities) {
+    throw asyncfem::Error(prefix + ".vtu output and output.velocities are not supported; the .afsim file is written");
+  }
+  asyncfem::PetscSimulationSettings settings;
+  if (scene.integrator.name == "backward-euler") {
+    settings.integrator = asyncfem::PetscIntegratorKind::backwardEuler;
+  } else if (scene.integrator.name == "trapezoidal") {
+    settings.integrator = asyncfem::PetscIntegratorKind::trapezoidal;
+  } else {
+    throw asyncfem::Error(prefix + "integrator \"" + scene.integrator.name +
+                          "\" is not available there (backward-euler, trapezoidal; --integrator switches)");
+  }
+  if (scene.forceModel == asyncfem::Scene::ForceModelKind::linear) {
+    settings.forceModel = asyncfem::PetscForceModelKind::linear;
+  } else if (scene.forceModel == asyncfem::Scene::ForceModelKind::corotational &&
+             scene.tangent == asyncfem::Scene::Tangent::simple) {
+    settings.forceModel = asyncfem::PetscForceModelKind::corotational;
+  } else {
+    throw asyncfem::Error(prefix + "forceModel: only linear and corotational (simple tangent) are available there");
+  }
+  settings.solver.kind = asyncfem::parsePetscSolverKind(options.petscSolver);
+  asyncfem::Stopwatch setupWatch;
+  setupWatch.start();
+  asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
+  const asyncfem::FrameTiming timing = asyncfem::resolveFrameTiming(scene);
+  const std::shared_ptr<const asyncfem::Problem> problem = asyncfem::buildProblem(scene);
+  settings.massType = scene.mass;
+  settings.timestep = timing.timestep;
+  settings.rayleighMass = scene.rayleighAlpha;
+  settings.rayleighStiffness = scene.rayleighBeta;
+  settings.fixedVertices = problem->fixedVertices();
+  settings.gravity = scene.gravity;
+  const std::vector<asyncfem::VertexLoad> windows = problem->windows();
+  if (!windows.empty()) {
+    settings.timeDependentForce = [windows](double time, Eigen::VectorXd& forces) {
+      for (const asyncfem::VertexLoad& load : windows) {
+        if (!load.active(time)) continue;
+        for (const int v : load.vertices) forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
+      }
+    };
+  }
+  asyncfem::PetscSimulation simulation(problem->mesh(), settings);
+  const bool root = simulation.rank() == 0;
+  std::unique_ptr<asyncfem::SimulationWriter> writer;
+  if (root) {
+    if (scene.output.file.has_parent_path()) fs::create_directories(scene.output.file.parent_path());
+    asyncfem::SimulationFileHeader header;
+    header.numVertices = problem->mesh().numVertices();
+    header.frameInterval = timing.frameInterval;
+    header.timestep = timing.timestep;
+    header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
+    header.sceneFingerprint = asyncfem::problemFingerprint(*problem);
+    writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, header,
+                                                          asyncfem::SimulationWriter::Options{scene.output.sync});
+  }
+  const double setupSeconds = setupWatch.stop();
+  asyncfem::Stopwatch loopWatch;
+  loopWatch.start();
+  for (int frame = 0; frame < scene.frames.count; ++frame) {
+    for (int s = 0; s < timing.stepsPerFrame; ++s) simulation.step();  // non-finite states throw on every rank
+    const Eigen::VectorXd u = simulation.gatherDisplacement();
+    if (root) writer->appendFrame(simulation.time(), u);
+  }
+  const double loopSeconds = loopWatch.stop();
+  if (root) {
+    writer->close();
+    const asyncfem::PetscRunStats& stats = simulation.stats();
+    if (!options.quiet) {
+      std::ostringstream out;
+      out.setf(std::ios::fixed);
+      out.precision(3);
+      out << "offlineSimulator: " << scene.sourceName << ": " << scene.frames.count << " frames, " << stats.steps
+          << " steps of h = " << std::defaultfloat << timing.timestep << std::fixed << " on the PETSc backend, "
+          << (setupSeconds + loopSeconds) << " s\n";
+      out << "  ranks       " << stats.ranks << " (" << stats.freeDofs << " free DOFs, " << stats.matrixNonZeros
+          << " matrix non-zeros; KSP " << stats.kspType << ", PC " << stats.pcType << ")\n";
+      out << "  setup       " << setupSeconds << " s\n";
+      out << "  per frame   " << milliseconds(loopSeconds, scene.frames.count) << "   (assembly "
+          << stats.assemblySeconds << " s, solves " << stats.solveSeconds << " s, " << stats.solverIterations
+          << " iterations in " << stats.solves << " solves)\n";
+      out << "  output      " << scene.output.file.string() << " (" << scene.frames.count
+          << " frames; no checkpoint on this backend)\n";
+      std::cout << out.str() << std::flush;
+    }
+  }
+  return 0;
+}
+#endif
+
 int run(int argc, char** argv) {
   CLI::App app{
       "Runs a scene file (docs/scene-format.md) and writes its frames to an .afsim file "
@@ -391,6 +498,15 @@ int run(int argc, char** argv) {
   app.add_flag("--no-stability-check", options.noStabilityCheck,
                "Skip the step-growth estimate (a few dozen steps) made before runs of the asynchronous integrator "
                "with the paper's coupling");
+  app.add_option("--backend", options.backend,
+                 "Where the scene runs: local (default) or petsc (PETSc over MPI: run under mpiexec -n N; "
+                 "backward-euler or trapezoidal, linear or corotational; docs/petsc-backend.md)")
+      ->check(CLI::IsMember({"local", "petsc"}))
+      ->capture_default_str();
+  app.add_option("--petsc-solver", options.petscSolver, "With --backend petsc: cg-gamg, cg-hypre or mumps")
+      ->capture_default_str();
+  app.add_option("--petsc-options", options.petscOptions,
+                 "With --backend petsc: PETSc options database entries, e.g. \"-ksp_rtol 1e-10 -ksp_monitor\"");
   if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "offlineSimulator")) return *status;
 
   asyncfem::Stopwatch setupWatch;
@@ -398,6 +514,15 @@ int run(int argc, char** argv) {
   asyncfem::Scene scene = asyncfem::loadScene(options.scene);
   applyOverrides(options, scene);
   refuseOutputsOverInputs(options, scene);
+  if (options.backend == "petsc") {
+#if ASYNCFEM_OFFLINE_WITH_PETSC
+    return runPetsc(argc, argv, options, scene);
+#else
+    throw asyncfem::Error(
+        "--backend petsc: this build has no PETSc backend (install libpetsc-real-dev and openmpi-bin, e.g. with "
+        "scripts/install-deps.sh, and configure again; ASYNCFEM_WITH_PETSC)");
+#endif
+  }
   asyncfem::Simulation simulation = asyncfem::buildSimulation(scene);
   for (const std::string& warning : simulation.warnings) std::cerr << "offlineSimulator: warning: " << warning << "\n";
   const double setupSeconds = setupWatch.stop();
