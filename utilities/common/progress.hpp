@@ -53,16 +53,3 @@ class ProgressReporter {
 };
 
 }  // namespace asyncfem::cli
-
-namespace asyncfem::offline {
-
-// The names offlineSimulator.cpp used before the reporter was shared; to be removed when
-// it constructs cli::ProgressReporter("offlineSimulator", ...) itself.
-using ProgressStyle = cli::ProgressStyle;
-class ProgressReporter : public cli::ProgressReporter {
- public:
-  ProgressReporter(ProgressStyle style, int totalFrames, int firstFrame = 0)
-      : cli::ProgressReporter("offlineSimulator", style, totalFrames, firstFrame) {}
-};
-
-}  // namespace asyncfem::offline

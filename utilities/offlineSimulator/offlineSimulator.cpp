@@ -57,8 +57,6 @@
 namespace {
 
 namespace fs = std::filesystem;
-using asyncfem::offline::ProgressReporter;
-using asyncfem::offline::ProgressStyle;
 
 struct CommandLine {
   std::string scene;
@@ -582,13 +580,9 @@ int run(int argc, char** argv) {
   };
   installStopHandlers();
 
-  ProgressStyle style = ProgressStyle::lines;
-  if (options.quiet) {
-    style = ProgressStyle::none;
-  } else if (options.progress || ::isatty(STDERR_FILENO) != 0) {
-    style = ProgressStyle::bar;
-  }
-  ProgressReporter progress(style, simulation.numFrames, firstFrame);
+  asyncfem::cli::ProgressReporter progress("offlineSimulator",
+                                           asyncfem::cli::chooseProgressStyle(options.quiet, options.progress),
+                                           simulation.numFrames, firstFrame);
 
   asyncfem::Stopwatch loopWatch;
   asyncfem::Stopwatch outputWatch;
