@@ -130,56 +130,6 @@ std::string fingerprintText(const fs::path& sceneFile) {
   return json.dump();
 }
 
-// Restores the state of the checkpoint next to the output after checking that it belongs
-// to this run and to the frames in the output file; returns the frames to keep.
-std::int64_t restoreFromCheckpoint(const asyncfem::Scene& scene, asyncfem::Simulation& simulation,
-                                   const asyncfem::SimulationFileHeader& header, std::uint32_t fingerprint) {
-  const fs::path& output = scene.output.file;
-  const fs::path checkpointFile = asyncfem::checkpointPathFor(output);
-  const std::string restart = "; run without --resume to start over";
-  if (!fs::exists(output)) {
-    throw asyncfem::Error("cannot resume: " + output.string() + " does not exist" + restart);
-  }
-  if (!fs::exists(checkpointFile)) {
-    throw asyncfem::Error("cannot resume: no checkpoint " + checkpointFile.string() + " next to " + output.string() +
-                          restart);
-  }
-  const asyncfem::SimulationCheckpoint checkpoint = asyncfem::readCheckpoint(checkpointFile);
-  asyncfem::Integrator& integrator = *simulation.integrator;
-  asyncfem::SimulationReader reader(output);
-  const asyncfem::SimulationFileHeader& stored = reader.header();
-  const std::vector<std::string> differences =
-      asyncfem::runDifferences(checkpoint, stored, integrator, header, checkpoint.fingerprint != fingerprint);
-  if (!differences.empty()) {
-    std::string list;
-    for (const std::string& difference : differences) list += (list.empty() ? "" : "; ") + difference;
-    throw asyncfem::Error("cannot resume: " + output.string() + " and " + checkpointFile.string() +
-                          " were written by a different run: " + list + restart);
-  }
-  if (checkpoint.frames > simulation.numFrames) {
-    throw asyncfem::Error("cannot resume: " + output.string() + " already has " + std::to_string(checkpoint.frames) +
-                          " finished frames, more than the " + std::to_string(simulation.numFrames) +
-                          " requested (frames.count or --frames)");
-  }
-  if (reader.numFrames() < checkpoint.frames) {
-    throw asyncfem::Error("cannot resume: " + output.string() + " holds " + std::to_string(reader.numFrames()) +
-                          " complete frames but its checkpoint says " + std::to_string(checkpoint.frames) + restart);
-  }
-  if (checkpoint.frames > 0) {
-    // The last kept record must hold exactly the checkpoint's state.
-    const asyncfem::SimulationFrame last = reader.readFrame(checkpoint.frames - 1);
-    const auto bytes = static_cast<std::size_t>(last.displacement.size()) * sizeof(double);
-    if (std::bit_cast<std::uint64_t>(last.time) != std::bit_cast<std::uint64_t>(checkpoint.time) ||
-        std::memcmp(last.displacement.data(), checkpoint.displacement.data(), bytes) != 0) {
-      throw asyncfem::Error("cannot resume: frame " + std::to_string(checkpoint.frames - 1) + " of " + output.string() +
-                            " differs from the state in " + checkpointFile.string() + restart);
-    }
-  }
-  integrator.setState(checkpoint.displacement, checkpoint.velocity, checkpoint.time);
-  integrator.setInternalState(checkpoint.internalState);
-  return checkpoint.frames;
-}
-
 // The command to continue an interrupted run: this one, with --resume added.
 std::string resumeCommand(int argc, char** argv) {
   std::string command;
@@ -560,7 +510,8 @@ int run(int argc, char** argv) {
   int firstFrame = 0;
   std::unique_ptr<asyncfem::SimulationWriter> writer;
   if (options.resume) {
-    firstFrame = static_cast<int>(restoreFromCheckpoint(scene, simulation, header, fingerprint));
+    firstFrame = static_cast<int>(asyncfem::resumeFromCheckpoint(scene.output.file, header, fingerprint,
+                                                                 simulation.numFrames, *simulation.integrator));
     writer = asyncfem::SimulationWriter::continueFile(scene.output.file, header, firstFrame, writerOptions);
   } else {
     writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, header, writerOptions);

@@ -6,6 +6,8 @@
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <bit>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <sstream>
 
 namespace asyncfem {
@@ -254,6 +256,52 @@ std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, 
         "elements, materials or fixed vertices)");
   }
   return differences;
+}
+
+std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const SimulationFileHeader& header,
+                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator) {
+  namespace fs = std::filesystem;
+  const fs::path checkpointFile = checkpointPathFor(output);
+  const std::string restart = "; run without --resume to start over";
+  if (!fs::exists(output)) {
+    throw Error("cannot resume: " + output.string() + " does not exist" + restart);
+  }
+  if (!fs::exists(checkpointFile)) {
+    throw Error("cannot resume: no checkpoint " + checkpointFile.string() + " next to " + output.string() + restart);
+  }
+  const SimulationCheckpoint checkpoint = readCheckpoint(checkpointFile);
+  SimulationReader reader(output);
+  const SimulationFileHeader& stored = reader.header();
+  const std::vector<std::string> differences =
+      runDifferences(checkpoint, stored, integrator, header, checkpoint.fingerprint != fingerprint);
+  if (!differences.empty()) {
+    std::string list;
+    for (const std::string& difference : differences) list += (list.empty() ? "" : "; ") + difference;
+    throw Error("cannot resume: " + output.string() + " and " + checkpointFile.string() +
+                " were written by a different run: " + list + restart);
+  }
+  if (checkpoint.frames > requestedFrames) {
+    throw Error("cannot resume: " + output.string() + " already has " + std::to_string(checkpoint.frames) +
+                " finished frames, more than the " + std::to_string(requestedFrames) +
+                " requested (frames.count or --frames)");
+  }
+  if (reader.numFrames() < checkpoint.frames) {
+    throw Error("cannot resume: " + output.string() + " holds " + std::to_string(reader.numFrames()) +
+                " complete frames but its checkpoint says " + std::to_string(checkpoint.frames) + restart);
+  }
+  if (checkpoint.frames > 0) {
+    // The last kept record must hold exactly the checkpoint's state.
+    const SimulationFrame last = reader.readFrame(checkpoint.frames - 1);
+    const auto bytes = static_cast<std::size_t>(last.displacement.size()) * sizeof(double);
+    if (std::bit_cast<std::uint64_t>(last.time) != std::bit_cast<std::uint64_t>(checkpoint.time) ||
+        std::memcmp(last.displacement.data(), checkpoint.displacement.data(), bytes) != 0) {
+      throw Error("cannot resume: frame " + std::to_string(checkpoint.frames - 1) + " of " + output.string() +
+                  " differs from the state in " + checkpointFile.string() + restart);
+    }
+  }
+  integrator.setState(checkpoint.displacement, checkpoint.velocity, checkpoint.time);
+  integrator.setInternalState(checkpoint.internalState);
+  return checkpoint.frames;
 }
 
 }  // namespace asyncfem

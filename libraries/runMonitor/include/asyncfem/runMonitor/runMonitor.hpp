@@ -8,6 +8,7 @@
 #include <asyncfem/simulationIO/checkpoint.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <vector>
@@ -102,5 +103,14 @@ SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_
 std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, const SimulationFileHeader& stored,
                                         const Integrator& integrator, const SimulationFileHeader& header,
                                         bool fingerprintDiffers);
+
+/// Continues an interrupted run: reads the checkpoint next to output (checkpointPathFor),
+/// checks that output and checkpoint were written by this run (runDifferences against
+/// header and fingerprint), that requestedFrames is not below the frames already finished,
+/// and that the output's last kept record holds exactly the checkpoint's state; then
+/// restores the state into integrator and returns the frames to keep. Throws
+/// asyncfem::Error "cannot resume: ..." naming what differs or what is missing.
+std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const SimulationFileHeader& header,
+                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator);
 
 }  // namespace asyncfem
