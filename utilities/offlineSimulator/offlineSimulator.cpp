@@ -351,13 +351,13 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   settings.rayleighStiffness = scene.rayleighBeta;
   settings.fixedVertices = problem->fixedVertices();
   settings.gravity = scene.gravity;
-  const std::vector<asyncfem::VertexLoad> windows = problem->windows();
-  if (!windows.empty()) {
-    settings.timeDependentForce = [windows](double time, Eigen::VectorXd& forces) {
-      for (const asyncfem::VertexLoad& load : windows) {
-        if (!load.active(time)) continue;
-        for (const int v : load.vertices) forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
-      }
+  // The windowed loads through Loads::addTo (gravity is the backend's own, settings.gravity).
+  auto timeLoads = std::make_shared<asyncfem::Loads>();
+  for (const asyncfem::VertexLoad& load : problem->windows()) timeLoads->addWindow(load);
+  if (!timeLoads->empty()) {
+    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(problem->numDofs());  // loads of time only
+    settings.timeDependentForce = [timeLoads, rest](double time, Eigen::VectorXd& forces) {
+      timeLoads->addTo(time, rest, rest, forces);
     };
   }
   asyncfem::PetscSimulation simulation(problem->mesh(), settings);

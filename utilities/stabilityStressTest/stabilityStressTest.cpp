@@ -180,6 +180,8 @@ Outcome runSimulation(Simulation& simulation, int frames, double freeFrom, doubl
   Outcome outcome;
   Stopwatch watch;
   Integrator& integrator = *simulation.integrator;
+  // The loads that stay constant (gravity, endless pulls), built once.
+  const Eigen::VectorXd constantLoad = simulation.problem->loads()->constantPart(simulation.problem->numDofs());
   for (int frame = 0; frame < frames; ++frame) {
     try {
       advanceFrame(simulation, frame);
@@ -190,10 +192,7 @@ Outcome runSimulation(Simulation& simulation, int frames, double freeFrom, doubl
     }
     if (integrator.time() >= freeFrom) {
       outcome.energyMeasured = true;
-      // Total energy, with the potential of the loads that stay constant (gravity, endless pulls).
-      const double potential =
-          simulation.problem->loads()->constantPart(simulation.problem->numDofs()).dot(integrator.displacement());
-      const double energy = integrator.mechanicalEnergy() - potential;
+      const double energy = integrator.mechanicalEnergy() - constantLoad.dot(integrator.displacement());
       if (referenceEnergy < 0.0) referenceEnergy = energy;
       if (referenceEnergy > 0.0) outcome.energyGrowth = std::max(outcome.energyGrowth, energy / referenceEnergy);
     }

@@ -121,26 +121,15 @@ CorotationalLinearFEM::CorotationalLinearFEM(const TetMesh& mesh, std::shared_pt
     const ElementPositions x = mesh.elementRestPositions(e);
     restPositions_[i] = x;
     shapeGradients_[i] = shapeFunctionGradients(x, &signedVolumes[i]);
-    double longestSquared = 0.0;
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) longestSquared = std::max(longestSquared, (x.col(a) - x.col(b)).squaredNorm());
-    longestEdges[i] = std::sqrt(longestSquared);
+    longestEdges[i] = longestEdge(x);
     const Material& material = mesh.elementMaterial(e);
     elementStiffness_[i] = linearElementStiffness(x, material.youngsModulus, material.poissonRatio);
     lameVolume_[i] = lameParameters(material.youngsModulus, material.poissonRatio) * std::abs(signedVolumes[i]);
   }
   // Checked after the loop, in element order, so the error names the lowest element
   // whatever the thread count.
-  for (int e = 0; e < numElements; ++e) {
-    const Index i = toIndex(e);
-    const double limit = 1e-14 * longestEdges[i] * longestEdges[i] * longestEdges[i];
-    if (!(std::abs(signedVolumes[i]) > limit) || !std::isfinite(signedVolumes[i])) {
-      std::ostringstream message;
-      message << "CorotationalLinearFEM: element " << e << " is degenerate (signed volume " << signedVolumes[i]
-              << ", longest edge " << longestEdges[i] << ")";
-      throw ValidationError(message.str());
-    }
-  }
+  for (int e = 0; e < numElements; ++e)
+    checkElementVolume(e, signedVolumes[toIndex(e)], longestEdges[toIndex(e)], "CorotationalLinearFEM");
   // Scatter offsets into the assembler's pattern and the vertex -> element incidences of
   // the per-vertex assembly pass.
   blockSlots_.resize(count * 16);

@@ -23,21 +23,12 @@ TetElementGeometry::TetElementGeometry(const TetMesh& mesh, const char* caller)
     restPositions[i] = x;
     shapeGradients[i] = shapeFunctionGradients(x, &signedVolumes[i]);
     volumes[i] = std::abs(signedVolumes[i]);
-    double longestSquared = 0.0;
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) longestSquared = std::max(longestSquared, (x.col(a) - x.col(b)).squaredNorm());
-    longestEdges[i] = std::sqrt(longestSquared);
+    longestEdges[i] = longestEdge(x);
   }
   // Checked in element order so that the message names the lowest bad element.
   for (int e = 0; e < count; ++e) {
     const auto i = static_cast<std::size_t>(e);
-    const double limit = 1e-14 * longestEdges[i] * longestEdges[i] * longestEdges[i];
-    if (!(volumes[i] > limit) || !std::isfinite(signedVolumes[i])) {
-      std::ostringstream message;
-      message << caller << ": element " << e << " is degenerate (signed volume " << signedVolumes[i]
-              << ", longest edge " << longestEdges[i] << ")";
-      throw ValidationError(message.str());
-    }
+    checkElementVolume(e, signedVolumes[i], longestEdges[i], caller);
   }
 }
 

@@ -377,18 +377,9 @@ Eigen::VectorXd MatrixAssembler::assembleVector(const ElementVectorFunction& ele
 
 namespace {
 
-// Throws ValidationError when element e is degenerate: |V| tiny against its longest edge
-// cubed (a regular tetrahedron has V = 0.118 L^3), or not finite.
+// Throws ValidationError when element e is degenerate (checkElementVolume).
 void checkVolume(int e, double signedVolume, const ElementPositions& x) {
-  double longestSquared = 0.0;
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) longestSquared = std::max(longestSquared, (x.col(a) - x.col(b)).squaredNorm());
-  // V^2 > (1e-14 L^3)^2, squared to avoid a square root per element.
-  if (!(signedVolume * signedVolume > 1e-28 * longestSquared * longestSquared * longestSquared)) {
-    throw ValidationError("element " + std::to_string(e) + " is degenerate (signed volume " +
-                          std::to_string(signedVolume) + ", longest edge " + std::to_string(std::sqrt(longestSquared)) +
-                          ")");
-  }
+  checkElementVolume(e, signedVolume, longestEdge(x));
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>
+#include <sstream>
 
 #include "detail/linearStiffness.hpp"
 
@@ -63,6 +66,23 @@ ElementMatrix lumpedElementMass(double volume, double density) {
   ElementMatrix m = ElementMatrix::Zero();
   m.diagonal().setConstant(density * std::abs(volume) / 4.0);
   return m;
+}
+
+double longestEdge(const ElementPositions& positions) {
+  double longestSquared = 0.0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b)
+      longestSquared = std::max(longestSquared, (positions.col(a) - positions.col(b)).squaredNorm());
+  return std::sqrt(longestSquared);
+}
+
+void checkElementVolume(int element, double signedVolume, double longestEdge, const char* caller) {
+  if (std::abs(signedVolume) > 1e-14 * longestEdge * longestEdge * longestEdge && std::isfinite(signedVolume)) return;
+  std::ostringstream message;
+  if (caller != nullptr) message << caller << ": ";
+  message << "element " << element << " is degenerate (signed volume " << signedVolume << ", longest edge "
+          << longestEdge << ")";
+  throw ValidationError(message.str());
 }
 
 }  // namespace asyncfem

@@ -45,6 +45,8 @@
 
 #if __has_include(<valgrind/callgrind.h>)
 #include <valgrind/callgrind.h>
+
+#include "../benchmarkMachine.hpp"
 #define ASYNCFEM_COLLECT_ON() CALLGRIND_TOGGLE_COLLECT
 #define ASYNCFEM_COLLECT_OFF() CALLGRIND_TOGGLE_COLLECT
 #else
@@ -53,6 +55,9 @@
 #endif
 
 namespace {
+
+using asyncfem::bench::cpuModel;
+using asyncfem::bench::loadAverage;
 
 using namespace asyncfem;
 
@@ -106,15 +111,6 @@ double timePerStep(Integrator& integrator, int warmup, int steps, double* setupS
     samples.push_back(watch.stop());
   }
   return median(samples);
-}
-
-std::string cpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "unknown CPU";
 }
 
 void growthStudy(int cells, int ratio, double hL, int steps) {

@@ -29,7 +29,12 @@
 #include <string>
 #include <vector>
 
+#include "../benchmarkMachine.hpp"
+
 namespace {
+
+using asyncfem::bench::cpuModel;
+using asyncfem::bench::loadAverage;
 
 using namespace asyncfem;
 using SparseMatrix = Eigen::SparseMatrix<double>;
@@ -283,22 +288,6 @@ double referenceKernelMicros(const Scene& scene, const Eigen::VectorXd& u, int r
 
 double scaledDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return (a - b).lpNorm<Eigen::Infinity>() / std::max(a.lpNorm<Eigen::Infinity>(), 1e-300);
-}
-
-std::string cpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "unknown";
-}
-
-std::string loadAverage() {
-  std::ifstream in("/proc/loadavg");
-  std::string a, b, c;
-  in >> a >> b >> c;
-  return a + " " + b + " " + c;
 }
 
 }  // namespace

@@ -28,7 +28,12 @@
 #include <thread>
 #include <vector>
 
+#include "../benchmarkMachine.hpp"
+
 namespace {
+
+using asyncfem::bench::cpuModel;
+using asyncfem::bench::loadAverage;
 
 using asyncfem::Stopwatch;
 
@@ -194,15 +199,6 @@ void corotationalBackwardEuler(benchmark::State& state) {
 // 25 x 8 x 8 cells = 9 600 tets; 54 x 18 x 18 cells = 104 976 tets.
 BENCHMARK(linearBackwardEuler)->Arg(25)->Arg(54)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 BENCHMARK(corotationalBackwardEuler)->Arg(25)->Arg(54)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
-
-std::string cpuModel() {
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(cpuinfo, line)) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "unknown";
-}
 
 }  // namespace
 

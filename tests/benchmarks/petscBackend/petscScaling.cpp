@@ -25,7 +25,12 @@
 #include <string>
 #include <thread>
 
+#include "../benchmarkMachine.hpp"
+
 namespace {
+
+using asyncfem::bench::cpuModel;
+using asyncfem::bench::loadAverage;
 
 struct Options {
   int cells = 18;  // cells across the 1 x 1 section; 3 * cells along x
@@ -76,22 +81,6 @@ asyncfem::TetMesh boxMesh(int cells) {
   spec.cells = Eigen::Vector3i(3 * cells, cells, cells);
   spec.material = asyncfem::Material{"rubber", 1000.0, 1e6, 0.45};
   return asyncfem::makeBoxMesh(spec);
-}
-
-std::string cpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "unknown CPU";
-}
-
-std::string loadAverage() {
-  std::ifstream in("/proc/loadavg");
-  std::string one;
-  in >> one;
-  return one;
 }
 
 struct Row {

@@ -31,7 +31,12 @@
 #include <thread>
 #include <vector>
 
+#include "../benchmarkMachine.hpp"
+
 namespace {
+
+using asyncfem::bench::cpuModel;
+using asyncfem::bench::loadAverage;
 
 using namespace asyncfem;
 
@@ -122,21 +127,6 @@ Row surfaceRow(const std::filesystem::path& path, int cells) {
   if (report.pinchedBoundaryEdges > 0)
     row.note += ", " + std::to_string(report.pinchedBoundaryEdges) + " pinched edges";
   return row;
-}
-
-std::string cpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown CPU";
-}
-
-std::string loadAverage() {
-  std::ifstream in("/proc/loadavg");
-  std::string a, b, c;
-  in >> a >> b >> c;
-  return a + " " + b + " " + c;
 }
 
 }  // namespace

@@ -27,7 +27,12 @@
 #include <thread>
 #include <vector>
 
+#include "../benchmarkMachine.hpp"
+
 namespace {
+
+using asyncfem::bench::cpuModel;
+using asyncfem::bench::loadAverage;
 
 using namespace asyncfem;
 
@@ -48,17 +53,6 @@ double medianSeconds(const std::function<void()>& call, int repeats) {
     samples.push_back(watch.stop());
   }
   return median(samples);
-}
-
-std::string cpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) {
-      return line.substr(line.find(':') + 2);
-    }
-  }
-  return "unknown CPU";
 }
 
 struct Row {

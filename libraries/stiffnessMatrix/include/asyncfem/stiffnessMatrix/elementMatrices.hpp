@@ -20,6 +20,14 @@ Eigen::Vector2d lameParameters(double youngsModulus, double poissonRatio);
 /// checks the volume.
 Eigen::Matrix<double, 3, 4> shapeFunctionGradients(const ElementPositions& restPositions, double* signedVolume);
 
+/// Longest edge of a tetrahedron.
+double longestEdge(const ElementPositions& positions);
+
+/// The one degeneracy rule of the toolkit: throws ValidationError
+/// "[caller: ]element E is degenerate (signed volume V, longest edge L)" when |V| <= 1e-14 L^3
+/// (a regular tetrahedron has V = 0.118 L^3) or V is not finite.
+void checkElementVolume(int element, double signedVolume, double longestEdge, const char* caller = nullptr);
+
 /// Linear (constant-strain) element stiffness K_e = V B^T C B for isotropic material
 /// (12 x 12, units of E times length). V = |signed volume|, so either vertex order gives
 /// the same matrix. Exactly symmetric, positive semi-definite, six rigid-body modes in
