@@ -138,10 +138,11 @@ ImplicitModel exampleModelShape(ExampleModel model) {
   throw ValidationError("unknown example model");
 }
 
-TetMesh makeExampleModel(ExampleModel model, double spacing, StuffingReport* report) {
+TetMesh makeExampleModel(ExampleModel model, double spacing, StuffingReport* report, int gradingLevels) {
   const ImplicitModel shape = exampleModelShape(model);
   const std::string name = exampleModelName(model);
   MesherOptions options;
+  options.gradingLevels = gradingLevels;
   // The soft default material of each model; the fast parts get stiffer, lighter ones.
   switch (model) {
     case ExampleModel::Dinosaur:

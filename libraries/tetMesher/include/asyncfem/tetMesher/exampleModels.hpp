@@ -40,7 +40,9 @@ ImplicitModel exampleModelShape(ExampleModel model);
 /// Meshes the model with stuffIsosurface (spacing <= 0: the shipped spacing), then adds the
 /// element and vertex sets of its parts and its extra sets, and assigns its materials.
 /// The result is checked (validateTetMesh) and must be one connected piece (ValidationError
-/// otherwise, e.g. when a spacing too coarse cuts a thin part off).
-TetMesh makeExampleModel(ExampleModel model, double spacing = 0.0, StuffingReport* report = nullptr);
+/// otherwise, e.g. when a spacing too coarse cuts a thin part off). gradingLevels as in
+/// MesherOptions (0: the uniform lattice of the shipped meshes).
+TetMesh makeExampleModel(ExampleModel model, double spacing = 0.0, StuffingReport* report = nullptr,
+                         int gradingLevels = 0);
 
 }  // namespace asyncfem

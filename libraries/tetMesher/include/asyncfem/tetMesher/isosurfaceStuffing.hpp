@@ -7,6 +7,9 @@
 
 namespace asyncfem {
 
+/// Largest MesherOptions::gradingLevels (interior cubes of up to 2^6 = 64 spacings).
+inline constexpr int kMaxGradingLevels = 6;
+
 /// Settings of stuffIsosurface.
 struct MesherOptions {
   /// Warping thresholds of Labelle & Shewchuk 2007 (Section 5): a lattice vertex closer than
@@ -40,6 +43,19 @@ struct MesherOptions {
   double minDihedralDegrees = 10.0;
   /// Run validateTetMesh on the result and throw if a check fails.
   bool check = true;
+  /// 0: a uniform lattice of the given spacing everywhere. N > 0: a graded lattice (the
+  /// paper's octree of BCC cubes, strongly balanced): cubes of the given spacing wherever
+  /// the surface is within two spacings, growing by factors of two inside, up to 2^N
+  /// spacings. Near the surface the mesh is the uniform one, so the angle bound and the
+  /// stencils are unchanged; the interior has far fewer, larger elements (their shapes:
+  /// BCC tetrahedra, bisected ones and pyramid halves, dihedral angles 45 to 120 degrees). Cubes are
+  /// refined where |f| at their centre is below their half-diagonal plus one spacing, which
+  /// finds the surface wherever |f| is at most the distance to it (signed distances,
+  /// SignedDistance, this library's primitives and their unions); a coarse tetrahedron whose
+  /// vertices still differ in sign, or touch a warped vertex, is refined afterwards, so the
+  /// mesh is valid and bounded for any f, but an f much steeper than a distance can lose
+  /// surface detail inside coarse cubes.
+  int gradingLevels = 0;
   /// Largest number of lattice vertices accepted (guards against a spacing far too small).
   long long maxLatticeVertices = 200'000'000;
 };
@@ -56,6 +72,9 @@ struct StuffingReport {
   int pinchedBoundaryEdges = 0;     ///< see MeshCheckReport::pinchedBoundaryEdges
   double minDihedralDegrees = 0.0;  ///< of the returned mesh
   double maxDihedralDegrees = 0.0;
+  int gradingLevels = 0;       ///< MesherOptions::gradingLevels used
+  long long latticeCells = 0;  ///< leaf cubes of the graded lattice (0 for a uniform one)
+  int refinementRounds = 0;    ///< extra refinements where the surface reached a coarse cube
 };
 
 /// Tetrahedral mesh of the solid {x : f(x) < 0} inside bounds, by isosurface stuffing
