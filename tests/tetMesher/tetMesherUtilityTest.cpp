@@ -150,13 +150,37 @@ TEST(TetMesherUtility, AShellAroundACoreBecomesATwoMaterialMeshInOneCommand) {
   for (int e = 0; e < mesh.numElements(); ++e) {
     const double r = mesh.elementRestPositions(e).rowwise().mean().norm();
     const std::string& material = mesh.elementMaterial(e).name;
-    if (r < 0.5 - spacing) EXPECT_EQ(material, "core") << "element " << e << " at radius " << r;
-    if (r > 0.5 + spacing) EXPECT_EQ(material, "shell") << "element " << e << " at radius " << r;
+    if (r < 0.5 - spacing) {
+      EXPECT_EQ(material, "core") << "element " << e << " at radius " << r;
+    }
+    if (r > 0.5 + spacing) {
+      EXPECT_EQ(material, "shell") << "element " << e << " at radius " << r;
+    }
   }
   // Material ids of the file work the same way (toObj writes no materials: one default).
   const RunResult materials = run(obj.string() + " --repair --spacing 0.2 --material-sets -o " + veg.string());
   EXPECT_EQ(materials.status, 0) << materials.output;
   EXPECT_NE(materials.output.find("set "), std::string::npos) << materials.output;
+}
+
+TEST(TetMesherUtility, GradedSurfaceMeshKeepsTheSurfaceWithFewerElements) {
+  const auto obj = scratch("ball.obj");
+  std::ofstream(obj) << test::toObj(test::uvSphere(Eigen::Vector3d::Zero(), 1.0, 32, 16));
+  const auto uniformVeg = scratch("uniform.veg"), gradedVeg = scratch("graded.veg");
+  const RunResult uniform = run(obj.string() + " --cells 30 -o " + uniformVeg.string());
+  const RunResult graded = run(obj.string() + " --cells 30 --grade 3 -o " + gradedVeg.string());
+  ASSERT_EQ(uniform.status, 0) << uniform.output;
+  ASSERT_EQ(graded.status, 0) << graded.output;
+  EXPECT_EQ(uniform.output.find("grading:"), std::string::npos) << uniform.output;
+  EXPECT_NE(graded.output.find("grading: 3 levels"), std::string::npos) << graded.output;
+  // The same "volume:" line (same boundary), fewer elements.
+  auto line = [](const std::string& text, const std::string& key) {
+    const auto at = text.find(key);
+    return at == std::string::npos ? std::string() : text.substr(at, text.find('\n', at) - at);
+  };
+  EXPECT_FALSE(line(graded.output, "volume:").empty());
+  EXPECT_EQ(line(graded.output, "volume:"), line(uniform.output, "volume:"));
+  EXPECT_LT(readVeg(gradedVeg).numElements(), readVeg(uniformVeg).numElements());
 }
 
 TEST(TetMesherUtility, BadOptionsAreErrors) {
@@ -175,6 +199,9 @@ TEST(TetMesherUtility, BadOptionsAreErrors) {
   EXPECT_EQ(negative.status, 2);
   EXPECT_NE(negative.output.find("tetMesher: --spacing: must be > 0 (got -1) (see --help)"), std::string::npos)
       << negative.output;
+  const auto grade = run("--model drop --grade 7 -o " + scratch("x.veg").string());
+  EXPECT_EQ(grade.status, 2);
+  EXPECT_NE(grade.output.find("--grade"), std::string::npos) << grade.output;
   const auto unknown = run("--no-such-option");
   EXPECT_EQ(unknown.status, 2);
   EXPECT_EQ(unknown.output.rfind("tetMesher: ", 0), 0U) << unknown.output;

@@ -117,6 +117,7 @@ struct Options {
   std::string output;
   double spacing = 0.0;
   int cells = 0;
+  int grade = 0;
   std::vector<std::string> boxSets;
   bool partSets = false;
   bool materialSets = false;
@@ -134,6 +135,11 @@ void printQuality(const TetMesh& mesh, const asyncfem::StuffingReport& stuffing,
   const asyncfem::MeshCheckReport check = asyncfem::checkTetMesh(mesh);
   std::printf("lattice: spacing %.6g, %lld lattice vertices, %d vertices warped onto the surface, %d cut points\n",
               spacing, stuffing.latticeVertices, stuffing.warpedVertices, stuffing.cutPoints);
+  if (stuffing.gradingLevels > 0) {
+    std::printf("grading: %d levels (interior cubes up to %g), %lld leaf cubes, %d extra refinement round%s\n",
+                stuffing.gradingLevels, spacing * static_cast<double>(1 << stuffing.gradingLevels),
+                stuffing.latticeCells, stuffing.refinementRounds, stuffing.refinementRounds == 1 ? "" : "s");
+  }
   if (stuffing.unwarpedVertices > 0) {
     std::printf(
         "pinches: %d vertices left on the lattice to keep the boundary manifold (thin parts); the angle "
@@ -171,6 +177,7 @@ int run(const Options& options) {
   }
   if (options.spacing > 0.0 && options.cells > 0) throw ValidationError("give either --spacing or --cells, not both");
   asyncfem::MesherOptions mesherOptions;
+  mesherOptions.gradingLevels = options.grade;
   if (!options.defaultMaterial.empty()) {
     const std::vector<double> v = parseNumbers(options.defaultMaterial, 3, "--default-material");
     mesherOptions.material = asyncfem::Material{"default", v[0], v[1], v[2]};
@@ -184,7 +191,7 @@ int run(const Options& options) {
     const asyncfem::ExampleModel model = asyncfem::exampleModelFromName(options.model);
     if (options.cells > 0) throw ValidationError("--cells applies to surfaces; give --spacing for a model");
     if (spacing <= 0.0) spacing = asyncfem::exampleModelShape(model).spacing;
-    mesh = asyncfem::makeExampleModel(model, spacing, &stuffing);
+    mesh = asyncfem::makeExampleModel(model, spacing, &stuffing, options.grade);
     if (!options.quiet) {
       const asyncfem::ImplicitModel shape = asyncfem::exampleModelShape(model);
       Eigen::Vector3d at = Eigen::Vector3d::Zero();
@@ -322,6 +329,10 @@ int main(int argc, char** argv) {
       ->check(asyncfem::cli::positive());
   app.add_option("--cells", options.cells, "Lattice cells across the longest side of the bounding box (default 30)")
       ->check(asyncfem::cli::inRange(1, 2000));
+  app.add_option("--grade", options.grade,
+                 "Graded lattice: the spacing near the surface, cubes up to 2^LEVELS spacings inside (default 0: "
+                 "uniform)")
+      ->check(asyncfem::cli::inRange(0, asyncfem::kMaxGradingLevels));
   app.add_option("--set", options.boxSets,
                  "Element and vertex set of the elements whose centroid lies in a box: "
                  "NAME:xmin,ymin,zmin,xmax,ymax,zmax (repeatable)");

@@ -5,7 +5,10 @@
 // stuff, check), microseconds per element, dihedral-angle range, volume error and Hausdorff
 // distance to the input in lattice spacings.
 //
-//   benchmarkTetMesher [--cells 30] [--models /usr/share/assimp/models]
+//   benchmarkTetMesher [--cells 30] [--models /usr/share/assimp/models] [--refine K] [--grade N]
+//
+// --refine K divides every spacing by K (the example models' shipped spacing and the
+// surfaces' cells); --grade N meshes on the graded lattice (MesherOptions::gradingLevels).
 //
 // Volume error: closed surfaces against the divergence-theorem volume of the input; the
 // implicit example models against a Monte Carlo estimate of {f < 0} (2e6 samples, relative
@@ -64,7 +67,13 @@ std::string percent(double value) {
   return text;
 }
 
-Row exampleRow(ExampleModel model) {
+struct Settings {
+  int cells = 30;
+  double refine = 1.0;
+  int grade = 0;
+};
+
+Row exampleRow(ExampleModel model, const Settings& settings) {
   Row row;
   row.name = exampleModelName(model);
   row.kind = "implicit";
@@ -73,7 +82,10 @@ Row exampleRow(ExampleModel model) {
   Stopwatch watch;
   watch.start();
   StuffingReport report;
-  const TetMesh mesh = stuffIsosurface(f, shape.bounds, shape.spacing, {}, &report);
+  MesherOptions options;
+  options.gradingLevels = settings.grade;
+  const double spacing = shape.spacing / settings.refine;
+  const TetMesh mesh = stuffIsosurface(f, shape.bounds, spacing, options, &report);
   row.seconds = watch.stop();
   row.elements = mesh.numElements();
   row.minAngle = report.minDihedralDegrees;
@@ -95,11 +107,11 @@ Row exampleRow(ExampleModel model) {
   char note[96];
   std::snprintf(note, sizeof(note), "volume reference +-%.2f%%; Hausdorff mesh-to-surface only", 100.0 * relativeError);
   row.note = note;
-  row.hausdorffSpacings = implicitDeviation(mesh, f) / shape.spacing;
+  row.hausdorffSpacings = implicitDeviation(mesh, f) / spacing;
   return row;
 }
 
-Row surfaceRow(const std::filesystem::path& path, int cells) {
+Row surfaceRow(const std::filesystem::path& path, const Settings& settings) {
   Row row;
   row.name = path.filename().string();
   Stopwatch watch;
@@ -110,11 +122,13 @@ Row surfaceRow(const std::filesystem::path& path, int cells) {
   const SurfaceTopology topology = surfaceTopology(surface);
   const bool closed = topology.closed() && topology.degenerateTriangles == 0;
   if (topology.signedVolume < 0.0) flipOrientation(surface);
-  const double spacing = bounds.sizes().maxCoeff() / cells;
+  const double spacing = bounds.sizes().maxCoeff() / (settings.cells * settings.refine);
   const SignedDistance distance(surface, closed ? SignMode::Pseudonormal : SignMode::WindingNumber);
   const Eigen::AlignedBox3d box(bounds.min().array() - spacing, bounds.max().array() + spacing);
   StuffingReport report;
-  const TetMesh mesh = stuffIsosurface(distance.function(), box, spacing, {}, &report);
+  MesherOptions options;
+  options.gradingLevels = settings.grade;
+  const TetMesh mesh = stuffIsosurface(distance.function(), box, spacing, options, &report);
   row.seconds = watch.stop();
   row.kind = closed ? "closed" : "open (winding number)";
   row.elements = mesh.numElements();
@@ -133,20 +147,25 @@ Row surfaceRow(const std::filesystem::path& path, int cells) {
 
 int main(int argc, char** argv) {
   CLI::App app{"tetMesher benchmark: shipped example models and assimp-testmodels surfaces"};
-  int cells = 30;
+  Settings settings;
   std::string models = "/usr/share/assimp/models";
-  app.add_option("--cells", cells, "Lattice cells across the longest side of each surface's bounding box");
+  app.add_option("--cells", settings.cells, "Lattice cells across the longest side of each surface's bounding box");
   app.add_option("--models", models, "Directory of Debian's assimp-testmodels");
+  app.add_option("--refine", settings.refine, "Divide every spacing by this factor")->check(CLI::PositiveNumber);
+  app.add_option("--grade", settings.grade, "Graded lattice levels (0: uniform)")
+      ->check(CLI::Range(0, kMaxGradingLevels));
   CLI11_PARSE(app, argc, argv);
+  const int cells = settings.cells;
 
   std::printf("machine: %s, %u hardware threads; load average before: %s\n", cpuModel().c_str(),
               std::thread::hardware_concurrency(), loadAverage().c_str());
-  std::printf("command: benchmarkTetMesher --cells %d --models %s\n\n", cells, models.c_str());
+  std::printf("command: benchmarkTetMesher --cells %d --models %s --refine %g --grade %d\n\n", cells, models.c_str(),
+              settings.refine, settings.grade);
   std::printf(
       "| input | kind | elements | seconds | us/element | min angle | max angle | volume error | Hausdorff "
       "(spacings) | notes |\n|---|---|---|---|---|---|---|---|---|---|\n");
   for (ExampleModel model : {ExampleModel::Dinosaur, ExampleModel::Flower, ExampleModel::Dragon, ExampleModel::Drop})
-    printRow(exampleRow(model));
+    printRow(exampleRow(model, settings));
 
   // Closed surfaces first, then open ones meshed through the winding number.
   const std::vector<std::string> surfaces{"Collada/duck.dae",
@@ -175,7 +194,7 @@ int main(int argc, char** argv) {
         continue;
       }
       try {
-        printRow(surfaceRow(path, cells));
+        printRow(surfaceRow(path, settings));
       } catch (const Error& e) {
         std::printf("| %s | error | | | | | | | | %s |\n", relative.c_str(), e.what());
       }
