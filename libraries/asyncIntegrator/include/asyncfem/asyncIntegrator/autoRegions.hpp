@@ -57,11 +57,11 @@ struct AutoRegionOptions {
   bool nonlinear = false;
 };
 
-/// The cost model of the proposal, in estimated flops (the counts the benchmarks report:
-/// sparse solves from factor sizes, dense interface work from interface sizes). A factor
-/// of a 3D mesh's N DOFs is estimated at kFactorFill N^{4/3} non-zeros (nested
-/// dissection; fitted to CHOLMOD's factors of the shipped meshes), a solve at 4 per factor
-/// non-zero, a numeric factorization at 2 nnz^2 / N.
+/// The cost model of the proposal, in flops (the counts the benchmarks report: sparse
+/// solves from factor sizes, dense interface work from interface sizes). Factor sizes and
+/// factorization flops are CHOLMOD's own, from a symbolic analysis (METIS ordering) of each
+/// block's pattern: the whole free system, every region's A^S, and A^L with each region's
+/// dense interface block (H^{LL*}); a solve costs 4 flops per factor non-zero.
 struct AutoRegionCost {
   bool evaluated = false;
   int freeDofs = 0;
