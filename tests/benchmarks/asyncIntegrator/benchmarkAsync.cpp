@@ -22,6 +22,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
@@ -527,6 +528,7 @@ struct SteadyRow {
   double hL = 0;
   double setupZ = 0, setupSchur = 0;
   double setup = 0, asyncStep = 0, asyncMeanStep = 0, singleSetup = 0, singleStep = 0, singleStepHS = 0;
+  AutoRegionCost model;  // the automatic regions' cost model of the same partition
 };
 
 /// Steady state: per scene, the async step (median wall, and the integrator's own mean of
@@ -563,6 +565,11 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
       row.ratio = std::max(row.ratio, partition.ratio(i));
     }
     row.interfaceDofs = async->runStats().interfaceDofs;
+    {
+      std::vector<AsyncRegion> regions;
+      for (int i = 0; i < partition.numRegions(); ++i) regions.push_back(partition.region(i));
+      row.model = estimateAsyncCost(*simulation.mesh, simulation.problem->freeDofs(), regions, corotational);
+    }
     const DynamicSystem system = async->system();
     // Collected for callgrind: the first step (set-up included) with --first, else the
     // timed steady steps.
@@ -619,24 +626,35 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
   if (!corotational) {
     std::printf(
         "| scene | vertices | S vertices (%%) | interface DOFs | m | hL | async ms/step | single-rate hL ms/step | "
-        "ratio | async set-up ms (Z, H^{LL*}) | single-rate set-up ms | set-up / single-rate step |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    for (const SteadyRow& r : rows)
-      std::printf("| %s | %d | %d (%.1f%%) | %d | %d | %.4g | %.3f | %.3f | %.2f | %.1f (%.1f, %.1f) | %.1f | %.1f |\n",
-                  r.name.c_str(), r.vertices, r.fastVertices, 100.0 * r.fastVertices / r.vertices, r.interfaceDofs,
-                  r.ratio, r.hL, 1e3 * r.asyncStep, 1e3 * r.singleStep, r.asyncStep / r.singleStep, 1e3 * r.setup,
-                  1e3 * r.setupZ, 1e3 * r.setupSchur, 1e3 * r.singleSetup, r.setup / r.singleStep);
+        "ratio | cost model ratio | async set-up ms (Z, H^{LL*}) | single-rate set-up ms | set-up / single-rate "
+        "step | cost model set-up ratio |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (const SteadyRow& r : rows) {
+      // The model's single-rate side is m steps at hL / m; one of them costs as one at hL.
+      const double modelStep = r.model.singleRateFlops / r.model.singleRateSubsteps;
+      std::printf(
+          "| %s | %d | %d (%.1f%%) | %d | %d | %.4g | %.3f | %.3f | %.2f | %.2f | %.1f (%.1f, %.1f) | %.1f | %.1f | "
+          "%.1f "
+          "|\n",
+          r.name.c_str(), r.vertices, r.fastVertices, 100.0 * r.fastVertices / r.vertices, r.interfaceDofs, r.ratio,
+          r.hL, 1e3 * r.asyncStep, 1e3 * r.singleStep, r.asyncStep / r.singleStep, r.model.asyncFlops / modelStep,
+          1e3 * r.setup, 1e3 * r.setupZ, 1e3 * r.setupSchur, 1e3 * r.singleSetup, r.setup / r.singleStep,
+          r.model.asyncSetupFlops / modelStep);
+    }
+    std::printf(
+        "\nCost model: the flops automatic regions estimate (AutoRegionCost, from CHOLMOD's symbolic analysis); "
+        "its ratios use the same denominators as the measured ones.\n");
   } else {
     std::printf("%s", laggedSchur ? "With AsyncOptions::laggedSchur.\n\n" : "");
     std::printf(
         "| scene | vertices | S vertices (%%) | interface DOFs | m | async ms/large step | single-rate hL ms/step | "
-        "single-rate hS ms per hL | async / single-rate hS | async set-up ms "
-        "|\n|---|---|---|---|---|---|---|---|---|---|\n");
+        "single-rate hS ms per hL | async / single-rate hS | cost model ratio | async set-up ms "
+        "|\n|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (const SteadyRow& r : rows)
-      std::printf("| %s | %d | %d (%.1f%%) | %d | %d | %.3f | %.3f | %.3f | %.2f | %.1f |\n", r.name.c_str(),
+      std::printf("| %s | %d | %d (%.1f%%) | %d | %d | %.3f | %.3f | %.3f | %.2f | %.2f | %.1f |\n", r.name.c_str(),
                   r.vertices, r.fastVertices, 100.0 * r.fastVertices / r.vertices, r.interfaceDofs, r.ratio,
                   1e3 * r.asyncStep, 1e3 * r.singleStep, 1e3 * r.singleStepHS, r.asyncStep / r.singleStepHS,
-                  1e3 * r.setup);
+                  r.model.ratio(), 1e3 * r.setup);
   }
   std::printf("\n");
 }
