@@ -311,8 +311,9 @@ double scaledDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 // identical one: DIR/NAME.veg (the mesh and its material, writeVeg), DIR/NAME.fixed (the
 // fixed DOFs, 0-based global ids x 3 + coordinate, ascending, one a line), DIR/NAME.params
 // (material, time step, Rayleigh damping, gravity, step counts: `key value...` lines) and
-// DIR/NAME.u (the toolkit's displacement after warmup + steps exact steps from rest, 17
-// significant digits, one DOF a line).
+// DIR/NAME.u and DIR/NAME.reuse.u (the toolkit's displacement after warmup + steps steps
+// from rest, exact solves and reuseFactor at the default 1e-8; 17 significant digits, one
+// DOF a line).
 void writeProblem(const Scene& scene, const std::filesystem::path& dir, int warmup, int steps) {
   std::filesystem::create_directories(dir);
   writeVeg(dir / (scene.name + ".veg"), scene.mesh);
@@ -340,17 +341,25 @@ void writeProblem(const Scene& scene, const std::filesystem::path& dir, int warm
            << "\nwarmupSteps " << warmup << "\ntimedSteps " << steps << "\nfixedDofs " << scene.freeDofs.numFixed()
            << '\n';
   }
-  BackwardEuler integrator(toolkitSystem(scene), kTimestep);
-  for (int k = 0; k < warmup + steps; ++k) integrator.step();
-  const Eigen::VectorXd& u = integrator.displacement();
-  if (!u.allFinite())
-    throw asyncfem::Error(scene.name + ": displacement not finite after " + std::to_string(warmup + steps) + " steps");
-  std::ofstream displacement = open(".u");
-  for (Eigen::Index i = 0; i < u.size(); ++i) displacement << u[i] << '\n';
+  Eigen::VectorXd exact;
+  for (const bool reuse : {false, true}) {
+    IntegratorOptions options;
+    options.reuseFactor = reuse;
+    BackwardEuler integrator(toolkitSystem(scene), kTimestep, options);
+    for (int k = 0; k < warmup + steps; ++k) integrator.step();
+    const Eigen::VectorXd& u = integrator.displacement();
+    if (!u.allFinite())
+      throw asyncfem::Error(scene.name + ": displacement not finite after " + std::to_string(warmup + steps) +
+                            " steps");
+    std::ofstream displacement = open(reuse ? ".reuse.u" : ".u");
+    for (Eigen::Index i = 0; i < u.size(); ++i) displacement << u[i] << '\n';
+    if (!reuse) exact = u;
+  }
   std::printf(
-      "%s: wrote %s/%s.{veg,fixed,params,u} (%d vertices, %d tets, %d fixed DOFs; u after %d steps, max |u| %.6f)\n",
+      "%s: wrote %s/%s.{veg,fixed,params,u,reuse.u} (%d vertices, %d tets, %d fixed DOFs; u after %d steps, max |u| "
+      "%.6f)\n",
       scene.name.c_str(), dir.string().c_str(), scene.name.c_str(), scene.mesh.numVertices(), scene.mesh.numElements(),
-      scene.freeDofs.numFixed(), warmup + steps, u.lpNorm<Eigen::Infinity>());
+      scene.freeDofs.numFixed(), warmup + steps, exact.lpNorm<Eigen::Infinity>());
 }
 
 }  // namespace
