@@ -31,6 +31,7 @@
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -398,7 +399,12 @@ int main(int argc, char** argv) {
         makeScene("dragon-sized", Eigen::Vector3d(3.2, 1.6, 1.4), Eigen::Vector3i(32, 16, 14), alpha, beta));
   }
   if (!writeDir.empty()) {
-    for (const Scene& scene : scenes) writeProblem(scene, writeDir, warmup, steps);
+    try {
+      for (const Scene& scene : scenes) writeProblem(scene, writeDir, warmup, steps);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "corotationalBenchmark --write-meshes %s: %s\n", writeDir.c_str(), error.what());
+      return 1;
+    }
     return 0;
   }
   if (!toolkitOnly.empty()) {
