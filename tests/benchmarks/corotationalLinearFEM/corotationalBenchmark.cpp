@@ -10,10 +10,16 @@
 // numeric factorization (the same CHOLMOD as the toolkit, so the comparison isolates
 // everything but the factorization library) and one solve per step.
 //
-// Usage: corotationalBenchmark [steps]   (default 30 timed steps per configuration)
+// Usage: corotationalBenchmark [STEPS] [--mesh NAME] [--rayleigh-mass A] [--rayleigh-stiffness B]
+//                              [--toolkit-only exact|reuse] [--write-meshes DIR]
+// (default 30 timed steps per configuration). --write-meshes writes each timed problem
+// for an external program (see writeProblem) and exits; --toolkit-only times one toolkit
+// configuration alone (for whole-process timing against another program).
 #include <omp.h>
 
+#include <CLI/CLI.hpp>
 #include <Eigen/Dense>
+#include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/core/threading.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
@@ -23,7 +29,10 @@
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/writers.hpp>
 #include <cstdio>
+#include <exception>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -40,6 +49,7 @@ using namespace asyncfem;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
 constexpr double kTimestep = 0.01;
+constexpr int kWarmupSteps = 5;
 const Eigen::Vector3d kGravity(0.0, 0.0, -9.81);
 
 struct Scene {
@@ -49,15 +59,18 @@ struct Scene {
   SparseMatrix mass;
   FreeDofs freeDofs;
   Eigen::VectorXd gravityForce;  // M g, full
+  double rayleighMass = 0.0;     // D = alpha M + beta K(u at the step start)
+  double rayleighStiffness = 0.0;
 };
 
 // A beam clamped at x = 0 that sags under gravity (rubber-like, so rotations are large).
-Scene makeScene(const std::string& name, const Eigen::Vector3d& size, const Eigen::Vector3i& cells) {
+Scene makeScene(const std::string& name, const Eigen::Vector3d& size, const Eigen::Vector3i& cells, double alpha,
+                double beta) {
   BoxMeshSpec spec;
   spec.size = size;
   spec.cells = cells;
   spec.material = Material{"rubber", 1000.0, 5e5, 0.45};
-  Scene scene{name, makeBoxMesh(spec), nullptr, {}, {}, {}};
+  Scene scene{name, makeBoxMesh(spec), nullptr, {}, {}, {}, alpha, beta};
   scene.assembler = std::make_shared<const MatrixAssembler>(scene.mesh);
   scene.mass = massMatrix(scene.mesh, *scene.assembler, MassType::consistent);
   std::vector<int> clamped;
@@ -145,7 +158,8 @@ class VegaStyleReference {
     }
   }
 
-  // One linearized backward Euler step (no damping), timing its phases.
+  // One linearized backward Euler step, timing its phases:
+  // (M + h D + h^2 K) dv = h (f_ext - f_int - D v - h K v), D = alpha M + beta K.
   void step(Eigen::VectorXd& u, Eigen::VectorXd& v) {
     Stopwatch watch;
     watch.start();
@@ -154,7 +168,9 @@ class VegaStyleReference {
     watch.start();
     extractor_.update(fullStiffness_, freeStiffness_);
     const double h = kTimestep;
-    systemMatrix_ = freeMass_ + (h * h) * freeStiffness_;
+    const double alpha = scene_.rayleighMass;
+    const double beta = scene_.rayleighStiffness;
+    systemMatrix_ = ((1.0 + (h * alpha)) * freeMass_) + (((h * beta) + (h * h)) * freeStiffness_);
     if (!analysed_) {
       solver_->analyzePattern(systemMatrix_);
       analysed_ = true;
@@ -164,8 +180,8 @@ class VegaStyleReference {
     watch.start();
     const FreeDofs& dofs = scene_.freeDofs;
     const Eigen::VectorXd freeV = dofs.restrict(v);
-    const Eigen::VectorXd rhs =
-        h * (dofs.restrict(scene_.gravityForce) - dofs.restrict(fullForces_) - h * (freeStiffness_ * freeV));
+    const Eigen::VectorXd rhs = h * (dofs.restrict(scene_.gravityForce) - dofs.restrict(fullForces_) -
+                                     (alpha * (freeMass_ * freeV)) - ((beta + h) * (freeStiffness_ * freeV)));
     const Eigen::VectorXd dv = solver_->solve(rhs);
     const Eigen::VectorXd newV = freeV + dv;
     v = dofs.expand(newV);
@@ -204,6 +220,8 @@ DynamicSystem toolkitSystem(const Scene& scene, RotationStart start = RotationSt
   system.forceModel = model;
   system.mass = scene.mass;
   system.freeDofs = scene.freeDofs;
+  system.rayleighMass = scene.rayleighMass;
+  system.rayleighStiffness = scene.rayleighStiffness;
   const Eigen::VectorXd gravity = scene.gravityForce;
   system.externalForce = [gravity](double, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& forces) {
     forces = gravity;
@@ -290,18 +308,116 @@ double scaledDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return (a - b).lpNorm<Eigen::Infinity>() / std::max(a.lpNorm<Eigen::Infinity>(), 1e-300);
 }
 
+// Writes the problem a run of this benchmark times, for an external program to run the
+// identical one: DIR/NAME.veg (the mesh and its material, writeVeg), DIR/NAME.fixed (the
+// fixed DOFs, 0-based global ids x 3 + coordinate, ascending, one a line), DIR/NAME.params
+// (material, time step, Rayleigh damping, gravity, step counts: `key value...` lines) and
+// DIR/NAME.u and DIR/NAME.reuse.u (the toolkit's displacement after warmup + steps steps
+// from rest, exact solves and reuseFactor at the default 1e-8; 17 significant digits, one
+// DOF a line).
+void writeProblem(const Scene& scene, const std::filesystem::path& dir, int warmup, int steps) {
+  std::filesystem::create_directories(dir);
+  writeVeg(dir / (scene.name + ".veg"), scene.mesh);
+  const auto open = [&](const std::string& extension) {
+    const std::filesystem::path path = dir / (scene.name + extension);
+    std::ofstream out(path);
+    if (!out) throw asyncfem::Error("cannot write " + path.string());
+    out.precision(17);
+    return out;
+  };
+  {
+    std::ofstream fixed = open(".fixed");
+    for (int dof = 0; dof < scene.mesh.numDofs(); ++dof) {
+      if (scene.freeDofs.isFixed(dof)) fixed << dof << '\n';
+    }
+  }
+  {
+    const Material& m = scene.mesh.elementMaterial(0);
+    std::ofstream params = open(".params");
+    params << "# corotational linear FEM (simple tangent R K R^T), consistent mass, external force M g,\n"
+           << "# from rest (u = v = 0), one linearized backward Euler step (one Newton iteration) per step\n"
+           << "youngsModulus " << m.youngsModulus << "\npoissonRatio " << m.poissonRatio << "\ndensity " << m.density
+           << "\ntimestep " << kTimestep << "\ndampingMass " << scene.rayleighMass << "\ndampingStiffness "
+           << scene.rayleighStiffness << "\ngravity " << kGravity.x() << ' ' << kGravity.y() << ' ' << kGravity.z()
+           << "\nwarmupSteps " << warmup << "\ntimedSteps " << steps << "\nfixedDofs " << scene.freeDofs.numFixed()
+           << '\n';
+  }
+  Eigen::VectorXd exact;
+  for (const bool reuse : {false, true}) {
+    IntegratorOptions options;
+    options.reuseFactor = reuse;
+    BackwardEuler integrator(toolkitSystem(scene), kTimestep, options);
+    for (int k = 0; k < warmup + steps; ++k) integrator.step();
+    const Eigen::VectorXd& u = integrator.displacement();
+    if (!u.allFinite())
+      throw asyncfem::Error(scene.name + ": displacement not finite after " + std::to_string(warmup + steps) +
+                            " steps");
+    std::ofstream displacement = open(reuse ? ".reuse.u" : ".u");
+    for (Eigen::Index i = 0; i < u.size(); ++i) displacement << u[i] << '\n';
+    if (!reuse) exact = u;
+  }
+  std::printf(
+      "%s: wrote %s/%s.{veg,fixed,params,u,reuse.u} (%d vertices, %d tets, %d fixed DOFs; u after %d steps, max |u| "
+      "%.6f)\n",
+      scene.name.c_str(), dir.string().c_str(), scene.name.c_str(), scene.mesh.numVertices(), scene.mesh.numElements(),
+      scene.freeDofs.numFixed(), warmup + steps, exact.lpNorm<Eigen::Infinity>());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   asyncfem::preferPassiveThreadWaiting(argv);
-  const int steps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 30;
-  const int warmup = 5;
+  CLI::App app{"Corotational backward Euler step of this toolkit against a Vega-style reference."};
+  int steps = 30;
+  std::string meshName = "all";
+  std::string writeDir;
+  std::string toolkitOnly;
+  double alpha = 0.0;
+  double beta = 0.0;
+  app.add_option("steps", steps, "Timed steps per configuration (after 5 warm-up steps)")->check(CLI::PositiveNumber);
+  app.add_option("--mesh", meshName, "Which mesh")->check(CLI::IsMember({"all", "bridge-sized", "dragon-sized"}));
+  app.add_option("--rayleigh-mass", alpha, "Rayleigh damping alpha (D = alpha M + beta K)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--rayleigh-stiffness", beta, "Rayleigh damping beta")->check(CLI::NonNegativeNumber);
+  app.add_option("--write-meshes", writeDir,
+                 "Write each problem (.veg, fixed DOFs, parameters, final displacement) to this folder and exit");
+  app.add_option("--toolkit-only", toolkitOnly, "Time only this toolkit configuration (exact or reuseFactor 1e-8)")
+      ->check(CLI::IsMember({"exact", "reuse"}));
+  CLI11_PARSE(app, argc, argv);
+  const int warmup = kWarmupSteps;
   const int threads = omp_get_max_threads();
-  std::printf("corotational backward Euler step, h = %g, %d warm-up + %d timed steps; %d OpenMP threads; %s; load %s\n",
-              kTimestep, warmup, steps, threads, cpuModel().c_str(), loadAverage().c_str());
+  std::printf(
+      "corotational backward Euler step, h = %g, %d warm-up + %d timed steps; Rayleigh alpha %g beta %g; %d OpenMP "
+      "threads; %s; load %s\n",
+      kTimestep, warmup, steps, alpha, beta, threads, cpuModel().c_str(), loadAverage().c_str());
   std::vector<Scene> scenes;
-  scenes.push_back(makeScene("bridge-sized", Eigen::Vector3d(4.8, 0.6, 0.7), Eigen::Vector3i(48, 6, 7)));
-  scenes.push_back(makeScene("dragon-sized", Eigen::Vector3d(3.2, 1.6, 1.4), Eigen::Vector3i(32, 16, 14)));
+  if (meshName != "dragon-sized") {
+    scenes.push_back(makeScene("bridge-sized", Eigen::Vector3d(4.8, 0.6, 0.7), Eigen::Vector3i(48, 6, 7), alpha, beta));
+  }
+  if (meshName != "bridge-sized") {
+    scenes.push_back(
+        makeScene("dragon-sized", Eigen::Vector3d(3.2, 1.6, 1.4), Eigen::Vector3i(32, 16, 14), alpha, beta));
+  }
+  if (!writeDir.empty()) {
+    try {
+      for (const Scene& scene : scenes) writeProblem(scene, writeDir, warmup, steps);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "corotationalBenchmark --write-meshes %s: %s\n", writeDir.c_str(), error.what());
+      return 1;
+    }
+    return 0;
+  }
+  if (!toolkitOnly.empty()) {
+    for (const Scene& scene : scenes) {
+      const Timing t = runToolkit(scene, warmup, steps, toolkitOnly == "reuse");
+      std::printf(
+          "%s, toolkit %s, per step (ms): elements %.2f, factor %.2f, solve %.2f, step %.2f; %lld factorizations, %lld "
+          "PCG iterations; max |u| %.6f\n",
+          scene.name.c_str(), toolkitOnly.c_str(), t.elementMs, t.factorMs, t.solveMs, t.stepMs, t.factorizations,
+          t.pcgIterations, t.finalDisplacement.lpNorm<Eigen::Infinity>());
+    }
+    return 0;
+  }
   for (const Scene& scene : scenes) {
     std::printf("\n%s: %d vertices, %d tets, %d free DOFs\n", scene.name.c_str(), scene.mesh.numVertices(),
                 scene.mesh.numElements(), scene.freeDofs.numFree());
@@ -348,7 +464,7 @@ int main(int argc, char** argv) {
                 reuse.factorCostInIterations);
   }
   // The exact and the factor-reusing path side by side over 100 steps of the bridge.
-  {
+  if (scenes.front().name == "bridge-sized") {
     const Scene& scene = scenes.front();
     IntegratorOptions reuseOptions;
     reuseOptions.reuseFactor = true;
