@@ -513,6 +513,8 @@ int run(int argc, char** argv) {
     firstFrame = static_cast<int>(asyncfem::resumeFromCheckpoint(scene.output.file, header, fingerprint,
                                                                  simulation.numFrames, *simulation.integrator));
     writer = asyncfem::SimulationWriter::continueFile(scene.output.file, header, firstFrame, writerOptions);
+    const std::string caveat = simulation.integrator->resumeCaveat();
+    if (!caveat.empty() && !options.quiet) std::printf("resume: %s\n", caveat.c_str());
   } else {
     writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, header, writerOptions);
     // The rest state, so that a run stopped before its first frame can be resumed too.

@@ -4,6 +4,7 @@
 #include <asyncfem/integrator/backwardEuler.hpp>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <string>
 
 #include "detail/freeSystem.hpp"
@@ -73,6 +74,15 @@ void BackwardEuler::assembleAndFactor() {
 }
 
 const FactorReuseStats* BackwardEuler::factorReuseStats() const { return reuse_ ? &reuse_->stats() : nullptr; }
+
+std::string BackwardEuler::resumeCaveat() const {
+  if (!reuse_) return {};
+  std::ostringstream text;
+  text << "reuseFactor: the factor kept as PCG preconditioner is not in the checkpoint, so the resumed run "
+          "refactors at its first step; its frames match an uninterrupted run to about the PCG tolerance ("
+       << options_.pcgTolerance << "), not bit for bit";
+  return text.str();
+}
 
 void BackwardEuler::assembleForReuse() {
   const double h = timestep_;

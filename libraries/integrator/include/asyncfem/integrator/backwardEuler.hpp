@@ -84,6 +84,9 @@ class BackwardEuler final : public Integrator {
   int lastLineSearchHalvings() const { return lastLineSearchHalvings_; }
   /// PCG and refactorization counters when options().reuseFactor is in effect, else null.
   const FactorReuseStats* factorReuseStats() const;
+  /// With reuseFactor in effect: the kept factor is no part of a checkpoint, so a resumed
+  /// run refactors at its first step and matches an uninterrupted one to the PCG tolerance.
+  std::string resumeCaveat() const override;
 
  private:
   void stepLinear();

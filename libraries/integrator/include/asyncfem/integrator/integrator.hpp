@@ -114,6 +114,10 @@ class Integrator {
   /// Lines the integrator adds to run summaries (set-up against steady-state cost,
   /// iterations, ...), each without a trailing newline; empty by default.
   virtual std::vector<std::string> runReport() const { return {}; }
+  /// Empty when a run resumed from a checkpoint (setState + setInternalState) continues
+  /// bit for bit; else one line saying how it differs (a kept factor that no checkpoint
+  /// holds), which drivers print when they resume.
+  virtual std::string resumeCaveat() const { return {}; }
   /// True when this configuration may gain energy from step to step (the asynchronous
   /// integrator with the paper's coupling): drivers then estimate the step growth first.
   virtual bool mayGainEnergy() const { return false; }
