@@ -71,8 +71,8 @@ struct AsyncOptions {
   /// Threads for the set-up and per-large-step rebuild (columns of Z in blocks, one A^S
   /// factor copy per block) and for the regions of a step: 0 = OpenMP's maximum.
   int threads = 0;
-  /// Nonlinear forces only. false (default): every large step recomputes Z and refactors
-  /// H^{LL*} (the paper's Algorithm 2). true: the factor of H^{LL*} from the last full
+  /// Nonlinear forces only. false: every large step recomputes Z and refactors H^{LL*}
+  /// (the paper's Algorithm 2). true (default): the factor of H^{LL*} from the last full
   /// rebuild is kept as a preconditioner and the Schur system of the current tangent is
   /// solved by preconditioned iterative refinement (each iteration: one forward substitution
   /// per region and one solve with the old factor) to a relative residual of
@@ -80,7 +80,7 @@ struct AsyncOptions {
   /// step does the full rebuild instead, and so does the next one after a slow
   /// convergence. A^S is refactored every step either way. The step then solves the
   /// coupled system to the tolerance instead of to round-off.
-  bool laggedSchur = false;
+  bool laggedSchur = true;
   int laggedSchurIterations = 8;
   double laggedSchurTolerance = 1e-10;
 };
