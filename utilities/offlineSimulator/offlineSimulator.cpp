@@ -286,7 +286,15 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
   out << "    solve         " << milliseconds(solve, frames) << "   ("
       << (after.solvedRightHandSides - before.solvedRightHandSides) << " right-hand sides)\n";
   out << "    output        " << milliseconds(outputSeconds, frames) << "\n";
-  out << "    other         " << milliseconds(other, frames) << "   (vector updates, loads, state checks)\n";
+  if (other >= 0.0) {
+    out << "    other         " << milliseconds(other, frames) << "   (vector updates, loads, state checks)\n";
+  } else {
+    // Phases timed on several threads at once (the regions of an asynchronous step, the
+    // blocks of Z) add up to more than the wall time: there is no remainder to show.
+    out << "    other                 -   (the phases above ran on several threads at once: their times add up to "
+        << std::setprecision(3) << 1000.0 * (loopSeconds - other) / frames
+        << " ms per frame, more than the wall time)\n";
+  }
   out << "  skipped:\n";
   for (const std::string& item : after.skipped) {
     out << "    - " << item << "\n";
