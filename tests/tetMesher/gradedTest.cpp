@@ -203,6 +203,22 @@ TEST(GradedLattice, IsDeterministicWhateverTheThreads) {
   EXPECT_EQ(a.restPositions(), b.restPositions());
 }
 
+TEST(GradedLattice, ASpacingFarTooSmallIsAnErrorNotAnExhaustedMachine) {
+  // The cube count is held to the lattice vertex limit while refining, before any large
+  // allocation (a real spacing 1e-4 against a 1 m model would hit the default 2e8).
+  MesherOptions options;
+  options.gradingLevels = 4;
+  options.maxLatticeVertices = 20'000;
+  try {
+    stuffIsosurface(implicitSphere(Vector3d::Zero(), 1.0),
+                    Eigen::AlignedBox3d(Vector3d::Constant(-1.1), Vector3d::Constant(1.1)), 0.01, options);
+    ADD_FAILURE() << "a lattice far over the limit was built";
+  } catch (const ValidationError& e) {
+    EXPECT_NE(std::string(e.what()).find("cubes at spacing"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("use a larger spacing"), std::string::npos) << e.what();
+  }
+}
+
 TEST(GradedLattice, BadLevelsAreErrors) {
   const ImplicitFunction sphere = implicitSphere(Vector3d::Zero(), 1.0);
   const Eigen::AlignedBox3d box(Vector3d::Constant(-1.1), Vector3d::Constant(1.1));

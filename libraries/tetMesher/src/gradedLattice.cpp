@@ -5,6 +5,7 @@
 #include <asyncfem/core/error.hpp>
 #include <cmath>
 #include <cstdlib>
+#include <string>
 
 namespace asyncfem::detail {
 
@@ -19,8 +20,13 @@ std::uint64_t GradedGrid::packKey(const Eigen::Vector3i& d) {
          (static_cast<std::uint64_t>(d.z()) << (2 * kKeyBits));
 }
 
-GradedGrid::GradedGrid(const Eigen::Vector3d& origin, double spacing, int levels, const Eigen::Array3i& roots)
-    : origin_(origin), spacing_(spacing), levels_(levels), roots_(roots) {
+GradedGrid::GradedGrid(const Eigen::Vector3d& origin, double spacing, int levels, const Eigen::Array3i& roots,
+                       long long maxCells)
+    : origin_(origin), spacing_(spacing), levels_(levels), roots_(roots), maxCells_(maxCells) {
+  if (static_cast<long long>(roots.prod()) > maxCells_) {
+    throw ValidationError("stuffIsosurface: the graded lattice would have " + std::to_string(roots.prod()) +
+                          " root cubes (limit " + std::to_string(maxCells_) + "); use a larger spacing");
+  }
   const long long rootSize = 2LL << levels;
   for (int a = 0; a < 3; ++a) {
     if (rootSize * roots[a] >= (1LL << kKeyBits)) {
@@ -55,6 +61,10 @@ int GradedGrid::locate(const Eigen::Vector3i& p) const {
 }
 
 void GradedGrid::split(int c) {
+  if (static_cast<long long>(cells_.size()) + 8 > maxCells_) {
+    throw ValidationError("stuffIsosurface: the graded lattice would have more than " + std::to_string(maxCells_) +
+                          " cubes at spacing " + std::to_string(spacing_) + "; use a larger spacing");
+  }
   const Cell parent = cells_[static_cast<std::size_t>(c)];
   const int half = size(parent) / 2;
   cells_[static_cast<std::size_t>(c)].firstChild = static_cast<int>(cells_.size());

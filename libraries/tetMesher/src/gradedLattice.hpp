@@ -44,7 +44,10 @@ struct GradedTetrahedra {
 class GradedGrid {
  public:
   /// Root cubes of 2^levels * spacing, `roots` of them along each axis, from `origin`.
-  GradedGrid(const Eigen::Vector3d& origin, double spacing, int levels, const Eigen::Array3i& roots);
+  /// Refinement that would make more than maxCells cubes (leaves and parents) throws a
+  /// ValidationError instead of exhausting memory.
+  GradedGrid(const Eigen::Vector3d& origin, double spacing, int levels, const Eigen::Array3i& roots,
+             long long maxCells);
 
   /// Splits, level by level, every cube of size s whose centre c has |f(c)| < s sqrt(3)/2 +
   /// band, so that (for a 1-Lipschitz f) every point within `band` of the surface lies in a
@@ -83,6 +86,7 @@ class GradedGrid {
   double spacing_;
   int levels_;
   Eigen::Array3i roots_;
+  long long maxCells_;
   std::vector<Cell> cells_;
   std::unordered_map<std::uint64_t, double> values_;
 };

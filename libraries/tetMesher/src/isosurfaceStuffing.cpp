@@ -584,7 +584,10 @@ TetMesh stuffGraded(const ImplicitFunction& f, const Eigen::AlignedBox3d& bounds
     }
     roots[a] = static_cast<int>(cells);
   }
-  detail::GradedGrid grid(origin, spacing, levels, roots);
+  // Every leaf cube brings about one black and one red lattice vertex: the cube count is
+  // held to the lattice vertex limit.
+  const long long maxCells = std::min<long long>(options.maxLatticeVertices, std::numeric_limits<std::int32_t>::max());
+  detail::GradedGrid grid(origin, spacing, levels, roots, maxCells);
   // Every point within one spacing of the surface gets a finest cube (for a 1-Lipschitz f,
   // as distances are). That keeps every tetrahedron outside the finest lattice at least half
   // a spacing from the surface, beyond the reach of warping (alphaShort * sqrt(3)/2 < 0.36
