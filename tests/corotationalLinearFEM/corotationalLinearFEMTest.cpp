@@ -24,30 +24,9 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 // Force on one vertex at unit strain: E h^2 with h the cell size.
 double forceScale(int cells) { return test::kYoungsModulus * test::cellSize(cells) * test::cellSize(cells); }
 
-Eigen::VectorXd forces(CorotationalLinearFEM& model, const Eigen::VectorXd& u) {
-  Eigen::VectorXd f;
-  model.internalForces(u, f);
-  return f;
-}
-
-Eigen::MatrixXd tangent(CorotationalLinearFEM& model, const Eigen::VectorXd& u) {
-  SparseMatrix k = model.createStiffnessMatrix();
-  model.tangentStiffness(u, k);
-  return Eigen::MatrixXd(k);
-}
-
-// Central differences of the forces, column j = (f(u + t e_j) - f(u - t e_j)) / 2t.
-Eigen::MatrixXd finiteDifferenceTangent(CorotationalLinearFEM& model, const Eigen::VectorXd& u, double step) {
-  Eigen::MatrixXd result(u.size(), u.size());
-  for (Eigen::Index j = 0; j < u.size(); ++j) {
-    Eigen::VectorXd plus = u;
-    Eigen::VectorXd minus = u;
-    plus[j] += step;
-    minus[j] -= step;
-    result.col(j) = (forces(model, plus) - forces(model, minus)) / (2.0 * step);
-  }
-  return result;
-}
+using test::finiteDifferenceTangent;
+using test::forces;
+using test::tangent;
 
 template <class Vector>
 bool bitIdentical(const Vector& a, const Vector& b) {

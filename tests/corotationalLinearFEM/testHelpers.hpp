@@ -9,6 +9,8 @@
 #include <random>
 #include <vector>
 
+#include "../common/forceModelTestHelpers.hpp"
+
 namespace asyncfem::test {
 
 /// Young's modulus and the edge length of the cubes of smallBox(); the force scale of
@@ -27,14 +29,6 @@ inline TetMesh smallBox(int cells) {
 /// Largest cell edge of smallBox(cells).
 inline double cellSize(int cells) { return 1.0 / cells; }
 
-/// A uniformly distributed rotation (normalised Gaussian quaternion), reproducible.
-inline Eigen::Matrix3d randomRotation(std::mt19937& random) {
-  std::normal_distribution<double> normal;
-  Eigen::Quaterniond q(normal(random), normal(random), normal(random), normal(random));
-  q.normalize();
-  return q.toRotationMatrix();
-}
-
 /// Displacement (3n) of the rigid motion x = Q X + t.
 inline Eigen::VectorXd rigidDisplacement(const TetMesh& mesh, const Eigen::Matrix3d& rotation,
                                          const Eigen::Vector3d& translation) {
@@ -42,22 +36,6 @@ inline Eigen::VectorXd rigidDisplacement(const TetMesh& mesh, const Eigen::Matri
   for (int v = 0; v < mesh.numVertices(); ++v) {
     const Eigen::Vector3d x = mesh.restPosition(v);
     u.segment<3>(3 * v) = rotation * x + translation - x;
-  }
-  return u;
-}
-
-/// Displacement of x = Q (X + d) + t with d uniform in [-amplitude, amplitude]^3 per
-/// vertex: a random deformation (strain about amplitude / cell size) followed by a rigid
-/// motion.
-inline Eigen::VectorXd deformedDisplacement(const TetMesh& mesh, const Eigen::Matrix3d& rotation,
-                                            const Eigen::Vector3d& translation, double amplitude,
-                                            std::mt19937& random) {
-  std::uniform_real_distribution<double> offset(-amplitude, amplitude);
-  Eigen::VectorXd u(mesh.numDofs());
-  for (int v = 0; v < mesh.numVertices(); ++v) {
-    const Eigen::Vector3d x = mesh.restPosition(v);
-    const Eigen::Vector3d d(offset(random), offset(random), offset(random));
-    u.segment<3>(3 * v) = rotation * (x + d) + translation - x;
   }
   return u;
 }

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "../common/forceModelTestHelpers.hpp"
+
 namespace asyncfem::test {
 
 inline constexpr double kYoungsModulus = 2e6;
@@ -56,36 +58,10 @@ inline Eigen::VectorXd homogeneousDisplacement(const TetMesh& mesh, const Eigen:
   return u;
 }
 
-inline Eigen::Matrix3d randomRotation(std::mt19937& random) {
-  std::normal_distribution<double> normal;
-  Eigen::Quaterniond q(normal(random), normal(random), normal(random), normal(random));
-  q.normalize();
-  return q.toRotationMatrix();
-}
-
-/// x = Q (X + d) + t with d uniform in [-amplitude, amplitude]^3 per vertex.
+/// deformedDisplacement with the translation t = (0.1, -0.2, 0.3) these tests use.
 inline Eigen::VectorXd deformedDisplacement(const TetMesh& mesh, const Eigen::Matrix3d& rotation, double amplitude,
                                             std::mt19937& random) {
-  std::uniform_real_distribution<double> offset(-amplitude, amplitude);
-  Eigen::VectorXd u(mesh.numDofs());
-  for (int v = 0; v < mesh.numVertices(); ++v) {
-    const Eigen::Vector3d x = mesh.restPosition(v);
-    const Eigen::Vector3d d(offset(random), offset(random), offset(random));
-    u.segment<3>(3 * v) = rotation * (x + d) + Eigen::Vector3d(0.1, -0.2, 0.3) - x;
-  }
-  return u;
-}
-
-inline Eigen::VectorXd forces(ForceModel& model, const Eigen::VectorXd& u) {
-  Eigen::VectorXd f;
-  model.internalForces(u, f);
-  return f;
-}
-
-inline Eigen::MatrixXd tangent(ForceModel& model, const Eigen::VectorXd& u) {
-  Eigen::SparseMatrix<double> k = model.createStiffnessMatrix();
-  model.tangentStiffness(u, k);
-  return Eigen::MatrixXd(k);
+  return deformedDisplacement(mesh, rotation, Eigen::Vector3d(0.1, -0.2, 0.3), amplitude, random);
 }
 
 /// Central differences of the energy, component j = (E(u + t e_j) - E(u - t e_j)) / 2t.
@@ -97,19 +73,6 @@ inline Eigen::VectorXd finiteDifferenceForces(ForceModel& model, const Eigen::Ve
     plus[j] += step;
     minus[j] -= step;
     result[j] = (model.elasticEnergy(plus) - model.elasticEnergy(minus)) / (2.0 * step);
-  }
-  return result;
-}
-
-/// Central differences of the forces, column j = (f(u + t e_j) - f(u - t e_j)) / 2t.
-inline Eigen::MatrixXd finiteDifferenceTangent(ForceModel& model, const Eigen::VectorXd& u, double step) {
-  Eigen::MatrixXd result(u.size(), u.size());
-  for (Eigen::Index j = 0; j < u.size(); ++j) {
-    Eigen::VectorXd plus = u;
-    Eigen::VectorXd minus = u;
-    plus[j] += step;
-    minus[j] -= step;
-    result.col(j) = (forces(model, plus) - forces(model, minus)) / (2.0 * step);
   }
   return result;
 }
