@@ -251,25 +251,9 @@ std::shared_ptr<const Problem> buildProblem(const Scene& scene) {
   std::vector<VertexLoad> loads = collectLoads(scene, *mesh);
   ProblemSettings settings;
   settings.mass = scene.mass;
-  switch (scene.forceModel) {
-    case Scene::ForceModelKind::linear:
-      settings.forceModel = ForceModelType::linear;
-      break;
-    case Scene::ForceModelKind::corotational:
-      settings.forceModel = ForceModelType::corotational;
-      break;
-    case Scene::ForceModelKind::stvk:
-      settings.forceModel = ForceModelType::stvk;
-      break;
-    case Scene::ForceModelKind::neoHookean:
-      settings.forceModel = ForceModelType::neoHookean;
-      break;
-    case Scene::ForceModelKind::mooneyRivlin:
-      settings.forceModel = ForceModelType::mooneyRivlin;
-      break;
-  }
+  settings.forceModel = scene.forceModel;
   settings.hyperelastic = scene.hyperelastic;
-  settings.tangent = scene.tangent == Scene::Tangent::exact ? TangentKind::exact : TangentKind::simple;
+  settings.tangent = scene.tangent;
   settings.rayleighAlpha = scene.rayleighAlpha;
   settings.rayleighBeta = scene.rayleighBeta;
   settings.gravity = scene.gravity;

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
+#include <asyncfem/problem/problem.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/vertexSelection.hpp>
@@ -66,9 +67,10 @@ struct Scene {
     double time = 0.0;  ///< impulse: when it is delivered
   };
 
-  /// linear and corotational FEM, and the hyperelastic materials of library hyperelasticFEM.
-  enum class ForceModelKind { linear, corotational, stvk, neoHookean, mooneyRivlin };
-  enum class Tangent { simple, exact };
+  /// linear and corotational FEM, and the hyperelastic materials of library hyperelasticFEM:
+  /// the problem layer's own types, so that a scene's choice passes to ProblemSettings as is.
+  using ForceModelKind = ForceModelType;
+  using Tangent = TangentKind;
 
   /// Name of the scene for messages: the file name as given to loadScene, or the
   /// sourceName given to parseScene. Every error reads "<sourceName>: <key path>: ...".
