@@ -115,6 +115,7 @@ DynamicSystem Problem::dynamicSystem() const {
   system.freeDofs = freeDofs_;
   system.rayleighMass = settings_.rayleighAlpha;
   system.rayleighStiffness = settings_.rayleighBeta;
+  system.mesh = mesh_;
   std::shared_ptr<const Loads> external = loads();
   if (!external->empty()) {
     system.externalForce = [external](double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,

@@ -6,7 +6,7 @@
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/forceModel/forceModel.hpp>
 #include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
-#include <asyncfem/integrator/integrator.hpp>
+#include <asyncfem/dynamics/dynamicSystem.hpp>
 #include <asyncfem/problem/loads.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>

@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <asyncfem/forceModel/forceModel.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <functional>
+#include <memory>
+
+namespace asyncfem {
+
+/// External force as a function of time and state: adds its contribution to forces
+/// (size 3n, zeroed by the caller). The state arguments let explicit force terms
+/// (penalty contact, springs) depend on it; time-only loads ignore them.
+using ExternalForceFunction = std::function<void(double time, const Eigen::VectorXd& displacement,
+                                                 const Eigen::VectorXd& velocity, Eigen::VectorXd& forces)>;
+
+/// The body an integrator advances: M a + D v + f_int(u) = f_ext(t), with
+/// D = alpha M + beta K (K the tangent stiffness at the start of a step) and the DOFs in
+/// freeDofs' fixed list held at zero displacement and velocity. What it is, not how it is
+/// stepped: the steppers (library integrator and above) take it by value.
+struct DynamicSystem {
+  std::shared_ptr<ForceModel> forceModel;
+  Eigen::SparseMatrix<double> mass;  ///< 3n x 3n, in the force model's stiffness pattern
+  FreeDofs freeDofs;
+  double rayleighMass = 0.0;            ///< alpha (1/s)
+  double rayleighStiffness = 0.0;       ///< beta (s)
+  ExternalForceFunction externalForce;  ///< may be empty: no external force
+  /// The mesh the matrices were built from (n vertices). Integrators that partition the
+  /// body by vertices or elements (the multirate ones) need it; single-rate ones do not,
+  /// so it may be null for a system built from matrices alone.
+  std::shared_ptr<const TetMesh> mesh;
+
+  int numDofs() const { return static_cast<int>(mass.rows()); }
+  bool damped() const { return rayleighMass != 0.0 || rayleighStiffness != 0.0; }
+  /// Throws asyncfem::ValidationError if sizes disagree (the mesh's too, when there is
+  /// one) or alpha, beta < 0.
+  void validate() const;
+};
+
+}  // namespace asyncfem
