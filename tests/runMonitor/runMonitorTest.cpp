@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <gtest/gtest.h>
 
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/integrator/factory.hpp>
 #include <asyncfem/runMonitor/runMonitor.hpp>
@@ -103,8 +104,8 @@ TEST(RunMonitor, EnergyGrowthAfterTheLoadsIsAnErrorAndNotBefore) {
 }
 
 /// A scripted integrator that reports one fast region holding the "tip" vertices, as
-/// multirate integrators do through the Integrator interface.
-class ScriptedMultirate : public ScriptedIntegrator {
+/// multirate integrators do through the MultirateIntegrator interface.
+class ScriptedMultirate : public ScriptedIntegrator, public MultirateIntegrator {
  public:
   ScriptedMultirate(DynamicSystem system, double h, Script script, std::vector<int> tip)
       : ScriptedIntegrator(std::move(system), h, std::move(script)), tip_(std::move(tip)) {}
@@ -112,6 +113,7 @@ class ScriptedMultirate : public ScriptedIntegrator {
   int regionOfVertex(int vertex) const override {
     return std::binary_search(tip_.begin(), tip_.end(), vertex) ? 0 : -1;
   }
+  const MultirateIntegrator* multirate() const override { return this; }
 
  private:
   std::vector<int> tip_;

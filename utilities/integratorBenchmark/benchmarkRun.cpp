@@ -2,6 +2,7 @@
 #include "benchmarkRun.hpp"
 
 #include <algorithm>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
 #include <asyncfem/core/error.hpp>
@@ -276,10 +277,10 @@ RunResult runConfiguration(const Scene& scene, const Configuration& configuratio
       result.solvesPerFrame = static_cast<double>(end.solvedRightHandSides - afterWarmUp.solvedRightHandSides) / count;
       result.factorFlopsPerFrame = (end.factorFlops - afterWarmUp.factorFlops) / count;
       result.solveFlopsPerFrame = (end.solveFlops - afterWarmUp.solveFlops) / count;
-      result.factorNonZeros = integrator.factorNonZeros();
+      result.factorNonZeros = integrator.report().factorNonZeros;
       std::ostringstream ratios;
       bool first = true;
-      for (const RegionSummary& region : integrator.regionSummaries()) {
+      for (const RegionSummary& region : regionSummaries(integrator)) {
         ratios << (first ? "" : ",") << region.ratio;
         first = false;
       }

@@ -19,6 +19,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/core/threading.hpp>
@@ -257,7 +258,7 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
                                                                             : " (simple tangent)")
       << ", " << (scene.mass == asyncfem::MassType::lumped ? "lumped" : "consistent") << " mass, integrator "
       << simulation.integrator->name() << "\n";
-  const std::vector<asyncfem::RegionSummary> regions = simulation.integrator->regionSummaries();
+  const std::vector<asyncfem::RegionSummary> regions = asyncfem::regionSummaries(*simulation.integrator);
   if (!regions.empty()) {
     out << "  regions     " << regions.size() << " fast region" << (regions.size() == 1 ? "" : "s") << " (the rest, L, "
         << "steps at h):\n";
@@ -267,7 +268,7 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
           << region.interfaceDofs << " interface DOFs, m = " << region.ratio << " (h / " << region.ratio << ")\n";
     }
   }
-  for (const std::string& line : simulation.integrator->runReport()) out << "  integrator  " << line << "\n";
+  for (const std::string& line : simulation.integrator->report().lines) out << "  integrator  " << line << "\n";
   out << "  setup       " << setupSeconds << " s (mesh, matrices, first factorization: " << before.factorizationSeconds
       << " s)\n";
   if (couplingCheck) {
@@ -521,7 +522,7 @@ int run(int argc, char** argv) {
     firstFrame = static_cast<int>(asyncfem::resumeFromCheckpoint(scene.output.file, header, fingerprint,
                                                                  simulation.numFrames, *simulation.integrator));
     writer = asyncfem::SimulationWriter::continueFile(scene.output.file, header, firstFrame, writerOptions);
-    const std::string caveat = simulation.integrator->resumeCaveat();
+    const std::string caveat = simulation.integrator->report().resumeCaveat;
     if (!caveat.empty() && !options.quiet) std::printf("resume: %s\n", caveat.c_str());
   } else {
     writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, header, writerOptions);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <string>
 
+#include "detail/fastRegion.hpp"
 #include "detail/multirateSupport.hpp"
 
 namespace asyncfem {
@@ -19,17 +20,9 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 using detail::gather;
 using detail::updateBlock;
 
-/// The blocks one fast region needs for its lone substeps r >= 2 (I: its interface DOFs).
-struct RegionBlocks {
-  int ratio = 1;
-  double smallStep = 0.0;
-  SubmatrixExtractor massSS, massSI, stiffSS, stiffSI;
-  SparseMatrix Mss, Msi, Kss, Ksi;
-  bool cut = false;           // K blocks extracted once; later only their values are updated
-  SparseMatrix systemMatrix;  // A^S
-  std::unique_ptr<SparseSolver> solver;
-  bool analyzed = false;
-};
+/// The blocks one fast region needs for its lone substeps r >= 2 (I: its interface DOFs):
+/// M^{SS}, M^{SI}, K^{SS}, K^{SI} and A^S of the asynchronous integrator's FastRegion.
+using RegionBlocks = detail::FastRegion;
 
 }  // namespace
 
@@ -50,14 +43,14 @@ struct UncoupledMultirate::Impl {
 
 UncoupledMultirate::UncoupledMultirate(const TetMesh& mesh, DynamicSystem system, double largeTimestep,
                                        std::vector<AsyncRegion> regions, UncoupledMultirateOptions options)
-    : Integrator(std::move(system), largeTimestep),
-      partition_(mesh, system_.freeDofs, std::move(regions)),
+    : UncoupledMultirate(withMesh("multirate-uncoupled", mesh, std::move(system)), largeTimestep, std::move(regions),
+                         options) {}
+
+UncoupledMultirate::UncoupledMultirate(DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions,
+                                       UncoupledMultirateOptions options)
+    : PartitionedIntegrator("multirate-uncoupled", std::move(system), largeTimestep, std::move(regions)),
       options_(options),
       impl_(std::make_unique<Impl>()) {
-  if (mesh.numDofs() != system_.numDofs()) {
-    throw ValidationError("multirate-uncoupled integrator: mesh has " + std::to_string(mesh.numDofs()) +
-                          " DOFs but the dynamic system has " + std::to_string(system_.numDofs()));
-  }
   Impl& d = *impl_;
   d.linear = system_.forceModel->isLinear();
   d.stiffness = system_.forceModel->createStiffnessMatrix();
@@ -71,19 +64,10 @@ UncoupledMultirate::UncoupledMultirate(const TetMesh& mesh, DynamicSystem system
     d.freeRegion[k] = partition_.vertexRegion()[static_cast<std::size_t>(free[k] / 3)];
   }
   d.compoundSolver = makeSparseSolver(options_.compoundSolver);
-  d.regions.resize(static_cast<std::size_t>(partition_.numRegions()));
+  d.regions.reserve(static_cast<std::size_t>(partition_.numRegions()));
   for (int i = 0; i < partition_.numRegions(); ++i) {
-    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
-    const std::vector<int>& s = partition_.regionDofs(i);
-    const std::vector<int>& iface = partition_.interfaceDofs(i);
-    rb.ratio = partition_.ratio(i);
-    rb.massSS = SubmatrixExtractor(system_.mass, s, s);
-    rb.massSI = SubmatrixExtractor(system_.mass, s, iface);
-    rb.stiffSS = SubmatrixExtractor(d.stiffness, s, s);
-    rb.stiffSI = SubmatrixExtractor(d.stiffness, s, iface);
-    rb.Mss = rb.massSS.extract(system_.mass);
-    rb.Msi = rb.massSI.extract(system_.mass);
-    rb.solver = makeSparseSolver(options_.regionSolver);
+    const detail::RegionLayout layout{&partition_.regionDofs(i), &partition_.interfaceDofs(i), partition_.ratio(i)};
+    d.regions.emplace_back(system_.mass, d.stiffness, layout, options_.regionSolver);
   }
   if (!system_.damped()) stats_.skipped.push_back("damping terms (alpha = beta = 0)");
   if (d.linear) stats_.skipped.push_back("per-step refactorization (linear forces: factored once)");
@@ -129,9 +113,7 @@ void UncoupledMultirate::rebuild() {
   for (RegionBlocks& rb : d.regions) {
     rb.smallStep = hL / rb.ratio;
     const double hS = rb.smallStep;
-    updateBlock(rb.stiffSS, d.stiffness, rb.Kss, rb.cut);
-    updateBlock(rb.stiffSI, d.stiffness, rb.Ksi, rb.cut);
-    rb.cut = true;
+    rb.updateStiffnessBlocks(d.stiffness);
     rb.systemMatrix = (1.0 + hS * alpha) * rb.Mss + (hS * hS + hS * beta) * rb.Kss;
     rb.systemMatrix.makeCompressed();
   }
@@ -244,15 +226,17 @@ void UncoupledMultirate::step() {
   }
   stats_.solveSeconds += solve.stop();
 
-  detail::checkFiniteState("multirate-uncoupled", newU, newV, t1);
-  displacement_ = std::move(newU);
-  velocity_ = std::move(newV);
-  advanceTime();
-  ++stats_.steps;
+  commitStep(newU, newV);
   stats_.solvedRightHandSides = 0;
   stats_.solveFlops = 0.0;
   detail::addSolveCounts(*d.compoundSolver, stats_);
   for (const RegionBlocks& rb : d.regions) detail::addSolveCounts(*rb.solver, stats_);
+}
+
+RunReport UncoupledMultirate::report() const {
+  RunReport report;
+  report.factorNonZeros = factorNonZeros();
+  return report;
 }
 
 long long UncoupledMultirate::factorNonZeros() const {

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
+#include <asyncfem/integrator/stepFormula.hpp>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -64,30 +65,34 @@ void BackwardEuler::setTimestep(double timestep) {
   if (timestep != previous) factorizationStale_ = true;
 }
 
+void BackwardEuler::assembleSystemMatrix() {
+  const stepFormula::MatrixWeights weights =
+      stepFormula::backwardEuler::systemMatrix(timestep_, system_.rayleighMass, system_.rayleighStiffness);
+  free_->assemble({weights.mass, weights.stiffness}, {&free_->mass, &free_->stiffness}, stats_);
+}
+
 void BackwardEuler::assembleAndFactor() {
-  const double h = timestep_;
-  // M + h D + h^2 K = (1 + h alpha) M + (h beta + h^2) K
-  free_->assemble({1.0 + (h * system_.rayleighMass), (h * system_.rayleighStiffness) + (h * h)},
-                  {&free_->mass, &free_->stiffness}, stats_);
+  assembleSystemMatrix();
   free_->factorize(stats_);
   factorizationStale_ = false;
 }
 
 const FactorReuseStats* BackwardEuler::factorReuseStats() const { return reuse_ ? &reuse_->stats() : nullptr; }
 
-std::string BackwardEuler::resumeCaveat() const {
-  if (!reuse_) return {};
+RunReport BackwardEuler::report() const {
+  RunReport report;
+  report.factorNonZeros = free_->solver().stats().factorNonZeros;
+  if (!reuse_) return report;
   std::ostringstream text;
   text << "reuseFactor: the factor kept as PCG preconditioner is not in the checkpoint, so the resumed run "
           "refactors at its first step; its frames match an uninterrupted run to about the PCG tolerance ("
        << options_.pcgTolerance << "), not bit for bit";
-  return text.str();
+  report.resumeCaveat = text.str();
+  return report;
 }
 
 void BackwardEuler::assembleForReuse() {
-  const double h = timestep_;
-  free_->assemble({1.0 + (h * system_.rayleighMass), (h * system_.rayleighStiffness) + (h * h)},
-                  {&free_->mass, &free_->stiffness}, stats_);
+  assembleSystemMatrix();
   updateReusedMatrix();
 }
 
@@ -137,14 +142,15 @@ void BackwardEuler::stepLinear() {
   }
   {
     // Fixed DOFs are zero, so the free rows of K u are K_ff u_f:
-    // b = h ( f_ext - K (u + (beta + h) v) - alpha M v ).
+    // b = h ( f_ext - K (u + (beta + h) v) - alpha M v ) (Eq. A1, stepFormula).
     TimeInto timer(stats_.forceSeconds);
-    work_ = u_ + (beta + h) * v_;
+    const stepFormula::RightHandSide recipe = stepFormula::backwardEuler::rightHandSide(h, beta);
+    work_ = u_ + recipe.velocityStiffness * v_;
     // A serial product on purpose: an OpenMP one leaves spinning threads that compete
     // with the solver's BLAS threads in the back-substitution right after it.
     rhs_.noalias() -= free_->stiffness * work_;
     if (alpha != 0.0) rhs_.noalias() -= alpha * (free_->mass * v_);
-    rhs_ *= h;
+    rhs_ *= recipe.scale;
   }
   free_->solve(rhs_, dv_, stats_);
   v_ += dv_;
@@ -154,11 +160,7 @@ void BackwardEuler::stepLinear() {
 
   detail::expandTo(dofs, u_, fullU_);
   detail::expandTo(dofs, v_, fullV_);
-  detail::checkFiniteState(fullU_, fullV_, stepEndTime(), name());
-  displacement_.swap(fullU_);
-  velocity_.swap(fullV_);
-  advanceTime();
-  ++stats_.steps;
+  commitStep(fullU_, fullV_);
 }
 
 void BackwardEuler::stepNonlinear() {
@@ -188,11 +190,12 @@ void BackwardEuler::stepNonlinear() {
   }
   {
     TimeInto timer(stats_.forceSeconds);
+    const stepFormula::RightHandSide recipe = stepFormula::backwardEuler::rightHandSide(h, beta);
     rhs_ = force_ - internal;
-    work_ = (beta + h) * v_;
+    work_ = recipe.velocityStiffness * v_;
     rhs_.noalias() -= free.stiffness * work_;
     if (alpha != 0.0) rhs_.noalias() -= alpha * (free.mass * v_);
-    rhs_ *= h;
+    rhs_ *= recipe.scale;
   }
   const double rhsNorm = rhs_.norm();
   if (reuse_) {
@@ -264,11 +267,7 @@ void BackwardEuler::stepNonlinear() {
   u_ += h * v_;
   detail::expandTo(dofs, u_, fullU_);
   detail::expandTo(dofs, v_, fullV_);
-  detail::checkFiniteState(fullU_, fullV_, stepEndTime(), name());
-  displacement_.swap(fullU_);
-  velocity_.swap(fullV_);
-  advanceTime();
-  ++stats_.steps;
+  commitStep(fullU_, fullV_);
 }
 
 double BackwardEuler::incrementalPotential(const Eigen::VectorXd& dv) {

@@ -61,12 +61,8 @@ void CentralDifferences::step() {
   // v_{k+1} = v_{k+1/2} + h/2 a_{k+1}
   v_ += (0.5 * h) * newAcceleration;
   detail::expandTo(dofs, v_, fullV_);
-  detail::checkFiniteState(fullU_, fullV_, stepEndTime(), name());
-  displacement_.swap(fullU_);
-  velocity_.swap(fullV_);
+  commitStep(fullU_, fullV_);
   acceleration_.swap(newAcceleration);
-  advanceTime();
-  ++stats_.steps;
 }
 
 }  // namespace asyncfem

@@ -7,24 +7,6 @@
 
 namespace asyncfem {
 
-void DynamicSystem::validate() const {
-  if (!forceModel) throw ValidationError("dynamic system has no force model");
-  const int n = forceModel->numDofs();
-  if (mass.rows() != n || mass.cols() != n) {
-    throw ValidationError("mass matrix is " + std::to_string(mass.rows()) + " x " + std::to_string(mass.cols()) +
-                          " but the force model has " + std::to_string(n) + " DOFs");
-  }
-  if (freeDofs.numDofs() != n) {
-    throw ValidationError("free-DOF map covers " + std::to_string(freeDofs.numDofs()) + " DOFs, expected " +
-                          std::to_string(n));
-  }
-  if (!(rayleighMass >= 0.0) || !(rayleighStiffness >= 0.0) || !std::isfinite(rayleighMass) ||
-      !std::isfinite(rayleighStiffness)) {
-    throw ValidationError("Rayleigh damping coefficients must be finite and >= 0 (alpha " +
-                          std::to_string(rayleighMass) + ", beta " + std::to_string(rayleighStiffness) + ")");
-  }
-}
-
 Integrator::Integrator(DynamicSystem system, double timestep) : system_(std::move(system)) {
   system_.validate();
   system_.mass.makeCompressed();
@@ -54,6 +36,33 @@ void Integrator::restartTimeGrid() {
     timeOrigin_ = time_;
     stepIndex_ = 0;
   }
+}
+
+namespace {
+const char* coordinateName(int c) { return c == 0 ? "x" : (c == 1 ? "y" : "z"); }
+
+void checkFinite(const Eigen::VectorXd& vector, const char* what, double time, const std::string& integratorName) {
+  for (Eigen::Index i = 0; i < vector.size(); ++i) {
+    if (!std::isfinite(vector[i])) {
+      const int dof = static_cast<int>(i);
+      throw NumericalError(integratorName + ": non-finite " + what + " (" + std::to_string(vector[i]) +
+                               ") in the step to time " + std::to_string(time) + " at DOF " + std::to_string(dof) +
+                               " (vertex " + std::to_string(dof / 3) + ", coordinate " + coordinateName(dof % 3) +
+                               "); the state was left at the start of the step",
+                           NumericalErrorLocation{time, -1, -1, dof, dof / 3, -1, {}});
+    }
+  }
+}
+}  // namespace
+
+void Integrator::commitStep(Eigen::VectorXd& displacement, Eigen::VectorXd& velocity) {
+  const double time = stepEndTime();
+  checkFinite(displacement, "displacement", time, name());
+  checkFinite(velocity, "velocity", time, name());
+  displacement_.swap(displacement);
+  velocity_.swap(velocity);
+  advanceTime();
+  ++stats_.steps;
 }
 
 double Integrator::stepEndTime() const { return timeOrigin_ + (static_cast<double>(stepIndex_ + 1) * timestep_); }

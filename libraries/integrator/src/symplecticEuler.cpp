@@ -31,11 +31,7 @@ void SymplecticEuler::step() {
   u_ += h * v_;
   detail::expandTo(dofs, u_, fullU_);
   detail::expandTo(dofs, v_, fullV_);
-  detail::checkFiniteState(fullU_, fullV_, stepEndTime(), name());
-  displacement_.swap(fullU_);
-  velocity_.swap(fullV_);
-  advanceTime();
-  ++stats_.steps;
+  commitStep(fullU_, fullV_);
 }
 
 }  // namespace asyncfem

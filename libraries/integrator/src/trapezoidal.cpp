@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/integrator/stepFormula.hpp>
 #include <asyncfem/integrator/trapezoidal.hpp>
 #include <string>
 
@@ -32,6 +33,12 @@ Trapezoidal::Trapezoidal(DynamicSystem system, double timestep, const Integrator
 
 Trapezoidal::~Trapezoidal() = default;
 
+RunReport Trapezoidal::report() const {
+  RunReport report;
+  report.factorNonZeros = free_->solver().stats().factorNonZeros;
+  return report;
+}
+
 void Trapezoidal::setTimestep(double timestep) {
   const double previous = timestep_;
   Integrator::setTimestep(timestep);
@@ -39,10 +46,10 @@ void Trapezoidal::setTimestep(double timestep) {
 }
 
 void Trapezoidal::assembleAndFactor() {
-  const double h = timestep_;
-  // M + h/2 D + h^2/4 K = (1 + h alpha / 2) M + (h beta / 2 + h^2 / 4) K
-  free_->assemble({1.0 + (0.5 * h * system_.rayleighMass), (0.5 * h * system_.rayleighStiffness) + (0.25 * h * h)},
-                  {&free_->mass, &free_->stiffness}, stats_);
+  // M + h/2 D + h^2/4 K (Eq. A1t)
+  const stepFormula::MatrixWeights weights =
+      stepFormula::trapezoidal::systemMatrix(timestep_, system_.rayleighMass, system_.rayleighStiffness);
+  free_->assemble({weights.mass, weights.stiffness}, {&free_->mass, &free_->stiffness}, stats_);
   free_->factorize(stats_);
   factorizationStale_ = false;
 }
@@ -112,12 +119,13 @@ void Trapezoidal::step() {
     force_.setZero(u_.size());
   }
 
+  // b = f_ext - f_int(u) - K (beta (v + h/2 a) + h v + h^2/4 a) - alpha M (v + h/2 a) (Eq. A1t)
+  const stepFormula::RightHandSide recipe = stepFormula::trapezoidal::rightHandSide(h, beta);
   if (linear_) {
     if (factorizationStale_) assembleAndFactor();
     TimeInto timer(stats_.forceSeconds);
-    // b = f_ext - K (u + beta (v + h/2 a) + h v + h^2/4 a) - alpha M (v + h/2 a)
     rhs_ = force_;
-    work_ = u_ + (beta + h) * v_ + (0.5 * h * beta + 0.25 * h * h) * a_;
+    work_ = u_ + recipe.velocityStiffness * v_ + recipe.accelerationStiffness * a_;
     rhs_.noalias() -= free.stiffness * work_;
   } else {
     free.evaluateForcesAndTangent(system_, displacement_, free.stiffness, stats_);
@@ -125,12 +133,12 @@ void Trapezoidal::step() {
     assembleAndFactor();
     TimeInto timer(stats_.forceSeconds);
     rhs_ = force_ - internal_;
-    work_ = (beta + h) * v_ + (0.5 * h * beta + 0.25 * h * h) * a_;
+    work_ = recipe.velocityStiffness * v_ + recipe.accelerationStiffness * a_;
     rhs_.noalias() -= free.stiffness * work_;
   }
   if (alpha != 0.0) {
     TimeInto timer(stats_.forceSeconds);
-    work_ = v_ + (0.5 * h) * a_;
+    work_ = v_ + recipe.accelerationMass * a_;
     rhs_.noalias() -= alpha * (free.mass * work_);
   }
   const double rhsNorm = rhs_.norm();
@@ -174,17 +182,13 @@ void Trapezoidal::step() {
 
   // u_{k+1} = u + h v + h^2/4 (a + a_new), v_{k+1} = v + h/2 (a + a_new)
   work_ = a_ + newA_;
-  u_ += h * v_ + (0.25 * h * h) * work_;
-  v_ += (0.5 * h) * work_;
+  u_ += h * v_ + stepFormula::trapezoidal::displacementWeight(h) * work_;
+  v_ += stepFormula::trapezoidal::velocityWeight(h) * work_;
   detail::expandTo(dofs, u_, fullU_);
   detail::expandTo(dofs, v_, fullV_);
   detail::expandTo(dofs, newA_, fullA_);
-  detail::checkFiniteState(fullU_, fullV_, stepEndTime(), name());
-  displacement_.swap(fullU_);
-  velocity_.swap(fullV_);
+  commitStep(fullU_, fullV_);
   acceleration_.swap(fullA_);
-  advanceTime();
-  ++stats_.steps;
 }
 
 }  // namespace asyncfem

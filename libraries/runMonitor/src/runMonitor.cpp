@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/runMonitor/runMonitor.hpp>
 #include <asyncfem/simulationIO/crc32.hpp>
@@ -53,9 +54,9 @@ std::vector<std::string> RunMonitor::skipped() const {
 std::string RunMonitor::describeVertex(const Integrator& integrator, int vertex) const {
   std::ostringstream out;
   out << "vertex " << vertex;
-  const std::vector<RegionSummary> regions = integrator.regionSummaries();
+  const std::vector<RegionSummary> regions = regionSummaries(integrator);
   if (!regions.empty()) {
-    const int region = integrator.regionOfVertex(vertex);
+    const int region = regionOfVertex(integrator, vertex);
     if (region >= 0 && region < static_cast<int>(regions.size())) {
       out << " in fast region S_" << (region + 1) << " '" << regions[static_cast<std::size_t>(region)].name << "'";
     } else {
@@ -81,8 +82,8 @@ NumericalErrorLocation RunMonitor::locate(const Integrator& integrator, long lon
   location.time = time;
   location.vertex = vertex;
   if (vertex >= 0) {
-    location.region = integrator.regionOfVertex(vertex);
-    const std::vector<RegionSummary> regions = integrator.regionSummaries();
+    location.region = regionOfVertex(integrator, vertex);
+    const std::vector<RegionSummary> regions = regionSummaries(integrator);
     if (location.region >= 0 && location.region < static_cast<int>(regions.size())) {
       location.regionName = regions[static_cast<std::size_t>(location.region)].name;
     }

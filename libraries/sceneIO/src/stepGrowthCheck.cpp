@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/stepGrowthCheck.hpp>
 #include <sstream>
@@ -18,12 +19,12 @@ StepGrowthEstimate estimateSceneStepGrowth(const Scene& scene, const Simulation&
 
 std::optional<PaperCouplingCheck> checkPaperCoupling(const Scene& scene, const Simulation& simulation,
                                                      const IntegratorRegistry& registry) {
-  if (!simulation.integrator->mayGainEnergy()) return std::nullopt;
+  if (!simulation.integrator->report().mayGainEnergy) return std::nullopt;
   PaperCouplingCheck check;
   check.estimate = estimateSceneStepGrowth(scene, simulation, {}, registry);
   std::ostringstream regions;
   bool first = true;
-  for (const RegionSummary& region : simulation.integrator->regionSummaries()) {
+  for (const RegionSummary& region : regionSummaries(*simulation.integrator)) {
     regions << (first ? "" : ", ") << region.name << " (m = " << region.ratio << ")";
     first = false;
   }

@@ -69,15 +69,4 @@ inline void addSolveCounts(const SparseSolver& solver, IntegratorStats& stats) {
   stats.solveFlops += static_cast<double>(solver.stats().solvedRightHandSides) * solver.stats().solveFlopsPerRhs;
 }
 
-/// Throws NumericalError naming the integrator, the time and the first non-finite entry.
-inline void checkFiniteState(const std::string& integrator, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
-                             double time) {
-  for (Eigen::Index k = 0; k < u.size(); ++k) {
-    if (!std::isfinite(u[k]) || !std::isfinite(v[k])) {
-      throw NumericalError(integrator + " integrator: non-finite state at t = " + std::to_string(time) + " (vertex " +
-                           std::to_string(k / 3) + ", coordinate " + std::to_string(k % 3) + ")");
-    }
-  }
-}
-
 }  // namespace asyncfem::detail

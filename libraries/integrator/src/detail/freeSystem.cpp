@@ -54,29 +54,6 @@ void expandTo(const FreeDofs& dofs, const Eigen::VectorXd& free, Eigen::VectorXd
   for (std::size_t i = 0; i < map.size(); ++i) full[map[i]] = free[static_cast<Eigen::Index>(i)];
 }
 
-namespace {
-const char* coordinateName(int c) { return c == 0 ? "x" : (c == 1 ? "y" : "z"); }
-
-void checkFinite(const Eigen::VectorXd& vector, const char* what, double time, const std::string& integratorName) {
-  for (Eigen::Index i = 0; i < vector.size(); ++i) {
-    if (!std::isfinite(vector[i])) {
-      const int dof = static_cast<int>(i);
-      throw NumericalError(integratorName + ": non-finite " + what + " (" + std::to_string(vector[i]) +
-                               ") in the step to time " + std::to_string(time) + " at DOF " + std::to_string(dof) +
-                               " (vertex " + std::to_string(dof / 3) + ", coordinate " + coordinateName(dof % 3) +
-                               "); the state was left at the start of the step",
-                           NumericalErrorLocation{time, -1, -1, dof, dof / 3, -1, {}});
-    }
-  }
-}
-}  // namespace
-
-void checkFiniteState(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, double time,
-                      const std::string& integratorName) {
-  checkFinite(displacement, "displacement", time, integratorName);
-  checkFinite(velocity, "velocity", time, integratorName);
-}
-
 FreeSystem::FreeSystem(const DynamicSystem& system, SolverKind solverKind) : solver_(makeSparseSolver(solverKind)) {
   fullStiffness_ = system.forceModel->createStiffnessMatrix();
   fullStiffness_.makeCompressed();

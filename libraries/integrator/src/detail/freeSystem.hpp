@@ -29,12 +29,6 @@ void restrictTo(const FreeDofs& dofs, const Eigen::VectorXd& full, Eigen::Vector
 /// full = free scattered to the full numbering, fixed entries exactly zero.
 void expandTo(const FreeDofs& dofs, const Eigen::VectorXd& free, Eigen::VectorXd& full);
 
-/// Throws asyncfem::NumericalError if displacement or velocity (full, 3n) has a
-/// non-finite entry, naming the integrator, the time the step was heading to, and the
-/// first bad DOF as vertex and coordinate.
-void checkFiniteState(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, double time,
-                      const std::string& integratorName);
-
 /// Adds the wall time of its lifetime to a stats field (one of IntegratorStats' seconds).
 class TimeInto {
  public:

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <asyncfem/asyncIntegrator/asyncOptions.hpp>
+#include <asyncfem/asyncIntegrator/partitionedIntegrator.hpp>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
@@ -11,117 +13,6 @@
 #include <vector>
 
 namespace asyncfem {
-
-/// How H^{LL*} = A^L - sum_i H^{L S_i} (H^{S_i S_i})^{-1} H^{S_i L} is factored.
-enum class SchurMode {
-  /// Exact, and the default. For the stable coupling, whose H^{LL*} is symmetric, this is
-  /// a Cholesky factor of H^{LL*} itself (what `symmetric` does; one sparse solve per step;
-  /// lu if the corrections are measurably unsymmetric, above 1e-10). For the paper's
-  /// coupling: H^{LL*} = A^L - U C U^T differs from the SPD A^L only by the dense interface
-  /// block C, so A^L is factored by Cholesky and C enters through a q x q capacitance
-  /// matrix (q = interface DOFs; W = (A^L)^{-1} U, |L| x q, is stored). Falls back to lu
-  /// when W would exceed 512 MiB.
-  lowRank,
-  lu,  ///< exact: unsymmetric LU (UMFPACK) of H^{LL*} itself, as in the paper
-  /// Cholesky of the symmetric part of H^{LL*}, as in the paper: approximate for the paper
-  /// coupling; exact (to round-off) for the stable one, whose H^{LL*} is symmetric.
-  symmetric,
-};
-/// How one large step's block system is solved.
-enum class AsyncSolveMethod {
-  structured,  ///< forward substitution + Schur complement on L: O(m) per step
-  naive,       ///< the whole (sum_i 3 m_i |S_i| + 3|L|) system, LU: the reference
-};
-/// How the S unknowns are recovered once Y is known (structured method only).
-enum class RecoveryMode {
-  automatic,     ///< per region, whichever of the two below needs fewer flops (Z up to 128 MiB)
-  substitution,  ///< a second forward substitution (m_i sparse solves per region)
-  /// The end-of-step state needs only X_m and sum_r X_r: X_m = y_m - Z_m Y_I and
-  /// sum_r X_r = sum_r y_r - (sum_r Z_r) Y_I, with Z_m and sum_r Z_r stored densely
-  /// (2 |S_i| x |I_i|), 4 |S_i| |I_i| flops per step whatever m_i. With a substep observer
-  /// installed the substeps are recovered by substitution.
-  denseZ,
-};
-
-/// How a fast region and L exchange forces inside a large step (docs/asynchronous-integrator.md,
-/// section "Method", Eqs. A4-A12).
-enum class AsyncCoupling {
-  /// The default. L moves at its end-of-step velocity inside the large step, interface
-  /// elements are subcycled with S and L receives their force averaged over the substeps.
-  /// The discrete energy of a free linear run never increases, for every ratio m.
-  stable,
-  /// Zhao, Li & Barbic 2016 as published: L's velocity interpolated linearly, the interface
-  /// force on L taken at the end of the step. Only conditionally stable in m.
-  paper,
-};
-
-struct AsyncOptions {
-  AsyncCoupling coupling = AsyncCoupling::stable;
-  SchurMode schur = SchurMode::lowRank;
-  AsyncSolveMethod method = AsyncSolveMethod::structured;
-  RecoveryMode recovery = RecoveryMode::automatic;
-  SolverKind regionSolver = SolverKind::cholmod;  ///< factors A^{S_i} (SPD)
-  /// State passed to the external force function at substep r of a fast region: false
-  /// (default) passes the large step's start state (u_0, v_0), so state-dependent forces
-  /// such as penalty contact act once per large step, as in the paper; true passes the
-  /// predicted state (u_0 + r hS v_0, v_0), so contacts of S vertices are tested at every
-  /// substep (an explicit prediction: the substep states themselves are unknowns of the
-  /// implicit solve).
-  bool substepStatePrediction = false;
-  /// Threads for the set-up and per-large-step rebuild (columns of Z in blocks, one A^S
-  /// factor copy per block) and for the regions of a step: 0 = OpenMP's maximum.
-  int threads = 0;
-  /// Nonlinear forces only. false: every large step recomputes Z and refactors H^{LL*}
-  /// (the paper's Algorithm 2). true (default): the factor of H^{LL*} from the last full
-  /// rebuild is kept as a preconditioner and the Schur system of the current tangent is
-  /// solved by preconditioned iterative refinement (each iteration: one forward substitution
-  /// per region and one solve with the old factor) to a relative residual of
-  /// laggedSchurTolerance; when that takes more than laggedSchurIterations iterations the
-  /// step does the full rebuild instead, and so does the next one after a slow
-  /// convergence. A^S is refactored every step either way. The step then solves the
-  /// coupled system to the tolerance instead of to round-off.
-  bool laggedSchur = true;
-  int laggedSchurIterations = 8;
-  double laggedSchurTolerance = 1e-10;
-};
-
-/// Where an asynchronous run's time went, set-up apart from the steady-state steps (the
-/// IntegratorStats of stats() hold the same time split by kind of work).
-struct AsyncRunStats {
-  /// First build (blocks, A^{S_i} factors, Z, the Schur corrections C_i, the H^{LL*}
-  /// factor): the cost before the first step can be taken. Linear forces: paid once per
-  /// timestep; nonlinear: the first step's rebuild.
-  double setupSeconds = 0.0;
-  double setupZSeconds = 0.0;      ///< of setupSeconds: Z columns and C_i
-  double setupSchurSeconds = 0.0;  ///< of setupSeconds: assembling and factoring H^{LL*} (or A^L)
-  /// Per-large-step rebuilds after the first (nonlinear forces: refactor A^S, Z, H^{LL*}).
-  double rebuildSeconds = 0.0;
-  double rebuildZSeconds = 0.0;  ///< of rebuildSeconds: Z columns and C_i
-  long long rebuilds = 0;
-  /// Everything else step() spends (forces, right-hand sides, solves, state update).
-  double stepSeconds = 0.0;
-  long long steps = 0;
-  int fastDofs = 0;                   ///< sum_i |S_i|
-  int interfaceDofs = 0;              ///< sum_i |I_i|
-  int largeDofs = 0;                  ///< |L|
-  int zThreads = 1;                   ///< threads (A^S factor copies) the last Z computation used
-  long long zColumns = 0;             ///< right-hand sides of one Z computation: sum_i m_i |I_i|
-  long long laggedSteps = 0;          ///< steps solved with the lagged H^{LL*} (AsyncOptions::laggedSchur)
-  long long schurIterations = 0;      ///< iterative refinement iterations over those steps
-  double largestSchurResidual = 0.0;  ///< largest final relative residual of those steps
-  /// Mean seconds of a steady-state large step (stepSeconds / steps), and with rebuilds.
-  double meanStepSeconds() const { return steps > 0 ? stepSeconds / static_cast<double>(steps) : 0.0; }
-  double meanStepWithRebuildSeconds() const {
-    return steps > 0 ? (stepSeconds + rebuildSeconds) / static_cast<double>(steps) : 0.0;
-  }
-};
-
-/// Called after a large step for every substep r = 1..m_i of fast region i, only when a
-/// caller installed it: time of the substep and the region's displacement and velocity at
-/// it, ordered as partition().regionDofs(i).
-using SubstepObserver =
-    std::function<void(int region, int substep, double time, const Eigen::VectorXd& regionDisplacement,
-                       const Eigen::VectorXd& regionVelocity)>;
 
 /// Asynchronous implicit backward Euler (Zhao, Li & Barbič 2016, with the equations of
 /// docs/asynchronous-integrator.md). Fast regions S_i take m_i backward Euler substeps of
@@ -134,21 +25,35 @@ using SubstepObserver =
 /// linear element stiffness (the model's K is then checked against the mesh's on the
 /// interface columns; a mismatch throws asyncfem::ValidationError).
 ///
-/// Linear force models: every block, Z and H^{LL*} are built and factored once (and again
-/// only after setTimestep). Nonlinear force models (corotational): f_int(u_0) and K(u_0) are
-/// evaluated once per large step and every block is refactored numerically (the paper's
-/// Algorithm 2); symbolic analyses are done once per run.
-class AsyncBackwardEuler final : public Integrator {
+/// Set-up is explicit: the constructor calls setUp() with the regions given, and setUp()
+/// may be called again between steps with another partition of the same mesh (the state
+/// is synchronous at large-step boundaries, so nothing has to be transferred). It cuts
+/// every block on its pattern and finds the interface elements; for linear force models
+/// it also builds and factors every block, Z and H^{LL*} (again only after setTimestep).
+/// Nonlinear force models (corotational, hyperelastic): f_int(u_0) and K(u_0) are evaluated
+/// once per large step and every block is refactored numerically (the paper's Algorithm 2,
+/// or with the H^{LL*} factor kept: AsyncOptions::laggedSchur); symbolic analyses are done
+/// once per partition.
+class AsyncBackwardEuler final : public PartitionedIntegrator {
  public:
+  /// system.mesh must be set (Problem::dynamicSystem() sets it): the regions are vertex
+  /// sets of it. largeTimestep hL in seconds. Throws asyncfem::ValidationError for a
+  /// partition RegionPartition rejects or a system without a mesh.
+  AsyncBackwardEuler(DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions,
+                     AsyncOptions options = {});
+  /// The same for a system assembled by hand without its mesh: mesh is copied into it.
   AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions,
                      AsyncOptions options = {});
   ~AsyncBackwardEuler() override;
+
+  /// Takes a new partition of system().mesh's vertices (built on system().freeDofs) from
+  /// the next step on: every block, factor and analysis of the old one is dropped.
+  void setUp(RegionPartition partition);
 
   std::string name() const override { return "async"; }
   void step() override;
   void setTimestep(double timestep) override;
 
-  const RegionPartition& partition() const { return partition_; }
   const AsyncOptions& options() const { return options_; }
   void setSubstepObserver(SubstepObserver observer) { observer_ = std::move(observer); }
 
@@ -164,8 +69,9 @@ class AsyncBackwardEuler final : public Integrator {
   SchurMode schurModeUsed() const { return schurModeUsed_; }
   /// Set-up, rebuild and steady-state step times, and the sizes that set them.
   const AsyncRunStats& runStats() const { return runStats_; }
-  /// Set-up, rebuild and steady-step times and the lagged-Schur counts of runStats().
-  std::vector<std::string> runReport() const override;
+  /// factorNonZeros(), the set-up, rebuild and steady-step times and the lagged-Schur
+  /// counts of runStats(), and whether the coupling may gain energy (the paper's).
+  RunReport report() const override;
 
   /// Seconds per large step of the sparse triangular solves alone, with the current
   /// factors and random right-hand sides (median of `repeats`): per region 2 m_i solves
@@ -175,22 +81,23 @@ class AsyncBackwardEuler final : public Integrator {
   double solveFloorSeconds(int repeats = 5);
   /// Sum over the factorizations this integrator owns of the solver libraries' factor
   /// non-zeros (machine-independent size of the factors).
-  long long factorNonZeros() const override;
-  std::vector<RegionSummary> regionSummaries() const override { return summarizeRegions(partition_); }
-  int regionOfVertex(int vertex) const override { return partition_.regionOfVertex(vertex); }
-  bool mayGainEnergy() const override { return options_.coupling == AsyncCoupling::paper; }
+  long long factorNonZeros() const;
 
  private:
   struct Impl;
-  void rebuildBlocks();
-  void buildSchurSolver();
+  void refactor();
+  void assembleBlocks();
   void subtractInterfaceStiffness();
-  void solveSchur(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
-  void computeCorrections(bool damped);
   void fullSchurRebuild();
   void applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out);
-  bool iterativeSchur(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
-  RegionPartition partition_;
+  void evaluateStartOfStep();
+  void gatherExternalForces(double t0, double t1);
+  void largeRightHandSide();
+  void regionRightHandSides();
+  void solveStructured();
+  void recoverRegion(int region);
+  void assembleNewState(double t0, double t1);
+  void countSolves();
   AsyncOptions options_;
   SubstepObserver observer_;
   double schurAsymmetry_ = 0.0;

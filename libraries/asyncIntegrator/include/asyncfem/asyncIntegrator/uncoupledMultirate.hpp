@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <asyncfem/asyncIntegrator/partitionedIntegrator.hpp>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
@@ -61,8 +62,12 @@ struct UncoupledMultirateOptions {
 /// factor both once (again after setTimestep), nonlinear ones refactor numerically per
 /// large step. Throws the same ValidationErrors as RegionPartition, and NumericalError for a
 /// non-finite state.
-class UncoupledMultirate final : public Integrator {
+class UncoupledMultirate final : public PartitionedIntegrator {
  public:
+  /// system.mesh must be set (Problem::dynamicSystem() sets it).
+  UncoupledMultirate(DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions,
+                     UncoupledMultirateOptions options = {});
+  /// The same for a system assembled by hand without its mesh: mesh is copied into it.
   UncoupledMultirate(const TetMesh& mesh, DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions,
                      UncoupledMultirateOptions options = {});
   ~UncoupledMultirate() override;
@@ -71,17 +76,15 @@ class UncoupledMultirate final : public Integrator {
   void step() override;
   void setTimestep(double timestep) override;
 
-  const RegionPartition& partition() const { return partition_; }
   const UncoupledMultirateOptions& options() const { return options_; }
   /// Sum over the factorizations this integrator owns of the factor non-zeros.
-  long long factorNonZeros() const override;
-  std::vector<RegionSummary> regionSummaries() const override { return summarizeRegions(partition_); }
-  int regionOfVertex(int vertex) const override { return partition_.regionOfVertex(vertex); }
+  long long factorNonZeros() const;
+  /// factorNonZeros().
+  RunReport report() const override;
 
  private:
   struct Impl;
   void rebuild();
-  RegionPartition partition_;
   UncoupledMultirateOptions options_;
   std::unique_ptr<Impl> impl_;
 };

@@ -86,11 +86,15 @@ class BackwardEuler final : public Integrator {
   const FactorReuseStats* factorReuseStats() const;
   /// With reuseFactor in effect: the kept factor is no part of a checkpoint, so a resumed
   /// run refactors at its first step and matches an uninterrupted one to the PCG tolerance.
-  std::string resumeCaveat() const override;
+  /// The factor non-zeros, and with reuseFactor the caveat that resumed frames match to
+  /// the PCG tolerance only.
+  RunReport report() const override;
 
  private:
   void stepLinear();
   void stepNonlinear();
+  /// free_->systemMatrix = the step formula's (A1) combination of M and K.
+  void assembleSystemMatrix();
   void assembleAndFactor();
   // Incremental potential Phi(dv) of the current step (see the class comment).
   double incrementalPotential(const Eigen::VectorXd& dv);

@@ -3,37 +3,14 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <asyncfem/dynamics/dynamicSystem.hpp>
 #include <asyncfem/forceModel/forceModel.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
-#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 namespace asyncfem {
-
-/// External force as a function of time and state: adds its contribution to forces
-/// (size 3n, zeroed by the caller). The state arguments let explicit force terms
-/// (penalty contact, springs) depend on it; time-only loads ignore them.
-using ExternalForceFunction = std::function<void(double time, const Eigen::VectorXd& displacement,
-                                                 const Eigen::VectorXd& velocity, Eigen::VectorXd& forces)>;
-
-/// The body an integrator advances: M a + D v + f_int(u) = f_ext(t), with
-/// D = alpha M + beta K (K the tangent stiffness at the start of a step) and the DOFs in
-/// freeDofs' fixed list held at zero displacement and velocity.
-struct DynamicSystem {
-  std::shared_ptr<ForceModel> forceModel;
-  Eigen::SparseMatrix<double> mass;  ///< 3n x 3n, in the force model's stiffness pattern
-  FreeDofs freeDofs;
-  double rayleighMass = 0.0;            ///< alpha
-  double rayleighStiffness = 0.0;       ///< beta
-  ExternalForceFunction externalForce;  ///< may be empty: no external force
-
-  int numDofs() const { return static_cast<int>(mass.rows()); }
-  bool damped() const { return rayleighMass != 0.0 || rayleighStiffness != 0.0; }
-  /// Throws asyncfem::ValidationError if sizes disagree or alpha, beta < 0.
-  void validate() const;
-};
 
 /// Where the time of a run went, and machine-independent counts.
 struct IntegratorStats {
@@ -56,6 +33,25 @@ struct RegionSummary {
   int interfaceDofs = 0;  ///< free DOFs of L coupled to the region's elements
   int ratio = 1;          ///< substeps per large step, m
 };
+
+/// What an integrator says about a run beyond its state and statistics, for summaries,
+/// resumes and drivers' checks: one value instead of one virtual per item.
+struct RunReport {
+  /// Non-zeros of the factors the integrator keeps, for cost reports (0: not reported).
+  long long factorNonZeros = 0;
+  /// Lines for run summaries (set-up against steady-state cost, iterations, ...), each
+  /// without a trailing newline.
+  std::vector<std::string> lines;
+  /// Empty when a run resumed from a checkpoint (setState + setInternalState) continues
+  /// bit for bit; else one line saying how it differs (a kept factor that no checkpoint
+  /// holds), which drivers print when they resume.
+  std::string resumeCaveat;
+  /// True when this configuration may gain energy from step to step (the asynchronous
+  /// integrator with the paper's coupling): drivers then estimate the step growth first.
+  bool mayGainEnergy = false;
+};
+
+class MultirateIntegrator;
 
 /// One time integrator: owns the state (u, v, t) of a DynamicSystem and advances it by
 /// step(). The linear solves are done by a SparseSolver the integrator owns, so
@@ -100,27 +96,12 @@ class Integrator {
   /// Changes h; implicit integrators refactor lazily at the next step.
   virtual void setTimestep(double timestep);
 
-  /// Multirate integrators: their fast regions, in region order; empty for single-rate
-  /// ones. Lets drivers describe any integrator without knowing its type.
-  virtual std::vector<RegionSummary> regionSummaries() const { return {}; }
-  /// Multirate integrators: the index (into regionSummaries()) of the fast region holding
-  /// vertex, or -1 when it lies in the large-step region L; single-rate: always -1.
-  virtual int regionOfVertex(int vertex) const {
-    (void)vertex;
-    return -1;
-  }
-  /// Non-zeros of the factors the integrator keeps, for cost reports (0: not reported).
-  virtual long long factorNonZeros() const { return 0; }
-  /// Lines the integrator adds to run summaries (set-up against steady-state cost,
-  /// iterations, ...), each without a trailing newline; empty by default.
-  virtual std::vector<std::string> runReport() const { return {}; }
-  /// Empty when a run resumed from a checkpoint (setState + setInternalState) continues
-  /// bit for bit; else one line saying how it differs (a kept factor that no checkpoint
-  /// holds), which drivers print when they resume.
-  virtual std::string resumeCaveat() const { return {}; }
-  /// True when this configuration may gain energy from step to step (the asynchronous
-  /// integrator with the paper's coupling): drivers then estimate the step growth first.
-  virtual bool mayGainEnergy() const { return false; }
+  /// What the integrator adds to run reports and drivers' decisions (RunReport); the
+  /// default is an empty report.
+  virtual RunReport report() const { return {}; }
+  /// This integrator as a multirate one (fast regions, their vertices), or nullptr for a
+  /// single-rate integrator. Lets drivers describe any integrator without knowing its type.
+  virtual const MultirateIntegrator* multirate() const { return nullptr; }
 
   const DynamicSystem& system() const { return system_; }
   /// Kinetic energy v^T M v / 2 plus the force model's elastic energy.
@@ -137,6 +118,13 @@ class Integrator {
   double stepEndTime() const;
   /// Ends a step: time() becomes stepEndTime().
   void advanceTime();
+  /// Ends every step the same way: throws asyncfem::NumericalError (naming the integrator,
+  /// the time the step was heading to, and the first non-finite DOF as vertex and
+  /// coordinate, with those in its location) if the new displacement or velocity (full,
+  /// 3n) has a non-finite entry, leaving the state at the step's start; otherwise swaps
+  /// them into the state (the arguments get the old state, as scratch for the next step),
+  /// advances the time to stepEndTime() and counts the step.
+  void commitStep(Eigen::VectorXd& displacement, Eigen::VectorXd& velocity);
   /// Zeroes the fixed entries of a full vector.
   void zeroFixed(Eigen::VectorXd& full) const;
   /// Called by setState() after the state changed, so that integrators that carry

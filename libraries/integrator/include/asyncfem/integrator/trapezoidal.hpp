@@ -45,6 +45,8 @@ class Trapezoidal final : public Integrator {
 
   std::string name() const override { return "trapezoidal"; }
   void step() override;
+  /// The non-zeros of the system matrix's factor.
+  RunReport report() const override;
   void setTimestep(double timestep) override;
   /// a_k (full, 3n), or empty while it is stale (it is then recomputed from u, v, t).
   Eigen::VectorXd internalState() const override;

@@ -35,7 +35,7 @@ struct PaperCouplingCheck {
   std::string warning;
 };
 
-/// When simulation's integrator may gain energy (Integrator::mayGainEnergy(): the
+/// When simulation's integrator may gain energy (RunReport::mayGainEnergy: the
 /// asynchronous integrator with the paper's coupling, as constructed):
 /// estimateSceneStepGrowth() and the warning. std::nullopt for every other integrator or
 /// coupling, without any work.

@@ -1,0 +1,257 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// A fast region's blocks and solves. Equation numbers refer to docs/asynchronous-integrator.md.
+#include "detail/fastRegion.hpp"
+
+#include <algorithm>
+#include <asyncfem/integrator/stepFormula.hpp>
+
+#include "detail/multirateSupport.hpp"
+#include "detail/parallelTasks.hpp"
+#include "detail/sparseBlocks.hpp"
+
+namespace asyncfem::detail {
+
+FastRegion::FastRegion(const SparseMatrix& mass, const SparseMatrix& stiffnessPattern, const RegionLayout& layout,
+                       SolverKind solverKind)
+    : ratio(layout.ratio) {
+  const std::vector<int>& s = *layout.dofs;
+  const std::vector<int>& iface = *layout.interfaceDofs;
+  massSS = SubmatrixExtractor(mass, s, s);
+  massSI = SubmatrixExtractor(mass, s, iface);
+  massIS = SubmatrixExtractor(mass, iface, s);
+  stiffSS = SubmatrixExtractor(stiffnessPattern, s, s);
+  stiffSI = SubmatrixExtractor(stiffnessPattern, s, iface);
+  stiffIS = SubmatrixExtractor(stiffnessPattern, iface, s);
+  Mss = massSS.extract(mass);
+  Msi = massSI.extract(mass);
+  Mis = massIS.extract(mass);
+  solver = makeSparseSolver(solverKind);
+}
+
+void FastRegion::updateStiffnessBlocks(const SparseMatrix& stiffness) {
+  updateBlock(stiffSS, stiffness, Kss, cut);
+  updateBlock(stiffSI, stiffness, Ksi, cut);
+  updateBlock(stiffIS, stiffness, Kis, cut);
+  cut = true;
+}
+
+void FastRegion::updateBlocks(const SparseMatrix& stiffness, double largeStep, double alpha, double beta, bool damped,
+                              AsyncCoupling couplingKind) {
+  const double hS = largeStep / ratio;
+  smallStep = hS;
+  updateStiffnessBlocks(stiffness);
+  if (damped) {
+    combineInto(alpha, Mss, beta, Kss, Dss);
+    combineInto(alpha, Msi, beta, Ksi, Dsi);
+    combineInto(alpha, Mis, beta, Kis, Dis);
+  }
+  // A^S = M^{SS} + hS D^{SS} + hS^2 K^{SS}: backward Euler's matrix at hS (Eq. A1).
+  const stepFormula::MatrixWeights weights = stepFormula::backwardEuler::systemMatrix(hS, alpha, beta);
+  combineInto(weights.mass, Mss, weights.stiffness, Kss, systemMatrix);
+  combineInto(0.0, Mss, hS * hS, Kss, G);
+  GT = G.transpose();
+  rhsWeight = 1.0 / (1.0 + hS * alpha);
+  stepWeight = (1.0 + beta / hS) / (1.0 + hS * alpha);
+  coupling = couplingCoefficients(couplingKind, ratio, largeStep);
+}
+
+void FastRegion::factorize(IntegratorStats& stats) { factorizeCounted(*solver, systemMatrix, analyzed, stats); }
+
+void FastRegion::subtractStiffnessProduct(const double* t, double* out) const {
+  const int* outer = G.outerIndexPtr();
+  const int* inner = G.innerIndexPtr();
+  const double* values = G.valuePtr();
+  const Eigen::Index size = G.outerSize();
+  for (Eigen::Index column = 0; column < size; ++column) {
+    const double tc = t[column];
+    for (int k = outer[column]; k < outer[column + 1]; ++k) out[inner[k]] -= values[k] * tc;
+  }
+}
+
+// Column c of outT is a sum of length-k vector updates over column c of G^T (row c of G).
+void FastRegion::rowWiseStiffnessProduct(const Eigen::MatrixXd& tT, Eigen::MatrixXd& outT) const {
+  const int* outer = GT.outerIndexPtr();
+  const int* inner = GT.innerIndexPtr();
+  const double* values = GT.valuePtr();
+  outT.setZero();
+  for (Eigen::Index c = 0; c < GT.outerSize(); ++c)
+    for (int k = outer[c]; k < outer[c + 1]; ++k) outT.col(c) += values[k] * tT.col(inner[k]);
+}
+
+// G sum_{i<r} x_i is a running sum; M^{SS} x_{r-1} comes from the previous right-hand side.
+void FastRegion::forwardSubstitute(const Eigen::MatrixXd& b, Eigen::MatrixXd& x) {
+  const Eigen::Index size = b.rows();
+  x.resize(size, b.cols());
+  runningStiffness.setZero(size);  // w = sum_{i<r} x_i
+  combined.resize(size);
+  for (int r = 1; r <= ratio; ++r) {
+    if (r == 1) {
+      substepRhs = b.col(0);
+    } else {
+      // rhs_r = rhsWeight rhs_{r-1} + b_r - G (stepWeight x_{r-1} + w).
+      runningStiffness += x.col(r - 2);
+      combined = runningStiffness + stepWeight * x.col(r - 2);
+      substepRhs *= rhsWeight;
+      substepRhs += b.col(r - 1);
+      subtractStiffnessProduct(combined.data(), substepRhs.data());
+    }
+    solver->solve(substepRhs, substepSolution);
+    x.col(r - 1) = substepSolution.col(0);
+  }
+}
+
+void FastRegion::interfaceRowOf(const Eigen::MatrixXd& columns, bool damped) {
+  weightedM.noalias() = columns * coupling.eM;
+  weightedK.noalias() = columns * coupling.eK;
+  interfaceRow.resize(Mis.rows());
+  interfaceRow.noalias() = Mis * weightedM;
+  interfaceRow.noalias() += Kis * weightedK;
+  if (damped) {
+    weightedD.noalias() = columns * coupling.eD;
+    interfaceRow.noalias() += Dis * weightedD;
+  }
+}
+
+void FastRegion::couplingProducts(bool damped) {
+  massY.noalias() = Msi * yInterface;
+  stiffY.noalias() = Ksi * yInterface;
+  if (damped) dampY.noalias() = Dsi * yInterface;
+}
+
+void FastRegion::correctionColumns(SparseSolver& columnSolver, bool damped, Eigen::Index first, Eigen::Index width) {
+  const Eigen::Index size = systemMatrix.rows();
+  const CouplingCoefficients& k = coupling;
+  Eigen::MatrixXd rhsColumns = Eigen::MatrixXd::Zero(size, width), z, combinedT(width, size), productT(width, size);
+  Eigen::MatrixXd runningT = Eigen::MatrixXd::Zero(width, size);  // (sum_{i<r} Z_i)^T
+  Eigen::MatrixXd sumM = Eigen::MatrixXd::Zero(size, width), sumK = sumM, sumD, sum;
+  if (damped) sumD = sumM;
+  if (useDenseZ) sum = sumM;
+  // rhsColumns += scale * block(:, first .. first + width), for a sparse block of H^{SI}.
+  const auto addColumns = [&](const SparseMatrix& block, double scale) {
+    if (scale == 0.0) return;
+    for (Eigen::Index c = 0; c < width; ++c)
+      for (SparseMatrix::InnerIterator it(block, first + c); it; ++it) rhsColumns(it.row(), c) += scale * it.value();
+  };
+  for (int r = 1; r <= ratio; ++r) {
+    // Row r of H^{SS} Z = H^{SI}: A^S Z_r = B_r + M^{SS} Z_{r-1} - G sum_{i<r} Z_i.
+    if (r >= 2) {
+      runningT += z.transpose();
+      combinedT = runningT;
+      combinedT += stepWeight * z.transpose();
+      rowWiseStiffnessProduct(combinedT, productT);
+      rhsColumns *= rhsWeight;
+      rhsColumns -= productT.transpose();
+    }
+    addColumns(Msi, k.bM[r - 1]);
+    addColumns(Ksi, k.bK[r - 1]);
+    if (damped) addColumns(Dsi, k.bD[r - 1]);
+    columnSolver.solve(rhsColumns, z);
+    if (k.eM[r - 1] != 0.0) sumM += k.eM[r - 1] * z;
+    sumK += k.eK[r - 1] * z;
+    if (damped) sumD += k.eD[r - 1] * z;
+    if (useDenseZ) sum += z;
+  }
+  if (useDenseZ) {
+    zLast.middleCols(first, width) = z;
+    zSum.middleCols(first, width) = sum;
+  }
+  Eigen::MatrixXd columns = Mis * sumM;
+  columns += Kis * sumK;
+  if (damped) columns += Dis * sumD;
+  correction.middleCols(first, width) = columns;
+}
+
+void FastRegion::assembleInterfaceStiffness(const ForceModel& forceModel, const Eigen::VectorXd& u, bool perElement) {
+  const auto q = static_cast<Eigen::Index>(Mis.rows());
+  interfaceStiffness.setZero(q, q);
+  for (InterfaceElement& element : interfaceElements) {
+    if (perElement) forceModel.elementTangent(u, element.element, element.tangent);
+    for (int b = 0; b < 12; ++b) {
+      const int column = element.interfaceIndex[static_cast<std::size_t>(b)];
+      if (column < 0) continue;
+      for (int a = 0; a < 12; ++a) {
+        const int row = element.interfaceIndex[static_cast<std::size_t>(a)];
+        if (row >= 0) interfaceStiffness(row, column) += element.tangent(a, b);
+      }
+    }
+  }
+}
+
+namespace {
+
+/// Largest dense Z (doubles) the automatic recovery stores: 16M doubles = 128 MiB.
+constexpr double kMaxDenseZEntries = 16.0 * 1024 * 1024;
+/// Fewest Z columns worth a thread of their own (below, the copy of the A^S factor costs
+/// more than the columns it takes over).
+constexpr Eigen::Index kMinZColumnsPerThread = 24;
+
+/// Recovery: the end state needs X_m = y_m - Z_m Y_I and sum_r X_r = sum_r y_r - (sum_r Z_r)
+/// Y_I (4 |S| q flops, 2 |S| q doubles), or a second forward substitution (m solves and 2m
+/// sparse products). Automatic picks the cheaper in flops while the two blocks fit.
+bool chooseDenseZ(const FastRegion& region, RecoveryMode mode) {
+  const Eigen::Index q = region.Msi.cols();
+  const Eigen::Index sizeS = region.systemMatrix.rows();
+  const double denseFlops = 4.0 * static_cast<double>(sizeS) * static_cast<double>(q);
+  const double substitutionFlops =
+      region.ratio * (region.solver->stats().solveFlopsPerRhs + 4.0 * static_cast<double>(region.Kss.nonZeros()));
+  return mode == RecoveryMode::denseZ ||
+         (mode == RecoveryMode::automatic && denseFlops <= substitutionFlops &&
+          2.0 * static_cast<double>(sizeS) * static_cast<double>(q) <= kMaxDenseZEntries);
+}
+
+struct ColumnTask {
+  int region = 0;
+  int block = 0;  // 0: the region's own solver, j > 0: helperSolvers[j - 1]
+  Eigen::Index first = 0, width = 0;
+};
+
+}  // namespace
+
+CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOptions& options, bool damped) {
+  const int threads = threadBudget(options.threads);
+  std::vector<ColumnTask> tasks;
+  std::vector<std::pair<int, int>> helpers;  // (region, helper) factorizations to run
+  CorrectionRun run;
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    FastRegion& rb = regions[i];
+    const Eigen::Index q = rb.Msi.cols();
+    const Eigen::Index sizeS = rb.systemMatrix.rows();
+    rb.useDenseZ = chooseDenseZ(rb, options.recovery);
+    rb.correction.resize(q, q);
+    rb.zLast.resize(rb.useDenseZ ? sizeS : 0, rb.useDenseZ ? q : 0);
+    rb.zSum.resize(rb.useDenseZ ? sizeS : 0, rb.useDenseZ ? q : 0);
+    if (q == 0) continue;
+    run.columns += static_cast<long long>(rb.ratio) * q;
+    const int blocks =
+        static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(threads, q / kMinZColumnsPerThread)));
+    run.threads = std::max(run.threads, blocks);
+    while (static_cast<int>(rb.helperSolvers.size()) < blocks - 1) {
+      rb.helperSolvers.push_back(makeSparseSolver(options.regionSolver));
+      rb.helperAnalyzed.push_back(0);
+    }
+    for (int j = 1; j < blocks; ++j) helpers.emplace_back(static_cast<int>(i), j - 1);
+    for (int j = 0; j < blocks; ++j) {
+      const Eigen::Index first = q * j / blocks, last = q * (j + 1) / blocks;
+      tasks.push_back({static_cast<int>(i), j, first, last - first});
+    }
+  }
+  parallelTasks(static_cast<int>(helpers.size()), threads, [&](int t) {
+    FastRegion& rb = regions[static_cast<std::size_t>(helpers[static_cast<std::size_t>(t)].first)];
+    const auto j = static_cast<std::size_t>(helpers[static_cast<std::size_t>(t)].second);
+    if (!rb.helperAnalyzed[j]) {
+      rb.helperSolvers[j]->analyzePattern(rb.systemMatrix);
+      rb.helperAnalyzed[j] = 1;
+    }
+    rb.helperSolvers[j]->factorize(rb.systemMatrix);
+  });
+  run.helperFactorizations = static_cast<long long>(helpers.size());
+  parallelTasks(static_cast<int>(tasks.size()), threads, [&](int t) {
+    const ColumnTask& task = tasks[static_cast<std::size_t>(t)];
+    FastRegion& rb = regions[static_cast<std::size_t>(task.region)];
+    SparseSolver& solver = task.block == 0 ? *rb.solver : *rb.helperSolvers[static_cast<std::size_t>(task.block - 1)];
+    rb.correctionColumns(solver, damped, task.first, task.width);
+  });
+  return run;
+}
+
+}  // namespace asyncfem::detail

@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// One fast region S_i of the asynchronous integrator: its blocks, the factor of A^S, the
+// forward substitution with H^{SS}, Z and the Schur correction C_i. Names as in
+// docs/asynchronous-integrator.md ("I" is the interface subset of L, the only L DOFs the
+// coupling blocks touch). Private to the library.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <array>
+#include <asyncfem/asyncIntegrator/asyncOptions.hpp>
+#include <asyncfem/asyncIntegrator/detail/coupling.hpp>
+#include <asyncfem/forceModel/forceModel.hpp>
+#include <asyncfem/integrator/integrator.hpp>
+#include <asyncfem/sparseSolver/sparseSolver.hpp>
+#include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <memory>
+#include <vector>
+
+namespace asyncfem::detail {
+
+/// One interface element of a fast region (vertices in S_i and in L): where its DOFs sit
+/// among the region's interface DOFs I_i (-1 for S DOFs and fixed DOFs), and its tangent.
+struct InterfaceElement {
+  int element = 0;
+  std::array<int, 12> interfaceIndex{};
+  Eigen::Matrix<double, 12, 12> tangent;
+};
+
+/// The time-step-independent description of a region: its DOFs and its interface.
+struct RegionLayout {
+  const std::vector<int>* dofs = nullptr;           ///< free DOFs of S_i (global, ascending)
+  const std::vector<int>* interfaceDofs = nullptr;  ///< I_i (global, ascending)
+  int ratio = 1;                                    ///< m_i
+};
+
+class FastRegion {
+ public:
+  using SparseMatrix = Eigen::SparseMatrix<double>;
+
+  /// Cuts the mass blocks (constant) and prepares the stiffness blocks on the pattern of
+  /// stiffnessPattern (3n x 3n, the force model's); solverKind factors A^S.
+  FastRegion(const SparseMatrix& mass, const SparseMatrix& stiffnessPattern, const RegionLayout& layout,
+             SolverKind solverKind);
+
+  /// K^{SS}, K^{SI}, K^{IS} of the current tangent K (3n x 3n): cut the first time, values
+  /// only after.
+  void updateStiffnessBlocks(const SparseMatrix& stiffness);
+  /// The blocks of the current tangent K (3n x 3n, values only after the first call), the
+  /// damping blocks D = alpha M + beta K, A^S = M + hS D + hS^2 K and the coupling
+  /// coefficients for large step hL (seconds).
+  void updateBlocks(const SparseMatrix& stiffness, double largeStep, double alpha, double beta, bool damped,
+                    AsyncCoupling coupling);
+  /// Numeric factorization of A^S (symbolic analysis the first time only).
+  void factorize(IntegratorStats& stats);
+
+  /// Forward substitution with H^{SS} (Eq. A13): A^S x_r = b_r + M^{SS} x_{r-1} - G sum_{i<r} x_i
+  /// for the columns b_r of b (|S| x m), into x (|S| x m).
+  void forwardSubstitute(const Eigen::MatrixXd& b, Eigen::MatrixXd& x);
+  /// interfaceRow = sum_r E_r x_r (Eq. A7) for the columns x_r of x (|S| x m): the
+  /// region's rows of H^{LS} x on its interface.
+  void interfaceRowOf(const Eigen::MatrixXd& x, bool damped);
+  /// massY, stiffY (and dampY) = M^{SI}, K^{SI} (D^{SI}) times yInterface.
+  void couplingProducts(bool damped);
+  /// Columns [first, first + width) of Z = (H^{SS})^{-1} H^{SI} with `solver` (a factor of
+  /// A^S), and the same columns of C_i = H^{IS} Z (Eq. A7), of Z_m and of sum_r Z_r
+  /// (dense recovery).
+  void correctionColumns(SparseSolver& solver, bool damped, Eigen::Index first, Eigen::Index width);
+  /// K_I^{II}: the interface elements' tangent on I x I (dense), with each element's
+  /// tangent from the force model at u when perElement (else the cached linear ones).
+  void assembleInterfaceStiffness(const ForceModel& forceModel, const Eigen::VectorXd& u, bool perElement);
+
+  int ratio = 1;
+  double smallStep = 0.0;  // hS
+  SubmatrixExtractor massSS, massSI, massIS, stiffSS, stiffSI, stiffIS;
+  SparseMatrix Mss, Kss, Dss, Msi, Ksi, Dsi, Mis, Kis, Dis;
+  bool cut = false;           // K blocks extracted once; later only their values are updated
+  SparseMatrix systemMatrix;  // A^S = M + hS D + hS^2 K
+  SparseMatrix G;             // hS^2 K^{SS}
+  CouplingCoefficients coupling;
+  // Stable coupling: the interface elements and K_I^{II}, their stiffness on I x I (dense).
+  std::vector<InterfaceElement> interfaceElements;
+  Eigen::MatrixXd interfaceStiffness;
+  SparseMatrix GT;  // G^T, for products with many columns held row-wise
+  // The previous substep's solve gives M^{SS} x_{r-1} for free: A^S = (1 + hS alpha) M^{SS}
+  // + (1 + beta / hS) G, so M^{SS} x_{r-1} = (rhs_{r-1} - (1 + beta / hS) G x_{r-1}) / (1 +
+  // hS alpha), and substep r's right-hand side b_r + M^{SS} x_{r-1} - G sum_{i<r} x_i needs
+  // one product with G: rhsWeight rhs_{r-1} + b_r - G (stepWeight x_{r-1} + sum_{i<r} x_i).
+  double rhsWeight = 1.0, stepWeight = 1.0;
+  std::unique_ptr<SparseSolver> solver;
+  bool analyzed = false;
+  // Copies of the A^S factor for the column blocks of Z computed on other threads.
+  std::vector<std::unique_ptr<SparseSolver>> helperSolvers;
+  std::vector<char> helperAnalyzed;
+  bool useDenseZ = false;
+  Eigen::MatrixXd zLast, zSum;  // Z_m and sum_r Z_r, |S| x q (dense recovery only)
+  Eigen::MatrixXd correction;   // C_i = H^{IS} Z, q x q
+  // Per-step buffers, sized once: no allocation in a steady-state step.
+  Eigen::MatrixXd rhs;                   // |S| x m, column r - 1 = b_r
+  Eigen::MatrixXd external;              // |S| x m, f_ext on S at the substeps
+  Eigen::MatrixXd y, x;                  // forward substitutions of b and of b - H^{SL} Y
+  Eigen::MatrixXd probe, probeSolution;  // H^{SL} y and its forward substitution (applySchur)
+  Eigen::VectorXd runningStiffness, substepRhs, combined;
+  Eigen::MatrixXd substepSolution;
+  Eigen::VectorXd weightedM, weightedD, weightedK, interfaceRow;  // Eq. (A7)
+  Eigen::VectorXd yInterface, massY, stiffY, dampY;
+  Eigen::VectorXd ySum, xLast, xSum;
+  bool substituted = false;  // x holds every substep (observer, substitution recovery)
+
+ private:
+  /// out -= G t for one column t (|S| entries), scattered column by column.
+  void subtractStiffnessProduct(const double* t, double* out) const;
+  /// outT = (G t)^T for tT = t^T (k x |S|), vectorized across the k columns.
+  void rowWiseStiffnessProduct(const Eigen::MatrixXd& tT, Eigen::MatrixXd& outT) const;
+};
+
+/// What one computation of Z over every region did.
+struct CorrectionRun {
+  int threads = 1;          ///< most A^S factor copies one region used
+  long long columns = 0;    ///< right-hand sides: sum_i m_i |I_i|
+  long long helperFactorizations = 0;
+};
+
+/// Z and the Schur corrections of every region (recovery mode chosen per region). The
+/// columns of Z are independent: each region's are split into blocks, one per thread, each
+/// solved with its own copy of the A^S factor, since one solver object is not thread-safe.
+CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOptions& options, bool damped);
+
+}  // namespace asyncfem::detail

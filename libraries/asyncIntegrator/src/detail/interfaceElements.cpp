@@ -1,0 +1,116 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "detail/interfaceElements.hpp"
+
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
+#include <string>
+
+#include "detail/sparseBlocks.hpp"
+
+namespace asyncfem::detail {
+
+namespace {
+
+/// The matrix model's K against the mesh's linear FEM stiffness on the columns of the
+/// interface DOFs (see findInterfaceElements).
+void checkLinearModelMatchesMesh(const TetMesh& mesh, const RegionPartition& partition, const DynamicSystem& system) {
+  const Eigen::VectorXd probe = Eigen::VectorXd::Zero(mesh.numDofs());
+  Eigen::SparseMatrix<double> stiffness = system.forceModel->createStiffnessMatrix();
+  system.forceModel->tangentStiffness(probe, stiffness);
+  std::vector<int> columnOf(static_cast<std::size_t>(mesh.numDofs()), -1);
+  std::vector<int> columns;
+  for (int i = 0; i < partition.numRegions(); ++i)
+    for (int dof : partition.interfaceDofs(i)) {
+      if (columnOf[static_cast<std::size_t>(dof)] < 0) {
+        columnOf[static_cast<std::size_t>(dof)] = static_cast<int>(columns.size());
+        columns.push_back(dof);
+      }
+    }
+  if (columns.empty()) return;
+  // Sparse 3n x |columns| blocks, so the check costs O(interface elements), not O(n |I|).
+  std::vector<Eigen::Triplet<double>> meshEntries, modelEntries;
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const Eigen::Vector4i vertices = mesh.element(e);
+    bool touches = false;
+    for (int a = 0; a < 4 && !touches; ++a)
+      for (int c = 0; c < 3; ++c) touches = touches || columnOf[static_cast<std::size_t>(3 * vertices[a] + c)] >= 0;
+    if (!touches) continue;
+    const Material& material = mesh.elementMaterial(e);
+    const ElementMatrix ke =
+        linearElementStiffness(mesh.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
+    for (int q = 0; q < 12; ++q) {
+      const int column = columnOf[static_cast<std::size_t>(3 * vertices[q / 3] + q % 3)];
+      if (column < 0) continue;
+      for (int p = 0; p < 12; ++p) meshEntries.emplace_back(3 * vertices[p / 3] + p % 3, column, ke(p, q));
+    }
+  }
+  for (std::size_t k = 0; k < columns.size(); ++k)
+    for (SparseMatrix::InnerIterator it(stiffness, columns[k]); it; ++it)
+      modelEntries.emplace_back(static_cast<int>(it.row()), static_cast<int>(k), it.value());
+  SparseMatrix fromMesh(mesh.numDofs(), static_cast<Eigen::Index>(columns.size()));
+  SparseMatrix fromModel(fromMesh.rows(), fromMesh.cols());
+  fromMesh.setFromTriplets(meshEntries.begin(), meshEntries.end());
+  fromModel.setFromTriplets(modelEntries.begin(), modelEntries.end());
+  const SparseMatrix differenceMatrix = fromMesh - fromModel;
+  const double scale = std::max(largestMagnitude(fromMesh), 1e-300);
+  const double difference = largestMagnitude(differenceMatrix) / scale;
+  if (!(difference <= 1e-10)) {
+    throw ValidationError(
+        "async integrator: the stable coupling needs the stiffness of each interface element; the force model "
+        "gives no per-element tangent and its K differs from the mesh's linear FEM stiffness on the interface "
+        "columns (relative difference " +
+        std::to_string(difference) + "): build it from this mesh, or use the coupling \"paper\"");
+  }
+}
+
+}  // namespace
+
+bool findInterfaceElements(const TetMesh& mesh, const RegionPartition& partition, const DynamicSystem& system,
+                           std::vector<FastRegion>& regions) {
+  const std::vector<int>& vertexRegion = partition.vertexRegion();
+  std::vector<std::vector<int>> interfaceIndex(regions.size());
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    std::vector<int>& index = interfaceIndex[static_cast<std::size_t>(i)];
+    index.assign(static_cast<std::size_t>(mesh.numDofs()), -1);
+    const std::vector<int>& iface = partition.interfaceDofs(i);
+    for (std::size_t k = 0; k < iface.size(); ++k) index[static_cast<std::size_t>(iface[k])] = static_cast<int>(k);
+  }
+  Eigen::VectorXd probe = Eigen::VectorXd::Zero(mesh.numDofs());
+  Eigen::Matrix<double, 12, 12> tangent;
+  const bool perElement = mesh.numElements() > 0 && system.forceModel->elementTangent(probe, 0, tangent);
+  if (!perElement && !system.forceModel->isLinear()) {
+    throw ValidationError(
+        "async integrator: the stable coupling needs the tangent of each interface element, and this nonlinear "
+        "force model gives none (ForceModel::elementTangent); use the coupling \"paper\"");
+  }
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const Eigen::Vector4i vertices = mesh.element(e);
+    int fast = -1;
+    bool touchesLarge = false;
+    for (int a = 0; a < 4; ++a) {
+      const int region = vertexRegion[static_cast<std::size_t>(vertices[a])];
+      if (region >= 0) fast = region;
+      if (region < 0) touchesLarge = true;
+    }
+    if (fast < 0 || !touchesLarge) continue;
+    InterfaceElement element;
+    element.element = e;
+    for (int a = 0; a < 4; ++a)
+      for (int c = 0; c < 3; ++c)
+        element.interfaceIndex[static_cast<std::size_t>(3 * a + c)] =
+            interfaceIndex[static_cast<std::size_t>(fast)][static_cast<std::size_t>(3 * vertices[a] + c)];
+    if (!perElement) {
+      const Material& material = mesh.elementMaterial(e);
+      element.tangent =
+          linearElementStiffness(mesh.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
+    }
+    regions[static_cast<std::size_t>(fast)].interfaceElements.push_back(element);
+  }
+  if (perElement) return true;
+  checkLinearModelMatchesMesh(mesh, partition, system);
+  return false;
+}
+
+
+}  // namespace asyncfem::detail

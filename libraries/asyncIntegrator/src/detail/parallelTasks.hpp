@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Task parallelism over fast regions and blocks of Z columns. Private to the library.
+#pragma once
+
+#include <omp.h>
+
+#include <algorithm>
+#include <exception>
+#include <vector>
+
+namespace asyncfem::detail {
+
+/// Threads to use for a request: requested when positive, else OpenMP's maximum.
+inline int threadBudget(int requested) { return requested > 0 ? requested : std::max(1, omp_get_max_threads()); }
+
+/// Runs body(t) for t = 0..count-1 on up to `threads` OpenMP threads and rethrows the first
+/// exception a task threw (an exception must not leave an OpenMP region).
+template <class Body>
+void parallelTasks(int count, int threads, const Body& body) {
+  std::vector<std::exception_ptr> failures(static_cast<std::size_t>(std::max(count, 0)));
+#pragma omp parallel for schedule(dynamic) num_threads(std::max(1, std::min(threads, count))) if (count > 1)
+  for (int t = 0; t < count; ++t) {
+    try {
+      body(t);
+    } catch (...) {
+      failures[static_cast<std::size_t>(t)] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace asyncfem::detail

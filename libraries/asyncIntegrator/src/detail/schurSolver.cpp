@@ -1,0 +1,201 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// H^{LL*} (Eq. A13 of docs/asynchronous-integrator.md): factor, solve, lagged refinement.
+#include "detail/schurSolver.hpp"
+
+#include <algorithm>
+#include <asyncfem/core/stopwatch.hpp>
+#include <cmath>
+
+#include "detail/multirateSupport.hpp"
+#include "detail/sparseBlocks.hpp"
+
+namespace asyncfem::detail {
+
+namespace {
+/// Largest W = (A^L)^{-1} U (doubles) the low-rank Schur form stores: 64M = 512 MiB.
+constexpr double kMaxLowRankEntries = 64.0 * 1024 * 1024;
+
+/// Positions (inside L) of the interface DOFs of every region, sorted and unique.
+std::vector<int> interfaceUnionOf(const RegionPartition& partition) {
+  std::vector<int> all;
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    const std::vector<int>& pos = partition.interfacePositions(i);
+    all.insert(all.end(), pos.begin(), pos.end());
+  }
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  return all;
+}
+}  // namespace
+
+void SchurSolver::reset() { *this = SchurSolver(); }
+
+void SchurSolver::chooseSolver(SchurMode mode) {
+  if (mode != modeUsed_ || !solver_) {
+    solver_ = makeSparseSolver(mode == SchurMode::lu ? SolverKind::umfpack : SolverKind::cholmod);
+    analyzed_ = false;
+  }
+  modeUsed_ = mode;
+}
+
+void SchurSolver::factor(const SparseMatrix& largeSystem, const RegionPartition& partition,
+                         const std::vector<FastRegion>& regions, SchurMode requested, AsyncCoupling coupling,
+                         double asymmetry, IntegratorStats& stats) {
+  factored_ = true;
+  refreshNext_ = false;
+  const auto numLarge = static_cast<double>(largeSystem.rows());
+  if (largeSystem.rows() == 0) return;
+  const std::vector<int> all = interfaceUnionOf(partition);
+  SchurMode mode = requested;
+  if (mode == SchurMode::lowRank && coupling == AsyncCoupling::stable) {
+    // The stable coupling's H^{LL*} is symmetric (to round-off): its own Cholesky factor
+    // is exact and costs one sparse solve per step, where the low-rank form adds a dense
+    // |L| x q product per step and q solves with A^L per rebuild.
+    mode = asymmetry <= 1e-10 ? SchurMode::symmetric : SchurMode::lu;
+  }
+  if (mode == SchurMode::lowRank && numLarge * static_cast<double>(all.size()) > kMaxLowRankEntries) {
+    mode = SchurMode::lu;  // A^{-1} U would not fit: factor H^{LL*} itself
+  }
+  chooseSolver(mode);
+  if (mode == SchurMode::lowRank) {
+    factorLowRank(largeSystem, partition, regions, all, stats);
+  } else {
+    factorAssembled(largeSystem, partition, regions, stats);
+  }
+}
+
+// H^{LL*} = A^L - U C U^T with U the interface columns and C the sum of the regions'
+// corrections. With W = (A^L)^{-1} U: x = y + W C z, y = (A^L)^{-1} b and
+// (I - U^T W C) z = U^T y (see solve). A^L is SPD: Cholesky.
+void SchurSolver::factorLowRank(const SparseMatrix& largeSystem, const RegionPartition& partition,
+                                const std::vector<FastRegion>& regions, const std::vector<int>& all,
+                                IntegratorStats& stats) {
+  factorizeCounted(*solver_, largeSystem, analyzed_, stats);
+  interfaceUnion_ = all;
+  const auto q = static_cast<Eigen::Index>(all.size());
+  if (q == 0) return;
+  const auto numLarge = static_cast<Eigen::Index>(largeSystem.rows());
+  std::vector<int> place(static_cast<std::size_t>(numLarge), -1);
+  for (Eigen::Index k = 0; k < q; ++k)
+    place[static_cast<std::size_t>(all[static_cast<std::size_t>(k)])] = static_cast<int>(k);
+  unionCorrection_.setZero(q, q);
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    const std::vector<int>& pos = partition.interfacePositions(i);
+    const Eigen::MatrixXd& c = regions[static_cast<std::size_t>(i)].correction;
+    for (std::size_t b = 0; b < pos.size(); ++b)
+      for (std::size_t a = 0; a < pos.size(); ++a)
+        unionCorrection_(place[static_cast<std::size_t>(pos[a])], place[static_cast<std::size_t>(pos[b])]) +=
+            c(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+  }
+  Eigen::MatrixXd selector = Eigen::MatrixXd::Zero(numLarge, q);
+  for (Eigen::Index k = 0; k < q; ++k) selector(all[static_cast<std::size_t>(k)], k) = 1.0;
+  solver_->solve(selector, lowRankBasis_);  // W
+  Eigen::MatrixXd interfaceRows(q, q);
+  for (Eigen::Index k = 0; k < q; ++k) interfaceRows.row(k) = lowRankBasis_.row(all[static_cast<std::size_t>(k)]);
+  capacitance_.compute(Eigen::MatrixXd::Identity(q, q) - interfaceRows * unionCorrection_);
+}
+
+// Every block entry is stored, so a refactor writes values only and the analysis is kept.
+void SchurSolver::buildPattern(const SparseMatrix& largeSystem, const RegionPartition& partition) {
+  const auto numLarge = static_cast<int>(largeSystem.rows());
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(largeSystem.nonZeros()));
+  appendTriplets(largeSystem, 1.0, 0, 0, triplets);
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    const std::vector<int>& pos = partition.interfacePositions(i);
+    for (int column : pos)
+      for (int row : pos) triplets.emplace_back(row, column, 0.0);
+  }
+  schur_.resize(numLarge, numLarge);
+  schur_.setFromTriplets(triplets.begin(), triplets.end());
+  schur_.makeCompressed();
+  fromLarge_.resize(static_cast<std::size_t>(largeSystem.nonZeros()));
+  for (int c = 0; c < numLarge; ++c)
+    for (int k = largeSystem.outerIndexPtr()[c]; k < largeSystem.outerIndexPtr()[c + 1]; ++k)
+      fromLarge_[static_cast<std::size_t>(k)] =
+          static_cast<int>(findEntry(schur_, largeSystem.innerIndexPtr()[k], c) - schur_.valuePtr());
+  fromBlock_.assign(static_cast<std::size_t>(partition.numRegions()), {});
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    const std::vector<int>& pos = partition.interfacePositions(i);
+    std::vector<int>& index = fromBlock_[static_cast<std::size_t>(i)];
+    index.reserve(pos.size() * pos.size());
+    for (int column : pos)
+      for (int row : pos) index.push_back(static_cast<int>(findEntry(schur_, row, column) - schur_.valuePtr()));
+  }
+  patternBuilt_ = true;
+}
+
+// H^{LL*} = A^L - sum_i C_i on the I_i x I_i blocks (their symmetric part in symmetric mode).
+void SchurSolver::factorAssembled(const SparseMatrix& largeSystem, const RegionPartition& partition,
+                                  const std::vector<FastRegion>& regions, IntegratorStats& stats) {
+  Stopwatch assembly;
+  if (!patternBuilt_) buildPattern(largeSystem, partition);
+  double* values = schur_.valuePtr();
+  std::fill(values, values + schur_.nonZeros(), 0.0);
+  for (std::size_t k = 0; k < fromLarge_.size(); ++k) values[fromLarge_[k]] += largeSystem.valuePtr()[k];
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    const Eigen::MatrixXd& c = regions[static_cast<std::size_t>(i)].correction;
+    const std::vector<int>& index = fromBlock_[static_cast<std::size_t>(i)];
+    const Eigen::Index qi = c.rows();
+    for (Eigen::Index b = 0; b < qi; ++b)
+      for (Eigen::Index a = 0; a < qi; ++a) {
+        const double entry = modeUsed_ == SchurMode::symmetric ? 0.5 * (c(a, b) + c(b, a)) : c(a, b);
+        values[index[static_cast<std::size_t>(b * qi + a)]] -= entry;
+      }
+  }
+  stats.assemblySeconds += assembly.stop();
+  factorizeCounted(*solver_, schur_, analyzed_, stats);
+}
+
+void SchurSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  solver_->solve(rhs, solution_);
+  solution = solution_.col(0);
+  if (modeUsed_ != SchurMode::lowRank || interfaceUnion_.empty()) return;
+  const Eigen::VectorXd yInterface = gather(solution, interfaceUnion_);
+  const Eigen::VectorXd z = capacitance_.solve(yInterface);
+  solution.noalias() += lowRankBasis_ * (unionCorrection_ * z);
+}
+
+bool SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, const Operator& apply,
+                         bool symmetric, const AsyncOptions& options, AsyncRunStats& runStats) {
+  const double scale = rhs.norm();
+  solve(rhs, solution);
+  if (scale == 0.0) return true;
+  apply(solution, product_);
+  residual_ = rhs - product_;  // r
+  double rz = 0.0;
+  for (int iteration = 1; iteration <= options.laggedSchurIterations; ++iteration) {
+    const double residual = residual_.norm() / scale;
+    if (!std::isfinite(residual)) return false;
+    if (residual <= options.laggedSchurTolerance) {
+      ++runStats.laggedSteps;
+      runStats.largestSchurResidual = std::max(runStats.largestSchurResidual, residual);
+      refreshNext_ = iteration > options.laggedSchurIterations / 2;  // slow: the next step refactors
+      return true;
+    }
+    ++runStats.schurIterations;
+    solve(residual_, correction_);  // z = P^{-1} r
+    if (!symmetric) {
+      solution += correction_;
+      apply(solution, product_);
+      residual_ = rhs - product_;
+      continue;
+    }
+    const double rzNew = residual_.dot(correction_);
+    if (iteration == 1) {
+      direction_ = correction_;
+    } else {
+      direction_ = correction_ + (rzNew / rz) * direction_;
+    }
+    rz = rzNew;
+    apply(direction_, product_);
+    const double curvature = direction_.dot(product_);
+    if (!(curvature > 0.0)) return false;
+    const double step = rz / curvature;
+    solution += step * direction_;
+    residual_ -= step * product_;
+  }
+  return false;
+}
+
+}  // namespace asyncfem::detail

@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The large-step system of the asynchronous integrator after the fast regions are
+// eliminated: H^{LL*} = Â^L - sum_i C_i on the interface blocks I_i x I_i. Private to
+// the library.
+#pragma once
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+#include <asyncfem/asyncIntegrator/asyncOptions.hpp>
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
+#include <asyncfem/integrator/integrator.hpp>
+#include <asyncfem/sparseSolver/sparseSolver.hpp>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "detail/fastRegion.hpp"
+
+namespace asyncfem::detail {
+
+/// Factors H^{LL*} in one of three strategies (SchurMode) and solves with it; with a
+/// factor kept from an earlier tangent, solves the current Schur system by preconditioned
+/// refinement (AsyncOptions::laggedSchur).
+class SchurSolver {
+ public:
+  using SparseMatrix = Eigen::SparseMatrix<double>;
+  /// out = H^{LL*} y for the current blocks (|L| entries each).
+  using Operator = std::function<void(const Eigen::VectorXd& y, Eigen::VectorXd& out)>;
+
+  /// Factors H^{LL*} from largeSystem (Â^L, |L| x |L|) and the regions' corrections C_i.
+  /// requested is the user's mode; the stable coupling's symmetric H^{LL*} (asymmetry of
+  /// the C_i at most 1e-10) is factored by Cholesky, and lowRank falls back to lu when
+  /// W = (A^L)^{-1} U would exceed 512 MiB. Adds to stats.
+  void factor(const SparseMatrix& largeSystem, const RegionPartition& partition,
+              const std::vector<FastRegion>& regions, SchurMode requested, AsyncCoupling coupling,
+              double asymmetry, IntegratorStats& stats);
+  /// solution = (H^{LL*})^{-1} rhs with the last factor.
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
+  /// H^{LL*} solution = rhs for the operator of the current blocks, with the last factor as
+  /// preconditioner: conjugate gradients when symmetric (the stable coupling), iterative
+  /// refinement otherwise, to a relative residual of options.laggedSchurTolerance in at
+  /// most options.laggedSchurIterations iterations. Returns false when it did not get there
+  /// (the caller then refactors). Counts into runStats; a slow convergence (more than half
+  /// the iterations) asks for a refactor at the next step (refreshRequested()).
+  bool refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, const Operator& apply, bool symmetric,
+              const AsyncOptions& options, AsyncRunStats& runStats);
+
+  /// Forgets the pattern, the analysis and the factor (a new partition).
+  void reset();
+  SchurMode modeUsed() const { return modeUsed_; }
+  bool factored() const { return factored_; }
+  /// Whether the last refine() converged slowly; cleared by the next factor().
+  bool refreshRequested() const { return refreshNext_; }
+  const SparseSolver* solver() const { return solver_.get(); }
+
+ private:
+  void chooseSolver(SchurMode mode);
+  void factorLowRank(const SparseMatrix& largeSystem, const RegionPartition& partition,
+                     const std::vector<FastRegion>& regions, const std::vector<int>& interfaceUnion,
+                     IntegratorStats& stats);
+  void buildPattern(const SparseMatrix& largeSystem, const RegionPartition& partition);
+  void factorAssembled(const SparseMatrix& largeSystem, const RegionPartition& partition,
+                       const std::vector<FastRegion>& regions, IntegratorStats& stats);
+
+  SchurMode modeUsed_ = SchurMode::lowRank;
+  std::unique_ptr<SparseSolver> solver_;  // of H^{LL*} (lu, symmetric) or of A^L (lowRank)
+  bool analyzed_ = false;
+  bool factored_ = false;
+  bool refreshNext_ = false;
+  // H^{LL*} on a fixed pattern (A^L's plus every region's dense I_i x I_i block), so a
+  // refactor only writes values: where each A^L entry and each block entry sits in it.
+  SparseMatrix schur_;
+  bool patternBuilt_ = false;
+  std::vector<int> fromLarge_;
+  std::vector<std::vector<int>> fromBlock_;
+  // Low-rank form H^{LL*} = A^L - U C U^T.
+  std::vector<int> interfaceUnion_;                   // positions in L of every region's interface DOFs
+  Eigen::MatrixXd unionCorrection_;                   // C, q x q
+  Eigen::MatrixXd lowRankBasis_;                      // W = (A^L)^{-1} U, |L| x q
+  Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;  // I - U^T W C
+  Eigen::MatrixXd solution_;
+  Eigen::VectorXd product_, residual_, correction_, direction_;
+};
+
+}  // namespace asyncfem::detail
