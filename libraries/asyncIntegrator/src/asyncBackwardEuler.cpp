@@ -115,6 +115,17 @@ AsyncBackwardEuler::~AsyncBackwardEuler() = default;
 void AsyncBackwardEuler::setUp(RegionPartition partition) {
   Impl& d = *impl_;
   Stopwatch watch;
+  std::size_t partitioned = partition.largeDofs().size();
+  for (int i = 0; i < partition.numRegions(); ++i) partitioned += partition.regionDofs(i).size();
+  if (partition.vertexRegion().size() != static_cast<std::size_t>(system_.mesh->numVertices()) ||
+      partitioned != system_.freeDofs.freeToFull().size()) {
+    throw ValidationError("async integrator: setUp: the partition covers " +
+                          std::to_string(partition.vertexRegion().size()) + " vertices and " +
+                          std::to_string(partitioned) + " free DOFs, but the system has " +
+                          std::to_string(system_.mesh->numVertices()) + " vertices and " +
+                          std::to_string(system_.freeDofs.freeToFull().size()) +
+                          " free DOFs: build it on system().mesh and system().freeDofs");
+  }
   partition_ = std::move(partition);
   const SparseMatrix& mass = system_.mass;
   const std::vector<int>& large = partition_.largeDofs();

@@ -5,6 +5,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
 #include <cmath>
 #include <cstdio>
 #include <iterator>
@@ -38,7 +39,9 @@ std::vector<AsyncRegion> AutoRegionProposal::asyncRegions() const {
   return out;
 }
 
-AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options) {
+namespace {
+
+void validate(const AutoRegionOptions& options) {
   if (!(options.largeTimestep > 0.0) || !std::isfinite(options.largeTimestep)) {
     throw ValidationError("automatic regions: the large timestep must be positive");
   }
@@ -48,38 +51,30 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   if (options.growLayers < 0 || options.maxRatio < 1) {
     throw ValidationError("automatic regions: growLayers must be >= 0 and maxRatio >= 1");
   }
-  const int nv = mesh.numVertices(), ne = mesh.numElements();
-  const Eigen::VectorXd omega = elementMaxFrequencies(mesh);
-  const double hL = options.largeTimestep;
-  double target = options.targetOmegaH;
-  if (!(target > 0.0)) {
-    std::vector<double> sorted(omega.data(), omega.data() + omega.size());
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-    const double median = sorted.empty() ? 0.0 : sorted[sorted.size() / 2];
-    target = options.relativeThreshold * median * hL;
-  }
+}
 
-  // Vertex -> elements adjacency.
-  std::vector<int> offsets(static_cast<std::size_t>(nv) + 1, 0), incident(static_cast<std::size_t>(4 * ne));
-  for (int e = 0; e < ne; ++e)
-    for (int a = 0; a < 4; ++a) ++offsets[static_cast<std::size_t>(mesh.elements()(a, e)) + 1];
-  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  {
-    std::vector<int> fill(offsets.begin(), offsets.end() - 1);
-    for (int e = 0; e < ne; ++e)
-      for (int a = 0; a < 4; ++a)
-        incident[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.elements()(a, e))]++)] = e;
-  }
+/// The omega hL above which an element is fast: the given target, or the relative
+/// threshold times the median element's omega hL.
+double targetOmegaH(const Eigen::VectorXd& omega, const AutoRegionOptions& options) {
+  if (options.targetOmegaH > 0.0) return options.targetOmegaH;
+  std::vector<double> sorted(omega.data(), omega.data() + omega.size());
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  const double median = sorted.empty() ? 0.0 : sorted[sorted.size() / 2];
+  return options.relativeThreshold * median * options.largeTimestep;
+}
 
-  std::vector<char> fast(static_cast<std::size_t>(nv), 0);
-  for (int e = 0; e < ne; ++e) {
+/// Vertices of elements above the target, grown by growLayers rings (every vertex sharing
+/// an element with a fast vertex).
+std::vector<char> fastVertices(const TetMesh& mesh, const Eigen::VectorXd& omega, double hL, double target,
+                               int growLayers) {
+  std::vector<char> fast(static_cast<std::size_t>(mesh.numVertices()), 0);
+  for (int e = 0; e < mesh.numElements(); ++e) {
     if (omega[e] * hL > target)
       for (int a = 0; a < 4; ++a) fast[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
   }
-  // Grow by rings: every vertex sharing an element with a fast vertex.
-  for (int layer = 0; layer < options.growLayers; ++layer) {
+  for (int layer = 0; layer < growLayers; ++layer) {
     std::vector<char> grown = fast;
-    for (int e = 0; e < ne; ++e) {
+    for (int e = 0; e < mesh.numElements(); ++e) {
       bool any = false;
       for (int a = 0; a < 4; ++a) any = any || fast[static_cast<std::size_t>(mesh.elements()(a, e))];
       if (any)
@@ -87,39 +82,52 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
     }
     fast.swap(grown);
   }
-  // Fill enclosed L vertices (every neighbour fast) until nothing changes.
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (int v = 0; v < nv; ++v) {
-      if (fast[static_cast<std::size_t>(v)]) continue;
-      bool enclosed = offsets[static_cast<std::size_t>(v)] < offsets[static_cast<std::size_t>(v) + 1];
-      for (int k = offsets[static_cast<std::size_t>(v)]; enclosed && k < offsets[static_cast<std::size_t>(v) + 1];
-           ++k) {
-        const int e = incident[static_cast<std::size_t>(k)];
-        for (int a = 0; a < 4; ++a) {
-          const int w = mesh.elements()(a, e);
-          if (w != v && !fast[static_cast<std::size_t>(w)]) enclosed = false;
-        }
-      }
-      if (enclosed) {
-        fast[static_cast<std::size_t>(v)] = 1;
-        changed = true;
-      }
+  return fast;
+}
+
+/// Whether every neighbour of vertex v (through its elements) is fast, and it has any.
+bool enclosed(const TetMesh& mesh, const VertexElementAdjacency& adjacency, const std::vector<char>& fast, int v) {
+  const auto begin = adjacency.offsets[static_cast<std::size_t>(v)];
+  const auto end = adjacency.offsets[static_cast<std::size_t>(v) + 1];
+  if (begin == end) return false;
+  for (int k = begin; k < end; ++k) {
+    const int e = adjacency.elements[static_cast<std::size_t>(k)];
+    for (int a = 0; a < 4; ++a) {
+      const int w = mesh.elements()(a, e);
+      if (w != v && !fast[static_cast<std::size_t>(w)]) return false;
     }
   }
+  return true;
+}
 
-  // Connected components of fast vertices (through elements), breadth first.
-  std::vector<int> component(static_cast<std::size_t>(nv), -1);
-  int numComponents = 0;
+/// Makes enclosed L vertices (every neighbour fast) fast, until nothing changes.
+void fillEnclosed(const TetMesh& mesh, const VertexElementAdjacency& adjacency, std::vector<char>& fast) {
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int v = 0; v < mesh.numVertices(); ++v) {
+      if (fast[static_cast<std::size_t>(v)] || !enclosed(mesh, adjacency, fast, v)) continue;
+      fast[static_cast<std::size_t>(v)] = 1;
+      changed = true;
+    }
+  }
+}
+
+/// Connected components of fast vertices (through elements), breadth first: the
+/// component of every vertex (-1 for L) and their count.
+std::vector<int> fastComponents(const TetMesh& mesh, const VertexElementAdjacency& adjacency,
+                                const std::vector<char>& fast, int& numComponents) {
+  std::vector<int> component(static_cast<std::size_t>(mesh.numVertices()), -1);
+  numComponents = 0;
   std::vector<int> queue;
-  for (int seed = 0; seed < nv; ++seed) {
+  for (int seed = 0; seed < mesh.numVertices(); ++seed) {
     if (!fast[static_cast<std::size_t>(seed)] || component[static_cast<std::size_t>(seed)] >= 0) continue;
     queue.assign(1, seed);
     component[static_cast<std::size_t>(seed)] = numComponents;
     for (std::size_t head = 0; head < queue.size(); ++head) {
       const int v = queue[head];
-      for (int k = offsets[static_cast<std::size_t>(v)]; k < offsets[static_cast<std::size_t>(v) + 1]; ++k) {
-        const int e = incident[static_cast<std::size_t>(k)];
+      for (int k = adjacency.offsets[static_cast<std::size_t>(v)]; k < adjacency.offsets[static_cast<std::size_t>(v) + 1];
+           ++k) {
+        const int e = adjacency.elements[static_cast<std::size_t>(k)];
         for (int a = 0; a < 4; ++a) {
           const int w = mesh.elements()(a, e);
           if (fast[static_cast<std::size_t>(w)] && component[static_cast<std::size_t>(w)] < 0) {
@@ -131,12 +139,16 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
     }
     ++numComponents;
   }
+  return component;
+}
 
-  AutoRegionProposal proposal;
-  proposal.largeTimestep = hL;
-  proposal.targetOmegaH = target;
+/// One region per component with a free DOF, its largest element frequency (every element
+/// touching it is integrated at least partly at its substep), element count and ratio;
+/// L's largest frequency into the proposal.
+void collectRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const Eigen::VectorXd& omega,
+                    const std::vector<int>& component, int numComponents, int maxRatio, AutoRegionProposal& proposal) {
   std::vector<ProposedRegion> regions(static_cast<std::size_t>(numComponents));
-  for (int e = 0; e < ne; ++e) {
+  for (int e = 0; e < mesh.numElements(); ++e) {
     int owner = -1;
     bool allFast = true;
     for (int a = 0; a < 4; ++a) {
@@ -148,12 +160,11 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
       proposal.largeRegionMaxFrequency = std::max(proposal.largeRegionMaxFrequency, omega[e]);
       continue;
     }
-    // Every element touching a region is integrated (at least partly) at its substep.
     ProposedRegion& r = regions[static_cast<std::size_t>(owner)];
     r.maxFrequency = std::max(r.maxFrequency, omega[e]);
     if (allFast) ++r.numElements;
   }
-  for (int v = 0; v < nv; ++v) {
+  for (int v = 0; v < mesh.numVertices(); ++v) {
     const int c = component[static_cast<std::size_t>(v)];
     if (c >= 0) regions[static_cast<std::size_t>(c)].region.vertices.push_back(v);
   }
@@ -162,26 +173,46 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
     for (int v : r.region.vertices)
       for (int c = 0; c < 3; ++c) hasFree = hasFree || !freeDofs.isFixed(3 * v + c);
     if (!hasFree) continue;
-    const double wanted = std::ceil(r.maxFrequency * hL / target - 1e-12);
-    r.region.ratio = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(options.maxRatio)));
+    const double wanted = std::ceil(r.maxFrequency * proposal.largeTimestep / proposal.targetOmegaH - 1e-12);
+    r.region.ratio = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(maxRatio)));
     r.region.name = "auto" + std::to_string(proposal.regions.size() + 1);
     proposal.regions.push_back(std::move(r));
   }
-  // Cap: keep the regions that need the largest ratios (then the largest ones); every
-  // region costs its own factor, Z and interface block.
-  if (static_cast<int>(proposal.regions.size()) > std::max(options.maxRegions, 0)) {
-    std::stable_sort(proposal.regions.begin(), proposal.regions.end(),
-                     [](const ProposedRegion& a, const ProposedRegion& b) {
-                       if (a.region.ratio != b.region.ratio) return a.region.ratio > b.region.ratio;
-                       return a.region.vertices.size() > b.region.vertices.size();
-                     });
-    const auto keep = static_cast<std::ptrdiff_t>(std::max(options.maxRegions, 0));
-    proposal.cappedRegions.assign(std::make_move_iterator(proposal.regions.begin() + keep),
-                                  std::make_move_iterator(proposal.regions.end()));
-    proposal.regions.erase(proposal.regions.begin() + keep, proposal.regions.end());
-    for (std::size_t i = 0; i < proposal.regions.size(); ++i)
-      proposal.regions[i].region.name = "auto" + std::to_string(i + 1);
-  }
+}
+
+/// Keeps the maxRegions regions that need the largest ratios (then the largest ones):
+/// every region costs its own factor, Z and interface block.
+void capRegions(int maxRegions, AutoRegionProposal& proposal) {
+  if (static_cast<int>(proposal.regions.size()) <= std::max(maxRegions, 0)) return;
+  std::stable_sort(proposal.regions.begin(), proposal.regions.end(),
+                   [](const ProposedRegion& a, const ProposedRegion& b) {
+                     if (a.region.ratio != b.region.ratio) return a.region.ratio > b.region.ratio;
+                     return a.region.vertices.size() > b.region.vertices.size();
+                   });
+  const auto keep = static_cast<std::ptrdiff_t>(std::max(maxRegions, 0));
+  proposal.cappedRegions.assign(std::make_move_iterator(proposal.regions.begin() + keep),
+                                std::make_move_iterator(proposal.regions.end()));
+  proposal.regions.erase(proposal.regions.begin() + keep, proposal.regions.end());
+  for (std::size_t i = 0; i < proposal.regions.size(); ++i)
+    proposal.regions[i].region.name = "auto" + std::to_string(i + 1);
+}
+
+}  // namespace
+
+AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options) {
+  validate(options);
+  const Eigen::VectorXd omega = elementMaxFrequencies(mesh);
+  AutoRegionProposal proposal;
+  proposal.largeTimestep = options.largeTimestep;
+  proposal.targetOmegaH = targetOmegaH(omega, options);
+  const VertexElementAdjacency adjacency = vertexElementAdjacency(mesh);
+  std::vector<char> fast =
+      fastVertices(mesh, omega, proposal.largeTimestep, proposal.targetOmegaH, options.growLayers);
+  fillEnclosed(mesh, adjacency, fast);
+  int numComponents = 0;
+  const std::vector<int> component = fastComponents(mesh, adjacency, fast, numComponents);
+  collectRegions(mesh, freeDofs, omega, component, numComponents, options.maxRatio, proposal);
+  capRegions(options.maxRegions, proposal);
   // Interface sizes, from the partition the proposal defines.
   const RegionPartition partition(mesh, freeDofs, proposal.asyncRegions());
   for (int i = 0; i < partition.numRegions(); ++i) {

@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// AsyncBackwardEuler::setUp(partition) between steps, as run-time regions will call it.
+#include <gtest/gtest.h>
+
+#include <asyncfem/core/error.hpp>
+
+#include "asyncTestSystem.hpp"
+
+namespace asyncfem {
+namespace {
+
+AsyncOptions withCoupling(AsyncCoupling coupling) {
+  AsyncOptions options;
+  options.coupling = coupling;
+  return options;
+}
+
+// After setUp() with another partition, the steps equal those of an integrator built with
+// that partition from the same state at the same time, bit for bit: the state is
+// synchronous at a large-step boundary, setUp() drops every block and factor of the old
+// partition, and both integrators then do the same operations in the same order.
+TEST(AsyncSetUp, NewPartitionEqualsAFreshIntegratorFromTheSameState) {
+  const test::TestSystem ts = test::makeTestSystem(0.3, 2e-3);
+  const double hL = 5e-3;
+  const std::vector<AsyncRegion> before{{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}};
+  const std::vector<AsyncRegion> after{{"half", test::verticesBeyond(ts.mesh, 0.5), 8}};
+  for (const AsyncCoupling coupling : {AsyncCoupling::stable, AsyncCoupling::paper}) {
+    AsyncBackwardEuler moving(ts.mesh, ts.system, hL, before, withCoupling(coupling));
+    moving.setState(ts.u0, ts.v0);
+    for (int k = 0; k < 3; ++k) moving.step();
+    AsyncBackwardEuler fresh(ts.mesh, ts.system, hL, after, withCoupling(coupling));
+    fresh.setState(moving.displacement(), moving.velocity(), moving.time());
+    moving.setUp(RegionPartition(ts.mesh, ts.system.freeDofs, after));
+    ASSERT_EQ(moving.partition().numRegions(), 1);
+    EXPECT_EQ(moving.partition().ratio(0), 8);
+    for (int k = 0; k < 3; ++k) {
+      moving.step();
+      fresh.step();
+    }
+    EXPECT_EQ(moving.time(), fresh.time());
+    EXPECT_EQ((moving.displacement() - fresh.displacement()).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ((moving.velocity() - fresh.velocity()).cwiseAbs().maxCoeff(), 0.0);
+  }
+}
+
+// Switching back and forth leaves nothing of an earlier partition behind: after tip, half
+// and tip again, the step equals that of a fresh tip integrator from the same state.
+TEST(AsyncSetUp, PartitionsCanAlternate) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  const double hL = 5e-3;
+  const std::vector<AsyncRegion> tip{{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}};
+  const std::vector<AsyncRegion> half{{"half", test::verticesBeyond(ts.mesh, 0.5), 2}};
+  AsyncBackwardEuler moving(ts.mesh, ts.system, hL, tip);
+  moving.setState(ts.u0, ts.v0);
+  moving.step();
+  moving.setUp(RegionPartition(ts.mesh, ts.system.freeDofs, half));
+  moving.step();
+  AsyncBackwardEuler fresh(ts.mesh, ts.system, hL, tip);
+  fresh.setState(moving.displacement(), moving.velocity(), moving.time());
+  moving.setUp(RegionPartition(ts.mesh, ts.system.freeDofs, tip));
+  moving.step();
+  fresh.step();
+  EXPECT_EQ((moving.displacement() - fresh.displacement()).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((moving.velocity() - fresh.velocity()).cwiseAbs().maxCoeff(), 0.0);
+}
+
+// A partition of another mesh or other free DOFs is refused with the counts that differ.
+TEST(AsyncSetUp, APartitionOfAnotherSystemIsAnError) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  AsyncBackwardEuler async(ts.mesh, ts.system, 5e-3, {{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}});
+  const FreeDofs allFree = FreeDofs::fromFixedVertices(ts.mesh.numVertices(), {});
+  try {
+    async.setUp(RegionPartition(ts.mesh, allFree, {{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}}));
+    FAIL() << "expected a ValidationError";
+  } catch (const ValidationError& error) {
+    EXPECT_NE(std::string(error.what()).find("free DOFs"), std::string::npos) << error.what();
+  }
+}
+
+// A system without its mesh cannot be partitioned: the error says how to give one.
+TEST(AsyncSetUp, ASystemWithoutAMeshIsAnError) {
+  test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  ts.system.mesh = nullptr;
+  try {
+    AsyncBackwardEuler async(ts.system, 5e-3, {{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}});
+    FAIL() << "expected a ValidationError";
+  } catch (const ValidationError& error) {
+    EXPECT_NE(std::string(error.what()).find("no mesh"), std::string::npos) << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace asyncfem
