@@ -30,15 +30,15 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 
 struct AsyncBackwardEuler::Impl {
   bool linear = true;
-  bool factorsCurrent = false;  // linear forces: blocks and factors built for this timestep and partition
-  bool settingUp = false;       // the build under way is a set-up (for AsyncRunStats)
+  bool factorsCurrent = false;     // linear forces: blocks and factors built for this timestep and partition
+  bool settingUp = false;          // the build under way is a set-up (for AsyncRunStats)
   SparseMatrix stiffness;          // full 3n x 3n tangent K(u_0)
   bool perElementTangent = false;  // interface element tangents from the force model (else cached linear ones)
   Eigen::VectorXd internalForce;
   std::vector<FastRegion> regions;
   SubmatrixExtractor massLL, stiffLL;
-  SparseMatrix Mll, Kll;  // M^{LL} (constant), K^{LL}
-  bool cutLL = false;     // K^{LL} extracted once per partition; later only its values are updated
+  SparseMatrix Mll, Kll;     // M^{LL} (constant), K^{LL}
+  bool cutLL = false;        // K^{LL} extracted once per partition; later only its values are updated
   SparseMatrix largeSystem;  // Â^L
   detail::SchurSolver schur;
   detail::NaiveSolver naive;
@@ -112,9 +112,7 @@ AsyncBackwardEuler::AsyncBackwardEuler(DynamicSystem system, double largeTimeste
 
 AsyncBackwardEuler::~AsyncBackwardEuler() = default;
 
-void AsyncBackwardEuler::setUp(RegionPartition partition) {
-  Impl& d = *impl_;
-  Stopwatch watch;
+void AsyncBackwardEuler::checkPartitionFits(const RegionPartition& partition) const {
   std::size_t partitioned = partition.largeDofs().size();
   for (int i = 0; i < partition.numRegions(); ++i) partitioned += partition.regionDofs(i).size();
   if (partition.vertexRegion().size() != static_cast<std::size_t>(system_.mesh->numVertices()) ||
@@ -126,6 +124,12 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
                           std::to_string(system_.freeDofs.freeToFull().size()) +
                           " free DOFs: build it on system().mesh and system().freeDofs");
   }
+}
+
+void AsyncBackwardEuler::setUp(RegionPartition partition) {
+  Impl& d = *impl_;
+  Stopwatch watch;
+  checkPartitionFits(partition);
   partition_ = std::move(partition);
   const SparseMatrix& mass = system_.mass;
   const std::vector<int>& large = partition_.largeDofs();
@@ -372,13 +376,19 @@ void AsyncBackwardEuler::largeRightHandSide() {
   for (std::size_t k = 0; k < large.size(); ++k) {
     const int dof = large[k];
     const double external = d.externalL ? (*d.externalL)[dof] : 0.0;
-    const double state = d.rowProducts()
-                             ? detail::columnDot(d.stiffness, dof, d.work) + (massDamping ? alpha * d.massVelocity[dof] : 0.0)
-                             : d.stateForce[dof] + hL * d.stiffVelocity[dof];
+    const double state = d.rowProducts() ? detail::columnDot(d.stiffness, dof, d.work) +
+                                               (massDamping ? alpha * d.massVelocity[dof] : 0.0)
+                                         : d.stateForce[dof] + hL * d.stiffVelocity[dof];
     d.rhsL[static_cast<Eigen::Index>(k)] = recipe.scale * (external - state);
   }
-  // Stable coupling: b^L += (1 - theta) hL^2 (K^{IS} v^S_0 + K_I^{II} v^I_0) (Eq. A12).
-  for (int i = 0; i < partition_.numRegions() && options_.coupling == AsyncCoupling::stable; ++i) {
+  if (options_.coupling == AsyncCoupling::stable) addInterfaceVelocityTerms();
+}
+
+// Stable coupling: b^L += (1 - theta) hL^2 (K^{IS} v^S_0 + K_I^{II} v^I_0) (Eq. A12).
+void AsyncBackwardEuler::addInterfaceVelocityTerms() {
+  Impl& d = *impl_;
+  const Eigen::VectorXd& v0 = velocity_;
+  for (int i = 0; i < partition_.numRegions(); ++i) {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& pos = partition_.interfacePositions(i);
     if (pos.empty()) continue;
@@ -447,8 +457,7 @@ void AsyncBackwardEuler::solveStructured() {
     d.Y.resize(0);
   } else if (!d.schurLagging) {
     d.schur.solve(d.rhsSchur, d.Y);
-  } else if (!d.schur.refine(d.rhsSchur, d.Y, apply, options_.coupling == AsyncCoupling::stable, options_,
-                             runStats_)) {
+  } else if (!d.schur.refine(d.rhsSchur, d.Y, apply, options_.coupling == AsyncCoupling::stable, options_, runStats_)) {
     // The old factor no longer preconditions well enough: rebuild now (exact solve).
     Stopwatch rebuild;
     fullSchurRebuild();
@@ -573,7 +582,8 @@ void AsyncBackwardEuler::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& o
 
 double AsyncBackwardEuler::solveFloorSeconds(int repeats) {
   Impl& d = *impl_;
-  if (!d.factorsCurrent) throw Error("solveFloorSeconds: take one step first (the factors are built at the first step)");
+  if (!d.factorsCurrent)
+    throw Error("solveFloorSeconds: take one step first (the factors are built at the first step)");
   std::vector<double> samples;
   for (int k = 0; k < std::max(1, repeats); ++k) {
     Stopwatch watch;

@@ -125,8 +125,8 @@ std::vector<int> fastComponents(const TetMesh& mesh, const VertexElementAdjacenc
     component[static_cast<std::size_t>(seed)] = numComponents;
     for (std::size_t head = 0; head < queue.size(); ++head) {
       const int v = queue[head];
-      for (int k = adjacency.offsets[static_cast<std::size_t>(v)]; k < adjacency.offsets[static_cast<std::size_t>(v) + 1];
-           ++k) {
+      for (int k = adjacency.offsets[static_cast<std::size_t>(v)];
+           k < adjacency.offsets[static_cast<std::size_t>(v) + 1]; ++k) {
         const int e = adjacency.elements[static_cast<std::size_t>(k)];
         for (int a = 0; a < 4; ++a) {
           const int w = mesh.elements()(a, e);
@@ -206,8 +206,7 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   proposal.largeTimestep = options.largeTimestep;
   proposal.targetOmegaH = targetOmegaH(omega, options);
   const VertexElementAdjacency adjacency = vertexElementAdjacency(mesh);
-  std::vector<char> fast =
-      fastVertices(mesh, omega, proposal.largeTimestep, proposal.targetOmegaH, options.growLayers);
+  std::vector<char> fast = fastVertices(mesh, omega, proposal.largeTimestep, proposal.targetOmegaH, options.growLayers);
   fillEnclosed(mesh, adjacency, fast);
   int numComponents = 0;
   const std::vector<int> component = fastComponents(mesh, adjacency, fast, numComponents);

@@ -46,7 +46,12 @@ RegionPartition::RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, 
     throw ValidationError("region partition: the free-DOF map has " + std::to_string(freeDofs.numDofs()) +
                           " DOFs but the mesh has " + std::to_string(3 * n));
   }
-  vertexRegion_.assign(static_cast<std::size_t>(n), -1);
+  assignVertices(n);
+  splitFreeDofs(freeDofs, classifyElements(mesh));
+}
+
+void RegionPartition::assignVertices(int numVertices) {
+  vertexRegion_.assign(static_cast<std::size_t>(numVertices), -1);
   for (int i = 0; i < numRegions(); ++i) {
     AsyncRegion& r = regions_[static_cast<std::size_t>(i)];
     if (r.name.empty()) r.name = std::string("S").append(std::to_string(i + 1));
@@ -56,9 +61,9 @@ RegionPartition::RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, 
     }
     sortUnique(r.vertices);
     for (int v : r.vertices) {
-      if (v < 0 || v >= n) {
+      if (v < 0 || v >= numVertices) {
         throw ValidationError("region '" + r.name + "': vertex " + std::to_string(v) + " outside [0, " +
-                              std::to_string(n) + ")");
+                              std::to_string(numVertices) + ")");
       }
       int& owner = vertexRegion_[static_cast<std::size_t>(v)];
       if (owner >= 0) {
@@ -68,37 +73,46 @@ RegionPartition::RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, 
       owner = i;
     }
   }
+}
 
-  // Elements: no element may touch two different fast regions; collect interface elements.
-  std::vector<std::vector<char>> touchesRegion(static_cast<std::size_t>(numRegions()),
-                                               std::vector<char>(static_cast<std::size_t>(3 * n), 0));
-  for (int e = 0; e < mesh.numElements(); ++e) {
-    int fast = -1;
-    bool hasLarge = false;
-    for (int a = 0; a < 4; ++a) {
-      const int region = vertexRegion_[static_cast<std::size_t>(mesh.elements()(a, e))];
-      if (region < 0) {
-        hasLarge = true;
-      } else if (fast < 0) {
-        fast = region;
-      } else if (fast != region) {
-        throw ValidationError("element " + std::to_string(e) + " has vertices in regions '" +
-                              regions_[static_cast<std::size_t>(fast)].name + "' and '" +
-                              regions_[static_cast<std::size_t>(region)].name +
-                              "': fast regions must be separated by at least one element layer of L");
-      }
-    }
-    if (fast >= 0 && hasLarge) {
-      interfaceElements_.push_back(e);
-      for (int a = 0; a < 4; ++a) {
-        const int v = mesh.elements()(a, e);
-        if (vertexRegion_[static_cast<std::size_t>(v)] >= 0) continue;
-        for (int c = 0; c < 3; ++c)
-          touchesRegion[static_cast<std::size_t>(fast)][static_cast<std::size_t>(3 * v + c)] = 1;
-      }
+int RegionPartition::fastRegionOfElement(const TetMesh& mesh, int e, bool& hasLarge) const {
+  int fast = -1;
+  hasLarge = false;
+  for (int a = 0; a < 4; ++a) {
+    const int region = vertexRegion_[static_cast<std::size_t>(mesh.elements()(a, e))];
+    if (region < 0) {
+      hasLarge = true;
+    } else if (fast < 0) {
+      fast = region;
+    } else if (fast != region) {
+      throw ValidationError("element " + std::to_string(e) + " has vertices in regions '" +
+                            regions_[static_cast<std::size_t>(fast)].name + "' and '" +
+                            regions_[static_cast<std::size_t>(region)].name +
+                            "': fast regions must be separated by at least one element layer of L");
     }
   }
+  return fast;
+}
 
+std::vector<std::vector<char>> RegionPartition::classifyElements(const TetMesh& mesh) {
+  std::vector<std::vector<char>> touchesRegion(static_cast<std::size_t>(numRegions()),
+                                               std::vector<char>(static_cast<std::size_t>(mesh.numDofs()), 0));
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    bool hasLarge = false;
+    const int fast = fastRegionOfElement(mesh, e, hasLarge);
+    if (fast < 0 || !hasLarge) continue;
+    interfaceElements_.push_back(e);
+    for (int a = 0; a < 4; ++a) {
+      const int v = mesh.elements()(a, e);
+      if (vertexRegion_[static_cast<std::size_t>(v)] >= 0) continue;
+      for (int c = 0; c < 3; ++c)
+        touchesRegion[static_cast<std::size_t>(fast)][static_cast<std::size_t>(3 * v + c)] = 1;
+    }
+  }
+  return touchesRegion;
+}
+
+void RegionPartition::splitFreeDofs(const FreeDofs& freeDofs, const std::vector<std::vector<char>>& touchesRegion) {
   regionDofs_.assign(static_cast<std::size_t>(numRegions()), {});
   interfaceDofs_.assign(static_cast<std::size_t>(numRegions()), {});
   interfacePositions_.assign(static_cast<std::size_t>(numRegions()), {});

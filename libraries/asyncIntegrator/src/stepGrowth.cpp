@@ -40,6 +40,82 @@ class EnergyProduct {
   Eigen::SparseMatrix<double> stiffness_;
 };
 
+/// A random start, its u and v parts scaled to equal energy so that neither dominates.
+Eigen::VectorXd randomStart(const DynamicSystem& system, const EnergyProduct& product, unsigned seed) {
+  const int n = system.numDofs();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd u(n), v(n);
+  for (int i = 0; i < n; ++i) u[i] = uniform(rng);
+  for (int i = 0; i < n; ++i) v[i] = uniform(rng);
+  for (int i = 0; i < n; ++i) {
+    if (system.freeDofs.isFixed(i)) u[i] = v[i] = 0.0;
+  }
+  Eigen::VectorXd zero = Eigen::VectorXd::Zero(n), state(2 * n);
+  state << u, zero;
+  const double displacementNorm = product.norm(state);
+  state << zero, v;
+  const double velocityNorm = product.norm(state);
+  if (!(displacementNorm > 0.0) || !(velocityNorm > 0.0)) throw Error("estimateStepGrowth: the system has no free DOF");
+  state << u / displacementNorm, v / velocityNorm;
+  return state;
+}
+
+/// The Arnoldi factorization of the step map from start, in the energy product.
+struct Arnoldi {
+  Eigen::MatrixXd hessenberg;    // (k + 1) x k
+  int used = 0;                  // columns filled
+  double lastSubdiagonal = 0.0;  // 0 when the Krylov space is invariant
+};
+
+/// Arnoldi with classical Gram-Schmidt applied twice (orthogonal to round-off), up to k
+/// columns, stopping early when the Krylov space is invariant (its Ritz values are then
+/// eigenvalues).
+template <class Apply>
+Arnoldi arnoldi(const Apply& apply, const EnergyProduct& product, const Eigen::VectorXd& start, int k) {
+  Arnoldi result;
+  result.hessenberg = Eigen::MatrixXd::Zero(k + 1, k);
+  std::vector<Eigen::VectorXd> basis;
+  basis.push_back(start / product.norm(start));
+  for (int j = 0; j < k; ++j) {
+    Eigen::VectorXd w = apply(basis[static_cast<std::size_t>(j)]);
+    const double imageNorm = product.norm(w);
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int i = 0; i <= j; ++i) {
+        const double coefficient = product(basis[static_cast<std::size_t>(i)], w);
+        result.hessenberg(i, j) += coefficient;
+        w -= coefficient * basis[static_cast<std::size_t>(i)];
+      }
+    }
+    result.used = j + 1;
+    result.lastSubdiagonal = product.norm(w);
+    result.hessenberg(j + 1, j) = result.lastSubdiagonal;
+    if (result.lastSubdiagonal <= 1e-12 * imageNorm) {
+      result.lastSubdiagonal = 0.0;
+      break;
+    }
+    basis.push_back(w / result.lastSubdiagonal);
+  }
+  return result;
+}
+
+/// The dominant Ritz value of the factorization: spectral radius and its residual.
+void dominantRitzValue(const Arnoldi& factorization, double tolerance, StepGrowthEstimate& estimate) {
+  const int used = factorization.used;
+  const Eigen::EigenSolver<Eigen::MatrixXd> eigen(factorization.hessenberg.topLeftCorner(used, used));
+  if (eigen.info() != Eigen::Success) throw NumericalError("estimateStepGrowth: the Hessenberg eigenproblem failed");
+  Eigen::Index dominant = 0;
+  eigen.eigenvalues().cwiseAbs().maxCoeff(&dominant);
+  const std::complex<double> ritzValue = eigen.eigenvalues()[dominant];
+  const Eigen::VectorXcd ritzVector = eigen.eigenvectors().col(dominant).normalized();
+  estimate.spectralRadius = std::abs(ritzValue);
+  estimate.residual = estimate.spectralRadius > 0.0
+                          ? factorization.lastSubdiagonal * std::abs(ritzVector[used - 1]) / estimate.spectralRadius
+                          : factorization.lastSubdiagonal;
+  estimate.converged = estimate.residual <= tolerance;
+  estimate.krylovDimension = used;
+}
+
 }  // namespace
 
 StepGrowthEstimate estimateStepGrowth(Integrator& integrator, const StepGrowthOptions& options) {
@@ -66,65 +142,11 @@ StepGrowthEstimate estimateStepGrowth(Integrator& integrator, const StepGrowthOp
     out << integrator.displacement(), integrator.velocity();
     return out;
   };
-
-  // Random start, u and v parts scaled to equal energy so that neither dominates.
-  std::mt19937 rng(options.seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  Eigen::VectorXd u(n), v(n);
-  for (int i = 0; i < n; ++i) u[i] = uniform(rng);
-  for (int i = 0; i < n; ++i) v[i] = uniform(rng);
-  for (int i = 0; i < n; ++i) {
-    if (system.freeDofs.isFixed(i)) u[i] = v[i] = 0.0;
-  }
-  Eigen::VectorXd zero = Eigen::VectorXd::Zero(n), state(2 * n);
-  state << u, zero;
-  const double displacementNorm = product.norm(state);
-  state << zero, v;
-  const double velocityNorm = product.norm(state);
-  if (!(displacementNorm > 0.0) || !(velocityNorm > 0.0)) throw Error("estimateStepGrowth: the system has no free DOF");
-  state << u / displacementNorm, v / velocityNorm;
-
-  // Arnoldi with classical Gram-Schmidt applied twice (orthogonal to round-off).
-  const int k = options.krylovDimension;
-  std::vector<Eigen::VectorXd> basis;
-  basis.push_back(state / product.norm(state));
-  Eigen::MatrixXd hessenberg = Eigen::MatrixXd::Zero(k + 1, k);
-  int used = 0;
-  double lastSubdiagonal = 0.0;
-  for (int j = 0; j < k; ++j) {
-    Eigen::VectorXd w = apply(basis[static_cast<std::size_t>(j)]);
-    const double imageNorm = product.norm(w);
-    for (int pass = 0; pass < 2; ++pass) {
-      for (int i = 0; i <= j; ++i) {
-        const double coefficient = product(basis[static_cast<std::size_t>(i)], w);
-        hessenberg(i, j) += coefficient;
-        w -= coefficient * basis[static_cast<std::size_t>(i)];
-      }
-    }
-    used = j + 1;
-    lastSubdiagonal = product.norm(w);
-    hessenberg(j + 1, j) = lastSubdiagonal;
-    if (lastSubdiagonal <= 1e-12 * imageNorm) {  // the Krylov space is invariant: its Ritz values are eigenvalues
-      lastSubdiagonal = 0.0;
-      break;
-    }
-    basis.push_back(w / lastSubdiagonal);
-  }
+  const Arnoldi factorization =
+      arnoldi(apply, product, randomStart(system, product, options.seed), options.krylovDimension);
   integrator.setState(savedDisplacement, savedVelocity, savedTime);
   integrator.setInternalState(savedInternal);
-
-  const Eigen::EigenSolver<Eigen::MatrixXd> eigen(hessenberg.topLeftCorner(used, used));
-  if (eigen.info() != Eigen::Success) throw NumericalError("estimateStepGrowth: the Hessenberg eigenproblem failed");
-  Eigen::Index dominant = 0;
-  eigen.eigenvalues().cwiseAbs().maxCoeff(&dominant);
-  const std::complex<double> ritzValue = eigen.eigenvalues()[dominant];
-  const Eigen::VectorXcd ritzVector = eigen.eigenvectors().col(dominant).normalized();
-  estimate.spectralRadius = std::abs(ritzValue);
-  estimate.residual = estimate.spectralRadius > 0.0
-                          ? lastSubdiagonal * std::abs(ritzVector[used - 1]) / estimate.spectralRadius
-                          : lastSubdiagonal;
-  estimate.converged = estimate.residual <= options.tolerance;
-  estimate.krylovDimension = used;
+  dominantRitzValue(factorization, options.tolerance, estimate);
   estimate.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return estimate;
 }

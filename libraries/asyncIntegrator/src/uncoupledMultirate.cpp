@@ -130,29 +130,44 @@ void UncoupledMultirate::rebuild() {
 
 void UncoupledMultirate::step() {
   Impl& d = *impl_;
-  const double hL = timestep();
   // Step times from the step index (t0 = k hL, t1 = (k + 1) hL); the last substep of a
   // region (r = m) is at exactly t1.
   const double t0 = time();
   const double t1 = stepEndTime();
-  const Eigen::VectorXd& u0 = displacement_;
-  const Eigen::VectorXd& v0 = velocity_;
-  const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
-  const bool damped = system_.damped();
-
-  detail::evaluateForces(system_, d.linear, d.built, u0, d.internalForce, d.stiffness, stats_);
+  detail::evaluateForces(system_, d.linear, d.built, displacement_, d.internalForce, d.stiffness, stats_);
   Stopwatch solve;
   if (!d.linear || !d.built) {
     rebuild();
     d.built = true;
   }
-
   solve.start();
-  // Compound right-hand side: b = h (f_ext(t_0 + h) - f_int(u_0) - D v_0 - h K v_0) with
-  // h = hS_i on the rows of S_i and hL on the rows of L.
+  const Eigen::VectorXd change = d.compoundSolver->solve(compoundRightHandSide(t0, t1));  // X_i on S, Y on L
+  Eigen::VectorXd newU = displacement_, newV = velocity_;
+  const std::vector<int>& free = system_.freeDofs.freeToFull();
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    if (d.freeRegion[k] >= 0) continue;
+    const int dof = free[k];
+    newV[dof] = velocity_[dof] + change[static_cast<Eigen::Index>(k)];
+    newU[dof] = displacement_[dof] + timestep() * newV[dof];
+  }
+  for (int i = 0; i < partition_.numRegions(); ++i) loneSubsteps(i, t0, t1, change, newU, newV);
+  stats_.solveSeconds += solve.stop();
+  commitStep(newU, newV);
+  stats_.solvedRightHandSides = 0;
+  stats_.solveFlops = 0.0;
+  detail::addSolveCounts(*d.compoundSolver, stats_);
+  for (const RegionBlocks& rb : d.regions) detail::addSolveCounts(*rb.solver, stats_);
+}
+
+// b = h (f_ext(t_0 + h) - f_int(u_0) - D v_0 - h K v_0) with h = hS_i on the rows of S_i and
+// hL on the rows of L.
+Eigen::VectorXd UncoupledMultirate::compoundRightHandSide(double t0, double t1) {
+  Impl& d = *impl_;
+  const Eigen::VectorXd& v0 = velocity_;
+  const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
   const Eigen::VectorXd stiffVelocity = d.stiffness * v0;
   Eigen::VectorXd stateForce = d.internalForce;
-  if (damped) stateForce += alpha * (system_.mass * v0) + beta * stiffVelocity;
+  if (system_.damped()) stateForce += alpha * (system_.mass * v0) + beta * stiffVelocity;
   const int numRegions = partition_.numRegions();
   std::vector<Eigen::VectorXd> externalAtFirstSubstep(static_cast<std::size_t>(numRegions));
   for (int i = 0; i < numRegions; ++i) {
@@ -166,71 +181,61 @@ void UncoupledMultirate::step() {
   for (std::size_t k = 0; k < free.size(); ++k) {
     const int dof = free[k];
     const int region = d.freeRegion[k];
-    const double h = region < 0 ? hL : d.regions[static_cast<std::size_t>(region)].smallStep;
+    const double h = region < 0 ? timestep() : d.regions[static_cast<std::size_t>(region)].smallStep;
     const double fext = region < 0 ? externalForce[dof] : externalAtFirstSubstep[static_cast<std::size_t>(region)][dof];
     rhs[static_cast<Eigen::Index>(k)] = h * (fext - stateForce[dof] - h * stiffVelocity[dof]);
   }
-  const Eigen::VectorXd change = d.compoundSolver->solve(rhs);  // X_i on S rows, Y on L rows
+  return rhs;
+}
 
-  Eigen::VectorXd newU = u0, newV = v0;
-  for (std::size_t k = 0; k < free.size(); ++k) {
-    if (d.freeRegion[k] >= 0) continue;
-    const int dof = free[k];
-    newV[dof] = v0[dof] + change[static_cast<Eigen::Index>(k)];
-    newU[dof] = u0[dof] + hL * newV[dof];
-  }
-
+// Region i's substeps r = 2..m alone, L frozen at its interpolated state (step 3 of the
+// class comment), from the compound step's change; the end state into newU, newV.
+void UncoupledMultirate::loneSubsteps(int i, double t0, double t1, const Eigen::VectorXd& change, Eigen::VectorXd& newU,
+                                      Eigen::VectorXd& newV) {
+  Impl& d = *impl_;
+  const Eigen::VectorXd& u0 = displacement_;
+  const Eigen::VectorXd& v0 = velocity_;
+  const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
+  RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
+  const double hS = rb.smallStep;
+  const int m = rb.ratio;
+  const std::vector<int>& s = partition_.regionDofs(i);
+  const std::vector<int>& iface = partition_.interfaceDofs(i);
   const std::vector<int>& fullToFree = system_.freeDofs.fullToFree();
-  for (int i = 0; i < numRegions; ++i) {
-    RegionBlocks& rb = d.regions[static_cast<std::size_t>(i)];
-    const double hS = rb.smallStep;
-    const int m = rb.ratio;
-    const std::vector<int>& s = partition_.regionDofs(i);
-    const std::vector<int>& iface = partition_.interfaceDofs(i);
-    const Eigen::VectorXd uS0 = gather(u0, s);
-    Eigen::VectorXd vS = gather(v0, s);
-    for (std::size_t k = 0; k < s.size(); ++k) {
-      vS[static_cast<Eigen::Index>(k)] += change[fullToFree[static_cast<std::size_t>(s[k])]];
-    }
-    Eigen::VectorXd uS = uS0 + hS * vS;
-    if (m > 1) {
-      // L frozen: its interface velocity change Y_I, interpolated over the substeps.
-      const Eigen::VectorXd vL0 = gather(v0, iface);
-      Eigen::VectorXd changeL(static_cast<Eigen::Index>(iface.size()));
-      for (std::size_t k = 0; k < iface.size(); ++k) {
-        changeL[static_cast<Eigen::Index>(k)] = change[fullToFree[static_cast<std::size_t>(iface[k])]];
+  const Eigen::VectorXd uS0 = gather(u0, s);
+  Eigen::VectorXd vS = gather(v0, s);
+  for (std::size_t k = 0; k < s.size(); ++k)
+    vS[static_cast<Eigen::Index>(k)] += change[fullToFree[static_cast<std::size_t>(s[k])]];
+  Eigen::VectorXd uS = uS0 + hS * vS;
+  if (m > 1) {
+    // L frozen: its interface velocity change Y_I, interpolated over the substeps.
+    const Eigen::VectorXd vL0 = gather(v0, iface);
+    Eigen::VectorXd changeL(static_cast<Eigen::Index>(iface.size()));
+    for (std::size_t k = 0; k < iface.size(); ++k)
+      changeL[static_cast<Eigen::Index>(k)] = change[fullToFree[static_cast<std::size_t>(iface[k])]];
+    const Eigen::VectorXd fintS = gather(d.internalForce, s);
+    Eigen::VectorXd rhsS, dS, vLr, externalForce;
+    for (int r = 2; r <= m; ++r) {
+      evaluateExternalForce(r == m ? t1 : t0 + (r * hS), externalForce);
+      vLr = vL0 + (double(r) / m) * changeL;
+      const Eigen::VectorXd uLdiff = (r * hS) * vLr;
+      const Eigen::VectorXd uSdiff = uS + hS * vS - uS0;
+      rhsS = hS * (gather(externalForce, s) - fintS);
+      rhsS -= rb.Msi * ((1.0 / m) * changeL);
+      rhsS -= hS * (rb.Kss * uSdiff + rb.Ksi * uLdiff);
+      if (system_.damped()) {
+        rhsS -= (hS * alpha) * (rb.Mss * vS + rb.Msi * vLr);
+        rhsS -= (hS * beta) * (rb.Kss * vS + rb.Ksi * vLr);
       }
-      const Eigen::VectorXd fintS = gather(d.internalForce, s);
-      Eigen::VectorXd rhsS, dS, vLr;
-      for (int r = 2; r <= m; ++r) {
-        evaluateExternalForce(r == m ? t1 : t0 + (r * hS), externalForce);
-        vLr = vL0 + (double(r) / m) * changeL;
-        const Eigen::VectorXd uLdiff = (r * hS) * vLr;
-        const Eigen::VectorXd uSdiff = uS + hS * vS - uS0;
-        rhsS = hS * (gather(externalForce, s) - fintS);
-        rhsS -= rb.Msi * ((1.0 / m) * changeL);
-        rhsS -= hS * (rb.Kss * uSdiff + rb.Ksi * uLdiff);
-        if (damped) {
-          rhsS -= (hS * alpha) * (rb.Mss * vS + rb.Msi * vLr);
-          rhsS -= (hS * beta) * (rb.Kss * vS + rb.Ksi * vLr);
-        }
-        dS = rb.solver->solve(rhsS);
-        vS += dS;
-        uS += hS * vS;
-      }
-    }
-    for (std::size_t k = 0; k < s.size(); ++k) {
-      newV[s[k]] = vS[static_cast<Eigen::Index>(k)];
-      newU[s[k]] = uS[static_cast<Eigen::Index>(k)];
+      dS = rb.solver->solve(rhsS);
+      vS += dS;
+      uS += hS * vS;
     }
   }
-  stats_.solveSeconds += solve.stop();
-
-  commitStep(newU, newV);
-  stats_.solvedRightHandSides = 0;
-  stats_.solveFlops = 0.0;
-  detail::addSolveCounts(*d.compoundSolver, stats_);
-  for (const RegionBlocks& rb : d.regions) detail::addSolveCounts(*rb.solver, stats_);
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    newV[s[k]] = vS[static_cast<Eigen::Index>(k)];
+    newU[s[k]] = uS[static_cast<Eigen::Index>(k)];
+  }
 }
 
 RunReport UncoupledMultirate::report() const {

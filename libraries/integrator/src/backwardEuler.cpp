@@ -125,21 +125,32 @@ void BackwardEuler::step() {
   }
 }
 
-void BackwardEuler::stepLinear() {
-  const double h = timestep_;
-  const double alpha = system_.rayleighMass;
-  const double beta = system_.rayleighStiffness;
+void BackwardEuler::restrictStepStart(Eigen::VectorXd& force) {
   const FreeDofs& dofs = system_.freeDofs;
-  if (factorizationStale_) assembleAndFactor();
-
   detail::restrictTo(dofs, displacement_, u_);
   detail::restrictTo(dofs, velocity_, v_);
   if (system_.externalForce) {
     evaluateExternalForce(stepEndTime(), fullForce_);
-    detail::restrictTo(dofs, fullForce_, rhs_);
+    detail::restrictTo(dofs, fullForce_, force);
   } else {
-    rhs_.setZero(u_.size());
+    force.setZero(u_.size());
   }
+}
+
+void BackwardEuler::finishStep() {
+  v_ += dv_;
+  u_ += timestep_ * v_;
+  detail::expandTo(system_.freeDofs, u_, fullU_);
+  detail::expandTo(system_.freeDofs, v_, fullV_);
+  commitStep(fullU_, fullV_);
+}
+
+void BackwardEuler::stepLinear() {
+  const double h = timestep_;
+  const double alpha = system_.rayleighMass;
+  const double beta = system_.rayleighStiffness;
+  if (factorizationStale_) assembleAndFactor();
+  restrictStepStart(rhs_);
   {
     // Fixed DOFs are zero, so the free rows of K u are K_ff u_f:
     // b = h ( f_ext - K (u + (beta + h) v) - alpha M v ) (Eq. A1, stepFormula).
@@ -153,36 +164,22 @@ void BackwardEuler::stepLinear() {
     rhs_ *= recipe.scale;
   }
   free_->solve(rhs_, dv_, stats_);
-  v_ += dv_;
-  u_ += h * v_;
   lastIterations_ = 1;
   lastRelativeResidual_ = -1.0;
-
-  detail::expandTo(dofs, u_, fullU_);
-  detail::expandTo(dofs, v_, fullV_);
-  commitStep(fullU_, fullV_);
+  finishStep();
 }
 
 void BackwardEuler::stepNonlinear() {
   const double h = timestep_;
   const double alpha = system_.rayleighMass;
   const double beta = system_.rayleighStiffness;
-  const FreeDofs& dofs = system_.freeDofs;
   detail::FreeSystem& free = *free_;
-
-  detail::restrictTo(dofs, displacement_, u_);
-  detail::restrictTo(dofs, velocity_, v_);
-  if (system_.externalForce) {
-    evaluateExternalForce(stepEndTime(), fullForce_);
-    detail::restrictTo(dofs, fullForce_, force_);
-  } else {
-    force_.setZero(u_.size());
-  }
+  restrictStepStart(force_);
 
   // Linearized step: tangent and forces at u_k.
   free.evaluateForcesAndTangent(system_, displacement_, free.stiffness, stats_);
   Eigen::VectorXd internal;
-  detail::restrictTo(dofs, free.fullForces(), internal);
+  detail::restrictTo(system_.freeDofs, free.fullForces(), internal);
   if (reuse_) {
     assembleForReuse();
   } else {
@@ -203,71 +200,81 @@ void BackwardEuler::stepNonlinear() {
   } else {
     free.solve(rhs_, dv_, stats_);
   }
-  int iterations = 1;
   lastRelativeResidual_ = -1.0;
   lastLineSearchHalvings_ = 0;
-  const bool lineSearch = options_.lineSearch && options_.maxIterations > 1;
-  const bool dampingAtIterate = options_.rayleighStiffnessAtIterate && beta != 0.0;
-  if (lineSearch) {
+  if (options_.lineSearch && options_.maxIterations > 1) {
     // The linearized step starts from dv = 0 with the slope estimated by its own
     // right-hand side (the linearization of -R(0)).
     Eigen::VectorXd start = Eigen::VectorXd::Zero(dv_.size());
     const Eigen::VectorXd step = dv_;
     dv_ = start + backtrack(start, step, incrementalPotential(start), -rhs_.dot(step)) * step;
   }
+  lastIterations_ = options_.maxIterations > 1 ? newtonIterations(rhsNorm, internal) : 1;
+  finishStep();
+}
 
-  if (options_.maxIterations > 1) {
-    const double scale = rhsNorm > 0.0 ? rhsNorm : 1.0;
-    Eigen::VectorXd newVelocity, newDisplacement, residual, correction;
-    while (true) {
-      newVelocity = v_ + dv_;
-      newDisplacement = u_ + h * newVelocity;
-      detail::expandTo(dofs, newDisplacement, fullU_);
-      const bool mayIterate = iterations < options_.maxIterations;
-      if (mayIterate || dampingAtIterate) {
-        free.evaluateForcesAndTangent(system_, fullU_, free.iterateStiffness, stats_);
-      } else {
-        free.evaluateForces(system_, fullU_, stats_);
-      }
-      detail::restrictTo(dofs, free.fullForces(), internal);
-      // D = alpha M + beta K(u_k), or beta K(u_{k+1}^{(i)}) with rayleighStiffnessAtIterate.
-      const Eigen::SparseMatrix<double>& dampingStiffness = dampingAtIterate ? free.iterateStiffness : free.stiffness;
-      {
-        // R = M dv - h ( f_ext - f_int(u_{k+1}) - D v_{k+1} )
-        TimeInto timer(stats_.forceSeconds);
-        residual = free.mass * dv_;
-        residual.noalias() -= h * (force_ - internal);
-        if (alpha != 0.0) residual.noalias() += (h * alpha) * (free.mass * newVelocity);
-        if (beta != 0.0) residual.noalias() += (h * beta) * (dampingStiffness * newVelocity);
-      }
-      lastRelativeResidual_ = residual.norm() / scale;
-      if (lastRelativeResidual_ <= options_.tolerance || !mayIterate) break;
-      // J = (1 + h alpha) M + h beta K_D + h^2 K(u_{k+1}^{(i)}), K_D the damping stiffness
-      free.assemble({1.0 + (h * alpha), h * beta, h * h}, {&free.mass, &dampingStiffness, &free.iterateStiffness},
-                    stats_);
-      if (reuse_) {
-        updateReusedMatrix();
-        solveWithReuse(-residual, correction);
-      } else {
-        free.factorize(stats_);
-        free.solve(-residual, correction, stats_);
-      }
-      // With D at the iterate R is not the potential's gradient, so Phi is no merit
-      // function for these updates: they are taken in full, as Vega FEM does.
-      if (lineSearch && !dampingAtIterate) {
-        correction *= backtrack(dv_, correction, incrementalPotential(dv_), residual.dot(correction));
-      }
-      dv_ += correction;
-      ++iterations;
+void BackwardEuler::iterateResidual(const Eigen::VectorXd& internal,
+                                    const Eigen::SparseMatrix<double>& dampingStiffness,
+                                    const Eigen::VectorXd& newVelocity, Eigen::VectorXd& residual) {
+  // R = M dv - h ( f_ext - f_int(u_{k+1}) - D v_{k+1} )
+  const double h = timestep_;
+  const double alpha = system_.rayleighMass;
+  const double beta = system_.rayleighStiffness;
+  TimeInto timer(stats_.forceSeconds);
+  residual = free_->mass * dv_;
+  residual.noalias() -= h * (force_ - internal);
+  if (alpha != 0.0) residual.noalias() += (h * alpha) * (free_->mass * newVelocity);
+  if (beta != 0.0) residual.noalias() += (h * beta) * (dampingStiffness * newVelocity);
+}
+
+int BackwardEuler::newtonIterations(double rhsNorm, Eigen::VectorXd& internal) {
+  const double h = timestep_;
+  const double beta = system_.rayleighStiffness;
+  detail::FreeSystem& free = *free_;
+  const bool lineSearch = options_.lineSearch && options_.maxIterations > 1;
+  const bool dampingAtIterate = options_.rayleighStiffnessAtIterate && beta != 0.0;
+  const double scale = rhsNorm > 0.0 ? rhsNorm : 1.0;
+  Eigen::VectorXd newVelocity, newDisplacement, residual, correction;
+  for (int iterations = 1;; ++iterations) {
+    newVelocity = v_ + dv_;
+    newDisplacement = u_ + h * newVelocity;
+    detail::expandTo(system_.freeDofs, newDisplacement, fullU_);
+    const bool mayIterate = iterations < options_.maxIterations;
+    if (mayIterate || dampingAtIterate) {
+      free.evaluateForcesAndTangent(system_, fullU_, free.iterateStiffness, stats_);
+    } else {
+      free.evaluateForces(system_, fullU_, stats_);
     }
+    detail::restrictTo(system_.freeDofs, free.fullForces(), internal);
+    // D = alpha M + beta K(u_k), or beta K(u_{k+1}^{(i)}) with rayleighStiffnessAtIterate.
+    const Eigen::SparseMatrix<double>& dampingStiffness = dampingAtIterate ? free.iterateStiffness : free.stiffness;
+    iterateResidual(internal, dampingStiffness, newVelocity, residual);
+    lastRelativeResidual_ = residual.norm() / scale;
+    if (lastRelativeResidual_ <= options_.tolerance || !mayIterate) return iterations;
+    solveNewtonCorrection(dampingStiffness, residual, correction);
+    // With D at the iterate R is not the potential's gradient, so Phi is no merit
+    // function for these updates: they are taken in full, as Vega FEM does.
+    if (lineSearch && !dampingAtIterate) {
+      correction *= backtrack(dv_, correction, incrementalPotential(dv_), residual.dot(correction));
+    }
+    dv_ += correction;
   }
-  lastIterations_ = iterations;
+}
 
-  v_ += dv_;
-  u_ += h * v_;
-  detail::expandTo(dofs, u_, fullU_);
-  detail::expandTo(dofs, v_, fullV_);
-  commitStep(fullU_, fullV_);
+void BackwardEuler::solveNewtonCorrection(const Eigen::SparseMatrix<double>& dampingStiffness,
+                                          const Eigen::VectorXd& residual, Eigen::VectorXd& correction) {
+  // J = (1 + h alpha) M + h beta K_D + h^2 K(u_{k+1}^{(i)}), K_D the damping stiffness
+  const double h = timestep_;
+  detail::FreeSystem& free = *free_;
+  free.assemble({1.0 + (h * system_.rayleighMass), h * system_.rayleighStiffness, h * h},
+                {&free.mass, &dampingStiffness, &free.iterateStiffness}, stats_);
+  if (reuse_) {
+    updateReusedMatrix();
+    solveWithReuse(-residual, correction);
+  } else {
+    free.factorize(stats_);
+    free.solve(-residual, correction, stats_);
+  }
 }
 
 double BackwardEuler::incrementalPotential(const Eigen::VectorXd& dv) {

@@ -103,12 +103,8 @@ void Trapezoidal::computeAcceleration() {
 
 void Trapezoidal::step() {
   const double h = timestep_;
-  const double alpha = system_.rayleighMass;
-  const double beta = system_.rayleighStiffness;
   const FreeDofs& dofs = system_.freeDofs;
-  detail::FreeSystem& free = *free_;
   if (accelerationStale_) computeAcceleration();
-
   detail::restrictTo(dofs, displacement_, u_);
   detail::restrictTo(dofs, velocity_, v_);
   detail::restrictTo(dofs, acceleration_, a_);
@@ -118,8 +114,30 @@ void Trapezoidal::step() {
   } else {
     force_.setZero(u_.size());
   }
+  linearizedRightHandSide();
+  const double rhsNorm = rhs_.norm();
+  free_->solve(rhs_, newA_, stats_);
+  lastRelativeResidual_ = -1.0;
+  lastIterations_ = !linear_ && options_.maxIterations > 1 ? newtonIterations(rhsNorm) : 1;
 
-  // b = f_ext - f_int(u) - K (beta (v + h/2 a) + h v + h^2/4 a) - alpha M (v + h/2 a) (Eq. A1t)
+  // u_{k+1} = u + h v + h^2/4 (a + a_new), v_{k+1} = v + h/2 (a + a_new)
+  work_ = a_ + newA_;
+  u_ += h * v_ + stepFormula::trapezoidal::displacementWeight(h) * work_;
+  v_ += stepFormula::trapezoidal::velocityWeight(h) * work_;
+  detail::expandTo(dofs, u_, fullU_);
+  detail::expandTo(dofs, v_, fullV_);
+  detail::expandTo(dofs, newA_, fullA_);
+  commitStep(fullU_, fullV_);
+  acceleration_.swap(fullA_);
+}
+
+// b = f_ext - f_int(u) - K (beta (v + h/2 a) + h v + h^2/4 a) - alpha M (v + h/2 a) (Eq. A1t),
+// with K and f_int at u_k (refactored for nonlinear models).
+void Trapezoidal::linearizedRightHandSide() {
+  const double h = timestep_;
+  const double alpha = system_.rayleighMass;
+  const double beta = system_.rayleighStiffness;
+  detail::FreeSystem& free = *free_;
   const stepFormula::RightHandSide recipe = stepFormula::trapezoidal::rightHandSide(h, beta);
   if (linear_) {
     if (factorizationStale_) assembleAndFactor();
@@ -129,7 +147,7 @@ void Trapezoidal::step() {
     rhs_.noalias() -= free.stiffness * work_;
   } else {
     free.evaluateForcesAndTangent(system_, displacement_, free.stiffness, stats_);
-    detail::restrictTo(dofs, free.fullForces(), internal_);
+    detail::restrictTo(system_.freeDofs, free.fullForces(), internal_);
     assembleAndFactor();
     TimeInto timer(stats_.forceSeconds);
     rhs_ = force_ - internal_;
@@ -141,54 +159,42 @@ void Trapezoidal::step() {
     work_ = v_ + recipe.accelerationMass * a_;
     rhs_.noalias() -= alpha * (free.mass * work_);
   }
-  const double rhsNorm = rhs_.norm();
-  free.solve(rhs_, newA_, stats_);
-  int iterations = 1;
-  lastRelativeResidual_ = -1.0;
+}
 
-  if (!linear_ && options_.maxIterations > 1) {
-    const double scale = rhsNorm > 0.0 ? rhsNorm : 1.0;
-    Eigen::VectorXd newVelocity, newDisplacement, residual, correction;
-    while (true) {
-      newVelocity = v_ + (0.5 * h) * (a_ + newA_);
-      newDisplacement = u_ + h * v_ + (0.25 * h * h) * (a_ + newA_);
-      detail::expandTo(dofs, newDisplacement, fullU_);
-      const bool mayIterate = iterations < options_.maxIterations;
-      if (mayIterate) {
-        free.evaluateForcesAndTangent(system_, fullU_, free.iterateStiffness, stats_);
-      } else {
-        free.evaluateForces(system_, fullU_, stats_);
-      }
-      detail::restrictTo(dofs, free.fullForces(), internal_);
-      {
-        // R = M a + D v_{k+1} + f_int(u_{k+1}) - f_ext,  D = alpha M + beta K(u_k)
-        TimeInto timer(stats_.forceSeconds);
-        residual = free.mass * newA_ + internal_ - force_;
-        if (alpha != 0.0) residual.noalias() += alpha * (free.mass * newVelocity);
-        if (beta != 0.0) residual.noalias() += beta * (free.stiffness * newVelocity);
-      }
-      lastRelativeResidual_ = residual.norm() / scale;
-      if (lastRelativeResidual_ <= options_.tolerance || !mayIterate) break;
-      // J = (1 + h alpha/2) M + h beta/2 K(u_k) + h^2/4 K(u_{k+1}^{(i)})
-      free.assemble({1.0 + (0.5 * h * alpha), 0.5 * h * beta, 0.25 * h * h},
-                    {&free.mass, &free.stiffness, &free.iterateStiffness}, stats_);
-      free.factorize(stats_);
-      free.solve(-residual, correction, stats_);
-      newA_ += correction;
-      ++iterations;
+int Trapezoidal::newtonIterations(double rhsNorm) {
+  const double h = timestep_;
+  const double alpha = system_.rayleighMass;
+  const double beta = system_.rayleighStiffness;
+  detail::FreeSystem& free = *free_;
+  const double scale = rhsNorm > 0.0 ? rhsNorm : 1.0;
+  Eigen::VectorXd newVelocity, newDisplacement, residual, correction;
+  for (int iterations = 1;; ++iterations) {
+    newVelocity = v_ + (0.5 * h) * (a_ + newA_);
+    newDisplacement = u_ + h * v_ + (0.25 * h * h) * (a_ + newA_);
+    detail::expandTo(system_.freeDofs, newDisplacement, fullU_);
+    const bool mayIterate = iterations < options_.maxIterations;
+    if (mayIterate) {
+      free.evaluateForcesAndTangent(system_, fullU_, free.iterateStiffness, stats_);
+    } else {
+      free.evaluateForces(system_, fullU_, stats_);
     }
+    detail::restrictTo(system_.freeDofs, free.fullForces(), internal_);
+    {
+      // R = M a + D v_{k+1} + f_int(u_{k+1}) - f_ext,  D = alpha M + beta K(u_k)
+      TimeInto timer(stats_.forceSeconds);
+      residual = free.mass * newA_ + internal_ - force_;
+      if (alpha != 0.0) residual.noalias() += alpha * (free.mass * newVelocity);
+      if (beta != 0.0) residual.noalias() += beta * (free.stiffness * newVelocity);
+    }
+    lastRelativeResidual_ = residual.norm() / scale;
+    if (lastRelativeResidual_ <= options_.tolerance || !mayIterate) return iterations;
+    // J = (1 + h alpha/2) M + h beta/2 K(u_k) + h^2/4 K(u_{k+1}^{(i)})
+    free.assemble({1.0 + (0.5 * h * alpha), 0.5 * h * beta, 0.25 * h * h},
+                  {&free.mass, &free.stiffness, &free.iterateStiffness}, stats_);
+    free.factorize(stats_);
+    free.solve(-residual, correction, stats_);
+    newA_ += correction;
   }
-  lastIterations_ = iterations;
-
-  // u_{k+1} = u + h v + h^2/4 (a + a_new), v_{k+1} = v + h/2 (a + a_new)
-  work_ = a_ + newA_;
-  u_ += h * v_ + stepFormula::trapezoidal::displacementWeight(h) * work_;
-  v_ += stepFormula::trapezoidal::velocityWeight(h) * work_;
-  detail::expandTo(dofs, u_, fullU_);
-  detail::expandTo(dofs, v_, fullV_);
-  detail::expandTo(dofs, newA_, fullA_);
-  commitStep(fullU_, fullV_);
-  acceleration_.swap(fullA_);
 }
 
 }  // namespace asyncfem

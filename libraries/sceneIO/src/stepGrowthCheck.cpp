@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/sceneIO/stepGrowthCheck.hpp>
 #include <sstream>
 

@@ -116,8 +116,8 @@ class FastRegion {
 
 /// What one computation of Z over every region did.
 struct CorrectionRun {
-  int threads = 1;          ///< most A^S factor copies one region used
-  long long columns = 0;    ///< right-hand sides: sum_i m_i |I_i|
+  int threads = 1;        ///< most A^S factor copies one region used
+  long long columns = 0;  ///< right-hand sides: sum_i m_i |I_i|
   long long helperFactorizations = 0;
 };
 

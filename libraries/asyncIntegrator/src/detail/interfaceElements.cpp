@@ -112,5 +112,4 @@ bool findInterfaceElements(const TetMesh& mesh, const RegionPartition& partition
   return false;
 }
 
-
 }  // namespace asyncfem::detail

@@ -156,8 +156,8 @@ void SchurSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
   solution.noalias() += lowRankBasis_ * (unionCorrection_ * z);
 }
 
-bool SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, const Operator& apply,
-                         bool symmetric, const AsyncOptions& options, AsyncRunStats& runStats) {
+bool SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, const Operator& apply, bool symmetric,
+                         const AsyncOptions& options, AsyncRunStats& runStats) {
   const double scale = rhs.norm();
   solve(rhs, solution);
   if (scale == 0.0) return true;

@@ -31,9 +31,8 @@ class SchurSolver {
   /// requested is the user's mode; the stable coupling's symmetric H^{LL*} (asymmetry of
   /// the C_i at most 1e-10) is factored by Cholesky, and lowRank falls back to lu when
   /// W = (A^L)^{-1} U would exceed 512 MiB. Adds to stats.
-  void factor(const SparseMatrix& largeSystem, const RegionPartition& partition,
-              const std::vector<FastRegion>& regions, SchurMode requested, AsyncCoupling coupling,
-              double asymmetry, IntegratorStats& stats);
+  void factor(const SparseMatrix& largeSystem, const RegionPartition& partition, const std::vector<FastRegion>& regions,
+              SchurMode requested, AsyncCoupling coupling, double asymmetry, IntegratorStats& stats);
   /// solution = (H^{LL*})^{-1} rhs with the last factor.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
   /// H^{LL*} solution = rhs for the operator of the current blocks, with the last factor as

@@ -93,6 +93,8 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   void evaluateStartOfStep();
   void gatherExternalForces(double t0, double t1);
   void largeRightHandSide();
+  void addInterfaceVelocityTerms();
+  void checkPartitionFits(const RegionPartition& partition) const;
   void regionRightHandSides();
   void solveStructured();
   void recoverRegion(int region);

@@ -72,6 +72,16 @@ class RegionPartition {
   }
 
  private:
+  /// vertexRegion_ from the regions (names defaulted, ratios and vertices checked).
+  void assignVertices(int numVertices);
+  /// The one fast region element e touches (-1: none), hasLarge when it touches L too;
+  /// throws for an element touching two fast regions.
+  int fastRegionOfElement(const TetMesh& mesh, int e, bool& hasLarge) const;
+  /// interfaceElements_, and per region which DOFs of L its interface elements touch.
+  std::vector<std::vector<char>> classifyElements(const TetMesh& mesh);
+  /// regionDofs_, largeDofs_, interfaceDofs_ and interfacePositions_ from the free DOFs.
+  void splitFreeDofs(const FreeDofs& freeDofs, const std::vector<std::vector<char>>& touchesRegion);
+
   std::vector<AsyncRegion> regions_;
   std::vector<std::vector<int>> regionDofs_;
   std::vector<int> largeDofs_;

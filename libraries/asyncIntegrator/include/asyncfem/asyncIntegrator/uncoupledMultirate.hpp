@@ -85,6 +85,9 @@ class UncoupledMultirate final : public PartitionedIntegrator {
  private:
   struct Impl;
   void rebuild();
+  Eigen::VectorXd compoundRightHandSide(double t0, double t1);
+  void loneSubsteps(int region, double t0, double t1, const Eigen::VectorXd& change, Eigen::VectorXd& newU,
+                    Eigen::VectorXd& newV);
   UncoupledMultirateOptions options_;
   std::unique_ptr<Impl> impl_;
 };

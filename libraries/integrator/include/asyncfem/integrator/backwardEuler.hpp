@@ -84,8 +84,6 @@ class BackwardEuler final : public Integrator {
   int lastLineSearchHalvings() const { return lastLineSearchHalvings_; }
   /// PCG and refactorization counters when options().reuseFactor is in effect, else null.
   const FactorReuseStats* factorReuseStats() const;
-  /// With reuseFactor in effect: the kept factor is no part of a checkpoint, so a resumed
-  /// run refactors at its first step and matches an uninterrupted one to the PCG tolerance.
   /// The factor non-zeros, and with reuseFactor the caveat that resumed frames match to
   /// the PCG tolerance only.
   RunReport report() const override;
@@ -93,6 +91,19 @@ class BackwardEuler final : public Integrator {
  private:
   void stepLinear();
   void stepNonlinear();
+  /// u_, v_ = the free state; force = f_ext(t_{k+1}) on the free DOFs (zero without one).
+  void restrictStepStart(Eigen::VectorXd& force);
+  /// v += dv, u += h v, and the step committed.
+  void finishStep();
+  /// Newton iterations after the linearized step (options_.maxIterations > 1): returns
+  /// how many were taken in all, counting the linearized one.
+  int newtonIterations(double rhsNorm, Eigen::VectorXd& internal);
+  /// residual = R(dv) at the iterate (internal forces f_int(u_{k+1}), free).
+  void iterateResidual(const Eigen::VectorXd& internal, const Eigen::SparseMatrix<double>& dampingStiffness,
+                       const Eigen::VectorXd& newVelocity, Eigen::VectorXd& residual);
+  /// J correction = -residual with J at the iterate (refactored, or the kept factor).
+  void solveNewtonCorrection(const Eigen::SparseMatrix<double>& dampingStiffness, const Eigen::VectorXd& residual,
+                             Eigen::VectorXd& correction);
   /// free_->systemMatrix = the step formula's (A1) combination of M and K.
   void assembleSystemMatrix();
   void assembleAndFactor();

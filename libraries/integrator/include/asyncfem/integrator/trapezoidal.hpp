@@ -65,6 +65,11 @@ class Trapezoidal final : public Integrator {
  private:
   void computeAcceleration();
   void assembleAndFactor();
+  /// rhs_ = the linearized step's right-hand side at u_k (Eq. A1t), refactoring first for
+  /// nonlinear models (and for linear ones after setTimestep).
+  void linearizedRightHandSide();
+  /// Newton iterations after the linearized step: returns how many were taken in all.
+  int newtonIterations(double rhsNorm);
 
   IntegratorOptions options_;
   std::unique_ptr<detail::FreeSystem> free_;

@@ -4,9 +4,9 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
+#include <asyncfem/dynamics/dynamicSystem.hpp>
 #include <asyncfem/forceModel/forceModel.hpp>
 #include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
-#include <asyncfem/dynamics/dynamicSystem.hpp>
 #include <asyncfem/problem/loads.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
