@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <gtest/gtest.h>
 
-#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/integrator/registry.hpp>
 #include <asyncfem/problem/problem.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>

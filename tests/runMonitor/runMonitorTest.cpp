@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <gtest/gtest.h>
 
-#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/integrator/factory.hpp>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/runMonitor/runMonitor.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <cmath>

@@ -2,11 +2,11 @@
 #include "benchmarkRun.hpp"
 
 #include <algorithm>
-#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/integrator/stableTimestep.hpp>
 #include <cmath>
 #include <fstream>

@@ -19,10 +19,10 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/core/threading.hpp>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/runMonitor/runMonitor.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
