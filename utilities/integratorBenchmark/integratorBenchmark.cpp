@@ -14,6 +14,7 @@
 // configuration, CSV files and PNG plots. docs/benchmarks.md describes the output.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/benchmarkTools/benchmarkReference.hpp>
 #include <asyncfem/benchmarkTools/benchmarkRun.hpp>
 #include <asyncfem/benchmarkTools/costInterpolation.hpp>
@@ -27,7 +28,6 @@
 #include <asyncfem/image/png.hpp>
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
 #include <asyncfem/modalAnalysis/regionModes.hpp>
-#include <asyncfem/sceneIO/asyncScene.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -321,17 +321,28 @@ void plotVertexAgainstEqualCost(const fs::path& path, const std::vector<Benchmar
   writePng(path, renderPlot(spec, 1100, 650), PngCompression::standard);
 }
 
+// The regions the scene itself runs with, resolved as the integrator resolves them
+// ("auto" included); none for a single-rate scene.
+std::vector<AsyncRegion> sceneRegions(const Scene& scene, const Simulation& baseline) {
+  BenchmarkConfiguration own;
+  own.integrator = scene.integrator.name;
+  own.timestep = scene.integrator.timestep;
+  own.options = scene.integrator.options;
+  return configurationRegions(scene, baseline, own);
+}
+
+std::vector<int> ratiosOf(const std::vector<AsyncRegion>& regions) {
+  std::vector<int> ratios;
+  for (const AsyncRegion& region : regions) ratios.push_back(region.ratio);
+  return ratios;
+}
+
 /// The K lowest modes of the scene (linear K, the scene's mass) with omega hL, omega hS and
 /// the share of each fast region, and the verdict: which modes async can keep here
 /// (docs/asynchronous-integrator.md, "Which modes can async keep?").
 void printSceneModes(const Scene& scene, const Simulation& baseline, int count) {
   const FreeDofs& freeDofs = baseline.integrator->system().freeDofs;
-  std::vector<AsyncRegion> regions;
-  const nlohmann::json& options = scene.integrator.options;
-  if (isMultirate(scene.integrator.name) && options.is_object() && options.contains("regions") &&
-      options["regions"].is_array()) {
-    regions = parseAsyncOptions(scene, *baseline.mesh, freeDofs, options).regions;
-  }
+  const std::vector<AsyncRegion> regions = sceneRegions(scene, baseline);
   const VibrationMatrices matrices = vibrationMatrices(*baseline.mesh, scene.mass);
   ModalOptions modal;
   modal.count = std::min(count, freeDofs.numFree() - 1);
@@ -340,18 +351,6 @@ void printSceneModes(const Scene& scene, const Simulation& baseline, int count) 
             << formatDouble(modes.solveSeconds, 3) << " s)\n\n";
   printRegionModeReport(std::cout, analyseRegionModes(modes, matrices.mass, modalRegions(regions),
                                                       scene.integrator.timestep, scene.frames.rate));
-}
-
-// The region ratios the scene itself runs with (regions resolved as the integrator
-// resolves them); empty for a single-rate scene.
-std::vector<int> sceneRatios(const Scene& scene, const Simulation& baseline) {
-  BenchmarkConfiguration own;
-  own.integrator = scene.integrator.name;
-  own.timestep = scene.integrator.timestep;
-  own.options = scene.integrator.options;
-  std::vector<int> ratios;
-  for (const AsyncRegion& region : configurationRegions(scene, baseline, own)) ratios.push_back(region.ratio);
-  return ratios;
 }
 
 // The configurations of the command line (file, then specs), else the scene's defaults.
@@ -483,7 +482,8 @@ int runBenchmark(const CommandLine& options) {
   if (!options.keptWindow.empty())
     printMotionKept(results, reference.frames, scene, baseline, vertex, options.keptWindow);
   writePlots(outFolder, results,
-             {scene, reference, groups, sceneRatios(scene, baseline), vertex, fs::path(options.scene).stem().string()});
+             {scene, reference, groups, ratiosOf(sceneRegions(scene, baseline)), vertex,
+              fs::path(options.scene).stem().string()});
   std::cout << "Wrote " << (outFolder / "results.csv").string() << " and "
             << (outFolder / "equal-cost-error.csv").string() << "\n";
   return 0;
