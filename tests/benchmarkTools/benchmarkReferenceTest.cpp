@@ -63,6 +63,25 @@ TEST(BenchmarkRun, RunsAConfigurationAndRecordsItsRatios) {
   EXPECT_TRUE(single.ratios.empty());
 }
 
+TEST(BenchmarkRun, ConfiguredScene) {
+  Scene scene = barScene(kExplicitRegions);
+  scene.output.file = "out/run.afsim";
+  const Scene bySteps = configuredScene(scene, configuration("trapezoidal", 4, {{"solver", "umfpack"}}), 7);
+  EXPECT_EQ(bySteps.integrator.name, "trapezoidal");
+  EXPECT_EQ(bySteps.integrator.stepsPerFrame, 4);
+  EXPECT_DOUBLE_EQ(bySteps.integrator.timestep, 1.0 / 40.0);
+  EXPECT_EQ(bySteps.integrator.options, nlohmann::json({{"solver", "umfpack"}}));
+  EXPECT_EQ(bySteps.frames.count, 7);
+  EXPECT_TRUE(bySteps.output.file.empty());  // benchmark runs write nothing
+  BenchmarkConfiguration byStep = configuration("backward-euler", 0);
+  byStep.timestep = 0.025;
+  const Scene configured = configuredScene(scene, byStep, 1);
+  EXPECT_EQ(configured.integrator.stepsPerFrame, 0);
+  EXPECT_EQ(configured.integrator.timestep, 0.025);
+  EXPECT_TRUE(isMultirate("async") && isMultirate("multirate-uncoupled"));
+  EXPECT_FALSE(isMultirate("backward-euler"));
+}
+
 TEST(BenchmarkRun, Formatting) {
   EXPECT_EQ(formatTimestep(1.0 / 120.0), "1/120");
   EXPECT_EQ(formatTimestep(0.3), "0.3");

@@ -52,6 +52,24 @@ std::vector<BenchmarkRun> costErrorLadder() {
   return runs;
 }
 
+// Only completed backward Euler runs with a positive cost of the kind and a positive error
+// of the group are points.
+TEST(BackwardEulerPoints, CompletedRunsWithCostAndError) {
+  std::vector<BenchmarkRun> runs = costErrorLadder();
+  runs[1].medianSecondsPerFrame = 0.0;  // not timed: no time point, still a flops point
+  runs[2].errors.clear();
+  const std::vector<SingleRatePoint> byTime = backwardEulerPoints(runs, CostKind::time, "all");
+  ASSERT_EQ(byTime.size(), 2u);
+  EXPECT_EQ(byTime[0].timestep, 0.25);
+  EXPECT_EQ(byTime[1].timestep, 0.03125);
+  EXPECT_EQ(byTime[1].cost, 1e-3 / 0.03125);
+  EXPECT_EQ(byTime[1].error, 0.2 * 0.03125);
+  const std::vector<SingleRatePoint> byFlops = backwardEulerPoints(runs, CostKind::flops, "all");
+  ASSERT_EQ(byFlops.size(), 3u);
+  EXPECT_EQ(byFlops[1].cost, 1e6 / 0.125);
+  EXPECT_TRUE(backwardEulerPoints(runs, CostKind::time, "tip").empty());
+}
+
 TEST(EqualAnswers, KnownAnswersOnAPowerLawLadder) {
   const std::vector<BenchmarkRun> runs = costErrorLadder();
   const std::vector<EqualAnswers> answers = equalAnswers(runs, {"all"});
