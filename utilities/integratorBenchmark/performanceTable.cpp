@@ -2,6 +2,8 @@
 #include "performanceTable.hpp"
 
 #include <algorithm>
+#include <asyncfem/asyncIntegrator/registration.hpp>
+#include <asyncfem/benchmarkTools/benchmarkRun.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/sceneIO/asyncScene.hpp>
@@ -11,7 +13,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "benchmarkRun.hpp"
+#include "configurations.hpp"
 
 namespace asyncfem::bench {
 
@@ -26,6 +28,20 @@ std::string milliseconds(double seconds) {
   return out.str();
 }
 
+// Rotation-strain warping of every frame (what display would add per frame): ms per
+// frame, median over repeats; "n/a" without frames.
+std::string warpingMilliseconds(const Simulation& simulation, const Trajectory& frames, int repeats) {
+  if (frames.empty()) return "n/a";
+  RotationStrainWarping warper(*simulation.mesh, simulation.fixedVertices);
+  std::vector<double> perRepeat;
+  for (int repeat = 0; repeat < std::max(1, repeats); ++repeat) {
+    Stopwatch watch;
+    for (const Eigen::VectorXd& u : frames) warper.warp(u);
+    perRepeat.push_back(watch.stop() / static_cast<double>(frames.size()));
+  }
+  return milliseconds(median(perRepeat));
+}
+
 // One row, or the reason the scene has none.
 std::string tableRow(const fs::path& path, int frames, int repeats) {
   const Scene scene = loadScene(path);
@@ -34,7 +50,7 @@ std::string tableRow(const fs::path& path, int frames, int repeats) {
     return "";  // single-rate variants of a scene have no row of their own
   }
   const int count = std::min(frames, scene.frames.count);
-  Configuration async;
+  BenchmarkConfiguration async;
   async.integrator = "async";
   async.timestep = scene.integrator.timestep;
   async.options = scene.integrator.options;
@@ -43,36 +59,23 @@ std::string tableRow(const fs::path& path, int frames, int repeats) {
   const AsyncSettings parsed =
       parseAsyncOptions(scene, *simulation.mesh, simulation.integrator->system().freeDofs, scene.integrator.options);
   std::ostringstream sizes, ratios;
-  int maxRatio = 1;
   for (std::size_t i = 0; i < parsed.regions.size(); ++i) {
     sizes << (i ? ", " : "") << parsed.regions[i].vertices.size();
     ratios << (i ? ", " : "") << parsed.regions[i].ratio;
-    maxRatio = std::max(maxRatio, parsed.regions[i].ratio);
   }
   std::cerr << "integratorBenchmark --table: " << name << " (async, warping, backward Euler at hL and hS)\n";
-  const RunResult asyncRun = runConfiguration(scene, async, count, repeats);
+  const BenchmarkRun asyncRun = runConfiguration(scene, async, count, repeats);
 
-  // Rotation-strain warping of every async frame (what display would add per frame).
-  std::string warping = "n/a";
-  if (!asyncRun.frames.empty()) {
-    RotationStrainWarping warper(*simulation.mesh, simulation.fixedVertices);
-    std::vector<double> perRepeat;
-    for (int repeat = 0; repeat < std::max(1, repeats); ++repeat) {
-      Stopwatch watch;
-      for (const Eigen::VectorXd& u : asyncRun.frames) warper.warp(u);
-      perRepeat.push_back(watch.stop() / static_cast<double>(asyncRun.frames.size()));
-    }
-    warping = milliseconds(median(perRepeat));
-  }
+  const std::string warping = warpingMilliseconds(simulation, asyncRun.frames, repeats);
 
-  Configuration large;
+  BenchmarkConfiguration large;
   large.integrator = "backward-euler";
   large.timestep = scene.integrator.timestep;
-  Configuration small = large;
-  small.timestep = scene.integrator.timestep / maxRatio;
-  const RunResult largeRun = runConfiguration(scene, large, count, repeats);
-  const RunResult smallRun = runConfiguration(scene, small, count, repeats);
-  auto cell = [](const RunResult& r) {
+  BenchmarkConfiguration small = large;
+  small.timestep = scene.integrator.timestep / largestRatio(parsed.regions);
+  const BenchmarkRun largeRun = runConfiguration(scene, large, count, repeats);
+  const BenchmarkRun smallRun = runConfiguration(scene, small, count, repeats);
+  auto cell = [](const BenchmarkRun& r) {
     return r.completed ? milliseconds(r.medianSecondsPerFrame)
                        : "unstable (frame " + std::to_string(r.failedFrame) + ")";
   };

@@ -20,9 +20,11 @@
 #include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/core/threading.hpp>
+#include <asyncfem/sceneIO/asyncScene.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/sceneIO/stepGrowthCheck.hpp>
@@ -154,7 +156,9 @@ TetMesh perturbedBar(const BoxMeshSpec& spec, unsigned seed, double* worstQualit
   throw Error("could not perturb the bar without inverting or flattening an element; use more cells");
 }
 
-Scene sceneFor(const Case& run, const fs::path& meshFile) {
+// The bar scene of a case; multirate integrators get one fast region, the stiff quarter
+// (stiffVertices: the vertices of its elements).
+Scene sceneFor(const Case& run, const fs::path& meshFile, const std::vector<int>& stiffVertices) {
   Scene scene;
   scene.sourceName = "stress";
   scene.mesh.source = Scene::MeshSource::file;
@@ -166,8 +170,10 @@ Scene sceneFor(const Case& run, const fs::path& meshFile) {
   scene.integrator.timestep = 1.0 / 120.0;
   scene.frames.rate = 30.0;
   if (run.integrator != "backward-euler") {
-    scene.integrator.options = {{"regions", {{{"name", "stiff"}, {"ratio", run.ratio}, {"elementSets", {"stiff"}}}}}};
-    if (!run.variant.empty()) scene.integrator.options["schur"] = run.variant;
+    AsyncSettings settings;
+    settings.regions = {{"stiff", stiffVertices, run.ratio}};
+    if (run.variant == "symmetric") settings.solver.schur = SchurMode::symmetric;
+    scene.integrator.options = asyncSettingsJson(settings);
   }
   return scene;
 }
@@ -202,8 +208,8 @@ Outcome runSimulation(Simulation& simulation, int frames, double freeFrom, doubl
   return outcome;
 }
 
-Outcome runCase(const Case& run, const fs::path& meshFile, int frames) {
-  Scene scene = sceneFor(run, meshFile);
+Outcome runCase(const Case& run, const fs::path& meshFile, const std::vector<int>& stiffVertices, int frames) {
+  Scene scene = sceneFor(run, meshFile, stiffVertices);
   scene.frames.count = frames;
   Simulation simulation = buildSimulation(scene);
   Integrator& integrator = *simulation.integrator;
@@ -259,67 +265,109 @@ std::vector<T> chosen(const std::vector<T>& requested, std::vector<T> grid) {
   return requested.empty() ? grid : requested;
 }
 
-int run(const Options& options) {
-  const int frames = options.full ? std::max(options.frames, 10000) : options.frames;
-  const std::vector<double> stiffnessRatios =
+// The grid a run covers: the full or default lists, narrowed by the options.
+struct Grid {
+  std::vector<double> stiffnessRatios;
+  std::vector<int> ratios;
+  std::vector<Damping> dampings;
+  std::vector<std::pair<std::string, std::string>> integrators;  // registry name, variant
+  std::vector<bool> meshes;                                      // perturbed?
+};
+
+// Whether name is in the requested list (an empty list requests everything).
+bool requested(const std::vector<std::string>& list, const std::string& name) {
+  return list.empty() || std::find(list.begin(), list.end(), name) != list.end();
+}
+
+Grid gridOf(const Options& options) {
+  Grid grid;
+  grid.stiffnessRatios =
       chosen(options.stiffnessRatios, options.full ? std::vector<double>{1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6}
                                                    : std::vector<double>{1, 1e2, 1e4, 1e6});
-  const std::vector<int> ratios =
+  grid.ratios =
       chosen(options.ratios, options.full ? std::vector<int>{1, 2, 8, 32, 100, 200} : std::vector<int>{1, 8, 50, 200});
-  const std::vector<Damping> allDampings = {{"none", 0.0, 0.0}, {"light", 0.1, 1e-4}, {"heavy", 5.0, 1e-2}};
+  for (const Damping& damping : std::vector<Damping>{{"none", 0.0, 0.0}, {"light", 0.1, 1e-4}, {"heavy", 5.0, 1e-2}}) {
+    if (requested(options.dampings, damping.name)) grid.dampings.push_back(damping);
+  }
   const std::vector<std::pair<std::string, std::string>> allIntegrators = {
       {"async", ""}, {"async", "symmetric"}, {"multirate-uncoupled", ""}, {"backward-euler", ""}};
-  std::vector<Damping> dampings;
-  for (const Damping& damping : allDampings) {
-    if (options.dampings.empty() ||
-        std::find(options.dampings.begin(), options.dampings.end(), damping.name) != options.dampings.end()) {
-      dampings.push_back(damping);
-    }
-  }
-  std::vector<std::pair<std::string, std::string>> integrators;
   for (const auto& entry : allIntegrators) {
     const std::string name = entry.second.empty() ? entry.first : entry.first + "-" + entry.second;
-    if (options.integrators.empty() ||
-        std::find(options.integrators.begin(), options.integrators.end(), name) != options.integrators.end()) {
-      integrators.push_back(entry);
-    }
+    if (requested(options.integrators, name)) grid.integrators.push_back(entry);
   }
-  std::vector<bool> meshes;
   for (const bool perturbed : {false, true}) {
-    const std::string name = perturbed ? "perturbed" : "regular";
-    if (options.meshes.empty() ||
-        std::find(options.meshes.begin(), options.meshes.end(), name) != options.meshes.end()) {
-      meshes.push_back(perturbed);
-    }
+    if (requested(options.meshes, perturbed ? "perturbed" : "regular")) grid.meshes.push_back(perturbed);
   }
+  return grid;
+}
 
-  const fs::path folder = fs::temp_directory_path() / ("asyncfem-stress-" + std::to_string(::getpid()));
-  fs::create_directories(folder);
-  // Every case of the grid, with the mesh file it runs on (written once per mesh).
-  struct Job {
-    Case c;
-    fs::path meshFile;
-    double quality;
-  };
+// One case of the grid with the mesh file it runs on (written once per mesh).
+struct Job {
+  Case c;
+  fs::path meshFile;
+  double quality;
+  std::vector<int> stiffVertices;  // the fast region of multirate cases
+};
+
+std::vector<Job> gridJobs(const Options& options, const Grid& grid, const fs::path& folder) {
   std::vector<Job> jobs;
-  for (const double stiffnessRatio : stiffnessRatios) {
+  for (const double stiffnessRatio : grid.stiffnessRatios) {
     const BoxMeshSpec spec = barSpec(options, stiffnessRatio);
-    for (const bool perturbed : meshes) {
+    for (const bool perturbed : grid.meshes) {
       double quality = 1.0;
       const TetMesh mesh = perturbed ? perturbedBar(spec, options.seed, &quality) : makeBoxMesh(spec);
       const fs::path meshFile =
           folder / ("bar-" + std::to_string(jobs.size()) + (perturbed ? "-perturbed" : "") + ".veg");
       writeVeg(meshFile, mesh);
-      for (const Damping& damping : dampings) {
-        for (const auto& [integrator, variant] : integrators) {
-          for (const int ratio : ratios) {
-            if (integrator == "backward-euler" && ratio != ratios.front()) continue;  // m does not apply
-            jobs.push_back({Case{integrator, variant, stiffnessRatio, ratio, damping, perturbed}, meshFile, quality});
+      RegionSelector stiff;
+      stiff.elementSets = {"stiff"};
+      const std::vector<int> stiffVertices = regionVertices(mesh, stiff);
+      for (const Damping& damping : grid.dampings) {
+        for (const auto& [integrator, variant] : grid.integrators) {
+          for (const int ratio : grid.ratios) {
+            if (integrator == "backward-euler" && ratio != grid.ratios.front()) continue;  // m does not apply
+            jobs.push_back({Case{integrator, variant, stiffnessRatio, ratio, damping, perturbed}, meshFile, quality,
+                            stiffVertices});
           }
         }
       }
     }
   }
+  return jobs;
+}
+
+// The table row and CSV line of a finished grid case; a blow-up or energy growth is added
+// to problems.
+void reportGridCase(const Job& job, const Outcome& o, int frames, std::ostream& csv,
+                    std::vector<std::string>& problems) {
+  const Case& c = job.c;
+  const bool grows = o.energyGrowth > 1.0 + 1e-9;
+  std::cout << "| " << c.integrator << (c.variant.empty() ? "" : " " + c.variant) << " | " << c.stiffnessRatio << " | "
+            << (c.integrator == "backward-euler" ? std::string("-") : std::to_string(c.ratio)) << " | "
+            << c.damping.name << " | "
+            << (c.perturbed ? "perturbed (q " + std::to_string(job.quality).substr(0, 5) + ")" : "regular") << " | "
+            << o.energyGrowth << " | " << (o.failedFrame < 0 ? std::string("-") : std::to_string(o.failedFrame))
+            << " | " << o.maxDisplacement << " | " << std::fixed << std::setprecision(1) << o.seconds
+            << std::defaultfloat << std::setprecision(6) << " |\n";
+  std::cout.flush();
+  csv << c.integrator << ',' << c.variant << ',' << c.stiffnessRatio << ',' << c.ratio << ',' << c.damping.name << ','
+      << (c.perturbed ? "perturbed" : "regular") << ',' << frames << ',' << o.energyGrowth << ',' << o.failedFrame
+      << ',' << o.maxDisplacement << ',' << o.seconds << ",\"" << o.failure << "\"\n";
+  csv.flush();
+  if (o.failedFrame >= 0) {
+    problems.push_back("BLOW-UP: " + describe(c) + ": frame " + std::to_string(o.failedFrame) + ": " + o.failure);
+  } else if (grows) {
+    std::ostringstream line;
+    line << "ENERGY GROWTH: " << describe(c) << ": max E/E0 = " << o.energyGrowth;
+    problems.push_back(line.str());
+  }
+}
+
+int run(const Options& options) {
+  const int frames = options.full ? std::max(options.frames, 10000) : options.frames;
+  const fs::path folder = fs::temp_directory_path() / ("asyncfem-stress-" + std::to_string(::getpid()));
+  fs::create_directories(folder);
+  const std::vector<Job> jobs = gridJobs(options, gridOf(options), folder);
 
   std::ofstream csv(options.csv);
   if (!csv) throw Error(options.csv + ": cannot open for writing");
@@ -335,34 +383,14 @@ int run(const Options& options) {
   std::cout << "|---|---|---|---|---|---|---|---|---|\n";
 
   std::vector<std::string> problems;
-  auto report = [&](std::size_t index, const Outcome& o) {
-    const Case& c = jobs[index].c;
-    const bool grows = o.energyGrowth > 1.0 + 1e-9;
-    std::cout << "| " << c.integrator << (c.variant.empty() ? "" : " " + c.variant) << " | " << c.stiffnessRatio
-              << " | " << (c.integrator == "backward-euler" ? std::string("-") : std::to_string(c.ratio)) << " | "
-              << c.damping.name << " | "
-              << (c.perturbed ? "perturbed (q " + std::to_string(jobs[index].quality).substr(0, 5) + ")" : "regular")
-              << " | " << o.energyGrowth << " | "
-              << (o.failedFrame < 0 ? std::string("-") : std::to_string(o.failedFrame)) << " | " << o.maxDisplacement
-              << " | " << std::fixed << std::setprecision(1) << o.seconds << std::defaultfloat << std::setprecision(6)
-              << " |\n";
-    std::cout.flush();
-    csv << c.integrator << ',' << c.variant << ',' << c.stiffnessRatio << ',' << c.ratio << ',' << c.damping.name << ','
-        << (c.perturbed ? "perturbed" : "regular") << ',' << frames << ',' << o.energyGrowth << ',' << o.failedFrame
-        << ',' << o.maxDisplacement << ',' << o.seconds << ",\"" << o.failure << "\"\n";
-    csv.flush();
-    if (o.failedFrame >= 0) {
-      problems.push_back("BLOW-UP: " + describe(c) + ": frame " + std::to_string(o.failedFrame) + ": " + o.failure);
-    } else if (grows) {
-      std::ostringstream line;
-      line << "ENERGY GROWTH: " << describe(c) << ": max E/E0 = " << o.energyGrowth;
-      problems.push_back(line.str());
-    }
-  };
   Stopwatch total;
   runOrdered(
-      jobs.size(), workers, [&](std::size_t index) { return runCase(jobs[index].c, jobs[index].meshFile, frames); },
-      report);
+      jobs.size(), workers,
+      [&](std::size_t index) {
+        const Job& job = jobs[index];
+        return runCase(job.c, job.meshFile, job.stiffVertices, frames);
+      },
+      [&](std::size_t index, const Outcome& o) { reportGridCase(jobs[index], o, frames, csv, problems); });
   std::cout << "\n"
             << jobs.size() << " runs in " << total.stop() << " s; " << problems.size()
             << " with a blow-up or energy growth (E/E0 > 1 + 1e-9)\n";
@@ -379,6 +407,80 @@ std::string formatGrowth(double value) {
   return out.str();
 }
 
+// --scene: one run, an integrator from the --integrators list at one ratio m.
+struct SceneJob {
+  std::string integrator;
+  int ratio;
+};
+
+std::vector<SceneJob> sceneJobs(const Options& options, const Scene& base) {
+  const std::vector<int> ratios = chosen(options.ratios, {2, 4, 8, 16, 32, 64});
+  const std::vector<std::string> integrators = chosen(
+      options.integrators, {base.integrator.name == "async" ? "async" : "multirate-uncoupled", "backward-euler"});
+  std::vector<SceneJob> jobs;
+  for (const std::string& integrator : integrators) {
+    for (const int ratio : ratios) {
+      if (integrator == "backward-euler" && ratio != ratios.front()) continue;  // m does not apply
+      jobs.push_back({integrator, ratio});
+    }
+  }
+  return jobs;
+}
+
+// The scene's regions as the simulator reads them (the mesh and constraints only, nothing
+// assembled).
+std::vector<AsyncRegion> sceneRegions(const Scene& scene) {
+  const std::shared_ptr<const Problem> problem = buildProblem(scene);
+  const nlohmann::json regionsOnly = {{"regions", scene.integrator.options.at("regions")}};
+  return parseAsyncOptions(scene, *problem->sharedMesh(), problem->freeDofs(), regionsOnly).regions;
+}
+
+// The scene of a job: every region's ratio set to the job's m, or backward Euler.
+Scene sceneForJob(const Scene& base, std::vector<AsyncRegion> regions, const SceneJob& job, int frames) {
+  Scene scene = base;
+  scene.frames.count = frames;
+  if (job.integrator == "backward-euler") {
+    scene.integrator.name = "backward-euler";
+    scene.integrator.options = nlohmann::json::object();
+    return scene;
+  }
+  scene.integrator.name = job.integrator == "multirate-uncoupled" ? "multirate-uncoupled" : "async";
+  for (AsyncRegion& region : regions) region.ratio = job.ratio;
+  scene.integrator.options["regions"] = asyncRegionsJson(regions);
+  if (job.integrator == "async-symmetric") scene.integrator.options["schur"] = "symmetric";
+  if (scene.integrator.name == "multirate-uncoupled") {
+    for (const char* key : {"coupling", "schur", "method", "recovery", "substepContact"}) {
+      scene.integrator.options.erase(key);
+    }
+  }
+  return scene;
+}
+
+void reportSceneCase(const SceneJob& job, const Outcome& o, std::vector<std::string>& problems) {
+  const std::string m = job.integrator == "backward-euler" ? std::string("-") : std::to_string(job.ratio);
+  std::ostringstream estimate;  // "-" when the scene failed before the estimate
+  if (o.stepGrowth) {
+    estimate << formatGrowth(o.stepGrowth->spectralRadius) << (o.stepGrowth->converged ? "" : " (not converged)")
+             << " | " << std::fixed << std::setprecision(1) << o.stepGrowth->seconds;
+  } else {
+    estimate << "- | -";
+  }
+  std::cout << "| " << job.integrator << " | " << m << " | " << estimate.str() << " | "
+            << (o.energyMeasured ? formatGrowth(o.energyGrowth) : std::string("-")) << " | "
+            << (o.failedFrame < 0 ? std::string("-") : std::to_string(o.failedFrame)) << " | " << o.maxDisplacement
+            << " | " << std::fixed << std::setprecision(1) << o.seconds << std::defaultfloat << std::setprecision(6)
+            << " |\n";
+  std::cout.flush();
+  const std::string what = job.integrator + (m == "-" ? "" : ", m = " + m);
+  if (o.failedFrame >= 0) {
+    problems.push_back("BLOW-UP: " + what + ": frame " + std::to_string(o.failedFrame) + ": " + o.failure);
+  } else if (o.energyMeasured && o.energyGrowth > 1.0 + 1e-9) {
+    std::ostringstream line;
+    line << "ENERGY GROWTH: " << what << ": max E/E_free = " << o.energyGrowth;
+    problems.push_back(line.str());
+  }
+}
+
 // --scene: a user's multirate scene under several ratios m (every region's ratio set to
 // m), and backward Euler at its large step, for its frames (or --frames); energy growth
 // is measured once the loads are over.
@@ -391,38 +493,8 @@ int runScene(const Options& options) {
                 "regions (not \"auto\")");
   }
   const int frames = options.framesGiven ? options.frames : base.frames.count;
-  const std::vector<int> ratios = chosen(options.ratios, {2, 4, 8, 16, 32, 64});
-  const std::vector<std::string> integrators = chosen(
-      options.integrators, {base.integrator.name == "async" ? "async" : "multirate-uncoupled", "backward-euler"});
-  struct Job {
-    std::string integrator;  // name from the --integrators list
-    int ratio;
-  };
-  std::vector<Job> jobs;
-  for (const std::string& integrator : integrators) {
-    for (const int ratio : ratios) {
-      if (integrator == "backward-euler" && ratio != ratios.front()) continue;  // m does not apply
-      jobs.push_back({integrator, ratio});
-    }
-  }
-  auto sceneFor = [&](const Job& job) {
-    Scene scene = base;
-    scene.frames.count = frames;
-    if (job.integrator == "backward-euler") {
-      scene.integrator.name = "backward-euler";
-      scene.integrator.options = nlohmann::json::object();
-      return scene;
-    }
-    scene.integrator.name = job.integrator == "multirate-uncoupled" ? "multirate-uncoupled" : "async";
-    for (nlohmann::json& region : scene.integrator.options["regions"]) region["ratio"] = job.ratio;
-    if (job.integrator == "async-symmetric") scene.integrator.options["schur"] = "symmetric";
-    if (scene.integrator.name == "multirate-uncoupled") {
-      for (const char* key : {"coupling", "schur", "method", "recovery", "substepContact"}) {
-        scene.integrator.options.erase(key);
-      }
-    }
-    return scene;
-  };
+  const std::vector<AsyncRegion> regions = sceneRegions(base);
+  const std::vector<SceneJob> jobs = sceneJobs(options, base);
   const int workers = std::max(1, std::min<int>(options.jobs, static_cast<int>(jobs.size())));
   std::cout
       << "# stabilityStressTest --scene " << options.scene << ": " << jobs.size() << " runs of " << frames
@@ -437,38 +509,14 @@ int runScene(const Options& options) {
   runOrdered(
       jobs.size(), workers,
       [&](std::size_t index) {
-        const Scene scene = sceneFor(jobs[index]);
+        const Scene scene = sceneForJob(base, regions, jobs[index], frames);
         Simulation simulation = buildSimulation(scene);
         const StepGrowthEstimate stepGrowth = estimateSceneStepGrowth(scene, simulation);
         Outcome outcome = runSimulation(simulation, frames, simulation.monitor->energyCheckFrom());
         outcome.stepGrowth = stepGrowth;
         return outcome;
       },
-      [&](std::size_t index, const Outcome& o) {
-        const Job& job = jobs[index];
-        const std::string m = job.integrator == "backward-euler" ? std::string("-") : std::to_string(job.ratio);
-        std::ostringstream estimate;  // "-" when the scene failed before the estimate
-        if (o.stepGrowth) {
-          estimate << formatGrowth(o.stepGrowth->spectralRadius) << (o.stepGrowth->converged ? "" : " (not converged)")
-                   << " | " << std::fixed << std::setprecision(1) << o.stepGrowth->seconds;
-        } else {
-          estimate << "- | -";
-        }
-        std::cout << "| " << job.integrator << " | " << m << " | " << estimate.str() << " | "
-                  << (o.energyMeasured ? formatGrowth(o.energyGrowth) : std::string("-")) << " | "
-                  << (o.failedFrame < 0 ? std::string("-") : std::to_string(o.failedFrame)) << " | "
-                  << o.maxDisplacement << " | " << std::fixed << std::setprecision(1) << o.seconds << std::defaultfloat
-                  << std::setprecision(6) << " |\n";
-        std::cout.flush();
-        const std::string what = job.integrator + (m == "-" ? "" : ", m = " + m);
-        if (o.failedFrame >= 0) {
-          problems.push_back("BLOW-UP: " + what + ": frame " + std::to_string(o.failedFrame) + ": " + o.failure);
-        } else if (o.energyMeasured && o.energyGrowth > 1.0 + 1e-9) {
-          std::ostringstream line;
-          line << "ENERGY GROWTH: " << what << ": max E/E_free = " << o.energyGrowth;
-          problems.push_back(line.str());
-        }
-      });
+      [&](std::size_t index, const Outcome& o) { reportSceneCase(jobs[index], o, problems); });
   std::cout << "\n"
             << jobs.size() << " runs in " << total.stop() << " s; " << problems.size()
             << " with a blow-up or energy growth (E/E_free > 1 + 1e-9)\n";

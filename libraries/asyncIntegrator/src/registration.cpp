@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
 #include <asyncfem/settings/jsonReader.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace asyncfem {
 
@@ -63,6 +66,85 @@ AsyncRegion parseRegion(const std::string& sourceName, const TetMesh& mesh, cons
   return region;
 }
 
+// The names of each choice of the options object, in both directions (read and written
+// from one table, so the two cannot drift apart).
+template <typename Enum>
+using ChoiceTable = std::vector<std::pair<std::string, Enum>>;
+
+const ChoiceTable<AsyncCoupling> kCouplings{{"stable", AsyncCoupling::stable}, {"paper", AsyncCoupling::paper}};
+const ChoiceTable<SchurMode> kSchurModes{
+    {"low-rank", SchurMode::lowRank}, {"lu", SchurMode::lu}, {"symmetric", SchurMode::symmetric}};
+const ChoiceTable<AsyncSolveMethod> kSolveMethods{{"structured", AsyncSolveMethod::structured},
+                                                  {"naive", AsyncSolveMethod::naive}};
+const ChoiceTable<RecoveryMode> kRecoveryModes{{"automatic", RecoveryMode::automatic},
+                                               {"substitution", RecoveryMode::substitution},
+                                               {"dense-z", RecoveryMode::denseZ}};
+
+// The value of key (one of the table's names; the first one when absent).
+template <typename Enum>
+Enum readChoice(JsonObjectReader& reader, const std::string& key, const ChoiceTable<Enum>& table) {
+  std::vector<std::string> names;
+  for (const auto& entry : table) names.push_back(entry.first);
+  const std::string name = reader.choice(key, names.front(), names);
+  for (const auto& [entryName, value] : table) {
+    if (entryName == name) return value;
+  }
+  return table.front().second;  // unreachable: choice() accepts only the names
+}
+
+template <typename Enum>
+const std::string& choiceName(const ChoiceTable<Enum>& table, Enum value) {
+  for (const auto& [name, entryValue] : table) {
+    if (entryValue == value) return name;
+  }
+  throw Error("asyncSettingsJson: invalid enumerator " + std::to_string(static_cast<int>(value)));
+}
+
+AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
+  AsyncOptions solver;
+  solver.coupling = readChoice(reader, "coupling", kCouplings);
+  solver.schur = readChoice(reader, "schur", kSchurModes);
+  solver.method = readChoice(reader, "method", kSolveMethods);
+  solver.recovery = readChoice(reader, "recovery", kRecoveryModes);
+  const std::string regionSolver =
+      reader.choice("regionSolver", "cholmod", {"cholmod", "umfpack", "eigen-ldlt", "eigen-lu"});
+  solver.regionSolver = parseSolverKind(regionSolver);
+  solver.substepStatePrediction = reader.boolean("substepContact", false);
+  solver.laggedSchur = reader.boolean("laggedSchur", solver.laggedSchur);
+  solver.threads = reader.integer("threads", solver.threads, 0, 1024);
+  if (solver.substepStatePrediction && !hasContact) {
+    reader.fail("substepContact", "only meaningful with a \"contact\" section");
+  }
+  return solver;
+}
+
+// "regions" (default "auto") and "auto" into out: the explicit regions, or the automatic
+// settings (the proposal runs after the keys are checked).
+void parseRegions(JsonObjectReader& reader, const IntegratorContext& context, const nlohmann::json& options,
+                  AsyncSettings& out) {
+  static const nlohmann::json automaticRegions = "auto";
+  const std::string& sourceName = context.sourceName;
+  const nlohmann::json* given = reader.find("regions");
+  const nlohmann::json& regions = given ? *given : automaticRegions;  // default: automatic regions
+  const std::string regionsPath = reader.keyPath("regions");
+  if (regions.is_string()) {
+    if (regions.get<std::string>() != "auto") {
+      JsonObjectReader::failAt(sourceName, regionsPath, "expected \"auto\" or an array of regions");
+    }
+    out.automaticRegions = true;
+    out.automatic = parseAutoRegionOptions(context, options);
+    (void)reader.find("auto");  // read by parseAutoRegionOptions
+  } else if (regions.is_array()) {
+    if (reader.find("auto")) reader.fail("auto", "only with \"regions\": \"auto\"");
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+      out.regions.push_back(parseRegion(sourceName, *context.mesh, regions[i], reader.elementPath("regions", i)));
+    }
+  } else {
+    JsonObjectReader::failAt(sourceName, regionsPath,
+                             "expected \"auto\" or an array of regions, got " + JsonObjectReader::describe(regions));
+  }
+}
+
 }  // namespace
 
 AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const nlohmann::json& options) {
@@ -102,46 +184,9 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
   const TetMesh& mesh = *context.mesh;
   JsonObjectReader reader(options, context.optionsPath, sourceName);
   AsyncSettings out;
-  const std::string coupling = reader.choice("coupling", "stable", {"stable", "paper"});
-  out.solver.coupling = coupling == "paper" ? AsyncCoupling::paper : AsyncCoupling::stable;
-  const std::string schur = reader.choice("schur", "low-rank", {"low-rank", "lu", "symmetric"});
-  out.solver.schur = schur == "lu" ? SchurMode::lu : schur == "symmetric" ? SchurMode::symmetric : SchurMode::lowRank;
-  const std::string method = reader.choice("method", "structured", {"structured", "naive"});
-  out.solver.method = method == "naive" ? AsyncSolveMethod::naive : AsyncSolveMethod::structured;
-  const std::string recovery = reader.choice("recovery", "automatic", {"automatic", "substitution", "dense-z"});
-  out.solver.recovery = recovery == "substitution" ? RecoveryMode::substitution
-                        : recovery == "dense-z"    ? RecoveryMode::denseZ
-                                                   : RecoveryMode::automatic;
-  const std::string regionSolver =
-      reader.choice("regionSolver", "cholmod", {"cholmod", "umfpack", "eigen-ldlt", "eigen-lu"});
-  out.solver.regionSolver = parseSolverKind(regionSolver);
-  out.solver.substepStatePrediction = reader.boolean("substepContact", false);
-  out.solver.laggedSchur = reader.boolean("laggedSchur", out.solver.laggedSchur);
-  out.solver.threads = reader.integer("threads", out.solver.threads, 0, 1024);
-  if (out.solver.substepStatePrediction && !context.hasContact) {
-    reader.fail("substepContact", "only meaningful with a \"contact\" section");
-  }
-
-  static const nlohmann::json automaticRegions = "auto";
-  const nlohmann::json* given = reader.find("regions");
-  const nlohmann::json& regions = given ? *given : automaticRegions;  // default: automatic regions
+  out.solver = parseSolverOptions(reader, context.hasContact);
   const std::string regionsPath = reader.keyPath("regions");
-  if (regions.is_string()) {
-    if (regions.get<std::string>() != "auto") {
-      JsonObjectReader::failAt(sourceName, regionsPath, "expected \"auto\" or an array of regions");
-    }
-    out.automaticRegions = true;
-    out.automatic = parseAutoRegionOptions(context, options);
-    (void)reader.find("auto");  // read by parseAutoRegionOptions
-  } else if (regions.is_array()) {
-    if (reader.find("auto")) reader.fail("auto", "only with \"regions\": \"auto\"");
-    for (std::size_t i = 0; i < regions.size(); ++i) {
-      out.regions.push_back(parseRegion(sourceName, mesh, regions[i], reader.elementPath("regions", i)));
-    }
-  } else {
-    JsonObjectReader::failAt(sourceName, regionsPath,
-                             "expected \"auto\" or an array of regions, got " + JsonObjectReader::describe(regions));
-  }
+  parseRegions(reader, context, options, out);
   reader.finish();
   const FreeDofs& freeDofs = context.system.freeDofs;
   if (out.automaticRegions) {
@@ -161,6 +206,43 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
     JsonObjectReader::failAt(sourceName, regionsPath, e.what());
   }
   return out;
+}
+
+nlohmann::json asyncRegionJson(const AsyncRegion& region) {
+  return {{"name", region.name}, {"ratio", region.ratio}, {"vertices", region.vertices}};
+}
+
+nlohmann::json asyncRegionsJson(const std::vector<AsyncRegion>& regions) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const AsyncRegion& region : regions) out.push_back(asyncRegionJson(region));
+  return out;
+}
+
+nlohmann::json asyncSettingsJson(const AsyncSettings& settings) {
+  const AsyncOptions defaults;
+  const AsyncOptions& solver = settings.solver;
+  nlohmann::json out = nlohmann::json::object();
+  const auto writeChoice = [&out](const char* key, const auto& table, auto value, auto defaultValue) {
+    if (value != defaultValue) out[key] = choiceName(table, value);
+  };
+  writeChoice("coupling", kCouplings, solver.coupling, defaults.coupling);
+  writeChoice("schur", kSchurModes, solver.schur, defaults.schur);
+  writeChoice("method", kSolveMethods, solver.method, defaults.method);
+  writeChoice("recovery", kRecoveryModes, solver.recovery, defaults.recovery);
+  if (solver.regionSolver != defaults.regionSolver) out["regionSolver"] = toString(solver.regionSolver);
+  if (solver.substepStatePrediction != defaults.substepStatePrediction) {
+    out["substepContact"] = solver.substepStatePrediction;
+  }
+  if (solver.laggedSchur != defaults.laggedSchur) out["laggedSchur"] = solver.laggedSchur;
+  if (solver.threads != defaults.threads) out["threads"] = solver.threads;
+  out["regions"] = asyncRegionsJson(settings.regions);
+  return out;
+}
+
+int largestRatio(const std::vector<AsyncRegion>& regions) {
+  int largest = 1;
+  for (const AsyncRegion& region : regions) largest = std::max(largest, region.ratio);
+  return largest;
 }
 
 void registerMultirateIntegrators(IntegratorRegistry& registry) {

@@ -80,12 +80,9 @@ ModalReference::ModalReference(const Eigen::SparseMatrix<double>& mass, const Ei
 
 std::string ModalReference::backend() { return detail::generalizedEigenBackend(); }
 
-std::vector<Eigen::VectorXd> ModalReference::displacements(const PiecewiseConstantLoad& load,
-                                                           const std::vector<double>& times,
-                                                           const Eigen::VectorXd& initialDisplacement,
-                                                           const Eigen::VectorXd& initialVelocity) const {
-  const int numDofs = freeDofs_.numDofs();
-  const Eigen::Index n = eigenvalues_.size();
+namespace {
+
+void checkTimesAndBreakpoints(const PiecewiseConstantLoad& load, const std::vector<double>& times) {
   for (std::size_t k = 0; k < times.size(); ++k) {
     if (!(times[k] >= 0.0) || (k > 0 && times[k] < times[k - 1])) {
       throw Error("modal reference: requested times must be >= 0 and ascending (entry " + std::to_string(k) + ")");
@@ -100,7 +97,13 @@ std::vector<Eigen::VectorXd> ModalReference::displacements(const PiecewiseConsta
                   ")");
     }
   }
-  auto checkSize = [numDofs](const Eigen::VectorXd& v, const std::string& what) {
+}
+
+// Full vectors are empty (zero) or 3n long; checked in the order the errors were always
+// reported: initial state, load vectors, impulses.
+void checkSizes(const PiecewiseConstantLoad& load, const Eigen::VectorXd& initialDisplacement,
+                const Eigen::VectorXd& initialVelocity, int numDofs) {
+  const auto checkSize = [numDofs](const Eigen::VectorXd& v, const std::string& what) {
     if (v.size() != 0 && v.size() != numDofs) {
       throw Error("modal reference: " + what + " has " + std::to_string(v.size()) + " entries, expected " +
                   std::to_string(numDofs));
@@ -108,6 +111,44 @@ std::vector<Eigen::VectorXd> ModalReference::displacements(const PiecewiseConsta
   };
   checkSize(initialDisplacement, "the initial displacement");
   checkSize(initialVelocity, "the initial velocity");
+  for (const Eigen::VectorXd& f : load.forces) checkSize(f, "a load vector");
+  for (const PiecewiseConstantLoad::Impulse& impulse : load.impulses) checkSize(impulse.impulse, "an impulse");
+}
+
+// What happens at a time: a requested output, an impulse, a load change. At equal times
+// they happen in this order (an output records the state before an impulse at its time).
+enum class EventKind { output, impulse, breakpoint };
+
+struct Event {
+  double time;
+  EventKind kind;
+  std::size_t index;  // into times, load.impulses or load.breakpoints
+};
+
+std::vector<Event> sortedEvents(const PiecewiseConstantLoad& load, const std::vector<double>& times) {
+  std::vector<Event> events;
+  for (std::size_t k = 0; k < times.size(); ++k) events.push_back({times[k], EventKind::output, k});
+  for (std::size_t k = 0; k < load.impulses.size(); ++k) {
+    events.push_back({load.impulses[k].time, EventKind::impulse, k});
+  }
+  for (std::size_t k = 0; k < load.breakpoints.size(); ++k) {
+    events.push_back({load.breakpoints[k], EventKind::breakpoint, k});
+  }
+  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
+    return a.time < b.time || (a.time == b.time && a.kind < b.kind);
+  });
+  return events;
+}
+
+}  // namespace
+
+std::vector<Eigen::VectorXd> ModalReference::displacements(const PiecewiseConstantLoad& load,
+                                                           const std::vector<double>& times,
+                                                           const Eigen::VectorXd& initialDisplacement,
+                                                           const Eigen::VectorXd& initialVelocity) const {
+  const Eigen::Index n = eigenvalues_.size();
+  checkTimesAndBreakpoints(load, times);
+  checkSizes(load, initialDisplacement, initialVelocity, freeDofs_.numDofs());
   // Modal coordinates: q = Phi^T M u (Phi M-orthonormal), modal force Phi^T f.
   auto modal = [&](const Eigen::VectorXd& full, bool weightByMass) -> Eigen::VectorXd {
     if (full.size() == 0) return Eigen::VectorXd::Zero(n);
@@ -116,13 +157,9 @@ std::vector<Eigen::VectorXd> ModalReference::displacements(const PiecewiseConsta
     return modes_.transpose() * restricted;
   };
   std::vector<Eigen::VectorXd> modalForces;
-  for (const Eigen::VectorXd& f : load.forces) {
-    checkSize(f, "a load vector");
-    modalForces.push_back(modal(f, false));
-  }
+  for (const Eigen::VectorXd& f : load.forces) modalForces.push_back(modal(f, false));
   std::vector<Eigen::VectorXd> modalImpulses;
   for (const PiecewiseConstantLoad::Impulse& impulse : load.impulses) {
-    checkSize(impulse.impulse, "an impulse");
     modalImpulses.push_back(modal(impulse.impulse, false));
   }
   Eigen::VectorXd q = modal(initialDisplacement, true);
@@ -131,25 +168,10 @@ std::vector<Eigen::VectorXd> ModalReference::displacements(const PiecewiseConsta
   // Rigid modes: eigenvalues at round-off level relative to the largest.
   const double rigidBelow = 1e-12 * std::max(1.0, eigenvalues_.size() > 0 ? eigenvalues_.maxCoeff() : 1.0);
 
-  // Events in time order: requested outputs, load changes, impulses (outputs first at
-  // equal times, then impulses).
-  struct Event {
-    double time;
-    int kind;  // 0: output, 1: impulse, 2: breakpoint
-    std::size_t index;
-  };
-  std::vector<Event> events;
-  for (std::size_t k = 0; k < times.size(); ++k) events.push_back({times[k], 0, k});
-  for (std::size_t k = 0; k < load.impulses.size(); ++k) events.push_back({load.impulses[k].time, 1, k});
-  for (std::size_t k = 0; k < load.breakpoints.size(); ++k) events.push_back({load.breakpoints[k], 2, k});
-  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
-    return a.time < b.time || (a.time == b.time && a.kind < b.kind);
-  });
-
   std::vector<Eigen::VectorXd> out(times.size());
   double now = 0.0;
   std::size_t piece = 0;
-  for (const Event& event : events) {
+  for (const Event& event : sortedEvents(load, times)) {
     const double duration = event.time - now;
     if (duration > 0.0) {
       const Eigen::VectorXd& p = modalForces[piece];
@@ -159,9 +181,9 @@ std::vector<Eigen::VectorXd> ModalReference::displacements(const PiecewiseConsta
       }
       now = event.time;
     }
-    if (event.kind == 0) {
+    if (event.kind == EventKind::output) {
       out[event.index] = freeDofs_.expand(modes_ * q);
-    } else if (event.kind == 1) {
+    } else if (event.kind == EventKind::impulse) {
       rate += modalImpulses[event.index];
     } else {
       piece = event.index + 1;

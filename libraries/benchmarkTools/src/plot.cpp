@@ -120,7 +120,116 @@ void drawMarker(Image& image, int x, int y, Marker marker, Rgb8 color) {
   }
 }
 
+// Whether a point can be drawn: finite, and positive on a log axis.
+bool drawable(const PlotSpec& spec, double x, double y) {
+  return std::isfinite(x) && std::isfinite(y) && (!spec.logX || x > 0.0) && (!spec.logY || y > 0.0);
+}
+
+// The plot area in pixels and the axes mapped onto it.
+struct PlotArea {
+  int left = 0, right = 0, top = 0, bottom = 0;
+  Axis ax, ay;
+  // Pixel column of an axis-unit position (tick) and of a data value.
+  int columnAt(double t) const {
+    return left + static_cast<int>(std::lround((t - ax.lo) / (ax.hi - ax.lo) * (right - left)));
+  }
+  int rowAt(double t) const {
+    return bottom - static_cast<int>(std::lround((t - ay.lo) / (ay.hi - ay.lo) * (bottom - top)));
+  }
+  int px(double v) const { return columnAt(ax.map(v)); }
+  int py(double v) const { return rowAt(ay.map(v)); }
+};
+
+PlotArea plotArea(const PlotSpec& spec, int width, int height) {
+  int legendWidth = 0;
+  for (const PlotSeries& s : spec.series) legendWidth = std::max(legendWidth, textAdvance(s.label, 1));
+  legendWidth = legendWidth > 0 ? legendWidth + 40 : 0;
+  PlotArea area;
+  area.left = 80;
+  area.right = width - 20 - legendWidth;
+  area.top = 50;
+  area.bottom = height - 60;
+  if (area.right - area.left < 50 || area.bottom - area.top < 50) {
+    throw Error("renderPlot: image too small for the plot and its legend");
+  }
+  std::vector<double> xs, ys;
+  for (const PlotSeries& s : spec.series) {
+    for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
+      if (!drawable(spec, s.x[k], s.y[k])) continue;
+      xs.push_back(s.x[k]);
+      ys.push_back(s.y[k]);
+    }
+  }
+  area.ax = makeAxis(xs, spec.logX);
+  area.ay = makeAxis(ys, spec.logY);
+  return area;
+}
+
+// Grid, tick labels, frame, title and axis labels.
+void drawAxes(Image& image, const PlotSpec& spec, const PlotArea& a) {
+  const Rgb8 black{0, 0, 0}, grid{225, 225, 225};
+  for (const auto& [t, label] : ticks(a.ax)) {
+    const int x = a.columnAt(t);
+    drawLine(image, x, a.top, x, a.bottom, grid);
+    drawLine(image, x, a.bottom, x, a.bottom + 5, black);
+    drawText(image, x - textAdvance(label, 1) / 2, a.bottom + 10, label, 1, black);
+  }
+  for (const auto& [t, label] : ticks(a.ay)) {
+    const int y = a.rowAt(t);
+    drawLine(image, a.left, y, a.right, y, grid);
+    drawLine(image, a.left - 5, y, a.left, y, black);
+    drawText(image, a.left - 8 - textAdvance(label, 1), y - 3, label, 1, black);
+  }
+  drawLine(image, a.left, a.top, a.left, a.bottom, black);
+  drawLine(image, a.left, a.bottom, a.right, a.bottom, black);
+  drawLine(image, a.left, a.top, a.right, a.top, black);
+  drawLine(image, a.right, a.top, a.right, a.bottom, black);
+  drawText(image, (a.left + a.right - textAdvance(spec.title, 2)) / 2, 14, spec.title, 2, black);
+  drawText(image, (a.left + a.right - textAdvance(spec.xLabel, 1)) / 2, a.bottom + 30, spec.xLabel, 1, black);
+  drawText(image, 8, a.top - 16, spec.yLabel, 1, black);
+}
+
+// One series: markers, and lines between consecutive drawable points when connected.
+void drawSeries(Image& image, const PlotSpec& spec, const PlotSeries& s, const PlotArea& a) {
+  bool havePrevious = false;
+  int previousX = 0, previousY = 0;
+  for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
+    if (!drawable(spec, s.x[k], s.y[k])) {
+      havePrevious = false;
+      continue;
+    }
+    const int x = a.px(s.x[k]), y = a.py(s.y[k]);
+    if (s.connect && havePrevious) drawLine(image, previousX, previousY, x, y, s.color, 2);
+    drawMarker(image, x, y, s.marker, s.color);
+    havePrevious = true;
+    previousX = x;
+    previousY = y;
+  }
+}
+
+// The legend to the right of the plot area.
+void drawLegend(Image& image, const PlotSpec& spec, const PlotArea& a) {
+  int row = a.top;
+  for (const PlotSeries& s : spec.series) {
+    if (s.label.empty()) continue;
+    const int x = a.right + 16;
+    if (s.connect) drawLine(image, x, row + 3, x + 16, row + 3, s.color, 2);
+    drawMarker(image, x + 8, row + 3, s.marker, s.color);
+    drawText(image, x + 24, row, s.label, 1, Rgb8{0, 0, 0});
+    row += 14;
+  }
+}
+
 }  // namespace
+
+Image renderPlot(const PlotSpec& spec, int width, int height) {
+  Image image(width, height, Rgb8{255, 255, 255});
+  const PlotArea area = plotArea(spec, width, height);
+  drawAxes(image, spec, area);
+  for (const PlotSeries& s : spec.series) drawSeries(image, spec, s, area);
+  drawLegend(image, spec, area);
+  return image;
+}
 
 Rgb8 paletteColor(int index) {
   static constexpr Rgb8 colors[] = {{31, 119, 180}, {214, 39, 40},   {44, 160, 44},  {255, 127, 14}, {148, 103, 189},
@@ -132,87 +241,6 @@ Marker paletteMarker(int index) {
   static constexpr Marker markers[] = {Marker::circle,  Marker::square, Marker::triangle,
                                        Marker::diamond, Marker::cross,  Marker::plus};
   return markers[static_cast<std::size_t>(index) % 6];
-}
-
-Image renderPlot(const PlotSpec& spec, int width, int height) {
-  Image image(width, height, Rgb8{255, 255, 255});
-  const Rgb8 black{0, 0, 0}, grid{225, 225, 225};
-  int legendWidth = 0;
-  for (const PlotSeries& s : spec.series) legendWidth = std::max(legendWidth, textAdvance(s.label, 1));
-  legendWidth = legendWidth > 0 ? legendWidth + 40 : 0;
-  const int left = 80, right = width - 20 - legendWidth, top = 50, bottom = height - 60;
-  if (right - left < 50 || bottom - top < 50) throw Error("renderPlot: image too small for the plot and its legend");
-
-  std::vector<double> xs, ys;
-  for (const PlotSeries& s : spec.series) {
-    for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
-      const bool ok = std::isfinite(s.x[k]) && std::isfinite(s.y[k]) && (!spec.logX || s.x[k] > 0.0) &&
-                      (!spec.logY || s.y[k] > 0.0);
-      if (!ok) continue;
-      xs.push_back(s.x[k]);
-      ys.push_back(s.y[k]);
-    }
-  }
-  const Axis ax = makeAxis(xs, spec.logX), ay = makeAxis(ys, spec.logY);
-  auto px = [&](double v) {
-    return left + static_cast<int>(std::lround((ax.map(v) - ax.lo) / (ax.hi - ax.lo) * (right - left)));
-  };
-  auto py = [&](double v) {
-    return bottom - static_cast<int>(std::lround((ay.map(v) - ay.lo) / (ay.hi - ay.lo) * (bottom - top)));
-  };
-
-  // Grid and tick labels.
-  for (const auto& [t, label] : ticks(ax)) {
-    const int x = left + static_cast<int>(std::lround((t - ax.lo) / (ax.hi - ax.lo) * (right - left)));
-    drawLine(image, x, top, x, bottom, grid);
-    drawLine(image, x, bottom, x, bottom + 5, black);
-    drawText(image, x - textAdvance(label, 1) / 2, bottom + 10, label, 1, black);
-  }
-  for (const auto& [t, label] : ticks(ay)) {
-    const int y = bottom - static_cast<int>(std::lround((t - ay.lo) / (ay.hi - ay.lo) * (bottom - top)));
-    drawLine(image, left, y, right, y, grid);
-    drawLine(image, left - 5, y, left, y, black);
-    drawText(image, left - 8 - textAdvance(label, 1), y - 3, label, 1, black);
-  }
-  drawLine(image, left, top, left, bottom, black);
-  drawLine(image, left, bottom, right, bottom, black);
-  drawLine(image, left, top, right, top, black);
-  drawLine(image, right, top, right, bottom, black);
-  drawText(image, (left + right - textAdvance(spec.title, 2)) / 2, 14, spec.title, 2, black);
-  drawText(image, (left + right - textAdvance(spec.xLabel, 1)) / 2, bottom + 30, spec.xLabel, 1, black);
-  drawText(image, 8, top - 16, spec.yLabel, 1, black);
-
-  // Series, clipped to the plot area by skipping points outside it.
-  for (const PlotSeries& s : spec.series) {
-    bool havePrevious = false;
-    int previousX = 0, previousY = 0;
-    for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
-      const bool ok = std::isfinite(s.x[k]) && std::isfinite(s.y[k]) && (!spec.logX || s.x[k] > 0.0) &&
-                      (!spec.logY || s.y[k] > 0.0);
-      if (!ok) {
-        havePrevious = false;
-        continue;
-      }
-      const int x = px(s.x[k]), y = py(s.y[k]);
-      if (s.connect && havePrevious) drawLine(image, previousX, previousY, x, y, s.color, 2);
-      drawMarker(image, x, y, s.marker, s.color);
-      havePrevious = true;
-      previousX = x;
-      previousY = y;
-    }
-  }
-
-  // Legend to the right of the plot.
-  int row = top;
-  for (const PlotSeries& s : spec.series) {
-    if (s.label.empty()) continue;
-    const int x = right + 16;
-    if (s.connect) drawLine(image, x, row + 3, x + 16, row + 3, s.color, 2);
-    drawMarker(image, x + 8, row + 3, s.marker, s.color);
-    drawText(image, x + 24, row, s.label, 1, black);
-    row += 14;
-  }
-  return image;
 }
 
 }  // namespace asyncfem

@@ -37,6 +37,25 @@ AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const
 /// default) runs suggestRegions() with the modal check on the context's mesh and mass type.
 AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohmann::json& options);
 
+/// The other direction: the options object that parseAsyncSettings() reads back to the same
+/// solver options and regions. Solver keys are written only where they differ from
+/// AsyncOptions' defaults (so an object with regions alone is also valid for
+/// "multirate-uncoupled"); the regions are always written explicitly (asyncRegionsJson),
+/// automatic ones as the regions they resolved to, so the object reproduces the run
+/// without running the proposal again.
+nlohmann::json asyncSettingsJson(const AsyncSettings& settings);
+
+/// One region as an element of "regions": {"name": ..., "ratio": m_i, "vertices": [0-based
+/// ids]}; parseAsyncSettings() reads it back to the same region (vertices sorted, unique).
+nlohmann::json asyncRegionJson(const AsyncRegion& region);
+
+/// The "regions" array of these regions (asyncRegionJson of each, in order).
+nlohmann::json asyncRegionsJson(const std::vector<AsyncRegion>& regions);
+
+/// The largest ratio m_i = hL / hS_i of the regions, so hL / largestRatio() is the smallest
+/// step any of them takes; 1 when there are none (everything runs at hL).
+int largestRatio(const std::vector<AsyncRegion>& regions);
+
 /// Adds "async" (AsyncBackwardEuler) and "multirate-uncoupled" (UncoupledMultirate).
 void registerMultirateIntegrators(IntegratorRegistry& registry);
 

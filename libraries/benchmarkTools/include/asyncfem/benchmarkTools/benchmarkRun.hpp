@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Configurations of the integrator benchmark and running one of them on a scene.
+// One integrator configuration of a benchmark, and running it on a scene.
 #pragma once
 
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/benchmarkTools/errorMetrics.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
@@ -10,11 +11,11 @@
 #include <string>
 #include <vector>
 
-namespace asyncfem::bench {
+namespace asyncfem {
 
 /// One integrator setting to measure. The timestep is either stepsPerFrame (h = frame
-/// interval / stepsPerFrame, exact) or timestep.
-struct Configuration {
+/// interval / stepsPerFrame, exact) or timestep (s).
+struct BenchmarkConfiguration {
   std::string label;
   std::string integrator = "backward-euler";          ///< registry name
   int stepsPerFrame = 0;                              ///< > 0: h = 1 / (rate stepsPerFrame)
@@ -23,27 +24,26 @@ struct Configuration {
   bool plotTrajectory = false;                        ///< draw its vertex curve in the trajectory plot
 };
 
-/// Multirate integrators (their options carry regions).
+/// Multirate integrators (their options carry regions): "async" and "multirate-uncoupled".
 bool isMultirate(const std::string& integrator);
 
-/// Reads {"configurations": [{label, integrator, stepsPerFrame | timestep, ratio, options,
-/// plot}, ...]}. "ratio" sets the ratio of every region of options.regions (taken from the
-/// scene when the configuration gives no regions). Errors name the file and key.
-std::vector<Configuration> readConfigurations(const std::string& path, const Scene& scene);
-/// Parses "NAME[:key=value]..." with keys spf (steps per frame), dt, ratio, schur, method,
-/// recovery, solver, label.
-Configuration parseConfigurationSpec(const std::string& spec, const Scene& scene);
-/// The default list for a scene (documented in docs/benchmarks.md).
-std::vector<Configuration> defaultConfigurations(const Scene& scene, const Simulation& baseline);
+/// The scene with the configuration's integrator, timestep, options and frame count, and
+/// no output.
+Scene configuredScene(const Scene& scene, const BenchmarkConfiguration& configuration, int frames);
 
-/// The scene with the configuration's integrator, timestep, options and frame count.
-Scene configuredScene(const Scene& scene, const Configuration& configuration, int frames);
+/// The fast regions a multirate configuration runs with, resolved on baseline's mesh and
+/// free DOFs as the integrator resolves them (parseAsyncSettings: explicit regions, or the
+/// automatic proposal at the configuration's step); empty for a single-rate integrator.
+/// Throws what parseAsyncSettings throws for bad regions.
+std::vector<AsyncRegion> configurationRegions(const Scene& scene, const Simulation& baseline,
+                                              const BenchmarkConfiguration& configuration);
 
-struct RunResult {
-  Configuration configuration;
-  double timestep = 0.0;  ///< h (large step for multirate)
+/// What running one configuration measured.
+struct BenchmarkRun {
+  BenchmarkConfiguration configuration;
+  double timestep = 0.0;  ///< h (s); the large step for multirate
   int stepsPerFrame = 0;
-  std::string ratios;  ///< "8" or "8,4" for multirate, "" otherwise
+  std::vector<int> ratios;  ///< m_i of every region of a multirate run, in order; empty otherwise
   bool completed = false;
   int failedFrame = -1;  ///< first frame that failed (non-finite or blow-up), -1 if none
   std::string failure;
@@ -55,8 +55,8 @@ struct RunResult {
   double firstFrameSeconds = 0.0;  ///< frame 0 (factorizations of linear models happen there)
   // Per frame over frames 1.. (machine independent, from IntegratorStats).
   double factorizationsPerFrame = 0.0, solvesPerFrame = 0.0, factorFlopsPerFrame = 0.0, solveFlopsPerFrame = 0.0;
-  long long factorNonZeros = -1;         ///< multirate integrators only
-  std::map<std::string, double> errors;  ///< per vertex group
+  long long factorNonZeros = -1;         ///< the integrator's kept factors (RunReport::factorNonZeros)
+  std::map<std::string, double> errors;  ///< relative L2 error per vertex group name (filled by the caller)
   double flopsPerFrame() const { return factorFlopsPerFrame + solveFlopsPerFrame; }
 };
 
@@ -64,15 +64,15 @@ struct RunResult {
 /// costs come from the first repeat, the time per frame is the median over repeats. A
 /// NumericalError (non-finite state, blow-up: advanceFrame's checks) ends the run and is
 /// recorded, never thrown; scene errors are thrown.
-RunResult runConfiguration(const Scene& scene, const Configuration& configuration, int frames, int repeats);
+BenchmarkRun runConfiguration(const Scene& scene, const BenchmarkConfiguration& configuration, int frames, int repeats);
 
-/// The machine for reports: "nproc 2, Intel(R) ... (CPU model), load average 3.1 2.9 2.5".
-std::string machineDescription();
-
-/// Median of a non-empty list (mean of the two middle values for an even count); 0 if empty.
+/// Median of a list (mean of the two middle values for an even count); 0 if empty.
 double median(std::vector<double> values);
 
-/// "1/120" style text for a timestep that divides the frame interval, else "%g".
+/// "1/120" style text for a timestep (s) whose inverse is a whole number, else "%g".
 std::string formatTimestep(double timestep);
 
-}  // namespace asyncfem::bench
+/// Ratios as the tables print them: "8" or "8,4"; "" for none.
+std::string formatRatios(const std::vector<int>& ratios);
+
+}  // namespace asyncfem

@@ -1,13 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "benchmarkRun.hpp"
+#include "configurations.hpp"
 
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
-#include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
+#include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/core/stopwatch.hpp>
-#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/integrator/stableTimestep.hpp>
+#include <asyncfem/sceneIO/asyncScene.hpp>
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -15,8 +13,6 @@
 #include <thread>
 
 namespace asyncfem::bench {
-
-bool isMultirate(const std::string& integrator) { return integrator == "async" || integrator == "multirate-uncoupled"; }
 
 namespace {
 
@@ -28,16 +24,29 @@ nlohmann::json sceneRegions(const Scene& scene) {
   return "auto";
 }
 
-void setRatio(nlohmann::json& options, int ratio, const std::string& where) {
-  if (!options.contains("regions") || !options["regions"].is_array()) {
+// The explicit regions of an options object, resolved on the baseline's mesh as the
+// integrator reads them; nullopt for "auto" or no regions.
+std::optional<std::vector<AsyncRegion>> explicitRegions(const nlohmann::json& options, const Scene& scene,
+                                                        const Simulation& baseline) {
+  if (!options.is_object() || !options.contains("regions") || !options["regions"].is_array()) return std::nullopt;
+  const nlohmann::json regionsOnly = {{"regions", options["regions"]}};
+  return parseAsyncOptions(scene, *baseline.mesh, baseline.integrator->system().freeDofs, regionsOnly).regions;
+}
+
+// Every explicit region of options at this ratio (written back by the regions codec).
+void setRatio(nlohmann::json& options, int ratio, const std::string& where, const Scene& scene,
+              const Simulation& baseline) {
+  std::optional<std::vector<AsyncRegion>> regions = explicitRegions(options, scene, baseline);
+  if (!regions) {
     throw ValidationError(where +
                           ": \"ratio\" needs explicit regions (the scene's or the configuration's), not \"auto\"");
   }
-  for (nlohmann::json& region : options["regions"]) region["ratio"] = ratio;
+  for (AsyncRegion& region : *regions) region.ratio = ratio;
+  options["regions"] = asyncRegionsJson(*regions);
 }
 
 // Multirate configurations without regions inherit the scene's.
-void completeOptions(Configuration& configuration, const Scene& scene) {
+void completeOptions(BenchmarkConfiguration& configuration, const Scene& scene) {
   if (isMultirate(configuration.integrator) && !configuration.options.contains("regions")) {
     configuration.options["regions"] = sceneRegions(scene);
     if (scene.integrator.options.contains("auto") && configuration.options["regions"] == "auto") {
@@ -46,7 +55,7 @@ void completeOptions(Configuration& configuration, const Scene& scene) {
   }
 }
 
-std::string defaultLabel(const Configuration& c) {
+std::string defaultLabel(const BenchmarkConfiguration& c, const Scene& scene, const Simulation& baseline) {
   std::ostringstream out;
   out << c.integrator;
   if (c.stepsPerFrame > 0) {
@@ -54,9 +63,9 @@ std::string defaultLabel(const Configuration& c) {
   } else {
     out << " h=" << c.timestep;
   }
-  if (isMultirate(c.integrator) && c.options.contains("regions") && c.options["regions"].is_array() &&
-      !c.options["regions"].empty() && c.options["regions"][0].contains("ratio")) {
-    out << " m=" << c.options["regions"][0]["ratio"].get<int>();
+  if (isMultirate(c.integrator)) {
+    const std::optional<std::vector<AsyncRegion>> regions = explicitRegions(c.options, scene, baseline);
+    if (regions && !regions->empty()) out << " m=" << regions->front().ratio;
   }
   for (const char* key : {"coupling", "schur", "method", "recovery"}) {
     if (c.options.contains(key)) out << " " << c.options[key].get<std::string>();
@@ -66,7 +75,8 @@ std::string defaultLabel(const Configuration& c) {
 
 }  // namespace
 
-std::vector<Configuration> readConfigurations(const std::string& path, const Scene& scene) {
+std::vector<BenchmarkConfiguration> readConfigurations(const std::string& path, const Scene& scene,
+                                                       const Simulation& baseline) {
   std::ifstream in(path);
   if (!in) throw Error(path + ": cannot open the configuration file");
   nlohmann::json json;
@@ -78,13 +88,13 @@ std::vector<Configuration> readConfigurations(const std::string& path, const Sce
   if (!json.is_object() || !json.contains("configurations") || !json["configurations"].is_array()) {
     throw ValidationError(path + ": expected {\"configurations\": [...]}");
   }
-  std::vector<Configuration> out;
+  std::vector<BenchmarkConfiguration> out;
   const nlohmann::json& list = json["configurations"];
   for (std::size_t i = 0; i < list.size(); ++i) {
     const std::string where = path + ": configurations[" + std::to_string(i) + "]";
     const nlohmann::json& item = list[i];
     if (!item.is_object()) throw ValidationError(where + ": expected an object");
-    Configuration c;
+    BenchmarkConfiguration c;
     for (const auto& [key, value] : item.items()) {
       if (key == "label") {
         c.label = value.get<std::string>();
@@ -108,20 +118,20 @@ std::vector<Configuration> readConfigurations(const std::string& path, const Sce
       throw ValidationError(where + ": give stepsPerFrame (>= 1) or timestep (> 0)");
     }
     completeOptions(c, scene);
-    if (item.contains("ratio")) setRatio(c.options, item["ratio"].get<int>(), where + ".ratio");
-    if (c.label.empty()) c.label = defaultLabel(c);
+    if (item.contains("ratio")) setRatio(c.options, item["ratio"].get<int>(), where + ".ratio", scene, baseline);
+    if (c.label.empty()) c.label = defaultLabel(c, scene, baseline);
     out.push_back(std::move(c));
   }
   return out;
 }
 
-Configuration parseConfigurationSpec(const std::string& spec, const Scene& scene) {
+BenchmarkConfiguration parseConfigurationSpec(const std::string& spec, const Scene& scene, const Simulation& baseline) {
   std::vector<std::string> parts;
   std::stringstream stream(spec);
   for (std::string part; std::getline(stream, part, ':');) parts.push_back(part);
   if (parts.empty() || parts[0].empty())
     throw ValidationError("--config \"" + spec + "\": expected NAME[:key=value]...");
-  Configuration c;
+  BenchmarkConfiguration c;
   c.integrator = parts[0];
   c.plotTrajectory = true;
   std::optional<int> ratio;
@@ -161,32 +171,32 @@ Configuration parseConfigurationSpec(const std::string& spec, const Scene& scene
   }
   completeOptions(c, scene);
   // Any given ratio goes to the regions, so that the scene check rejects one out of range.
-  if (ratio) setRatio(c.options, *ratio, "--config \"" + spec + "\".ratio");
-  if (c.label.empty()) c.label = defaultLabel(c);
+  if (ratio) setRatio(c.options, *ratio, "--config \"" + spec + "\".ratio", scene, baseline);
+  if (c.label.empty()) c.label = defaultLabel(c, scene, baseline);
   return c;
 }
 
-std::vector<Configuration> defaultConfigurations(const Scene& scene, const Simulation& baseline) {
+std::vector<BenchmarkConfiguration> defaultConfigurations(const Scene& scene, const Simulation& baseline) {
   const double frame = 1.0 / scene.frames.rate;
   // Steps per frame of the scene's own (large) timestep, at least 1.
   const int sceneSteps = std::max(1, static_cast<int>(std::lround(frame / scene.integrator.timestep)));
-  const bool explicitRegions = isMultirate(scene.integrator.name) && scene.integrator.options.contains("regions") &&
-                               scene.integrator.options["regions"].is_array();
-  std::vector<Configuration> out;
+  const std::optional<std::vector<AsyncRegion>> sceneRegions =
+      isMultirate(scene.integrator.name) ? explicitRegions(scene.integrator.options, scene, baseline) : std::nullopt;
+  const bool explicitRegions = sceneRegions.has_value();
+  std::vector<BenchmarkConfiguration> out;
   auto add = [&](const std::string& integrator, int spf, int ratio, nlohmann::json options, bool plot) {
-    Configuration c;
+    BenchmarkConfiguration c;
     c.integrator = integrator;
     c.stepsPerFrame = spf;
     c.options = std::move(options);
     c.plotTrajectory = plot;
     completeOptions(c, scene);
-    if (ratio > 0 && explicitRegions) setRatio(c.options, ratio, "default configuration");
-    c.label = defaultLabel(c);
+    if (ratio > 0 && explicitRegions) setRatio(c.options, ratio, "default configuration", scene, baseline);
+    c.label = defaultLabel(c, scene, baseline);
     out.push_back(std::move(c));
   };
-  const int sceneRatio = explicitRegions && !scene.integrator.options["regions"].empty()
-                             ? scene.integrator.options["regions"][0].value("ratio", 8)
-                             : 8;
+  // The scene's own ratio; without explicit regions the middle of the ratios below.
+  const int sceneRatio = explicitRegions ? largestRatio(*sceneRegions) : 8;
   for (const int spf : {1, 2, 4, 8, 16, 32, 64}) {
     add("backward-euler", spf, 0, nlohmann::json::object(), spf == sceneSteps || spf == sceneSteps * sceneRatio);
   }
@@ -219,84 +229,6 @@ std::vector<Configuration> defaultConfigurations(const Scene& scene, const Simul
   return out;
 }
 
-Scene configuredScene(const Scene& scene, const Configuration& configuration, int frames) {
-  Scene out = scene;
-  out.integrator.name = configuration.integrator;
-  out.integrator.timestep = configuration.stepsPerFrame > 0 ? 1.0 / (scene.frames.rate * configuration.stepsPerFrame)
-                                                            : configuration.timestep;
-  out.integrator.stepsPerFrame = configuration.stepsPerFrame > 0 ? configuration.stepsPerFrame : 0;
-  out.integrator.options = configuration.options;
-  out.frames.count = frames;
-  out.output = Scene::OutputSettings{};
-  return out;
-}
-
-RunResult runConfiguration(const Scene& scene, const Configuration& configuration, int frames, int repeats) {
-  RunResult result;
-  result.configuration = configuration;
-  const Scene configured = configuredScene(scene, configuration, frames);
-  result.timestep = configured.integrator.timestep;
-  result.stepsPerFrame = static_cast<int>(std::lround(1.0 / (scene.frames.rate * result.timestep)));
-  for (int repeat = 0; repeat < std::max(1, repeats); ++repeat) {
-    Stopwatch setup;
-    Simulation simulation = buildSimulation(configured);
-    const double setupSeconds = setup.stop();
-    Integrator& integrator = *simulation.integrator;
-    IntegratorStats afterWarmUp;
-    double timedSeconds = 0.0;
-    int timedFrames = 0;
-    bool failed = false;
-    for (int frame = 0; frame < frames; ++frame) {
-      Stopwatch watch;
-      try {
-        advanceFrame(simulation, frame);
-      } catch (const NumericalError& error) {
-        if (repeat == 0) {
-          result.failedFrame = frame;
-          result.failure = error.what();
-        }
-        failed = true;
-        break;
-      }
-      const double seconds = watch.stop();
-      if (frame == 0) {
-        // Warm-up: linear models factor here; excluded from the time per frame.
-        afterWarmUp = integrator.stats();
-        if (repeat == 0) result.firstFrameSeconds = seconds;
-      } else {
-        timedSeconds += seconds;
-        ++timedFrames;
-      }
-      if (repeat == 0) result.frames.push_back(integrator.displacement());
-    }
-    if (repeat == 0) {
-      result.setupSeconds = setupSeconds;
-      const IntegratorStats& end = integrator.stats();
-      const double count = std::max(1, timedFrames);
-      result.factorizationsPerFrame = static_cast<double>(end.factorizations - afterWarmUp.factorizations) / count;
-      result.solvesPerFrame = static_cast<double>(end.solvedRightHandSides - afterWarmUp.solvedRightHandSides) / count;
-      result.factorFlopsPerFrame = (end.factorFlops - afterWarmUp.factorFlops) / count;
-      result.solveFlopsPerFrame = (end.solveFlops - afterWarmUp.solveFlops) / count;
-      result.factorNonZeros = integrator.report().factorNonZeros;
-      std::ostringstream ratios;
-      bool first = true;
-      for (const RegionSummary& region : regionSummaries(integrator)) {
-        ratios << (first ? "" : ",") << region.ratio;
-        first = false;
-      }
-      result.ratios = ratios.str();
-    }
-    if (failed) break;  // an unstable configuration is not timed again
-    if (timedFrames > 0) result.secondsPerFrame.push_back(timedSeconds / timedFrames);
-  }
-  result.completed = result.failedFrame < 0;
-  if (!result.secondsPerFrame.empty()) {
-    result.medianSecondsPerFrame = median(result.secondsPerFrame);
-    result.minSecondsPerFrame = *std::min_element(result.secondsPerFrame.begin(), result.secondsPerFrame.end());
-  }
-  return result;
-}
-
 std::string machineDescription() {
   std::string model = "unknown CPU";
   std::ifstream cpuinfo("/proc/cpuinfo");
@@ -316,25 +248,6 @@ std::string machineDescription() {
   }
   std::ostringstream out;
   out << "nproc " << std::thread::hardware_concurrency() << ", " << model << ", load average " << load;
-  return out.str();
-}
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-std::string formatTimestep(double timestep) {
-  const double inverse = 1.0 / timestep;
-  const double rounded = std::round(inverse);
-  std::ostringstream out;
-  if (rounded >= 1.0 && std::abs(inverse - rounded) <= 1e-9 * inverse) {
-    out << "1/" << static_cast<long long>(rounded);
-  } else {
-    out << timestep;
-  }
   return out.str();
 }
 
