@@ -9,12 +9,6 @@
 namespace asyncfem {
 namespace {
 
-AsyncOptions withCoupling(AsyncCoupling coupling) {
-  AsyncOptions options;
-  options.coupling = coupling;
-  return options;
-}
-
 // After setUp() with another partition, the steps equal those of an integrator built with
 // that partition from the same state at the same time, bit for bit: the state is
 // synchronous at a large-step boundary, setUp() drops every block and factor of the old
@@ -25,10 +19,10 @@ TEST(AsyncSetUp, NewPartitionEqualsAFreshIntegratorFromTheSameState) {
   const std::vector<AsyncRegion> before{{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}};
   const std::vector<AsyncRegion> after{{"half", test::verticesBeyond(ts.mesh, 0.5), 8}};
   for (const AsyncCoupling coupling : {AsyncCoupling::stable, AsyncCoupling::paper}) {
-    AsyncBackwardEuler moving(ts.mesh, ts.system, hL, before, withCoupling(coupling));
+    AsyncBackwardEuler moving(ts.mesh, ts.system, hL, before, test::withCoupling(coupling));
     moving.setState(ts.u0, ts.v0);
     for (int k = 0; k < 3; ++k) moving.step();
-    AsyncBackwardEuler fresh(ts.mesh, ts.system, hL, after, withCoupling(coupling));
+    AsyncBackwardEuler fresh(ts.mesh, ts.system, hL, after, test::withCoupling(coupling));
     fresh.setState(moving.displacement(), moving.velocity(), moving.time());
     moving.setUp(RegionPartition(ts.mesh, ts.system.freeDofs, after));
     ASSERT_EQ(moving.partition().numRegions(), 1);

@@ -108,22 +108,32 @@ def test_step_releases_the_gil():
     system, _, _ = linear_system(beam, fixed_set="root", external_force=None)
     integrator = af.BackwardEuler(system, 1e-3)
     integrator.step()
-    window = {}
 
-    def stepper():
-        window["start"] = time.perf_counter()
-        integrator.step(500)
-        window["end"] = time.perf_counter()
+    def run_alongside(steps):
+        """Steps `steps` times in a thread while this one records when it runs."""
+        window, stamps = {}, []
 
-    stamps = []
-    thread = threading.Thread(target=stepper)
-    thread.start()
-    while thread.is_alive():
-        stamps.append(time.perf_counter())
-        time.sleep(0)
-    thread.join()
+        def stepper():
+            window["start"] = time.perf_counter()
+            integrator.step(steps)
+            window["end"] = time.perf_counter()
+
+        thread = threading.Thread(target=stepper)
+        thread.start()
+        while thread.is_alive():
+            stamps.append(time.perf_counter())
+            time.sleep(0)
+        thread.join()
+        return window, stamps
+
+    # The call must outlast the GIL switch interval many times over for the test to tell
+    # anything: the step count doubles until it does (a precondition, not a speed check).
+    steps = 500
+    window, stamps = run_alongside(steps)
+    while window["end"] - window["start"] <= 0.05 and steps < 500 * 2**10:
+        steps *= 2
+        window, stamps = run_alongside(steps)
     duration = window["end"] - window["start"]
-    assert duration > 0.05, "the call is too short to tell; take more steps"
     middle = (window["start"] + 0.2 * duration, window["end"] - 0.2 * duration)
     inside = [t for t in stamps if middle[0] < t < middle[1]]
     assert len(inside) > 0, f"no Python ran during the middle of {duration:.3f} s of stepping"
