@@ -4,6 +4,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/corotationalLinearFEM/polarDecomposition.hpp>
+#include <asyncfem/stiffnessMatrix/symmetrizeElementMatrix.hpp>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -35,18 +36,12 @@ void simpleElementTangent(const ElementMatrix& stiffness, const Eigen::Matrix3d&
   }
 }
 
-/// d f_e / d x = R (K_e R^T + (Z + K_e Y) W), symmetrised; see the class comment for Z,
-/// Y and W. differentialOperator is (tr S I - S)^{-1}.
-void exactElementTangent(const ElementMatrix& stiffness, const Eigen::Matrix3d& rotation,
-                         const Eigen::Matrix3d& differentialOperator, const Eigen::Matrix<double, 3, 4>& gradients,
-                         const ElementPositions& current, const ElementPositions& rest, ElementMatrix& out) {
-  const ElementPositions corotatedPositions = rotation.transpose() * current;  // y = R^T x
-  const ElementPositions v = corotatedPositions - rest;
-  const ElementVector kv = stiffness * Eigen::Map<const ElementVector>(v.data());
-
-  // Column 3a + c of W: the axial vector w of R^T dR for a unit change of coordinate c
-  // of vertex a. There dF = e_c g_a^T, so R^T dF - dF^T R = r_c g_a^T - g_a r_c^T with
-  // axial vector g_a x r_c.
+/// W (3x12): column 3a + c is the axial vector w of R^T dR for a unit change of
+/// coordinate c of vertex a. There dF = e_c g_a^T, so R^T dF - dF^T R = r_c g_a^T -
+/// g_a r_c^T with axial vector g_a x r_c, and w = (tr S I - S)^{-1} (g_a x r_c).
+inline Eigen::Matrix<double, 3, 12> rotationDifferentials(const Eigen::Matrix3d& rotation,
+                                                          const Eigen::Matrix3d& differentialOperator,
+                                                          const Eigen::Matrix<double, 3, 4>& gradients) {
   Eigen::Matrix<double, 3, 12> w;
   for (int a = 0; a < 4; ++a) {
     const Eigen::Vector3d g = gradients.col(a);
@@ -55,12 +50,33 @@ void exactElementTangent(const ElementMatrix& stiffness, const Eigen::Matrix3d& 
       w.col((3 * a) + c).noalias() = differentialOperator * g.cross(rowOfRotation);
     }
   }
-  // d(R^T x_b) from dR = R [w]x is -[w]x y_b = [y_b]x w, and dR (K v)_b = -R [(K v)_b]x w.
-  Eigen::Matrix<double, 12, 3> rotationResponse = Eigen::Matrix<double, 12, 3>::Zero();
+  return w;
+}
+
+/// Z + K Y (12x3): the change of R^T f_e per unit axial vector w of R^T dR, at corotated
+/// positions y and K v (v = y - X). d(R^T x_b) from dR = R [w]x is -[w]x y_b = [y_b]x w,
+/// and dR (K v)_b = -R [(K v)_b]x w.
+inline Eigen::Matrix<double, 12, 3> rotationResponse(const ElementMatrix& stiffness,
+                                                     const ElementPositions& corotatedPositions,
+                                                     const ElementVector& kv) {
+  Eigen::Matrix<double, 12, 3> response = Eigen::Matrix<double, 12, 3>::Zero();
   for (int b = 0; b < 4; ++b) {
-    rotationResponse.noalias() += stiffness.middleCols<3>(3 * b) * crossMatrix(corotatedPositions.col(b));
+    response.noalias() += stiffness.middleCols<3>(3 * b) * crossMatrix(corotatedPositions.col(b));
   }
-  for (int b = 0; b < 4; ++b) rotationResponse.middleRows<3>(3 * b) -= crossMatrix(kv.segment<3>(3 * b));
+  for (int b = 0; b < 4; ++b) response.middleRows<3>(3 * b) -= crossMatrix(kv.segment<3>(3 * b));
+  return response;
+}
+
+/// d f_e / d x = R (K_e R^T + (Z + K_e Y) W), symmetrised; see the class comment for Z,
+/// Y and W. differentialOperator is (tr S I - S)^{-1}.
+void exactElementTangent(const ElementMatrix& stiffness, const Eigen::Matrix3d& rotation,
+                         const Eigen::Matrix3d& differentialOperator, const Eigen::Matrix<double, 3, 4>& gradients,
+                         const ElementPositions& current, const ElementPositions& rest, ElementMatrix& out) {
+  const ElementPositions corotatedPositions = rotation.transpose() * current;  // y = R^T x
+  const ElementPositions v = corotatedPositions - rest;
+  const ElementVector kv = stiffness * Eigen::Map<const ElementVector>(v.data());
+  const Eigen::Matrix<double, 3, 12> w = rotationDifferentials(rotation, differentialOperator, gradients);
+  const Eigen::Matrix<double, 12, 3> response = rotationResponse(stiffness, corotatedPositions, kv);
 
   ElementMatrix inner;  // K R^T + (Z + K Y) W, before the final rotation
   const Eigen::Matrix3d rotationTransposed = rotation.transpose();
@@ -69,20 +85,82 @@ void exactElementTangent(const ElementMatrix& stiffness, const Eigen::Matrix3d& 
       inner.block<3, 3>(3 * a, 3 * b).noalias() = stiffness.block<3, 3>(3 * a, 3 * b) * rotationTransposed;
     }
   }
-  inner.noalias() += rotationResponse * w;
+  inner.noalias() += response * w;
   for (int b = 0; b < 4; ++b) {
     for (int a = 0; a < 4; ++a) {
       out.block<3, 3>(3 * a, 3 * b).noalias() = rotation * inner.block<3, 3>(3 * a, 3 * b);
     }
   }
-  // The Hessian of the energy is symmetric; averaging removes the rounding asymmetry.
-  for (int j = 0; j < 12; ++j) {
-    for (int i = j + 1; i < 12; ++i) {
-      const double average = 0.5 * (out(i, j) + out(j, i));
-      out(i, j) = average;
-      out(j, i) = average;
+  symmetrizeElementMatrix(out);
+}
+
+/// Throws Error unless the assembler was built for the mesh (same DOFs and elements).
+void checkAssemblerMatchesMesh(const MatrixAssembler* assembler, const TetMesh& mesh) {
+  if (assembler == nullptr) throw Error("CorotationalLinearFEM: the assembler is null");
+  if (assembler->numDofs() != mesh.numDofs() || assembler->numElements() != mesh.numElements()) {
+    throw Error("CorotationalLinearFEM: the assembler was built for a mesh with " +
+                std::to_string(assembler->numDofs() / 3) + " vertices and " + std::to_string(assembler->numElements()) +
+                " elements, not " + std::to_string(mesh.numVertices()) + " and " + std::to_string(mesh.numElements()));
+  }
+}
+
+/// Scatter offsets into the assembler's pattern: blockSlots[16 e + 4 b + a] is the
+/// valuePtr() index of block (a, b) of element e, columnLengths[4 e + b] the distance
+/// between two scalar columns of vertex b's block column.
+void elementScatterOffsets(const MatrixAssembler& assembler, int numElements, std::vector<int>& blockSlots,
+                           std::vector<int>& columnLengths) {
+  blockSlots.resize(toIndex(numElements) * 16);
+  columnLengths.resize(toIndex(numElements) * 4);
+  for (int e = 0; e < numElements; ++e) {
+    for (int b = 0; b < 4; ++b) {
+      for (int a = 0; a < 4; ++a)
+        blockSlots[(toIndex(e) * 16) + toIndex((4 * b) + a)] = assembler.slot(e, 3 * a, 3 * b);
+      columnLengths[(toIndex(e) * 4) + toIndex(b)] = assembler.slot(e, 0, (3 * b) + 1) - assembler.slot(e, 0, 3 * b);
     }
   }
+}
+
+/// Vertex -> element incidences of the per-vertex assembly pass: the (element, local
+/// vertex) pairs 4 e + a of vertex v are incidences[offsets[v] .. offsets[v+1]),
+/// ascending.
+void vertexIncidences(const Eigen::Matrix4Xi& elements, int numVertices, std::vector<int>& offsets,
+                      std::vector<int>& incidences) {
+  const auto entries = static_cast<Index>(elements.size());
+  offsets.assign(toIndex(numVertices) + 1, 0);
+  for (Index k = 0; k < entries; ++k) ++offsets[toIndex(elements.data()[k]) + 1];
+  for (Index v = 0; v < toIndex(numVertices); ++v) offsets[v + 1] += offsets[v];
+  incidences.resize(entries);
+  std::vector<int> fill(offsets.begin(), offsets.end() - 1);
+  for (int k = 0; k < static_cast<int>(entries); ++k) incidences[toIndex(fill[toIndex(elements.data()[k])]++)] = k;
+}
+
+/// F = I + sum_a u_a g_a^T of element e: the same as sum_a x_a g_a^T (sum_a X_a g_a^T =
+/// I), without the cancellation of positions far from the origin.
+inline Eigen::Matrix3d elementDeformationGradient(const Eigen::VectorXd& displacement, const Eigen::Matrix4Xi& elements,
+                                                  int e, const Eigen::Matrix<double, 3, 4>& g) {
+  ElementPositions elementDisplacement;
+  for (int a = 0; a < 4; ++a) {
+    elementDisplacement.col(a) = displacement.segment<3>(3 * static_cast<Eigen::Index>(elements(a, e)));
+  }
+  Eigen::Matrix3d f = elementDisplacement * g.transpose();
+  f.diagonal().array() += 1.0;
+  return f;
+}
+
+/// V sigma = lambda V tr(eps) I + 2 mu V eps for the corotated strain eps = sym(R^T F) - I,
+/// with lameVolume = (lambda V, mu V); sets energy to the element's strain energy.
+inline Eigen::Matrix3d corotatedStressVolume(const Eigen::Matrix3d& rotation, const Eigen::Matrix3d& f,
+                                             const Eigen::Vector2d& lameVolume, double& energy) {
+  const Eigen::Matrix3d corotated = rotation.transpose() * f;
+  Eigen::Matrix3d strain = 0.5 * (corotated + corotated.transpose());
+  strain.diagonal().array() -= 1.0;
+  const double lambdaVolume = lameVolume[0];
+  const double muVolume = lameVolume[1];
+  const double trace = strain.trace();
+  Eigen::Matrix3d stressVolume = (2.0 * muVolume) * strain;
+  stressVolume.diagonal().array() += lambdaVolume * trace;
+  energy = (muVolume * strain.squaredNorm()) + (0.5 * lambdaVolume * trace * trace);
+  return stressVolume;
 }
 
 }  // namespace
@@ -96,13 +174,7 @@ CorotationalLinearFEM::CorotationalLinearFEM(const TetMesh& mesh, std::shared_pt
       tangentKind_(tangentKind),
       numDofs_(mesh.numDofs()),
       elements_(mesh.elements()) {
-  if (!assembler_) throw Error("CorotationalLinearFEM: the assembler is null");
-  if (assembler_->numDofs() != mesh.numDofs() || assembler_->numElements() != mesh.numElements()) {
-    throw Error("CorotationalLinearFEM: the assembler was built for a mesh with " +
-                std::to_string(assembler_->numDofs() / 3) + " vertices and " +
-                std::to_string(assembler_->numElements()) + " elements, not " + std::to_string(mesh.numVertices()) +
-                " and " + std::to_string(mesh.numElements()));
-  }
+  checkAssemblerMatchesMesh(assembler_.get(), mesh);
   const int numElements = mesh.numElements();
   const Index count = toIndex(numElements);
   restPositions_.resize(count);
@@ -130,25 +202,8 @@ CorotationalLinearFEM::CorotationalLinearFEM(const TetMesh& mesh, std::shared_pt
   // whatever the thread count.
   for (int e = 0; e < numElements; ++e)
     checkElementVolume(e, signedVolumes[toIndex(e)], longestEdges[toIndex(e)], "CorotationalLinearFEM");
-  // Scatter offsets into the assembler's pattern and the vertex -> element incidences of
-  // the per-vertex assembly pass.
-  blockSlots_.resize(count * 16);
-  columnLengths_.resize(count * 4);
-  for (int e = 0; e < numElements; ++e) {
-    for (int b = 0; b < 4; ++b) {
-      for (int a = 0; a < 4; ++a)
-        blockSlots_[(toIndex(e) * 16) + toIndex((4 * b) + a)] = assembler_->slot(e, 3 * a, 3 * b);
-      columnLengths_[(toIndex(e) * 4) + toIndex(b)] =
-          assembler_->slot(e, 0, (3 * b) + 1) - assembler_->slot(e, 0, 3 * b);
-    }
-  }
-  const int numVertices = mesh.numVertices();
-  incidenceOffsets_.assign(toIndex(numVertices) + 1, 0);
-  for (Index k = 0; k < count * 4; ++k) ++incidenceOffsets_[toIndex(elements_.data()[k]) + 1];
-  for (Index v = 0; v < toIndex(numVertices); ++v) incidenceOffsets_[v + 1] += incidenceOffsets_[v];
-  incidences_.resize(count * 4);
-  std::vector<int> fill(incidenceOffsets_.begin(), incidenceOffsets_.end() - 1);
-  for (int k = 0; k < numElements * 4; ++k) incidences_[toIndex(fill[toIndex(elements_.data()[k])]++)] = k;
+  elementScatterOffsets(*assembler_, numElements, blockSlots_, columnLengths_);
+  vertexIncidences(elements_, mesh.numVertices(), incidenceOffsets_, incidences_);
   const Eigen::SparseMatrix<double> pattern = assembler_->createMatrix();
   patternOuter_.assign(pattern.outerIndexPtr(), pattern.outerIndexPtr() + pattern.outerSize() + 1);
 }
@@ -189,14 +244,7 @@ void CorotationalLinearFEM::evaluateElements(const Eigen::VectorXd& displacement
   for (int e = 0; e < numElements; ++e) {
     const Index i = toIndex(e);
     const Eigen::Matrix<double, 3, 4>& g = shapeGradients_[i];
-    // F = I + sum_a u_a g_a^T: the same as sum_a x_a g_a^T (sum_a X_a g_a^T = I), without
-    // the cancellation of positions far from the origin.
-    ElementPositions elementDisplacement;
-    for (int a = 0; a < 4; ++a) {
-      elementDisplacement.col(a) = displacement.segment<3>(3 * static_cast<Eigen::Index>(elements_(a, e)));
-    }
-    Eigen::Matrix3d deformationGradient = elementDisplacement * g.transpose();
-    deformationGradient.diagonal().array() += 1.0;
+    const Eigen::Matrix3d deformationGradient = elementDeformationGradient(displacement, elements_, e, g);
     const PolarRotation polar =
         polarRotation(deformationGradient, warmStart ? &rotations_[i] : nullptr, needDifferentialOperator);
     newtonSteps += polar.newtonSteps;
@@ -204,16 +252,8 @@ void CorotationalLinearFEM::evaluateElements(const Eigen::VectorXd& displacement
     const Eigen::Matrix3d& rotation = polar.rotation;
     rotations_[i] = rotation;
     if (needDifferentialOperator) differentialOperators_[i] = polar.differentialOperator;
-    // Corotated strain eps = sym(R^T F) - I and V sigma = lambda V tr(eps) I + 2 mu V eps.
-    const Eigen::Matrix3d corotated = rotation.transpose() * deformationGradient;
-    Eigen::Matrix3d strain = 0.5 * (corotated + corotated.transpose());
-    strain.diagonal().array() -= 1.0;
-    const double lambdaVolume = lameVolume_[i][0];
-    const double muVolume = lameVolume_[i][1];
-    const double trace = strain.trace();
-    Eigen::Matrix3d stressVolume = (2.0 * muVolume) * strain;
-    stressVolume.diagonal().array() += lambdaVolume * trace;
-    elementEnergies_[i] = (muVolume * strain.squaredNorm()) + (0.5 * lambdaVolume * trace * trace);
+    const Eigen::Matrix3d stressVolume =
+        corotatedStressVolume(rotation, deformationGradient, lameVolume_[i], elementEnergies_[i]);
     const Eigen::Matrix3d rotatedStress = rotation * stressVolume;
     elementForces_[i].noalias() = rotatedStress * g;
     rotatedGradients_[i].noalias() = rotation * g;

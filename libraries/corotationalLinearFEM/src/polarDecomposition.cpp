@@ -181,6 +181,17 @@ PolarRotation fromDecomposition(const Eigen::Matrix3d& f, bool withDifferentialO
   return result;
 }
 
+// The result for a non-finite F: NaN rotation and operator. The SVD of a non-finite
+// matrix may come out finite; callers detect blow-ups by non-finite results, so make that
+// explicit.
+PolarRotation nonFiniteRotation() {
+  PolarRotation result;
+  result.rotation.setConstant(std::numeric_limits<double>::quiet_NaN());
+  result.differentialOperator.setConstant(std::numeric_limits<double>::quiet_NaN());
+  result.usedDecomposition = false;
+  return result;
+}
+
 }  // namespace
 
 PolarRotation polarRotation(const Eigen::Matrix3d& deformationGradient, const Eigen::Matrix3d* warmStart,
@@ -188,15 +199,8 @@ PolarRotation polarRotation(const Eigen::Matrix3d& deformationGradient, const Ei
   const Eigen::Matrix3d& f = deformationGradient;
   // Rounding of B = R^T F is a few ulps of |F|: a gradient below this is noise.
   const double gradientFloor = 8.0 * std::numeric_limits<double>::epsilon() * f.norm();
+  if (!f.allFinite()) return nonFiniteRotation();
   PolarRotation result;
-  if (!f.allFinite()) {
-    // The SVD of a non-finite matrix may come out finite; callers detect blow-ups by
-    // non-finite results, so make that explicit.
-    result.rotation.setConstant(std::numeric_limits<double>::quiet_NaN());
-    result.differentialOperator.setConstant(std::numeric_limits<double>::quiet_NaN());
-    result.usedDecomposition = false;
-    return result;
-  }
   result.rotation = warmStart != nullptr ? *warmStart : deterministicStart(f);
   NewtonSystem system = newtonSystem(result.rotation, f);
   if (warmStart != nullptr && !system.positiveDefinite) {

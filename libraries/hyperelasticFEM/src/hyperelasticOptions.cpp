@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
+#include <asyncfem/core/enumNames.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
 #include <cctype>
@@ -8,27 +9,31 @@
 
 namespace asyncfem {
 
+namespace {
+
+// Names of the materials, in the order error messages list them.
+constexpr EnumName<HyperelasticMaterialKind> kMaterialNames[] = {
+    {HyperelasticMaterialKind::stvk, "stvk"},
+    {HyperelasticMaterialKind::neoHookean, "neo-hookean"},
+    {HyperelasticMaterialKind::mooneyRivlin, "mooney-rivlin"}};
+// Other spellings parseHyperelasticMaterialKind accepts.
+constexpr EnumName<HyperelasticMaterialKind> kMaterialAliases[] = {
+    {HyperelasticMaterialKind::neoHookean, "neohookean"}, {HyperelasticMaterialKind::mooneyRivlin, "mooneyrivlin"}};
+
+}  // namespace
+
 HyperelasticMaterialKind parseHyperelasticMaterialKind(std::string_view name) {
   std::string lower(name);
   std::transform(lower.begin(), lower.end(), lower.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (lower == "stvk") return HyperelasticMaterialKind::stvk;
-  if (lower == "neo-hookean" || lower == "neohookean") return HyperelasticMaterialKind::neoHookean;
-  if (lower == "mooney-rivlin" || lower == "mooneyrivlin") return HyperelasticMaterialKind::mooneyRivlin;
-  throw ValidationError("unknown hyperelastic material '" + std::string(name) +
-                        "' (expected stvk, neo-hookean or mooney-rivlin)");
+  if (const std::optional<HyperelasticMaterialKind> kind = findEnumValue(kMaterialNames, lower)) return *kind;
+  if (const std::optional<HyperelasticMaterialKind> kind = findEnumValue(kMaterialAliases, lower)) return *kind;
+  throw ValidationError("unknown hyperelastic material '" + std::string(name) + "' (expected " +
+                        joinEnumNames(kMaterialNames, ", ", " or ") + ")");
 }
 
 std::string toString(HyperelasticMaterialKind kind) {
-  switch (kind) {
-    case HyperelasticMaterialKind::stvk:
-      return "stvk";
-    case HyperelasticMaterialKind::neoHookean:
-      return "neo-hookean";
-    case HyperelasticMaterialKind::mooneyRivlin:
-      return "mooney-rivlin";
-  }
-  return "unknown";
+  return std::string(findEnumName(kMaterialNames, kind).value_or("unknown"));
 }
 
 LameParameters vegaLameParameters(double youngsModulus, double poissonRatio) {

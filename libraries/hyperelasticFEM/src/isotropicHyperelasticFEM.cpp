@@ -5,6 +5,7 @@
 #include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/hyperelasticFEM/isotropicHyperelasticFEM.hpp>
+#include <asyncfem/stiffnessMatrix/symmetrizeElementMatrix.hpp>
 #include <cmath>
 #include <complex>
 #include <limits>
@@ -43,11 +44,12 @@ constexpr double kDividedDifferenceGap = 1e-7;
 /// (no subtractive cancellation), so any tiny step works.
 constexpr double kComplexStep = 1e-30;
 
-StretchTerms stretchTerms(HyperelasticMaterialKind kind, const IsotropicMaterialConstants& constants,
-                          const HyperelasticOptions& options, const Array3& stretches, bool wantTangent) {
-  StretchTerms terms;
-  Array3 clampedStretches = stretches;
-  std::array<bool, 3> clamped{false, false, false};
+/// Stretches raised to the inversion threshold where below it (when inversion handling is
+/// on); clamped[i] says which. Returns whether any was.
+inline bool clampStretches(const HyperelasticOptions& options, const Array3& stretches, Array3& clampedStretches,
+                           std::array<bool, 3>& clamped) {
+  clampedStretches = stretches;
+  clamped = {false, false, false};
   bool anyClamped = false;
   if (options.inversionHandlingEnabled()) {
     for (int i = 0; i < 3; ++i) {
@@ -58,6 +60,80 @@ StretchTerms stretchTerms(HyperelasticMaterialKind kind, const IsotropicMaterial
       }
     }
   }
+  return anyClamped;
+}
+
+/// Eigenvalues a + b and a - b of the 2x2 rotation blocks of dP/dF at stretches s: Teran
+/// et al.'s alpha_ij and beta_ij in Vega's invariant form, from the invariant gradient.
+inline void invariantPairTerms(const detail::InvariantDerivatives<double>& invariants, const Array3& s,
+                               StretchTerms& terms) {
+  const double f1 = invariants.gradient[0];
+  const double f2 = invariants.gradient[1];
+  const double f3 = invariants.gradient[2];
+  for (int p = 0; p < 3; ++p) {
+    const int i = kPairs[p][0];
+    const int j = kPairs[p][1];
+    const int k = 3 - i - j;
+    // I3 / (s_i s_j) written as s_i s_j s_k^2 so that a zero stretch stays finite.
+    const double alpha = (2.0 * f1) + (4.0 * ((s[i] * s[i]) + (s[j] * s[j])) * f2);
+    const double beta = (4.0 * s[i] * s[j] * f2) - (2.0 * s[i] * s[j] * s[k] * s[k] * f3);
+    terms.pairSum[p] = alpha + beta;
+    terms.pairDifference[p] = alpha - beta;
+  }
+}
+
+/// Hessian of the first-order extension W~ below the threshold: zero between clamped
+/// stretches, H(s^) between a clamped and a free one, and H(s^) + (dH/ds . d) between
+/// free ones; the directional third derivative comes from one complex-step evaluation of
+/// H at s^ + i t d (d = offset = s - s^).
+inline void extendedHessian(HyperelasticMaterialKind kind, const IsotropicMaterialConstants& constants,
+                            const Array3& clampedStretches, const Array3& offset, const std::array<bool, 3>& clamped,
+                            const Array33& hessian, Array33& extended) {
+  std::array<std::complex<double>, 3> complexStretches{};
+  for (int i = 0; i < 3; ++i) complexStretches[i] = {clampedStretches[i], kComplexStep * offset[i]};
+  std::complex<double> complexEnergy;
+  std::array<std::complex<double>, 3> complexGradient{};
+  std::array<std::array<std::complex<double>, 3>, 3> complexHessian{};
+  detail::stretchDerivatives(kind, constants, complexStretches, complexEnergy, complexGradient, &complexHessian);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (clamped[i] && clamped[j]) {
+        extended[i][j] = 0.0;
+      } else if (clamped[i] || clamped[j]) {
+        extended[i][j] = hessian[i][j];
+      } else {
+        extended[i][j] = hessian[i][j] + (complexHessian[i][j].imag() / kComplexStep);
+      }
+    }
+  }
+}
+
+/// Eigenvalues of the 2x2 rotation blocks from divided differences of the gradient at
+/// stretches s, replaced by their limits from the Hessian where the stretches are close.
+inline void dividedDifferencePairTerms(const Array3& s, StretchTerms& terms) {
+  const Array3& g = terms.gradient;
+  for (int p = 0; p < 3; ++p) {
+    const int i = kPairs[p][0];
+    const int j = kPairs[p][1];
+    const double scale = std::max({1.0, std::abs(s[i]), std::abs(s[j])});
+    const double gap = s[i] - s[j];
+    const double sum = s[i] + s[j];
+    terms.pairSum[p] =
+        std::abs(gap) > kDividedDifferenceGap * scale ? (g[i] - g[j]) / gap : terms.hessian[i][i] - terms.hessian[i][j];
+    terms.pairDifference[p] =
+        std::abs(sum) > kDividedDifferenceGap * scale ? (g[i] + g[j]) / sum : terms.hessian[i][i] + terms.hessian[i][j];
+  }
+}
+
+/// StretchTerms at the principal stretches: the energy density's derivatives, below the
+/// inversion threshold clamped (Vega) or extended to first order (extrapolate); the
+/// tangent data only when wantTangent.
+StretchTerms stretchTerms(HyperelasticMaterialKind kind, const IsotropicMaterialConstants& constants,
+                          const HyperelasticOptions& options, const Array3& stretches, bool wantTangent) {
+  StretchTerms terms;
+  Array3 clampedStretches;
+  std::array<bool, 3> clamped;
+  const bool anyClamped = clampStretches(options, stretches, clampedStretches, clamped);
   const bool extrapolate = anyClamped && options.inversionHandling == InversionHandling::extrapolate;
   detail::InvariantDerivatives<double> invariants;
   Array33 hessian{};
@@ -67,21 +143,7 @@ StretchTerms stretchTerms(HyperelasticMaterialKind kind, const IsotropicMaterial
     // Unclamped, or Vega's clamp: everything at the (clamped) stretches.
     if (!wantTangent) return terms;
     terms.hessian = hessian;
-    const double f1 = invariants.gradient[0];
-    const double f2 = invariants.gradient[1];
-    const double f3 = invariants.gradient[2];
-    const Array3& s = clampedStretches;
-    for (int p = 0; p < 3; ++p) {
-      const int i = kPairs[p][0];
-      const int j = kPairs[p][1];
-      const int k = 3 - i - j;
-      // Teran et al.'s alpha_ij and beta_ij in Vega's invariant form; I3 / (s_i s_j)
-      // written as s_i s_j s_k^2 so that a zero stretch stays finite.
-      const double alpha = (2.0 * f1) + (4.0 * ((s[i] * s[i]) + (s[j] * s[j])) * f2);
-      const double beta = (4.0 * s[i] * s[j] * f2) - (2.0 * s[i] * s[j] * s[k] * s[k] * f3);
-      terms.pairSum[p] = alpha + beta;
-      terms.pairDifference[p] = alpha - beta;
-    }
+    invariantPairTerms(invariants, clampedStretches, terms);
     return terms;
   }
 
@@ -96,40 +158,8 @@ StretchTerms stretchTerms(HyperelasticMaterialKind kind, const IsotropicMaterial
     for (int i = 0; i < 3; ++i) terms.gradient[j] += hessian[j][i] * offset[i];
   }
   if (!wantTangent) return terms;
-
-  // Hessian of W~: zero between clamped stretches, H(s^) between a clamped and a free
-  // one, and H(s^) + (dH/ds . d) between free ones; the directional third derivative
-  // comes from one complex-step evaluation of H at s^ + i t d.
-  std::array<std::complex<double>, 3> complexStretches{};
-  for (int i = 0; i < 3; ++i) complexStretches[i] = {clampedStretches[i], kComplexStep * offset[i]};
-  std::complex<double> complexEnergy;
-  std::array<std::complex<double>, 3> complexGradient{};
-  std::array<std::array<std::complex<double>, 3>, 3> complexHessian{};
-  detail::stretchDerivatives(kind, constants, complexStretches, complexEnergy, complexGradient, &complexHessian);
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      if (clamped[i] && clamped[j]) {
-        terms.hessian[i][j] = 0.0;
-      } else if (clamped[i] || clamped[j]) {
-        terms.hessian[i][j] = hessian[i][j];
-      } else {
-        terms.hessian[i][j] = hessian[i][j] + (complexHessian[i][j].imag() / kComplexStep);
-      }
-    }
-  }
-  const Array3& g = terms.gradient;
-  const Array3& s = stretches;
-  for (int p = 0; p < 3; ++p) {
-    const int i = kPairs[p][0];
-    const int j = kPairs[p][1];
-    const double scale = std::max({1.0, std::abs(s[i]), std::abs(s[j])});
-    const double gap = s[i] - s[j];
-    const double sum = s[i] + s[j];
-    terms.pairSum[p] =
-        std::abs(gap) > kDividedDifferenceGap * scale ? (g[i] - g[j]) / gap : terms.hessian[i][i] - terms.hessian[i][j];
-    terms.pairDifference[p] =
-        std::abs(sum) > kDividedDifferenceGap * scale ? (g[i] + g[j]) / sum : terms.hessian[i][i] + terms.hessian[i][j];
-  }
+  extendedHessian(kind, constants, clampedStretches, offset, clamped, hessian, terms.hessian);
+  dividedDifferencePairTerms(stretches, terms);
   return terms;
 }
 
@@ -167,6 +197,78 @@ void validateOptions(const HyperelasticOptions& options) {
   }
 }
 
+/// D (9x12): column 3b + c is U^T dF V for a unit change of coordinate c of vertex b,
+/// i.e. the outer product of row c of U and g^_b (rotatedGradients, 3x4); entry (p, q)
+/// at row 3p + q.
+inline Eigen::Matrix<double, 9, 12> rotatedFrameDifferentials(const Eigen::Matrix3d& u,
+                                                              const Eigen::Matrix<double, 3, 4>& rotatedGradients) {
+  Eigen::Matrix<double, 9, 12> d;
+  for (int b = 0; b < 4; ++b) {
+    for (int c = 0; c < 3; ++c) {
+      for (int p = 0; p < 3; ++p) {
+        for (int q = 0; q < 3; ++q) d((3 * p) + q, (3 * b) + c) = u(c, p) * rotatedGradients(q, b);
+      }
+    }
+  }
+  return d;
+}
+
+/// A D with A = dP^/dF^ (9x9, block structure described in the class comment): the
+/// stretch Hessian on the diagonal entries, a 2x2 block per rotation pair.
+inline Eigen::Matrix<double, 9, 12> applyRotatedTangent(const StretchTerms& terms,
+                                                        const Eigen::Matrix<double, 9, 12>& d) {
+  Eigen::Matrix<double, 9, 12> ad;
+  for (int i = 0; i < 3; ++i) {
+    ad.row(4 * i) =
+        (terms.hessian[i][0] * d.row(0)) + (terms.hessian[i][1] * d.row(4)) + (terms.hessian[i][2] * d.row(8));
+  }
+  for (int p = 0; p < 3; ++p) {
+    const int i = kPairs[p][0];
+    const int j = kPairs[p][1];
+    const double a = 0.5 * (terms.pairSum[p] + terms.pairDifference[p]);
+    const double b = 0.5 * (terms.pairSum[p] - terms.pairDifference[p]);
+    const int ij = (3 * i) + j;
+    const int ji = (3 * j) + i;
+    ad.row(ij) = (a * d.row(ij)) + (b * d.row(ji));
+    ad.row(ji) = (b * d.row(ij)) + (a * d.row(ji));
+  }
+  return ad;
+}
+
+/// Compression resistance factor k = resistance E / (1 - 2 nu) of a material with small-
+/// strain moduli E and nu; zero when the term is off.
+double compressionFactor(const HyperelasticOptions& options, double youngsModulus, double poissonRatio) {
+  if (!options.enableCompressionResistance) return 0.0;
+  return options.compressionResistance * youngsModulus / (1.0 - (2.0 * poissonRatio));
+}
+
+/// Constants of a St. Venant-Kirchhoff or neo-Hookean material: Vega's Lame parameters.
+IsotropicMaterialConstants lameConstants(const Material& material, const HyperelasticOptions& options) {
+  IsotropicMaterialConstants constants;
+  const LameParameters lame = vegaLameParameters(material.youngsModulus, material.poissonRatio);
+  constants.lambda = lame.lambda;
+  constants.mu = lame.mu;
+  constants.compressionFactor = compressionFactor(options, material.youngsModulus, material.poissonRatio);
+  return constants;
+}
+
+/// Constants of a Mooney-Rivlin material; the compression resistance uses its small-strain
+/// moduli.
+IsotropicMaterialConstants mooneyRivlinConstants(const MooneyRivlinParameters& parameters,
+                                                 const HyperelasticOptions& options) {
+  IsotropicMaterialConstants constants;
+  const SmallStrainModuli moduli = mooneyRivlinSmallStrainModuli(parameters);
+  constants.mooneyRivlin = parameters;
+  constants.compressionFactor = compressionFactor(options, moduli.youngsModulus, moduli.poissonRatio);
+  return constants;
+}
+
+/// The lowest element of material m, or -1 when no element has it.
+int firstElementOfMaterial(const std::vector<int>& elementMaterials, int m) {
+  const auto found = std::find(elementMaterials.begin(), elementMaterials.end(), m);
+  return found == elementMaterials.end() ? -1 : static_cast<int>(found - elementMaterials.begin());
+}
+
 }  // namespace
 
 SignedSvd signedSvd(const Eigen::Matrix3d& deformationGradient) {
@@ -195,37 +297,24 @@ IsotropicHyperelasticFEM::IsotropicHyperelasticFEM(const TetMesh& mesh, Hyperela
   validateOptions(options_);
   const std::vector<Material>& materials = mesh.materials();
   constants_.resize(materials.size());
-  std::vector<bool> used(materials.size(), false);
-  for (const int m : elementMaterials_) used[static_cast<std::size_t>(m)] = true;
   for (std::size_t m = 0; m < materials.size(); ++m) {
     const Material& material = materials[m];
-    IsotropicMaterialConstants& constants = constants_[m];
-    double youngsModulus = material.youngsModulus;
-    double poissonRatio = material.poissonRatio;
-    if (kind_ == HyperelasticMaterialKind::mooneyRivlin) {
-      std::optional<MooneyRivlinParameters> parameters = options_.mooneyRivlin;
-      if (!parameters) parameters = material.mooneyRivlin;
-      if (!parameters) {
-        if (!used[m]) continue;
-        int firstElement = 0;
-        while (elementMaterials_[static_cast<std::size_t>(firstElement)] != static_cast<int>(m)) ++firstElement;
-        throw ValidationError("IsotropicHyperelasticFEM: element " + std::to_string(firstElement) + " has material '" +
-                              material.name +
-                              "' without Mooney-Rivlin parameters: give it a 'MOONEYRIVLIN, density, mu01, mu10, v1' "
-                              "line or set the Mooney-Rivlin override");
-      }
-      const SmallStrainModuli moduli = mooneyRivlinSmallStrainModuli(*parameters);
-      constants.mooneyRivlin = *parameters;
-      youngsModulus = moduli.youngsModulus;
-      poissonRatio = moduli.poissonRatio;
-    } else {
-      const LameParameters lame = vegaLameParameters(youngsModulus, poissonRatio);
-      constants.lambda = lame.lambda;
-      constants.mu = lame.mu;
+    if (kind_ != HyperelasticMaterialKind::mooneyRivlin) {
+      constants_[m] = lameConstants(material, options_);
+      continue;
     }
-    if (options_.enableCompressionResistance) {
-      constants.compressionFactor = options_.compressionResistance * youngsModulus / (1.0 - (2.0 * poissonRatio));
+    const std::optional<MooneyRivlinParameters> parameters =
+        options_.mooneyRivlin ? options_.mooneyRivlin : material.mooneyRivlin;
+    if (parameters) {
+      constants_[m] = mooneyRivlinConstants(*parameters, options_);
+      continue;
     }
+    const int firstElement = firstElementOfMaterial(elementMaterials_, static_cast<int>(m));
+    if (firstElement < 0) continue;  // unused: its constants are never read
+    throw ValidationError("IsotropicHyperelasticFEM: element " + std::to_string(firstElement) + " has material '" +
+                          material.name +
+                          "' without Mooney-Rivlin parameters: give it a 'MOONEYRIVLIN, density, mu01, mu10, v1' "
+                          "line or set the Mooney-Rivlin override");
   }
 }
 
@@ -261,41 +350,9 @@ void IsotropicHyperelasticFEM::computeElement(int element, const Eigen::Matrix3d
   if (tangent == nullptr) return;
   if (options_.enforceSPD) clampToPositiveSemidefinite(terms);
 
-  // D: column 3b + c is U^T dF V for a unit change of coordinate c of vertex b, i.e. the
-  // outer product of row c of U and g^_b; entry (p, q) at row 3p + q.
-  Eigen::Matrix<double, 9, 12> d;
-  for (int b = 0; b < 4; ++b) {
-    for (int c = 0; c < 3; ++c) {
-      for (int p = 0; p < 3; ++p) {
-        for (int q = 0; q < 3; ++q) d((3 * p) + q, (3 * b) + c) = svd.u(c, p) * rotatedGradients(q, b);
-      }
-    }
-  }
-  // A D with A = dP^/dF^ (block structure described in the class comment).
-  Eigen::Matrix<double, 9, 12> ad;
-  for (int i = 0; i < 3; ++i) {
-    ad.row(4 * i) =
-        (terms.hessian[i][0] * d.row(0)) + (terms.hessian[i][1] * d.row(4)) + (terms.hessian[i][2] * d.row(8));
-  }
-  for (int p = 0; p < 3; ++p) {
-    const int i = kPairs[p][0];
-    const int j = kPairs[p][1];
-    const double a = 0.5 * (terms.pairSum[p] + terms.pairDifference[p]);
-    const double b = 0.5 * (terms.pairSum[p] - terms.pairDifference[p]);
-    const int ij = (3 * i) + j;
-    const int ji = (3 * j) + i;
-    ad.row(ij) = (a * d.row(ij)) + (b * d.row(ji));
-    ad.row(ji) = (b * d.row(ij)) + (a * d.row(ji));
-  }
-  tangent->noalias() = volume * (d.transpose() * ad);
-  // The exact Hessian is symmetric; averaging removes the rounding asymmetry.
-  for (int j = 0; j < 12; ++j) {
-    for (int i = j + 1; i < 12; ++i) {
-      const double average = 0.5 * ((*tangent)(i, j) + (*tangent)(j, i));
-      (*tangent)(i, j) = average;
-      (*tangent)(j, i) = average;
-    }
-  }
+  const Eigen::Matrix<double, 9, 12> d = rotatedFrameDifferentials(svd.u, rotatedGradients);
+  tangent->noalias() = volume * (d.transpose() * applyRotatedTangent(terms, d));
+  symmetrizeElementMatrix(*tangent);
 }
 
 }  // namespace asyncfem

@@ -124,6 +124,37 @@ void drawText(Image& image, int x, int y, const std::string& text, int scale, Rg
   }
 }
 
+namespace {
+
+// Sum of the images' widths; throws Error unless they all have the first one's height.
+int sideBySideWidth(const std::vector<Image>& images) {
+  int width = 0;
+  for (const Image& image : images) {
+    if (image.height != images.front().height) {
+      throw Error("composeSideBySide: images of different heights (" + std::to_string(image.height) + " and " +
+                  std::to_string(images.front().height) + ")");
+    }
+    width += image.width;
+  }
+  return width;
+}
+
+// Fills rows [0, bar) of columns [x, x + width) of out with color and centres label on it
+// in white, at the largest scale whose glyphs fill at most 70% of the bar and whose text
+// fits.
+void drawLabelBar(Image& out, int x, int width, int bar, const std::string& label, const Eigen::Vector3f& color) {
+  out.fillRectangle(x, 0, x + width, bar, color);
+  int scale = std::max(1, (bar * 7) / (10 * glyphHeight));
+  while (scale > 1 && textWidth(label, scale) > width - 4) {
+    --scale;
+  }
+  const int textX = x + ((width - textWidth(label, scale)) / 2);
+  const int textY = (bar - (glyphHeight * scale)) / 2;
+  drawText(out, std::max(x, textX), textY, label, scale, Eigen::Vector3f::Ones());
+}
+
+}  // namespace
+
 Image composeSideBySide(const std::vector<Image>& images, const std::vector<std::string>& labels, int barHeight,
                         const std::vector<Eigen::Vector3f>& barColors) {
   if (images.empty()) {
@@ -133,14 +164,7 @@ Image composeSideBySide(const std::vector<Image>& images, const std::vector<std:
     throw Error("composeSideBySide: " + std::to_string(labels.size()) + " labels for " + std::to_string(images.size()) +
                 " images");
   }
-  int width = 0;
-  for (const Image& image : images) {
-    if (image.height != images.front().height) {
-      throw Error("composeSideBySide: images of different heights (" + std::to_string(image.height) + " and " +
-                  std::to_string(images.front().height) + ")");
-    }
-    width += image.width;
-  }
+  const int width = sideBySideWidth(images);
   const int bar = labels.empty() ? 0 : std::max(barHeight, 0);
   const std::vector<Eigen::Vector3f> palette =
       barColors.empty()
@@ -150,17 +174,7 @@ Image composeSideBySide(const std::vector<Image>& images, const std::vector<std:
   int x = 0;
   for (std::size_t i = 0; i < images.size(); ++i) {
     const Image& image = images[i];
-    if (bar > 0) {
-      out.fillRectangle(x, 0, x + image.width, bar, palette[i % palette.size()]);
-      // Largest scale whose glyphs fill at most 70% of the bar and whose text fits.
-      int scale = std::max(1, (bar * 7) / (10 * glyphHeight));
-      while (scale > 1 && textWidth(labels[i], scale) > image.width - 4) {
-        --scale;
-      }
-      const int textX = x + ((image.width - textWidth(labels[i], scale)) / 2);
-      const int textY = (bar - (glyphHeight * scale)) / 2;
-      drawText(out, std::max(x, textX), textY, labels[i], scale, Eigen::Vector3f::Ones());
-    }
+    if (bar > 0) drawLabelBar(out, x, image.width, bar, labels[i], palette[i % palette.size()]);
     out.paste(image, x, bar);
     x += image.width;
   }

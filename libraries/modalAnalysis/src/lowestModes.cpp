@@ -86,18 +86,10 @@ double defaultShift(const Eigen::SparseMatrix<double>& stiffness, const Eigen::S
   return largest > 0.0 ? -1e-8 * largest : -1.0;
 }
 
-}  // namespace
-
-VibrationMatrices vibrationMatrices(const TetMesh& mesh, MassType massType) {
-  const MatrixAssembler assembler(mesh);
-  VibrationMatrices matrices;
-  matrices.stiffness = linearStiffnessMatrix(mesh, assembler);
-  matrices.mass = massMatrix(mesh, assembler, massType);
-  return matrices;
-}
-
-ModalResult lowestModes(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
-                        const FreeDofs& freeDofs, const ModalOptions& options) {
+// Throws ValidationError unless K and M are square over the DOFs of freeDofs and the
+// options ask for 1 to numFree - 1 modes with a positive tolerance and iteration cap.
+void checkModalProblem(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
+                       const FreeDofs& freeDofs, const ModalOptions& options) {
   const int numDofs = freeDofs.numDofs();
   if (stiffness.rows() != numDofs || stiffness.cols() != numDofs || mass.rows() != numDofs || mass.cols() != numDofs) {
     throw ValidationError("modal analysis: K is " + std::to_string(stiffness.rows()) + "x" +
@@ -114,6 +106,35 @@ ModalResult lowestModes(const Eigen::SparseMatrix<double>& stiffness, const Eige
   if (!(options.tolerance > 0.0) || options.maxIterations < 1) {
     throw ValidationError("modal analysis: the tolerance must be > 0 and maxIterations >= 1");
   }
+}
+
+// Modes over all DOFs (numDofs x count, zero at fixed DOFs) from the free-DOF Lanczos
+// vectors, each scaled to unit M-norm: they are M-orthonormal already, normalising
+// again removes round-off.
+Eigen::MatrixXd massNormalizedModes(const Eigen::MatrixXd& freeModes, const Eigen::SparseMatrix<double>& massFree,
+                                    const FreeDofs& freeDofs) {
+  Eigen::MatrixXd modes = Eigen::MatrixXd::Zero(freeDofs.numDofs(), freeModes.cols());
+  for (Eigen::Index j = 0; j < freeModes.cols(); ++j) {
+    const double norm = std::sqrt(freeModes.col(j).dot(massFree * freeModes.col(j)));
+    modes.col(j) = freeDofs.expand(freeModes.col(j) / norm);
+  }
+  return modes;
+}
+
+}  // namespace
+
+VibrationMatrices vibrationMatrices(const TetMesh& mesh, MassType massType) {
+  const MatrixAssembler assembler(mesh);
+  VibrationMatrices matrices;
+  matrices.stiffness = linearStiffnessMatrix(mesh, assembler);
+  matrices.mass = massMatrix(mesh, assembler, massType);
+  return matrices;
+}
+
+ModalResult lowestModes(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
+                        const FreeDofs& freeDofs, const ModalOptions& options) {
+  checkModalProblem(stiffness, mass, freeDofs, options);
+  const int numFree = freeDofs.numFree();
   Stopwatch total;
   const SubmatrixExtractor extractor(stiffness, freeDofs.freeToFull(), freeDofs.freeToFull());
   const Eigen::SparseMatrix<double> stiffnessFree = extractor.extract(stiffness);
@@ -143,13 +164,7 @@ ModalResult lowestModes(const Eigen::SparseMatrix<double>& stiffness, const Eige
   result.shift = sigma;
   result.eigenvalues = eigs.eigenvalues();
   result.frequencies = result.eigenvalues.cwiseMax(0.0).cwiseSqrt();
-  const Eigen::MatrixXd freeModes = eigs.eigenvectors();
-  result.modes.setZero(numDofs, options.count);
-  for (int j = 0; j < options.count; ++j) {
-    // Lanczos vectors are M-orthonormal already; normalise again against round-off.
-    const double norm = std::sqrt(freeModes.col(j).dot(massFree * freeModes.col(j)));
-    result.modes.col(j) = freeDofs.expand(freeModes.col(j) / norm);
-  }
+  result.modes = massNormalizedModes(eigs.eigenvectors(), massFree, freeDofs);
   result.iterations = static_cast<int>(eigs.num_iterations());
   result.operatorApplications = shiftInvert.applications();
   result.factorSeconds = shiftInvert.factorSeconds();

@@ -45,8 +45,11 @@ std::string RegionModeReport::verdictText() const {
   return "no mode below the frame Nyquist frequency lives in S: single-rate at hL costs less for the same result";
 }
 
-RegionModeReport analyseRegionModes(const ModalResult& result, const Eigen::SparseMatrix<double>& mass,
-                                    const std::vector<ModalRegion>& regions, double largeTimestep, double frameRate) {
+namespace {
+
+// Throws ValidationError unless hL and the frame rate are positive and the modes match M.
+void checkModalInputs(const ModalResult& result, const Eigen::SparseMatrix<double>& mass, double largeTimestep,
+                      double frameRate) {
   if (!(largeTimestep > 0.0) || !std::isfinite(largeTimestep)) {
     throw ValidationError("modal report: the large timestep hL must be positive");
   }
@@ -59,70 +62,89 @@ RegionModeReport analyseRegionModes(const ModalResult& result, const Eigen::Spar
                           " DOFs) do not match M (" + std::to_string(mass.rows()) + "x" + std::to_string(mass.cols()) +
                           ")");
   }
-  RegionModeReport report;
-  report.largeTimestep = largeTimestep;
-  report.frameRate = frameRate;
-  report.nyquistOmega = modalCriteria::nyquistPerFrameRate * frameRate;
+}
 
-  // Shares: for each region, mask the modes to its DOFs and take phi_S^T M phi_S (the
-  // masked vector has zeros outside S, so this is phi_S^T M^{SS} phi_S).
-  const auto numModes = static_cast<std::size_t>(result.modes.cols());
-  std::vector<Eigen::VectorXd> shares;
-  for (const ModalRegion& region : regions) {
-    if (region.ratio < 1) {
-      throw ValidationError("modal report: region '" + region.name + "' has ratio " + std::to_string(region.ratio) +
-                            " (must be >= 1)");
-    }
-    Eigen::VectorXd mask = Eigen::VectorXd::Zero(numDofs);
-    for (int v : region.vertices) {
-      if (v < 0 || 3 * static_cast<Eigen::Index>(v) + 2 >= numDofs) {
-        throw ValidationError("modal report: region '" + region.name + "' names vertex " + std::to_string(v) +
-                              ", outside [0, " + std::to_string(numDofs / 3) + ")");
-      }
-      mask.segment<3>(3 * static_cast<Eigen::Index>(v)).setOnes();
-    }
-    const Eigen::MatrixXd masked = mask.asDiagonal() * result.modes;
-    const Eigen::MatrixXd massTimesMasked = mass * masked;
-    shares.emplace_back(masked.cwiseProduct(massTimesMasked).colwise().sum().transpose());
-    report.regionNames.push_back(region.name);
-    report.ratios.push_back(region.ratio);
+// Share of every mode in the region: the modes masked to its DOFs, phi_S^T M phi_S (the
+// masked vector has zeros outside S, so this is phi_S^T M^{SS} phi_S). Throws
+// ValidationError for a ratio below 1 or a vertex outside the mesh.
+Eigen::VectorXd regionShares(const ModalRegion& region, const ModalResult& result,
+                             const Eigen::SparseMatrix<double>& mass) {
+  const Eigen::Index numDofs = mass.rows();
+  if (region.ratio < 1) {
+    throw ValidationError("modal report: region '" + region.name + "' has ratio " + std::to_string(region.ratio) +
+                          " (must be >= 1)");
   }
-
-  for (std::size_t j = 0; j < numModes; ++j) {
-    ModeInRegions mode;
-    mode.omega = result.frequencies[static_cast<Eigen::Index>(j)];
-    mode.hertz = mode.omega / (2.0 * modalCriteria::nyquistPerFrameRate);
-    mode.omegaLargeStep = mode.omega * largeTimestep;
-    std::size_t mainRegion = 0;
-    for (std::size_t i = 0; i < regions.size(); ++i) {
-      mode.omegaSubstep.push_back(mode.omegaLargeStep / regions[i].ratio);
-      mode.regionShare.push_back(shares[i][static_cast<Eigen::Index>(j)]);
-      mode.fastShare += mode.regionShare.back();
-      if (mode.regionShare[i] > mode.regionShare[mainRegion]) mainRegion = i;
+  Eigen::VectorXd mask = Eigen::VectorXd::Zero(numDofs);
+  for (int v : region.vertices) {
+    if (v < 0 || 3 * static_cast<Eigen::Index>(v) + 2 >= numDofs) {
+      throw ValidationError("modal report: region '" + region.name + "' names vertex " + std::to_string(v) +
+                            ", outside [0, " + std::to_string(numDofs / 3) + ")");
     }
-    mode.visible = mode.omega < report.nyquistOmega;
-    mode.livesInFastRegions = mode.visible && mode.fastShare >= modalCriteria::minFastShare;
-    mode.keepable = mode.livesInFastRegions && mode.omegaLargeStep >= modalCriteria::minDampedOmegaLargeStep &&
-                    mode.omegaSubstep[mainRegion] <= modalCriteria::maxResolvedOmegaSubstep;
-    if (mode.keepable) report.keptModes.push_back(static_cast<int>(j));
-    report.modes.push_back(std::move(mode));
+    mask.segment<3>(3 * static_cast<Eigen::Index>(v)).setOnes();
   }
-  report.visibleModesTruncated = !report.modes.empty() && report.modes.back().visible;
+  const Eigen::MatrixXd masked = mask.asDiagonal() * result.modes;
+  const Eigen::MatrixXd massTimesMasked = mass * masked;
+  return masked.cwiseProduct(massTimesMasked).colwise().sum().transpose();
+}
 
+// Mode j against the regions: frequencies, omega h per region, shares, and whether it
+// is visible at the frame rate, lives in the fast regions and can be kept by async.
+ModeInRegions classifyMode(std::size_t j, const ModalResult& result, const std::vector<ModalRegion>& regions,
+                           const std::vector<Eigen::VectorXd>& shares, double largeTimestep, double nyquistOmega) {
+  ModeInRegions mode;
+  mode.omega = result.frequencies[static_cast<Eigen::Index>(j)];
+  mode.hertz = mode.omega / (2.0 * modalCriteria::nyquistPerFrameRate);
+  mode.omegaLargeStep = mode.omega * largeTimestep;
+  std::size_t mainRegion = 0;
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    mode.omegaSubstep.push_back(mode.omegaLargeStep / regions[i].ratio);
+    mode.regionShare.push_back(shares[i][static_cast<Eigen::Index>(j)]);
+    mode.fastShare += mode.regionShare.back();
+    if (mode.regionShare[i] > mode.regionShare[mainRegion]) mainRegion = i;
+  }
+  mode.visible = mode.omega < nyquistOmega;
+  mode.livesInFastRegions = mode.visible && mode.fastShare >= modalCriteria::minFastShare;
+  mode.keepable = mode.livesInFastRegions && mode.omegaLargeStep >= modalCriteria::minDampedOmegaLargeStep &&
+                  mode.omegaSubstep[mainRegion] <= modalCriteria::maxResolvedOmegaSubstep;
+  return mode;
+}
+
+// The report's verdict from its classified modes and kept modes.
+ModalVerdict regionModeVerdict(const RegionModeReport& report) {
   const bool anyInFast = std::any_of(report.modes.begin(), report.modes.end(),
                                      [](const ModeInRegions& m) { return m.livesInFastRegions; });
   const bool allResolvedAtLarge = std::all_of(report.modes.begin(), report.modes.end(), [](const ModeInRegions& m) {
     return !m.livesInFastRegions || m.omegaLargeStep < modalCriteria::minDampedOmegaLargeStep;
   });
-  if (!report.keptModes.empty()) {
-    report.verdict = ModalVerdict::asyncKeepsModes;
-  } else if (!anyInFast) {
-    report.verdict = ModalVerdict::noVisibleModeInFast;
-  } else if (allResolvedAtLarge) {
-    report.verdict = ModalVerdict::resolvedAtLargeStep;
-  } else {
-    report.verdict = ModalVerdict::unresolvedAtSubstep;
+  if (!report.keptModes.empty()) return ModalVerdict::asyncKeepsModes;
+  if (!anyInFast) return ModalVerdict::noVisibleModeInFast;
+  if (allResolvedAtLarge) return ModalVerdict::resolvedAtLargeStep;
+  return ModalVerdict::unresolvedAtSubstep;
+}
+
+}  // namespace
+
+RegionModeReport analyseRegionModes(const ModalResult& result, const Eigen::SparseMatrix<double>& mass,
+                                    const std::vector<ModalRegion>& regions, double largeTimestep, double frameRate) {
+  checkModalInputs(result, mass, largeTimestep, frameRate);
+  RegionModeReport report;
+  report.largeTimestep = largeTimestep;
+  report.frameRate = frameRate;
+  report.nyquistOmega = modalCriteria::nyquistPerFrameRate * frameRate;
+  std::vector<Eigen::VectorXd> shares;
+  for (const ModalRegion& region : regions) {
+    shares.push_back(regionShares(region, result, mass));
+    report.regionNames.push_back(region.name);
+    report.ratios.push_back(region.ratio);
   }
+  const auto numModes = static_cast<std::size_t>(result.modes.cols());
+  for (std::size_t j = 0; j < numModes; ++j) {
+    ModeInRegions mode = classifyMode(j, result, regions, shares, largeTimestep, report.nyquistOmega);
+    if (mode.keepable) report.keptModes.push_back(static_cast<int>(j));
+    report.modes.push_back(std::move(mode));
+  }
+  report.visibleModesTruncated = !report.modes.empty() && report.modes.back().visible;
+  report.verdict = regionModeVerdict(report);
   return report;
 }
 

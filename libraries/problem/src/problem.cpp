@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
+#include <asyncfem/core/enumNames.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/hyperelasticFEM/factory.hpp>
@@ -74,20 +75,32 @@ const std::shared_ptr<const Loads>& Problem::loads() const {
   return loads_;
 }
 
-std::string toString(ForceModelType type) {
+namespace {
+
+// Names of the force models that are not a hyperelastic material; the others are
+// written as their material.
+constexpr EnumName<ForceModelType> kForceModelNames[] = {{ForceModelType::linear, "linear"},
+                                                         {ForceModelType::corotational, "corotational"}};
+
+// The material of a hyperelastic force model, or nullopt for the others.
+std::optional<HyperelasticMaterialKind> hyperelasticMaterial(ForceModelType type) {
   switch (type) {
-    case ForceModelType::linear:
-      return "linear";
-    case ForceModelType::corotational:
-      return "corotational";
     case ForceModelType::stvk:
-      return toString(HyperelasticMaterialKind::stvk);
+      return HyperelasticMaterialKind::stvk;
     case ForceModelType::neoHookean:
-      return toString(HyperelasticMaterialKind::neoHookean);
+      return HyperelasticMaterialKind::neoHookean;
     case ForceModelType::mooneyRivlin:
-      return toString(HyperelasticMaterialKind::mooneyRivlin);
+      return HyperelasticMaterialKind::mooneyRivlin;
+    default:
+      return std::nullopt;
   }
-  return "unknown";
+}
+
+}  // namespace
+
+std::string toString(ForceModelType type) {
+  if (const std::optional<HyperelasticMaterialKind> material = hyperelasticMaterial(type)) return toString(*material);
+  return std::string(findEnumName(kForceModelNames, type).value_or("unknown"));
 }
 
 std::shared_ptr<ForceModel> Problem::makeForceModel() const {

@@ -71,8 +71,7 @@ class CholmodSolver final : public SolverBase {
   std::string ordering() const override { return factor_ ? cholmodOrderingName(factor_->ordering) : "none"; }
 
   void analyzePattern(const SparseMatrix& a) override {
-    Stopwatch watch;
-    watch.start();
+    Stopwatch watch;  // runs from construction
     beginAnalyze(a, "cholmod");
     if (factor_) cholmod_free_factor(&factor_, common_.get());
     cholmod_sparse view = upperTriangleView(a);
@@ -96,8 +95,7 @@ class CholmodSolver final : public SolverBase {
   }
 
   void factorize(const SparseMatrix& a) override {
-    Stopwatch watch;
-    watch.start();
+    Stopwatch watch;  // runs from construction
     beginFactorize(a, "cholmod");
     cholmod_sparse view = upperTriangleView(a);
     const int ok = cholmod_factorize(&view, factor_, common_.get());
@@ -115,14 +113,11 @@ class CholmodSolver final : public SolverBase {
                            std::to_string(factor_->n) + ")");
     }
     recordFactorCosts();
-    factored_ = true;
-    ++stats_.factorizations;
-    stats_.factorSeconds += watch.stop();
+    endFactorize(watch);
   }
 
   void solve(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) override {
-    Stopwatch watch;
-    watch.start();
+    Stopwatch watch;  // runs from construction
     beginSolve(rhs, "cholmod");
     solution.resize(rhs.rows(), rhs.cols());
     if (rhs.cols() == 0) return;
@@ -148,8 +143,7 @@ class CholmodSolver final : public SolverBase {
       throw NumericalError("cholmod: solve failed (CHOLMOD status " + std::to_string(common_->status) + ")");
     }
     solution = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x_->x), rhs.rows(), rhs.cols());
-    stats_.solvedRightHandSides += rhs.cols();
-    stats_.solveSeconds += watch.stop();
+    endSolve(rhs.cols(), watch);
   }
 
  private:

@@ -91,8 +91,7 @@ class EigenSolver final : public SolverBase {
   }
 
   void analyzePattern(const SparseMatrix& a) override {
-    Stopwatch watch;
-    watch.start();
+    Stopwatch watch;  // runs from construction
     beginAnalyze(a, name());
     factorization_.analyzePattern(a);
     ++stats_.analyses;
@@ -100,8 +99,7 @@ class EigenSolver final : public SolverBase {
   }
 
   void factorize(const SparseMatrix& a) override {
-    Stopwatch watch;
-    watch.start();
+    Stopwatch watch;  // runs from construction
     beginFactorize(a, name());
     factorization_.factorize(a);
     FactorCosts costs;
@@ -122,19 +120,15 @@ class EigenSolver final : public SolverBase {
     stats_.factorNonZeros = costs.nonZeros;
     stats_.factorFlops = costs.flops;
     stats_.solveFlopsPerRhs = costs.solveFlopsPerRhs;
-    factored_ = true;
-    ++stats_.factorizations;
-    stats_.factorSeconds += watch.stop();
+    endFactorize(watch);
   }
 
   void solve(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) override {
-    Stopwatch watch;
-    watch.start();
+    Stopwatch watch;  // runs from construction
     beginSolve(rhs, name());
     solution = factorization_.solve(rhs);
     if (factorization_.info() != Eigen::Success) throw NumericalError(std::string(name()) + ": solve failed");
-    stats_.solvedRightHandSides += rhs.cols();
-    stats_.solveSeconds += watch.stop();
+    endSolve(rhs.cols(), watch);
   }
 
  private:

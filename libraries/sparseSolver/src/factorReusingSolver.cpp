@@ -1,10 +1,94 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sparseSolver/factorReusingSolver.hpp>
 #include <cmath>
 #include <string>
 
 namespace asyncfem {
+
+namespace {
+
+// Throws Error unless a matrix is set and rhs has its number of rows.
+void checkSolveInput(const Eigen::SparseMatrix<double>* matrix, const Eigen::VectorXd& rhs) {
+  if (matrix == nullptr) throw Error("FactorReusingSolver::solve: called before setMatrix()");
+  if (rhs.size() != matrix->rows()) {
+    throw Error("FactorReusingSolver::solve: right-hand side has " + std::to_string(rhs.size()) +
+                " rows, the matrix has " + std::to_string(matrix->rows()));
+  }
+}
+
+// Records a solve that took no PCG iteration (exact, or a zero right-hand side).
+void recordNoIterations(FactorReuseStats& stats) {
+  stats.lastIterations = 0;
+  stats.lastRelativeResidual = 0.0;
+}
+
+// Start of the iteration: x = initialGuess when it has rhs's size and a smaller residual
+// than x = 0 (then product = A x0), else x = 0; residual = rhs - A x.
+void startFromGuessOrZero(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& rhs, double rhsNorm,
+                          const Eigen::VectorXd& initialGuess, Eigen::VectorXd& solution, Eigen::VectorXd& residual,
+                          Eigen::VectorXd& product) {
+  residual = rhs;
+  bool fromGuess = false;
+  if (initialGuess.size() == rhs.size()) {
+    product.noalias() = a * initialGuess;
+    fromGuess = (rhs - product).norm() < rhsNorm;
+  }
+  if (fromGuess) {
+    if (&solution != &initialGuess) solution = initialGuess;
+    residual -= product;
+  } else {
+    solution.setZero(rhs.size());
+  }
+}
+
+// Preconditioned conjugate gradients (Saad, Iterative Methods, Alg. 9.1) from solution
+// with its residual, until |residual| <= target, maxIterations, or a direction along
+// which A is not positive. Returns the iterations; residualNorm is |residual| at the end.
+// z, direction and product are scratch.
+template <class Preconditioner>
+int preconditionedConjugateGradients(const Eigen::SparseMatrix<double>& a, double target, int maxIterations,
+                                     const Preconditioner& precondition, Eigen::VectorXd& solution,
+                                     Eigen::VectorXd& residual, Eigen::VectorXd& z, Eigen::VectorXd& direction,
+                                     Eigen::VectorXd& product, double& residualNorm) {
+  precondition(residual, z);
+  direction = z;
+  double residualDotZ = residual.dot(z);
+  int iterations = 0;
+  residualNorm = residual.norm();
+  while (residualNorm > target && iterations < maxIterations) {
+    product.noalias() = a * direction;
+    const double curvature = direction.dot(product);
+    if (!(curvature > 0.0) || !std::isfinite(curvature)) break;  // not SPD along p: solve exactly below
+    const double step = residualDotZ / curvature;
+    solution.noalias() += step * direction;
+    residual.noalias() -= step * product;
+    ++iterations;
+    residualNorm = residual.norm();
+    if (residualNorm <= target) break;
+    precondition(residual, z);
+    const double nextDot = residual.dot(z);
+    direction = z + (nextDot / residualDotZ) * direction;
+    residualDotZ = nextDot;
+  }
+  return iterations;
+}
+
+// Whether the next setMatrix() should refactor after a converged PCG solve of iterations:
+// too many iterations, growth against the first solve with this factor, or (amortize)
+// more than the average cost per solve of the cycle so far.
+bool refactorIsDue(const FactorReuseOptions& options, int iterations, int firstStaleIterations, double cycleCost,
+                   long long cycleSolves) {
+  const bool tooMany = iterations > options.refactorAfterIterations;
+  const bool grew =
+      options.growthFactor > 0.0 &&
+      static_cast<double>(iterations) > std::max(2.0, options.growthFactor * static_cast<double>(firstStaleIterations));
+  const bool pays = options.amortize && static_cast<double>(iterations) > cycleCost / static_cast<double>(cycleSolves);
+  return tooMany || grew || pays;
+}
+
+}  // namespace
 
 FactorReusingSolver::FactorReusingSolver(SolverKind direct, const FactorReuseOptions& options)
     : options_(options), direct_(makeSparseSolver(direct)) {
@@ -62,63 +146,27 @@ void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& sol
 
 void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, const Eigen::VectorXd& initialGuess,
                                 Eigen::VectorXd& solution) {
-  if (matrix_ == nullptr) throw Error("FactorReusingSolver::solve: called before setMatrix()");
-  if (rhs.size() != matrix_->rows()) {
-    throw Error("FactorReusingSolver::solve: right-hand side has " + std::to_string(rhs.size()) +
-                " rows, the matrix has " + std::to_string(matrix_->rows()));
-  }
+  checkSolveInput(matrix_, rhs);
   ++stats_.solves;
   if (factorIsCurrent_) {
     applyPreconditioner(rhs, solution);
     ++cycleSolves_;
     ++stats_.exactSolves;
-    stats_.lastIterations = 0;
-    stats_.lastRelativeResidual = 0.0;
+    recordNoIterations(stats_);
     return;
   }
-  // Preconditioned conjugate gradients (Saad, Iterative Methods, Alg. 9.1) from x = 0 or
-  // from the initial guess.
-  const Eigen::SparseMatrix<double>& a = *matrix_;
   const double rhsNorm = rhs.norm();
   if (rhsNorm == 0.0) {
     solution.setZero(rhs.size());
-    stats_.lastIterations = 0;
-    stats_.lastRelativeResidual = 0.0;
+    recordNoIterations(stats_);
     return;
   }
   const double target = options_.relativeTolerance * rhsNorm;
-  residual_ = rhs;
-  bool fromGuess = false;
-  if (initialGuess.size() == rhs.size()) {
-    product_.noalias() = a * initialGuess;
-    fromGuess = (rhs - product_).norm() < rhsNorm;
-  }
-  if (fromGuess) {
-    if (&solution != &initialGuess) solution = initialGuess;
-    residual_ -= product_;
-  } else {
-    solution.setZero(rhs.size());
-  }
-  applyPreconditioner(residual_, z_);
-  direction_ = z_;
-  double residualDotZ = residual_.dot(z_);
-  int iterations = 0;
-  double residualNorm = residual_.norm();
-  while (residualNorm > target && iterations < options_.maxIterations) {
-    product_.noalias() = a * direction_;
-    const double curvature = direction_.dot(product_);
-    if (!(curvature > 0.0) || !std::isfinite(curvature)) break;  // not SPD along p: solve exactly below
-    const double step = residualDotZ / curvature;
-    solution.noalias() += step * direction_;
-    residual_.noalias() -= step * product_;
-    ++iterations;
-    residualNorm = residual_.norm();
-    if (residualNorm <= target) break;
-    applyPreconditioner(residual_, z_);
-    const double nextDot = residual_.dot(z_);
-    direction_ = z_ + (nextDot / residualDotZ) * direction_;
-    residualDotZ = nextDot;
-  }
+  startFromGuessOrZero(*matrix_, rhs, rhsNorm, initialGuess, solution, residual_, product_);
+  const auto precondition = [this](const Eigen::VectorXd& in, Eigen::VectorXd& out) { applyPreconditioner(in, out); };
+  double residualNorm = 0.0;
+  const int iterations = preconditionedConjugateGradients(*matrix_, target, options_.maxIterations, precondition,
+                                                          solution, residual_, z_, direction_, product_, residualNorm);
   stats_.pcgIterations += iterations;
   stats_.lastIterations = iterations;
   if (!(residualNorm <= target)) {
@@ -132,15 +180,9 @@ void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, const Eigen::VectorX
   }
   stats_.lastRelativeResidual = residualNorm / rhsNorm;
   if (firstStaleIterations_ == 0) firstStaleIterations_ = iterations;
-  const bool tooMany = iterations > options_.refactorAfterIterations;
-  const bool grew = options_.growthFactor > 0.0 &&
-                    static_cast<double>(iterations) >
-                        std::max(2.0, options_.growthFactor * static_cast<double>(firstStaleIterations_));
   cycleCost_ += iterations;
   ++cycleSolves_;
-  const bool pays =
-      options_.amortize && static_cast<double>(iterations) > cycleCost_ / static_cast<double>(cycleSolves_);
-  if (tooMany || grew || pays) refactorPending_ = true;
+  if (refactorIsDue(options_, iterations, firstStaleIterations_, cycleCost_, cycleSolves_)) refactorPending_ = true;
 }
 
 }  // namespace asyncfem

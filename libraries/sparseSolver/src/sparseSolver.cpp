@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/core/enumNames.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <string>
@@ -8,31 +9,23 @@
 namespace asyncfem {
 
 namespace {
-constexpr SolverKind kAllKinds[] = {SolverKind::cholmod, SolverKind::umfpack, SolverKind::eigenLDLT,
-                                    SolverKind::eigenLU};
+
+// Names of the solver kinds, in the order error messages list them.
+constexpr EnumName<SolverKind> kSolverNames[] = {{SolverKind::cholmod, "cholmod"},
+                                                 {SolverKind::umfpack, "umfpack"},
+                                                 {SolverKind::eigenLDLT, "eigen-ldlt"},
+                                                 {SolverKind::eigenLU, "eigen-lu"}};
+
 }  // namespace
 
 std::string toString(SolverKind kind) {
-  switch (kind) {
-    case SolverKind::cholmod:
-      return "cholmod";
-    case SolverKind::umfpack:
-      return "umfpack";
-    case SolverKind::eigenLDLT:
-      return "eigen-ldlt";
-    case SolverKind::eigenLU:
-      return "eigen-lu";
-  }
+  if (const std::optional<std::string_view> name = findEnumName(kSolverNames, kind)) return std::string(*name);
   throw Error("toString: invalid SolverKind value " + std::to_string(static_cast<int>(kind)));
 }
 
 SolverKind parseSolverKind(const std::string& name) {
-  std::string valid;
-  for (SolverKind kind : kAllKinds) {
-    if (toString(kind) == name) return kind;
-    valid += (valid.empty() ? "" : ", ") + toString(kind);
-  }
-  throw Error("unknown sparse solver '" + name + "' (valid: " + valid + ")");
+  if (const std::optional<SolverKind> kind = findEnumValue(kSolverNames, name)) return *kind;
+  throw Error("unknown sparse solver '" + name + "' (valid: " + joinEnumNames(kSolverNames, ", ", ", ") + ")");
 }
 
 std::unique_ptr<SparseSolver> makeSparseSolver(SolverKind kind) {

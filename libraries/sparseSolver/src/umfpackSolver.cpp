@@ -50,8 +50,7 @@ class UmfpackSolver final : public SolverBase {
   std::string ordering() const override { return ordering_; }
 
   void analyzePattern(const SparseMatrix& a) override {
-    Stopwatch watch;
-    watch.start();
+    Stopwatch watch;  // runs from construction
     beginAnalyze(a, "umfpack");
     numeric_.reset();
     const int n = static_cast<int>(a.rows());
@@ -69,8 +68,7 @@ class UmfpackSolver final : public SolverBase {
   }
 
   void factorize(const SparseMatrix& a) override {
-    Stopwatch watch;
-    watch.start();
+    Stopwatch watch;  // runs from construction
     beginFactorize(a, "umfpack");
     const int status = umfpack_di_numeric(a.outerIndexPtr(), a.innerIndexPtr(), a.valuePtr(), symbolic_.get(),
                                           numeric_.resetAndAddress(), control_, info_);
@@ -93,14 +91,11 @@ class UmfpackSolver final : public SolverBase {
     stats_.factorFlops = info_[UMFPACK_FLOPS];
     // Forward and back substitution: one multiply and one add per entry of L and U.
     stats_.solveFlopsPerRhs = 2.0 * factorEntries;
-    factored_ = true;
-    ++stats_.factorizations;
-    stats_.factorSeconds += watch.stop();
+    endFactorize(watch);
   }
 
   void solve(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) override {
-    Stopwatch watch;
-    watch.start();
+    Stopwatch watch;  // runs from construction
     beginSolve(rhs, "umfpack");
     solution.resize(rhs.rows(), rhs.cols());
     // UMFPACK solves one column at a time; columns of a Ref are contiguous (inner stride 1).
@@ -112,8 +107,7 @@ class UmfpackSolver final : public SolverBase {
                              std::to_string(status) + ")");
       }
     }
-    stats_.solvedRightHandSides += rhs.cols();
-    stats_.solveSeconds += watch.stop();
+    endSolve(rhs.cols(), watch);
   }
 
  private:

@@ -40,53 +40,67 @@ long long exclusiveScan(std::vector<int>& counts) {
   return running;
 }
 
+// Compressed rows: the items of row r are items[offsets[r] .. offsets[r+1]).
+struct CompressedRows {
+  std::vector<int> offsets;
+  std::vector<int> items;
+};
+
+// Distinct vertices of every chunk of chunkSize consecutive elements, in first-seen
+// order.
+CompressedRows chunkVertexSets(const Eigen::Matrix4Xi& elements, int numVertices, int chunkSize) {
+  const int numElements = static_cast<int>(elements.cols());
+  const int numChunks = (numElements + chunkSize - 1) / chunkSize;
+  CompressedRows chunkVertices{std::vector<int>(toIndex(numChunks) + 1, 0), std::vector<int>(toIndex(numElements) * 4)};
+  std::vector<int> stamp(toIndex(numVertices), -1);
+  int written = 0;
+  for (int chunk = 0; chunk < numChunks; ++chunk) {
+    chunkVertices.offsets[toIndex(chunk)] = written;
+    const Index first = toIndex(chunk * chunkSize) * 4;
+    const Index last = toIndex(std::min(numElements, (chunk + 1) * chunkSize)) * 4;
+    for (Index k = first; k < last; ++k) {
+      const int v = elements.data()[k];
+      if (stamp[toIndex(v)] == chunk) continue;
+      stamp[toIndex(v)] = chunk;
+      chunkVertices.items[toIndex(written++)] = v;
+    }
+  }
+  chunkVertices.offsets[toIndex(numChunks)] = written;
+  chunkVertices.items.resize(toIndex(written));
+  return chunkVertices;
+}
+
+// Transpose of chunkVertices: the chunks touching every vertex, ascending.
+CompressedRows vertexChunkSets(const CompressedRows& chunkVertices, int numVertices) {
+  const int numChunks = static_cast<int>(chunkVertices.offsets.size()) - 1;
+  CompressedRows vertexChunks{std::vector<int>(toIndex(numVertices) + 1, 0),
+                              std::vector<int>(chunkVertices.items.size())};
+  for (int v : chunkVertices.items) ++vertexChunks.offsets[toIndex(v)];
+  exclusiveScan(vertexChunks.offsets);
+  std::vector<int> fill(vertexChunks.offsets.begin(), vertexChunks.offsets.end() - 1);
+  for (int chunk = 0; chunk < numChunks; ++chunk) {
+    for (int p = chunkVertices.offsets[toIndex(chunk)]; p < chunkVertices.offsets[toIndex(chunk) + 1]; ++p) {
+      const int v = chunkVertices.items[toIndex(p)];
+      vertexChunks.items[toIndex(fill[toIndex(v)]++)] = chunk;
+    }
+  }
+  return vertexChunks;
+}
+
 // Chunk colouring: chunks of chunkSize consecutive elements; greedy, smallest colour not
 // used by an earlier chunk sharing a vertex. Returns the colour of every chunk.
 std::vector<int> colorChunks(const Eigen::Matrix4Xi& elements, int numVertices, int chunkSize, int* numColors) {
-  const int numElements = static_cast<int>(elements.cols());
-  const int numChunks = (numElements + chunkSize - 1) / chunkSize;
-  // Distinct vertices of every chunk (CSR).
-  std::vector<int> chunkVertexOffsets(toIndex(numChunks) + 1, 0);
-  std::vector<int> chunkVertices(toIndex(numElements) * 4);
-  {
-    std::vector<int> stamp(toIndex(numVertices), -1);
-    int written = 0;
-    for (int chunk = 0; chunk < numChunks; ++chunk) {
-      chunkVertexOffsets[toIndex(chunk)] = written;
-      const Index first = toIndex(chunk * chunkSize) * 4;
-      const Index last = toIndex(std::min(numElements, (chunk + 1) * chunkSize)) * 4;
-      for (Index k = first; k < last; ++k) {
-        const int v = elements.data()[k];
-        if (stamp[toIndex(v)] == chunk) continue;
-        stamp[toIndex(v)] = chunk;
-        chunkVertices[toIndex(written++)] = v;
-      }
-    }
-    chunkVertexOffsets[toIndex(numChunks)] = written;
-    chunkVertices.resize(toIndex(written));
-  }
-  // Transpose: the chunks touching every vertex, ascending.
-  std::vector<int> vertexChunkOffsets(toIndex(numVertices) + 1, 0);
-  for (int v : chunkVertices) ++vertexChunkOffsets[toIndex(v)];
-  exclusiveScan(vertexChunkOffsets);
-  std::vector<int> vertexChunks(chunkVertices.size());
-  {
-    std::vector<int> fill(vertexChunkOffsets.begin(), vertexChunkOffsets.end() - 1);
-    for (int chunk = 0; chunk < numChunks; ++chunk) {
-      for (int p = chunkVertexOffsets[toIndex(chunk)]; p < chunkVertexOffsets[toIndex(chunk) + 1]; ++p) {
-        const int v = chunkVertices[toIndex(p)];
-        vertexChunks[toIndex(fill[toIndex(v)]++)] = chunk;
-      }
-    }
-  }
+  const CompressedRows chunkVertices = chunkVertexSets(elements, numVertices, chunkSize);
+  const CompressedRows vertexChunks = vertexChunkSets(chunkVertices, numVertices);
+  const int numChunks = static_cast<int>(chunkVertices.offsets.size()) - 1;
   std::vector<int> colors(toIndex(numChunks), -1);
   std::vector<int> forbiddenBy;  // forbiddenBy[c] == chunk: colour c is taken by a neighbour of chunk
   int colorCount = 0;
   for (int chunk = 0; chunk < numChunks; ++chunk) {
-    for (int p = chunkVertexOffsets[toIndex(chunk)]; p < chunkVertexOffsets[toIndex(chunk) + 1]; ++p) {
-      const int v = chunkVertices[toIndex(p)];
-      for (int q = vertexChunkOffsets[toIndex(v)]; q < vertexChunkOffsets[toIndex(v) + 1]; ++q) {
-        const int other = vertexChunks[toIndex(q)];
+    for (int p = chunkVertices.offsets[toIndex(chunk)]; p < chunkVertices.offsets[toIndex(chunk) + 1]; ++p) {
+      const int v = chunkVertices.items[toIndex(p)];
+      for (int q = vertexChunks.offsets[toIndex(v)]; q < vertexChunks.offsets[toIndex(v) + 1]; ++q) {
+        const int other = vertexChunks.items[toIndex(q)];
         if (other >= chunk) break;  // ascending: the rest are not coloured yet
         forbiddenBy[toIndex(colors[toIndex(other)])] = chunk;
       }
@@ -103,65 +117,70 @@ std::vector<int> colorChunks(const Eigen::Matrix4Xi& elements, int numVertices, 
   return colors;
 }
 
-}  // namespace
+// Incident (element, local vertex) pairs of every vertex, encoded 4 e + b, ascending in
+// e: counting sort, two passes.
+CompressedRows vertexIncidences(const Eigen::Matrix4Xi& elements, int numVertices) {
+  const int numElements = static_cast<int>(elements.cols());
+  CompressedRows incidences{std::vector<int>(toIndex(numVertices) + 1, 0), std::vector<int>(toIndex(numElements) * 4)};
+  for (Index k = 0; k < toIndex(numElements) * 4; ++k) ++incidences.offsets[toIndex(elements.data()[k])];
+  exclusiveScan(incidences.offsets);
+  std::vector<int> fill(incidences.offsets.begin(), incidences.offsets.end() - 1);
+  for (int k = 0; k < numElements * 4; ++k) incidences.items[toIndex(fill[toIndex(elements.data()[k])]++)] = k;
+  return incidences;
+}
 
-MatrixAssembler::MatrixAssembler(const TetMesh& mesh)
-    : numDofs_(mesh.numDofs()), numElements_(mesh.numElements()), elements_(mesh.elements()) {
-  const int numVertices = mesh.numVertices();
-  const Index vertexCount = toIndex(numVertices);
-
-  // Incident (element, local vertex) pairs of every vertex, encoded 4 e + b, ascending
-  // in e: counting sort, two passes.
-  std::vector<int> incidenceOffsets(vertexCount + 1, 0);
-  for (Index k = 0; k < toIndex(numElements_) * 4; ++k) ++incidenceOffsets[toIndex(elements_.data()[k])];
-  exclusiveScan(incidenceOffsets);
-  std::vector<int> incidences(toIndex(numElements_) * 4);
-  {
-    std::vector<int> fill(incidenceOffsets.begin(), incidenceOffsets.end() - 1);
-    for (int k = 0; k < numElements_ * 4; ++k) incidences[toIndex(fill[toIndex(elements_.data()[k])]++)] = k;
-  }
-
-  // Row vertices of column vertex v: v itself (so that every diagonal block is in the
-  // pattern, even for a vertex no element uses) and the vertices of its elements. Pass 1
-  // counts them, pass 2 writes them sorted and, through a vertex -> position map, the
-  // block slots of every incident element. Per-thread stamp and position arrays replace
-  // sets and searches.
-  const int* elementVertices = elements_.data();
-  // Appends the row vertices of column vertex v to rows (cleared first), unsorted;
-  // stamp[u] == v marks u as seen.
-  const auto collectRows = [&](int v, std::vector<int>& stamp, std::vector<int>& rows) {
-    rows.clear();
-    stamp[toIndex(v)] = v;
-    rows.push_back(v);
-    for (int p = incidenceOffsets[toIndex(v)]; p < incidenceOffsets[toIndex(v) + 1]; ++p) {
-      const Index e = toIndex(incidences[toIndex(p)] / 4);
-      for (Index a = 0; a < 4; ++a) {
-        const int u = elementVertices[(4 * e) + a];
-        if (stamp[toIndex(u)] != v) {
-          stamp[toIndex(u)] = v;
-          rows.push_back(u);
-        }
+// Row vertices of column vertex v: v itself (so that every diagonal block is in the
+// pattern, even for a vertex no element uses) and the vertices of its elements, appended
+// to rows (cleared first) unsorted; stamp[u] == v marks u as seen.
+inline void collectRows(int v, const CompressedRows& incidences, const int* elementVertices, std::vector<int>& stamp,
+                        std::vector<int>& rows) {
+  rows.clear();
+  stamp[toIndex(v)] = v;
+  rows.push_back(v);
+  for (int p = incidences.offsets[toIndex(v)]; p < incidences.offsets[toIndex(v) + 1]; ++p) {
+    const Index e = toIndex(incidences.items[toIndex(p)] / 4);
+    for (Index a = 0; a < 4; ++a) {
+      const int u = elementVertices[(4 * e) + a];
+      if (stamp[toIndex(u)] != v) {
+        stamp[toIndex(u)] = v;
+        rows.push_back(u);
       }
     }
-  };
-  blockOuter_.assign(vertexCount + 1, 0);
+  }
+}
+
+// Pattern pass 1: blockOuter[v] = the number of row vertices of column vertex v, then
+// the exclusive prefix sum; returns the number of vertex blocks. Per-thread stamp
+// arrays replace sets and searches.
+long long countBlockRows(const CompressedRows& incidences, const int* elementVertices, int numVertices,
+                         std::vector<int>& blockOuter) {
+  const Index vertexCount = toIndex(numVertices);
+  blockOuter.assign(vertexCount + 1, 0);
 #pragma omp parallel
   {
     std::vector<int> stamp(vertexCount, -1);
     std::vector<int> rows;
 #pragma omp for schedule(static)
     for (int v = 0; v < numVertices; ++v) {
-      collectRows(v, stamp, rows);
-      blockOuter_[toIndex(v)] = static_cast<int>(rows.size());
+      collectRows(v, incidences, elementVertices, stamp, rows);
+      blockOuter[toIndex(v)] = static_cast<int>(rows.size());
     }
   }
-  const long long blockCount = exclusiveScan(blockOuter_);
+  const long long blockCount = exclusiveScan(blockOuter);
   if (9 * blockCount > INT_MAX) {
     throw Error("MatrixAssembler: the pattern has " + std::to_string(9 * blockCount) +
                 " entries, more than int indices can address");
   }
-  blockRows_.resize(static_cast<Index>(blockCount));
-  blockSlots_.resize(toIndex(numElements_) * 16);
+  return blockCount;
+}
+
+// Pattern pass 2: writes the sorted row vertices of every column vertex into blockRows
+// and, through a vertex -> position map, the block slots (valuePtr() offsets) of every
+// incident element into blockSlots (numElements * 16, at e * 16 + b * 4 + a).
+void writeBlockRowsAndSlots(const CompressedRows& incidences, const int* elementVertices, int numVertices,
+                            const std::vector<int>& blockOuter, std::vector<int>& blockRows,
+                            std::vector<int>& blockSlots) {
+  const Index vertexCount = toIndex(numVertices);
 #pragma omp parallel
   {
     std::vector<int> stamp(vertexCount, -1);
@@ -169,48 +188,135 @@ MatrixAssembler::MatrixAssembler(const TetMesh& mesh)
     std::vector<int> rows;
 #pragma omp for schedule(static)
     for (int v = 0; v < numVertices; ++v) {
-      collectRows(v, stamp, rows);
+      collectRows(v, incidences, elementVertices, stamp, rows);
       std::sort(rows.begin(), rows.end());
-      const int begin = blockOuter_[toIndex(v)];
+      const int begin = blockOuter[toIndex(v)];
       for (std::size_t p = 0; p < rows.size(); ++p) {
-        blockRows_[toIndex(begin) + p] = rows[p];
+        blockRows[toIndex(begin) + p] = rows[p];
         position[toIndex(rows[p])] = static_cast<int>(p);
       }
-      // Scalar column 3 v starts at 9 * blockOuter_[v]; block row p starts 3 p below.
-      for (int p = incidenceOffsets[toIndex(v)]; p < incidenceOffsets[toIndex(v) + 1]; ++p) {
-        const Index e = toIndex(incidences[toIndex(p)] / 4);
-        const Index b = toIndex(incidences[toIndex(p)] % 4);
+      // Scalar column 3 v starts at 9 * blockOuter[v]; block row p starts 3 p below.
+      for (int p = incidences.offsets[toIndex(v)]; p < incidences.offsets[toIndex(v) + 1]; ++p) {
+        const Index e = toIndex(incidences.items[toIndex(p)] / 4);
+        const Index b = toIndex(incidences.items[toIndex(p)] % 4);
         for (Index a = 0; a < 4; ++a) {
           const int u = elementVertices[(4 * e) + a];
-          blockSlots_[(e * 16) + (b * 4) + a] = (9 * begin) + (3 * position[toIndex(u)]);
+          blockSlots[(e * 16) + (b * 4) + a] = (9 * begin) + (3 * position[toIndex(u)]);
         }
       }
     }
   }
-  incidences = std::vector<int>();
-  incidenceOffsets = std::vector<int>();
+}
 
-  // Scheduling: colour chunks of consecutive elements (good locality within a chunk);
-  // shrink the chunks until every colour has enough of them to keep threads busy. The
-  // result depends on the mesh only, never on the thread count.
-  int chunkSize = std::max(1, std::min(256, numElements_ / 64));
-  std::vector<int> colors;
-  int numColors = 0;
+// Chunk colouring of the scheduling: chunks of consecutive elements (good locality
+// within a chunk), shrunk until every colour has enough of them to keep threads busy.
+// Returns the colour of every chunk and sets chunkSize and numColors. The result depends
+// on the mesh only, never on the thread count.
+std::vector<int> chooseChunkColoring(const Eigen::Matrix4Xi& elements, int numVertices, int* chunkSize,
+                                     int* numColors) {
+  const int numElements = static_cast<int>(elements.cols());
+  *chunkSize = std::max(1, std::min(256, numElements / 64));
   while (true) {
-    colors = colorChunks(elements_, numVertices, chunkSize, &numColors);
+    std::vector<int> colors = colorChunks(elements, numVertices, *chunkSize, numColors);
     const int numChunks = static_cast<int>(colors.size());
-    if (chunkSize == 1 || numChunks >= 16 * numColors) break;
-    chunkSize = std::max(1, chunkSize / 4);
+    if (*chunkSize == 1 || numChunks >= 16 * *numColors) return colors;
+    *chunkSize = std::max(1, *chunkSize / 4);
   }
-  chunkSize_ = chunkSize;
-  colorOffsets_.assign(toIndex(numColors) + 1, 0);
-  for (int c : colors) ++colorOffsets_[toIndex(c)];
-  exclusiveScan(colorOffsets_);
-  coloredChunks_.resize(colors.size());
-  std::vector<int> fill(colorOffsets_.begin(), colorOffsets_.end() - 1);
+}
+
+// Counting sort of the chunks by colour: colour c holds
+// coloredChunks[colorOffsets[c] .. colorOffsets[c+1]), ascending.
+void groupChunksByColor(const std::vector<int>& colors, int numColors, std::vector<int>& colorOffsets,
+                        std::vector<int>& coloredChunks) {
+  colorOffsets.assign(toIndex(numColors) + 1, 0);
+  for (int c : colors) ++colorOffsets[toIndex(c)];
+  exclusiveScan(colorOffsets);
+  coloredChunks.resize(colors.size());
+  std::vector<int> fill(colorOffsets.begin(), colorOffsets.end() - 1);
   for (int chunk = 0; chunk < static_cast<int>(colors.size()); ++chunk) {
-    coloredChunks_[toIndex(fill[toIndex(colors[toIndex(chunk)])]++)] = chunk;
+    coloredChunks[toIndex(fill[toIndex(colors[toIndex(chunk)])]++)] = chunk;
   }
+}
+
+// The exception of the lowest failing element of a parallel loop: exceptions may not
+// leave a parallel region, and keeping the lowest element's one makes the error reported
+// independent of the thread count and the schedule.
+class FirstElementError {
+ public:
+  // Keeps the exception in flight if element e is below every earlier failing element.
+  void record(int e) {
+#pragma omp critical(asyncfem_assembler_error)
+    {
+      if (e < element_) {
+        element_ = e;
+        error_ = std::current_exception();
+      }
+    }
+  }
+  // Rethrows the kept exception, if any.
+  void rethrowIfAny() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  std::exception_ptr error_;
+  int element_ = INT_MAX;
+};
+
+// Element schedule of an assembler: chunks of chunkSize consecutive elements grouped by
+// colour (see MatrixAssembler's members of the same names).
+struct ColoredChunkSchedule {
+  const std::vector<int>& colorOffsets;
+  const std::vector<int>& coloredChunks;
+  int chunkSize;
+  int numElements;
+};
+
+// Inside a parallel region: computes compute(e, local) and then scatter(e, local) for
+// every element, colours in order and the chunks of one colour shared among the threads.
+// Chunks of one colour share no vertex, so no two threads write the same value and every
+// entry receives its contributions in the same order whatever the thread count. An
+// element whose compute throws is recorded in errors and not scattered; all elements are
+// still visited.
+template <class Local, class Compute, class Scatter>
+inline void forEachElementByColor(const ColoredChunkSchedule& schedule, const Compute& compute, const Scatter& scatter,
+                                  FirstElementError& errors) {
+  const int numColors = static_cast<int>(schedule.colorOffsets.size()) - 1;
+  for (int color = 0; color < numColors; ++color) {
+#pragma omp for schedule(dynamic, 1)
+    for (int k = schedule.colorOffsets[toIndex(color)]; k < schedule.colorOffsets[toIndex(color) + 1]; ++k) {
+      const int chunk = schedule.coloredChunks[toIndex(k)];
+      const int first = chunk * schedule.chunkSize;
+      const int last = std::min(schedule.numElements, first + schedule.chunkSize);
+      Local local;
+      for (int e = first; e < last; ++e) {
+        try {
+          compute(e, local);
+        } catch (...) {
+          errors.record(e);
+          continue;
+        }
+        scatter(e, local);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+MatrixAssembler::MatrixAssembler(const TetMesh& mesh)
+    : numDofs_(mesh.numDofs()), numElements_(mesh.numElements()), elements_(mesh.elements()) {
+  const int numVertices = mesh.numVertices();
+  {
+    const CompressedRows incidences = vertexIncidences(elements_, numVertices);
+    const long long blockCount = countBlockRows(incidences, elements_.data(), numVertices, blockOuter_);
+    blockRows_.resize(static_cast<Index>(blockCount));
+    blockSlots_.resize(toIndex(numElements_) * 16);
+    writeBlockRowsAndSlots(incidences, elements_.data(), numVertices, blockOuter_, blockRows_, blockSlots_);
+  }
+  int numColors = 0;
+  const std::vector<int> colors = chooseChunkColoring(elements_, numVertices, &chunkSize_, &numColors);
+  groupChunksByColor(colors, numColors, colorOffsets_, coloredChunks_);
 }
 
 Eigen::Index MatrixAssembler::nonZeros() const {
@@ -270,56 +376,31 @@ void MatrixAssembler::assembleWith(const ElementFunction& elementMatrix, Eigen::
   checkPattern(matrix, "assemble");
   double* values = matrix.valuePtr();
   const Eigen::Index nnz = matrix.nonZeros();
-  const int numColors = this->numColors();
-  // Exceptions may not leave a parallel region: keep the one of the lowest failing
-  // element (all elements are still visited) so that the error reported does not depend
-  // on the thread count or the schedule.
-  std::exception_ptr firstError;
-  int firstErrorElement = INT_MAX;
+  const ColoredChunkSchedule schedule{colorOffsets_, coloredChunks_, chunkSize_, numElements_};
+  // Adds the element's 4x4 vertex blocks at their slots; a column of a block is
+  // columnLength values before the next.
+  const auto scatter = [&](int e, const ElementMatrix& local) {
+    const int* slots = blockSlots_.data() + (toIndex(e) * 16);
+    for (int b = 0; b < 4; ++b) {
+      const Index columnVertex = toIndex(elements_(b, e));
+      const int columnLength = 3 * (blockOuter_[columnVertex + 1] - blockOuter_[columnVertex]);
+      for (int a = 0; a < 4; ++a) {
+        double* block = values + slots[(b * 4) + a];
+        for (int cj = 0; cj < 3; ++cj) {
+          double* column = block + (cj * columnLength);
+          for (int ci = 0; ci < 3; ++ci) column[ci] += local((3 * a) + ci, (3 * b) + cj);
+        }
+      }
+    }
+  };
+  FirstElementError errors;
 #pragma omp parallel if (numElements_ >= kMinElementsForThreads)
   {
 #pragma omp for schedule(static)
     for (Eigen::Index k = 0; k < nnz; ++k) values[k] = 0.0;
-    // Colours in order, the chunks of one colour in parallel; chunks of one colour share
-    // no vertex, so no two threads write the same value and every entry receives its
-    // contributions in the same order whatever the thread count.
-    for (int color = 0; color < numColors; ++color) {
-#pragma omp for schedule(dynamic, 1)
-      for (int k = colorOffsets_[toIndex(color)]; k < colorOffsets_[toIndex(color) + 1]; ++k) {
-        const int chunk = coloredChunks_[toIndex(k)];
-        const int first = chunk * chunkSize_;
-        const int last = std::min(numElements_, first + chunkSize_);
-        ElementMatrix local;
-        for (int e = first; e < last; ++e) {
-          try {
-            elementMatrix(e, local);
-          } catch (...) {
-#pragma omp critical(asyncfem_assembler_error)
-            {
-              if (e < firstErrorElement) {
-                firstErrorElement = e;
-                firstError = std::current_exception();
-              }
-            }
-            continue;
-          }
-          const int* slots = blockSlots_.data() + (toIndex(e) * 16);
-          for (int b = 0; b < 4; ++b) {
-            const Index columnVertex = toIndex(elements_(b, e));
-            const int columnLength = 3 * (blockOuter_[columnVertex + 1] - blockOuter_[columnVertex]);
-            for (int a = 0; a < 4; ++a) {
-              double* block = values + slots[(b * 4) + a];
-              for (int cj = 0; cj < 3; ++cj) {
-                double* column = block + (cj * columnLength);
-                for (int ci = 0; ci < 3; ++ci) column[ci] += local((3 * a) + ci, (3 * b) + cj);
-              }
-            }
-          }
-        }
-      }
-    }
+    forEachElementByColor<ElementMatrix>(schedule, elementMatrix, scatter, errors);
   }
-  if (firstError) std::rethrow_exception(firstError);
+  errors.rethrowIfAny();
 }
 
 void MatrixAssembler::assemble(const ElementMatrixFunction& elementMatrix, Eigen::SparseMatrix<double>& matrix) const {
@@ -338,40 +419,17 @@ void MatrixAssembler::assemble(const std::vector<ElementMatrix>& elementMatrices
 Eigen::VectorXd MatrixAssembler::assembleVector(const ElementVectorFunction& elementVector) const {
   Eigen::VectorXd result = Eigen::VectorXd::Zero(numDofs_);
   double* values = result.data();
-  const int numColors = this->numColors();
-  std::exception_ptr firstError;
-  int firstErrorElement = INT_MAX;
-#pragma omp parallel if (numElements_ >= kMinElementsForThreads)
-  {
-    for (int color = 0; color < numColors; ++color) {
-#pragma omp for schedule(dynamic, 1)
-      for (int k = colorOffsets_[toIndex(color)]; k < colorOffsets_[toIndex(color) + 1]; ++k) {
-        const int chunk = coloredChunks_[toIndex(k)];
-        const int first = chunk * chunkSize_;
-        const int last = std::min(numElements_, first + chunkSize_);
-        ElementVector local;
-        for (int e = first; e < last; ++e) {
-          try {
-            elementVector(e, local);
-          } catch (...) {
-#pragma omp critical(asyncfem_assembler_error)
-            {
-              if (e < firstErrorElement) {
-                firstErrorElement = e;
-                firstError = std::current_exception();
-              }
-            }
-            continue;
-          }
-          for (int a = 0; a < 4; ++a) {
-            double* vertexValues = values + (3 * toIndex(elements_(a, e)));
-            for (int c = 0; c < 3; ++c) vertexValues[c] += local((3 * a) + c);
-          }
-        }
-      }
+  const ColoredChunkSchedule schedule{colorOffsets_, coloredChunks_, chunkSize_, numElements_};
+  const auto scatter = [&](int e, const ElementVector& local) {
+    for (int a = 0; a < 4; ++a) {
+      double* vertexValues = values + (3 * toIndex(elements_(a, e)));
+      for (int c = 0; c < 3; ++c) vertexValues[c] += local((3 * a) + c);
     }
-  }
-  if (firstError) std::rethrow_exception(firstError);
+  };
+  FirstElementError errors;
+#pragma omp parallel if (numElements_ >= kMinElementsForThreads)
+  forEachElementByColor<ElementVector>(schedule, elementVector, scatter, errors);
+  errors.rethrowIfAny();
   return result;
 }
 

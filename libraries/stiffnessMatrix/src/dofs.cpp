@@ -27,6 +27,31 @@ void checkIndexList(const std::vector<int>& indices, Eigen::Index size, const ch
   }
 }
 
+// End of column c's stored entries in valuePtr() order (also for an uncompressed matrix).
+inline int columnEnd(const Eigen::SparseMatrix<double>& matrix, int c) {
+  const int* innerNonZeros = matrix.innerNonZeroPtr();  // null when compressed
+  return innerNonZeros != nullptr ? matrix.outerIndexPtr()[c] + innerNonZeros[c] : matrix.outerIndexPtr()[c + 1];
+}
+
+// Row map of a submatrix: entry r is the position of full row r in rows, -1 where r is
+// not kept.
+std::vector<int> subRowMap(const std::vector<int>& rows, Eigen::Index fullRows) {
+  std::vector<int> fullToSubRow(toIndex(static_cast<int>(fullRows)), -1);
+  for (std::size_t k = 0; k < rows.size(); ++k) fullToSubRow[toIndex(rows[k])] = static_cast<int>(k);
+  return fullToSubRow;
+}
+
+// Number of stored entries of full in columns cols whose row is kept by fullToSubRow.
+long long countKeptEntries(const Eigen::SparseMatrix<double>& full, const std::vector<int>& cols,
+                           const std::vector<int>& fullToSubRow) {
+  const int* inner = full.innerIndexPtr();
+  long long kept = 0;
+  for (int c : cols)
+    for (int p = full.outerIndexPtr()[c]; p < columnEnd(full, c); ++p)
+      kept += fullToSubRow[toIndex(inner[p])] >= 0 ? 1 : 0;
+  return kept;
+}
+
 }  // namespace
 
 FreeDofs::FreeDofs(int numDofs, const std::vector<int>& fixedDofs) {
@@ -85,20 +110,14 @@ SubmatrixExtractor::SubmatrixExtractor(const Eigen::SparseMatrix<double>& full, 
                                        const std::vector<int>& cols) {
   checkIndexList(rows, full.rows(), "row");
   checkIndexList(cols, full.cols(), "column");
-  std::vector<int> fullToSubRow(toIndex(static_cast<int>(full.rows())), -1);
-  for (std::size_t k = 0; k < rows.size(); ++k) fullToSubRow[toIndex(rows[k])] = static_cast<int>(k);
-
+  const std::vector<int> fullToSubRow = subRowMap(rows, full.rows());
   const int numSubCols = static_cast<int>(cols.size());
   const int* outer = full.outerIndexPtr();
-  const int* innerNonZeros = full.innerNonZeroPtr();  // null when compressed
   const int* inner = full.innerIndexPtr();
-  auto columnEnd = [&](int c) { return innerNonZeros != nullptr ? outer[c] + innerNonZeros[c] : outer[c + 1]; };
 
   // Two passes: count the kept entries of every column, then fill rows and sources. Rows
   // of full are sorted and the row map is increasing, so sub's rows come out sorted.
-  long long kept = 0;
-  for (int c : cols)
-    for (int p = outer[c]; p < columnEnd(c); ++p) kept += fullToSubRow[toIndex(inner[p])] >= 0 ? 1 : 0;
+  const long long kept = countKeptEntries(full, cols, fullToSubRow);
   pattern_.resize(static_cast<Eigen::Index>(rows.size()), numSubCols);
   pattern_.resizeNonZeros(static_cast<Eigen::Index>(kept));
   sourceSlots_.resize(static_cast<std::size_t>(kept));
@@ -108,7 +127,7 @@ SubmatrixExtractor::SubmatrixExtractor(const Eigen::SparseMatrix<double>& full, 
   for (int j = 0; j < numSubCols; ++j) {
     subOuter[j] = written;
     const int c = cols[toIndex(j)];
-    for (int p = outer[c]; p < columnEnd(c); ++p) {
+    for (int p = outer[c]; p < columnEnd(full, c); ++p) {
       const int subRow = fullToSubRow[toIndex(inner[p])];
       if (subRow < 0) continue;
       subInner[written] = subRow;

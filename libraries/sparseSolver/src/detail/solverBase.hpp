@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <memory>
 #include <string>
@@ -67,6 +68,19 @@ class SolverBase : public SparseSolver {
       throw Error(who + ": right-hand side has " + std::to_string(rhs.rows()) + " rows, the matrix has " +
                   std::to_string(signature_.rows) + " rows");
     }
+  }
+  /// Ends a successful factorize() timed by watch: the factor is usable; counts the
+  /// factorization and its seconds.
+  void endFactorize(Stopwatch& watch) {
+    factored_ = true;
+    ++stats_.factorizations;
+    stats_.factorSeconds += watch.stop();
+  }
+  /// Ends a successful solve() of `columns` right-hand sides timed by watch: counts them
+  /// and its seconds.
+  void endSolve(Eigen::Index columns, Stopwatch& watch) {
+    stats_.solvedRightHandSides += columns;
+    stats_.solveSeconds += watch.stop();
   }
 
   PatternSignature signature_;
