@@ -36,6 +36,12 @@ struct BoundingBox {
   Eigen::Vector3d min;
   Eigen::Vector3d max;
 };
+/// Corner i (0 <= i < 8) of box: bit 0 of i takes max.x instead of min.x, bit 1 max.y,
+/// bit 2 max.z.
+inline Eigen::Vector3d boxCorner(const BoundingBox& box, int i) {
+  return {(i & 1) != 0 ? box.max.x() : box.min.x(), (i & 2) != 0 ? box.max.y() : box.min.y(),
+          (i & 4) != 0 ? box.max.z() : box.min.z()};
+}
 /// Box of the rest positions (of positions + displacement if given, size 3n; other sizes
 /// throw ValidationError). Zero box for a mesh without vertices.
 BoundingBox boundingBox(const TetMesh& mesh, const Eigen::VectorXd& displacement = {});
