@@ -5,6 +5,7 @@
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 namespace asyncfem {
@@ -156,6 +157,23 @@ std::vector<ElementQuality> elementQualities(const TetMesh& mesh) {
   qualities.reserve(static_cast<std::size_t>(mesh.numElements()));
   for (int e = 0; e < mesh.numElements(); ++e) qualities.push_back(elementQuality(mesh, e));
   return qualities;
+}
+
+QualitySummary summarizeQuality(const TetMesh& mesh) {
+  QualitySummary s;
+  if (mesh.numElements() == 0) return s;
+  const double toDegrees = 180.0 / std::numbers::pi;
+  s.minDihedralDegrees = std::numeric_limits<double>::infinity();
+  double sum = 0.0;
+  for (const ElementQuality& q : elementQualities(mesh)) {
+    const double angle = q.minDihedralAngle * toDegrees;
+    s.minDihedralDegrees = std::min(s.minDihedralDegrees, angle);
+    s.maxDihedralDegrees = std::max(s.maxDihedralDegrees, angle);
+    sum += angle;
+    s.worstAspectRatio = std::max(s.worstAspectRatio, q.aspectRatio);
+  }
+  s.meanDihedralDegrees = sum / mesh.numElements();
+  return s;
 }
 
 std::vector<int> unusedVertices(const TetMesh& mesh) {

@@ -61,6 +61,18 @@ ElementQuality elementQuality(const TetMesh& mesh, int e);
 /// elementQuality for every element, in element order.
 std::vector<ElementQuality> elementQualities(const TetMesh& mesh);
 
+/// The spread of element quality over a mesh: the smallest, mean and largest of the
+/// elements' minimum dihedral angles (degrees) and the worst (largest) aspect ratio. All
+/// zero for a mesh without elements.
+struct QualitySummary {
+  double minDihedralDegrees = 0.0;   ///< smallest min dihedral angle over elements
+  double meanDihedralDegrees = 0.0;  ///< mean over elements of the min dihedral angle
+  double maxDihedralDegrees = 0.0;   ///< largest min dihedral angle over elements
+  double worstAspectRatio = 0.0;
+};
+/// QualitySummary of elementQualities(mesh).
+QualitySummary summarizeQuality(const TetMesh& mesh);
+
 /// Vertices referenced by no element.
 std::vector<int> unusedVertices(const TetMesh& mesh);
 
