@@ -229,6 +229,39 @@ TEST_F(SimulationFileTest, CorruptedRecordNamesTheFrame) {
   }
 }
 
+TEST_F(SimulationFileTest, ScanReportsTheFirstBadRecordAndTheTimesBefore) {
+  const fs::path path = file("scan.afsim");
+  SimulationFileHeader header;
+  header.numVertices = 2;
+  header.frameInterval = 0.1;
+  {
+    SimulationWriter writer(path, header);
+    for (int k = 0; k < 4; ++k) {
+      writer.appendFrame(0.1 * (k + 1), sample(6, k));
+    }
+  }
+  {
+    SimulationReader reader(path);
+    const asyncfem::RecordScan scan = reader.scanRecords();
+    EXPECT_EQ(scan.goodFrames, 4);
+    EXPECT_FALSE(scan.badFrame.has_value());
+    EXPECT_EQ(scan.firstTime, 0.1);
+    EXPECT_EQ(scan.lastTime, 0.4);
+  }
+  std::vector<char> bytes = readBytes(path);
+  const std::size_t offset = 64 + (static_cast<std::size_t>(header.recordBytes()) * 2) + 20;
+  bytes[offset] = static_cast<char>(bytes[offset] ^ 0x10);
+  writeBytes(path, bytes);
+  SimulationReader reader(path);
+  const asyncfem::RecordScan scan = reader.scanRecords();
+  EXPECT_EQ(scan.goodFrames, 2);
+  ASSERT_TRUE(scan.badFrame.has_value());
+  EXPECT_EQ(*scan.badFrame, 2);
+  EXPECT_NE(scan.badMessage.find("frame 2"), std::string::npos) << scan.badMessage;
+  EXPECT_EQ(scan.firstTime, 0.1);
+  EXPECT_EQ(scan.lastTime, 0.2);
+}
+
 TEST_F(SimulationFileTest, BadMagicIsNamed) {
   const fs::path path = file("magic.afsim");
   writeBytes(path, std::vector<char>(200, 'x'));

@@ -215,4 +215,22 @@ void SimulationReader::verifyAll() {
   }
 }
 
+RecordScan SimulationReader::scanRecords() {
+  RecordScan scan;
+  SimulationFrame frame;
+  for (std::int64_t k = 0; k < numFrames_; ++k) {
+    try {
+      readFrame(k, frame);
+    } catch (const ParseError& error) {
+      scan.badFrame = k;
+      scan.badMessage = error.what();
+      break;
+    }
+    if (k == 0) scan.firstTime = frame.time;
+    scan.lastTime = frame.time;
+    scan.goodFrames = k + 1;
+  }
+  return scan;
+}
+
 }  // namespace asyncfem
