@@ -49,6 +49,18 @@ class SimulationFileTest : public ::testing::Test {
     return v;
   }
 
+  // Writes `frames` sample frames of numVertices vertices, frame k at time interval (k + 1).
+  static SimulationFileHeader writeSampleFrames(const fs::path& path, int numVertices, double interval, int frames) {
+    SimulationFileHeader header;
+    header.numVertices = numVertices;
+    header.frameInterval = interval;
+    SimulationWriter writer(path, header);
+    for (int k = 0; k < frames; ++k) {
+      writer.appendFrame(interval * (k + 1), sample(3 * numVertices, k));
+    }
+    return header;
+  }
+
   static std::vector<char> readBytes(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -162,15 +174,7 @@ TEST_F(SimulationFileTest, WriterTruncatesAnExistingFile) {
 
 TEST_F(SimulationFileTest, TruncatedLastFrameIsIgnoredAndReported) {
   const fs::path path = file("truncated.afsim");
-  SimulationFileHeader header;
-  header.numVertices = 4;
-  header.frameInterval = 0.25;
-  {
-    SimulationWriter writer(path, header);
-    for (int k = 0; k < 3; ++k) {
-      writer.appendFrame(0.25 * (k + 1), sample(12, k));
-    }
-  }
+  const SimulationFileHeader header = writeSampleFrames(path, 4, 0.25, 3);
   std::vector<char> bytes = readBytes(path);
   bytes.resize(bytes.size() - 17);  // cut into the last record
   writeBytes(path, bytes);
@@ -231,15 +235,7 @@ TEST_F(SimulationFileTest, CorruptedRecordNamesTheFrame) {
 
 TEST_F(SimulationFileTest, ScanReportsTheFirstBadRecordAndTheTimesBefore) {
   const fs::path path = file("scan.afsim");
-  SimulationFileHeader header;
-  header.numVertices = 2;
-  header.frameInterval = 0.1;
-  {
-    SimulationWriter writer(path, header);
-    for (int k = 0; k < 4; ++k) {
-      writer.appendFrame(0.1 * (k + 1), sample(6, k));
-    }
-  }
+  const SimulationFileHeader header = writeSampleFrames(path, 2, 0.1, 4);
   {
     SimulationReader reader(path);
     const asyncfem::RecordScan scan = reader.scanRecords();
