@@ -219,7 +219,7 @@ Eigen::VectorXd RotationStrainWarping::warp(const Eigen::Ref<const Eigen::Vector
 
 /// F_e = exp([omega_e]x) (I + S_e) of every element; its contribution V_e (F_e - I) grad N_a
 /// to the right-hand side goes to elementRightHandSides_.
-void RotationStrainWarping::elementPass(const Eigen::Ref<const Eigen::Matrix3Xd>& u) {
+void RotationStrainWarping::elementPass(const Eigen::Map<const Eigen::Matrix3Xd>& u) {
   // Threads only pay off beyond a few thousand elements (a parallel region costs about
   // as much as 1000 elements here, and far more when the cores are oversubscribed).
 #pragma omp parallel for schedule(static) if (numElements_ >= kParallelThreshold)
@@ -241,7 +241,7 @@ void RotationStrainWarping::elementPass(const Eigen::Ref<const Eigen::Matrix3Xd>
 
 /// Gathers b at the unknown vertices into rightHandSide_ and moves the constrained values
 /// to the right side.
-void RotationStrainWarping::gatherRightHandSide(const Eigen::Ref<const Eigen::Matrix3Xd>& u) {
+void RotationStrainWarping::gatherRightHandSide(const Eigen::Map<const Eigen::Matrix3Xd>& u) {
   const auto numUnknown = static_cast<Eigen::Index>(unknownVertices_.size());
   const auto numConstrained = static_cast<Eigen::Index>(constrainedVertices_.size());
   rightHandSide_.resize(numUnknown, 3);
@@ -265,7 +265,7 @@ void RotationStrainWarping::gatherRightHandSide(const Eigen::Ref<const Eigen::Ma
 
 /// Translation-free (pinned) components: shifted to match the mean displacement of the
 /// linear input.
-void RotationStrainWarping::shiftPinnedComponents(const Eigen::Ref<const Eigen::Matrix3Xd>& u,
+void RotationStrainWarping::shiftPinnedComponents(const Eigen::Map<const Eigen::Matrix3Xd>& u,
                                                   Eigen::VectorXd& warped) const {
   for (std::size_t c = 0; c < componentVertices_.size(); ++c) {
     if (!componentPinned_[c]) {

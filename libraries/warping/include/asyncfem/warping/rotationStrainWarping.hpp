@@ -77,9 +77,9 @@ class RotationStrainWarping final : public Warping {
                        SolverKind solverKind);
   void buildGatherMap(const TetMesh& mesh);
   /// Stages of warp() for the displacement u (3 x n).
-  void elementPass(const Eigen::Ref<const Eigen::Matrix3Xd>& u);
-  void gatherRightHandSide(const Eigen::Ref<const Eigen::Matrix3Xd>& u);
-  void shiftPinnedComponents(const Eigen::Ref<const Eigen::Matrix3Xd>& u, Eigen::VectorXd& warped) const;
+  void elementPass(const Eigen::Map<const Eigen::Matrix3Xd>& u);
+  void gatherRightHandSide(const Eigen::Map<const Eigen::Matrix3Xd>& u);
+  void shiftPinnedComponents(const Eigen::Map<const Eigen::Matrix3Xd>& u, Eigen::VectorXd& warped) const;
 
   int numVertices_ = 0;
   int numElements_ = 0;
