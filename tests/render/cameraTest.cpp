@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// fitCamera and projectToPixel.
+// fitCamera, projectToPixel and groundBelow.
 #include <gtest/gtest.h>
 
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/render/camera.hpp>
+#include <asyncfem/render/renderer.hpp>
 
 namespace {
 
@@ -30,10 +31,7 @@ TEST(Camera, FittedCameraShowsEveryCornerWithTheMargin) {
     const Camera camera = fitCamera(box, aspect);
     double worst = 0.0;
     for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3d c((corner & 1) != 0 ? box.max.x() : box.min.x(),
-                              (corner & 2) != 0 ? box.max.y() : box.min.y(),
-                              (corner & 4) != 0 ? box.max.z() : box.min.z());
-      const Eigen::Vector2d p = projectToPixel(camera, width, height, c);
+      const Eigen::Vector2d p = projectToPixel(camera, width, height, boxCorner(box, corner));
       // Normalised distance from the centre: 1 at the border, 0.92 at the margin.
       const double u = std::abs(p.x() - (0.5 * width)) / (0.5 * width);
       const double v = std::abs(p.y() - (0.5 * height)) / (0.5 * height);
@@ -44,6 +42,25 @@ TEST(Camera, FittedCameraShowsEveryCornerWithTheMargin) {
     EXPECT_NEAR(worst, 0.92, 1e-9) << "aspect " << aspect;  // tight: some corner on the margin
   }
   EXPECT_THROW(fitCamera(box, 1.0, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitY()), Error);
+}
+
+TEST(GroundPlane, LiesJustBelowTheLowestCornerAlongUp) {
+  // Diagonal 3 (sides 1, 2, 2): the plane sits 0.06 below the lowest corner, tiles near
+  // 3/6 = 0.5 round to 0.5, and the plane reaches 4 diagonals to each side.
+  const BoundingBox box{Eigen::Vector3d(-1.0, 0.5, 0.0), Eigen::Vector3d(0.0, 2.5, 2.0)};
+  const GroundPlane yUp = groundBelow(box, Eigen::Vector3d(0.0, 2.0, 0.0));
+  EXPECT_NEAR(yUp.center.y(), 0.5 - 0.06, 1e-12);
+  EXPECT_NEAR(yUp.center.x(), -0.5, 1e-12);
+  EXPECT_NEAR(yUp.center.z(), 1.0, 1e-12);
+  EXPECT_NEAR(yUp.halfSize, 12.0, 1e-12);
+  EXPECT_NEAR(yUp.tileSize, 0.5, 1e-12);
+  EXPECT_TRUE(yUp.shadow);
+  // Up along -z: the lowest corner is the one with the largest z.
+  const GroundPlane zDown = groundBelow(box, Eigen::Vector3d(0.0, 0.0, -1.0));
+  EXPECT_NEAR(zDown.center.z(), 2.0 + 0.06, 1e-12);
+  // Tile sizes are 1, 2 or 5 times a power of ten.
+  const BoundingBox small{Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, 0.09)};
+  EXPECT_NEAR(groundBelow(small, Eigen::Vector3d::UnitY()).tileSize, 0.02, 1e-15);  // 0.09 / 6 = 0.015
 }
 
 }  // namespace

@@ -49,6 +49,18 @@ class SimulationFileTest : public ::testing::Test {
     return v;
   }
 
+  // Writes `frames` sample frames of numVertices vertices, frame k at time interval (k + 1).
+  static SimulationFileHeader writeSampleFrames(const fs::path& path, int numVertices, double interval, int frames) {
+    SimulationFileHeader header;
+    header.numVertices = numVertices;
+    header.frameInterval = interval;
+    SimulationWriter writer(path, header);
+    for (int k = 0; k < frames; ++k) {
+      writer.appendFrame(interval * (k + 1), sample(3 * numVertices, k));
+    }
+    return header;
+  }
+
   static std::vector<char> readBytes(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -162,15 +174,7 @@ TEST_F(SimulationFileTest, WriterTruncatesAnExistingFile) {
 
 TEST_F(SimulationFileTest, TruncatedLastFrameIsIgnoredAndReported) {
   const fs::path path = file("truncated.afsim");
-  SimulationFileHeader header;
-  header.numVertices = 4;
-  header.frameInterval = 0.25;
-  {
-    SimulationWriter writer(path, header);
-    for (int k = 0; k < 3; ++k) {
-      writer.appendFrame(0.25 * (k + 1), sample(12, k));
-    }
-  }
+  const SimulationFileHeader header = writeSampleFrames(path, 4, 0.25, 3);
   std::vector<char> bytes = readBytes(path);
   bytes.resize(bytes.size() - 17);  // cut into the last record
   writeBytes(path, bytes);
@@ -227,6 +231,31 @@ TEST_F(SimulationFileTest, CorruptedRecordNamesTheFrame) {
     EXPECT_NE(message.find("checksum"), std::string::npos) << message;
     EXPECT_NE(message.find(path.string()), std::string::npos) << message;
   }
+}
+
+TEST_F(SimulationFileTest, ScanReportsTheFirstBadRecordAndTheTimesBefore) {
+  const fs::path path = file("scan.afsim");
+  const SimulationFileHeader header = writeSampleFrames(path, 2, 0.1, 4);
+  {
+    SimulationReader reader(path);
+    const asyncfem::RecordScan scan = reader.scanRecords();
+    EXPECT_EQ(scan.goodFrames, 4);
+    EXPECT_FALSE(scan.badFrame.has_value());
+    EXPECT_EQ(scan.firstTime, 0.1);
+    EXPECT_EQ(scan.lastTime, 0.4);
+  }
+  std::vector<char> bytes = readBytes(path);
+  const std::size_t offset = 64 + (static_cast<std::size_t>(header.recordBytes()) * 2) + 20;
+  bytes[offset] = static_cast<char>(bytes[offset] ^ 0x10);
+  writeBytes(path, bytes);
+  SimulationReader reader(path);
+  const asyncfem::RecordScan scan = reader.scanRecords();
+  EXPECT_EQ(scan.goodFrames, 2);
+  ASSERT_TRUE(scan.badFrame.has_value());
+  EXPECT_EQ(*scan.badFrame, 2);
+  EXPECT_NE(scan.badMessage.find("frame 2"), std::string::npos) << scan.badMessage;
+  EXPECT_EQ(scan.firstTime, 0.1);
+  EXPECT_EQ(scan.lastTime, 0.2);
 }
 
 TEST_F(SimulationFileTest, BadMagicIsNamed) {

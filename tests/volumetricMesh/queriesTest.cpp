@@ -167,6 +167,29 @@ TEST(MeshQueries, FlattenedTetHasWorseQuality) {
   EXPECT_GT(q.maxDihedralAngle, 3.0);
 }
 
+TEST(MeshQueries, QualitySummarySpansTheElements) {
+  // The regular tet and a flattened one: the minimum and maximum of the elements' minimum
+  // dihedral angles are the two elements' own, the mean lies halfway, the aspect ratio is
+  // the flattened one's. Tolerances: a few ulps of the per-element values.
+  Eigen::Matrix3Xd x(3, 8);
+  x << 1, 1, -1, -1, 10, 11, 10, 10.3,  //
+      1, -1, 1, -1, 0, 0, 1, 0.3,       //
+      1, -1, -1, 1, 0, 0, 0, 0.01;
+  Eigen::Matrix4Xi t(4, 2);
+  t << 0, 4, 1, 5, 2, 6, 3, 7;
+  const TetMesh mesh(x, t, {Material{"m", 1, 1, 0}}, {0, 0});
+  const std::vector<ElementQuality> each = elementQualities(mesh);
+  const double toDegrees = 180.0 / std::acos(-1.0);
+  const QualitySummary s = summarizeQuality(mesh);
+  EXPECT_NEAR(s.maxDihedralDegrees, std::acos(1.0 / 3.0) * toDegrees, 1e-12);
+  EXPECT_NEAR(s.minDihedralDegrees, each[1].minDihedralAngle * toDegrees, 1e-12);
+  EXPECT_NEAR(s.meanDihedralDegrees, 0.5 * (s.minDihedralDegrees + s.maxDihedralDegrees), 1e-12);
+  EXPECT_DOUBLE_EQ(s.worstAspectRatio, each[1].aspectRatio);
+  const QualitySummary none = summarizeQuality(TetMesh());
+  EXPECT_EQ(none.minDihedralDegrees, 0.0);
+  EXPECT_EQ(none.worstAspectRatio, 0.0);
+}
+
 TEST(MeshQueries, UnusedVertices) {
   Eigen::Matrix3Xd x(3, 5);
   x << 0, 1, 0, 0, 5, 0, 0, 1, 0, 5, 0, 0, 0, 1, 5;

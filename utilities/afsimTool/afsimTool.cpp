@@ -116,66 +116,76 @@ std::optional<TetMesh> loadMesh(const CommandLine& options, const SimulationRead
   return mesh;
 }
 
-int info(const CommandLine& options) {
-  const auto reader = openSimulation(options.simulation);
-  const SimulationFileHeader& header = reader->header();
-  std::cout << "file        " << options.simulation << " (" << fs::file_size(options.simulation) << " bytes)\n"
+/// The header lines of info: file, format, scene, sizes, frame rate, record size.
+void printHeader(const std::string& simulation, const SimulationReader& reader) {
+  const SimulationFileHeader& header = reader.header();
+  std::cout << "file        " << simulation << " (" << fs::file_size(simulation) << " bytes)\n"
             << "format      AsyncFEM simulation file, version " << (header.scenePath.empty() ? 1 : 2) << '\n';
   if (!header.scenePath.empty()) {
     char fingerprint[16];
     std::snprintf(fingerprint, sizeof(fingerprint), "%08x", header.sceneFingerprint);
     std::cout << "scene       " << header.scenePath << " (mesh and fixed vertices fingerprint " << fingerprint << ")\n";
   }
-  std::cout << "vertices    " << header.numVertices << '\n' << "frames      " << reader->numFrames() << " complete";
-  if (reader->hasTruncatedFrame()) {
-    std::cout << " (+ " << reader->truncatedTrailingBytes() << " bytes of an interrupted frame, ignored)";
+  std::cout << "vertices    " << header.numVertices << '\n' << "frames      " << reader.numFrames() << " complete";
+  if (reader.hasTruncatedFrame()) {
+    std::cout << " (+ " << reader.truncatedTrailingBytes() << " bytes of an interrupted frame, ignored)";
   }
   std::cout << "\nframe rate  " << exact(header.frameInterval > 0 ? 1.0 / header.frameInterval : 0.0)
             << " per time unit (interval " << exact(header.frameInterval) << ")\n"
             << "timestep    " << (header.timestep > 0 ? exact(header.timestep) : std::string("unknown")) << '\n'
             << "velocities  " << (header.hasVelocities ? "yes" : "no") << '\n'
             << "record      " << header.recordBytes() << " bytes\n";
+}
 
-  // Every record, so that the times come from the file and a bad checksum is found.
-  SimulationFrame frame;
-  std::optional<std::string> firstBad;
-  double firstTime = 0.0;
-  double lastTime = 0.0;
-  for (std::int64_t k = 0; k < reader->numFrames() && !firstBad; ++k) {
-    try {
-      reader->readFrame(k, frame);
-      if (k == 0) firstTime = frame.time;
-      lastTime = frame.time;
-    } catch (const ParseError& error) {
-      firstBad = error.what();
-    }
+/// The checkpoint lines of info: the .afsim stores no scene; the checkpoint next to it
+/// identifies the run.
+void printCheckpoint(const std::string& simulation) {
+  const fs::path checkpointFile = checkpointPathFor(simulation);
+  std::cout << "scene       not recorded in the .afsim file";
+  if (!fs::exists(checkpointFile)) {
+    std::cout << "\ncheckpoint  none (" << checkpointFile.string() << " does not exist)\n";
+    return;
   }
+  try {
+    const SimulationCheckpoint checkpoint = readCheckpoint(checkpointFile);
+    std::cout << "; run fingerprint " << hex(checkpoint.fingerprint) << " (scene, mesh, timestep)\n"
+              << "checkpoint  " << checkpointFile.string() << ": after frame " << checkpoint.frames
+              << ", t = " << exact(checkpoint.time) << ", integrator " << checkpoint.integrator << '\n';
+  } catch (const Error& error) {
+    std::cout << "\ncheckpoint  " << checkpointFile.string() << ": unreadable: " << error.what() << '\n';
+  }
+}
+
+int info(const CommandLine& options) {
+  const auto reader = openSimulation(options.simulation);
+  printHeader(options.simulation, *reader);
+  // Every record, so that the times come from the file and a bad checksum is found.
+  const RecordScan scan = reader->scanRecords();
   if (reader->numFrames() > 0) {
-    std::cout << "times       " << exact(firstTime) << " to " << exact(lastTime) << '\n';
+    std::cout << "times       " << exact(scan.firstTime) << " to " << exact(scan.lastTime) << '\n';
   }
   std::cout << "checksums   "
-            << (firstBad ? "BAD: " + *firstBad : "ok (" + std::to_string(reader->numFrames()) + " frames)") << '\n';
-
-  // The .afsim stores no scene; the checkpoint next to it identifies the run.
-  const fs::path checkpointFile = checkpointPathFor(options.simulation);
-  std::cout << "scene       not recorded in the .afsim file";
-  if (fs::exists(checkpointFile)) {
-    try {
-      const SimulationCheckpoint checkpoint = readCheckpoint(checkpointFile);
-      std::cout << "; run fingerprint " << hex(checkpoint.fingerprint) << " (scene, mesh, timestep)\n"
-                << "checkpoint  " << checkpointFile.string() << ": after frame " << checkpoint.frames
-                << ", t = " << exact(checkpoint.time) << ", integrator " << checkpoint.integrator << '\n';
-    } catch (const Error& error) {
-      std::cout << "\ncheckpoint  " << checkpointFile.string() << ": unreadable: " << error.what() << '\n';
-    }
-  } else {
-    std::cout << "\ncheckpoint  none (" << checkpointFile.string() << " does not exist)\n";
-  }
-  if (firstBad) {
-    std::cerr << "afsimTool: " << *firstBad << '\n';
+            << (scan.badFrame ? "BAD: " + scan.badMessage : "ok (" + std::to_string(reader->numFrames()) + " frames)")
+            << '\n';
+  printCheckpoint(options.simulation);
+  if (scan.badFrame) {
+    std::cerr << "afsimTool: " << scan.badMessage << '\n';
     return 1;
   }
   return 0;
+}
+
+/// The CSV header row: frame, time and per vertex its displacement (and with a mesh its
+/// position) components.
+void writeCsvHeader(std::ostream& out, const std::vector<int>& vertices, bool withPositions) {
+  out << "frame,time";
+  for (const int v : vertices) {
+    for (const char* axis : {"x", "y", "z"}) out << ",u" << v << '_' << axis;
+    if (withPositions) {
+      for (const char* axis : {"x", "y", "z"}) out << ",p" << v << '_' << axis;
+    }
+  }
+  out << '\n';
 }
 
 int csv(const CommandLine& options) {
@@ -193,14 +203,7 @@ int csv(const CommandLine& options) {
     if (!file) throw Error("cannot write '" + options.output + "'");
   }
   std::ostream& out = options.output.empty() ? std::cout : file;
-  out << "frame,time";
-  for (const int v : vertices) {
-    for (const char* axis : {"x", "y", "z"}) out << ",u" << v << '_' << axis;
-    if (mesh) {
-      for (const char* axis : {"x", "y", "z"}) out << ",p" << v << '_' << axis;
-    }
-  }
-  out << '\n';
+  writeCsvHeader(out, vertices, mesh.has_value());
   SimulationFrame frame;
   for (const std::int64_t k : frames) {
     reader->readFrame(k, frame);

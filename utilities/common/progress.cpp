@@ -48,28 +48,37 @@ void ProgressReporter::update(int framesDone) {
   latest_ = framesDone;
   const Clock::time_point now = Clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
-  const double fraction = static_cast<double>(framesDone) / totalFrames_;
   const int framesThisRun = framesDone - firstFrame_;
   const double remaining = framesThisRun > 0 ? elapsed * (totalFrames_ - framesDone) / framesThisRun : 0.0;
-  const int percent = static_cast<int>(std::floor(100.0 * fraction));
-
   if (style_ == ProgressStyle::bar) {
-    // Redraw at most ~20 times a second, and always for the last frame.
-    if (framesDone < totalFrames_ && barDrawn_ && now - lastPrint_ < std::chrono::milliseconds(50)) {
-      return;
-    }
-    constexpr int width = 30;
-    const int filled = static_cast<int>(std::round(fraction * width));
-    std::string bar(static_cast<std::size_t>(filled), '#');
-    bar.append(static_cast<std::size_t>(width - filled), '.');
-    std::fprintf(out_, "\r[%s] %d/%d frames %3d%%  elapsed %s  ETA %s   ", bar.c_str(), framesDone, totalFrames_,
-                 percent, formatDuration(elapsed).c_str(), formatDuration(remaining).c_str());
-    std::fflush(out_);
-    barDrawn_ = true;
-    lastPrint_ = now;
+    drawBar(framesDone, now, elapsed, remaining);
+  } else {
+    printLine(framesDone, now, elapsed, remaining);
+  }
+}
+
+void ProgressReporter::drawBar(int framesDone, Clock::time_point now, double elapsed, double remaining) {
+  // Redraw at most ~20 times a second, and always for the last frame.
+  if (framesDone < totalFrames_ && barDrawn_ && now - lastPrint_ < std::chrono::milliseconds(50)) {
     return;
   }
-  // Plain lines: every 10% of the frames or every 10 s, whichever comes first.
+  const double fraction = static_cast<double>(framesDone) / totalFrames_;
+  const int percent = static_cast<int>(std::floor(100.0 * fraction));
+  constexpr int width = 30;
+  const int filled = static_cast<int>(std::round(fraction * width));
+  std::string bar(static_cast<std::size_t>(filled), '#');
+  bar.append(static_cast<std::size_t>(width - filled), '.');
+  std::fprintf(out_, "\r[%s] %d/%d frames %3d%%  elapsed %s  ETA %s   ", bar.c_str(), framesDone, totalFrames_, percent,
+               formatDuration(elapsed).c_str(), formatDuration(remaining).c_str());
+  std::fflush(out_);
+  barDrawn_ = true;
+  lastPrint_ = now;
+}
+
+void ProgressReporter::printLine(int framesDone, Clock::time_point now, double elapsed, double remaining) {
+  const double fraction = static_cast<double>(framesDone) / totalFrames_;
+  const int percent = static_cast<int>(std::floor(100.0 * fraction));
+  // Every 10% of the frames or every 10 s, whichever comes first.
   const bool step = percent / 10 > lastPercentPrinted_ / 10;
   const bool late = now - lastPrint_ >= std::chrono::seconds(10);
   if (!step && !late && framesDone < totalFrames_) {

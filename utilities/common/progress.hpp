@@ -39,6 +39,10 @@ class ProgressReporter {
  private:
   using Clock = std::chrono::steady_clock;
 
+  /// The two styles' output for framesDone frames at time now (mutex_ held).
+  void drawBar(int framesDone, Clock::time_point now, double elapsed, double remaining);
+  void printLine(int framesDone, Clock::time_point now, double elapsed, double remaining);
+
   std::string program_;
   ProgressStyle style_;
   int totalFrames_;

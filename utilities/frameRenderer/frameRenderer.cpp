@@ -152,26 +152,14 @@ void forEachParallel(const Shared& shared, int threads, std::size_t count, const
   }
 }
 
-/// 1, 2 or 5 times a power of ten, near x.
-double roundLength(double x) {
-  const double power = std::pow(10.0, std::floor(std::log10(x)));
-  for (const double m : {1.0, 2.0, 5.0}) {
-    if (m * power >= 0.7 * x) {
-      return m * power;
-    }
-  }
-  return 10.0 * power;
-}
-
 std::string frameName(std::int64_t k) {
   char name[32];
   std::snprintf(name, sizeof(name), "frame_%05lld.png", static_cast<long long>(k));
   return name;
 }
 
-int run(int argc, char** argv) {
-  CLI::App app{"Draws the frames of an .afsim simulation file (docs/simulation-output.md) as PNG images."};
-  CommandLine options;
+/// The options of the input files, what is drawn and how (in --help order, first part).
+void addInputOptions(CLI::App& app, CommandLine& options) {
   app.add_option("simulation", options.simulation, "Simulation output (.afsim) from offlineSimulator")->required();
   app.add_option("--mesh", options.mesh, "The tet mesh the simulation ran on (.veg, .node/.ele, .msh)");
   app.add_option("--scene", options.scene, "The scene the simulation ran (its mesh and fixed vertices are used)");
@@ -201,6 +189,10 @@ int run(int argc, char** argv) {
   app.add_flag("--ground", options.ground, "Draw a checkered ground plane with a shadow under the object");
   app.add_option("--compare", options.compare, "Second .afsim of the same mesh, drawn on the right");
   app.add_option("--labels", options.labels, "Labels of the two runs with --compare, \"left,right\"");
+}
+
+/// The options of the camera, the image quality and the console (in --help order, second part).
+void addViewOptions(CLI::App& app, CommandLine& options) {
   app.add_option("--camera-position", options.cameraPosition, "Eye position x,y,z (with --camera-target)")
       ->delimiter(',')
       ->expected(3);
@@ -222,14 +214,10 @@ int run(int argc, char** argv) {
       ->check(asyncfem::cli::inRange(1, 64));
   app.add_flag("--progress", options.progress, "Draw the progress bar even when stderr is not a terminal");
   app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "frameRenderer: " << e.what() << " (see --help)\n";
-    return 2;
-  }
+}
+
+/// Options that cannot go together, found after parsing.
+void checkOptionCombinations(const CommandLine& options) {
   if (options.mesh && options.scene) {
     throw Error(
         "give the mesh with --mesh FILE or --scene SCENE.json, not both (without either, the scene the "
@@ -241,32 +229,43 @@ int run(int argc, char** argv) {
   if (options.labels && !options.compare) {
     throw Error("--labels needs --compare");
   }
-  Stopwatch total;
-  total.start();
+}
 
-  // The simulation files first: a missing or broken file is the most common mistake.
-  Shared shared;
-  shared.warping = parseWarpingKind(options.warp);
-  shared.runs.push_back({fs::path(options.simulation).stem().string(), options.simulation});
+/// The simulation file, and with --compare the second one, labelled by --labels or by
+/// their file names.
+std::vector<Run> namedRuns(const CommandLine& options) {
+  std::vector<Run> runs;
+  runs.push_back({fs::path(options.simulation).stem().string(), options.simulation});
   if (options.compare) {
-    shared.runs.push_back({fs::path(*options.compare).stem().string(), *options.compare});
+    runs.push_back({fs::path(*options.compare).stem().string(), *options.compare});
     if (options.labels) {
       const std::size_t comma = options.labels->find(',');
       if (comma == std::string::npos || options.labels->find(',', comma + 1) != std::string::npos) {
         throw Error("--labels \"" + *options.labels + "\": expected two labels separated by one comma");
       }
-      shared.runs[0].label = options.labels->substr(0, comma);
-      shared.runs[1].label = options.labels->substr(comma + 1);
+      runs[0].label = options.labels->substr(0, comma);
+      runs[1].label = options.labels->substr(comma + 1);
     }
   }
-  std::int64_t numFrames = -1;
+  return runs;
+}
+
+/// What the simulation files hold together.
+struct RunsExtent {
+  std::int64_t numFrames = -1;  ///< complete frames of the shorter file
   std::int64_t numVertices = 0;
-  for (const Run& run : shared.runs) {
+};
+
+/// Opens every run once: it exists, holds a complete frame, and all runs have the same
+/// vertex count. Warns (unless quiet) about a partial last frame.
+RunsExtent checkRuns(const std::vector<Run>& runs, bool quiet) {
+  RunsExtent extent;
+  for (const Run& run : runs) {
     if (!fs::exists(run.file)) {
       throw Error(run.file.string() + ": no such simulation file");
     }
     SimulationReader reader(run.file);
-    if (reader.hasTruncatedFrame() && !options.quiet) {
+    if (reader.hasTruncatedFrame() && !quiet) {
       std::cerr << "frameRenderer: warning: " << run.file.string() << " ends in a partial frame ("
                 << reader.truncatedTrailingBytes() << " bytes, an interrupted run); it is ignored\n";
     }
@@ -274,20 +273,19 @@ int run(int argc, char** argv) {
       throw Error(run.file.string() + ": holds no complete frame" +
                   (reader.hasTruncatedFrame() ? " (the file is truncated inside its first frame)" : ""));
     }
-    if (numVertices != 0 && reader.numVertices() != numVertices) {
+    if (extent.numVertices != 0 && reader.numVertices() != extent.numVertices) {
       throw Error(run.file.string() + ": " + std::to_string(reader.numVertices()) + " vertices, but " +
-                  shared.runs.front().file.string() + " has " + std::to_string(numVertices));
+                  runs.front().file.string() + " has " + std::to_string(extent.numVertices));
     }
-    numVertices = reader.numVertices();
-    numFrames = numFrames < 0 ? reader.numFrames() : std::min(numFrames, reader.numFrames());
+    extent.numVertices = reader.numVertices();
+    extent.numFrames = extent.numFrames < 0 ? reader.numFrames() : std::min(extent.numFrames, reader.numFrames());
   }
-  const std::string framesSource =
-      shared.runs.size() == 1 ? shared.runs[0].file.string() : "both simulation files (the shorter one)";
-  const std::vector<std::int64_t> frames =
-      frames::selectFrames(frames::parseFrameSelection(options.frames), numFrames, framesSource);
+  return extent;
+}
 
-  // The mesh, and the vertices held fixed in the simulation: from --scene, from the scene
-  // the file records, or from --mesh. Only the problem is built: no matrix, no factorization.
+/// The mesh, and the vertices held fixed in the simulation: from --scene, from the scene
+/// the file records, or from --mesh. Only the problem is built: no matrix, no factorization.
+void loadMesh(const CommandLine& options, std::int64_t numVertices, Shared& shared) {
   if (options.scene || !options.mesh) {
     const std::shared_ptr<const Problem> problem =
         options.scene ? buildProblem(loadScene(*options.scene))
@@ -310,47 +308,41 @@ int run(int argc, char** argv) {
                 meshName + ") has " + std::to_string(shared.mesh->numVertices()) +
                 ": the simulation did not run on this mesh");
   }
-  shared.surface = options.renderMesh ? SurfaceEmbedding::embed(*shared.mesh, loadSurfaceMesh(*options.renderMesh))
-                                      : SurfaceEmbedding::boundary(*shared.mesh);
-  RenderStyle style;
-  if (!options.tintSets.empty()) {
-    // The first set in --tint-color, the others in colours far from it and from the surface.
-    static const Eigen::Vector3f palette[] = {
-        {0.25f, 0.45f, 0.95f}, {0.2f, 0.75f, 0.3f}, {0.65f, 0.3f, 0.8f}, {0.95f, 0.8f, 0.15f}, {0.1f, 0.75f, 0.8f}};
-    Eigen::Matrix3Xf tetColors = style.surfaceColor.replicate(1, shared.mesh->numVertices());
-    for (std::size_t i = 0; i < options.tintSets.size(); ++i) {
-      VertexSelection selection;
-      selection.sets.push_back(options.tintSets[i]);
-      std::vector<int> tinted;
-      try {
-        tinted = selectVertices(*shared.mesh, selection);
-      } catch (const SelectionError& error) {
-        throw Error("--tint-set " + options.tintSets[i] + ": " + error.what());
-      }
-      const Eigen::Vector3f tint =
-          i == 0 ? Eigen::Vector3f(options.tintColor[0], options.tintColor[1], options.tintColor[2])
-                 : palette[(i - 1) % (sizeof(palette) / sizeof(palette[0]))];
-      for (const int v : tinted) tetColors.col(v) = tint;
+}
+
+/// Per surface vertex colours with the --tint-set sets tinted: the first set in
+/// --tint-color, the others in colours far from it and from the surface.
+Eigen::Matrix3Xf tintedSurfaceColors(const CommandLine& options, const Shared& shared,
+                                     const Eigen::Vector3f& surfaceColor) {
+  static const Eigen::Vector3f palette[] = {
+      {0.25f, 0.45f, 0.95f}, {0.2f, 0.75f, 0.3f}, {0.65f, 0.3f, 0.8f}, {0.95f, 0.8f, 0.15f}, {0.1f, 0.75f, 0.8f}};
+  Eigen::Matrix3Xf tetColors = surfaceColor.replicate(1, shared.mesh->numVertices());
+  for (std::size_t i = 0; i < options.tintSets.size(); ++i) {
+    VertexSelection selection;
+    selection.sets.push_back(options.tintSets[i]);
+    std::vector<int> tinted;
+    try {
+      tinted = selectVertices(*shared.mesh, selection);
+    } catch (const SelectionError& error) {
+      throw Error("--tint-set " + options.tintSets[i] + ": " + error.what());
     }
-    shared.colors = shared.surface.interpolate(tetColors);
+    const Eigen::Vector3f tint = i == 0
+                                     ? Eigen::Vector3f(options.tintColor[0], options.tintColor[1], options.tintColor[2])
+                                     : palette[(i - 1) % (sizeof(palette) / sizeof(palette[0]))];
+    for (const int v : tinted) tetColors.col(v) = tint;
   }
+  return shared.surface.interpolate(tetColors);
+}
 
-  const int maxThreads = std::max(
-      1, options.threads > 0 ? options.threads : static_cast<int>(std::min(8U, std::thread::hardware_concurrency())));
-  const int threads = std::min(maxThreads, static_cast<int>(frames.size()));
-
-  // Camera: fitted to the rest shape and every frame of every run (so that renders of
-  // different frame selections share one camera), unless given.
-  const int bar = shared.runs.size() > 1 ? std::max(14, options.height / 14) : 0;
-  const int leftWidth = shared.runs.size() > 1 ? options.width / 2 : options.width;
-  const int panelHeight = options.height - bar;
-  Stopwatch boundsWatch;
-  boundsWatch.start();
-  std::vector<BoundingBox> frameBoxes(shared.runs.size() * static_cast<std::size_t>(numFrames + 1));
+/// The box of the rest shape and of every frame of every run (so that renders of
+/// different frame selections share one camera), computed on up to maxThreads threads.
+BoundingBox boundsOfAllFrames(const Shared& shared, int maxThreads, std::int64_t numFrames) {
+  const std::size_t framesPerRun = static_cast<std::size_t>(numFrames + 1);
+  std::vector<BoundingBox> frameBoxes(shared.runs.size() * framesPerRun);
   forEachParallel(shared, std::min(maxThreads, static_cast<int>(frameBoxes.size())), frameBoxes.size(),
                   [&](Worker& worker, int, std::size_t i) {
-                    const std::size_t r = i / static_cast<std::size_t>(numFrames + 1);
-                    const std::int64_t k = static_cast<std::int64_t>(i % static_cast<std::size_t>(numFrames + 1)) - 1;
+                    const std::size_t r = i / framesPerRun;
+                    const std::int64_t k = static_cast<std::int64_t>(i % framesPerRun) - 1;
                     const Eigen::Matrix3Xd x = worker.surfacePositions(shared, r, k);
                     frameBoxes[i] = {x.rowwise().minCoeff(), x.rowwise().maxCoeff()};
                   });
@@ -359,43 +351,89 @@ int run(int argc, char** argv) {
     box.min = box.min.cwiseMin(b.min);
     box.max = box.max.cwiseMax(b.max);
   }
-  const double boundsSeconds = boundsWatch.stop();
-  const Eigen::Vector3d up = toVector(options.cameraUp);
-  if (!(up.norm() > 0.0)) {
-    throw Error("--camera-up must not be zero");
+  return box;
+}
+
+/// Where the panels go in the image: one, or two side by side under a label bar.
+struct PanelLayout {
+  int bar = 0;  ///< height of the label bar (0: one run, no bar)
+  int leftWidth = 0;
+  int panelHeight = 0;
+
+  PanelLayout(const CommandLine& options, std::size_t numRuns)
+      : bar(numRuns > 1 ? std::max(14, options.height / 14) : 0),
+        leftWidth(numRuns > 1 ? options.width / 2 : options.width),
+        panelHeight(options.height - bar) {}
+  int panelWidth(const CommandLine& options, std::size_t r) const {
+    return r == 0 ? leftWidth : options.width - leftWidth;
   }
+};
+
+/// The camera given by --camera-position and --camera-target, or fitted to box.
+Camera chooseCamera(const CommandLine& options, const BoundingBox& box, const PanelLayout& layout,
+                    const Eigen::Vector3d& up) {
   Camera camera;
   if (!options.cameraPosition.empty()) {
     camera.position = toVector(options.cameraPosition);
     camera.target = toVector(options.cameraTarget);
     camera.up = up;
     camera.verticalFieldOfViewDegrees = options.fieldOfView;
-  } else {
-    const Eigen::Vector3d direction =
-        options.viewDirection.empty() ? defaultViewDirection() : toVector(options.viewDirection);
-    camera = fitCamera(box, static_cast<double>(leftWidth) / panelHeight, direction, up, options.fieldOfView);
+    return camera;
   }
-  const double diagonal = std::max((box.max - box.min).norm(), 1e-12);
-  if (options.ground) {
-    const Eigen::Vector3d center = 0.5 * (box.min + box.max);
-    const Eigen::Vector3d n = up.normalized();
-    // Lowest point of the box along up, a little below it.
-    double lowest = std::numeric_limits<double>::infinity();
-    for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3d c((corner & 1) != 0 ? box.max.x() : box.min.x(),
-                              (corner & 2) != 0 ? box.max.y() : box.min.y(),
-                              (corner & 4) != 0 ? box.max.z() : box.min.z());
-      lowest = std::min(lowest, n.dot(c));
-    }
-    style.ground = GroundPlane{center + ((lowest - n.dot(center) - (0.02 * diagonal)) * n), 4.0 * diagonal,
-                               roundLength(diagonal / 6.0), true};
-  }
+  const Eigen::Vector3d direction =
+      options.viewDirection.empty() ? defaultViewDirection() : toVector(options.viewDirection);
+  return fitCamera(box, static_cast<double>(layout.leftWidth) / layout.panelHeight, direction, up, options.fieldOfView);
+}
 
+/// Seconds spent drawing the frames: wall time, and summed over the threads the time
+/// spent rendering and writing PNG files.
+struct RenderTimes {
+  double wall = 0.0;
+  double render = 0.0;
+  double png = 0.0;
+};
+
+/// What every frame is drawn with.
+struct FrameSetup {
+  const PanelLayout& layout;
+  const Camera& camera;
+  const RenderStyle& style;
+};
+
+/// Frame k of every run drawn with the worker's readers, panels side by side under their
+/// labels when there are two. own: this thread's renderers, one per panel, made on first use.
+Image drawFrame(Worker& worker, std::vector<std::unique_ptr<OffscreenRenderer>>& own, const CommandLine& options,
+                const Shared& shared, const FrameSetup& setup, std::int64_t k) {
+  own.resize(shared.runs.size());
+  std::vector<Image> panels;
+  for (std::size_t r = 0; r < shared.runs.size(); ++r) {
+    if (!own[r]) {
+      own[r] = std::make_unique<OffscreenRenderer>(setup.layout.panelWidth(options, r), setup.layout.panelHeight,
+                                                   options.supersampling);
+    }
+    const Eigen::Matrix3Xd x = worker.surfacePositions(shared, r, k);
+    panels.push_back(own[r]->render({{x, shared.surface.triangles(), shared.colors ? &*shared.colors : nullptr}},
+                                    setup.camera, setup.style));
+  }
+  if (panels.size() == 1) {
+    return std::move(panels.front());
+  }
+  std::vector<std::string> labels;
+  for (const Run& run : shared.runs) {
+    labels.push_back(run.label);
+  }
+  return composeSideBySide(panels, labels, setup.layout.bar);
+}
+
+/// Draws the frames on `threads` threads into options.output, one renderer (OSMesa
+/// context) per thread and panel, reporting progress.
+RenderTimes renderFrames(const CommandLine& options, const Shared& shared, const std::vector<std::int64_t>& frames,
+                         int threads, const FrameSetup& setup) {
   fs::create_directories(options.output);
   cli::ProgressReporter progress("frameRenderer", cli::chooseProgressStyle(options.quiet, options.progress),
                                  static_cast<int>(frames.size()));
   std::atomic<int> done{0};
-  // One renderer (OSMesa context) per thread and panel; panels may differ in width by one.
+  // Panels may differ in width by one, so each has its own renderer.
   std::vector<std::vector<std::unique_ptr<OffscreenRenderer>>> renderers(static_cast<std::size_t>(threads));
   std::vector<double> renderSeconds(static_cast<std::size_t>(threads), 0.0);
   std::vector<double> pngSeconds(static_cast<std::size_t>(threads), 0.0);
@@ -403,30 +441,10 @@ int run(int argc, char** argv) {
   renderWatch.start();
   try {
     forEachParallel(shared, threads, frames.size(), [&](Worker& worker, int thread, std::size_t i) {
-      auto& own = renderers[static_cast<std::size_t>(thread)];
-      own.resize(shared.runs.size());
       Stopwatch watch;
       watch.start();
-      std::vector<Image> panels;
-      for (std::size_t r = 0; r < shared.runs.size(); ++r) {
-        if (!own[r]) {
-          const int panelWidth = r == 0 ? leftWidth : options.width - leftWidth;
-          own[r] = std::make_unique<OffscreenRenderer>(panelWidth, panelHeight, options.supersampling);
-        }
-        const Eigen::Matrix3Xd x = worker.surfacePositions(shared, r, frames[i]);
-        panels.push_back(own[r]->render({{x, shared.surface.triangles(), shared.colors ? &*shared.colors : nullptr}},
-                                        camera, style));
-      }
-      Image image;
-      if (panels.size() == 1) {
-        image = std::move(panels.front());
-      } else {
-        std::vector<std::string> labels;
-        for (const Run& run : shared.runs) {
-          labels.push_back(run.label);
-        }
-        image = composeSideBySide(panels, labels, bar);
-      }
+      const Image image =
+          drawFrame(worker, renderers[static_cast<std::size_t>(thread)], options, shared, setup, frames[i]);
       renderSeconds[static_cast<std::size_t>(thread)] += watch.stop();
       watch.start();
       writePng(fs::path(options.output) / frameName(frames[i]), image);
@@ -438,41 +456,118 @@ int run(int argc, char** argv) {
     throw;
   }
   progress.finish();
-  const double renderWall = renderWatch.stop();
+  RenderTimes times;
+  times.wall = renderWatch.stop();
+  for (int t = 0; t < threads; ++t) {
+    times.render += renderSeconds[static_cast<std::size_t>(t)];
+    times.png += pngSeconds[static_cast<std::size_t>(t)];
+  }
+  return times;
+}
 
+/// The summary on stdout.
+void printSummary(const CommandLine& options, const Shared& shared, std::size_t numFramesDrawn, int threads,
+                  double totalSeconds, double boundsSeconds, const RenderTimes& times) {
+  const double frameCount = static_cast<double>(numFramesDrawn);
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(2);
+  out << "frameRenderer: " << numFramesDrawn << " frames" << (options.frames.empty() ? "" : " (" + options.frames + ")")
+      << " of " << shared.runs.front().file.string();
+  if (shared.runs.size() > 1) {
+    out << " and " << shared.runs[1].file.string();
+  }
+  out << " -> " << (fs::path(options.output) / "frame_NNNNN.png").string() << " (" << options.width << " x "
+      << options.height << "), " << totalSeconds << " s\n";
+  out << "  surface     " << (options.renderMesh ? *options.renderMesh : std::string("tet mesh boundary")) << ", "
+      << shared.surface.numSurfaceVertices() << " vertices, " << shared.surface.triangles().size() << " triangles";
+  if (shared.surface.numOutsideVertices() > 0) {
+    out << " (" << shared.surface.numOutsideVertices() << " outside the tet mesh, up to "
+        << shared.surface.maxOutsideDistance() << " away)";
+  }
+  out << "\n  problem     " << (options.mesh ? "mesh file, no scene" : "mesh and fixed vertices of the scene") << ": "
+      << shared.assemblies << " matrices assembled, no factorization for the simulation\n";
+  out << "  warping     " << options.warp << "\n";
+  out << "  camera      " << (options.cameraPosition.empty() ? "fitted to all frames" : "given") << ", bounds "
+      << boundsSeconds << " s\n";
+  out << "  per frame   " << 1e3 * times.wall / frameCount << " ms wall on " << threads
+      << (threads == 1 ? " thread" : " threads") << " (per thread: draw " << 1e3 * times.render / frameCount
+      << " ms, PNG " << 1e3 * times.png / frameCount << " ms)\n";
+  std::cout << out.str() << std::flush;
+}
+
+/// Parses the command line into options; the exit status when there is nothing to run
+/// (--help, a usage error).
+std::optional<int> parseCommandLine(int argc, char** argv, CommandLine& options) {
+  CLI::App app{"Draws the frames of an .afsim simulation file (docs/simulation-output.md) as PNG images."};
+  addInputOptions(app, options);
+  addViewOptions(app, options);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "frameRenderer: " << e.what() << " (see --help)\n";
+    return 2;
+  }
+  checkOptionCombinations(options);
+  return std::nullopt;
+}
+
+/// The simulation files (checked first: a missing or broken file is the most common
+/// mistake), the selected frames, the mesh and the surface drawn, in surfaceColor with the
+/// tinted sets.
+Shared openInputs(const CommandLine& options, const Eigen::Vector3f& surfaceColor, std::int64_t& numFrames,
+                  std::vector<std::int64_t>& frames) {
+  Shared shared;
+  shared.warping = parseWarpingKind(options.warp);
+  shared.runs = namedRuns(options);
+  const RunsExtent extent = checkRuns(shared.runs, options.quiet);
+  const std::string framesSource =
+      shared.runs.size() == 1 ? shared.runs[0].file.string() : "both simulation files (the shorter one)";
+  numFrames = extent.numFrames;
+  frames = frames::selectFrames(frames::parseFrameSelection(options.frames), extent.numFrames, framesSource);
+  loadMesh(options, extent.numVertices, shared);
+  shared.surface = options.renderMesh ? SurfaceEmbedding::embed(*shared.mesh, loadSurfaceMesh(*options.renderMesh))
+                                      : SurfaceEmbedding::boundary(*shared.mesh);
+  if (!options.tintSets.empty()) {
+    shared.colors = tintedSurfaceColors(options, shared, surfaceColor);
+  }
+  return shared;
+}
+
+int run(int argc, char** argv) {
+  CommandLine options;
+  if (const std::optional<int> status = parseCommandLine(argc, argv, options)) {
+    return *status;
+  }
+  Stopwatch total;
+  total.start();
+  RenderStyle style;
+  std::int64_t numFrames = 0;
+  std::vector<std::int64_t> frames;
+  const Shared shared = openInputs(options, style.surfaceColor, numFrames, frames);
+
+  const int maxThreads = std::max(
+      1, options.threads > 0 ? options.threads : static_cast<int>(std::min(8U, std::thread::hardware_concurrency())));
+  const int threads = std::min(maxThreads, static_cast<int>(frames.size()));
+  const PanelLayout layout(options, shared.runs.size());
+  Stopwatch boundsWatch;
+  boundsWatch.start();
+  const BoundingBox box = boundsOfAllFrames(shared, maxThreads, numFrames);
+  const double boundsSeconds = boundsWatch.stop();
+  const Eigen::Vector3d up = toVector(options.cameraUp);
+  if (!(up.norm() > 0.0)) {
+    throw Error("--camera-up must not be zero");
+  }
+  const Camera camera = chooseCamera(options, box, layout, up);
+  if (options.ground) {
+    style.ground = groundBelow(box, up);
+  }
+
+  const RenderTimes times = renderFrames(options, shared, frames, threads, {layout, camera, style});
   if (!options.quiet) {
-    double render = 0.0;
-    double png = 0.0;
-    for (int t = 0; t < threads; ++t) {
-      render += renderSeconds[static_cast<std::size_t>(t)];
-      png += pngSeconds[static_cast<std::size_t>(t)];
-    }
-    std::ostringstream out;
-    out.setf(std::ios::fixed);
-    out.precision(2);
-    out << "frameRenderer: " << frames.size() << " frames"
-        << (options.frames.empty() ? "" : " (" + options.frames + ")") << " of " << shared.runs.front().file.string();
-    if (shared.runs.size() > 1) {
-      out << " and " << shared.runs[1].file.string();
-    }
-    out << " -> " << (fs::path(options.output) / "frame_NNNNN.png").string() << " (" << options.width << " x "
-        << options.height << "), " << total.stop() << " s\n";
-    out << "  surface     " << (options.renderMesh ? *options.renderMesh : std::string("tet mesh boundary")) << ", "
-        << shared.surface.numSurfaceVertices() << " vertices, " << shared.surface.triangles().size() << " triangles";
-    if (shared.surface.numOutsideVertices() > 0) {
-      out << " (" << shared.surface.numOutsideVertices() << " outside the tet mesh, up to "
-          << shared.surface.maxOutsideDistance() << " away)";
-    }
-    out << "\n  problem     " << (options.mesh ? "mesh file, no scene" : "mesh and fixed vertices of the scene") << ": "
-        << shared.assemblies << " matrices assembled, no factorization for the simulation\n";
-    out << "  warping     " << options.warp << "\n";
-    out << "  camera      " << (options.cameraPosition.empty() ? "fitted to all frames" : "given") << ", bounds "
-        << boundsSeconds << " s\n";
-    out << "  per frame   " << 1e3 * renderWall / static_cast<double>(frames.size()) << " ms wall on " << threads
-        << (threads == 1 ? " thread" : " threads") << " (per thread: draw "
-        << 1e3 * render / static_cast<double>(frames.size()) << " ms, PNG "
-        << 1e3 * png / static_cast<double>(frames.size()) << " ms)\n";
-    std::cout << out.str() << std::flush;
+    printSummary(options, shared, frames.size(), threads, total.stop(), boundsSeconds, times);
   }
   return 0;
 }

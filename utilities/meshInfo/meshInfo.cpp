@@ -17,9 +17,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
-#include <limits>
 #include <nlohmann/json.hpp>
-#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,30 +27,6 @@
 namespace {
 
 using asyncfem::TetMesh;
-
-struct QualitySummary {
-  double minDihedralDegrees = 0.0;   ///< smallest min dihedral angle over elements
-  double meanDihedralDegrees = 0.0;  ///< mean over elements of the min dihedral angle
-  double maxDihedralDegrees = 0.0;   ///< largest min dihedral angle over elements
-  double worstAspectRatio = 0.0;
-};
-
-QualitySummary summarizeQuality(const TetMesh& mesh) {
-  QualitySummary s;
-  if (mesh.numElements() == 0) return s;
-  const double toDegrees = 180.0 / std::numbers::pi;
-  s.minDihedralDegrees = std::numeric_limits<double>::infinity();
-  double sum = 0.0;
-  for (const asyncfem::ElementQuality& q : asyncfem::elementQualities(mesh)) {
-    const double angle = q.minDihedralAngle * toDegrees;
-    s.minDihedralDegrees = std::min(s.minDihedralDegrees, angle);
-    s.maxDihedralDegrees = std::max(s.maxDihedralDegrees, angle);
-    sum += angle;
-    s.worstAspectRatio = std::max(s.worstAspectRatio, q.aspectRatio);
-  }
-  s.meanDihedralDegrees = sum / mesh.numElements();
-  return s;
-}
 
 nlohmann::json describe(const TetMesh& mesh, const std::string& source, const asyncfem::MeshReadReport& report) {
   nlohmann::json j;
@@ -81,7 +55,7 @@ nlohmann::json describe(const TetMesh& mesh, const std::string& source, const as
   const asyncfem::BoundingBox box = asyncfem::boundingBox(mesh);
   j["boundingBox"] = {{"min", {box.min.x(), box.min.y(), box.min.z()}},
                       {"max", {box.max.x(), box.max.y(), box.max.z()}}};
-  const QualitySummary q = summarizeQuality(mesh);
+  const asyncfem::QualitySummary q = asyncfem::summarizeQuality(mesh);
   j["quality"] = {{"minDihedralAngleDegrees",
                    {{"min", q.minDihedralDegrees}, {"mean", q.meanDihedralDegrees}, {"max", q.maxDihedralDegrees}}},
                   {"worstAspectRatio", q.worstAspectRatio}};
@@ -119,87 +93,109 @@ void printText(const nlohmann::json& j) {
             << "reoriented elements: " << j["reorientedElements"] << '\n';
 }
 
-int run(int argc, char** argv) {
-  CLI::App app{
-      "Print the contents of a tetrahedral mesh (.veg, TetGen .node/.ele, Gmsh .msh), "
-      "or generate a beam, box, antenna or snail mesh."};
+/// The command line.
+struct Options {
   std::string input;
   std::string output;
   std::string generate;
   int cells = 0;
+  std::vector<int> blockCells;
   bool json = false;
-  app.add_option("file", input, "mesh file to read (.veg, .node, .ele, .msh)");
-  app.add_option("--generate", generate,
+};
+
+void addOptions(CLI::App& app, Options& options) {
+  app.add_option("file", options.input, "mesh file to read (.veg, .node, .ele, .msh)");
+  app.add_option("--generate", options.generate,
                  "generate instead of reading: beam (makeBeamMesh), box (makeBoxMesh), antenna (makeAntennaMesh) "
                  "or snail (makeSnailMesh)")
       ->check(CLI::IsMember({"beam", "box", "antenna", "snail"}));
-  app.add_option("--cells", cells,
+  app.add_option("--cells", options.cells,
                  "with --generate: beam cells along the length (default 20), box cells per axis (default 4), "
                  "antenna rod cells (default 8) or snail tentacle cells (default 6)")
       ->check(asyncfem::cli::inRange(1, 1000));
-  std::vector<int> blockCells;
-  app.add_option("--block-cells", blockCells,
+  app.add_option("--block-cells", options.blockCells,
                  "with --generate antenna: the block's cells along x, y (up) and z "
                  "(default 10 4 10)")
       ->expected(3)
       ->check(asyncfem::cli::inRange(1, 1000));
-  app.add_flag("--json", json, "print a JSON object instead of text");
-  app.add_option("--write", output, "also write the mesh to OUT.veg or OUT.vtu");
-  if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "meshInfo")) return *status;
-  // Checked before any work, so a typo does not cost a mesh generation or read.
-  const std::string extension = std::filesystem::path(output).extension().string();
-  if (!output.empty() && extension != ".veg" && extension != ".vtu") {
-    throw asyncfem::cli::UsageError("--write: cannot write '" + output + "': unknown extension '" + extension +
+  app.add_flag("--json", options.json, "print a JSON object instead of text");
+  app.add_option("--write", options.output, "also write the mesh to OUT.veg or OUT.vtu");
+}
+
+/// Checked before any work, so a typo does not cost a mesh generation or read.
+void checkOptions(const Options& options) {
+  const std::string extension = std::filesystem::path(options.output).extension().string();
+  if (!options.output.empty() && extension != ".veg" && extension != ".vtu") {
+    throw asyncfem::cli::UsageError("--write: cannot write '" + options.output + "': unknown extension '" + extension +
                                     "' (supported: .veg, .vtu)");
   }
-  if (input.empty() == generate.empty())
+  if (options.input.empty() == options.generate.empty())
     throw asyncfem::Error("give either a mesh file or --generate beam|box|antenna|snail (see --help)");
-  if (cells != 0 && generate.empty()) throw asyncfem::Error("--cells only applies to --generate");
-  if (!blockCells.empty() && generate != "antenna")
+  if (options.cells != 0 && options.generate.empty()) throw asyncfem::Error("--cells only applies to --generate");
+  if (!options.blockCells.empty() && options.generate != "antenna")
     throw asyncfem::Error("--block-cells only applies to --generate antenna");
+}
 
-  TetMesh mesh;
-  asyncfem::MeshReadReport report;
-  std::string source = input;
-  if (!generate.empty()) report.format = "generated";
-  if (generate == "beam") {
+/// The mesh --generate names, with its description in source.
+TetMesh generateMesh(const Options& options, std::string& source) {
+  const int cells = options.cells;
+  if (options.generate == "beam") {
     asyncfem::BeamSpec spec;
     if (cells > 0) spec.cellsAlongLength = cells;
-    mesh = asyncfem::makeBeamMesh(spec);
     source = "generated beam, " + std::to_string(spec.cellsAlongLength) + " cells along the length";
-  } else if (generate == "box") {
+    return asyncfem::makeBeamMesh(spec);
+  }
+  if (options.generate == "box") {
     asyncfem::BoxMeshSpec spec;
     if (cells > 0) spec.cells = Eigen::Vector3i::Constant(cells);
-    mesh = asyncfem::makeBoxMesh(spec);
     source = "generated box, " + std::to_string(spec.cells.x()) + " cells per axis";
-  } else if (generate == "antenna") {
+    return asyncfem::makeBoxMesh(spec);
+  }
+  if (options.generate == "antenna") {
     asyncfem::AntennaSpec spec;
     if (cells > 0) spec.rodCells = cells;
-    if (!blockCells.empty()) spec.blockCells = Eigen::Vector3i(blockCells[0], blockCells[1], blockCells[2]);
-    mesh = asyncfem::makeAntennaMesh(spec);
+    const std::vector<int>& block = options.blockCells;
+    if (!block.empty()) spec.blockCells = Eigen::Vector3i(block[0], block[1], block[2]);
     source = "generated antenna on a block, rod of " + std::to_string(spec.rodCells) + " cells";
-  } else if (generate == "snail") {
-    asyncfem::SnailSpec spec;
-    if (cells > 0) spec.tentacleCells = cells;
-    mesh = asyncfem::makeSnailMesh(spec);
-    source = "generated snail, tentacles of " + std::to_string(spec.tentacleCells) + " cells";
+    return asyncfem::makeAntennaMesh(spec);
+  }
+  asyncfem::SnailSpec spec;
+  if (cells > 0) spec.tentacleCells = cells;
+  source = "generated snail, tentacles of " + std::to_string(spec.tentacleCells) + " cells";
+  return asyncfem::makeSnailMesh(spec);
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{
+      "Print the contents of a tetrahedral mesh (.veg, TetGen .node/.ele, Gmsh .msh), "
+      "or generate a beam, box, antenna or snail mesh."};
+  Options options;
+  addOptions(app, options);
+  if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "meshInfo")) return *status;
+  checkOptions(options);
+
+  asyncfem::MeshReadReport report;
+  std::string source = options.input;
+  TetMesh mesh;
+  if (!options.generate.empty()) {
+    report.format = "generated";
+    mesh = generateMesh(options, source);
   } else {
-    mesh = asyncfem::readMesh(input, {}, &report);
+    mesh = asyncfem::readMesh(options.input, {}, &report);
   }
   for (const std::string& warning : report.warnings) std::cerr << "meshInfo: warning: " << warning << '\n';
 
   const nlohmann::json description = describe(mesh, source, report);
-  if (json) {
+  if (options.json) {
     std::cout << description.dump(2) << '\n';
   } else {
     printText(description);
   }
-  if (!output.empty()) {
-    const std::string extension = std::filesystem::path(output).extension().string();
-    if (extension == ".veg") {
-      asyncfem::writeVeg(output, mesh);
+  if (!options.output.empty()) {
+    if (std::filesystem::path(options.output).extension() == ".veg") {
+      asyncfem::writeVeg(options.output, mesh);
     } else {
-      asyncfem::writeVtu(output, mesh);
+      asyncfem::writeVtu(options.output, mesh);
     }
   }
   return 0;

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/render/camera.hpp>
+#include <asyncfem/render/renderer.hpp>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace asyncfem {
@@ -11,6 +13,17 @@ namespace asyncfem {
 namespace {
 
 double tanHalfAngle(double degrees) { return std::tan(0.5 * degrees * std::numbers::pi / 180.0); }
+
+/// 1, 2 or 5 times a power of ten, near x.
+double roundLength(double x) {
+  const double power = std::pow(10.0, std::floor(std::log10(x)));
+  for (const double m : {1.0, 2.0, 5.0}) {
+    if (m * power >= 0.7 * x) {
+      return m * power;
+    }
+  }
+  return 10.0 * power;
+}
 
 }  // namespace
 
@@ -63,10 +76,7 @@ Camera fitCamera(const BoundingBox& box, double aspect, const Eigen::Vector3d& v
   double distance = 0.0;
   const double diagonal = (box.max - box.min).norm();
   for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d c =
-        Eigen::Vector3d((corner & 1) != 0 ? box.max.x() : box.min.x(), (corner & 2) != 0 ? box.max.y() : box.min.y(),
-                        (corner & 4) != 0 ? box.max.z() : box.min.z()) -
-        center;
+    const Eigen::Vector3d c = boxCorner(box, corner) - center;
     const double depth = back.dot(c);
     distance = std::max(distance, depth + std::abs(side.dot(c)) / halfWidth);
     distance = std::max(distance, depth + std::abs(upward.dot(c)) / halfHeight);
@@ -81,6 +91,18 @@ Camera fitCamera(const BoundingBox& box, double aspect, const Eigen::Vector3d& v
   camera.up = up;
   camera.verticalFieldOfViewDegrees = verticalFieldOfViewDegrees;
   return camera;
+}
+
+GroundPlane groundBelow(const BoundingBox& box, const Eigen::Vector3d& up) {
+  const double diagonal = std::max((box.max - box.min).norm(), 1e-12);
+  const Eigen::Vector3d center = 0.5 * (box.min + box.max);
+  const Eigen::Vector3d n = up.normalized();
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int corner = 0; corner < 8; ++corner) {
+    lowest = std::min(lowest, n.dot(boxCorner(box, corner)));
+  }
+  return GroundPlane{center + ((lowest - n.dot(center) - (0.02 * diagonal)) * n), 4.0 * diagonal,
+                     roundLength(diagonal / 6.0), true};
 }
 
 }  // namespace asyncfem

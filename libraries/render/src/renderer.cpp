@@ -13,6 +13,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <utility>
 
 #if defined(ASYNCFEM_SANITIZE)
 // LeakSanitizer: Mesa's OSMesa keeps per-context and per-thread state that
@@ -108,6 +109,40 @@ struct CornerArrays {
   GLsizei count() const { return static_cast<GLsizei>(positions.size() / 3); }
 };
 
+/// The triangles around each vertex of a surface, in compressed rows: those around vertex
+/// v are incident[offsets[v]] .. incident[offsets[v + 1] - 1], in increasing order.
+struct VertexTriangles {
+  std::vector<int> offsets;
+  std::vector<int> incident;
+};
+
+/// Checks that every triangle names a vertex in [0, m) and lists the triangles around
+/// each vertex.
+VertexTriangles vertexTriangles(const std::vector<std::array<int, 3>>& triangles, Eigen::Index m) {
+  VertexTriangles around;
+  around.offsets.assign(static_cast<std::size_t>(m) + 1, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    for (const int v : triangles[t]) {
+      if (v < 0 || v >= m) {
+        throw Error("OffscreenRenderer: triangle " + std::to_string(t) + " names vertex " + std::to_string(v) +
+                    ", out of range [0, " + std::to_string(m) + ")");
+      }
+      ++around.offsets[static_cast<std::size_t>(v) + 1];
+    }
+  }
+  for (std::size_t v = 1; v < around.offsets.size(); ++v) {
+    around.offsets[v] += around.offsets[v - 1];
+  }
+  std::vector<int> cursor(around.offsets.begin(), around.offsets.end() - 1);
+  around.incident.resize(static_cast<std::size_t>(around.offsets.back()));
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    for (const int v : triangles[t]) {
+      around.incident[static_cast<std::size_t>(cursor[static_cast<std::size_t>(v)]++)] = static_cast<int>(t);
+    }
+  }
+  return around;
+}
+
 /// Per-corner normals: the corner of triangle t at vertex v gets the area-weighted sum of
 /// the normals of the triangles around v that are within the crease angle of t.
 void appendSurface(const DrawSurface& surface, const Eigen::Vector3f& defaultColor, double creaseAngleDegrees,
@@ -117,33 +152,16 @@ void appendSurface(const DrawSurface& surface, const Eigen::Vector3f& defaultCol
     throw Error("OffscreenRenderer: " + std::to_string(surface.colors->cols()) + " colours for " + std::to_string(m) +
                 " vertices");
   }
+  const VertexTriangles around = vertexTriangles(surface.triangles, m);
   const std::size_t numTriangles = surface.triangles.size();
   std::vector<Eigen::Vector3d> areaNormals(numTriangles);
   std::vector<Eigen::Vector3d> unitNormals(numTriangles);
-  std::vector<int> offsets(static_cast<std::size_t>(m) + 1, 0);
   for (std::size_t t = 0; t < numTriangles; ++t) {
     const auto& tri = surface.triangles[t];
-    for (const int v : tri) {
-      if (v < 0 || v >= m) {
-        throw Error("OffscreenRenderer: triangle " + std::to_string(t) + " names vertex " + std::to_string(v) +
-                    ", out of range [0, " + std::to_string(m) + ")");
-      }
-      ++offsets[static_cast<std::size_t>(v) + 1];
-    }
     const Eigen::Vector3d a = surface.positions.col(tri[0]);
     areaNormals[t] = (surface.positions.col(tri[1]) - a).cross(surface.positions.col(tri[2]) - a);
     const double length = areaNormals[t].norm();
     unitNormals[t] = length > 0.0 ? Eigen::Vector3d(areaNormals[t] / length) : Eigen::Vector3d::Zero();
-  }
-  for (std::size_t v = 1; v < offsets.size(); ++v) {
-    offsets[v] += offsets[v - 1];
-  }
-  std::vector<int> cursor(offsets.begin(), offsets.end() - 1);
-  std::vector<int> incident(static_cast<std::size_t>(offsets.back()));
-  for (std::size_t t = 0; t < numTriangles; ++t) {
-    for (const int v : surface.triangles[t]) {
-      incident[static_cast<std::size_t>(cursor[static_cast<std::size_t>(v)]++)] = static_cast<int>(t);
-    }
   }
   const double cosCrease = std::cos(creaseAngleDegrees * std::numbers::pi / 180.0);
   out.positions.reserve(out.positions.size() + (9 * numTriangles));
@@ -152,8 +170,9 @@ void appendSurface(const DrawSurface& surface, const Eigen::Vector3f& defaultCol
   for (std::size_t t = 0; t < numTriangles; ++t) {
     for (const int v : surface.triangles[t]) {
       Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-      for (int s = offsets[static_cast<std::size_t>(v)]; s < offsets[static_cast<std::size_t>(v) + 1]; ++s) {
-        const auto f = static_cast<std::size_t>(incident[static_cast<std::size_t>(s)]);
+      for (int s = around.offsets[static_cast<std::size_t>(v)]; s < around.offsets[static_cast<std::size_t>(v) + 1];
+           ++s) {
+        const auto f = static_cast<std::size_t>(around.incident[static_cast<std::size_t>(s)]);
         if (unitNormals[f].dot(unitNormals[t]) >= cosCrease) {
           normal += areaNormals[f];
         }
@@ -164,6 +183,90 @@ void appendSurface(const DrawSurface& surface, const Eigen::Vector3f& defaultCol
       out.add(surface.positions.col(v), normal, color);
     }
   }
+}
+
+/// Appends the ground's checker tiles as pairs of triangles in the plane through its
+/// centre normal to up (unit); returns the four corners of the plane.
+std::array<Eigen::Vector3d, 4> appendGround(const GroundPlane& g, const Eigen::Vector3d& up,
+                                            const std::array<Eigen::Vector3f, 2>& colors, CornerArrays& out) {
+  const Eigen::Vector3d u = up.unitOrthogonal();
+  const Eigen::Vector3d w = up.cross(u);
+  const int tiles = std::clamp(static_cast<int>(std::ceil(2.0 * g.halfSize / g.tileSize)), 1, 400);
+  const double tile = 2.0 * g.halfSize / tiles;
+  const Eigen::Vector3d origin = g.center - (g.halfSize * u) - (g.halfSize * w);
+  for (int i = 0; i < tiles; ++i) {
+    for (int j = 0; j < tiles; ++j) {
+      const Eigen::Vector3f& color = colors[static_cast<std::size_t>((i + j) % 2)];
+      const Eigen::Vector3d p00 = origin + (i * tile * u) + (j * tile * w);
+      const Eigen::Vector3d p10 = p00 + (tile * u);
+      const Eigen::Vector3d p01 = p00 + (tile * w);
+      const Eigen::Vector3d p11 = p10 + (tile * w);
+      for (const Eigen::Vector3d& p : {p00, p10, p11, p00, p11, p01}) {
+        out.add(p, up, color);
+      }
+    }
+  }
+  return {origin, origin + (2.0 * g.halfSize * u), origin + (2.0 * g.halfSize * w),
+          origin + (2.0 * g.halfSize * (u + w))};
+}
+
+/// Near and far distances that bracket every surface vertex and, when given, the ground's
+/// corners (so depth precision follows the scene).
+std::pair<double, double> depthRange(const Eigen::Matrix4d& view, const std::vector<DrawSurface>& surfaces,
+                                     const std::array<Eigen::Vector3d, 4>* groundCorners) {
+  double nearest = std::numeric_limits<double>::infinity();
+  double farthest = 0.0;
+  const auto extendDepth = [&](const Eigen::Vector3d& p) {
+    const double depth = -(view.block<1, 3>(2, 0).dot(p) + view(2, 3));
+    nearest = std::min(nearest, depth);
+    farthest = std::max(farthest, depth);
+  };
+  for (const DrawSurface& surface : surfaces) {
+    for (Eigen::Index k = 0; k < surface.positions.cols(); ++k) {
+      extendDepth(surface.positions.col(k));
+    }
+  }
+  if (groundCorners != nullptr) {
+    for (const Eigen::Vector3d& p : *groundCorners) {
+      extendDepth(p);
+    }
+  }
+  if (!(farthest > 0.0)) {
+    farthest = 1.0;
+  }
+  const double farDistance = farthest * 1.05;
+  const double nearDistance = std::max(nearest * 0.95, farDistance * 1e-4);
+  return {nearDistance, farDistance};
+}
+
+/// Box-filters s x s blocks of the RGBA buffer ((s width) x (s height), top row first)
+/// into a width x height RGB image.
+Image downsample(const std::vector<GLubyte>& buffer, int width, int height, int s) {
+  Image image;
+  image.width = width;
+  image.height = height;
+  image.pixels.resize(3 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  const auto rowBytes = static_cast<std::size_t>(4 * width * s);
+  const int samples = s * s;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      int sum[3] = {0, 0, 0};
+      for (int dy = 0; dy < s; ++dy) {
+        const GLubyte* row = buffer.data() + (static_cast<std::size_t>((y * s) + dy) * rowBytes);
+        for (int dx = 0; dx < s; ++dx) {
+          const GLubyte* p = row + (4 * static_cast<std::size_t>((x * s) + dx));
+          sum[0] += p[0];
+          sum[1] += p[1];
+          sum[2] += p[2];
+        }
+      }
+      std::uint8_t* out = image.pixel(x, y);
+      for (int c = 0; c < 3; ++c) {
+        out[c] = static_cast<std::uint8_t>((sum[c] + (samples / 2)) / samples);
+      }
+    }
+  }
+  return image;
 }
 
 void drawCorners(const CornerArrays& arrays) {
@@ -217,6 +320,61 @@ struct OffscreenRenderer::Impl {
     flatShadingLocation = glGetUniformLocation(program, "flatShading");
     flatColorLocation = glGetUniformLocation(program, "flatColor");
   }
+
+  /// Makes the context current and clears it; sets the matrices, the depth test, the
+  /// shading program and the vertex arrays every frame uses.
+  void beginFrame(const Eigen::Vector3f& background, const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view) {
+    makeCurrent();
+    glViewport(0, 0, bufferWidth(), bufferHeight());
+    glClearColor(background.x(), background.y(), background.z(), 1.0F);
+    glClearStencil(0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixd(projection.data());
+    glMatrixMode(GL_MODELVIEW);
+    glLoadMatrixd(view.data());
+    glUseProgram(program);
+    glUniform1i(flatShadingLocation, 0);
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glEnableClientState(GL_NORMAL_ARRAY);
+    glEnableClientState(GL_COLOR_ARRAY);
+  }
+
+  /// Draws the ground and, if it has one, the surfaces' shadow on it. The ground marks its
+  /// pixels in the stencil buffer (1) so that the shadow darkens each ground pixel once (2)
+  /// and nothing else.
+  void drawGround(const GroundPlane& plane, const Eigen::Vector3d& up, const Eigen::Matrix4d& view) {
+    glEnable(GL_STENCIL_TEST);
+    glStencilFunc(GL_ALWAYS, 1, 0xFF);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+    drawCorners(ground);
+    if (plane.shadow && surfaces.count() > 0) {
+      // Flatten the surfaces onto the plane n.x = d along n: x' = x - (n.x - d) n.
+      const double d = up.dot(plane.center);
+      Eigen::Matrix4d flatten = Eigen::Matrix4d::Identity();
+      flatten.block<3, 3>(0, 0) -= up * up.transpose();
+      flatten.block<3, 1>(0, 3) = d * up;
+      const Eigen::Matrix4d shadowView = view * flatten;
+      glLoadMatrixd(shadowView.data());
+      glStencilFunc(GL_EQUAL, 1, 0xFF);
+      glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+      glEnable(GL_BLEND);
+      glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+      glEnable(GL_POLYGON_OFFSET_FILL);
+      glPolygonOffset(-1.0F, -1.0F);
+      glUniform1i(flatShadingLocation, 1);
+      glUniform4f(flatColorLocation, 0.15F, 0.15F, 0.17F, 0.35F);
+      drawCorners(surfaces);
+      glUniform1i(flatShadingLocation, 0);
+      glDisable(GL_POLYGON_OFFSET_FILL);
+      glDisable(GL_BLEND);
+      glLoadMatrixd(view.data());
+    }
+    glDisable(GL_STENCIL_TEST);
+  }
 };
 
 OffscreenRenderer::OffscreenRenderer(int width, int height, int supersampling) : impl_(std::make_unique<Impl>()) {
@@ -255,108 +413,19 @@ Image OffscreenRenderer::render(const std::vector<DrawSurface>& surfaces, const 
     appendSurface(surface, style.surfaceColor, style.creaseAngleDegrees, impl.surfaces);
   }
   const Eigen::Vector3d up = camera.up.normalized();
-
-  // Ground: checker tiles as pairs of triangles in the plane through center normal to up.
   impl.ground.clear();
   std::array<Eigen::Vector3d, 4> groundCorners;
   if (style.ground) {
-    const GroundPlane& g = *style.ground;
-    const Eigen::Vector3d u = up.unitOrthogonal();
-    const Eigen::Vector3d w = up.cross(u);
-    const int tiles = std::clamp(static_cast<int>(std::ceil(2.0 * g.halfSize / g.tileSize)), 1, 400);
-    const double tile = 2.0 * g.halfSize / tiles;
-    const Eigen::Vector3d origin = g.center - (g.halfSize * u) - (g.halfSize * w);
-    for (int i = 0; i < tiles; ++i) {
-      for (int j = 0; j < tiles; ++j) {
-        const Eigen::Vector3f& color = style.groundColors[static_cast<std::size_t>((i + j) % 2)];
-        const Eigen::Vector3d p00 = origin + (i * tile * u) + (j * tile * w);
-        const Eigen::Vector3d p10 = p00 + (tile * u);
-        const Eigen::Vector3d p01 = p00 + (tile * w);
-        const Eigen::Vector3d p11 = p10 + (tile * w);
-        for (const Eigen::Vector3d& p : {p00, p10, p11, p00, p11, p01}) {
-          impl.ground.add(p, up, color);
-        }
-      }
-    }
-    groundCorners = {origin, origin + (2.0 * g.halfSize * u), origin + (2.0 * g.halfSize * w),
-                     origin + (2.0 * g.halfSize * (u + w))};
+    groundCorners = appendGround(*style.ground, up, style.groundColors, impl.ground);
   }
-
-  // Near and far planes bracket everything drawn (depth precision follows the scene).
   const Eigen::Matrix4d view = viewMatrix(camera);
-  double nearest = std::numeric_limits<double>::infinity();
-  double farthest = 0.0;
-  const auto extendDepth = [&](const Eigen::Vector3d& p) {
-    const double depth = -(view.block<1, 3>(2, 0).dot(p) + view(2, 3));
-    nearest = std::min(nearest, depth);
-    farthest = std::max(farthest, depth);
-  };
-  for (const DrawSurface& surface : surfaces) {
-    for (Eigen::Index k = 0; k < surface.positions.cols(); ++k) {
-      extendDepth(surface.positions.col(k));
-    }
-  }
-  if (style.ground) {
-    for (const Eigen::Vector3d& p : groundCorners) {
-      extendDepth(p);
-    }
-  }
-  if (!(farthest > 0.0)) {
-    farthest = 1.0;
-  }
-  const double farDistance = farthest * 1.05;
-  const double nearDistance = std::max(nearest * 0.95, farDistance * 1e-4);
+  const auto [nearDistance, farDistance] = depthRange(view, surfaces, style.ground ? &groundCorners : nullptr);
   const Eigen::Matrix4d projection =
       projectionMatrix(camera, static_cast<double>(impl.width) / impl.height, nearDistance, farDistance);
 
-  impl.makeCurrent();
-  glViewport(0, 0, impl.bufferWidth(), impl.bufferHeight());
-  glClearColor(style.background.x(), style.background.y(), style.background.z(), 1.0F);
-  glClearStencil(0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDisable(GL_CULL_FACE);
-  glMatrixMode(GL_PROJECTION);
-  glLoadMatrixd(projection.data());
-  glMatrixMode(GL_MODELVIEW);
-  glLoadMatrixd(view.data());
-  glUseProgram(impl.program);
-  glUniform1i(impl.flatShadingLocation, 0);
-  glEnableClientState(GL_VERTEX_ARRAY);
-  glEnableClientState(GL_NORMAL_ARRAY);
-  glEnableClientState(GL_COLOR_ARRAY);
-
+  impl.beginFrame(style.background, projection, view);
   if (style.ground) {
-    // The ground marks its pixels in the stencil buffer (1) so that the shadow darkens
-    // each ground pixel once (2) and nothing else.
-    glEnable(GL_STENCIL_TEST);
-    glStencilFunc(GL_ALWAYS, 1, 0xFF);
-    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
-    drawCorners(impl.ground);
-    if (style.ground->shadow && impl.surfaces.count() > 0) {
-      // Flatten the surfaces onto the plane n.x = d along n: x' = x - (n.x - d) n.
-      const double d = up.dot(style.ground->center);
-      Eigen::Matrix4d flatten = Eigen::Matrix4d::Identity();
-      flatten.block<3, 3>(0, 0) -= up * up.transpose();
-      flatten.block<3, 1>(0, 3) = d * up;
-      const Eigen::Matrix4d shadowView = view * flatten;
-      glLoadMatrixd(shadowView.data());
-      glStencilFunc(GL_EQUAL, 1, 0xFF);
-      glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
-      glEnable(GL_BLEND);
-      glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-      glEnable(GL_POLYGON_OFFSET_FILL);
-      glPolygonOffset(-1.0F, -1.0F);
-      glUniform1i(impl.flatShadingLocation, 1);
-      glUniform4f(impl.flatColorLocation, 0.15F, 0.15F, 0.17F, 0.35F);
-      drawCorners(impl.surfaces);
-      glUniform1i(impl.flatShadingLocation, 0);
-      glDisable(GL_POLYGON_OFFSET_FILL);
-      glDisable(GL_BLEND);
-      glLoadMatrixd(view.data());
-    }
-    glDisable(GL_STENCIL_TEST);
+    impl.drawGround(*style.ground, up, view);
   }
   drawCorners(impl.surfaces);
   glFinish();
@@ -364,34 +433,7 @@ Image OffscreenRenderer::render(const std::vector<DrawSurface>& surfaces, const 
   if (glError != GL_NO_ERROR) {
     throw Error("OffscreenRenderer: OpenGL error " + std::to_string(glError));
   }
-
-  // Box-filter s x s blocks of the RGBA buffer into the RGB image.
-  Image image;
-  image.width = impl.width;
-  image.height = impl.height;
-  image.pixels.resize(3 * static_cast<std::size_t>(impl.width) * static_cast<std::size_t>(impl.height));
-  const int s = impl.supersampling;
-  const auto rowBytes = static_cast<std::size_t>(4 * impl.bufferWidth());
-  const int samples = s * s;
-  for (int y = 0; y < impl.height; ++y) {
-    for (int x = 0; x < impl.width; ++x) {
-      int sum[3] = {0, 0, 0};
-      for (int dy = 0; dy < s; ++dy) {
-        const GLubyte* row = impl.buffer.data() + (static_cast<std::size_t>((y * s) + dy) * rowBytes);
-        for (int dx = 0; dx < s; ++dx) {
-          const GLubyte* p = row + (4 * static_cast<std::size_t>((x * s) + dx));
-          sum[0] += p[0];
-          sum[1] += p[1];
-          sum[2] += p[2];
-        }
-      }
-      std::uint8_t* out = image.pixel(x, y);
-      for (int c = 0; c < 3; ++c) {
-        out[c] = static_cast<std::uint8_t>((sum[c] + (samples / 2)) / samples);
-      }
-    }
-  }
-  return image;
+  return downsample(impl.buffer, impl.width, impl.height, impl.supersampling);
 }
 
 }  // namespace asyncfem

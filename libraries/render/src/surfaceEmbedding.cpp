@@ -56,13 +56,54 @@ Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Ve
 class ElementGrid {
  public:
   explicit ElementGrid(const TetMesh& mesh) : mesh_(mesh) {
-    const int numElements = mesh.numElements();
+    const Eigen::Vector3d upper = measureElements();
+    chooseCells(upper);
+    fillCells();
+    visited_.assign(static_cast<std::size_t>(mesh.numElements()), -1);
+  }
+
+  /// Barycentric coordinates of p in element e (sum 1).
+  Eigen::Vector4d barycentric(int e, const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d l = inverses_[static_cast<std::size_t>(e)] * (p - mesh_.restPosition(mesh_.elements()(0, e)));
+    return {1.0 - l.sum(), l.x(), l.y(), l.z()};
+  }
+
+  /// Euclidean distance from p to element e (0 inside).
+  double distance(int e, const Eigen::Vector3d& p) const {
+    if (barycentric(e, p).minCoeff() >= 0.0) {
+      return 0.0;
+    }
+    const Eigen::Matrix<double, 3, 4> x = mesh_.elementRestPositions(e);
+    double best = std::numeric_limits<double>::infinity();
+    constexpr int faces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+    for (const auto& f : faces) {
+      best = std::min(best, (p - closestPointOnTriangle(p, x.col(f[0]), x.col(f[1]), x.col(f[2]))).norm());
+    }
+    return best;
+  }
+
+  /// The element containing p (largest smallest barycentric coordinate among the
+  /// candidates, ties to the lower id) or else the nearest one; its distance in *dist.
+  int locate(const Eigen::Vector3d& p, int stamp, double* dist) {
+    const Eigen::Vector3i center = cellOf(p);
+    const int containing = containingElement(center, p);
+    if (containing >= 0) {
+      *dist = 0.0;
+      return containing;
+    }
+    return nearestElement(center, p, stamp, dist);
+  }
+
+ private:
+  /// Element boxes and inverse edge matrices, and lower_; returns the upper corner of all boxes.
+  Eigen::Vector3d measureElements() {
+    const int numElements = mesh_.numElements();
     lower_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     Eigen::Vector3d upper = -lower_;
     boxes_.resize(static_cast<std::size_t>(numElements));
     inverses_.resize(static_cast<std::size_t>(numElements));
     for (int e = 0; e < numElements; ++e) {
-      const Eigen::Matrix<double, 3, 4> x = mesh.elementRestPositions(e);
+      const Eigen::Matrix<double, 3, 4> x = mesh_.elementRestPositions(e);
       boxes_[static_cast<std::size_t>(e)] = {x.rowwise().minCoeff(), x.rowwise().maxCoeff()};
       lower_ = lower_.cwiseMin(boxes_[static_cast<std::size_t>(e)].min);
       upper = upper.cwiseMax(boxes_[static_cast<std::size_t>(e)].max);
@@ -70,13 +111,22 @@ class ElementGrid {
       edges << x.col(1) - x.col(0), x.col(2) - x.col(0), x.col(3) - x.col(0);
       inverses_[static_cast<std::size_t>(e)] = edges.inverse();
     }
-    // About one element per cell, at most 256 cells per axis.
+    return upper;
+  }
+
+  /// Cell size and counts: about one element per cell, at most 256 cells per axis.
+  void chooseCells(const Eigen::Vector3d& upper) {
     const Eigen::Vector3d extent = (upper - lower_).cwiseMax(1e-12 * std::max(1.0, (upper - lower_).norm()));
-    cellSize_ = std::cbrt(extent.prod() / std::max(1, numElements));
+    cellSize_ = std::cbrt(extent.prod() / std::max(1, mesh_.numElements()));
     cellSize_ = std::max({cellSize_, extent.maxCoeff() / 256.0, 1e-300});
     for (int k = 0; k < 3; ++k) {
       cells_[k] = std::max(1, static_cast<int>(std::ceil(extent[k] / cellSize_)));
     }
+  }
+
+  /// Lists every element in each cell its box overlaps: counts in a first pass, fills in a second.
+  void fillCells() {
+    const int numElements = mesh_.numElements();
     std::vector<int> counts(static_cast<std::size_t>(cells_[0]) * cells_[1] * cells_[2] + 1, 0);
     for (int pass = 0; pass < 2; ++pass) {
       for (int e = 0; e < numElements; ++e) {
@@ -104,33 +154,11 @@ class ElementGrid {
         cellElements_.resize(static_cast<std::size_t>(counts.back()));
       }
     }
-    visited_.assign(static_cast<std::size_t>(numElements), -1);
   }
 
-  /// Barycentric coordinates of p in element e (sum 1).
-  Eigen::Vector4d barycentric(int e, const Eigen::Vector3d& p) const {
-    const Eigen::Vector3d l = inverses_[static_cast<std::size_t>(e)] * (p - mesh_.restPosition(mesh_.elements()(0, e)));
-    return {1.0 - l.sum(), l.x(), l.y(), l.z()};
-  }
-
-  /// Euclidean distance from p to element e (0 inside).
-  double distance(int e, const Eigen::Vector3d& p) const {
-    if (barycentric(e, p).minCoeff() >= 0.0) {
-      return 0.0;
-    }
-    const Eigen::Matrix<double, 3, 4> x = mesh_.elementRestPositions(e);
-    double best = std::numeric_limits<double>::infinity();
-    constexpr int faces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-    for (const auto& f : faces) {
-      best = std::min(best, (p - closestPointOnTriangle(p, x.col(f[0]), x.col(f[1]), x.col(f[2]))).norm());
-    }
-    return best;
-  }
-
-  /// The element containing p (largest smallest barycentric coordinate among the
-  /// candidates, ties to the lower id) or else the nearest one; its distance in *dist.
-  int locate(const Eigen::Vector3d& p, int stamp, double* dist) {
-    const Eigen::Vector3i center = cellOf(p);
+  /// The element of center's cell that contains p (largest smallest barycentric
+  /// coordinate, ties to the lower id), or -1.
+  int containingElement(const Eigen::Vector3i& center, const Eigen::Vector3d& p) const {
     int best = -1;
     double bestScore = -std::numeric_limits<double>::infinity();
     for (std::size_t s = offsets_[cellIndex(center)]; s < static_cast<std::size_t>(offsets_[cellIndex(center) + 1]);
@@ -142,13 +170,13 @@ class ElementGrid {
         best = e;
       }
     }
-    if (best >= 0 && bestScore >= 0.0) {
-      *dist = 0.0;
-      return best;
-    }
-    // Outside every element: nearest element by rings of cells around p's cell, until
-    // the unexamined cells are provably farther than the best element found.
-    best = -1;
+    return best >= 0 && bestScore >= 0.0 ? best : -1;
+  }
+
+  /// The element nearest to p (outside every element), by rings of cells around p's cell
+  /// until the unexamined cells are provably farther than the best element found.
+  int nearestElement(const Eigen::Vector3i& center, const Eigen::Vector3d& p, int stamp, double* dist) {
+    int best = -1;
     double bestDistance = std::numeric_limits<double>::infinity();
     for (int ring = 0;; ++ring) {
       for (int i = center.x() - ring; i <= center.x() + ring; ++i) {
@@ -176,28 +204,30 @@ class ElementGrid {
           }
         }
       }
-      // Unexamined elements lie beyond the covered block of cells along some axis.
-      double bound = std::numeric_limits<double>::infinity();
-      for (int axis = 0; axis < 3; ++axis) {
-        if (center[axis] - ring > 0) {
-          bound = std::min(bound, std::max(0.0, p[axis] - (lower_[axis] + (center[axis] - ring) * cellSize_)));
-        }
-        if (center[axis] + ring + 1 < cells_[axis]) {
-          bound = std::min(bound, std::max(0.0, (lower_[axis] + (center[axis] + ring + 1) * cellSize_) - p[axis]));
-        }
-      }
-      if (best >= 0 && bestDistance <= bound) {
-        break;
-      }
-      if (bound == std::numeric_limits<double>::infinity()) {
-        break;  // every cell examined
+      const double bound = unexaminedDistance(center, ring, p);
+      if ((best >= 0 && bestDistance <= bound) || bound == std::numeric_limits<double>::infinity()) {
+        break;  // nothing closer is left, or every cell was examined
       }
     }
     *dist = bestDistance;
     return best;
   }
 
- private:
+  /// A lower bound on the distance from p to elements outside the block of cells within
+  /// ring of center: they lie beyond the block along some axis (infinity: no cell is left).
+  double unexaminedDistance(const Eigen::Vector3i& center, int ring, const Eigen::Vector3d& p) const {
+    double bound = std::numeric_limits<double>::infinity();
+    for (int axis = 0; axis < 3; ++axis) {
+      if (center[axis] - ring > 0) {
+        bound = std::min(bound, std::max(0.0, p[axis] - (lower_[axis] + (center[axis] - ring) * cellSize_)));
+      }
+      if (center[axis] + ring + 1 < cells_[axis]) {
+        bound = std::min(bound, std::max(0.0, (lower_[axis] + (center[axis] + ring + 1) * cellSize_) - p[axis]));
+      }
+    }
+    return bound;
+  }
+
   Eigen::Vector3i cellOf(const Eigen::Vector3d& p) const {
     Eigen::Vector3i cell;
     for (int k = 0; k < 3; ++k) {

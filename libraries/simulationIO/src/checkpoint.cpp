@@ -59,16 +59,9 @@ class Descriptor {
   int fd_;
 };
 
-}  // namespace
-
-std::filesystem::path checkpointPathFor(const std::filesystem::path& outputPath) {
-  std::filesystem::path path = outputPath;
-  path += ".checkpoint";
-  return path;
-}
-
-void writeCheckpoint(const std::filesystem::path& path, const SimulationCheckpoint& checkpoint, bool sync) {
-  const std::string name = path.string();
+/// Refuses a checkpoint that cannot be stored: a bad integrator name, state vectors of
+/// different sizes, a negative frame count or non-finite values.
+void checkStorable(const std::string& name, const SimulationCheckpoint& checkpoint) {
   const std::size_t nameLength = checkpoint.integrator.size();
   if (nameLength == 0 || nameLength > maxNameLength) {
     throw Error(name + ": the integrator name must have 1 to 64 characters");
@@ -81,10 +74,14 @@ void writeCheckpoint(const std::filesystem::path& path, const SimulationCheckpoi
       !checkpoint.velocity.allFinite() || !checkpoint.internalState.allFinite()) {
     throw Error(name + ": refusing to store a negative frame count or non-finite values");
   }
+}
+
+/// The bytes of a checkpoint file: header, integrator name, the three vectors, checksum.
+std::vector<unsigned char> encodeCheckpoint(const SimulationCheckpoint& checkpoint) {
+  const std::size_t nameLength = checkpoint.integrator.size();
   const auto numDofs = static_cast<std::size_t>(checkpoint.displacement.size());
   const auto internal = static_cast<std::size_t>(checkpoint.internalState.size());
   const std::size_t total = headerBytes + paddedName(nameLength) + (8 * (2 * numDofs + internal)) + suffixBytes;
-
   std::vector<unsigned char> bytes(total, 0);
   unsigned char* out = bytes.data();
   std::memcpy(out, checkpointMagic, sizeof(checkpointMagic));
@@ -103,15 +100,21 @@ void writeCheckpoint(const std::filesystem::path& path, const SimulationCheckpoi
     for (Eigen::Index i = 0; i < values->size(); ++i, offset += 8) detail::putF64(out + offset, (*values)[i]);
   }
   detail::putU32(out + offset, crc32(out, offset));
+  return bytes;
+}
 
+/// Writes bytes to PATH.tmp (fsync'ed when sync) and renames it to path, so that path
+/// holds either the old or the new contents.
+void replaceFile(const std::filesystem::path& path, const std::vector<unsigned char>& bytes, bool sync) {
+  const std::string name = path.string();
   std::filesystem::path temporary = path;
   temporary += ".tmp";
   const std::string temporaryName = temporary.string();
   Descriptor fd(::open(temporaryName.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
   if (fd.get() < 0) throw Error(temporaryName + ": cannot create: " + systemMessage());
   std::size_t written = 0;
-  while (written < total) {
-    const ssize_t n = ::write(fd.get(), out + written, total - written);
+  while (written < bytes.size()) {
+    const ssize_t n = ::write(fd.get(), bytes.data() + written, bytes.size() - written);
     if (n < 0) {
       if (errno == EINTR) continue;
       throw Error(temporaryName + ": write failed: " + systemMessage());
@@ -125,7 +128,8 @@ void writeCheckpoint(const std::filesystem::path& path, const SimulationCheckpoi
   }
 }
 
-SimulationCheckpoint parseCheckpoint(const unsigned char* data, std::size_t size, const std::string& name) {
+/// Checks a checkpoint's fixed header: size, magic, version, header size, checksum.
+void checkCheckpointHeader(const unsigned char* data, std::size_t size, const std::string& name) {
   if (size < headerBytes) {
     throw ParseError(name, 0, "truncated checkpoint: " + std::to_string(size) + " bytes, expected at least 64");
   }
@@ -142,25 +146,40 @@ SimulationCheckpoint parseCheckpoint(const unsigned char* data, std::size_t size
   if (detail::getU32(data + offsetHeaderCrc) != crc32(data, offsetHeaderCrc)) {
     throw ParseError(name, 0, "checkpoint header checksum mismatch: the file is corrupted");
   }
-  const std::uint64_t frames = detail::getU64(data + offsetFrames);
-  const std::uint64_t numDofs = detail::getU64(data + offsetNumDofs);
-  const std::uint64_t internal = detail::getU64(data + offsetInternal);
-  const std::uint32_t nameLength = detail::getU32(data + offsetNameLength);
-  if (frames > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
+}
+
+/// The counts a checked header gives.
+struct CheckpointCounts {
+  std::uint64_t frames = 0;
+  std::uint64_t numDofs = 0;
+  std::uint64_t internal = 0;
+  std::uint32_t nameLength = 0;
+};
+
+/// Reads the counts of a checked header and checks them against each other and the file
+/// size (before anything is allocated from them), then the whole file's checksum.
+CheckpointCounts checkedCounts(const unsigned char* data, std::size_t size, const std::string& name) {
+  CheckpointCounts counts;
+  counts.frames = detail::getU64(data + offsetFrames);
+  counts.numDofs = detail::getU64(data + offsetNumDofs);
+  counts.internal = detail::getU64(data + offsetInternal);
+  counts.nameLength = detail::getU32(data + offsetNameLength);
+  if (counts.frames > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
     throw ParseError(name, 0, "checkpoint claims a negative frame count");
   }
-  if (nameLength == 0 || nameLength > maxNameLength) {
-    throw ParseError(name, 0,
-                     "checkpoint integrator name has " + std::to_string(nameLength) + " characters (expected 1 to 64)");
+  if (counts.nameLength == 0 || counts.nameLength > maxNameLength) {
+    throw ParseError(
+        name, 0,
+        "checkpoint integrator name has " + std::to_string(counts.nameLength) + " characters (expected 1 to 64)");
   }
-  // Sizes are compared with the bytes present before anything is allocated from them.
   const std::uint64_t limit = 3 * static_cast<std::uint64_t>(maxSimulationFileVertices);
-  if (numDofs > limit || numDofs % 3 != 0 || internal > 4 * limit) {
+  if (counts.numDofs > limit || counts.numDofs % 3 != 0 || counts.internal > 4 * limit) {
     throw ParseError(name, 0,
-                     "checkpoint claims " + std::to_string(numDofs) + " state entries and " + std::to_string(internal) +
-                         " internal ones");
+                     "checkpoint claims " + std::to_string(counts.numDofs) + " state entries and " +
+                         std::to_string(counts.internal) + " internal ones");
   }
-  const std::uint64_t expected = headerBytes + paddedName(nameLength) + (8 * ((2 * numDofs) + internal)) + suffixBytes;
+  const std::uint64_t expected =
+      headerBytes + paddedName(counts.nameLength) + (8 * ((2 * counts.numDofs) + counts.internal)) + suffixBytes;
   if (expected != size) {
     throw ParseError(name, 0,
                      "checkpoint is " + std::to_string(size) + " bytes, its header implies " +
@@ -170,20 +189,38 @@ SimulationCheckpoint parseCheckpoint(const unsigned char* data, std::size_t size
   if (detail::getU32(data + crcOffset) != crc32(data, crcOffset)) {
     throw ParseError(name, 0, "checkpoint checksum mismatch: the file is corrupted");
   }
+  return counts;
+}
 
+}  // namespace
+
+std::filesystem::path checkpointPathFor(const std::filesystem::path& outputPath) {
+  std::filesystem::path path = outputPath;
+  path += ".checkpoint";
+  return path;
+}
+
+void writeCheckpoint(const std::filesystem::path& path, const SimulationCheckpoint& checkpoint, bool sync) {
+  checkStorable(path.string(), checkpoint);
+  replaceFile(path, encodeCheckpoint(checkpoint), sync);
+}
+
+SimulationCheckpoint parseCheckpoint(const unsigned char* data, std::size_t size, const std::string& name) {
+  checkCheckpointHeader(data, size, name);
+  const CheckpointCounts counts = checkedCounts(data, size, name);
   SimulationCheckpoint checkpoint;
-  checkpoint.frames = static_cast<std::int64_t>(frames);
+  checkpoint.frames = static_cast<std::int64_t>(counts.frames);
   checkpoint.time = detail::getF64(data + offsetTime);
   checkpoint.fingerprint = detail::getU32(data + offsetFingerprint);
-  checkpoint.integrator.assign(reinterpret_cast<const char*>(data + headerBytes), nameLength);
-  std::size_t offset = headerBytes + paddedName(nameLength);
+  checkpoint.integrator.assign(reinterpret_cast<const char*>(data + headerBytes), counts.nameLength);
+  std::size_t offset = headerBytes + paddedName(counts.nameLength);
   const auto read = [&](Eigen::VectorXd& values, std::uint64_t count) {
     values.resize(static_cast<Eigen::Index>(count));
     for (Eigen::Index i = 0; i < values.size(); ++i, offset += 8) values[i] = detail::getF64(data + offset);
   };
-  read(checkpoint.displacement, numDofs);
-  read(checkpoint.velocity, numDofs);
-  read(checkpoint.internalState, internal);
+  read(checkpoint.displacement, counts.numDofs);
+  read(checkpoint.velocity, counts.numDofs);
+  read(checkpoint.internalState, counts.internal);
   if (!std::isfinite(checkpoint.time) || !checkpoint.displacement.allFinite() || !checkpoint.velocity.allFinite() ||
       !checkpoint.internalState.allFinite()) {
     throw ParseError(name, 0, "checkpoint holds non-finite values");

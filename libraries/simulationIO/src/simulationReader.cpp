@@ -26,16 +26,15 @@ std::string hex32(std::uint32_t value) {
   return text;
 }
 
-}  // namespace
+/// Format version and header size of a file.
+struct HeaderLayout {
+  std::uint32_t version = 0;
+  std::uint32_t headerBytes = 0;
+};
 
-SimulationReader::SimulationReader(const std::filesystem::path& path) : path_(path) {
-  const std::string name = path.string();
-  file_.reset(std::fopen(name.c_str(), "rb"));
-  if (!file_) {
-    throw Error(name + ": cannot open: " + std::strerror(errno));
-  }
-  unsigned char bytes[simulationHeaderBytes] = {};
-  const std::size_t got = std::fread(bytes, 1, sizeof(bytes), file_.get());
+/// Checks the fixed part of a header (got bytes read into bytes): the magic, its size,
+/// the format version, the header size and the checksum.
+HeaderLayout checkHeaderFrame(const std::string& name, const unsigned char* bytes, std::size_t got) {
   if (got < sizeof(detail::simulationMagic) ||
       std::memcmp(bytes, detail::simulationMagic, sizeof(detail::simulationMagic)) != 0) {
     if (got < sizeof(detail::simulationMagic)) {
@@ -45,7 +44,7 @@ SimulationReader::SimulationReader(const std::filesystem::path& path) : path_(pa
     }
     throw ParseError(name, 0, "not an AsyncFEM simulation file (bad magic)");
   }
-  if (got < sizeof(bytes)) {
+  if (got < simulationHeaderBytes) {
     throw ParseError(
         name, 0,
         "truncated header: " + std::to_string(got) + " bytes, expected " + std::to_string(simulationHeaderBytes));
@@ -72,34 +71,69 @@ SimulationReader::SimulationReader(const std::filesystem::path& path) : path_(pa
                      "header checksum mismatch (stored " + hex32(storedCrc) + ", computed " + hex32(actualCrc) +
                          "): the header is corrupted");
   }
+  return {version, headerBytes};
+}
 
-  // Sizes are checked before anything is allocated from them.
+/// Reads the vertex count, frame interval, timestep and flags of a checked header into
+/// header, and checks them and the record size. Sizes are checked before anything is
+/// allocated from them.
+void readHeaderFields(const std::string& name, const unsigned char* bytes, SimulationFileHeader& header) {
   const std::uint64_t numVertices = detail::getU64(bytes + detail::offsetNumVertices);
   if (numVertices == 0 || numVertices > static_cast<std::uint64_t>(maxSimulationFileVertices)) {
     throw ParseError(name, 0,
                      "header claims " + std::to_string(numVertices) + " vertices (expected 1 to " +
                          std::to_string(maxSimulationFileVertices) + ")");
   }
-  header_.numVertices = static_cast<std::int64_t>(numVertices);
-  header_.frameInterval = detail::getF64(bytes + detail::offsetFrameInterval);
-  header_.timestep = detail::getF64(bytes + detail::offsetTimestep);
-  if (!std::isfinite(header_.frameInterval) || header_.frameInterval < 0.0 || !std::isfinite(header_.timestep) ||
-      header_.timestep < 0.0) {
+  header.numVertices = static_cast<std::int64_t>(numVertices);
+  header.frameInterval = detail::getF64(bytes + detail::offsetFrameInterval);
+  header.timestep = detail::getF64(bytes + detail::offsetTimestep);
+  if (!std::isfinite(header.frameInterval) || header.frameInterval < 0.0 || !std::isfinite(header.timestep) ||
+      header.timestep < 0.0) {
     throw ParseError(name, 0, "header has a non-finite or negative frame interval or timestep");
   }
   const std::uint64_t flags = detail::getU64(bytes + detail::offsetFlags);
   if ((flags & ~detail::flagVelocities) != 0) {
     throw ParseError(name, 0, "header has unknown flags " + std::to_string(flags));
   }
-  header_.hasVelocities = (flags & detail::flagVelocities) != 0;
+  header.hasVelocities = (flags & detail::flagVelocities) != 0;
   const std::uint64_t recordBytes = detail::getU64(bytes + detail::offsetRecordBytes);
-  if (recordBytes != static_cast<std::uint64_t>(header_.recordBytes())) {
+  if (recordBytes != static_cast<std::uint64_t>(header.recordBytes())) {
     throw ParseError(name, 0,
                      "header record size " + std::to_string(recordBytes) + " disagrees with " +
-                         std::to_string(numVertices) + " vertices (expected " + std::to_string(header_.recordBytes()) +
+                         std::to_string(numVertices) + " vertices (expected " + std::to_string(header.recordBytes()) +
                          ")");
   }
-  if (version == 2) readSceneBlock(headerBytes);
+}
+
+/// Checks the checksum and the frame index of the record of frame k (recordBytes at in).
+void checkRecord(const std::string& name, std::int64_t k, const unsigned char* in, std::size_t recordBytes) {
+  const std::size_t crcOffset = recordBytes - detail::recordSuffixBytes;
+  const std::uint32_t storedCrc = detail::getU32(in + crcOffset);
+  const std::uint32_t actualCrc = crc32(in, crcOffset);
+  if (storedCrc != actualCrc) {
+    throw ParseError(name, 0,
+                     "frame " + std::to_string(k) + ": checksum mismatch (stored " + hex32(storedCrc) + ", computed " +
+                         hex32(actualCrc) + "): the record is corrupted");
+  }
+  const auto index = static_cast<std::int64_t>(detail::getU64(in));
+  if (index != k) {
+    throw ParseError(name, 0, "frame " + std::to_string(k) + ": record says it is frame " + std::to_string(index));
+  }
+}
+
+}  // namespace
+
+SimulationReader::SimulationReader(const std::filesystem::path& path) : path_(path) {
+  const std::string name = path.string();
+  file_.reset(std::fopen(name.c_str(), "rb"));
+  if (!file_) {
+    throw Error(name + ": cannot open: " + std::strerror(errno));
+  }
+  unsigned char bytes[simulationHeaderBytes] = {};
+  const std::size_t got = std::fread(bytes, 1, sizeof(bytes), file_.get());
+  const HeaderLayout layout = checkHeaderFrame(name, bytes, got);
+  readHeaderFields(name, bytes, header_);
+  if (layout.version == 2) readSceneBlock(layout.headerBytes);
   refresh();
 }
 
@@ -155,20 +189,8 @@ void SimulationReader::readFrame(std::int64_t k, SimulationFrame& out) {
     throw ParseError(path_.string(), 0, "frame " + std::to_string(k) + ": cannot read the record");
   }
   const unsigned char* in = buffer_.data();
-  const std::size_t crcOffset = recordBytes - detail::recordSuffixBytes;
-  const std::uint32_t storedCrc = detail::getU32(in + crcOffset);
-  const std::uint32_t actualCrc = crc32(in, crcOffset);
-  if (storedCrc != actualCrc) {
-    throw ParseError(path_.string(), 0,
-                     "frame " + std::to_string(k) + ": checksum mismatch (stored " + hex32(storedCrc) + ", computed " +
-                         hex32(actualCrc) + "): the record is corrupted");
-  }
-  const auto index = static_cast<std::int64_t>(detail::getU64(in));
-  if (index != k) {
-    throw ParseError(path_.string(), 0,
-                     "frame " + std::to_string(k) + ": record says it is frame " + std::to_string(index));
-  }
-  out.index = index;
+  checkRecord(path_.string(), k, in, recordBytes);
+  out.index = k;
   out.time = detail::getF64(in + 8);
   const auto size = static_cast<Eigen::Index>(3 * header_.numVertices);
   std::size_t position = detail::recordPrefixBytes;
@@ -191,6 +213,24 @@ void SimulationReader::verifyAll() {
   for (std::int64_t k = 0; k < numFrames_; ++k) {
     readFrame(k, frame);
   }
+}
+
+RecordScan SimulationReader::scanRecords() {
+  RecordScan scan;
+  SimulationFrame frame;
+  for (std::int64_t k = 0; k < numFrames_; ++k) {
+    try {
+      readFrame(k, frame);
+    } catch (const ParseError& error) {
+      scan.badFrame = k;
+      scan.badMessage = error.what();
+      break;
+    }
+    if (k == 0) scan.firstTime = frame.time;
+    scan.lastTime = frame.time;
+    scan.goodFrames = k + 1;
+  }
+  return scan;
 }
 
 }  // namespace asyncfem

@@ -47,6 +47,54 @@ void appendCellTets(const std::array<int, 3>& low, const VertexId& vertexId, con
   }
 }
 
+/// Sets name to the elements, and the vertex set of the same name to their vertices.
+void setElementAndVertexSet(TetMesh& mesh, const std::string& name, std::vector<int> elements) {
+  std::vector<int> vertices;
+  for (int el : elements)
+    for (int a = 0; a < 4; ++a) vertices.push_back(mesh.elements()(a, el));
+  mesh.setElementSet(name, std::move(elements));
+  mesh.setVertexSet(name, std::move(vertices));
+}
+
+/// The box's elements by region: elementMaterials (region r's material is r + 1, later
+/// regions win) and the elements of each region, by centroid.
+std::vector<std::vector<int>> assignBoxRegions(const BoxMeshSpec& spec, const Eigen::Matrix3Xd& x,
+                                               const Eigen::Matrix4Xi& elements, std::vector<int>& elementMaterials) {
+  elementMaterials.assign(static_cast<std::size_t>(elements.cols()), 0);
+  std::vector<std::vector<int>> regionElements(spec.regions.size());
+  for (int el = 0; el < elements.cols(); ++el) {
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 4; ++a) centroid += 0.25 * x.col(elements(a, el));
+    for (std::size_t r = 0; r < spec.regions.size(); ++r) {
+      if (inside(centroid, spec.regions[r].min, spec.regions[r].max)) {
+        // Later regions win the material; every containing region lists the element.
+        elementMaterials[static_cast<std::size_t>(el)] = static_cast<int>(r) + 1;
+        regionElements[r].push_back(el);
+      }
+    }
+  }
+  return regionElements;
+}
+
+/// The vertex sets xmin, xmax, ..., zmax of a box of cells[0] x cells[1] x cells[2] cells.
+template <class VertexId>
+void addBoxFaceSets(TetMesh& mesh, const Eigen::Vector3i& cells, const VertexId& vertexId) {
+  const std::array<const char*, 6> faceNames{"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<int> low, high;
+    for (int k = 0; k <= cells.z(); ++k)
+      for (int j = 0; j <= cells.y(); ++j)
+        for (int i = 0; i <= cells.x(); ++i) {
+          const std::array<int, 3> c{i, j, k};
+          const int last = cells[axis];
+          if (c[static_cast<std::size_t>(axis)] == 0) low.push_back(vertexId(i, j, k));
+          if (c[static_cast<std::size_t>(axis)] == last) high.push_back(vertexId(i, j, k));
+        }
+    mesh.setVertexSet(faceNames[static_cast<std::size_t>(2 * axis)], std::move(low));
+    mesh.setVertexSet(faceNames[static_cast<std::size_t>(2 * axis + 1)], std::move(high));
+  }
+}
+
 }  // namespace
 
 TetMesh makeBoxMesh(const BoxMeshSpec& spec) {
@@ -74,43 +122,15 @@ TetMesh makeBoxMesh(const BoxMeshSpec& spec) {
       for (int i = 0; i < n.x(); ++i) appendCellTets({i, j, k}, vertexId, x, elements, e);
 
   std::vector<Material> materials{spec.material};
-  std::vector<int> elementMaterials(static_cast<std::size_t>(elements.cols()), 0);
-  std::vector<std::vector<int>> regionElements(spec.regions.size());
-  for (int el = 0; el < elements.cols(); ++el) {
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (int a = 0; a < 4; ++a) centroid += 0.25 * x.col(elements(a, el));
-    for (std::size_t r = 0; r < spec.regions.size(); ++r) {
-      if (inside(centroid, spec.regions[r].min, spec.regions[r].max)) {
-        // Later regions win the material; every containing region lists the element.
-        elementMaterials[static_cast<std::size_t>(el)] = static_cast<int>(r) + 1;
-        regionElements[r].push_back(el);
-      }
-    }
-  }
+  std::vector<int> elementMaterials;
+  std::vector<std::vector<int>> regionElements = assignBoxRegions(spec, x, elements, elementMaterials);
   for (const BoxRegion& r : spec.regions) materials.push_back(r.material);
 
   TetMesh mesh(std::move(x), std::move(elements), std::move(materials), std::move(elementMaterials));
   for (std::size_t r = 0; r < spec.regions.size(); ++r) {
-    std::vector<int> vertices;
-    for (int el : regionElements[r])
-      for (int a = 0; a < 4; ++a) vertices.push_back(mesh.elements()(a, el));
-    mesh.setElementSet(spec.regions[r].name, regionElements[r]);
-    mesh.setVertexSet(spec.regions[r].name, std::move(vertices));
+    setElementAndVertexSet(mesh, spec.regions[r].name, std::move(regionElements[r]));
   }
-  const std::array<const char*, 6> faceNames{"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
-  for (int axis = 0; axis < 3; ++axis) {
-    std::vector<int> low, high;
-    for (int k = 0; k < nz; ++k)
-      for (int j = 0; j < ny; ++j)
-        for (int i = 0; i < nx; ++i) {
-          const std::array<int, 3> c{i, j, k};
-          const int last = n[axis];
-          if (c[static_cast<std::size_t>(axis)] == 0) low.push_back(vertexId(i, j, k));
-          if (c[static_cast<std::size_t>(axis)] == last) high.push_back(vertexId(i, j, k));
-        }
-    mesh.setVertexSet(faceNames[static_cast<std::size_t>(2 * axis)], std::move(low));
-    mesh.setVertexSet(faceNames[static_cast<std::size_t>(2 * axis + 1)], std::move(high));
-  }
+  addBoxFaceSets(mesh, n, vertexId);
   return mesh;
 }
 
@@ -146,26 +166,50 @@ TetMesh makeBeamMesh(const BeamSpec& spec) {
   return mesh;
 }
 
-TetMesh makeCellMesh(const CellMeshSpec& spec) {
+namespace {
+
+/// The lattice a cell mesh's blocks span: cells lo .. hi - 1 on each axis, and the
+/// lattice points lo .. hi.
+struct CellLattice {
+  Eigen::Vector3i lo;
+  Eigen::Vector3i hi;
+  Eigen::Vector3i cells;   ///< hi - lo
+  Eigen::Vector3i points;  ///< cells + 1
+
+  std::size_t cellIndex(int i, int j, int k) const {
+    return static_cast<std::size_t>((i - lo.x()) + cells.x() * ((j - lo.y()) + cells.y() * (k - lo.z())));
+  }
+  std::size_t pointIndex(int i, int j, int k) const {
+    return static_cast<std::size_t>((i - lo.x()) + points.x() * ((j - lo.y()) + points.y() * (k - lo.z())));
+  }
+  long long numCells() const { return static_cast<long long>(cells.x()) * cells.y() * cells.z(); }
+};
+
+/// Checks the spec's cell size and blocks; the lattice they span.
+CellLattice checkedLattice(const CellMeshSpec& spec) {
   if (!(spec.cellSize > 0.0) || !std::isfinite(spec.cellSize) || !spec.origin.allFinite()) {
     throw ValidationError("cell mesh: cellSize must be positive and finite, origin finite");
   }
   if (spec.blocks.empty()) throw ValidationError("cell mesh: no blocks");
-  Eigen::Vector3i lo = spec.blocks.front().begin, hi = spec.blocks.front().end;
+  CellLattice lattice{spec.blocks.front().begin, spec.blocks.front().end, {}, {}};
   for (const CellBlock& b : spec.blocks) {
     if (b.name.empty()) throw ValidationError("cell mesh: a block has no name");
     if ((b.end.array() <= b.begin.array()).any()) {
       throw ValidationError("cell mesh: block '" + b.name + "' is empty (end must exceed begin on every axis)");
     }
-    lo = lo.cwiseMin(b.begin);
-    hi = hi.cwiseMax(b.end);
+    lattice.lo = lattice.lo.cwiseMin(b.begin);
+    lattice.hi = lattice.hi.cwiseMax(b.end);
   }
-  const Eigen::Vector3i cells = hi - lo;
-  const long long latticeCells = static_cast<long long>(cells.x()) * cells.y() * cells.z();
-  if (latticeCells > 50'000'000LL) throw ValidationError("cell mesh: the blocks span more than 5e7 lattice cells");
+  lattice.cells = lattice.hi - lattice.lo;
+  lattice.points = lattice.cells + Eigen::Vector3i::Ones();
+  if (lattice.numCells() > 50'000'000LL) {
+    throw ValidationError("cell mesh: the blocks span more than 5e7 lattice cells");
+  }
+  return lattice;
+}
 
-  // Materials by name, in order of first use; each cell's owner is the last block claiming it.
-  std::vector<Material> materials;
+/// Materials by name, in order of first use, into materials; the material of each block.
+std::vector<int> blockMaterials(const CellMeshSpec& spec, std::vector<Material>& materials) {
   std::vector<int> blockMaterial;
   for (const CellBlock& b : spec.blocks) {
     auto same =
@@ -179,76 +223,51 @@ TetMesh makeCellMesh(const CellMeshSpec& spec) {
     }
     blockMaterial.push_back(static_cast<int>(same - materials.begin()));
   }
-  std::vector<int> owner(static_cast<std::size_t>(latticeCells), -1);
-  auto cellIndex = [&](int i, int j, int k) {
-    return static_cast<std::size_t>((i - lo.x()) + cells.x() * ((j - lo.y()) + cells.y() * (k - lo.z())));
-  };
+  return blockMaterial;
+}
+
+/// The block owning each lattice cell (the last block claiming it; -1: empty).
+std::vector<int> cellOwners(const CellMeshSpec& spec, const CellLattice& lattice) {
+  std::vector<int> owner(static_cast<std::size_t>(lattice.numCells()), -1);
   for (std::size_t b = 0; b < spec.blocks.size(); ++b)
     for (int k = spec.blocks[b].begin.z(); k < spec.blocks[b].end.z(); ++k)
       for (int j = spec.blocks[b].begin.y(); j < spec.blocks[b].end.y(); ++j)
         for (int i = spec.blocks[b].begin.x(); i < spec.blocks[b].end.x(); ++i)
-          owner[cellIndex(i, j, k)] = static_cast<int>(b);
+          owner[lattice.cellIndex(i, j, k)] = static_cast<int>(b);
+  return owner;
+}
 
-  // Lattice points used by some occupied cell, numbered in lattice order.
-  const Eigen::Vector3i points = cells + Eigen::Vector3i::Ones();
-  auto pointIndex = [&](int i, int j, int k) {
-    return static_cast<std::size_t>((i - lo.x()) + points.x() * ((j - lo.y()) + points.y() * (k - lo.z())));
-  };
-  std::vector<int> vertexOfPoint(static_cast<std::size_t>(points.prod()), -1);
-  int occupied = 0;
+/// Numbers the lattice points used by some occupied cell in lattice order: vertexOfPoint
+/// (by CellLattice::pointIndex, -1 unused); returns the point of each vertex.
+std::vector<Eigen::Vector3i> numberCellVertices(const CellLattice& lattice, const std::vector<int>& owner,
+                                                std::vector<int>& vertexOfPoint) {
+  const Eigen::Vector3i& lo = lattice.lo;
+  const Eigen::Vector3i& hi = lattice.hi;
+  vertexOfPoint.assign(static_cast<std::size_t>(lattice.points.prod()), -1);
   for (int k = lo.z(); k < hi.z(); ++k)
     for (int j = lo.y(); j < hi.y(); ++j)
       for (int i = lo.x(); i < hi.x(); ++i) {
-        if (owner[cellIndex(i, j, k)] < 0) continue;
-        ++occupied;
-        for (int c = 0; c < 8; ++c) vertexOfPoint[pointIndex(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2))] = 0;
+        if (owner[lattice.cellIndex(i, j, k)] < 0) continue;
+        for (int c = 0; c < 8; ++c)
+          vertexOfPoint[lattice.pointIndex(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2))] = 0;
       }
   std::vector<Eigen::Vector3i> pointOfVertex;
   for (int k = lo.z(); k <= hi.z(); ++k)
     for (int j = lo.y(); j <= hi.y(); ++j)
       for (int i = lo.x(); i <= hi.x(); ++i) {
-        int& v = vertexOfPoint[pointIndex(i, j, k)];
+        int& v = vertexOfPoint[lattice.pointIndex(i, j, k)];
         if (v < 0) continue;
         v = static_cast<int>(pointOfVertex.size());
         pointOfVertex.emplace_back(i, j, k);
       }
-  Eigen::Matrix3Xd x(3, static_cast<Eigen::Index>(pointOfVertex.size()));
-  for (std::size_t v = 0; v < pointOfVertex.size(); ++v) {
-    x.col(static_cast<Eigen::Index>(v)) = spec.origin + spec.cellSize * pointOfVertex[v].cast<double>();
-  }
-  auto vertexId = [&](int i, int j, int k) { return vertexOfPoint[pointIndex(i, j, k)]; };
+  return pointOfVertex;
+}
 
-  Eigen::Matrix4Xi elements(4, 6 * occupied);
-  std::vector<int> elementMaterials;
-  std::map<std::string, std::vector<int>> setElements;
-  int e = 0;
-  for (int k = lo.z(); k < hi.z(); ++k)
-    for (int j = lo.y(); j < hi.y(); ++j)
-      for (int i = lo.x(); i < hi.x(); ++i) {
-        const int b = owner[cellIndex(i, j, k)];
-        if (b < 0) continue;
-        std::vector<int>& set = setElements[spec.blocks[static_cast<std::size_t>(b)].name];
-        for (int t = 0; t < 6; ++t) {
-          set.push_back(e + t);
-          elementMaterials.push_back(blockMaterial[static_cast<std::size_t>(b)]);
-        }
-        appendCellTets({i, j, k}, vertexId, x, elements, e);
-      }
-
-  TetMesh mesh(std::move(x), std::move(elements), std::move(materials), std::move(elementMaterials));
-  for (auto& [name, members] : setElements) {
-    std::vector<int> vertices;
-    for (int el : members)
-      for (int a = 0; a < 4; ++a) vertices.push_back(mesh.elements()(a, el));
-    mesh.setElementSet(name, std::move(members));
-    mesh.setVertexSet(name, std::move(vertices));
-  }
-  std::vector<int> bottom;
-  for (int v = 0; v < mesh.numVertices(); ++v)
-    if (pointOfVertex[static_cast<std::size_t>(v)].y() == lo.y()) bottom.push_back(v);
-  mesh.setVertexSet("bottom", std::move(bottom));
-
-  for (const CellVertexRing& ring : spec.vertexRings) {
+/// The vertex set of each vertex ring: the vertices within ring.rings lattice steps (in
+/// the max norm) of the sets it is around.
+void addVertexRings(TetMesh& mesh, const std::vector<CellVertexRing>& rings,
+                    const std::vector<Eigen::Vector3i>& pointOfVertex) {
+  for (const CellVertexRing& ring : rings) {
     if (ring.name.empty() || ring.rings < 0)
       throw ValidationError("cell mesh: a vertex ring needs a name and rings >= 0");
     std::vector<Eigen::Vector3i> core;
@@ -268,6 +287,48 @@ TetMesh makeCellMesh(const CellMeshSpec& spec) {
     }
     mesh.setVertexSet(ring.name, std::move(members));
   }
+}
+
+}  // namespace
+
+TetMesh makeCellMesh(const CellMeshSpec& spec) {
+  const CellLattice lattice = checkedLattice(spec);
+  std::vector<Material> materials;
+  const std::vector<int> blockMaterial = blockMaterials(spec, materials);
+  const std::vector<int> owner = cellOwners(spec, lattice);
+  std::vector<int> vertexOfPoint;
+  const std::vector<Eigen::Vector3i> pointOfVertex = numberCellVertices(lattice, owner, vertexOfPoint);
+  Eigen::Matrix3Xd x(3, static_cast<Eigen::Index>(pointOfVertex.size()));
+  for (std::size_t v = 0; v < pointOfVertex.size(); ++v) {
+    x.col(static_cast<Eigen::Index>(v)) = spec.origin + spec.cellSize * pointOfVertex[v].cast<double>();
+  }
+  auto vertexId = [&](int i, int j, int k) { return vertexOfPoint[lattice.pointIndex(i, j, k)]; };
+
+  const auto occupied = static_cast<int>(std::count_if(owner.begin(), owner.end(), [](int b) { return b >= 0; }));
+  Eigen::Matrix4Xi elements(4, 6 * occupied);
+  std::vector<int> elementMaterials;
+  std::map<std::string, std::vector<int>> setElements;
+  int e = 0;
+  for (int k = lattice.lo.z(); k < lattice.hi.z(); ++k)
+    for (int j = lattice.lo.y(); j < lattice.hi.y(); ++j)
+      for (int i = lattice.lo.x(); i < lattice.hi.x(); ++i) {
+        const int b = owner[lattice.cellIndex(i, j, k)];
+        if (b < 0) continue;
+        std::vector<int>& set = setElements[spec.blocks[static_cast<std::size_t>(b)].name];
+        for (int t = 0; t < 6; ++t) {
+          set.push_back(e + t);
+          elementMaterials.push_back(blockMaterial[static_cast<std::size_t>(b)]);
+        }
+        appendCellTets({i, j, k}, vertexId, x, elements, e);
+      }
+
+  TetMesh mesh(std::move(x), std::move(elements), std::move(materials), std::move(elementMaterials));
+  for (auto& [name, members] : setElements) setElementAndVertexSet(mesh, name, std::move(members));
+  std::vector<int> bottom;
+  for (int v = 0; v < mesh.numVertices(); ++v)
+    if (pointOfVertex[static_cast<std::size_t>(v)].y() == lattice.lo.y()) bottom.push_back(v);
+  mesh.setVertexSet("bottom", std::move(bottom));
+  addVertexRings(mesh, spec.vertexRings, pointOfVertex);
   return mesh;
 }
 

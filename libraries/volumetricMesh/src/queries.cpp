@@ -5,6 +5,7 @@
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 namespace asyncfem {
@@ -32,9 +33,14 @@ double totalMass(const TetMesh& mesh) {
   return mass;
 }
 
-std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh) {
-  // Faces of a positively oriented tet (v0..v3) with outward normals (b-a)x(c-a).
-  static constexpr std::array<std::array<int, 3>, 4> kFaces{{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+namespace {
+
+// Faces of a positively oriented tet (v0..v3) with outward normals (b-a)x(c-a).
+constexpr std::array<std::array<int, 3>, 4> kTetFaces{{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+
+/// The (element, local face) pairs of the faces that belong to one element only, in
+/// element order.
+std::vector<std::pair<int, int>> unsharedFaces(const TetMesh& mesh) {
   struct Face {
     std::array<int, 3> key;  // sorted vertex ids
     int element;
@@ -47,7 +53,7 @@ std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh) {
     for (int f = 0; f < 4; ++f) {
       std::array<int, 3> key{};
       for (int a = 0; a < 3; ++a)
-        key[static_cast<std::size_t>(a)] = t[kFaces[static_cast<std::size_t>(f)][static_cast<std::size_t>(a)]];
+        key[static_cast<std::size_t>(a)] = t[kTetFaces[static_cast<std::size_t>(f)][static_cast<std::size_t>(a)]];
       std::sort(key.begin(), key.end());
       faces.push_back({key, e, f});
     }
@@ -55,7 +61,7 @@ std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh) {
   std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) {
     return a.key != b.key ? a.key < b.key : (a.element != b.element ? a.element < b.element : a.local < b.local);
   });
-  std::vector<std::pair<int, int>> boundary;  // (element, local face), kept in element order below
+  std::vector<std::pair<int, int>> boundary;
   for (std::size_t i = 0; i < faces.size();) {
     std::size_t j = i + 1;
     while (j < faces.size() && faces[j].key == faces[i].key) ++j;
@@ -63,11 +69,18 @@ std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh) {
     i = j;
   }
   std::sort(boundary.begin(), boundary.end());
+  return boundary;
+}
+
+}  // namespace
+
+std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh) {
+  const std::vector<std::pair<int, int>> boundary = unsharedFaces(mesh);
   std::vector<std::array<int, 3>> triangles;
   triangles.reserve(boundary.size());
   for (const auto& [e, f] : boundary) {
     const Eigen::Vector4i t = mesh.element(e);
-    const auto& local = kFaces[static_cast<std::size_t>(f)];
+    const auto& local = kTetFaces[static_cast<std::size_t>(f)];
     std::array<int, 3> tri{t[local[0]], t[local[1]], t[local[2]]};
     // An element stored with negative orientation has every face turned inward.
     if (signedElementVolume(mesh, e) < 0.0) std::swap(tri[1], tri[2]);
@@ -144,6 +157,23 @@ std::vector<ElementQuality> elementQualities(const TetMesh& mesh) {
   qualities.reserve(static_cast<std::size_t>(mesh.numElements()));
   for (int e = 0; e < mesh.numElements(); ++e) qualities.push_back(elementQuality(mesh, e));
   return qualities;
+}
+
+QualitySummary summarizeQuality(const TetMesh& mesh) {
+  QualitySummary s;
+  if (mesh.numElements() == 0) return s;
+  const double toDegrees = 180.0 / std::numbers::pi;
+  s.minDihedralDegrees = std::numeric_limits<double>::infinity();
+  double sum = 0.0;
+  for (const ElementQuality& q : elementQualities(mesh)) {
+    const double angle = q.minDihedralAngle * toDegrees;
+    s.minDihedralDegrees = std::min(s.minDihedralDegrees, angle);
+    s.maxDihedralDegrees = std::max(s.maxDihedralDegrees, angle);
+    sum += angle;
+    s.worstAspectRatio = std::max(s.worstAspectRatio, q.aspectRatio);
+  }
+  s.meanDihedralDegrees = sum / mesh.numElements();
+  return s;
 }
 
 std::vector<int> unusedVertices(const TetMesh& mesh) {

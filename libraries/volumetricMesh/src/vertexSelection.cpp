@@ -15,12 +15,10 @@ std::string setNames(const Sets& sets) {
   return names.empty() ? "none" : names;
 }
 
-}  // namespace
-
-std::vector<int> selectVertices(const TetMesh& mesh, const VertexSelection& selection) {
-  std::vector<int> selected;
-  for (std::size_t i = 0; i < selection.sets.size(); ++i) {
-    const std::string& name = selection.sets[i];
+/// Appends the vertices of the named sets (of either kind) to selected.
+void appendSetVertices(const TetMesh& mesh, const std::vector<std::string>& sets, std::vector<int>& selected) {
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    const std::string& name = sets[i];
     if (!mesh.vertexSets().count(name) && !mesh.elementSets().count(name)) {
       throw SelectionError("sets", static_cast<int>(i),
                            "unknown set \"" + name + "\" (vertex sets: " + setNames(mesh.vertexSets()) +
@@ -30,8 +28,12 @@ std::vector<int> selectVertices(const TetMesh& mesh, const VertexSelection& sele
     if (members.empty()) throw SelectionError("sets", static_cast<int>(i), "set \"" + name + "\" is empty");
     selected.insert(selected.end(), members.begin(), members.end());
   }
-  for (std::size_t b = 0; b < selection.boxes.size(); ++b) {
-    const VertexBox& box = selection.boxes[b];
+}
+
+/// Appends the vertices whose rest position lies in each box to selected.
+void appendBoxVertices(const TetMesh& mesh, const std::vector<VertexBox>& boxes, std::vector<int>& selected) {
+  for (std::size_t b = 0; b < boxes.size(); ++b) {
+    const VertexBox& box = boxes[b];
     if (!(box.min.array() <= box.max.array()).all()) {
       throw SelectionError("boxes", static_cast<int>(b), "expected min <= max");
     }
@@ -45,6 +47,14 @@ std::vector<int> selectVertices(const TetMesh& mesh, const VertexSelection& sele
     }
     if (count == 0) throw SelectionError("boxes", static_cast<int>(b), "selects no vertex");
   }
+}
+
+}  // namespace
+
+std::vector<int> selectVertices(const TetMesh& mesh, const VertexSelection& selection) {
+  std::vector<int> selected;
+  appendSetVertices(mesh, selection.sets, selected);
+  appendBoxVertices(mesh, selection.boxes, selected);
   for (std::size_t k = 0; k < selection.vertices.size(); ++k) {
     const int v = selection.vertices[k];
     if (v < 0 || v >= mesh.numVertices()) {

@@ -161,9 +161,9 @@ class VtuBuilder {
   std::string appended_;
 };
 
-}  // namespace
-
-void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
+/// Every material and set name must be one .veg token; element sets must not use the
+/// prefix of the reader's material sets.
+void checkVegNames(const TetMesh& mesh) {
   for (const Material& m : mesh.materials()) checkVegName(m.name, "material");
   for (const auto& [name, members] : mesh.elementSets()) {
     checkVegName(name, "element set");
@@ -173,10 +173,10 @@ void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
     }
   }
   for (const auto& [name, members] : mesh.vertexSets()) checkVegName(name, "vertex set");
+}
 
-  std::ostringstream out;
-  out << "# " << mesh.numVertices() << " vertices, " << mesh.numElements() << " tetrahedra, " << mesh.materials().size()
-      << " materials\n";
+/// The *VERTICES and *ELEMENTS sections (1-based ids).
+void writeVegGeometry(std::ostream& out, const TetMesh& mesh) {
   out << "*VERTICES\n" << mesh.numVertices() << " 3 0 0\n";
   for (int v = 0; v < mesh.numVertices(); ++v) {
     const Eigen::Vector3d x = mesh.restPosition(v);
@@ -188,6 +188,10 @@ void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
     const Eigen::Vector4i t = mesh.element(e);
     out << e + 1 << ' ' << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << ' ' << t[3] + 1 << '\n';
   }
+}
+
+/// One *MATERIAL section per material.
+void writeVegMaterials(std::ostream& out, const TetMesh& mesh) {
   for (const Material& m : mesh.materials()) {
     out << "\n*MATERIAL " << m.name << '\n';
     if (m.mooneyRivlin) {
@@ -200,17 +204,11 @@ void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
           << detail::formatDouble(m.poissonRatio) << '\n';
     }
   }
-  for (const auto& [name, members] : mesh.elementSets()) {
-    out << "\n*SET " << name << '\n';
-    writeIdList(out, members);
-  }
-  for (const auto& [name, members] : mesh.vertexSets()) {
-    out << "\n*VERTEXSET " << name << '\n';
-    writeIdList(out, members);
-  }
+}
 
-  // One *REGION line per material that has elements, naming an existing set with
-  // exactly those elements when there is one, otherwise a helper set.
+/// One *REGION line per material that has elements, naming an existing set with exactly
+/// those elements when there is one, otherwise a helper set (written here).
+void writeVegRegions(std::ostringstream& out, const TetMesh& mesh) {
   std::vector<std::vector<int>> materialElements(mesh.materials().size());
   for (int e = 0; e < mesh.numElements(); ++e)
     materialElements[static_cast<std::size_t>(mesh.elementMaterialIndex(e))].push_back(e);
@@ -234,6 +232,62 @@ void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
     regions += setName + ", " + mesh.materials()[m].name + '\n';
   }
   out << "\n*REGION\n" << regions;
+}
+
+/// The <PointData> (displacement, pointArrays) and <CellData> (material, cellArrays) sections.
+void appendVtuData(VtuBuilder& vtu, const TetMesh& mesh, const Eigen::VectorXd& displacement,
+                   const std::vector<VtuArray>& pointArrays, const std::vector<VtuArray>& cellArrays) {
+  const auto numVertices = static_cast<std::size_t>(mesh.numVertices());
+  const auto numElements = static_cast<std::size_t>(mesh.numElements());
+  vtu.xml() << "      <PointData" << (displacement.size() != 0 ? " Vectors=\"displacement\"" : "") << ">\n";
+  if (displacement.size() != 0) vtu.array("Float64", "displacement", 3, displacement.data(), 3 * numVertices);
+  for (const VtuArray& array : pointArrays) {
+    vtu.array("Float64", array.name, array.components, array.values.data(), array.values.size());
+  }
+  vtu.xml() << "      </PointData>\n      <CellData>\n";
+  const std::vector<int>& materials = mesh.elementMaterials();
+  vtu.array("Int32", "material", 1, materials.data(), numElements);
+  for (const VtuArray& array : cellArrays) {
+    vtu.array("Float64", array.name, array.components, array.values.data(), array.values.size());
+  }
+  vtu.xml() << "      </CellData>\n";
+}
+
+/// The <Cells> arrays of the tetrahedra: connectivity, offsets and VTK types.
+void appendVtuCells(VtuBuilder& vtu, const TetMesh& mesh) {
+  const auto numElements = static_cast<std::size_t>(mesh.numElements());
+  std::vector<std::int32_t> connectivity(4 * numElements);
+  std::vector<std::int32_t> offsets(numElements);
+  for (std::size_t e = 0; e < numElements; ++e) {
+    const Eigen::Vector4i t = mesh.element(static_cast<int>(e));
+    for (int corner = 0; corner < 4; ++corner) connectivity[4 * e + static_cast<std::size_t>(corner)] = t[corner];
+    offsets[e] = static_cast<std::int32_t>(4 * (e + 1));
+  }
+  constexpr std::uint8_t vtkTetra = 10;
+  const std::vector<std::uint8_t> types(numElements, vtkTetra);
+  vtu.array("Int32", "connectivity", 1, connectivity.data(), connectivity.size());
+  vtu.array("Int32", "offsets", 1, offsets.data(), offsets.size());
+  vtu.array("UInt8", "types", 1, types.data(), types.size());
+}
+
+}  // namespace
+
+void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
+  checkVegNames(mesh);
+  std::ostringstream out;
+  out << "# " << mesh.numVertices() << " vertices, " << mesh.numElements() << " tetrahedra, " << mesh.materials().size()
+      << " materials\n";
+  writeVegGeometry(out, mesh);
+  writeVegMaterials(out, mesh);
+  for (const auto& [name, members] : mesh.elementSets()) {
+    out << "\n*SET " << name << '\n';
+    writeIdList(out, members);
+  }
+  for (const auto& [name, members] : mesh.vertexSets()) {
+    out << "\n*VERTEXSET " << name << '\n';
+    writeIdList(out, members);
+  }
+  writeVegRegions(out, mesh);
   writeAtomically(path, out.str());
 }
 
@@ -255,34 +309,13 @@ void writeVtu(const std::filesystem::path& path, const TetMesh& mesh, const Eige
             << "\" header_type=\"UInt64\">\n"
             << "  <UnstructuredGrid>\n"
             << "    <Piece NumberOfPoints=\"" << numVertices << "\" NumberOfCells=\"" << numElements << "\">\n";
-  vtu.xml() << "      <PointData" << (displacement.size() != 0 ? " Vectors=\"displacement\"" : "") << ">\n";
-  if (displacement.size() != 0) vtu.array("Float64", "displacement", 3, displacement.data(), 3 * numVertices);
-  for (const VtuArray& array : pointArrays) {
-    vtu.array("Float64", array.name, array.components, array.values.data(), array.values.size());
-  }
-  vtu.xml() << "      </PointData>\n      <CellData>\n";
-  const std::vector<int>& materials = mesh.elementMaterials();
-  vtu.array("Int32", "material", 1, materials.data(), numElements);
-  for (const VtuArray& array : cellArrays) {
-    vtu.array("Float64", array.name, array.components, array.values.data(), array.values.size());
-  }
+  appendVtuData(vtu, mesh, displacement, pointArrays, cellArrays);
   // Rest positions: the displacement array carries the deformation (Warp By Vector),
   // so it must not be added here as well.
-  vtu.xml() << "      </CellData>\n      <Points>\n";
+  vtu.xml() << "      <Points>\n";
   vtu.array("Float64", "", 3, mesh.restPositions().data(), 3 * numVertices);
   vtu.xml() << "      </Points>\n      <Cells>\n";
-  std::vector<std::int32_t> connectivity(4 * numElements);
-  std::vector<std::int32_t> offsets(numElements);
-  for (std::size_t e = 0; e < numElements; ++e) {
-    const Eigen::Vector4i t = mesh.element(static_cast<int>(e));
-    for (int corner = 0; corner < 4; ++corner) connectivity[4 * e + static_cast<std::size_t>(corner)] = t[corner];
-    offsets[e] = static_cast<std::int32_t>(4 * (e + 1));
-  }
-  constexpr std::uint8_t vtkTetra = 10;
-  const std::vector<std::uint8_t> types(numElements, vtkTetra);
-  vtu.array("Int32", "connectivity", 1, connectivity.data(), connectivity.size());
-  vtu.array("Int32", "offsets", 1, offsets.data(), offsets.size());
-  vtu.array("UInt8", "types", 1, types.data(), types.size());
+  appendVtuCells(vtu, mesh);
   vtu.xml() << "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n";
   writeAtomically(path, vtu.finish());
 }

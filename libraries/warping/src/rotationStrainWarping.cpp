@@ -39,6 +39,19 @@ void unite(std::vector<int>& parent, int a, int b) {
   }
 }
 
+/// fixed[v]: v is in fixedVertices (ValidationError naming one out of [0, numVertices)).
+std::vector<bool> fixedMask(const std::vector<int>& fixedVertices, int numVertices) {
+  std::vector<bool> fixed(static_cast<std::size_t>(numVertices), false);
+  for (const int v : fixedVertices) {
+    if (v < 0 || v >= numVertices) {
+      throw ValidationError("rotation-strain warping: fixed vertex " + std::to_string(v) + " out of range [0, " +
+                            std::to_string(numVertices) + ")");
+    }
+    fixed[static_cast<std::size_t>(v)] = true;
+  }
+  return fixed;
+}
+
 }  // namespace
 
 RotationStrainWarping::RotationStrainWarping(const TetMesh& mesh, const std::vector<int>& fixedVertices,
@@ -46,26 +59,31 @@ RotationStrainWarping::RotationStrainWarping(const TetMesh& mesh, const std::vec
     : numVertices_(mesh.numVertices()), numElements_(mesh.numElements()), elements_(mesh.elements()) {
   detail::elementShapeGradients(mesh, shapeGradients_, volumes_);
   const auto n = static_cast<std::size_t>(numVertices_);
-
-  std::vector<bool> fixed(n, false);
-  for (const int v : fixedVertices) {
-    if (v < 0 || v >= numVertices_) {
-      throw ValidationError("rotation-strain warping: fixed vertex " + std::to_string(v) + " out of range [0, " +
-                            std::to_string(numVertices_) + ")");
-    }
-    fixed[static_cast<std::size_t>(v)] = true;
-  }
-
-  // Connected components of the used vertices.
-  std::vector<int> parent(n);
-  std::iota(parent.begin(), parent.end(), 0);
+  const std::vector<bool> fixed = fixedMask(fixedVertices, numVertices_);
   std::vector<bool> used(n, false);
   for (int e = 0; e < numElements_; ++e) {
     for (int a = 0; a < 4; ++a) {
       used[static_cast<std::size_t>(elements_(a, e))] = true;
-      if (a > 0) {
-        unite(parent, elements_(0, e), elements_(a, e));
-      }
+    }
+  }
+  findComponents(used, fixed);
+  std::vector<int> unknownIndex(n, -1);
+  std::vector<int> constrainedIndex(n, -1);
+  numberVertices(used, fixed, unknownIndex, constrainedIndex);
+  factorLaplacian(unknownIndex, constrainedIndex, solverKind);
+  buildGatherMap(mesh);
+  elementRightHandSides_.resize(3, 4 * static_cast<Eigen::Index>(numElements_));
+}
+
+/// Connected components of the used vertices (through shared elements), numbered by
+/// their lowest vertex; a component without a fixed vertex is pinned.
+void RotationStrainWarping::findComponents(const std::vector<bool>& used, const std::vector<bool>& fixed) {
+  const auto n = static_cast<std::size_t>(numVertices_);
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int e = 0; e < numElements_; ++e) {
+    for (int a = 1; a < 4; ++a) {
+      unite(parent, elements_(0, e), elements_(a, e));
     }
   }
   component_.assign(n, -1);
@@ -88,16 +106,18 @@ RotationStrainWarping::RotationStrainWarping(const TetMesh& mesh, const std::vec
       componentPinned_[static_cast<std::size_t>(id)] = false;
     }
   }
+}
 
-  // Constrained: fixed vertices, and the lowest vertex of every component without one.
-  std::vector<bool> constrained(n, false);
+/// Constrained: fixed vertices, and the lowest vertex of every pinned component; the
+/// other used vertices are unknowns. Both lists ascend.
+void RotationStrainWarping::numberVertices(const std::vector<bool>& used, const std::vector<bool>& fixed,
+                                           std::vector<int>& unknownIndex, std::vector<int>& constrainedIndex) {
+  std::vector<bool> constrained(static_cast<std::size_t>(numVertices_), false);
   for (std::size_t c = 0; c < componentVertices_.size(); ++c) {
     if (componentPinned_[c]) {
       constrained[static_cast<std::size_t>(componentVertices_[c].front())] = true;
     }
   }
-  std::vector<int> unknownIndex(n, -1);
-  std::vector<int> constrainedIndex(n, -1);
   for (int v = 0; v < numVertices_; ++v) {
     const auto sv = static_cast<std::size_t>(v);
     if (!used[sv]) {
@@ -111,9 +131,12 @@ RotationStrainWarping::RotationStrainWarping(const TetMesh& mesh, const std::vec
       unknownVertices_.push_back(v);
     }
   }
+}
 
-  // L_ab = sum_e V_e grad N_a . grad N_b, split into the unknown-unknown block (factored)
-  // and the unknown-constrained block (moves the constrained values to the right side).
+/// L_ab = sum_e V_e grad N_a . grad N_b, split into the unknown-unknown block (factored)
+/// and the unknown-constrained block (moves the constrained values to the right side).
+void RotationStrainWarping::factorLaplacian(const std::vector<int>& unknownIndex,
+                                            const std::vector<int>& constrainedIndex, SolverKind solverKind) {
   std::vector<Eigen::Triplet<double>> unknownTriplets;
   std::vector<Eigen::Triplet<double>> couplingTriplets;
   unknownTriplets.reserve(static_cast<std::size_t>(numElements_) * 16);
@@ -146,9 +169,11 @@ RotationStrainWarping::RotationStrainWarping(const TetMesh& mesh, const std::vec
   if (numUnknown > 0) {
     solver_->compute(laplacian);
   }
+}
 
-  // Gather map for the right-hand side: for each vertex, (element, local index) pairs in
-  // ascending element order, so every b_a is summed in one fixed order.
+/// Gather map for the right-hand side: for each vertex, (element, local index) pairs in
+/// ascending element order, so every b_a is summed in one fixed order.
+void RotationStrainWarping::buildGatherMap(const TetMesh& mesh) {
   const VertexElementAdjacency adjacency = vertexElementAdjacency(mesh);
   adjacencyOffsets_ = adjacency.offsets;
   adjacencySlots_.resize(adjacency.elements.size());
@@ -163,7 +188,6 @@ RotationStrainWarping::RotationStrainWarping(const TetMesh& mesh, const std::vec
       adjacencySlots_[static_cast<std::size_t>(k)] = (4 * e) + local;
     }
   }
-  elementRightHandSides_.resize(3, 4 * static_cast<Eigen::Index>(numElements_));
 }
 
 RotationStrainWarping::~RotationStrainWarping() = default;
@@ -178,8 +202,24 @@ Eigen::VectorXd RotationStrainWarping::warp(const Eigen::Ref<const Eigen::Vector
                 " entries, expected 3 x " + std::to_string(numVertices_));
   }
   const Eigen::Map<const Eigen::Matrix3Xd> u(displacement.data(), 3, numVertices_);
+  elementPass(u);
+  gatherRightHandSide(u);
+  Eigen::VectorXd warped = displacement;  // constrained and unused vertices keep theirs
+  const auto numUnknown = static_cast<Eigen::Index>(unknownVertices_.size());
+  if (numUnknown > 0) {
+    solver_->solve(rightHandSide_, solution_);
+    for (Eigen::Index k = 0; k < numUnknown; ++k) {
+      warped.segment<3>(3 * static_cast<Eigen::Index>(unknownVertices_[static_cast<std::size_t>(k)])) =
+          solution_.row(k).transpose();
+    }
+  }
+  shiftPinnedComponents(u, warped);
+  return warped;
+}
 
-  // Element pass: F_e = exp([omega_e]x) (I + S_e); contribution V_e (F_e - I) grad N_a.
+/// F_e = exp([omega_e]x) (I + S_e) of every element; its contribution V_e (F_e - I) grad N_a
+/// to the right-hand side goes to elementRightHandSides_.
+void RotationStrainWarping::elementPass(const Eigen::Map<const Eigen::Matrix3Xd>& u) {
   // Threads only pay off beyond a few thousand elements (a parallel region costs about
   // as much as 1000 elements here, and far more when the cores are oversubscribed).
 #pragma omp parallel for schedule(static) if (numElements_ >= kParallelThreshold)
@@ -197,8 +237,11 @@ Eigen::VectorXd RotationStrainWarping::warp(const Eigen::Ref<const Eigen::Vector
     const Eigen::Matrix3d target = (rotation - Eigen::Matrix3d::Identity()) + rotation * strain;
     elementRightHandSides_.block<3, 4>(0, 4 * static_cast<Eigen::Index>(e)) = volumes_[e] * (target * g);
   }
+}
 
-  // Gather b at the unknown vertices and move the constrained values to the right side.
+/// Gathers b at the unknown vertices into rightHandSide_ and moves the constrained values
+/// to the right side.
+void RotationStrainWarping::gatherRightHandSide(const Eigen::Map<const Eigen::Matrix3Xd>& u) {
   const auto numUnknown = static_cast<Eigen::Index>(unknownVertices_.size());
   const auto numConstrained = static_cast<Eigen::Index>(constrainedVertices_.size());
   rightHandSide_.resize(numUnknown, 3);
@@ -218,17 +261,12 @@ Eigen::VectorXd RotationStrainWarping::warp(const Eigen::Ref<const Eigen::Vector
     }
     rightHandSide_.noalias() -= laplacianUnknownConstrained_ * constrainedValues;
   }
+}
 
-  Eigen::VectorXd warped = displacement;  // constrained and unused vertices keep theirs
-  if (numUnknown > 0) {
-    solver_->solve(rightHandSide_, solution_);
-    for (Eigen::Index k = 0; k < numUnknown; ++k) {
-      warped.segment<3>(3 * static_cast<Eigen::Index>(unknownVertices_[static_cast<std::size_t>(k)])) =
-          solution_.row(k).transpose();
-    }
-  }
-
-  // Translation-free components: match the mean displacement of the linear input.
+/// Translation-free (pinned) components: shifted to match the mean displacement of the
+/// linear input.
+void RotationStrainWarping::shiftPinnedComponents(const Eigen::Map<const Eigen::Matrix3Xd>& u,
+                                                  Eigen::VectorXd& warped) const {
   for (std::size_t c = 0; c < componentVertices_.size(); ++c) {
     if (!componentPinned_[c]) {
       continue;
@@ -242,7 +280,6 @@ Eigen::VectorXd RotationStrainWarping::warp(const Eigen::Ref<const Eigen::Vector
       warped.segment<3>(3 * static_cast<Eigen::Index>(v)) += shift;
     }
   }
-  return warped;
 }
 
 }  // namespace asyncfem

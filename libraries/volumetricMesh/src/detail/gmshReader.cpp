@@ -38,6 +38,20 @@ class GmshParser {
     }
     readMeshFormat();
     report.format = version41_ ? "gmsh 4.1" : "gmsh 2.2";
+    readSections();
+    reportIgnoredElements(report);
+    for (const auto& [tag, members] : physicalElements_) {
+      auto it = physicalNames_.find(tag);
+      const std::string name = it != physicalNames_.end() ? it->second : "physical_" + std::to_string(tag);
+      auto& set = raw_.elementSets[name];
+      set.insert(set.end(), members.begin(), members.end());
+    }
+    return detail::finishMesh(std::move(raw_), cursor_, options, report, detail::MissingMaterialPolicy::FormatDefault);
+  }
+
+ private:
+  /// The sections after $MeshFormat, up to the end of the file.
+  void readSections() {
     bool haveNodes = false;
     bool haveElements = false;
     while (cursor_.next()) {
@@ -66,7 +80,11 @@ class GmshParser {
     }
     if (!haveNodes) cursor_.failAtEnd("no $Nodes section");
     if (!haveElements) cursor_.failAtEnd("no $Elements section");
+  }
 
+  /// Counts the elements that are not 4-node tetrahedra into report, with a warning by
+  /// type; a file of 10-node tetrahedra only is an error.
+  void reportIgnoredElements(MeshReadReport& report) const {
     report.ignoredElements = ignoredTotal_;
     if (ignoredTotal_ > 0) {
       std::string types;
@@ -79,16 +97,8 @@ class GmshParser {
     if (raw_.elements.empty() && ignoredByType_.count(kQuadraticTet)) {
       cursor_.failAtEnd("only 10-node tetrahedra (type 11) found: export a first-order mesh (Mesh.ElementOrder = 1)");
     }
-    for (const auto& [tag, members] : physicalElements_) {
-      auto it = physicalNames_.find(tag);
-      const std::string name = it != physicalNames_.end() ? it->second : "physical_" + std::to_string(tag);
-      auto& set = raw_.elementSets[name];
-      set.insert(set.end(), members.begin(), members.end());
-    }
-    return detail::finishMesh(std::move(raw_), cursor_, options, report, detail::MissingMaterialPolicy::FormatDefault);
   }
 
- private:
   std::vector<std::string_view> nextRecord(const std::string& what) {
     if (!cursor_.next()) cursor_.failAtEnd("file ends inside " + what);
     if (cursor_.line().front() == '$')
@@ -238,39 +248,45 @@ class GmshParser {
     reserveNodes(count);
     long long read = 0;
     for (long long b = 0; b < blocks; ++b) {
-      const auto block = nextRecord("a node block header 'entityDim entityTag parametric numNodesInBlock'");
-      if (block.size() != 4) cursor_.fail("node block header needs 'entityDim entityTag parametric numNodesInBlock'");
-      const long long dim = detail::integerAt(cursor_, block[0], "node block entity dimension");
-      const long long parametric = detail::integerAt(cursor_, block[2], "node block parametric flag");
-      const long long inBlock = detail::integerAt(cursor_, block[3], "node block size");
-      if (dim < 0 || dim > 3) cursor_.fail("node block entity dimension must be 0..3, got " + std::to_string(dim));
-      if (parametric != 0 && parametric != 1) cursor_.fail("node block parametric flag must be 0 or 1");
-      cursor_.checkCountFits(inBlock, 7, "nodes in the block");
-      if (read + inBlock > count)
-        cursor_.failAt(headerAt, "$Nodes says " + std::to_string(count) + " nodes, but its blocks hold more");
-      std::vector<long long> tags(static_cast<std::size_t>(inBlock));
-      for (auto& tag : tags) {
-        const auto tokens = nextRecord("a node tag");
-        if (tokens.size() != 1)
-          cursor_.fail("node block: expected one node tag per line, got " + std::to_string(tokens.size()) + " fields");
-        tag = detail::integerAt(cursor_, tokens[0], "node tag");
-      }
-      const std::size_t fields = 3 + static_cast<std::size_t>(parametric ? dim : 0);
-      for (long long tag : tags) {
-        const auto tokens = nextRecord("node coordinates");
-        if (tokens.size() != fields) {
-          cursor_.fail("node " + std::to_string(tag) + ": expected " + std::to_string(fields) + " coordinates, got " +
-                       std::to_string(tokens.size()));
-        }
-        addNode(tag, tokens.data());
-      }
-      read += inBlock;
+      read += readNodeBlock(headerAt, count, read);
     }
     if (read != count) {
       cursor_.failAt(headerAt,
                      "$Nodes says " + std::to_string(count) + " nodes, but its blocks hold " + std::to_string(read));
     }
     expectEnd("Nodes", "$Nodes has more lines than its blocks describe");
+  }
+
+  /// Reads one node block of a 4.1 $Nodes section (the tags, then the coordinates) after
+  /// `read` of the section's `count` nodes; returns the nodes in the block.
+  long long readNodeBlock(detail::Location headerAt, long long count, long long read) {
+    const auto block = nextRecord("a node block header 'entityDim entityTag parametric numNodesInBlock'");
+    if (block.size() != 4) cursor_.fail("node block header needs 'entityDim entityTag parametric numNodesInBlock'");
+    const long long dim = detail::integerAt(cursor_, block[0], "node block entity dimension");
+    const long long parametric = detail::integerAt(cursor_, block[2], "node block parametric flag");
+    const long long inBlock = detail::integerAt(cursor_, block[3], "node block size");
+    if (dim < 0 || dim > 3) cursor_.fail("node block entity dimension must be 0..3, got " + std::to_string(dim));
+    if (parametric != 0 && parametric != 1) cursor_.fail("node block parametric flag must be 0 or 1");
+    cursor_.checkCountFits(inBlock, 7, "nodes in the block");
+    if (read + inBlock > count)
+      cursor_.failAt(headerAt, "$Nodes says " + std::to_string(count) + " nodes, but its blocks hold more");
+    std::vector<long long> tags(static_cast<std::size_t>(inBlock));
+    for (auto& tag : tags) {
+      const auto tokens = nextRecord("a node tag");
+      if (tokens.size() != 1)
+        cursor_.fail("node block: expected one node tag per line, got " + std::to_string(tokens.size()) + " fields");
+      tag = detail::integerAt(cursor_, tokens[0], "node tag");
+    }
+    const std::size_t fields = 3 + static_cast<std::size_t>(parametric ? dim : 0);
+    for (long long tag : tags) {
+      const auto tokens = nextRecord("node coordinates");
+      if (tokens.size() != fields) {
+        cursor_.fail("node " + std::to_string(tag) + ": expected " + std::to_string(fields) + " coordinates, got " +
+                     std::to_string(tokens.size()));
+      }
+      addNode(tag, tokens.data());
+    }
+    return inBlock;
   }
 
   /// Appends one tetrahedron given its Gmsh element tag and four node tags.
@@ -349,41 +365,47 @@ class GmshParser {
     cursor_.checkCountFits(count, 3, "elements");
     long long read = 0;
     for (long long b = 0; b < blocks; ++b) {
-      const auto block = nextRecord("an element block header 'entityDim entityTag elementType numElementsInBlock'");
-      if (block.size() != 4)
-        cursor_.fail("element block header needs 'entityDim entityTag elementType numElementsInBlock'");
-      const long long dim = detail::integerAt(cursor_, block[0], "element block entity dimension");
-      const long long entity = detail::integerAt(cursor_, block[1], "element block entity tag");
-      const long long type = detail::integerAt(cursor_, block[2], "element block type");
-      const long long inBlock = detail::integerAt(cursor_, block[3], "element block size");
-      cursor_.checkCountFits(inBlock, 3, "elements in the block");
-      if (read + inBlock > count)
-        cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but its blocks hold more");
-      const std::vector<long long>* physicals = nullptr;
-      if (dim == 3) {
-        if (auto it = volumePhysicals_.find(entity); it != volumePhysicals_.end()) physicals = &it->second;
-      }
-      for (long long i = 0; i < inBlock; ++i) {
-        const auto tokens = nextRecord("an element line");
-        if (type != kTetrahedron) {
-          ignore(type);
-          continue;
-        }
-        if (tokens.size() != 5)
-          cursor_.fail("4-node tetrahedron line needs 'tag n1 n2 n3 n4', got " + std::to_string(tokens.size()) +
-                       " fields");
-        addTet(detail::integerAt(cursor_, tokens[0], "element tag"), &tokens[1]);
-        if (physicals) {
-          for (long long p : *physicals) physicalElements_[p].push_back(static_cast<int>(raw_.elements.size()) - 1);
-        }
-      }
-      read += inBlock;
+      read += readElementBlock(headerAt, count, read);
     }
     if (read != count) {
       cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but its blocks hold " +
                                    std::to_string(read));
     }
     expectEnd("Elements", "$Elements has more lines than its blocks describe");
+  }
+
+  /// Reads one element block of a 4.1 $Elements section after `read` of the section's
+  /// `count` elements; returns the elements in the block.
+  long long readElementBlock(detail::Location headerAt, long long count, long long read) {
+    const auto block = nextRecord("an element block header 'entityDim entityTag elementType numElementsInBlock'");
+    if (block.size() != 4)
+      cursor_.fail("element block header needs 'entityDim entityTag elementType numElementsInBlock'");
+    const long long dim = detail::integerAt(cursor_, block[0], "element block entity dimension");
+    const long long entity = detail::integerAt(cursor_, block[1], "element block entity tag");
+    const long long type = detail::integerAt(cursor_, block[2], "element block type");
+    const long long inBlock = detail::integerAt(cursor_, block[3], "element block size");
+    cursor_.checkCountFits(inBlock, 3, "elements in the block");
+    if (read + inBlock > count)
+      cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but its blocks hold more");
+    const std::vector<long long>* physicals = nullptr;
+    if (dim == 3) {
+      if (auto it = volumePhysicals_.find(entity); it != volumePhysicals_.end()) physicals = &it->second;
+    }
+    for (long long i = 0; i < inBlock; ++i) {
+      const auto tokens = nextRecord("an element line");
+      if (type != kTetrahedron) {
+        ignore(type);
+        continue;
+      }
+      if (tokens.size() != 5)
+        cursor_.fail("4-node tetrahedron line needs 'tag n1 n2 n3 n4', got " + std::to_string(tokens.size()) +
+                     " fields");
+      addTet(detail::integerAt(cursor_, tokens[0], "element tag"), &tokens[1]);
+      if (physicals) {
+        for (long long p : *physicals) physicalElements_[p].push_back(static_cast<int>(raw_.elements.size()) - 1);
+      }
+    }
+    return inBlock;
   }
 
   LineCursor cursor_;

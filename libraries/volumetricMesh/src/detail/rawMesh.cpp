@@ -34,15 +34,11 @@ int resolveDefaultMaterial(RawMesh& raw, const Material& material, const LineCur
   return static_cast<int>(raw.materials.size()) - 1;
 }
 
-}  // namespace
-
-TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions& options, MeshReadReport& report,
-                   MissingMaterialPolicy policy) {
+/// Gives the elements that no region or group covers a material: the caller's default,
+/// the format's default (with a warning), or an error naming the first of them.
+void assignMissingMaterials(RawMesh& raw, const LineCursor& cursor, const MeshReadOptions& options,
+                            MeshReadReport& report, MissingMaterialPolicy policy) {
   const std::size_t numElements = raw.elements.size();
-  const std::size_t numVertices = raw.vertexFileIds.size();
-  if (numElements == 0) cursor.failAtEnd("the file has no tetrahedral elements");
-
-  // Materials for elements no region or group covers.
   std::size_t firstMissing = numElements;
   for (std::size_t e = 0; e < numElements; ++e) {
     if (raw.elementMaterials[e] < 0) {
@@ -50,76 +46,65 @@ TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions&
       break;
     }
   }
-  if (firstMissing < numElements) {
-    int fallback = -1;
-    if (options.defaultMaterial) {
-      if (options.defaultMaterial->name.empty()) cursor.failAtEnd("the default material needs a name");
-      fallback = resolveDefaultMaterial(raw, *options.defaultMaterial, cursor);
-    } else if (policy == MissingMaterialPolicy::FormatDefault) {
-      const Material fallbackMaterial = formatDefaultMaterial();
-      fallback = resolveDefaultMaterial(raw, fallbackMaterial, cursor);
-      report.warnings.push_back("the file has no materials: every element gets the default material '" +
-                                fallbackMaterial.name + "' (density " + formatDouble(fallbackMaterial.density) +
-                                ", E " + formatDouble(fallbackMaterial.youngsModulus) + ", nu " +
-                                formatDouble(fallbackMaterial.poissonRatio) +
-                                "); pass a default material to choose another");
-    } else {
-      cursor.failAt(raw.elementLocations[firstMissing],
-                    "element " + std::to_string(raw.elementFileIds[firstMissing]) +
-                        " is covered by no *REGION, so it has no material (add a *REGION line for a set "
-                        "containing it, or give a default material)");
-    }
-    for (int& m : raw.elementMaterials) {
-      if (m < 0) m = fallback;
-    }
+  if (firstMissing == numElements) return;
+  int fallback = -1;
+  if (options.defaultMaterial) {
+    if (options.defaultMaterial->name.empty()) cursor.failAtEnd("the default material needs a name");
+    fallback = resolveDefaultMaterial(raw, *options.defaultMaterial, cursor);
+  } else if (policy == MissingMaterialPolicy::FormatDefault) {
+    const Material fallbackMaterial = formatDefaultMaterial();
+    fallback = resolveDefaultMaterial(raw, fallbackMaterial, cursor);
+    report.warnings.push_back(
+        "the file has no materials: every element gets the default material '" + fallbackMaterial.name + "' (density " +
+        formatDouble(fallbackMaterial.density) + ", E " + formatDouble(fallbackMaterial.youngsModulus) + ", nu " +
+        formatDouble(fallbackMaterial.poissonRatio) + "); pass a default material to choose another");
+  } else {
+    cursor.failAt(raw.elementLocations[firstMissing],
+                  "element " + std::to_string(raw.elementFileIds[firstMissing]) +
+                      " is covered by no *REGION, so it has no material (add a *REGION line for a set "
+                      "containing it, or give a default material)");
   }
+  for (int& m : raw.elementMaterials) {
+    if (m < 0) m = fallback;
+  }
+}
 
-  Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(numVertices));
-  for (std::size_t v = 0; v < numVertices; ++v) {
-    positions.col(static_cast<Eigen::Index>(v)) =
-        Eigen::Vector3d(raw.positions[3 * v], raw.positions[3 * v + 1], raw.positions[3 * v + 2]);
+/// Element e's vertices, checked against degeneracy and, when options allow, reoriented
+/// (last two swapped) if inverted, counted in report.
+std::array<int, 4> checkedElement(const RawMesh& raw, std::size_t e, const Eigen::Matrix3Xd& positions,
+                                  const LineCursor& cursor, const MeshReadOptions& options, MeshReadReport& report) {
+  std::array<int, 4> t = raw.elements[e];
+  Eigen::Matrix3d edges;
+  const Eigen::Vector3d x0 = positions.col(t[0]);
+  for (int a = 0; a < 3; ++a) edges.col(a) = positions.col(t[static_cast<std::size_t>(a + 1)]) - x0;
+  const double volume = edges.determinant() / 6.0;
+  double edgeSum = 0.0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b)
+      edgeSum += (positions.col(t[static_cast<std::size_t>(a)]) - positions.col(t[static_cast<std::size_t>(b)])).norm();
+  const double meanEdge = edgeSum / 6.0;
+  const std::string name = "element " + std::to_string(raw.elementFileIds[e]);
+  // <= so that an element whose vertices all coincide (mean edge 0) is degenerate too.
+  if (!(std::abs(volume) > options.degenerateVolumeTolerance * meanEdge * meanEdge * meanEdge)) {
+    cursor.failAt(raw.elementLocations[e], name + " is degenerate: volume " + formatDouble(volume) +
+                                               " with mean edge length " + formatDouble(meanEdge));
   }
-  Eigen::Matrix4Xi elements(4, static_cast<Eigen::Index>(numElements));
-  std::vector<char> used(numVertices, 0);
-  for (std::size_t e = 0; e < numElements; ++e) {
-    std::array<int, 4> t = raw.elements[e];
-    Eigen::Matrix3d edges;
-    const Eigen::Vector3d x0 = positions.col(t[0]);
-    for (int a = 0; a < 3; ++a) edges.col(a) = positions.col(t[static_cast<std::size_t>(a + 1)]) - x0;
-    const double volume = edges.determinant() / 6.0;
-    double edgeSum = 0.0;
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b)
-        edgeSum +=
-            (positions.col(t[static_cast<std::size_t>(a)]) - positions.col(t[static_cast<std::size_t>(b)])).norm();
-    const double meanEdge = edgeSum / 6.0;
-    const std::string name = "element " + std::to_string(raw.elementFileIds[e]);
-    // <= so that an element whose vertices all coincide (mean edge 0) is degenerate too.
-    if (!(std::abs(volume) > options.degenerateVolumeTolerance * meanEdge * meanEdge * meanEdge)) {
-      cursor.failAt(raw.elementLocations[e], name + " is degenerate: volume " + formatDouble(volume) +
-                                                 " with mean edge length " + formatDouble(meanEdge));
+  if (volume < 0.0) {
+    if (!options.reorientInvertedElements) {
+      cursor.failAt(raw.elementLocations[e], name + " is inverted (signed volume " + formatDouble(volume) +
+                                                 "); swap two of its vertices or allow reorientation");
     }
-    if (volume < 0.0) {
-      if (!options.reorientInvertedElements) {
-        cursor.failAt(raw.elementLocations[e], name + " is inverted (signed volume " + formatDouble(volume) +
-                                                   "); swap two of its vertices or allow reorientation");
-      }
-      std::swap(t[2], t[3]);
-      ++report.reorientedElements;
-    }
-    for (int a = 0; a < 4; ++a) {
-      elements(a, static_cast<Eigen::Index>(e)) = t[static_cast<std::size_t>(a)];
-      used[static_cast<std::size_t>(t[static_cast<std::size_t>(a)])] = 1;
-    }
+    std::swap(t[2], t[3]);
+    ++report.reorientedElements;
   }
-  if (report.reorientedElements > 0) {
-    report.warnings.push_back("reoriented " + std::to_string(report.reorientedElements) +
-                              " inverted element(s) (negative volume) by swapping their last two vertices");
-  }
+  return t;
+}
 
+/// Counts the vertices no element uses into report, with a warning naming the first.
+void reportUnusedVertices(const RawMesh& raw, const std::vector<char>& used, MeshReadReport& report) {
   int unused = 0;
   long long firstUnused = 0;
-  for (std::size_t v = 0; v < numVertices; ++v) {
+  for (std::size_t v = 0; v < used.size(); ++v) {
     if (!used[v]) {
       if (unused == 0) firstUnused = raw.vertexFileIds[v];
       ++unused;
@@ -131,6 +116,36 @@ TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions&
                               std::to_string(firstUnused) +
                               "); they have no mass or stiffness, so fix them or remove them");
   }
+}
+
+}  // namespace
+
+TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions& options, MeshReadReport& report,
+                   MissingMaterialPolicy policy) {
+  const std::size_t numElements = raw.elements.size();
+  const std::size_t numVertices = raw.vertexFileIds.size();
+  if (numElements == 0) cursor.failAtEnd("the file has no tetrahedral elements");
+  assignMissingMaterials(raw, cursor, options, report, policy);
+
+  Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(numVertices));
+  for (std::size_t v = 0; v < numVertices; ++v) {
+    positions.col(static_cast<Eigen::Index>(v)) =
+        Eigen::Vector3d(raw.positions[3 * v], raw.positions[3 * v + 1], raw.positions[3 * v + 2]);
+  }
+  Eigen::Matrix4Xi elements(4, static_cast<Eigen::Index>(numElements));
+  std::vector<char> used(numVertices, 0);
+  for (std::size_t e = 0; e < numElements; ++e) {
+    const std::array<int, 4> t = checkedElement(raw, e, positions, cursor, options, report);
+    for (int a = 0; a < 4; ++a) {
+      elements(a, static_cast<Eigen::Index>(e)) = t[static_cast<std::size_t>(a)];
+      used[static_cast<std::size_t>(t[static_cast<std::size_t>(a)])] = 1;
+    }
+  }
+  if (report.reorientedElements > 0) {
+    report.warnings.push_back("reoriented " + std::to_string(report.reorientedElements) +
+                              " inverted element(s) (negative volume) by swapping their last two vertices");
+  }
+  reportUnusedVertices(raw, used, report);
 
   TetMesh mesh(std::move(positions), std::move(elements), std::move(raw.materials), std::move(raw.elementMaterials));
   for (auto& [name, members] : raw.elementSets) mesh.setElementSet(name, std::move(members));

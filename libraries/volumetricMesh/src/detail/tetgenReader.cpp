@@ -27,62 +27,85 @@ long long headerField(const LineCursor& cursor, const std::vector<std::string_vi
   return i < tokens.size() ? detail::integerAt(cursor, tokens[i], what) : fallback;
 }
 
-/// Reads the .node file into raw; returns the numbering base (0 or 1).
-long long readNodes(LineCursor& cursor, detail::RawMesh& raw) {
+/// The .node header: vertex count, attributes per vertex, boundary marker flag.
+struct NodeHeader {
+  long long count = 0;
+  long long attributes = 0;
+  long long markers = 0;
+  detail::Location at;
+};
+
+NodeHeader readNodeHeader(LineCursor& cursor) {
   const auto header = headerTokens(cursor, "<count> 3 <attributes> <boundaryMarker>");
-  const auto headerAt = cursor.location();
+  NodeHeader node;
+  node.at = cursor.location();
   if (header.size() > 4)
     cursor.fail(".node header needs '<count> 3 <attributes> <boundaryMarker>', got " + std::to_string(header.size()) +
                 " fields");
-  const long long count = headerField(cursor, header, 0, 0, ".node vertex count");
+  node.count = headerField(cursor, header, 0, 0, ".node vertex count");
   const long long dimension = headerField(cursor, header, 1, 3, ".node dimension");
-  const long long attributes = headerField(cursor, header, 2, 0, ".node attribute count");
-  const long long markers = headerField(cursor, header, 3, 0, ".node boundary marker flag");
+  node.attributes = headerField(cursor, header, 2, 0, ".node attribute count");
+  node.markers = headerField(cursor, header, 3, 0, ".node boundary marker flag");
   if (dimension != 3) cursor.fail(".node dimension must be 3, got " + std::to_string(dimension));
-  if (attributes < 0 || attributes > kMaxAttributes)
-    cursor.fail(".node attribute count " + std::to_string(attributes) + " is out of range");
-  if (markers != 0 && markers != 1)
-    cursor.fail(".node boundary marker flag must be 0 or 1, got " + std::to_string(markers));
-  cursor.checkCountFits(count, 7, "vertices");
+  if (node.attributes < 0 || node.attributes > kMaxAttributes)
+    cursor.fail(".node attribute count " + std::to_string(node.attributes) + " is out of range");
+  if (node.markers != 0 && node.markers != 1)
+    cursor.fail(".node boundary marker flag must be 0 or 1, got " + std::to_string(node.markers));
+  cursor.checkCountFits(node.count, 7, "vertices");
+  return node;
+}
+
+/// Reads one vertex line (already split into the right number of tokens) into raw; the
+/// first line sets the numbering base.
+void readVertexLine(const LineCursor& cursor, const std::vector<std::string_view>& tokens, bool first,
+                    const NodeHeader& header, long long& base, std::vector<char>& seen, detail::RawMesh& raw) {
+  const long long count = header.count;
+  const long long id = detail::integerAt(cursor, tokens[0], "vertex index");
+  if (first) {
+    if (id != 0 && id != 1)
+      cursor.fail("the first vertex index must be 0 or 1 (it sets the numbering base), got " + std::to_string(id));
+    base = id;
+  }
+  if (id < base || id >= base + count) {
+    cursor.fail("vertex index " + std::to_string(id) + " is outside [" + std::to_string(base) + ", " +
+                std::to_string(base + count - 1) + "]");
+  }
+  const auto v = static_cast<std::size_t>(id - base);
+  if (seen[v]) cursor.fail("duplicate vertex index " + std::to_string(id));
+  seen[v] = 1;
+  raw.vertexFileIds[v] = id;
+  for (std::size_t c = 0; c < 3; ++c) {
+    raw.positions[3 * v + c] =
+        detail::finiteDoubleAt(cursor, tokens[c + 1], "vertex " + std::to_string(id) + " coordinate");
+  }
+  for (std::size_t a = 4; a < 4 + static_cast<std::size_t>(header.attributes); ++a) {
+    detail::doubleAt(cursor, tokens[a], "vertex " + std::to_string(id) + " attribute");
+  }
+  if (header.markers) detail::integerAt(cursor, tokens.back(), "vertex " + std::to_string(id) + " boundary marker");
+}
+
+/// Reads the .node file into raw; returns the numbering base (0 or 1).
+long long readNodes(LineCursor& cursor, detail::RawMesh& raw) {
+  const NodeHeader header = readNodeHeader(cursor);
+  const long long count = header.count;
   const auto n = static_cast<std::size_t>(count);
-  const std::size_t fields = 4 + static_cast<std::size_t>(attributes + markers);
+  const std::size_t fields = 4 + static_cast<std::size_t>(header.attributes + header.markers);
   raw.positions.assign(3 * n, 0.0);
   raw.vertexFileIds.resize(n);
   std::vector<char> seen(n, 0);
   long long base = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (!cursor.next()) {
-      cursor.failAt(headerAt, ".node header says " + std::to_string(count) + " vertices, but the file has only " +
-                                  std::to_string(i));
+      cursor.failAt(header.at, ".node header says " + std::to_string(count) + " vertices, but the file has only " +
+                                   std::to_string(i));
     }
     const auto tokens = detail::splitTokens(cursor.line(), false);
     if (tokens.size() != fields) {
       cursor.fail("vertex line needs " + std::to_string(fields) + " fields (index x y z, " +
-                  std::to_string(attributes) + " attributes, " + std::to_string(markers) + " marker), got " +
-                  std::to_string(tokens.size()));
+                  std::to_string(header.attributes) + " attributes, " + std::to_string(header.markers) +
+                  " marker), got " + std::to_string(tokens.size()));
     }
-    const long long id = detail::integerAt(cursor, tokens[0], "vertex index");
-    if (i == 0) {
-      if (id != 0 && id != 1)
-        cursor.fail("the first vertex index must be 0 or 1 (it sets the numbering base), got " + std::to_string(id));
-      base = id;
-    }
-    if (id < base || id >= base + count) {
-      cursor.fail("vertex index " + std::to_string(id) + " is outside [" + std::to_string(base) + ", " +
-                  std::to_string(base + count - 1) + "]");
-    }
-    const auto v = static_cast<std::size_t>(id - base);
-    if (seen[v]) cursor.fail("duplicate vertex index " + std::to_string(id));
-    seen[v] = 1;
-    raw.vertexFileIds[v] = id;
-    for (std::size_t c = 0; c < 3; ++c) {
-      raw.positions[3 * v + c] =
-          detail::finiteDoubleAt(cursor, tokens[c + 1], "vertex " + std::to_string(id) + " coordinate");
-    }
-    for (std::size_t a = 4; a < 4 + static_cast<std::size_t>(attributes); ++a) {
-      detail::doubleAt(cursor, tokens[a], "vertex " + std::to_string(id) + " attribute");
-    }
-    if (markers) detail::integerAt(cursor, tokens.back(), "vertex " + std::to_string(id) + " boundary marker");
+    readVertexLine(cursor, tokens, i == 0, header, base, seen, raw);
   }
   if (cursor.next()) {
     cursor.fail(".node header says " + std::to_string(count) + " vertices, but there are more vertex lines");
@@ -90,39 +113,117 @@ long long readNodes(LineCursor& cursor, detail::RawMesh& raw) {
   return base;
 }
 
-void readTets(LineCursor& cursor, detail::RawMesh& raw, long long base, MeshReadReport& report) {
+/// The .ele header: element count, nodes per tetrahedron (4 or 10), region attribute flag.
+struct EleHeader {
+  long long count = 0;
+  long long nodesPerTet = 4;
+  long long region = 0;
+  detail::Location at;
+};
+
+EleHeader readEleHeader(LineCursor& cursor) {
   const auto header = headerTokens(cursor, "<count> <4|10> <regionAttribute 0|1>");
-  const auto headerAt = cursor.location();
+  EleHeader ele;
+  ele.at = cursor.location();
   if (header.size() > 3)
     cursor.fail(".ele header needs '<count> <4|10> <0|1>', got " + std::to_string(header.size()) + " fields");
-  const long long count = headerField(cursor, header, 0, 0, ".ele element count");
-  const long long nodesPerTet = headerField(cursor, header, 1, 4, ".ele nodes per tetrahedron");
-  const long long region = headerField(cursor, header, 2, 0, ".ele region attribute flag");
-  if (nodesPerTet != 4 && nodesPerTet != 10) {
-    cursor.fail(".ele nodes per tetrahedron must be 4 or 10, got " + std::to_string(nodesPerTet));
+  ele.count = headerField(cursor, header, 0, 0, ".ele element count");
+  ele.nodesPerTet = headerField(cursor, header, 1, 4, ".ele nodes per tetrahedron");
+  ele.region = headerField(cursor, header, 2, 0, ".ele region attribute flag");
+  if (ele.nodesPerTet != 4 && ele.nodesPerTet != 10) {
+    cursor.fail(".ele nodes per tetrahedron must be 4 or 10, got " + std::to_string(ele.nodesPerTet));
   }
-  if (region != 0 && region != 1)
-    cursor.fail(".ele region attribute flag must be 0 or 1, got " + std::to_string(region));
-  cursor.checkCountFits(count, 9, "elements");
-  const auto n = static_cast<std::size_t>(count);
+  if (ele.region != 0 && ele.region != 1)
+    cursor.fail(".ele region attribute flag must be 0 or 1, got " + std::to_string(ele.region));
+  cursor.checkCountFits(ele.count, 9, "elements");
+  return ele;
+}
+
+/// Which vertices some element uses as a corner, and which as an edge node (10-node tets).
+struct VertexRoles {
+  std::vector<char> corner;
+  std::vector<char> edge;
+};
+
+/// Reads the vertices of element e (file index id) from tokens[1 ..] into raw.elements[e],
+/// marking their roles.
+void readElementVertices(const LineCursor& cursor, const std::vector<std::string_view>& tokens, std::size_t e,
+                         long long id, const EleHeader& header, long long base, detail::RawMesh& raw,
+                         VertexRoles& roles) {
   const auto numVertices = static_cast<long long>(raw.vertexFileIds.size());
-  const std::size_t fields = 1 + static_cast<std::size_t>(nodesPerTet + region);
+  const std::string name = "element " + std::to_string(id);
+  for (std::size_t a = 0; a < static_cast<std::size_t>(header.nodesPerTet); ++a) {
+    const long long v = detail::integerAt(cursor, tokens[a + 1], name + " vertex");
+    if (v < base || v >= base + numVertices) {
+      cursor.fail(name + " references vertex " + std::to_string(v) + ", outside [" + std::to_string(base) + ", " +
+                  std::to_string(base + numVertices - 1) + "]");
+    }
+    const int local = static_cast<int>(v - base);
+    if (a < 4) {
+      for (std::size_t b = 0; b < a; ++b) {
+        if (raw.elements[e][b] == local) cursor.fail(name + " uses vertex " + std::to_string(v) + " twice");
+      }
+      raw.elements[e][a] = local;
+      roles.corner[static_cast<std::size_t>(local)] = 1;
+    } else {
+      roles.edge[static_cast<std::size_t>(local)] = 1;
+    }
+  }
+  if (header.region) {
+    const double value = detail::finiteDoubleAt(cursor, tokens.back(), name + " region attribute");
+    raw.elementSets["region_" + detail::formatDouble(value)].push_back(static_cast<int>(e));
+  }
+}
+
+/// Linear elements use only the corners of 10-node tetrahedra; vertices that only ever
+/// were edge nodes would carry no mass or stiffness, so they are dropped and the rest
+/// renumbered (with a warning in report).
+void dropEdgeOnlyVertices(detail::RawMesh& raw, const VertexRoles& roles, MeshReadReport& report) {
+  std::vector<int> newIndex(raw.vertexFileIds.size(), -1);
+  int kept = 0;
+  int dropped = 0;
+  for (std::size_t v = 0; v < newIndex.size(); ++v) {
+    if (roles.edge[v] && !roles.corner[v]) {
+      ++dropped;
+      continue;
+    }
+    newIndex[v] = kept;
+    raw.vertexFileIds[static_cast<std::size_t>(kept)] = raw.vertexFileIds[v];
+    for (std::size_t c = 0; c < 3; ++c)
+      raw.positions[3 * static_cast<std::size_t>(kept) + c] = raw.positions[3 * v + c];
+    ++kept;
+  }
+  raw.vertexFileIds.resize(static_cast<std::size_t>(kept));
+  raw.positions.resize(3 * static_cast<std::size_t>(kept));
+  for (auto& t : raw.elements)
+    for (int& v : t) v = newIndex[static_cast<std::size_t>(v)];
+  report.warnings.push_back(
+      "10-node (quadratic) tetrahedra: using the 4 corner vertices of each element and "
+      "dropping the " +
+      std::to_string(dropped) + " edge-only nodes (vertices are renumbered)");
+}
+
+void readTets(LineCursor& cursor, detail::RawMesh& raw, long long base, MeshReadReport& report) {
+  const EleHeader header = readEleHeader(cursor);
+  const long long count = header.count;
+  const auto n = static_cast<std::size_t>(count);
+  const std::size_t fields = 1 + static_cast<std::size_t>(header.nodesPerTet + header.region);
   raw.elements.resize(n);
   raw.elementLocations.resize(n);
   raw.elementFileIds.resize(n);
   raw.elementMaterials.assign(n, -1);
   std::vector<char> seen(n, 0);
-  std::vector<char> cornerVertex(static_cast<std::size_t>(numVertices), 0);
-  std::vector<char> edgeVertex(static_cast<std::size_t>(numVertices), 0);
+  VertexRoles roles{std::vector<char>(raw.vertexFileIds.size(), 0), std::vector<char>(raw.vertexFileIds.size(), 0)};
   for (std::size_t i = 0; i < n; ++i) {
     if (!cursor.next()) {
-      cursor.failAt(headerAt, ".ele header says " + std::to_string(count) + " elements, but the file has only " +
-                                  std::to_string(i));
+      cursor.failAt(header.at, ".ele header says " + std::to_string(count) + " elements, but the file has only " +
+                                   std::to_string(i));
     }
     const auto tokens = detail::splitTokens(cursor.line(), false);
     if (tokens.size() != fields) {
-      cursor.fail("element line needs " + std::to_string(fields) + " fields (index, " + std::to_string(nodesPerTet) +
-                  " vertices" + (region ? ", region" : "") + "), got " + std::to_string(tokens.size()));
+      cursor.fail("element line needs " + std::to_string(fields) + " fields (index, " +
+                  std::to_string(header.nodesPerTet) + " vertices" + (header.region ? ", region" : "") + "), got " +
+                  std::to_string(tokens.size()));
     }
     const long long id = detail::integerAt(cursor, tokens[0], "element index");
     if (id < base || id >= base + count) {
@@ -132,60 +233,13 @@ void readTets(LineCursor& cursor, detail::RawMesh& raw, long long base, MeshRead
     const auto e = static_cast<std::size_t>(id - base);
     if (seen[e]) cursor.fail("duplicate element index " + std::to_string(id));
     seen[e] = 1;
-    const std::string name = "element " + std::to_string(id);
-    for (std::size_t a = 0; a < static_cast<std::size_t>(nodesPerTet); ++a) {
-      const long long v = detail::integerAt(cursor, tokens[a + 1], name + " vertex");
-      if (v < base || v >= base + numVertices) {
-        cursor.fail(name + " references vertex " + std::to_string(v) + ", outside [" + std::to_string(base) + ", " +
-                    std::to_string(base + numVertices - 1) + "]");
-      }
-      const int local = static_cast<int>(v - base);
-      if (a < 4) {
-        for (std::size_t b = 0; b < a; ++b) {
-          if (raw.elements[e][b] == local) cursor.fail(name + " uses vertex " + std::to_string(v) + " twice");
-        }
-        raw.elements[e][a] = local;
-        cornerVertex[static_cast<std::size_t>(local)] = 1;
-      } else {
-        edgeVertex[static_cast<std::size_t>(local)] = 1;
-      }
-    }
-    if (region) {
-      const double value = detail::finiteDoubleAt(cursor, tokens.back(), name + " region attribute");
-      raw.elementSets["region_" + detail::formatDouble(value)].push_back(static_cast<int>(e));
-    }
+    readElementVertices(cursor, tokens, e, id, header, base, raw, roles);
     raw.elementLocations[e] = cursor.location();
     raw.elementFileIds[e] = id;
   }
   if (cursor.next())
     cursor.fail(".ele header says " + std::to_string(count) + " elements, but there are more element lines");
-
-  if (nodesPerTet == 10) {
-    // Linear elements use only the corners; vertices that only ever were edge nodes
-    // would carry no mass or stiffness, so drop them and renumber the rest.
-    std::vector<int> newIndex(static_cast<std::size_t>(numVertices), -1);
-    int kept = 0;
-    int dropped = 0;
-    for (std::size_t v = 0; v < newIndex.size(); ++v) {
-      if (edgeVertex[v] && !cornerVertex[v]) {
-        ++dropped;
-        continue;
-      }
-      newIndex[v] = kept;
-      raw.vertexFileIds[static_cast<std::size_t>(kept)] = raw.vertexFileIds[v];
-      for (std::size_t c = 0; c < 3; ++c)
-        raw.positions[3 * static_cast<std::size_t>(kept) + c] = raw.positions[3 * v + c];
-      ++kept;
-    }
-    raw.vertexFileIds.resize(static_cast<std::size_t>(kept));
-    raw.positions.resize(3 * static_cast<std::size_t>(kept));
-    for (auto& t : raw.elements)
-      for (int& v : t) v = newIndex[static_cast<std::size_t>(v)];
-    report.warnings.push_back(
-        "10-node (quadratic) tetrahedra: using the 4 corner vertices of each element and "
-        "dropping the " +
-        std::to_string(dropped) + " edge-only nodes (vertices are renumbered)");
-  }
+  if (header.nodesPerTet == 10) dropEdgeOnlyVertices(raw, roles, report);
 }
 
 }  // namespace

@@ -45,19 +45,7 @@ class IncludeLoader {
   /// includerFile/includerLine say where it was included from (file -1: top level).
   void load(const std::filesystem::path& path, const std::string& displayName, int includerFile,
             std::size_t includerLine) {
-    std::string text;
-    if (includerFile < 0) {
-      text = readWholeFile(path);
-    } else {
-      try {
-        text = readWholeFile(path);
-      } catch (const ParseError&) {
-        throw;
-      } catch (const Error& error) {
-        throw ParseError(flat_.files[static_cast<std::size_t>(includerFile)], includerLine,
-                         std::string("*INCLUDE: ") + error.what());
-      }
-    }
+    const std::string text = readIncluded(path, includerFile, includerLine);
     std::error_code ec;
     std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
     if (ec) canonical = path.lexically_normal();
@@ -65,7 +53,28 @@ class IncludeLoader {
     const int fileIndex = static_cast<int>(flat_.files.size());
     flat_.files.push_back(displayName);
     stack_.push_back(canonical);
+    appendExpanded(path, text, fileIndex);
+    stack_.pop_back();
+  }
 
+ private:
+  /// The text of the file at path; an included file that cannot be read is a ParseError
+  /// at the *INCLUDE line.
+  std::string readIncluded(const std::filesystem::path& path, int includerFile, std::size_t includerLine) const {
+    if (includerFile < 0) return readWholeFile(path);
+    try {
+      return readWholeFile(path);
+    } catch (const ParseError&) {
+      throw;
+    } catch (const Error& error) {
+      throw ParseError(flat_.files[static_cast<std::size_t>(includerFile)], includerLine,
+                       std::string("*INCLUDE: ") + error.what());
+    }
+  }
+
+  /// Appends text (file fileIndex, read from path) to the flat text, replacing every
+  /// *INCLUDE line by the included file when expanding.
+  void appendExpanded(const std::filesystem::path& path, const std::string& text, int fileIndex) {
     std::size_t chunkStart = 0;
     std::size_t chunkFirstLine = 1;
     std::size_t lineNumber = 1;
@@ -84,10 +93,8 @@ class IncludeLoader {
       ++lineNumber;
     }
     appendChunk(text, chunkStart, text.size(), fileIndex, chunkFirstLine);
-    stack_.pop_back();
   }
 
- private:
   void appendChunk(const std::string& text, std::size_t begin, std::size_t end, int file, std::size_t firstLine) {
     if (begin >= end) return;
     flat_.segments.push_back({flat_.text.size(), file, firstLine});

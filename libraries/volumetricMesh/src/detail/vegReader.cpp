@@ -92,11 +92,9 @@ class VegParser {
     return tokens;
   }
 
-  void readVertices() {
-    if (haveVertices_) cursor_.fail("second *VERTICES section");
-    haveVertices_ = true;
+  /// The vertex count of the *VERTICES header line, checked.
+  long long readVerticesHeader() {
     const auto header = headerLine("*VERTICES", "<count> 3 0 0");
-    const Location headerAt = cursor_.location();
     if (header.size() > 4)
       cursor_.fail("*VERTICES header has " + std::to_string(header.size()) + " fields; expected '<count> 3 0 0'");
     const long long count = detail::integerAt(cursor_, header[0], "*VERTICES count");
@@ -105,6 +103,14 @@ class VegParser {
     }
     for (std::size_t i = 2; i < header.size(); ++i) detail::integerAt(cursor_, header[i], "*VERTICES header");
     cursor_.checkCountFits(count, 7, "vertices");
+    return count;
+  }
+
+  void readVertices() {
+    if (haveVertices_) cursor_.fail("second *VERTICES section");
+    haveVertices_ = true;
+    const long long count = readVerticesHeader();
+    const Location headerAt = cursor_.location();
     const auto n = static_cast<std::size_t>(count);
     raw_.positions.assign(3 * n, 0.0);
     raw_.vertexFileIds.resize(n);
@@ -138,32 +144,10 @@ class VegParser {
     if (haveElements_) cursor_.fail("second *ELEMENTS section");
     if (!haveVertices_) cursor_.fail("*ELEMENTS before *VERTICES: vertices must come first");
     haveElements_ = true;
-    if (!cursor_.next() || isKeywordLine(cursor_.line()))
-      cursor_.fail("*ELEMENTS needs the element type (TET) on the next line");
-    const std::string_view type = cursor_.line();
-    long long ignored = 0;
-    if (detail::equalsIgnoreCase(type, "CUBIC")) {
-      cursor_.fail("element type CUBIC (hexahedra) is not supported: only TET meshes can be read");
-    }
-    if (!detail::equalsIgnoreCase(type, "TET")) {
-      const auto typeTokens = detail::splitTokens(type, true);
-      if (!typeTokens.empty() && detail::parseInteger(typeTokens.front(), ignored)) {
-        cursor_.fail("*ELEMENTS needs the element type (TET) on its own line before the count");
-      }
-      cursor_.fail("unsupported element type '" + std::string(type) + "': only TET is supported");
-    }
-    const auto header = headerLine("*ELEMENTS", "<count> 4 0");
+    readElementType();
+    const long long count = readElementsHeader();
     const Location headerAt = cursor_.location();
-    if (header.size() > 3)
-      cursor_.fail("*ELEMENTS header has " + std::to_string(header.size()) + " fields; expected '<count> 4 0'");
-    const long long count = detail::integerAt(cursor_, header[0], "*ELEMENTS count");
-    if (header.size() >= 2 && detail::integerAt(cursor_, header[1], "*ELEMENTS vertices per element") != 4) {
-      cursor_.fail("TET elements have 4 vertices, but the header says " + std::string(header[1]));
-    }
-    if (header.size() >= 3) detail::integerAt(cursor_, header[2], "*ELEMENTS header");
-    cursor_.checkCountFits(count, 9, "elements");
     const auto n = static_cast<std::size_t>(count);
-    const auto numVertices = static_cast<long long>(raw_.vertexFileIds.size());
     raw_.elements.resize(n);
     raw_.elementLocations.resize(n);
     raw_.elementFileIds.resize(n);
@@ -185,24 +169,63 @@ class VegParser {
       const auto e = static_cast<std::size_t>(id - 1);
       if (seen[e]) cursor_.fail("duplicate element index " + std::to_string(id));
       seen[e] = 1;
-      const std::string name = "element " + std::to_string(id);
-      for (std::size_t a = 0; a < 4; ++a) {
-        const long long v = detail::integerAt(cursor_, tokens[a + 1], name + " vertex");
-        if (v < 1 || v > numVertices) {
-          cursor_.fail(name + " references vertex " + std::to_string(v) + ", outside [1, " +
-                       std::to_string(numVertices) + "]");
-        }
-        for (std::size_t b = 0; b < a; ++b) {
-          if (raw_.elements[e][b] == static_cast<int>(v - 1)) {
-            cursor_.fail(name + " uses vertex " + std::to_string(v) + " twice");
-          }
-        }
-        raw_.elements[e][a] = static_cast<int>(v - 1);
-      }
+      readElementVertices(tokens, e, id);
       raw_.elementLocations[e] = cursor_.location();
       raw_.elementFileIds[e] = id;
     }
     expectSectionEnd("*ELEMENTS", count, "elements", "element");
+  }
+
+  /// The line after *ELEMENTS must name the element type TET.
+  void readElementType() {
+    if (!cursor_.next() || isKeywordLine(cursor_.line()))
+      cursor_.fail("*ELEMENTS needs the element type (TET) on the next line");
+    const std::string_view type = cursor_.line();
+    long long ignored = 0;
+    if (detail::equalsIgnoreCase(type, "CUBIC")) {
+      cursor_.fail("element type CUBIC (hexahedra) is not supported: only TET meshes can be read");
+    }
+    if (!detail::equalsIgnoreCase(type, "TET")) {
+      const auto typeTokens = detail::splitTokens(type, true);
+      if (!typeTokens.empty() && detail::parseInteger(typeTokens.front(), ignored)) {
+        cursor_.fail("*ELEMENTS needs the element type (TET) on its own line before the count");
+      }
+      cursor_.fail("unsupported element type '" + std::string(type) + "': only TET is supported");
+    }
+  }
+
+  /// The element count of the *ELEMENTS header line, checked.
+  long long readElementsHeader() {
+    const auto header = headerLine("*ELEMENTS", "<count> 4 0");
+    if (header.size() > 3)
+      cursor_.fail("*ELEMENTS header has " + std::to_string(header.size()) + " fields; expected '<count> 4 0'");
+    const long long count = detail::integerAt(cursor_, header[0], "*ELEMENTS count");
+    if (header.size() >= 2 && detail::integerAt(cursor_, header[1], "*ELEMENTS vertices per element") != 4) {
+      cursor_.fail("TET elements have 4 vertices, but the header says " + std::string(header[1]));
+    }
+    if (header.size() >= 3) detail::integerAt(cursor_, header[2], "*ELEMENTS header");
+    cursor_.checkCountFits(count, 9, "elements");
+    return count;
+  }
+
+  /// Reads the four vertices of element e (file index id) from tokens[1 .. 4].
+  template <class Tokens>
+  void readElementVertices(const Tokens& tokens, std::size_t e, long long id) {
+    const auto numVertices = static_cast<long long>(raw_.vertexFileIds.size());
+    const std::string name = "element " + std::to_string(id);
+    for (std::size_t a = 0; a < 4; ++a) {
+      const long long v = detail::integerAt(cursor_, tokens[a + 1], name + " vertex");
+      if (v < 1 || v > numVertices) {
+        cursor_.fail(name + " references vertex " + std::to_string(v) + ", outside [1, " + std::to_string(numVertices) +
+                     "]");
+      }
+      for (std::size_t b = 0; b < a; ++b) {
+        if (raw_.elements[e][b] == static_cast<int>(v - 1)) {
+          cursor_.fail(name + " uses vertex " + std::to_string(v) + " twice");
+        }
+      }
+      raw_.elements[e][a] = static_cast<int>(v - 1);
+    }
   }
 
   /// After count records, the next line must be a keyword (or the end of the input).
@@ -315,6 +338,19 @@ class VegParser {
   }
 
   void resolveSetsAndRegions() {
+    const std::map<std::string, std::vector<int>> regionSets = resolveSets();
+    for (const RegionLine& region : regions_) {
+      std::vector<int> all;
+      const std::vector<int>& members = regionMembers(region, regionSets, all);
+      const int material = regionMaterial(region);
+      // Later *REGION lines win where sets overlap.
+      for (int e : members) raw_.elementMaterials[static_cast<std::size_t>(e)] = material;
+    }
+  }
+
+  /// Checks the ids of every set and stores the sets in raw_ (0-based); returns the
+  /// element sets a *REGION line may name (material sets included).
+  std::map<std::string, std::vector<int>> resolveSets() {
     const auto numElements = static_cast<long long>(raw_.elements.size());
     const auto numVertices = static_cast<long long>(raw_.vertexFileIds.size());
     std::map<std::string, std::vector<int>> regionSets;
@@ -336,34 +372,39 @@ class VegParser {
         if (set.name.rfind(kMaterialSetPrefix, 0) != 0) raw_.elementSets[set.name] = std::move(members);
       }
     }
-    for (const RegionLine& region : regions_) {
-      const std::vector<int>* members = nullptr;
-      std::vector<int> all;
-      if (auto it = regionSets.find(region.setName); it != regionSets.end()) {
-        members = &it->second;
-      } else if (region.setName == "allElements") {
-        all.resize(raw_.elements.size());
-        for (std::size_t e = 0; e < all.size(); ++e) all[e] = static_cast<int>(e);
-        members = &all;
-      } else {
-        std::string known = "allElements";
-        for (const auto& [n, s] : raw_.elementSets) known += ", " + n;
-        cursor_.failAt(region.location,
-                       "*REGION refers to unknown set '" + region.setName + "' (known: " + known + ")");
-      }
-      int material = -1;
-      for (std::size_t m = 0; m < raw_.materials.size(); ++m) {
-        if (raw_.materials[m].name == region.materialName) material = static_cast<int>(m);
-      }
-      if (material < 0) {
-        std::string known;
-        for (const Material& m : raw_.materials) known += (known.empty() ? "" : ", ") + m.name;
-        cursor_.failAt(region.location, "*REGION refers to unknown material '" + region.materialName +
-                                            "' (known: " + (known.empty() ? "none" : known) + ")");
-      }
-      // Later *REGION lines win where sets overlap.
-      for (int e : *members) raw_.elementMaterials[static_cast<std::size_t>(e)] = material;
+    return regionSets;
+  }
+
+  /// The elements of the set a *REGION line names (allElements: every element, built in all).
+  const std::vector<int>& regionMembers(const RegionLine& region,
+                                        const std::map<std::string, std::vector<int>>& regionSets,
+                                        std::vector<int>& all) const {
+    if (auto it = regionSets.find(region.setName); it != regionSets.end()) {
+      return it->second;
     }
+    if (region.setName != "allElements") {
+      std::string known = "allElements";
+      for (const auto& [n, s] : raw_.elementSets) known += ", " + n;
+      cursor_.failAt(region.location, "*REGION refers to unknown set '" + region.setName + "' (known: " + known + ")");
+    }
+    all.resize(raw_.elements.size());
+    for (std::size_t e = 0; e < all.size(); ++e) all[e] = static_cast<int>(e);
+    return all;
+  }
+
+  /// The index of the material a *REGION line names (the last of that name).
+  int regionMaterial(const RegionLine& region) const {
+    int material = -1;
+    for (std::size_t m = 0; m < raw_.materials.size(); ++m) {
+      if (raw_.materials[m].name == region.materialName) material = static_cast<int>(m);
+    }
+    if (material < 0) {
+      std::string known;
+      for (const Material& m : raw_.materials) known += (known.empty() ? "" : ", ") + m.name;
+      cursor_.failAt(region.location, "*REGION refers to unknown material '" + region.materialName +
+                                          "' (known: " + (known.empty() ? "none" : known) + ")");
+    }
+    return material;
   }
 
   LineCursor cursor_;

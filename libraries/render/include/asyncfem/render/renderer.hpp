@@ -28,6 +28,12 @@ struct GroundPlane {
   bool shadow = true;                                ///< darken the floor under the surfaces (projection along -up)
 };
 
+/// The ground under box for a scene whose up direction is up (non-zero): perpendicular to
+/// up, 2% of the box diagonal below the box's lowest corner along up, centred under the
+/// box's centre, 4 diagonals to each side, tiles of 1, 2 or 5 times a power of ten near a
+/// sixth of the diagonal, with a shadow.
+GroundPlane groundBelow(const BoundingBox& box, const Eigen::Vector3d& up);
+
 /// How a frame looks. Colours are RGB in [0, 1].
 struct RenderStyle {
   Eigen::Vector3f background = Eigen::Vector3f(1.0F, 1.0F, 1.0F);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -137,6 +138,16 @@ class SimulationWriter {
 /// Reads a simulation output file, possibly one still being written or left behind by an
 /// interrupted run.
 ///
+/// What SimulationReader::scanRecords() found: the times of the first and the last
+/// frame read and, when a record failed its checks, which one and why.
+struct RecordScan {
+  std::int64_t goodFrames = 0;           ///< frames read before the first bad one (all when none is bad)
+  double firstTime = 0.0;                ///< time of frame 0 (0 when it is bad or there is none)
+  double lastTime = 0.0;                 ///< time of the last good frame (0 when there is none)
+  std::optional<std::int64_t> badFrame;  ///< the first frame that failed its checks
+  std::string badMessage;                ///< the ParseError's message for it
+};
+
 /// The constructor validates the header and throws asyncfem::ParseError naming the file
 /// for a missing or truncated header, bad magic, an unsupported version, a header
 /// checksum mismatch, unknown flags, or absurd sizes (n = 0, n > maxSimulationFileVertices,
@@ -169,6 +180,9 @@ class SimulationReader {
   void readFrame(std::int64_t k, SimulationFrame& out);
   /// Reads and checks every complete frame; throws at the first bad one.
   void verifyAll();
+  /// Reads and checks every complete frame in order and stops at the first bad one,
+  /// reporting it in the result instead of throwing.
+  RecordScan scanRecords();
 
  private:
   struct FileCloser {

@@ -36,6 +36,12 @@ struct BoundingBox {
   Eigen::Vector3d min;
   Eigen::Vector3d max;
 };
+/// Corner i (0 <= i < 8) of box: bit 0 of i takes max.x instead of min.x, bit 1 max.y,
+/// bit 2 max.z.
+inline Eigen::Vector3d boxCorner(const BoundingBox& box, int i) {
+  return {(i & 1) != 0 ? box.max.x() : box.min.x(), (i & 2) != 0 ? box.max.y() : box.min.y(),
+          (i & 4) != 0 ? box.max.z() : box.min.z()};
+}
 /// Box of the rest positions (of positions + displacement if given, size 3n; other sizes
 /// throw ValidationError). Zero box for a mesh without vertices.
 BoundingBox boundingBox(const TetMesh& mesh, const Eigen::VectorXd& displacement = {});
@@ -54,6 +60,18 @@ struct ElementQuality {
 ElementQuality elementQuality(const TetMesh& mesh, int e);
 /// elementQuality for every element, in element order.
 std::vector<ElementQuality> elementQualities(const TetMesh& mesh);
+
+/// The spread of element quality over a mesh: the smallest, mean and largest of the
+/// elements' minimum dihedral angles (degrees) and the worst (largest) aspect ratio. All
+/// zero for a mesh without elements.
+struct QualitySummary {
+  double minDihedralDegrees = 0.0;   ///< smallest min dihedral angle over elements
+  double meanDihedralDegrees = 0.0;  ///< mean over elements of the min dihedral angle
+  double maxDihedralDegrees = 0.0;   ///< largest min dihedral angle over elements
+  double worstAspectRatio = 0.0;
+};
+/// QualitySummary of elementQualities(mesh).
+QualitySummary summarizeQuality(const TetMesh& mesh);
 
 /// Vertices referenced by no element.
 std::vector<int> unusedVertices(const TetMesh& mesh);

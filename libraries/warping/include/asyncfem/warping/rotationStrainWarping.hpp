@@ -67,6 +67,20 @@ class RotationStrainWarping final : public Warping {
   const SolverStats& solverStats() const;
 
  private:
+  /// Set-up steps of the constructor, in order. used: vertex is in some element;
+  /// fixed: vertex is in fixedVertices. The index vectors map a vertex to its row among
+  /// the unknown or the constrained vertices (-1: not one).
+  void findComponents(const std::vector<bool>& used, const std::vector<bool>& fixed);
+  void numberVertices(const std::vector<bool>& used, const std::vector<bool>& fixed, std::vector<int>& unknownIndex,
+                      std::vector<int>& constrainedIndex);
+  void factorLaplacian(const std::vector<int>& unknownIndex, const std::vector<int>& constrainedIndex,
+                       SolverKind solverKind);
+  void buildGatherMap(const TetMesh& mesh);
+  /// Stages of warp() for the displacement u (3 x n).
+  void elementPass(const Eigen::Map<const Eigen::Matrix3Xd>& u);
+  void gatherRightHandSide(const Eigen::Map<const Eigen::Matrix3Xd>& u);
+  void shiftPinnedComponents(const Eigen::Map<const Eigen::Matrix3Xd>& u, Eigen::VectorXd& warped) const;
+
   int numVertices_ = 0;
   int numElements_ = 0;
   Eigen::Matrix4Xi elements_;
