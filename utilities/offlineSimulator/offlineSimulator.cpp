@@ -176,24 +176,13 @@ void applyOverrides(const CommandLine& options, asyncfem::Scene& scene) {
                 << ")\n";
     }
   }
-  if (options.timestep) {
-    scene.integrator.timestep = *options.timestep;
-    scene.integrator.stepsPerFrame = 0;
-  }
-  if (options.stepsPerFrame) {
-    scene.integrator.stepsPerFrame = *options.stepsPerFrame;
-  }
-  if (options.frames) {
-    scene.frames.count = *options.frames;
-  }
+  asyncfem::overrideFrameTiming(scene, {options.timestep, options.stepsPerFrame, options.frames});
   if (options.vtuFolder) {
     scene.output.vtuFolder = *options.vtuFolder;
   }
   if (scene.output.file.empty()) {
     throw asyncfem::Error("no output file: set output.file in " + scene.sourceName + " or pass --output FILE");
   }
-  // Every part of the run sees the timestep it will run with (and a bad one fails first).
-  scene.integrator.timestep = asyncfem::resolveFrameTiming(scene).timestep;
 }
 
 // Refuses an output (the .afsim file or its checkpoint) that is one of the run's inputs:
@@ -232,7 +221,8 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
                   const asyncfem::CheckpointSchedule& schedule, int checkpointsWritten) {
   const asyncfem::IntegratorStats& after = simulation.integrator->stats();
   // Frames computed by this run (a resumed run starts at firstFrame).
-  const int frames = std::max(simulation.numFrames - firstFrame, 1);
+  const asyncfem::FrameTiming& timing = simulation.timing;
+  const int frames = std::max(timing.frameCount - firstFrame, 1);
   const double forces = after.forceSeconds - before.forceSeconds;
   const double assembly = after.assemblySeconds - before.assemblySeconds;
   const double factorization = after.factorizationSeconds - before.factorizationSeconds;
@@ -243,12 +233,13 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
   std::ostringstream out;
   out.setf(std::ios::fixed);
   out.precision(3);
-  out << "offlineSimulator: " << scene.sourceName << ": " << (simulation.numFrames - firstFrame) << " frames";
+  out << "offlineSimulator: " << scene.sourceName << ": " << (timing.frameCount - firstFrame) << " frames";
   if (firstFrame > 0) {
-    out << " (resumed after frame " << firstFrame << " of " << simulation.numFrames << ")";
+    out << " (resumed after frame " << firstFrame << " of " << timing.frameCount << ")";
   }
-  out << ", " << steps << " steps of h = " << std::defaultfloat << std::setprecision(9) << simulation.timestep
-      << std::setprecision(3) << " (" << simulation.stepsPerFrame << " per frame), " << std::fixed
+  out << ", " << steps << " steps of h = " << std::defaultfloat << std::setprecision(9)
+      << simulation.integrator->timestep() << std::setprecision(3) << " (" << timing.stepsPerFrame << " per frame), "
+      << std::fixed
       << (setupSeconds + loopSeconds + (couplingCheck ? couplingCheck->estimate.seconds : 0.0)) << " s\n";
   out << "  mesh        " << simulation.mesh->numVertices() << " vertices, " << simulation.mesh->numElements()
       << " elements, " << simulation.fixedVertices.size() << " fixed vertices\n";
@@ -308,7 +299,7 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
                                                             " evaluations (once per frame after the loads)"
                                                       : std::string("not evaluated (see skipped)"))
       << "\n";
-  out << "  output      " << scene.output.file.string() << " (" << simulation.numFrames << " frames, " << outputBytes
+  out << "  output      " << scene.output.file.string() << " (" << timing.frameCount << " frames, " << outputBytes
       << " bytes; " << checkpointsWritten << " checkpoints, " << schedule.describe() << " and at the end, in "
       << asyncfem::checkpointPathFor(scene.output.file).string() << ")";
   if (!scene.output.vtuFolder.empty()) {
@@ -352,7 +343,7 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   asyncfem::Stopwatch setupWatch;
   setupWatch.start();
   asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
-  const asyncfem::FrameTiming timing = asyncfem::resolveFrameTiming(scene);
+  const asyncfem::FrameTiming& timing = scene.timing;
   const std::shared_ptr<const asyncfem::Problem> problem = asyncfem::buildProblem(scene);
   settings.massType = scene.mass;
   settings.timestep = timing.timestep;
@@ -386,7 +377,7 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   const double setupSeconds = setupWatch.stop();
   asyncfem::Stopwatch loopWatch;
   loopWatch.start();
-  for (int frame = 0; frame < scene.frames.count; ++frame) {
+  for (int frame = 0; frame < timing.frameCount; ++frame) {
     for (int s = 0; s < timing.stepsPerFrame; ++s) simulation.step();  // non-finite states throw on every rank
     const Eigen::VectorXd u = simulation.gatherDisplacement();
     if (root) writer->appendFrame(simulation.time(), u);
@@ -399,16 +390,16 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
       std::ostringstream out;
       out.setf(std::ios::fixed);
       out.precision(3);
-      out << "offlineSimulator: " << scene.sourceName << ": " << scene.frames.count << " frames, " << stats.steps
+      out << "offlineSimulator: " << scene.sourceName << ": " << timing.frameCount << " frames, " << stats.steps
           << " steps of h = " << std::defaultfloat << timing.timestep << std::fixed << " on the PETSc backend, "
           << (setupSeconds + loopSeconds) << " s\n";
       out << "  ranks       " << stats.ranks << " (" << stats.freeDofs << " free DOFs, " << stats.matrixNonZeros
           << " matrix non-zeros; KSP " << stats.kspType << ", PC " << stats.pcType << ")\n";
       out << "  setup       " << setupSeconds << " s\n";
-      out << "  per frame   " << milliseconds(loopSeconds, scene.frames.count) << "   (assembly "
+      out << "  per frame   " << milliseconds(loopSeconds, timing.frameCount) << "   (assembly "
           << stats.assemblySeconds << " s, solves " << stats.solveSeconds << " s, " << stats.solverIterations
           << " iterations in " << stats.solves << " solves)\n";
-      out << "  output      " << scene.output.file.string() << " (" << scene.frames.count
+      out << "  output      " << scene.output.file.string() << " (" << timing.frameCount
           << " frames; no checkpoint on this backend)\n";
       std::cout << out.str() << std::flush;
     }
@@ -503,16 +494,16 @@ int run(int argc, char** argv) {
   }
   asyncfem::SimulationFileHeader header;
   header.numVertices = simulation.mesh->numVertices();
-  header.frameInterval = simulation.frameInterval;
-  header.timestep = simulation.timestep;
+  header.frameInterval = simulation.timing.frameInterval;
+  header.timestep = simulation.integrator->timestep();
   header.hasVelocities = scene.output.velocities;
   // The scene, so that frameRenderer and afsimTool find the mesh by themselves.
   header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
   header.sceneFingerprint = asyncfem::problemFingerprint(*simulation.problem);
   const asyncfem::SimulationWriter::Options writerOptions{scene.output.sync};
   const std::uint32_t fingerprint =
-      asyncfem::runFingerprint(fingerprintText(options.scene), scene.integrator.name, simulation.timestep,
-                               simulation.frameInterval, *simulation.problem);
+      asyncfem::runFingerprint(fingerprintText(options.scene), scene.integrator.name, header.timestep,
+                               header.frameInterval, *simulation.problem);
   const asyncfem::CheckpointSchedule schedule{options.checkpointEvery, options.checkpointSeconds};
   const fs::path checkpointFile = asyncfem::checkpointPathFor(scene.output.file);
 
@@ -520,7 +511,7 @@ int run(int argc, char** argv) {
   std::unique_ptr<asyncfem::SimulationWriter> writer;
   if (options.resume) {
     firstFrame = static_cast<int>(asyncfem::resumeFromCheckpoint(scene.output.file, header, fingerprint,
-                                                                 simulation.numFrames, *simulation.integrator));
+                                                                 simulation.timing.frameCount, *simulation.integrator));
     writer = asyncfem::SimulationWriter::continueFile(scene.output.file, header, firstFrame, writerOptions);
     const std::string caveat = simulation.integrator->report().resumeCaveat;
     if (!caveat.empty() && !options.quiet) std::printf("resume: %s\n", caveat.c_str());
@@ -544,14 +535,14 @@ int run(int argc, char** argv) {
 
   asyncfem::cli::ProgressReporter progress("offlineSimulator",
                                            asyncfem::cli::chooseProgressStyle(options.quiet, options.progress),
-                                           simulation.numFrames, firstFrame);
+                                           simulation.timing.frameCount, firstFrame);
 
   asyncfem::Stopwatch loopWatch;
   asyncfem::Stopwatch outputWatch;
   loopWatch.start();
   int frame = firstFrame;
   try {
-    for (; frame < simulation.numFrames && stopSignal == 0; ++frame) {
+    for (; frame < simulation.timing.frameCount && stopSignal == 0; ++frame) {
       asyncfem::advanceFrame(simulation, frame);
       {
         const asyncfem::ScopedTimer timer(outputWatch);
@@ -563,7 +554,7 @@ int run(int argc, char** argv) {
         }
         // After the record, so that the checkpoint never runs ahead of the file.
         const int done = frame + 1;
-        if (schedule.due(done, secondsSince(lastCheckpoint)) || done == simulation.numFrames || stopSignal != 0) {
+        if (schedule.due(done, secondsSince(lastCheckpoint)) || done == simulation.timing.frameCount || stopSignal != 0) {
           asyncfem::writeCheckpoint(checkpointFile, asyncfem::captureCheckpoint(integrator, done, fingerprint),
                                     scene.output.sync);
           checkpointFrames = done;
@@ -593,9 +584,9 @@ int run(int argc, char** argv) {
   }
   writer->close();
 
-  if (stopSignal != 0 && frame < simulation.numFrames) {
+  if (stopSignal != 0 && frame < simulation.timing.frameCount) {
     std::cerr << "offlineSimulator: interrupted by " << signalName(stopSignal) << ": " << writer->numFrames() << " of "
-              << simulation.numFrames << " frames are complete in " << scene.output.file.string()
+              << simulation.timing.frameCount << " frames are complete in " << scene.output.file.string()
               << " (checkpoint after frame " << checkpointFrames << " in " << checkpointFile.string()
               << "); continue the run with:\n  " << resumeCommand(argc, argv) << "\n";
     return 128 + static_cast<int>(stopSignal);
