@@ -50,6 +50,7 @@
 #if ASYNCFEM_OFFLINE_WITH_PETSC
 #include <asyncfem/petscBackend/petscRuntime.hpp>
 #include <asyncfem/petscBackend/petscSimulation.hpp>
+#include <asyncfem/petscBackend/problemSettings.hpp>
 #endif
 
 #include "commandLine.hpp"
@@ -310,57 +311,64 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
 }
 
 #if ASYNCFEM_OFFLINE_WITH_PETSC
+const std::string petscPrefix = "--backend petsc: ";
+
+// What the PETSc backend does not write: checkpoints (so no --resume), .vtu files, velocities.
+void refusePetscOutputs(const CommandLine& options, const asyncfem::Scene& scene) {
+  if (options.resume) {
+    throw asyncfem::Error(petscPrefix + "--resume is not supported (this backend writes no checkpoint)");
+  }
+  if (!scene.output.vtuFolder.empty() || scene.output.velocities) {
+    throw asyncfem::Error(petscPrefix +
+                          ".vtu output and output.velocities are not supported; the .afsim file is written");
+  }
+}
+
+// The backend's settings for the scene's problem (asyncfem::petscSettingsForProblem), with
+// the solver chosen on the command line.
+asyncfem::PetscSimulationSettings petscSettings(const CommandLine& options, const asyncfem::Scene& scene,
+                                                const asyncfem::Problem& problem) {
+  asyncfem::PetscSimulationSettings settings;
+  try {
+    settings = asyncfem::petscSettingsForProblem(problem, scene.integrator.name, scene.timing.timestep);
+  } catch (const asyncfem::ValidationError& error) {
+    throw asyncfem::Error(petscPrefix + scene.sourceName + ": " + error.what());
+  }
+  settings.solver.kind = asyncfem::parsePetscSolverKind(options.petscSolver);
+  return settings;
+}
+
+void printPetscSummary(const asyncfem::Scene& scene, const asyncfem::PetscRunStats& stats, double setupSeconds,
+                       double loopSeconds) {
+  const asyncfem::FrameTiming& timing = scene.timing;
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(3);
+  out << "offlineSimulator: " << scene.sourceName << ": " << timing.frameCount << " frames, " << stats.steps
+      << " steps of h = " << std::defaultfloat << timing.timestep << std::fixed << " on the PETSc backend, "
+      << (setupSeconds + loopSeconds) << " s\n";
+  out << "  ranks       " << stats.ranks << " (" << stats.freeDofs << " free DOFs, " << stats.matrixNonZeros
+      << " matrix non-zeros; KSP " << stats.kspType << ", PC " << stats.pcType << ")\n";
+  out << "  setup       " << setupSeconds << " s\n";
+  out << "  per frame   " << milliseconds(loopSeconds, timing.frameCount) << "   (assembly " << stats.assemblySeconds
+      << " s, solves " << stats.solveSeconds << " s, " << stats.solverIterations << " iterations in " << stats.solves
+      << " solves)\n";
+  out << "  output      " << scene.output.file.string() << " (" << timing.frameCount
+      << " frames; no checkpoint on this backend)\n";
+  std::cout << out.str() << std::flush;
+}
+
 // --backend petsc: the scene's problem on the PETSc backend (every rank builds the problem,
 // rank 0 writes the frames). Supports what that backend integrates: linear and
 // corotational backward Euler and trapezoidal, loads that depend on time only.
 int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::Scene& scene) {
-  const std::string prefix = "--backend petsc: ";
-  if (options.resume) throw asyncfem::Error(prefix + "--resume is not supported (this backend writes no checkpoint)");
-  if (scene.contact.enabled()) {
-    throw asyncfem::Error(prefix + scene.sourceName + ": contact: not supported (its forces depend on the state)");
-  }
-  if (!scene.output.vtuFolder.empty() || scene.output.velocities) {
-    throw asyncfem::Error(prefix + ".vtu output and output.velocities are not supported; the .afsim file is written");
-  }
-  asyncfem::PetscSimulationSettings settings;
-  if (scene.integrator.name == "backward-euler") {
-    settings.integrator = asyncfem::PetscIntegratorKind::backwardEuler;
-  } else if (scene.integrator.name == "trapezoidal") {
-    settings.integrator = asyncfem::PetscIntegratorKind::trapezoidal;
-  } else {
-    throw asyncfem::Error(prefix + "integrator \"" + scene.integrator.name +
-                          "\" is not available there (backward-euler, trapezoidal; --integrator switches)");
-  }
-  if (scene.forceModel == asyncfem::Scene::ForceModelKind::linear) {
-    settings.forceModel = asyncfem::PetscForceModelKind::linear;
-  } else if (scene.forceModel == asyncfem::Scene::ForceModelKind::corotational &&
-             scene.tangent == asyncfem::Scene::Tangent::simple) {
-    settings.forceModel = asyncfem::PetscForceModelKind::corotational;
-  } else {
-    throw asyncfem::Error(prefix + "forceModel: only linear and corotational (simple tangent) are available there");
-  }
-  settings.solver.kind = asyncfem::parsePetscSolverKind(options.petscSolver);
+  refusePetscOutputs(options, scene);
   asyncfem::Stopwatch setupWatch;
   setupWatch.start();
   asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
   const asyncfem::FrameTiming& timing = scene.timing;
   const std::shared_ptr<const asyncfem::Problem> problem = asyncfem::buildProblem(scene);
-  settings.massType = scene.mass;
-  settings.timestep = timing.timestep;
-  settings.rayleighMass = scene.rayleighAlpha;
-  settings.rayleighStiffness = scene.rayleighBeta;
-  settings.fixedVertices = problem->fixedVertices();
-  settings.gravity = scene.gravity;
-  // The windowed loads through Loads::addTo (gravity is the backend's own, settings.gravity).
-  auto timeLoads = std::make_shared<asyncfem::Loads>();
-  for (const asyncfem::VertexLoad& load : problem->windows()) timeLoads->addWindow(load);
-  if (!timeLoads->empty()) {
-    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(problem->numDofs());  // loads of time only
-    settings.timeDependentForce = [timeLoads, rest](double time, Eigen::VectorXd& forces) {
-      timeLoads->addTo(time, rest, rest, forces);
-    };
-  }
-  asyncfem::PetscSimulation simulation(problem->mesh(), settings);
+  asyncfem::PetscSimulation simulation(problem->mesh(), petscSettings(options, scene, *problem));
   const bool root = simulation.rank() == 0;
   std::unique_ptr<asyncfem::SimulationWriter> writer;
   if (root) {
@@ -368,7 +376,7 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
     asyncfem::SimulationFileHeader header;
     header.numVertices = problem->mesh().numVertices();
     header.frameInterval = timing.frameInterval;
-    header.timestep = timing.timestep;
+    header.timestep = simulation.timestep();
     header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
     header.sceneFingerprint = asyncfem::problemFingerprint(*problem);
     writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, header,
@@ -385,24 +393,7 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   const double loopSeconds = loopWatch.stop();
   if (root) {
     writer->close();
-    const asyncfem::PetscRunStats& stats = simulation.stats();
-    if (!options.quiet) {
-      std::ostringstream out;
-      out.setf(std::ios::fixed);
-      out.precision(3);
-      out << "offlineSimulator: " << scene.sourceName << ": " << timing.frameCount << " frames, " << stats.steps
-          << " steps of h = " << std::defaultfloat << timing.timestep << std::fixed << " on the PETSc backend, "
-          << (setupSeconds + loopSeconds) << " s\n";
-      out << "  ranks       " << stats.ranks << " (" << stats.freeDofs << " free DOFs, " << stats.matrixNonZeros
-          << " matrix non-zeros; KSP " << stats.kspType << ", PC " << stats.pcType << ")\n";
-      out << "  setup       " << setupSeconds << " s\n";
-      out << "  per frame   " << milliseconds(loopSeconds, timing.frameCount) << "   (assembly "
-          << stats.assemblySeconds << " s, solves " << stats.solveSeconds << " s, " << stats.solverIterations
-          << " iterations in " << stats.solves << " solves)\n";
-      out << "  output      " << scene.output.file.string() << " (" << timing.frameCount
-          << " frames; no checkpoint on this backend)\n";
-      std::cout << out.str() << std::flush;
-    }
+    if (!options.quiet) printPetscSummary(scene, simulation.stats(), setupSeconds, loopSeconds);
   }
   return 0;
 }
