@@ -302,9 +302,10 @@ std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& 
   return problem;
 }
 
-IntegratorContext integratorContext(const Scene& scene) {
+IntegratorContext integratorContext(const Scene& scene) { return integratorContext(scene, frameTimingOf(scene)); }
+
+IntegratorContext integratorContext(const Scene& scene, const FrameTiming& timing) {
   IntegratorContext context;
-  const FrameTiming timing = frameTimingOf(scene);
   context.timestep = timing.timestep;
   context.frameRate = timing.frameRate;
   context.massType = scene.mass;
@@ -353,7 +354,7 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
   simulation.contact = problem.contact();
   noteSkippedAndWarnings(scene, simulation);
 
-  IntegratorContext context = integratorContext(scene);
+  IntegratorContext context = integratorContext(scene, simulation.timing);
   context.mesh = problem.sharedMesh();
   context.system = problem.dynamicSystem();
   simulation.integrator = registry.create(scene.integrator.name, std::move(context), scene.integrator.options);

@@ -44,8 +44,12 @@ std::shared_ptr<const Problem> buildProblem(const Scene& scene);
 /// builds another mesh or other fixed vertices than the run had (fingerprint).
 std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& header, const std::string& fileName);
 
-/// The context registry factories get for scene (timing from frameTimingOf(scene), mass
-/// type, contact, names for messages); mesh and system are left for the caller to fill.
+/// The context registry factories get for scene at the given timing (timestep, frame
+/// rate), with its mass type, contact and names for messages; mesh and system are left
+/// for the caller to fill. A program that asks about another timestep than the scene's
+/// (suggestRegions --dt) passes a FrameTiming with that timestep.
+IntegratorContext integratorContext(const Scene& scene, const FrameTiming& timing);
+/// integratorContext(scene, frameTimingOf(scene)).
 IntegratorContext integratorContext(const Scene& scene);
 
 /// A scene ready to run: the problem, the integrator (which owns the state, starting at
