@@ -39,4 +39,4 @@ PY
 done
 # What it cannot run is refused by name.
 if "$bin/offlineSimulator" scene.json --backend petsc --integrator async -o x.afsim 2> err.txt; then exit 1; fi
-grep -q 'integrator "async" is not available there' err.txt || { cat err.txt; exit 1; }
+grep -q 'integrator "async" is not available on the PETSc backend' err.txt || { cat err.txt; exit 1; }

@@ -16,6 +16,7 @@
 #include <asyncfem/petscBackend/partition.hpp>
 #include <asyncfem/petscBackend/petscRuntime.hpp>
 #include <asyncfem/petscBackend/petscSimulation.hpp>
+#include <asyncfem/petscBackend/problemSettings.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
@@ -200,6 +201,67 @@ INSTANTIATE_TEST_SUITE_P(Trapezoidal, PetscVersusCholmod,
                                                               PetscForceModelKind::corotational),
                                             ::testing::Values(PetscSolverKind::cgGamg, PetscSolverKind::mumps)),
                          caseName);
+
+// The backend's settings come from the Problem the single-process path runs: its mass,
+// damping, fixed vertices and gravity as they are, its load windows as the time-dependent
+// force (f(t) equal to the windows' sum, zero outside them).
+TEST(PetscProblemSettings, FollowTheProblem) {
+  auto mesh = std::make_shared<const TetMesh>(beamMesh());
+  ProblemSettings physics;
+  physics.mass = MassType::lumped;
+  physics.forceModel = ForceModelType::corotational;
+  physics.rayleighAlpha = 0.5;
+  physics.rayleighBeta = 2e-3;
+  physics.gravity = kGravity;
+  VertexLoad pull;
+  pull.vertices = {5, 7};
+  pull.perVertex = Eigen::Vector3d(0.0, 0.0, 3.0);
+  pull.start = 0.1;
+  pull.end = 0.2;
+  const Problem problem(mesh, {0, 1, 2}, physics, {pull});
+  const PetscSimulationSettings settings = petscSettingsForProblem(problem, "trapezoidal", kTimestep);
+  EXPECT_EQ(settings.integrator, PetscIntegratorKind::trapezoidal);
+  EXPECT_EQ(settings.forceModel, PetscForceModelKind::corotational);
+  EXPECT_EQ(settings.massType, MassType::lumped);
+  EXPECT_EQ(settings.timestep, kTimestep);
+  EXPECT_EQ(settings.rayleighMass, 0.5);
+  EXPECT_EQ(settings.rayleighStiffness, 2e-3);
+  EXPECT_EQ(settings.fixedVertices, (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(settings.gravity, kGravity);
+  ASSERT_TRUE(settings.timeDependentForce);
+  for (const double t : {0.05, 0.15, 0.25}) {
+    Eigen::VectorXd forces = Eigen::VectorXd::Zero(mesh->numDofs());
+    settings.timeDependentForce(t, forces);
+    const double expected = pull.active(t) ? 3.0 : 0.0;
+    EXPECT_EQ(forces[(3 * 5) + 2], expected) << "t = " << t;
+    EXPECT_EQ(forces[(3 * 7) + 2], expected) << "t = " << t;
+    EXPECT_EQ(forces.cwiseAbs().sum(), 2.0 * expected) << "t = " << t;
+  }
+  EXPECT_FALSE(petscSettingsForProblem(Problem(mesh, {0}, ProblemSettings{}), "backward-euler", kTimestep)
+                   .timeDependentForce);
+}
+
+TEST(PetscProblemSettings, NameWhatTheBackendCannotRun) {
+  auto mesh = std::make_shared<const TetMesh>(beamMesh());
+  const auto messageOf = [&](const ProblemSettings& physics, const std::string& integrator) {
+    try {
+      (void)petscSettingsForProblem(Problem(mesh, {0}, physics), integrator, kTimestep);
+    } catch (const ValidationError& error) {
+      return std::string(error.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(messageOf(ProblemSettings{}, "async"),
+            "integrator \"async\" is not available on the PETSc backend (it runs backward-euler and trapezoidal)");
+  ProblemSettings neoHookean;
+  neoHookean.forceModel = ForceModelType::neoHookean;
+  EXPECT_EQ(messageOf(neoHookean, "backward-euler"),
+            "forceModel: only linear and corotational (simple tangent) are available on the PETSc backend");
+  ProblemSettings exactTangent;
+  exactTangent.forceModel = ForceModelType::corotational;
+  exactTangent.tangent = TangentKind::exact;
+  EXPECT_EQ(messageOf(exactTangent, "backward-euler"), messageOf(neoHookean, "backward-euler"));
+}
 
 // Corotational and linear trajectories differ here by far more than the comparison
 // tolerance, so the corotational comparison above could not pass with the wrong model.

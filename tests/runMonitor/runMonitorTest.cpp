@@ -43,7 +43,7 @@ TEST(RunMonitor, NonFiniteStateIsReportedWithItsLocation) {
   ScriptedIntegrator integrator(problem.dynamicSystem(), 0.01, [&](long long step, Eigen::VectorXd& u, auto&) {
     if (step == 5) u[3 * vertex + 2] = std::nan("");
   });
-  RunMonitor monitor(problem, 0.01);
+  RunMonitor monitor(problem);
   monitor.advanceFrame(integrator, 0, 3);  // steps 1-3: fine
   try {
     monitor.advanceFrame(integrator, 1, 3);  // step 5 fails
@@ -61,7 +61,7 @@ TEST(RunMonitor, NonFiniteStateIsReportedWithItsLocation) {
 TEST(RunMonitor, BlowUpBeyondTheLimitIsAnError) {
   const auto mesh = beam();
   const Problem problem(mesh, {}, ProblemSettings{});
-  RunMonitor monitor(problem, 0.01);
+  RunMonitor monitor(problem);
   const double limit = monitor.blowUpDisplacement();
   EXPECT_NEAR(limit, 1000.0 * monitor.boundingBoxDiagonal(), 1e-12 * limit);
   double amplitude = 0.5 * limit;
@@ -85,7 +85,7 @@ TEST(RunMonitor, EnergyGrowthAfterTheLoadsIsAnErrorAndNotBefore) {
   pull.perVertex = Eigen::Vector3d(0, 1, 0);
   pull.end = 0.1;
   const Problem problem(mesh, mesh->vertexSets().at("root"), ProblemSettings{}, {pull});
-  RunMonitor monitor(problem, 0.01);
+  RunMonitor monitor(problem);
   EXPECT_NEAR(monitor.energyCheckFrom(), 0.1, 1e-15);
   double speed = 1.0;
   ScriptedIntegrator integrator(problem.dynamicSystem(), 0.01, [&](long long, auto&, Eigen::VectorXd& v) {
@@ -130,7 +130,7 @@ TEST(RunMonitor, ErrorsNameTheRegionOfTheVertex) {
         if (step == 3) u[3 * vertex] = std::numeric_limits<double>::infinity();
       },
       tip);
-  RunMonitor monitor(problem, 0.01);
+  RunMonitor monitor(problem);
   try {
     for (int frame = 0; frame < 5; ++frame) monitor.advanceFrame(integrator, frame, 1);
     FAIL() << "no error";
@@ -153,7 +153,7 @@ TEST(RunMonitor, ErrorsOfTheIntegratorGainFrameAndStep) {
     if (t > 0.025) f[3 * vertex] = std::nan("");
   };
   auto integrator = makeIntegrator("backward-euler", std::move(system), 0.01);
-  RunMonitor monitor(problem, 0.01);
+  RunMonitor monitor(problem);
   try {
     for (int frame = 0; frame < 10; ++frame) monitor.advanceFrame(*integrator, frame, 1);
     FAIL() << "no error";

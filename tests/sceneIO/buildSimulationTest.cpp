@@ -21,6 +21,11 @@ Simulation build(const nlohmann::json& json, const std::filesystem::path& base =
   return asyncfem::buildSimulation(asyncfem::parseScene(json, base, "scene.json"));
 }
 
+// The frame timing parseScene resolves (nothing is built).
+asyncfem::FrameTiming timingOf(const nlohmann::json& json) {
+  return asyncfem::parseScene(json, "", "scene.json").timing;
+}
+
 // f_ext(t) of a built simulation at rest (size 3n; zero when it has no external force).
 Eigen::VectorXd externalForce(const Simulation& simulation, double time) {
   const asyncfem::DynamicSystem& system = simulation.integrator->system();
@@ -67,10 +72,11 @@ TEST(BuildSimulation, SwitchingIntegratorsDropsTheOptionsTheNewOneDoesNotRead) {
 TEST(BuildSimulation, GeneratorMeshAndTiming) {
   const Simulation simulation = build(smallScene());
   EXPECT_EQ(simulation.mesh->numVertices(), 12);
-  EXPECT_EQ(simulation.timestep, 0.01);
-  EXPECT_DOUBLE_EQ(simulation.frameInterval, 0.1);
-  EXPECT_EQ(simulation.stepsPerFrame, 10);
-  EXPECT_EQ(simulation.numFrames, 3);
+  EXPECT_EQ(simulation.timing.timestep, 0.01);
+  EXPECT_EQ(simulation.integrator->timestep(), 0.01);
+  EXPECT_DOUBLE_EQ(simulation.timing.frameInterval, 0.1);
+  EXPECT_EQ(simulation.timing.stepsPerFrame, 10);
+  EXPECT_EQ(simulation.timing.frameCount, 3);
   EXPECT_EQ(simulation.integrator->name(), "backward-euler");
   EXPECT_DOUBLE_EQ(simulation.monitor->boundingBoxDiagonal(), std::sqrt(6.0));
   EXPECT_DOUBLE_EQ(simulation.monitor->blowUpDisplacement(), 1000.0 * std::sqrt(6.0));
@@ -80,10 +86,10 @@ TEST(BuildSimulation, StepsPerFrameToleratesRounding) {
   auto json = smallScene();
   json["frames"]["rate"] = 30;
   json["integrator"]["timestep"] = 1.0 / 300.0;
-  EXPECT_EQ(build(json).stepsPerFrame, 10);
+  EXPECT_EQ(timingOf(json).stepsPerFrame, 10);
   json["integrator"]["timestep"] = 1.0 / 290.0;
   try {
-    (void)build(json);
+    (void)timingOf(json);
     FAIL() << "expected a timing error";
   } catch (const asyncfem::ValidationError& error) {
     const std::string message = error.what();
@@ -97,11 +103,55 @@ TEST(BuildSimulation, StepsPerFrameGivesTheTimestep) {
   json["integrator"].erase("timestep");
   json["integrator"]["stepsPerFrame"] = 4;
   const Scene scene = asyncfem::parseScene(json, "", "scene.json");
-  EXPECT_EQ(scene.integrator.timestep, 0.1 / 4);  // known before the build, for utilities
+  EXPECT_EQ(scene.timing.timestep, 0.1 / 4);  // known before the build, for utilities
+  EXPECT_EQ(scene.timing.stepsPerFrame, 4);
   const Simulation simulation = asyncfem::buildSimulation(scene);
-  EXPECT_EQ(simulation.stepsPerFrame, 4);
-  EXPECT_EQ(simulation.timestep, 0.1 / 4);
+  EXPECT_EQ(simulation.timing, scene.timing);
   EXPECT_EQ(simulation.integrator->timestep(), 0.1 / 4);
+}
+
+asyncfem::TimingOverrides overrides(std::optional<double> timestep, std::optional<int> stepsPerFrame,
+                                    std::optional<int> frameCount) {
+  asyncfem::TimingOverrides result;
+  result.timestep = timestep;
+  result.stepsPerFrame = stepsPerFrame;
+  result.frameCount = frameCount;
+  return result;
+}
+
+// Command-line values go through overrideFrameTiming, which resolves the timing again
+// with the scene's errors; buildSimulation then runs with it.
+TEST(BuildSimulation, TimingOverridesAreResolvedAgain) {
+  Scene scene = asyncfem::parseScene(smallScene(), "", "scene.json");  // rate 10, h 0.01, 3 frames
+  asyncfem::overrideFrameTiming(scene, overrides({}, 5, 7));
+  EXPECT_EQ(scene.timing.timestep, 0.1 / 5);
+  EXPECT_EQ(scene.timing.frameCount, 7);
+  asyncfem::overrideFrameTiming(scene, overrides(0.025, {}, {}));
+  EXPECT_EQ(scene.timing.stepsPerFrame, 4);
+  EXPECT_EQ(scene.timing.frameCount, 7);
+  EXPECT_EQ(asyncfem::buildSimulation(scene).integrator->timestep(), 0.025);
+  try {
+    asyncfem::overrideFrameTiming(scene, overrides(0.03, {}, {}));
+    FAIL() << "expected a timing error";
+  } catch (const asyncfem::ValidationError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("scene.json: integrator.timestep: 0.03 does not divide", 0), 0U)
+        << error.what();
+  }
+  EXPECT_THROW(asyncfem::overrideFrameTiming(scene, overrides({}, {}, 0)), asyncfem::ValidationError);
+  EXPECT_THROW(asyncfem::overrideFrameTiming(scene, overrides(0.02, 5, {})),
+               asyncfem::ValidationError);
+}
+
+// A Scene built or edited in code (its timing not resolved from its keys) is resolved
+// when it is built.
+TEST(BuildSimulation, TimingOfAnEditedSceneIsResolvedFromItsKeys) {
+  Scene scene = asyncfem::parseScene(smallScene(), "", "scene.json");
+  scene.integrator.timestep = 0.05;
+  scene.frames.count = 2;
+  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
+  EXPECT_EQ(timing.stepsPerFrame, 2);
+  EXPECT_EQ(timing.frameCount, 2);
+  EXPECT_EQ(asyncfem::buildSimulation(scene).integrator->timestep(), 0.05);
 }
 
 // A timestep within a relative 1e-9 (timestepDivisorTolerance) of a divisor T / N of the
@@ -111,14 +161,14 @@ TEST(BuildSimulation, TimestepWithinRoundOffOfADivisorIsAccepted) {
   auto json = smallScene();
   json["frames"]["rate"] = 30;
   json["integrator"]["timestep"] = (1.0 / 990.0) * (1.0 + 5e-10);
-  EXPECT_EQ(build(json).stepsPerFrame, 33);
+  EXPECT_EQ(timingOf(json).stepsPerFrame, 33);
   json["integrator"]["timestep"] = 0.001010101010;  // 1/990 to ten significant digits
-  EXPECT_EQ(build(json).stepsPerFrame, 33);
+  EXPECT_EQ(timingOf(json).stepsPerFrame, 33);
   json["integrator"]["timestep"] = (1.0 / 990.0) * (1.0 + 2e-9);
-  EXPECT_THROW((void)build(json), asyncfem::ValidationError);
+  EXPECT_THROW((void)timingOf(json), asyncfem::ValidationError);
   json["integrator"]["timestep"] = 0.001;
   try {
-    (void)build(json);
+    (void)timingOf(json);
     FAIL() << "expected a timing error";
   } catch (const asyncfem::ValidationError& error) {
     EXPECT_EQ(std::string(error.what()),
@@ -276,7 +326,7 @@ TEST(BuildSimulation, ImpulseIsDeliveredOnceWhateverTheEvaluationTimes) {
   auto json = smallScene();
   json["forces"] = nlohmann::json::parse(R"([{"type": "impulse", "set": "xmax", "impulse": [0, 0, 3], "time": 0.05}])");
   const Simulation simulation = build(json);
-  const double h = simulation.timestep;
+  const double h = simulation.integrator->timestep();
   // Integrators evaluate f_ext at step starts (k h), step ends ((k + 1) h) or average both.
   double delivered = 0.0;
   int activeSteps = 0;

@@ -50,6 +50,7 @@
 #if ASYNCFEM_OFFLINE_WITH_PETSC
 #include <asyncfem/petscBackend/petscRuntime.hpp>
 #include <asyncfem/petscBackend/petscSimulation.hpp>
+#include <asyncfem/petscBackend/problemSettings.hpp>
 #endif
 
 #include "commandLine.hpp"
@@ -176,24 +177,13 @@ void applyOverrides(const CommandLine& options, asyncfem::Scene& scene) {
                 << ")\n";
     }
   }
-  if (options.timestep) {
-    scene.integrator.timestep = *options.timestep;
-    scene.integrator.stepsPerFrame = 0;
-  }
-  if (options.stepsPerFrame) {
-    scene.integrator.stepsPerFrame = *options.stepsPerFrame;
-  }
-  if (options.frames) {
-    scene.frames.count = *options.frames;
-  }
+  asyncfem::overrideFrameTiming(scene, {options.timestep, options.stepsPerFrame, options.frames});
   if (options.vtuFolder) {
     scene.output.vtuFolder = *options.vtuFolder;
   }
   if (scene.output.file.empty()) {
     throw asyncfem::Error("no output file: set output.file in " + scene.sourceName + " or pass --output FILE");
   }
-  // Every part of the run sees the timestep it will run with (and a bad one fails first).
-  scene.integrator.timestep = asyncfem::resolveFrameTiming(scene).timestep;
 }
 
 // Refuses an output (the .afsim file or its checkpoint) that is one of the run's inputs:
@@ -225,31 +215,34 @@ std::string milliseconds(double seconds, int frames) {
   return text;
 }
 
-void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simulation,
-                  const asyncfem::IntegratorStats& before, double setupSeconds, double loopSeconds,
-                  double outputSeconds, std::int64_t outputBytes, int firstFrame,
-                  const std::optional<asyncfem::PaperCouplingCheck>& couplingCheck,
-                  const asyncfem::CheckpointSchedule& schedule, int checkpointsWritten) {
-  const asyncfem::IntegratorStats& after = simulation.integrator->stats();
-  // Frames computed by this run (a resumed run starts at firstFrame).
-  const int frames = std::max(simulation.numFrames - firstFrame, 1);
-  const double forces = after.forceSeconds - before.forceSeconds;
-  const double assembly = after.assemblySeconds - before.assemblySeconds;
-  const double factorization = after.factorizationSeconds - before.factorizationSeconds;
-  const double solve = after.solveSeconds - before.solveSeconds;
-  const double other = loopSeconds - forces - assembly - factorization - solve - outputSeconds;
-  const long long steps = after.steps - before.steps;
+/// What the summary reports about a run besides the simulation itself.
+struct RunRecord {
+  asyncfem::IntegratorStats before;  ///< the integrator's statistics after the set-up
+  double setupSeconds = 0.0;
+  double loopSeconds = 0.0;
+  double outputSeconds = 0.0;
+  std::int64_t outputBytes = 0;
+  int firstFrame = 0;  ///< a resumed run starts after the frames already in the file
+  std::optional<asyncfem::PaperCouplingCheck> couplingCheck;
+  asyncfem::CheckpointSchedule schedule;
+  int checkpointsWritten = 0;
+};
 
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(3);
-  out << "offlineSimulator: " << scene.sourceName << ": " << (simulation.numFrames - firstFrame) << " frames";
-  if (firstFrame > 0) {
-    out << " (resumed after frame " << firstFrame << " of " << simulation.numFrames << ")";
+// The first lines: frames and steps, mesh, model, regions, integrator report, set-up and
+// the stability estimate. Leaves out fixed with precision 3.
+void printRunHeader(std::ostream& out, const asyncfem::Scene& scene, const asyncfem::Simulation& simulation,
+                    const RunRecord& record) {
+  const asyncfem::FrameTiming& timing = simulation.timing;
+  const std::optional<asyncfem::PaperCouplingCheck>& couplingCheck = record.couplingCheck;
+  out << "offlineSimulator: " << scene.sourceName << ": " << (timing.frameCount - record.firstFrame) << " frames";
+  if (record.firstFrame > 0) {
+    out << " (resumed after frame " << record.firstFrame << " of " << timing.frameCount << ")";
   }
-  out << ", " << steps << " steps of h = " << std::defaultfloat << std::setprecision(9) << simulation.timestep
-      << std::setprecision(3) << " (" << simulation.stepsPerFrame << " per frame), " << std::fixed
-      << (setupSeconds + loopSeconds + (couplingCheck ? couplingCheck->estimate.seconds : 0.0)) << " s\n";
+  out << ", " << (simulation.integrator->stats().steps - record.before.steps) << " steps of h = " << std::defaultfloat
+      << std::setprecision(9) << simulation.integrator->timestep() << std::setprecision(3) << " ("
+      << timing.stepsPerFrame << " per frame), " << std::fixed
+      << (record.setupSeconds + record.loopSeconds + (couplingCheck ? couplingCheck->estimate.seconds : 0.0))
+      << " s\n";
   out << "  mesh        " << simulation.mesh->numVertices() << " vertices, " << simulation.mesh->numElements()
       << " elements, " << simulation.fixedVertices.size() << " fixed vertices\n";
   out << "  model       " << asyncfem::toString(simulation.problem->settings().forceModel)
@@ -269,8 +262,8 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
     }
   }
   for (const std::string& line : simulation.integrator->report().lines) out << "  integrator  " << line << "\n";
-  out << "  setup       " << setupSeconds << " s (mesh, matrices, first factorization: " << before.factorizationSeconds
-      << " s)\n";
+  out << "  setup       " << record.setupSeconds << " s (mesh, matrices, first factorization: "
+      << record.before.factorizationSeconds << " s)\n";
   if (couplingCheck) {
     const asyncfem::StepGrowthEstimate& estimate = couplingCheck->estimate;
     out << "  stability   paper coupling, " << couplingCheck->regions << ": step growth estimate " << std::defaultfloat
@@ -279,6 +272,20 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
         << " steps of the linearized scene, " << std::fixed << estimate.seconds << " s"
         << (couplingCheck->warning.empty() ? "" : " (WARNING above)") << "\n";
   }
+}
+
+// The frame loop's time per frame, phase by phase (this run's share of the statistics).
+void printFrameTimes(std::ostream& out, const asyncfem::Simulation& simulation, const RunRecord& record) {
+  const asyncfem::IntegratorStats& after = simulation.integrator->stats();
+  const asyncfem::IntegratorStats& before = record.before;
+  // Frames computed by this run (a resumed run starts at firstFrame).
+  const int frames = std::max(simulation.timing.frameCount - record.firstFrame, 1);
+  const double forces = after.forceSeconds - before.forceSeconds;
+  const double assembly = after.assemblySeconds - before.assemblySeconds;
+  const double factorization = after.factorizationSeconds - before.factorizationSeconds;
+  const double solve = after.solveSeconds - before.solveSeconds;
+  const double loopSeconds = record.loopSeconds;
+  const double other = loopSeconds - forces - assembly - factorization - solve - record.outputSeconds;
   out << "  per frame   " << milliseconds(loopSeconds, frames) << "   (total " << loopSeconds << " s)\n";
   out << "    forces        " << milliseconds(forces, frames) << "\n";
   out << "    assembly      " << milliseconds(assembly, frames) << "\n";
@@ -286,7 +293,7 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
       << (after.factorizations - before.factorizations) << " factorizations in the run)\n";
   out << "    solve         " << milliseconds(solve, frames) << "   ("
       << (after.solvedRightHandSides - before.solvedRightHandSides) << " right-hand sides)\n";
-  out << "    output        " << milliseconds(outputSeconds, frames) << "\n";
+  out << "    output        " << milliseconds(record.outputSeconds, frames) << "\n";
   if (other >= 0.0) {
     out << "    other         " << milliseconds(other, frames) << "   (vector updates, loads, state checks)\n";
   } else {
@@ -296,80 +303,102 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
         << std::setprecision(3) << 1000.0 * (loopSeconds - other) / frames
         << " ms per frame, more than the wall time)\n";
   }
+}
+
+// What was skipped, what was checked, and where the output went.
+void printRunTrailer(std::ostream& out, const asyncfem::Scene& scene, const asyncfem::Simulation& simulation,
+                     const RunRecord& record) {
   out << "  skipped:\n";
-  for (const std::string& item : after.skipped) {
+  for (const std::string& item : simulation.integrator->stats().skipped) {
     out << "    - " << item << "\n";
   }
   for (const std::string& item : simulation.skipped) {
     out << "    - " << item << "\n";
   }
+  const long long evaluations = simulation.monitor->energyEvaluations();
   out << "  checks      finite state and blow-up after every step; energy "
-      << (simulation.monitor->energyEvaluations() > 0 ? std::to_string(simulation.monitor->energyEvaluations()) +
-                                                            " evaluations (once per frame after the loads)"
-                                                      : std::string("not evaluated (see skipped)"))
+      << (evaluations > 0 ? std::to_string(evaluations) + " evaluations (once per frame after the loads)"
+                          : std::string("not evaluated (see skipped)"))
       << "\n";
-  out << "  output      " << scene.output.file.string() << " (" << simulation.numFrames << " frames, " << outputBytes
-      << " bytes; " << checkpointsWritten << " checkpoints, " << schedule.describe() << " and at the end, in "
+  out << "  output      " << scene.output.file.string() << " (" << simulation.timing.frameCount << " frames, "
+      << record.outputBytes << " bytes; " << record.checkpointsWritten << " checkpoints, "
+      << record.schedule.describe() << " and at the end, in "
       << asyncfem::checkpointPathFor(scene.output.file).string() << ")";
   if (!scene.output.vtuFolder.empty()) {
     out << ", .vtu files in " << scene.output.vtuFolder.string();
   }
   out << "\n";
+}
+
+void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simulation, const RunRecord& record) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(3);
+  printRunHeader(out, scene, simulation, record);
+  printFrameTimes(out, simulation, record);
+  printRunTrailer(out, scene, simulation, record);
   std::cout << out.str() << std::flush;
 }
 
 #if ASYNCFEM_OFFLINE_WITH_PETSC
+const std::string petscPrefix = "--backend petsc: ";
+
+// What the PETSc backend does not write: checkpoints (so no --resume), .vtu files, velocities.
+void refusePetscOutputs(const CommandLine& options, const asyncfem::Scene& scene) {
+  if (options.resume) {
+    throw asyncfem::Error(petscPrefix + "--resume is not supported (this backend writes no checkpoint)");
+  }
+  if (!scene.output.vtuFolder.empty() || scene.output.velocities) {
+    throw asyncfem::Error(petscPrefix +
+                          ".vtu output and output.velocities are not supported; the .afsim file is written");
+  }
+}
+
+// The backend's settings for the scene's problem (asyncfem::petscSettingsForProblem), with
+// the solver chosen on the command line.
+asyncfem::PetscSimulationSettings petscSettings(const CommandLine& options, const asyncfem::Scene& scene,
+                                                const asyncfem::Problem& problem) {
+  asyncfem::PetscSimulationSettings settings;
+  try {
+    settings = asyncfem::petscSettingsForProblem(problem, scene.integrator.name, scene.timing.timestep);
+  } catch (const asyncfem::ValidationError& error) {
+    throw asyncfem::Error(petscPrefix + scene.sourceName + ": " + error.what());
+  }
+  settings.solver.kind = asyncfem::parsePetscSolverKind(options.petscSolver);
+  return settings;
+}
+
+void printPetscSummary(const asyncfem::Scene& scene, const asyncfem::PetscRunStats& stats, double setupSeconds,
+                       double loopSeconds) {
+  const asyncfem::FrameTiming& timing = scene.timing;
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(3);
+  out << "offlineSimulator: " << scene.sourceName << ": " << timing.frameCount << " frames, " << stats.steps
+      << " steps of h = " << std::defaultfloat << timing.timestep << std::fixed << " on the PETSc backend, "
+      << (setupSeconds + loopSeconds) << " s\n";
+  out << "  ranks       " << stats.ranks << " (" << stats.freeDofs << " free DOFs, " << stats.matrixNonZeros
+      << " matrix non-zeros; KSP " << stats.kspType << ", PC " << stats.pcType << ")\n";
+  out << "  setup       " << setupSeconds << " s\n";
+  out << "  per frame   " << milliseconds(loopSeconds, timing.frameCount) << "   (assembly " << stats.assemblySeconds
+      << " s, solves " << stats.solveSeconds << " s, " << stats.solverIterations << " iterations in " << stats.solves
+      << " solves)\n";
+  out << "  output      " << scene.output.file.string() << " (" << timing.frameCount
+      << " frames; no checkpoint on this backend)\n";
+  std::cout << out.str() << std::flush;
+}
+
 // --backend petsc: the scene's problem on the PETSc backend (every rank builds the problem,
 // rank 0 writes the frames). Supports what that backend integrates: linear and
 // corotational backward Euler and trapezoidal, loads that depend on time only.
 int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::Scene& scene) {
-  const std::string prefix = "--backend petsc: ";
-  if (options.resume) throw asyncfem::Error(prefix + "--resume is not supported (this backend writes no checkpoint)");
-  if (scene.contact.enabled()) {
-    throw asyncfem::Error(prefix + scene.sourceName + ": contact: not supported (its forces depend on the state)");
-  }
-  if (!scene.output.vtuFolder.empty() || scene.output.velocities) {
-    throw asyncfem::Error(prefix + ".vtu output and output.velocities are not supported; the .afsim file is written");
-  }
-  asyncfem::PetscSimulationSettings settings;
-  if (scene.integrator.name == "backward-euler") {
-    settings.integrator = asyncfem::PetscIntegratorKind::backwardEuler;
-  } else if (scene.integrator.name == "trapezoidal") {
-    settings.integrator = asyncfem::PetscIntegratorKind::trapezoidal;
-  } else {
-    throw asyncfem::Error(prefix + "integrator \"" + scene.integrator.name +
-                          "\" is not available there (backward-euler, trapezoidal; --integrator switches)");
-  }
-  if (scene.forceModel == asyncfem::Scene::ForceModelKind::linear) {
-    settings.forceModel = asyncfem::PetscForceModelKind::linear;
-  } else if (scene.forceModel == asyncfem::Scene::ForceModelKind::corotational &&
-             scene.tangent == asyncfem::Scene::Tangent::simple) {
-    settings.forceModel = asyncfem::PetscForceModelKind::corotational;
-  } else {
-    throw asyncfem::Error(prefix + "forceModel: only linear and corotational (simple tangent) are available there");
-  }
-  settings.solver.kind = asyncfem::parsePetscSolverKind(options.petscSolver);
+  refusePetscOutputs(options, scene);
   asyncfem::Stopwatch setupWatch;
   setupWatch.start();
   asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
-  const asyncfem::FrameTiming timing = asyncfem::resolveFrameTiming(scene);
+  const asyncfem::FrameTiming& timing = scene.timing;
   const std::shared_ptr<const asyncfem::Problem> problem = asyncfem::buildProblem(scene);
-  settings.massType = scene.mass;
-  settings.timestep = timing.timestep;
-  settings.rayleighMass = scene.rayleighAlpha;
-  settings.rayleighStiffness = scene.rayleighBeta;
-  settings.fixedVertices = problem->fixedVertices();
-  settings.gravity = scene.gravity;
-  // The windowed loads through Loads::addTo (gravity is the backend's own, settings.gravity).
-  auto timeLoads = std::make_shared<asyncfem::Loads>();
-  for (const asyncfem::VertexLoad& load : problem->windows()) timeLoads->addWindow(load);
-  if (!timeLoads->empty()) {
-    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(problem->numDofs());  // loads of time only
-    settings.timeDependentForce = [timeLoads, rest](double time, Eigen::VectorXd& forces) {
-      timeLoads->addTo(time, rest, rest, forces);
-    };
-  }
-  asyncfem::PetscSimulation simulation(problem->mesh(), settings);
+  asyncfem::PetscSimulation simulation(problem->mesh(), petscSettings(options, scene, *problem));
   const bool root = simulation.rank() == 0;
   std::unique_ptr<asyncfem::SimulationWriter> writer;
   if (root) {
@@ -377,7 +406,7 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
     asyncfem::SimulationFileHeader header;
     header.numVertices = problem->mesh().numVertices();
     header.frameInterval = timing.frameInterval;
-    header.timestep = timing.timestep;
+    header.timestep = simulation.timestep();
     header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
     header.sceneFingerprint = asyncfem::problemFingerprint(*problem);
     writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, header,
@@ -386,7 +415,7 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   const double setupSeconds = setupWatch.stop();
   asyncfem::Stopwatch loopWatch;
   loopWatch.start();
-  for (int frame = 0; frame < scene.frames.count; ++frame) {
+  for (int frame = 0; frame < timing.frameCount; ++frame) {
     for (int s = 0; s < timing.stepsPerFrame; ++s) simulation.step();  // non-finite states throw on every rank
     const Eigen::VectorXd u = simulation.gatherDisplacement();
     if (root) writer->appendFrame(simulation.time(), u);
@@ -394,34 +423,13 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   const double loopSeconds = loopWatch.stop();
   if (root) {
     writer->close();
-    const asyncfem::PetscRunStats& stats = simulation.stats();
-    if (!options.quiet) {
-      std::ostringstream out;
-      out.setf(std::ios::fixed);
-      out.precision(3);
-      out << "offlineSimulator: " << scene.sourceName << ": " << scene.frames.count << " frames, " << stats.steps
-          << " steps of h = " << std::defaultfloat << timing.timestep << std::fixed << " on the PETSc backend, "
-          << (setupSeconds + loopSeconds) << " s\n";
-      out << "  ranks       " << stats.ranks << " (" << stats.freeDofs << " free DOFs, " << stats.matrixNonZeros
-          << " matrix non-zeros; KSP " << stats.kspType << ", PC " << stats.pcType << ")\n";
-      out << "  setup       " << setupSeconds << " s\n";
-      out << "  per frame   " << milliseconds(loopSeconds, scene.frames.count) << "   (assembly "
-          << stats.assemblySeconds << " s, solves " << stats.solveSeconds << " s, " << stats.solverIterations
-          << " iterations in " << stats.solves << " solves)\n";
-      out << "  output      " << scene.output.file.string() << " (" << scene.frames.count
-          << " frames; no checkpoint on this backend)\n";
-      std::cout << out.str() << std::flush;
-    }
+    if (!options.quiet) printPetscSummary(scene, simulation.stats(), setupSeconds, loopSeconds);
   }
   return 0;
 }
 #endif
 
-int run(int argc, char** argv) {
-  CLI::App app{
-      "Runs a scene file (docs/scene-format.md) and writes its frames to an .afsim file "
-      "(docs/simulation-output.md)."};
-  CommandLine options;
+void addSceneOptions(CLI::App& app, CommandLine& options) {
   app.add_option("scene", options.scene, "Scene file (.json)")->required();
   app.add_option("-o,--output", options.output,
                  "Output .afsim file (replaces output.file; truncated at the start of the run)");
@@ -439,6 +447,9 @@ int run(int argc, char** argv) {
       ->check(asyncfem::cli::atLeast(1));
   app.add_option("--vtu", options.vtuFolder,
                  "Also write FOLDER/frame_NNNNN.vtu per frame (replaces output.vtu.folder)");
+}
+
+void addRunOptions(CLI::App& app, CommandLine& options) {
   app.add_flag("--resume", options.resume,
                "Continue the output file from its last checkpoint instead of starting over; the result is "
                "bit-identical to an uninterrupted run (frames.count / --frames may be raised)");
@@ -464,6 +475,172 @@ int run(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--petsc-options", options.petscOptions,
                  "With --backend petsc: PETSc options database entries, e.g. \"-ksp_rtol 1e-10 -ksp_monitor\"");
+}
+
+/// Where the frame loop writes: the .afsim file, the .vtu series, the checkpoint and its
+/// bookkeeping.
+struct RunOutput {
+  asyncfem::SimulationFileHeader header;
+  std::unique_ptr<asyncfem::SimulationWriter> writer;
+  std::optional<asyncfem::VtuSeriesWriter> vtuSeries;
+  std::uint32_t fingerprint = 0;
+  fs::path checkpointFile;
+  std::int64_t checkpointFrames = 0;  ///< frames the last checkpoint holds
+  std::chrono::steady_clock::time_point lastCheckpoint = std::chrono::steady_clock::now();
+
+  void checkpoint(const asyncfem::Integrator& integrator, std::int64_t frames, bool sync, RunRecord& record) {
+    asyncfem::writeCheckpoint(checkpointFile, asyncfem::captureCheckpoint(integrator, frames, fingerprint), sync);
+    checkpointFrames = frames;
+    ++record.checkpointsWritten;
+    lastCheckpoint = std::chrono::steady_clock::now();
+  }
+};
+
+asyncfem::SimulationFileHeader outputHeader(const CommandLine& options, const asyncfem::Scene& scene,
+                                            const asyncfem::Simulation& simulation) {
+  asyncfem::SimulationFileHeader header;
+  header.numVertices = simulation.mesh->numVertices();
+  header.frameInterval = simulation.timing.frameInterval;
+  header.timestep = simulation.integrator->timestep();
+  header.hasVelocities = scene.output.velocities;
+  // The scene, so that frameRenderer and afsimTool find the mesh by themselves.
+  header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
+  header.sceneFingerprint = asyncfem::problemFingerprint(*simulation.problem);
+  return header;
+}
+
+// The output file is created (truncated) only once the scene has been built, so a scene
+// error leaves an existing file alone; from here on it holds this run's frames. A resumed
+// run continues the file from its checkpoint and sets record.firstFrame.
+RunOutput openOutput(const CommandLine& options, const asyncfem::Scene& scene, asyncfem::Simulation& simulation,
+                     RunRecord& record) {
+  if (scene.output.file.has_parent_path()) fs::create_directories(scene.output.file.parent_path());
+  RunOutput output;
+  if (!scene.output.vtuFolder.empty()) output.vtuSeries.emplace(scene.output.vtuFolder, scene.output.vtuEncoding);
+  output.header = outputHeader(options, scene, simulation);
+  const asyncfem::SimulationWriter::Options writerOptions{scene.output.sync};
+  output.fingerprint = asyncfem::runFingerprint(fingerprintText(options.scene), scene.integrator.name,
+                                                output.header.timestep, output.header.frameInterval,
+                                                *simulation.problem);
+  output.checkpointFile = asyncfem::checkpointPathFor(scene.output.file);
+  if (options.resume) {
+    record.firstFrame = static_cast<int>(asyncfem::resumeFromCheckpoint(
+        scene.output.file, output.header, output.fingerprint, simulation.timing.frameCount, *simulation.integrator));
+    output.writer =
+        asyncfem::SimulationWriter::continueFile(scene.output.file, output.header, record.firstFrame, writerOptions);
+    const std::string caveat = simulation.integrator->report().resumeCaveat;
+    if (!caveat.empty() && !options.quiet) std::printf("resume: %s\n", caveat.c_str());
+  } else {
+    output.writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, output.header, writerOptions);
+    // The rest state, so that a run stopped before its first frame can be resumed too.
+    asyncfem::writeCheckpoint(output.checkpointFile,
+                              asyncfem::captureCheckpoint(*simulation.integrator, 0, output.fingerprint),
+                              scene.output.sync);
+  }
+  output.checkpointFrames = record.firstFrame;
+  if (output.vtuSeries) {
+    if (record.firstFrame > 0) listEarlierVtuFrames(scene, record.firstFrame, *output.vtuSeries);
+    output.vtuSeries->writeCollection();
+  }
+  return output;
+}
+
+// The frame's record, then (never ahead of the file) the checkpoint when due, and the .vtu file.
+void writeFrame(RunOutput& output, const asyncfem::Scene& scene, const asyncfem::Simulation& simulation, int frame,
+                RunRecord& record) {
+  const asyncfem::Integrator& integrator = *simulation.integrator;
+  if (output.header.hasVelocities) {
+    output.writer->appendFrame(integrator.time(), integrator.displacement(), integrator.velocity());
+  } else {
+    output.writer->appendFrame(integrator.time(), integrator.displacement());
+  }
+  const int done = frame + 1;
+  const double sinceLast =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - output.lastCheckpoint).count();
+  if (record.schedule.due(done, sinceLast) || done == simulation.timing.frameCount || stopSignal != 0) {
+    output.checkpoint(integrator, done, scene.output.sync, record);
+  }
+  if (output.vtuSeries && frame % scene.output.vtuEvery == 0) {
+    output.vtuSeries->writeFrame(frame, integrator.time(), *simulation.mesh, integrator.displacement());
+  }
+}
+
+// Runs the frames from record.firstFrame until the last one or a stop signal; returns the
+// frame it stopped at. A failing frame's error names the frames kept in the file.
+int runFrames(const CommandLine& options, const asyncfem::Scene& scene, asyncfem::Simulation& simulation,
+              RunOutput& output, RunRecord& record) {
+  asyncfem::cli::ProgressReporter progress("offlineSimulator",
+                                           asyncfem::cli::chooseProgressStyle(options.quiet, options.progress),
+                                           simulation.timing.frameCount, record.firstFrame);
+  asyncfem::Stopwatch loopWatch;
+  asyncfem::Stopwatch outputWatch;
+  loopWatch.start();
+  int frame = record.firstFrame;
+  try {
+    for (; frame < simulation.timing.frameCount && stopSignal == 0; ++frame) {
+      asyncfem::advanceFrame(simulation, frame);
+      {
+        const asyncfem::ScopedTimer timer(outputWatch);
+        writeFrame(output, scene, simulation, frame, record);
+      }
+      progress.update(frame + 1);
+    }
+  } catch (const asyncfem::Error& error) {
+    progress.finish();
+    // The frames before the failing one are complete, checksummed records.
+    throw asyncfem::Error(std::string(error.what()) + "; the " + std::to_string(output.writer->numFrames()) +
+                          " frames before it are kept in " + scene.output.file.string());
+  }
+  record.loopSeconds = loopWatch.stop();
+  record.outputSeconds = outputWatch.totalSeconds();
+  progress.finish();
+  return frame;
+}
+
+// The scene on this process: build, estimate the step growth, run the frames, report.
+int runLocal(int argc, char** argv, const CommandLine& options, const asyncfem::Scene& scene,
+             asyncfem::Stopwatch& setupWatch) {
+  asyncfem::Simulation simulation = asyncfem::buildSimulation(scene);
+  for (const std::string& warning : simulation.warnings) std::cerr << "offlineSimulator: warning: " << warning << "\n";
+  RunRecord record;
+  record.setupSeconds = setupWatch.stop();
+  record.before = simulation.integrator->stats();
+  record.schedule = asyncfem::CheckpointSchedule{options.checkpointEvery, options.checkpointSeconds};
+  // On a separate integrator built for the linearized scene: the run's own state and
+  // statistics are untouched.
+  if (!options.noStabilityCheck) record.couplingCheck = asyncfem::checkPaperCoupling(scene, simulation);
+  if (record.couplingCheck && !record.couplingCheck->warning.empty()) {
+    std::cerr << "offlineSimulator: warning: " << record.couplingCheck->warning << "\n";
+  }
+  RunOutput output = openOutput(options, scene, simulation, record);
+  installStopHandlers();
+  const int frame = runFrames(options, scene, simulation, output, record);
+  if (stopSignal != 0 && output.checkpointFrames != output.writer->numFrames()) {
+    // The signal came after the last frame's checkpoint decision.
+    output.checkpoint(*simulation.integrator, output.writer->numFrames(), scene.output.sync, record);
+  }
+  output.writer->close();
+  if (stopSignal != 0 && frame < simulation.timing.frameCount) {
+    std::cerr << "offlineSimulator: interrupted by " << signalName(stopSignal) << ": " << output.writer->numFrames()
+              << " of " << simulation.timing.frameCount << " frames are complete in " << scene.output.file.string()
+              << " (checkpoint after frame " << output.checkpointFrames << " in " << output.checkpointFile.string()
+              << "); continue the run with:\n  " << resumeCommand(argc, argv) << "\n";
+    return 128 + static_cast<int>(stopSignal);
+  }
+  if (!options.quiet) {
+    record.outputBytes = static_cast<std::int64_t>(fs::file_size(scene.output.file));
+    printSummary(scene, simulation, record);
+  }
+  return 0;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{
+      "Runs a scene file (docs/scene-format.md) and writes its frames to an .afsim file "
+      "(docs/simulation-output.md)."};
+  CommandLine options;
+  addSceneOptions(app, options);
+  addRunOptions(app, options);
   if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "offlineSimulator")) return *status;
 
   asyncfem::Stopwatch setupWatch;
@@ -480,132 +657,7 @@ int run(int argc, char** argv) {
         "scripts/install-deps.sh, and configure again; ASYNCFEM_WITH_PETSC)");
 #endif
   }
-  asyncfem::Simulation simulation = asyncfem::buildSimulation(scene);
-  for (const std::string& warning : simulation.warnings) std::cerr << "offlineSimulator: warning: " << warning << "\n";
-  const double setupSeconds = setupWatch.stop();
-  const asyncfem::IntegratorStats statsAfterSetup = simulation.integrator->stats();
-  // On a separate integrator built for the linearized scene: the run's own state and
-  // statistics are untouched.
-  const std::optional<asyncfem::PaperCouplingCheck> couplingCheck =
-      options.noStabilityCheck ? std::nullopt : asyncfem::checkPaperCoupling(scene, simulation);
-  if (couplingCheck && !couplingCheck->warning.empty()) {
-    std::cerr << "offlineSimulator: warning: " << couplingCheck->warning << "\n";
-  }
-
-  // The output file is created (truncated) only once the scene has been built, so a
-  // scene error leaves an existing file alone; from here on it holds this run's frames.
-  if (scene.output.file.has_parent_path()) {
-    fs::create_directories(scene.output.file.parent_path());
-  }
-  std::optional<asyncfem::VtuSeriesWriter> vtuSeries;
-  if (!scene.output.vtuFolder.empty()) {
-    vtuSeries.emplace(scene.output.vtuFolder, scene.output.vtuEncoding);
-  }
-  asyncfem::SimulationFileHeader header;
-  header.numVertices = simulation.mesh->numVertices();
-  header.frameInterval = simulation.frameInterval;
-  header.timestep = simulation.timestep;
-  header.hasVelocities = scene.output.velocities;
-  // The scene, so that frameRenderer and afsimTool find the mesh by themselves.
-  header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
-  header.sceneFingerprint = asyncfem::problemFingerprint(*simulation.problem);
-  const asyncfem::SimulationWriter::Options writerOptions{scene.output.sync};
-  const std::uint32_t fingerprint =
-      asyncfem::runFingerprint(fingerprintText(options.scene), scene.integrator.name, simulation.timestep,
-                               simulation.frameInterval, *simulation.problem);
-  const asyncfem::CheckpointSchedule schedule{options.checkpointEvery, options.checkpointSeconds};
-  const fs::path checkpointFile = asyncfem::checkpointPathFor(scene.output.file);
-
-  int firstFrame = 0;
-  std::unique_ptr<asyncfem::SimulationWriter> writer;
-  if (options.resume) {
-    firstFrame = static_cast<int>(asyncfem::resumeFromCheckpoint(scene.output.file, header, fingerprint,
-                                                                 simulation.numFrames, *simulation.integrator));
-    writer = asyncfem::SimulationWriter::continueFile(scene.output.file, header, firstFrame, writerOptions);
-    const std::string caveat = simulation.integrator->report().resumeCaveat;
-    if (!caveat.empty() && !options.quiet) std::printf("resume: %s\n", caveat.c_str());
-  } else {
-    writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, header, writerOptions);
-    // The rest state, so that a run stopped before its first frame can be resumed too.
-    asyncfem::writeCheckpoint(checkpointFile, asyncfem::captureCheckpoint(*simulation.integrator, 0, fingerprint),
-                              scene.output.sync);
-  }
-  if (vtuSeries) {
-    if (firstFrame > 0) listEarlierVtuFrames(scene, firstFrame, *vtuSeries);
-    vtuSeries->writeCollection();
-  }
-  std::int64_t checkpointFrames = firstFrame;
-  int checkpointsWritten = 0;
-  auto lastCheckpoint = std::chrono::steady_clock::now();
-  const auto secondsSince = [](std::chrono::steady_clock::time_point then) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - then).count();
-  };
-  installStopHandlers();
-
-  asyncfem::cli::ProgressReporter progress("offlineSimulator",
-                                           asyncfem::cli::chooseProgressStyle(options.quiet, options.progress),
-                                           simulation.numFrames, firstFrame);
-
-  asyncfem::Stopwatch loopWatch;
-  asyncfem::Stopwatch outputWatch;
-  loopWatch.start();
-  int frame = firstFrame;
-  try {
-    for (; frame < simulation.numFrames && stopSignal == 0; ++frame) {
-      asyncfem::advanceFrame(simulation, frame);
-      {
-        const asyncfem::ScopedTimer timer(outputWatch);
-        const asyncfem::Integrator& integrator = *simulation.integrator;
-        if (header.hasVelocities) {
-          writer->appendFrame(integrator.time(), integrator.displacement(), integrator.velocity());
-        } else {
-          writer->appendFrame(integrator.time(), integrator.displacement());
-        }
-        // After the record, so that the checkpoint never runs ahead of the file.
-        const int done = frame + 1;
-        if (schedule.due(done, secondsSince(lastCheckpoint)) || done == simulation.numFrames || stopSignal != 0) {
-          asyncfem::writeCheckpoint(checkpointFile, asyncfem::captureCheckpoint(integrator, done, fingerprint),
-                                    scene.output.sync);
-          checkpointFrames = done;
-          ++checkpointsWritten;
-          lastCheckpoint = std::chrono::steady_clock::now();
-        }
-        if (vtuSeries && frame % scene.output.vtuEvery == 0) {
-          vtuSeries->writeFrame(frame, integrator.time(), *simulation.mesh, integrator.displacement());
-        }
-      }
-      progress.update(frame + 1);
-    }
-  } catch (const asyncfem::Error& error) {
-    progress.finish();
-    // The frames before the failing one are complete, checksummed records.
-    throw asyncfem::Error(std::string(error.what()) + "; the " + std::to_string(writer->numFrames()) +
-                          " frames before it are kept in " + scene.output.file.string());
-  }
-  const double loopSeconds = loopWatch.stop();
-  progress.finish();
-  if (stopSignal != 0 && checkpointFrames != writer->numFrames()) {
-    // The signal came after the last frame's checkpoint decision.
-    asyncfem::writeCheckpoint(checkpointFile,
-                              asyncfem::captureCheckpoint(*simulation.integrator, writer->numFrames(), fingerprint),
-                              scene.output.sync);
-    checkpointFrames = writer->numFrames();
-  }
-  writer->close();
-
-  if (stopSignal != 0 && frame < simulation.numFrames) {
-    std::cerr << "offlineSimulator: interrupted by " << signalName(stopSignal) << ": " << writer->numFrames() << " of "
-              << simulation.numFrames << " frames are complete in " << scene.output.file.string()
-              << " (checkpoint after frame " << checkpointFrames << " in " << checkpointFile.string()
-              << "); continue the run with:\n  " << resumeCommand(argc, argv) << "\n";
-    return 128 + static_cast<int>(stopSignal);
-  }
-  if (!options.quiet) {
-    const auto bytes = static_cast<std::int64_t>(fs::file_size(scene.output.file));
-    printSummary(scene, simulation, statsAfterSetup, setupSeconds, loopSeconds, outputWatch.totalSeconds(), bytes,
-                 firstFrame, couplingCheck, schedule, checkpointsWritten);
-  }
-  return 0;
+  return runLocal(argc, argv, options, scene, setupWatch);
 }
 
 }  // namespace

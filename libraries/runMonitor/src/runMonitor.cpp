@@ -29,8 +29,7 @@ std::uint32_t crcOf(const T& value, std::uint32_t crc) {
 
 }  // namespace
 
-RunMonitor::RunMonitor(const Problem& problem, double timestep, Settings settings)
-    : mesh_(&problem.mesh()), settings_(settings), timestep_(timestep) {
+RunMonitor::RunMonitor(const Problem& problem, Settings settings) : mesh_(&problem.mesh()), settings_(settings) {
   const BoundingBox box = boundingBox(problem.mesh());
   boundingBoxDiagonal_ = (box.max - box.min).norm();
   blowUpDisplacement_ = settings_.blowUpFactor * boundingBoxDiagonal_;
@@ -92,62 +91,67 @@ NumericalErrorLocation RunMonitor::locate(const Integrator& integrator, long lon
 }
 
 void RunMonitor::advanceFrame(Integrator& integrator, long long frame, int stepsPerFrame) {
-  for (int s = 0; s < stepsPerFrame; ++s) {
-    const long long step = (frame * stepsPerFrame) + s + 1;
-    // The time the step ends at, taken before the step (which advances time() on success).
-    const double stepEnd = integrator.time() + integrator.timestep();
-    const std::string where =
-        "frame " + std::to_string(frame) + " (step " + std::to_string(step) + ", t = " + formatNumber(stepEnd) + ")";
-    try {
-      integrator.step();
-    } catch (const NumericalError& error) {
-      // Keep what the integrator knew (DOF, vertex) and add frame, step and region.
-      NumericalErrorLocation location = error.location();
-      const NumericalErrorLocation here = locate(integrator, frame, step, stepEnd, location.vertex);
-      location.frame = here.frame;
-      location.step = here.step;
-      if (!location.hasTime()) location.time = here.time;
-      location.region = here.region;
-      location.regionName = here.regionName;
-      const std::string vertex =
-          location.vertex >= 0 ? " [" + describeVertex(integrator, location.vertex) + "]" : std::string();
-      throw NumericalError(where + ": " + error.what() + vertex, location);
-    }
-    const Eigen::VectorXd& u = integrator.displacement();
-    const Eigen::VectorXd& v = integrator.velocity();
-    Eigen::Index firstNonFinite = -1;
-    Eigen::Index largest = 0;
-    double maxDisplacement = 0.0;
-    for (Eigen::Index i = 0; i < u.size(); ++i) {
-      if (!std::isfinite(u[i]) || !std::isfinite(v[i])) {
-        firstNonFinite = i;
-        break;
-      }
-      if (std::abs(u[i]) > maxDisplacement) {
-        maxDisplacement = std::abs(u[i]);
-        largest = i;
-      }
-    }
-    if (firstNonFinite >= 0) {
-      const int vertex = static_cast<int>(firstNonFinite / 3);
+  for (int s = 0; s < stepsPerFrame; ++s) checkedStep(integrator, frame, (frame * stepsPerFrame) + s + 1);
+  checkEnergy(integrator, frame);
+}
+
+void RunMonitor::checkedStep(Integrator& integrator, long long frame, long long step) const {
+  // The time the step ends at, taken before the step (which advances time() on success).
+  const double stepEnd = integrator.time() + integrator.timestep();
+  const std::string where =
+      "frame " + std::to_string(frame) + " (step " + std::to_string(step) + ", t = " + formatNumber(stepEnd) + ")";
+  try {
+    integrator.step();
+  } catch (const NumericalError& error) {
+    // Keep what the integrator knew (DOF, vertex) and add frame, step and region.
+    NumericalErrorLocation location = error.location();
+    const NumericalErrorLocation here = locate(integrator, frame, step, stepEnd, location.vertex);
+    location.frame = here.frame;
+    location.step = here.step;
+    if (!location.hasTime()) location.time = here.time;
+    location.region = here.region;
+    location.regionName = here.regionName;
+    const std::string vertex =
+        location.vertex >= 0 ? " [" + describeVertex(integrator, location.vertex) + "]" : std::string();
+    throw NumericalError(where + ": " + error.what() + vertex, location);
+  }
+  checkState(integrator, frame, step, stepEnd, where);
+}
+
+void RunMonitor::checkState(const Integrator& integrator, long long frame, long long step, double stepEnd,
+                            const std::string& where) const {
+  const Eigen::VectorXd& u = integrator.displacement();
+  const Eigen::VectorXd& v = integrator.velocity();
+  Eigen::Index largest = 0;
+  double maxDisplacement = 0.0;
+  for (Eigen::Index i = 0; i < u.size(); ++i) {
+    if (!std::isfinite(u[i]) || !std::isfinite(v[i])) {
+      const int vertex = static_cast<int>(i / 3);
       NumericalErrorLocation location = locate(integrator, frame, step, stepEnd, vertex);
-      location.dof = static_cast<int>(firstNonFinite);
+      location.dof = static_cast<int>(i);
       throw NumericalError(where + ": the state is not finite (NaN or infinity), first at " +
                                describeVertex(integrator, vertex) + "; the simulation is unstable",
                            location);
     }
-    if (maxDisplacement > blowUpDisplacement_) {
-      const int vertex = static_cast<int>(largest / 3);
-      NumericalErrorLocation location = locate(integrator, frame, step, stepEnd, vertex);
-      location.dof = static_cast<int>(largest);
-      throw NumericalError(where + ": blow-up: max |u| = " + formatNumber(maxDisplacement) + " at " +
-                               describeVertex(integrator, vertex) + " exceeds " + formatNumber(settings_.blowUpFactor) +
-                               " x the bounding-box diagonal (" + formatNumber(boundingBoxDiagonal_) +
-                               "); the simulation is unstable",
-                           location);
+    if (std::abs(u[i]) > maxDisplacement) {
+      maxDisplacement = std::abs(u[i]);
+      largest = i;
     }
   }
-  if (integrator.time() < energyCheckFrom_ + (0.5 * timestep_)) return;
+  if (maxDisplacement > blowUpDisplacement_) {
+    const int vertex = static_cast<int>(largest / 3);
+    NumericalErrorLocation location = locate(integrator, frame, step, stepEnd, vertex);
+    location.dof = static_cast<int>(largest);
+    throw NumericalError(where + ": blow-up: max |u| = " + formatNumber(maxDisplacement) + " at " +
+                             describeVertex(integrator, vertex) + " exceeds " + formatNumber(settings_.blowUpFactor) +
+                             " x the bounding-box diagonal (" + formatNumber(boundingBoxDiagonal_) +
+                             "); the simulation is unstable",
+                         location);
+  }
+}
+
+void RunMonitor::checkEnergy(const Integrator& integrator, long long frame) {
+  if (integrator.time() < energyCheckFrom_ + (0.5 * integrator.timestep())) return;
   const Eigen::VectorXd& u = integrator.displacement();
   const double mechanical = integrator.mechanicalEnergy();
   ++energyEvaluations_;
@@ -159,21 +163,20 @@ void RunMonitor::advanceFrame(Integrator& integrator, long long frame, int steps
     freeEnergyTime_ = integrator.time();
     return;
   }
-  if (energy - freeEnergy_ > 9.0 * freeEnergyScale_) {
-    Eigen::Index largest = 0;
-    u.cwiseAbs().maxCoeff(&largest);
-    const int vertex = static_cast<int>(largest / 3);
-    std::ostringstream out;
-    out << "frame " << frame << " (t = " << formatNumber(integrator.time())
-        << "): energy blow-up: with no load changing since t = " << formatNumber(energyCheckFrom_)
-        << ", the total energy (kinetic + elastic - constant loads . u) grew from " << formatNumber(freeEnergy_)
-        << " at t = " << formatNumber(freeEnergyTime_) << " to " << formatNumber(energy)
-        << "; largest |u| = " << formatNumber(std::abs(u[largest])) << " at " << describeVertex(integrator, vertex)
-        << "; the simulation is unstable";
-    NumericalErrorLocation location = locate(integrator, frame, -1, integrator.time(), vertex);
-    location.dof = static_cast<int>(largest);
-    throw NumericalError(out.str(), location);
-  }
+  if (energy - freeEnergy_ <= 9.0 * freeEnergyScale_) return;
+  Eigen::Index largest = 0;
+  u.cwiseAbs().maxCoeff(&largest);
+  const int vertex = static_cast<int>(largest / 3);
+  std::ostringstream out;
+  out << "frame " << frame << " (t = " << formatNumber(integrator.time())
+      << "): energy blow-up: with no load changing since t = " << formatNumber(energyCheckFrom_)
+      << ", the total energy (kinetic + elastic - constant loads . u) grew from " << formatNumber(freeEnergy_)
+      << " at t = " << formatNumber(freeEnergyTime_) << " to " << formatNumber(energy)
+      << "; largest |u| = " << formatNumber(std::abs(u[largest])) << " at " << describeVertex(integrator, vertex)
+      << "; the simulation is unstable";
+  NumericalErrorLocation location = locate(integrator, frame, -1, integrator.time(), vertex);
+  location.dof = static_cast<int>(largest);
+  throw NumericalError(out.str(), location);
 }
 
 std::string CheckpointSchedule::describe() const {

@@ -85,6 +85,74 @@ void requirePositive(JsonObjectReader& reader, const std::string& key, double va
   }
 }
 
+void parseBeam(JsonObjectReader& reader, const std::string& source, BeamSpec& beam) {
+  beam.length = reader.number("length", beam.length);
+  requirePositive(reader, "length", beam.length);
+  beam.height = reader.number("height", beam.height);
+  requirePositive(reader, "height", beam.height);
+  beam.depth = reader.number("depth", beam.depth);
+  requirePositive(reader, "depth", beam.depth);
+  beam.cellsAlongLength = reader.integer("cellsAlongLength", beam.cellsAlongLength, 1, 100000);
+  beam.tipFraction = reader.number("tipFraction", beam.tipFraction);
+  if (beam.tipFraction < 0.0 || beam.tipFraction >= 1.0) {
+    reader.fail("tipFraction", "expected a fraction in [0, 1)");
+  }
+  if (const json* body = reader.find("body")) {
+    beam.body = parseMaterial(*body, reader.keyPath("body"), source, beam.body);
+  }
+  if (const json* tip = reader.find("tip")) {
+    beam.tip = parseMaterial(*tip, reader.keyPath("tip"), source, beam.tip);
+  }
+}
+
+// mesh.regions[i]: { "name", "min", "max", "material" }.
+BoxRegion parseBoxRegion(const json& value, const std::string& path, const std::string& source) {
+  JsonObjectReader region(value, path, source);
+  BoxRegion result;
+  result.name = region.string("name", "");
+  if (result.name.empty()) {
+    region.fail("name", "expected a non-empty name");
+  }
+  result.min = JsonObjectReader::toVector3(region.required("min"), region.keyPath("min"), source);
+  result.max = JsonObjectReader::toVector3(region.required("max"), region.keyPath("max"), source);
+  if ((result.min.array() > result.max.array()).any()) {
+    JsonObjectReader::failAt(source, path, "expected min <= max");
+  }
+  result.material = parseMaterial(region.required("material"), region.keyPath("material"), source,
+                                  Material{result.name, 1000.0, 1e6, 0.45});
+  region.finish();
+  return result;
+}
+
+void parseBox(JsonObjectReader& reader, const std::string& source, BoxMeshSpec& box) {
+  box.origin = reader.vector3("origin", box.origin);
+  box.size = reader.vector3("size", box.size);
+  if ((box.size.array() <= 0.0).any()) {
+    reader.fail("size", "expected three sizes > 0");
+  }
+  if (const json* cells = reader.find("cells")) {
+    const std::string path = reader.keyPath("cells");
+    if (!cells->is_array() || cells->size() != 3) {
+      JsonObjectReader::failAt(source, path, "expected [nx, ny, nz] (three integers >= 1)");
+    }
+    for (int i = 0; i < 3; ++i) {
+      box.cells[i] = JsonObjectReader::toInteger((*cells)[static_cast<std::size_t>(i)],
+                                                 path + "[" + std::to_string(i) + "]", source, 1, 10000);
+    }
+  }
+  if (const json* material = reader.find("material")) {
+    box.material = parseMaterial(*material, reader.keyPath("material"), source, box.material);
+  }
+  if (const json* regions = reader.find("regions")) {
+    if (!regions->is_array()) {
+      reader.fail("regions", "expected an array of {name, min, max, material}");
+    }
+    for (std::size_t i = 0; i < regions->size(); ++i) {
+      box.regions.push_back(parseBoxRegion((*regions)[i], reader.elementPath("regions", i), source));
+    }
+  }
+}
+
 void parseMesh(JsonObjectReader& top, Scene& scene) {
   const std::string source = scene.sourceName;
   JsonObjectReader reader(top.required("mesh"), "mesh", source);
@@ -96,74 +164,12 @@ void parseMesh(JsonObjectReader& top, Scene& scene) {
   if (hasFile) {
     scene.mesh.source = Scene::MeshSource::file;
     scene.mesh.file = resolvePath(scene.baseDirectory, pathString(reader, "file"));
-    reader.finish();
-    return;
-  }
-  const std::string generator = reader.choice("generator", "", {"beam", "box"});
-  if (generator == "beam") {
+  } else if (reader.choice("generator", "", {"beam", "box"}) == "beam") {
     scene.mesh.source = Scene::MeshSource::beam;
-    BeamSpec& beam = scene.mesh.beam;
-    beam.length = reader.number("length", beam.length);
-    requirePositive(reader, "length", beam.length);
-    beam.height = reader.number("height", beam.height);
-    requirePositive(reader, "height", beam.height);
-    beam.depth = reader.number("depth", beam.depth);
-    requirePositive(reader, "depth", beam.depth);
-    beam.cellsAlongLength = reader.integer("cellsAlongLength", beam.cellsAlongLength, 1, 100000);
-    beam.tipFraction = reader.number("tipFraction", beam.tipFraction);
-    if (beam.tipFraction < 0.0 || beam.tipFraction >= 1.0) {
-      reader.fail("tipFraction", "expected a fraction in [0, 1)");
-    }
-    if (const json* body = reader.find("body")) {
-      beam.body = parseMaterial(*body, reader.keyPath("body"), source, beam.body);
-    }
-    if (const json* tip = reader.find("tip")) {
-      beam.tip = parseMaterial(*tip, reader.keyPath("tip"), source, beam.tip);
-    }
+    parseBeam(reader, source, scene.mesh.beam);
   } else {
     scene.mesh.source = Scene::MeshSource::box;
-    BoxMeshSpec& box = scene.mesh.box;
-    box.origin = reader.vector3("origin", box.origin);
-    box.size = reader.vector3("size", box.size);
-    if ((box.size.array() <= 0.0).any()) {
-      reader.fail("size", "expected three sizes > 0");
-    }
-    if (const json* cells = reader.find("cells")) {
-      const std::string path = reader.keyPath("cells");
-      if (!cells->is_array() || cells->size() != 3) {
-        JsonObjectReader::failAt(source, path, "expected [nx, ny, nz] (three integers >= 1)");
-      }
-      for (int i = 0; i < 3; ++i) {
-        box.cells[i] = JsonObjectReader::toInteger((*cells)[static_cast<std::size_t>(i)],
-                                                   path + "[" + std::to_string(i) + "]", source, 1, 10000);
-      }
-    }
-    if (const json* material = reader.find("material")) {
-      box.material = parseMaterial(*material, reader.keyPath("material"), source, box.material);
-    }
-    if (const json* regions = reader.find("regions")) {
-      if (!regions->is_array()) {
-        reader.fail("regions", "expected an array of {name, min, max, material}");
-      }
-      for (std::size_t i = 0; i < regions->size(); ++i) {
-        const std::string path = reader.elementPath("regions", i);
-        JsonObjectReader region((*regions)[i], path, source);
-        BoxRegion result;
-        result.name = region.string("name", "");
-        if (result.name.empty()) {
-          region.fail("name", "expected a non-empty name");
-        }
-        result.min = JsonObjectReader::toVector3(region.required("min"), region.keyPath("min"), source);
-        result.max = JsonObjectReader::toVector3(region.required("max"), region.keyPath("max"), source);
-        if ((result.min.array() > result.max.array()).any()) {
-          JsonObjectReader::failAt(source, path, "expected min <= max");
-        }
-        result.material = parseMaterial(region.required("material"), region.keyPath("material"), source,
-                                        Material{result.name, 1000.0, 1e6, 0.45});
-        region.finish();
-        box.regions.push_back(result);
-      }
-    }
+    parseBox(reader, source, scene.mesh.box);
   }
   reader.finish();
 }
@@ -239,66 +245,75 @@ void parseFixed(JsonObjectReader& top, Scene& scene) {
   reader.finish();
 }
 
+// The vertices a force acts on: "set" or "vertices" (0-based ids).
+void parseForceTarget(JsonObjectReader& reader, const std::string& source, Scene::Force& force) {
+  const bool hasSet = reader.has("set");
+  if (hasSet == reader.has("vertices")) {
+    JsonObjectReader::failAt(source, reader.path(), "give either \"set\" or \"vertices\"");
+  }
+  if (hasSet) {
+    force.set = reader.string("set", "");
+    if (force.set.empty()) {
+      reader.fail("set", "expected a non-empty vertex set name");
+    }
+    return;
+  }
+  const json& vertices = *reader.find("vertices");
+  if (!vertices.is_array() || vertices.empty()) {
+    reader.fail("vertices", "expected a non-empty array of 0-based vertex ids");
+  }
+  for (std::size_t k = 0; k < vertices.size(); ++k) {
+    force.vertices.push_back(
+        JsonObjectReader::toInteger(vertices[k], reader.elementPath("vertices", k), source, 0, maxInt));
+  }
+}
+
+// A pull's "force" and optional "window": [start, end].
+void parsePull(JsonObjectReader& reader, const std::string& source, Scene::Force& force) {
+  force.vector = JsonObjectReader::toVector3(reader.required("force"), reader.keyPath("force"), source);
+  const json* window = reader.find("window");
+  if (window == nullptr) return;
+  const std::string windowPath = reader.keyPath("window");
+  const char* expected = "expected [start, end] with start <= end";
+  if (!window->is_array() || window->size() != 2 || !(*window)[0].is_number() || !(*window)[1].is_number()) {
+    JsonObjectReader::failAt(source, windowPath, expected);
+  }
+  force.start = JsonObjectReader::toNumber((*window)[0], windowPath + "[0]", source);
+  force.end = JsonObjectReader::toNumber((*window)[1], windowPath + "[1]", source);
+  if (force.start > force.end) {
+    JsonObjectReader::failAt(source, windowPath, expected);
+  }
+}
+
+Scene::Force parseForce(const json& value, const std::string& path, const std::string& source) {
+  JsonObjectReader reader(value, path, source);
+  Scene::Force force;
+  const std::string type = reader.choice("type", "", {"pull", "impulse"});
+  force.type = type == "pull" ? Scene::ForceType::pull : Scene::ForceType::impulse;
+  parseForceTarget(reader, source, force);
+  if (force.type == Scene::ForceType::pull) {
+    parsePull(reader, source, force);
+  } else {
+    force.vector = JsonObjectReader::toVector3(reader.required("impulse"), reader.keyPath("impulse"), source);
+    force.time = reader.number("time", 0.0);
+    if (force.time < 0.0) {
+      reader.fail("time", "expected a time >= 0");
+    }
+  }
+  reader.finish();
+  return force;
+}
+
 void parseForces(JsonObjectReader& top, Scene& scene) {
   const json* forces = top.find("forces");
   if (forces == nullptr) {
     return;
   }
-  const std::string& source = scene.sourceName;
   if (!forces->is_array()) {
     top.fail("forces", "expected an array of {type, set | vertices, ...}");
   }
   for (std::size_t i = 0; i < forces->size(); ++i) {
-    const std::string path = top.elementPath("forces", i);
-    JsonObjectReader reader((*forces)[i], path, source);
-    Scene::Force force;
-    const std::string type = reader.choice("type", "", {"pull", "impulse"});
-    force.type = type == "pull" ? Scene::ForceType::pull : Scene::ForceType::impulse;
-
-    const bool hasSet = reader.has("set");
-    const bool hasVertices = reader.has("vertices");
-    if (hasSet == hasVertices) {
-      JsonObjectReader::failAt(source, path, "give either \"set\" or \"vertices\"");
-    }
-    if (hasSet) {
-      force.set = reader.string("set", "");
-      if (force.set.empty()) {
-        reader.fail("set", "expected a non-empty vertex set name");
-      }
-    } else {
-      const json& vertices = *reader.find("vertices");
-      if (!vertices.is_array() || vertices.empty()) {
-        reader.fail("vertices", "expected a non-empty array of 0-based vertex ids");
-      }
-      for (std::size_t k = 0; k < vertices.size(); ++k) {
-        force.vertices.push_back(
-            JsonObjectReader::toInteger(vertices[k], reader.elementPath("vertices", k), source, 0, maxInt));
-      }
-    }
-
-    if (force.type == Scene::ForceType::pull) {
-      force.vector = JsonObjectReader::toVector3(reader.required("force"), reader.keyPath("force"), source);
-      if (const json* window = reader.find("window")) {
-        const std::string windowPath = reader.keyPath("window");
-        const char* expected = "expected [start, end] with start <= end";
-        if (!window->is_array() || window->size() != 2 || !(*window)[0].is_number() || !(*window)[1].is_number()) {
-          JsonObjectReader::failAt(source, windowPath, expected);
-        }
-        force.start = JsonObjectReader::toNumber((*window)[0], windowPath + "[0]", source);
-        force.end = JsonObjectReader::toNumber((*window)[1], windowPath + "[1]", source);
-        if (force.start > force.end) {
-          JsonObjectReader::failAt(source, windowPath, expected);
-        }
-      }
-    } else {
-      force.vector = JsonObjectReader::toVector3(reader.required("impulse"), reader.keyPath("impulse"), source);
-      force.time = reader.number("time", 0.0);
-      if (force.time < 0.0) {
-        reader.fail("time", "expected a time >= 0");
-      }
-    }
-    reader.finish();
-    scene.forces.push_back(std::move(force));
+    scene.forces.push_back(parseForce((*forces)[i], top.elementPath("forces", i), scene.sourceName));
   }
 }
 
@@ -352,19 +367,8 @@ void parseOutput(JsonObjectReader& top, Scene& scene) {
   reader.finish();
 }
 
-}  // namespace
-
-void throwSceneError(const Scene& scene, const std::string& keyPath, const std::string& message) {
-  JsonObjectReader::failAt(scene.sourceName, keyPath, message);
-}
-
-void parseContact(JsonObjectReader& top, Scene& scene) {
-  const nlohmann::json* contact = top.find("contact");
-  if (contact == nullptr) return;
-  const std::string& source = scene.sourceName;
-  JsonObjectReader reader(*contact, "contact", source);
-  Scene::Contact& out = scene.contact;
-  if (const nlohmann::json* ground = reader.find("ground")) {
+void parseContactPlanes(JsonObjectReader& reader, const std::string& source, Scene::Contact& out) {
+  if (const json* ground = reader.find("ground")) {
     JsonObjectReader groundReader(*ground, reader.keyPath("ground"), source);
     ContactPlane plane;
     plane.normal = groundReader.vector3("up", Eigen::Vector3d::UnitY());
@@ -374,34 +378,46 @@ void parseContact(JsonObjectReader& top, Scene& scene) {
     groundReader.finish();
     out.planes.push_back(plane);
   }
-  if (const nlohmann::json* planes = reader.find("planes")) {
-    if (!planes->is_array())
-      reader.fail("planes", "expected an array of {\"point\": [x, y, z], \"normal\": [x, y, z]}");
-    for (std::size_t i = 0; i < planes->size(); ++i) {
-      JsonObjectReader planeReader((*planes)[i], reader.elementPath("planes", i), source);
-      const Eigen::Vector3d point =
-          JsonObjectReader::toVector3(planeReader.required("point"), planeReader.keyPath("point"), source);
-      Eigen::Vector3d normal =
-          JsonObjectReader::toVector3(planeReader.required("normal"), planeReader.keyPath("normal"), source);
-      if (!(normal.norm() > 0.0)) planeReader.fail("normal", "expected a non-zero vector");
-      planeReader.finish();
-      normal.normalize();
-      out.planes.push_back({normal, normal.dot(point)});
-    }
+  const json* planes = reader.find("planes");
+  if (planes == nullptr) return;
+  if (!planes->is_array()) reader.fail("planes", "expected an array of {\"point\": [x, y, z], \"normal\": [x, y, z]}");
+  for (std::size_t i = 0; i < planes->size(); ++i) {
+    JsonObjectReader planeReader((*planes)[i], reader.elementPath("planes", i), source);
+    const Eigen::Vector3d point =
+        JsonObjectReader::toVector3(planeReader.required("point"), planeReader.keyPath("point"), source);
+    Eigen::Vector3d normal =
+        JsonObjectReader::toVector3(planeReader.required("normal"), planeReader.keyPath("normal"), source);
+    if (!(normal.norm() > 0.0)) planeReader.fail("normal", "expected a non-zero vector");
+    planeReader.finish();
+    normal.normalize();
+    out.planes.push_back({normal, normal.dot(point)});
   }
-  if (const nlohmann::json* spheres = reader.find("spheres")) {
-    if (!spheres->is_array()) reader.fail("spheres", "expected an array of {\"center\": [x, y, z], \"radius\": r}");
-    for (std::size_t i = 0; i < spheres->size(); ++i) {
-      JsonObjectReader sphereReader((*spheres)[i], reader.elementPath("spheres", i), source);
-      ContactSphere sphere;
-      sphere.center =
-          JsonObjectReader::toVector3(sphereReader.required("center"), sphereReader.keyPath("center"), source);
-      sphere.radius = sphereReader.requiredNumber("radius");
-      requirePositive(sphereReader, "radius", sphere.radius);
-      sphereReader.finish();
-      out.spheres.push_back(sphere);
-    }
+}
+
+void parseContactSpheres(JsonObjectReader& reader, const std::string& source, Scene::Contact& out) {
+  const json* spheres = reader.find("spheres");
+  if (spheres == nullptr) return;
+  if (!spheres->is_array()) reader.fail("spheres", "expected an array of {\"center\": [x, y, z], \"radius\": r}");
+  for (std::size_t i = 0; i < spheres->size(); ++i) {
+    JsonObjectReader sphereReader((*spheres)[i], reader.elementPath("spheres", i), source);
+    ContactSphere sphere;
+    sphere.center =
+        JsonObjectReader::toVector3(sphereReader.required("center"), sphereReader.keyPath("center"), source);
+    sphere.radius = sphereReader.requiredNumber("radius");
+    requirePositive(sphereReader, "radius", sphere.radius);
+    sphereReader.finish();
+    out.spheres.push_back(sphere);
   }
+}
+
+void parseContact(JsonObjectReader& top, Scene& scene) {
+  const json* contact = top.find("contact");
+  if (contact == nullptr) return;
+  const std::string& source = scene.sourceName;
+  JsonObjectReader reader(*contact, "contact", source);
+  Scene::Contact& out = scene.contact;
+  parseContactPlanes(reader, source, out);
+  parseContactSpheres(reader, source, out);
   PenaltyContactParameters& p = out.parameters;
   p.stiffness = reader.number("stiffness", p.stiffness);
   requirePositive(reader, "stiffness", p.stiffness);
@@ -413,6 +429,141 @@ void parseContact(JsonObjectReader& top, Scene& scene) {
   requirePositive(reader, "frictionViscosity", p.frictionViscosity);
   reader.finish();
   if (!out.enabled()) reader.fail("ground", "contact needs a ground, planes or spheres");
+}
+
+void parseDamping(JsonObjectReader& top, Scene& scene) {
+  const json* damping = top.find("damping");
+  if (damping == nullptr) return;
+  JsonObjectReader reader(*damping, "damping", scene.sourceName);
+  scene.rayleighAlpha = reader.number("alpha", 0.0);
+  scene.rayleighBeta = reader.number("beta", 0.0);
+  reader.finish();
+  if (scene.rayleighAlpha < 0.0) {
+    reader.fail("alpha", "expected alpha >= 0");
+  }
+  if (scene.rayleighBeta < 0.0) {
+    reader.fail("beta", "expected beta >= 0");
+  }
+}
+
+// forceModel's hyperelastic keys; rejects each one the chosen model does not read.
+void parseHyperelasticOptions(JsonObjectReader& reader, const Scene& scene, HyperelasticOptions& h) {
+  const bool hyperelastic =
+      scene.forceModel != Scene::ForceModelKind::linear && scene.forceModel != Scene::ForceModelKind::corotational;
+  for (const char* key : {"inversionThreshold", "inversionHandling", "compressionResistance", "enforceSPD",
+                          "stvkFormulation", "mooneyRivlin"}) {
+    if (reader.has(key) && !hyperelastic) {
+      reader.fail(key, "only the hyperelastic force models (stvk, neo-hookean, mooney-rivlin) read it");
+    }
+  }
+  if (reader.has("inversionThreshold")) {
+    h.inversionThreshold = reader.number("inversionThreshold", 0.0);
+    if (!(h.inversionThreshold > 0.0 && h.inversionThreshold < 1.0)) {
+      reader.fail("inversionThreshold", "expected a principal stretch in (0, 1)");
+    }
+  }
+  h.inversionHandling = reader.choice("inversionHandling", "extrapolate", {"extrapolate", "vega-clamp"}) == "vega-clamp"
+                            ? InversionHandling::vegaClamp
+                            : InversionHandling::extrapolate;
+  if (reader.has("compressionResistance")) {
+    h.enableCompressionResistance = true;
+    h.compressionResistance = reader.number("compressionResistance", h.compressionResistance);
+    if (!(h.compressionResistance >= 0.0)) reader.fail("compressionResistance", "expected a number >= 0");
+  }
+  h.enforceSPD = reader.boolean("enforceSPD", h.enforceSPD);
+  h.stvkFormulation =
+      reader.choice("stvkFormulation", "green-strain", {"green-strain", "principal-stretches"}) == "green-strain"
+          ? StVKFormulation::greenStrain
+          : StVKFormulation::principalStretches;
+  if (scene.forceModel == Scene::ForceModelKind::stvk && h.stvkFormulation == StVKFormulation::greenStrain) {
+    for (const char* key : {"inversionThreshold", "compressionResistance", "enforceSPD"}) {
+      if (reader.has(key)) {
+        reader.fail(key,
+                    "the Green-strain StVK has no inversion handling: set \"stvkFormulation\": "
+                    "\"principal-stretches\" to use it");
+      }
+    }
+  }
+}
+
+void parseMooneyRivlin(JsonObjectReader& reader, const Scene& scene, HyperelasticOptions& h) {
+  const json* mooney = reader.find("mooneyRivlin");
+  if (mooney == nullptr) return;
+  if (scene.forceModel != Scene::ForceModelKind::mooneyRivlin) {
+    reader.fail("mooneyRivlin", "only with \"type\": \"mooney-rivlin\"");
+  }
+  JsonObjectReader m(*mooney, reader.keyPath("mooneyRivlin"), scene.sourceName);
+  MooneyRivlinParameters parameters;
+  parameters.mu01 = m.number("mu01", parameters.mu01);
+  parameters.mu10 = m.number("mu10", parameters.mu10);
+  parameters.v1 = m.number("v1", parameters.v1);
+  m.finish();
+  h.mooneyRivlin = parameters;
+}
+
+void parseForceModel(JsonObjectReader& top, Scene& scene) {
+  const json* forceModel = top.find("forceModel");
+  if (forceModel == nullptr) return;
+  JsonObjectReader reader(*forceModel, "forceModel", scene.sourceName);
+  const std::string type =
+      reader.choice("type", "linear", {"linear", "corotational", "stvk", "neo-hookean", "mooney-rivlin"});
+  scene.forceModel = type == "linear"         ? Scene::ForceModelKind::linear
+                     : type == "corotational" ? Scene::ForceModelKind::corotational
+                     : type == "stvk"         ? Scene::ForceModelKind::stvk
+                     : type == "neo-hookean"  ? Scene::ForceModelKind::neoHookean
+                                              : Scene::ForceModelKind::mooneyRivlin;
+  if (reader.has("tangent")) {
+    if (scene.forceModel != Scene::ForceModelKind::corotational) {
+      reader.fail("tangent", "only the corotational force model has a tangent choice");
+    }
+    scene.tangent = reader.choice("tangent", "simple", {"simple", "exact"}) == "exact" ? Scene::Tangent::exact
+                                                                                       : Scene::Tangent::simple;
+  }
+  parseHyperelasticOptions(reader, scene, scene.hyperelastic);
+  parseMooneyRivlin(reader, scene, scene.hyperelastic);
+  reader.finish();
+}
+
+void parseFrames(JsonObjectReader& top, Scene& scene) {
+  const json* frames = top.find("frames");
+  if (frames == nullptr) return;
+  JsonObjectReader reader(*frames, "frames", scene.sourceName);
+  scene.frames.rate = reader.number("rate", scene.frames.rate);
+  requirePositive(reader, "rate", scene.frames.rate);
+  scene.frames.count = reader.integer("count", scene.frames.count, 1, maxInt);
+  reader.finish();
+}
+
+// Why the timestep h does not divide the frame interval 1 / rate into whole steps
+// (ratio of them), with the valid timesteps nearest to it.
+std::string describeTimestepMismatch(double rate, double h, double ratio) {
+  std::string message = formatNumber(h, 9) + " does not divide the frame interval " + describeDuration(rate, 1) +
+                        " (frames.rate " + formatNumber(rate, 9) + ") into whole steps: " + formatNumber(ratio, 12) +
+                        " steps per frame; ";
+  if (ratio > maxStepsPerFrame) {
+    message += "the smallest timestep allowed is " + describeDivisor(rate, maxStepsPerFrame);
+  } else if (ratio < 1.0) {
+    message += "the timestep is longer than a frame; the longest valid timestep is " + describeDivisor(rate, 1);
+  } else {
+    const auto fewer = static_cast<long long>(std::floor(ratio));
+    message +=
+        "the nearest valid timesteps are " + describeDivisor(rate, fewer) + " and " + describeDivisor(rate, fewer + 1);
+  }
+  return message + "; or give the steps per frame instead (integrator.stepsPerFrame)";
+}
+
+// Whether timing was resolved from the scene's current frames and integrator keys.
+bool resolvedFromKeys(const Scene& scene, const FrameTiming& timing) {
+  const bool sameStep = scene.integrator.stepsPerFrame > 0 ? timing.stepsPerFrame == scene.integrator.stepsPerFrame
+                                                           : timing.timestep == scene.integrator.timestep;
+  return timing.frameInterval > 0.0 && timing.frameRate == scene.frames.rate &&
+         timing.frameCount == scene.frames.count && sameStep;
+}
+
+}  // namespace
+
+void throwSceneError(const Scene& scene, const std::string& keyPath, const std::string& message) {
+  JsonObjectReader::failAt(scene.sourceName, keyPath, message);
 }
 
 Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePath, const std::string& sourceName) {
@@ -429,100 +580,16 @@ Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePa
   parseForces(top, scene);
   scene.mass =
       top.choice("mass", "consistent", {"consistent", "lumped"}) == "lumped" ? MassType::lumped : MassType::consistent;
-  if (const nlohmann::json* damping = top.find("damping")) {
-    JsonObjectReader reader(*damping, "damping", sourceName);
-    scene.rayleighAlpha = reader.number("alpha", 0.0);
-    scene.rayleighBeta = reader.number("beta", 0.0);
-    reader.finish();
-    if (scene.rayleighAlpha < 0.0) {
-      reader.fail("alpha", "expected alpha >= 0");
-    }
-    if (scene.rayleighBeta < 0.0) {
-      reader.fail("beta", "expected beta >= 0");
-    }
-  }
-  if (const nlohmann::json* forceModel = top.find("forceModel")) {
-    JsonObjectReader reader(*forceModel, "forceModel", sourceName);
-    const std::string type =
-        reader.choice("type", "linear", {"linear", "corotational", "stvk", "neo-hookean", "mooney-rivlin"});
-    scene.forceModel = type == "linear"         ? Scene::ForceModelKind::linear
-                       : type == "corotational" ? Scene::ForceModelKind::corotational
-                       : type == "stvk"         ? Scene::ForceModelKind::stvk
-                       : type == "neo-hookean"  ? Scene::ForceModelKind::neoHookean
-                                                : Scene::ForceModelKind::mooneyRivlin;
-    if (reader.has("tangent")) {
-      if (scene.forceModel != Scene::ForceModelKind::corotational) {
-        reader.fail("tangent", "only the corotational force model has a tangent choice");
-      }
-      scene.tangent = reader.choice("tangent", "simple", {"simple", "exact"}) == "exact" ? Scene::Tangent::exact
-                                                                                         : Scene::Tangent::simple;
-    }
-    const bool hyperelastic =
-        scene.forceModel != Scene::ForceModelKind::linear && scene.forceModel != Scene::ForceModelKind::corotational;
-    for (const char* key : {"inversionThreshold", "inversionHandling", "compressionResistance", "enforceSPD",
-                            "stvkFormulation", "mooneyRivlin"}) {
-      if (reader.has(key) && !hyperelastic) {
-        reader.fail(key, "only the hyperelastic force models (stvk, neo-hookean, mooney-rivlin) read it");
-      }
-    }
-    HyperelasticOptions& h = scene.hyperelastic;
-    if (reader.has("inversionThreshold")) {
-      h.inversionThreshold = reader.number("inversionThreshold", 0.0);
-      if (!(h.inversionThreshold > 0.0 && h.inversionThreshold < 1.0)) {
-        reader.fail("inversionThreshold", "expected a principal stretch in (0, 1)");
-      }
-    }
-    h.inversionHandling =
-        reader.choice("inversionHandling", "extrapolate", {"extrapolate", "vega-clamp"}) == "vega-clamp"
-            ? InversionHandling::vegaClamp
-            : InversionHandling::extrapolate;
-    if (reader.has("compressionResistance")) {
-      h.enableCompressionResistance = true;
-      h.compressionResistance = reader.number("compressionResistance", h.compressionResistance);
-      if (!(h.compressionResistance >= 0.0)) reader.fail("compressionResistance", "expected a number >= 0");
-    }
-    h.enforceSPD = reader.boolean("enforceSPD", h.enforceSPD);
-    h.stvkFormulation =
-        reader.choice("stvkFormulation", "green-strain", {"green-strain", "principal-stretches"}) == "green-strain"
-            ? StVKFormulation::greenStrain
-            : StVKFormulation::principalStretches;
-    if (scene.forceModel == Scene::ForceModelKind::stvk && h.stvkFormulation == StVKFormulation::greenStrain) {
-      for (const char* key : {"inversionThreshold", "compressionResistance", "enforceSPD"}) {
-        if (reader.has(key)) {
-          reader.fail(key,
-                      "the Green-strain StVK has no inversion handling: set \"stvkFormulation\": "
-                      "\"principal-stretches\" to use it");
-        }
-      }
-    }
-    if (const nlohmann::json* mooney = reader.find("mooneyRivlin")) {
-      if (scene.forceModel != Scene::ForceModelKind::mooneyRivlin) {
-        reader.fail("mooneyRivlin", "only with \"type\": \"mooney-rivlin\"");
-      }
-      JsonObjectReader m(*mooney, reader.keyPath("mooneyRivlin"), sourceName);
-      MooneyRivlinParameters parameters;
-      parameters.mu01 = m.number("mu01", parameters.mu01);
-      parameters.mu10 = m.number("mu10", parameters.mu10);
-      parameters.v1 = m.number("v1", parameters.v1);
-      m.finish();
-      h.mooneyRivlin = parameters;
-    }
-    reader.finish();
-  }
+  parseDamping(top, scene);
+  parseForceModel(top, scene);
   parseContact(top, scene);
   parseIntegrator(top, scene);
-  if (const nlohmann::json* frames = top.find("frames")) {
-    JsonObjectReader reader(*frames, "frames", sourceName);
-    scene.frames.rate = reader.number("rate", scene.frames.rate);
-    requirePositive(reader, "rate", scene.frames.rate);
-    scene.frames.count = reader.integer("count", scene.frames.count, 1, maxInt);
-    reader.finish();
-  }
-  if (scene.integrator.stepsPerFrame > 0) {
-    scene.integrator.timestep = (1.0 / scene.frames.rate) / scene.integrator.stepsPerFrame;
-  }
+  parseFrames(top, scene);
   parseOutput(top, scene);
   top.finish();
+  scene.timing = resolveFrameTiming(scene);
+  // For programs that still read the key rather than timing.
+  scene.integrator.timestep = scene.timing.timestep;
   return scene;
 }
 
@@ -531,8 +598,11 @@ FrameTiming resolveFrameTiming(const Scene& scene) {
   if (!(rate > 0.0) || !std::isfinite(rate)) {
     throwSceneError(scene, "frames.rate", "expected a number > 0");
   }
+  if (scene.frames.count < 1) throwSceneError(scene, "frames.count", "expected a count >= 1");
   FrameTiming timing;
+  timing.frameRate = rate;
   timing.frameInterval = 1.0 / rate;
+  timing.frameCount = scene.frames.count;
   if (scene.integrator.stepsPerFrame > 0) {
     timing.stepsPerFrame = scene.integrator.stepsPerFrame;
     timing.timestep = timing.frameInterval / timing.stepsPerFrame;
@@ -550,20 +620,28 @@ FrameTiming resolveFrameTiming(const Scene& scene) {
     timing.stepsPerFrame = static_cast<int>(steps);
     return timing;
   }
-  const std::string interval = describeDuration(rate, 1);
-  std::string message = formatNumber(h, 9) + " does not divide the frame interval " + interval + " (frames.rate " +
-                        formatNumber(rate, 9) + ") into whole steps: " + formatNumber(ratio, 12) + " steps per frame; ";
-  if (ratio > maxStepsPerFrame) {
-    message += "the smallest timestep allowed is " + describeDivisor(rate, maxStepsPerFrame);
-  } else if (ratio < 1.0) {
-    message += "the timestep is longer than a frame; the longest valid timestep is " + describeDivisor(rate, 1);
-  } else {
-    const auto fewer = static_cast<long long>(std::floor(ratio));
-    message +=
-        "the nearest valid timesteps are " + describeDivisor(rate, fewer) + " and " + describeDivisor(rate, fewer + 1);
+  throwSceneError(scene, "integrator.timestep", describeTimestepMismatch(rate, h, ratio));
+}
+
+FrameTiming frameTimingOf(const Scene& scene) {
+  return resolvedFromKeys(scene, scene.timing) ? scene.timing : resolveFrameTiming(scene);
+}
+
+void overrideFrameTiming(Scene& scene, const TimingOverrides& overrides) {
+  if (overrides.timestep && overrides.stepsPerFrame) {
+    throwSceneError(scene, "integrator", "give either a timestep or steps per frame, not both");
   }
-  throwSceneError(scene, "integrator.timestep",
-                  message + "; or give the steps per frame instead (integrator.stepsPerFrame)");
+  if (overrides.timestep) {
+    scene.integrator.timestep = *overrides.timestep;
+    scene.integrator.stepsPerFrame = 0;
+  }
+  if (overrides.stepsPerFrame) {
+    if (*overrides.stepsPerFrame < 1) throwSceneError(scene, "integrator.stepsPerFrame", "expected a count >= 1");
+    scene.integrator.stepsPerFrame = *overrides.stepsPerFrame;
+  }
+  if (overrides.frameCount) scene.frames.count = *overrides.frameCount;
+  scene.timing = resolveFrameTiming(scene);
+  scene.integrator.timestep = scene.timing.timestep;
 }
 
 Scene loadScene(const std::filesystem::path& path) {

@@ -58,6 +58,50 @@ std::string knownSets(const std::map<std::string, std::vector<int>>& sets) {
   return names.empty() ? "none" : joined(names);
 }
 
+// The elements of override.set ("allElements" or an element set of the mesh).
+std::vector<int> overrideElements(const Scene& scene, const TetMesh& mesh, const Scene::MaterialOverride& override,
+                                  const std::string& keyPath) {
+  if (override.set != "allElements") {
+    const auto it = mesh.elementSets().find(override.set);
+    if (it == mesh.elementSets().end()) {
+      throwSceneError(
+          scene, keyPath,
+          "unknown element set \"" + override.set + "\" (known: allElements, " + knownSets(mesh.elementSets()) + ")");
+    }
+    return it->second;
+  }
+  std::vector<int> elements(static_cast<std::size_t>(mesh.numElements()));
+  for (int e = 0; e < mesh.numElements(); ++e) elements[static_cast<std::size_t>(e)] = e;
+  return elements;
+}
+
+// Gives members (the elements of override.set that use materialIndex) the overridden
+// material: in place when no other element uses it, else as "<material>@<set>".
+void overrideMaterial(const Scene::MaterialOverride& override, int materialIndex, const std::vector<int>& members,
+                      std::vector<Material>& materials, std::vector<int>& elementMaterials) {
+  Material material = materials[static_cast<std::size_t>(materialIndex)];
+  material.density = override.density.value_or(material.density);
+  material.youngsModulus = override.youngsModulus.value_or(material.youngsModulus);
+  material.poissonRatio = override.poissonRatio.value_or(material.poissonRatio);
+  const auto users =
+      static_cast<std::size_t>(std::count(elementMaterials.begin(), elementMaterials.end(), materialIndex));
+  if (users == members.size()) {
+    materials[static_cast<std::size_t>(materialIndex)] = material;
+    return;
+  }
+  material.name += "@" + override.set;
+  const auto existing =
+      std::find_if(materials.begin(), materials.end(), [&](const Material& m) { return m.name == material.name; });
+  int newIndex = static_cast<int>(materials.size());
+  if (existing != materials.end()) {
+    newIndex = static_cast<int>(existing - materials.begin());
+    *existing = material;
+  } else {
+    materials.push_back(material);
+  }
+  for (const int e : members) elementMaterials[static_cast<std::size_t>(e)] = newIndex;
+}
+
 // Material overrides: new materials for the elements of each set. A material used only
 // by the set's elements is changed in place (keeping its name); otherwise the set's
 // elements get a copy named "<material>@<set>".
@@ -70,49 +114,12 @@ TetMesh applyMaterialOverrides(const Scene& scene, TetMesh mesh) {
   for (std::size_t i = 0; i < scene.materials.size(); ++i) {
     const Scene::MaterialOverride& override = scene.materials[i];
     const std::string keyPath = "materials[" + std::to_string(i) + "].set";
-    std::vector<int> elements;
-    if (override.set == "allElements") {
-      elements.resize(static_cast<std::size_t>(mesh.numElements()));
-      for (int e = 0; e < mesh.numElements(); ++e) {
-        elements[static_cast<std::size_t>(e)] = e;
-      }
-    } else {
-      const auto it = mesh.elementSets().find(override.set);
-      if (it == mesh.elementSets().end()) {
-        throwSceneError(
-            scene, keyPath,
-            "unknown element set \"" + override.set + "\" (known: allElements, " + knownSets(mesh.elementSets()) + ")");
-      }
-      elements = it->second;
-    }
     std::map<int, std::vector<int>> byMaterial;
-    for (const int e : elements) {
+    for (const int e : overrideElements(scene, mesh, override, keyPath)) {
       byMaterial[elementMaterials[static_cast<std::size_t>(e)]].push_back(e);
     }
     for (const auto& [materialIndex, members] : byMaterial) {
-      Material material = materials[static_cast<std::size_t>(materialIndex)];
-      material.density = override.density.value_or(material.density);
-      material.youngsModulus = override.youngsModulus.value_or(material.youngsModulus);
-      material.poissonRatio = override.poissonRatio.value_or(material.poissonRatio);
-      const auto users =
-          static_cast<std::size_t>(std::count(elementMaterials.begin(), elementMaterials.end(), materialIndex));
-      if (users == members.size()) {
-        materials[static_cast<std::size_t>(materialIndex)] = material;
-        continue;
-      }
-      material.name += "@" + override.set;
-      const auto existing =
-          std::find_if(materials.begin(), materials.end(), [&](const Material& m) { return m.name == material.name; });
-      int newIndex = static_cast<int>(materials.size());
-      if (existing != materials.end()) {
-        newIndex = static_cast<int>(existing - materials.begin());
-        *existing = material;
-      } else {
-        materials.push_back(material);
-      }
-      for (const int e : members) {
-        elementMaterials[static_cast<std::size_t>(e)] = newIndex;
-      }
+      overrideMaterial(override, materialIndex, members, materials, elementMaterials);
     }
   }
   TetMesh result(mesh.restPositions(), mesh.elements(), materials, elementMaterials);
@@ -152,26 +159,31 @@ std::vector<int> collectFixedVertices(const Scene& scene, const TetMesh& mesh) {
 // below any deliberate offset from a step time.
 constexpr double windowTolerance = 1e-9;
 
-std::vector<VertexLoad> collectLoads(const Scene& scene, const TetMesh& mesh) {
+// The vertices a force acts on, with errors at "forces[i].set" or "forces[i]".
+std::vector<int> forceVertices(const Scene& scene, const TetMesh& mesh, const Scene::Force& force,
+                               const std::string& keyPath) {
+  VertexSelection selection;
+  if (force.set.empty()) {
+    selection.vertices = force.vertices;
+    return selectAt(scene, mesh, selection, keyPath);
+  }
+  selection.sets.push_back(force.set);
+  try {
+    return selectVertices(mesh, selection);
+  } catch (const SelectionError& error) {
+    throwSceneError(scene, keyPath + ".set", error.what());
+  }
+}
+
+// h: the timestep the loads are stepped with (impulses last one step).
+std::vector<VertexLoad> collectLoads(const Scene& scene, const TetMesh& mesh, double h) {
   std::vector<VertexLoad> loads;
   for (std::size_t i = 0; i < scene.forces.size(); ++i) {
     const Scene::Force& force = scene.forces[i];
     const std::string keyPath = "forces[" + std::to_string(i) + "]";
     VertexLoad load;
-    VertexSelection selection;
-    if (!force.set.empty()) {
-      selection.sets.push_back(force.set);
-      try {
-        load.vertices = selectVertices(mesh, selection);
-      } catch (const SelectionError& error) {
-        throwSceneError(scene, keyPath + ".set", error.what());
-      }
-    } else {
-      selection.vertices = force.vertices;
-      load.vertices = selectAt(scene, mesh, selection, keyPath);
-    }
+    load.vertices = forceVertices(scene, mesh, force, keyPath);
     const double count = static_cast<double>(load.vertices.size());
-    const double h = scene.integrator.timestep;
     if (force.type == Scene::ForceType::pull) {
       load.perVertex = force.vector / count;
       // Acts at step times start <= t < end, where a step time within 1e-9 h of a bound
@@ -208,10 +220,8 @@ std::string formatNumber(double value) {
 // held by their stiff (implicit) neighbours, so the median boundary vertex is the measure:
 // measured with benchmarkAsync --study contact, omega h of 3.2 and 4.6 for it gained energy
 // at impacts, 1.1 did not (docs/benchmarks.md). Warn from omega h > 2.
-std::vector<std::string> contactStepWarnings(const Scene& scene, const TetMesh& mesh,
-                                             const Eigen::SparseMatrix<double>& mass) {
-  const double k = scene.contact.parameters.stiffness;
-  const double h = scene.integrator.timestep;
+// The median lumped mass of the boundary vertices (0 when none has mass).
+double medianBoundaryMass(const TetMesh& mesh, const Eigen::SparseMatrix<double>& mass) {
   const Eigen::VectorXd lumped = mass * Eigen::VectorXd::Ones(mass.cols());
   std::vector<char> onBoundary(static_cast<std::size_t>(mesh.numVertices()), 0);
   for (const std::array<int, 3>& triangle : boundaryTriangles(mesh)) {
@@ -223,10 +233,17 @@ std::vector<std::string> contactStepWarnings(const Scene& scene, const TetMesh& 
       masses.push_back(lumped[3 * static_cast<Eigen::Index>(v)]);
     }
   }
-  std::vector<std::string> warnings;
-  if (masses.empty()) return warnings;
+  if (masses.empty()) return 0.0;
   std::nth_element(masses.begin(), masses.begin() + static_cast<std::ptrdiff_t>(masses.size() / 2), masses.end());
-  const double median = masses[masses.size() / 2];
+  return masses[masses.size() / 2];
+}
+
+std::vector<std::string> contactStepWarnings(const Scene& scene, const TetMesh& mesh,
+                                             const Eigen::SparseMatrix<double>& mass, double h) {
+  const double k = scene.contact.parameters.stiffness;
+  const double median = medianBoundaryMass(mesh, mass);
+  std::vector<std::string> warnings;
+  if (median == 0.0) return warnings;
   const double omegaH = std::sqrt(k / median) * h;
   if (omegaH > 2.0) {
     warnings.push_back(
@@ -248,7 +265,7 @@ TetMesh buildSceneMesh(const Scene& scene) { return applyMaterialOverrides(scene
 std::shared_ptr<const Problem> buildProblem(const Scene& scene) {
   auto mesh = std::make_shared<const TetMesh>(buildSceneMesh(scene));
   std::vector<int> fixed = collectFixedVertices(scene, *mesh);
-  std::vector<VertexLoad> loads = collectLoads(scene, *mesh);
+  std::vector<VertexLoad> loads = collectLoads(scene, *mesh, frameTimingOf(scene).timestep);
   ProblemSettings settings;
   settings.mass = scene.mass;
   settings.forceModel = scene.forceModel;
@@ -285,10 +302,12 @@ std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& 
   return problem;
 }
 
-IntegratorContext integratorContext(const Scene& scene) {
+IntegratorContext integratorContext(const Scene& scene) { return integratorContext(scene, frameTimingOf(scene)); }
+
+IntegratorContext integratorContext(const Scene& scene, const FrameTiming& timing) {
   IntegratorContext context;
-  context.timestep = scene.integrator.timestep;
-  context.frameRate = scene.frames.rate;
+  context.timestep = timing.timestep;
+  context.frameRate = timing.frameRate;
   context.massType = scene.mass;
   context.hasContact = scene.contact.enabled();
   context.sourceName = scene.sourceName;
@@ -296,49 +315,57 @@ IntegratorContext integratorContext(const Scene& scene) {
   return context;
 }
 
-Simulation buildSimulation(const Scene& givenScene, const IntegratorRegistry& registry) {
-  Simulation simulation;
-  // The timestep every part below uses is the resolved one (from integrator.stepsPerFrame
-  // when the scene gives it).
-  const FrameTiming timing = resolveFrameTiming(givenScene);
-  Scene scene = givenScene;
-  scene.integrator.timestep = timing.timestep;
+namespace {
 
-  // Cheap checks first, so a bad scene fails before the mesh is read and matrices built.
-  if (registry.find(scene.integrator.name) == nullptr) {
-    std::string known;
-    for (const std::string& name : registry.names()) known += (known.empty() ? "" : ", ") + name;
-    throwSceneError(scene, "integrator.name",
-                    "unknown integrator \"" + scene.integrator.name + "\" (known: " + known + ")");
+void requireKnownIntegrator(const Scene& scene, const IntegratorRegistry& registry) {
+  if (registry.find(scene.integrator.name) != nullptr) return;
+  std::string known;
+  for (const std::string& name : registry.names()) known += (known.empty() ? "" : ", ") + name;
+  throwSceneError(scene, "integrator.name", "unknown integrator \"" + scene.integrator.name + "\" (known: " + known + ")");
+}
+
+// What the builder leaves out and what the user should know before the run.
+void noteSkippedAndWarnings(const Scene& scene, Simulation& simulation) {
+  const Problem& problem = *simulation.problem;
+  simulation.skipped = problem.skipped();
+  if (simulation.contact) {
+    simulation.warnings =
+        contactStepWarnings(scene, problem.mesh(), problem.massMatrix(), simulation.timing.timestep);
   }
-  if (scene.frames.count < 1) throwSceneError(scene, "frames.count", "expected a count >= 1");
-  simulation.timestep = timing.timestep;
-  simulation.frameInterval = timing.frameInterval;
-  simulation.stepsPerFrame = timing.stepsPerFrame;
-  simulation.numFrames = scene.frames.count;
+  if (scene.output.vtuFolder.empty()) simulation.skipped.emplace_back("vtu output (output.vtu not set)");
+  if (!scene.output.velocities) simulation.skipped.emplace_back("velocity output (output.velocities = false)");
+}
+
+}  // namespace
+
+Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registry) {
+  Simulation simulation;
+  // Cheap checks first, so a bad scene fails before the mesh is read and matrices built.
+  simulation.timing = frameTimingOf(scene);
+  requireKnownIntegrator(scene, registry);
+  simulation.timestep = simulation.timing.timestep;
+  simulation.frameInterval = simulation.timing.frameInterval;
+  simulation.numFrames = simulation.timing.frameCount;
 
   simulation.problem = buildProblem(scene);
   const Problem& problem = *simulation.problem;
   simulation.mesh = problem.sharedMesh();
   simulation.fixedVertices = problem.fixedVertices();
   simulation.contact = problem.contact();
-  simulation.skipped = problem.skipped();
-  if (simulation.contact) simulation.warnings = contactStepWarnings(scene, problem.mesh(), problem.massMatrix());
-  if (scene.output.vtuFolder.empty()) simulation.skipped.emplace_back("vtu output (output.vtu not set)");
-  if (!scene.output.velocities) simulation.skipped.emplace_back("velocity output (output.velocities = false)");
+  noteSkippedAndWarnings(scene, simulation);
 
-  IntegratorContext context = integratorContext(scene);
+  IntegratorContext context = integratorContext(scene, simulation.timing);
   context.mesh = problem.sharedMesh();
   context.system = problem.dynamicSystem();
   simulation.integrator = registry.create(scene.integrator.name, std::move(context), scene.integrator.options);
-  simulation.monitor.emplace(problem, timing.timestep);
+  simulation.monitor.emplace(problem);
   for (const std::string& item : simulation.monitor->skipped()) simulation.skipped.push_back(item);
   return simulation;
 }
 
 void advanceFrame(Simulation& simulation, int frame) {
   if (!simulation.monitor) throw Error("advanceFrame: the simulation has no run monitor (use buildSimulation)");
-  simulation.monitor->advanceFrame(*simulation.integrator, frame, simulation.stepsPerFrame);
+  simulation.monitor->advanceFrame(*simulation.integrator, frame, simulation.timing.stepsPerFrame);
 }
 
 }  // namespace asyncfem

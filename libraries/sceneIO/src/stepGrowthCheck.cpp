@@ -9,7 +9,6 @@ namespace asyncfem {
 StepGrowthEstimate estimateSceneStepGrowth(const Scene& scene, const Simulation& simulation,
                                            const StepGrowthOptions& options, const IntegratorRegistry& registry) {
   IntegratorContext context = integratorContext(scene);
-  context.timestep = simulation.timestep;
   context.mesh = simulation.mesh;
   context.system = homogeneousLinearSystem(simulation.integrator->system());
   const std::unique_ptr<Integrator> integrator =

@@ -30,8 +30,9 @@ class RunMonitor {
     double blowUpFactor = 1000.0;
     bool energyCheck = true;
   };
-  RunMonitor(const Problem& problem, double timestep, Settings settings);
-  RunMonitor(const Problem& problem, double timestep) : RunMonitor(problem, timestep, Settings{}) {}
+  /// The step size is the integrator's (Integrator::timestep()), read at every frame.
+  RunMonitor(const Problem& problem, Settings settings);
+  explicit RunMonitor(const Problem& problem) : RunMonitor(problem, Settings{}) {}
 
   /// Runs stepsPerFrame steps of integrator with the checks; frame is the 0-based frame
   /// index used in messages and locations.
@@ -52,10 +53,16 @@ class RunMonitor {
  private:
   NumericalErrorLocation locate(const Integrator& integrator, long long frame, long long step, double time,
                                 int vertex) const;
+  /// One step with the finiteness and blow-up checks; step is 1-based over the run.
+  void checkedStep(Integrator& integrator, long long frame, long long step) const;
+  /// Throws when u or v is not finite or max |u| exceeds the blow-up limit.
+  void checkState(const Integrator& integrator, long long frame, long long step, double stepEnd,
+                  const std::string& where) const;
+  /// The energy check at the end of a frame.
+  void checkEnergy(const Integrator& integrator, long long frame);
 
   const TetMesh* mesh_;
   Settings settings_;
-  double timestep_;
   double boundingBoxDiagonal_ = 0.0;
   double blowUpDisplacement_ = 0.0;
   double energyCheckFrom_ = std::numeric_limits<double>::infinity();

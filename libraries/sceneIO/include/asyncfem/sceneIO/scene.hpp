@@ -18,6 +18,18 @@
 
 namespace asyncfem {
 
+/// How the integrator's steps fill the frames of a scene, resolved once from frames.rate,
+/// frames.count and integrator.timestep or integrator.stepsPerFrame (resolveFrameTiming).
+/// Everything downstream reads these values, not the scene keys they came from.
+struct FrameTiming {
+  double frameRate = 0.0;      ///< frames per second (frames.rate)
+  double frameInterval = 0.0;  ///< 1 / frameRate, seconds
+  int stepsPerFrame = 0;       ///< frameInterval / timestep, a whole number
+  double timestep = 0.0;       ///< h, seconds
+  int frameCount = 0;          ///< frames to run (frames.count)
+  bool operator==(const FrameTiming&) const = default;
+};
+
 /// A scene as written in its JSON file (format: docs/scene-format.md), checked for types,
 /// ranges and unknown keys but not yet against the mesh (set names, vertex ids: that is
 /// buildSimulation's job). Plain data: utilities may change fields (command-line
@@ -102,7 +114,9 @@ struct Scene {
 
   struct IntegratorSettings {
     std::string name = "backward-euler";
-    /// h (> 0). With stepsPerFrame it is set from it: (1 / frames.rate) / stepsPerFrame.
+    /// The timestep as written (integrator.timestep); with stepsPerFrame, parseScene and
+    /// overrideFrameTiming set it to timing.timestep for programs that still read it here.
+    /// The timestep a run uses is timing.timestep.
     double timestep = 0.0;
     /// Steps per frame given instead of the timestep (integrator.stepsPerFrame); 0: the
     /// timestep was given, and must divide the frame interval (resolveFrameTiming).
@@ -112,10 +126,17 @@ struct Scene {
     nlohmann::json options = nlohmann::json::object();
   } integrator;
 
+  /// The frames as written; read by resolveFrameTiming only (see timing).
   struct FrameSettings {
     double rate = 30.0;  ///< frames per time unit; frame interval = 1 / rate
     int count = 60;
   } frames;
+
+  /// The frame timing resolved from frames and integrator.timestep / stepsPerFrame by
+  /// parseScene (and again by overrideFrameTiming): the one place a run reads its
+  /// timestep, steps per frame and frame count from. A program that builds a Scene in
+  /// code or edits those keys itself leaves it stale; frameTimingOf() then resolves them.
+  FrameTiming timing;
 
   struct OutputSettings {
     std::filesystem::path file;       ///< .afsim output; empty: none given in the scene
@@ -128,26 +149,37 @@ struct Scene {
   } output;
 };
 
-/// How the integrator's steps fill the frames of a scene.
-struct FrameTiming {
-  double frameInterval = 0.0;  ///< 1 / frames.rate
-  double timestep = 0.0;       ///< h
-  int stepsPerFrame = 0;       ///< frameInterval / h, a whole number
-};
-
 /// The relative distance |h - frameInterval / N| / (frameInterval / N) up to which a
 /// timestep counts as the divisor frameInterval / N of the frame interval: far above the
 /// round-off of a timestep written as 1/990 or with ten significant digits
 /// (0.001010101010), far below the gap 1/N between neighbouring divisors (N <= 1e9).
 inline constexpr double timestepDivisorTolerance = 1e-9;
 
-/// The frame timing of a scene: with integrator.stepsPerFrame N, h = frameInterval / N;
+/// The frame timing of a scene's keys: with integrator.stepsPerFrame N, h = frameInterval / N;
 /// otherwise N = frameInterval / integrator.timestep, which must be a whole number to
 /// timestepDivisorTolerance (h is then used as given). Throws asyncfem::ValidationError
 /// "<scene>: integrator.timestep: ..." naming the frame interval and the two nearest valid
-/// timesteps with their steps per frame when it is not, and "<scene>: frames: ..." for a
-/// bad frames.rate.
+/// timesteps with their steps per frame when it is not, "<scene>: frames.rate: ..." for a
+/// bad rate and "<scene>: frames.count: ..." for a count below 1.
 FrameTiming resolveFrameTiming(const Scene& scene);
+
+/// scene.timing when it is the timing of the scene's keys (as parseScene and
+/// overrideFrameTiming leave it), otherwise resolveFrameTiming(scene): for Scenes built or
+/// edited in code.
+FrameTiming frameTimingOf(const Scene& scene);
+
+/// Timing values given outside the scene file (a utility's --dt, --steps-per-frame,
+/// --frames); an empty field keeps the scene's.
+struct TimingOverrides {
+  std::optional<double> timestep;    ///< replaces integrator.timestep or integrator.stepsPerFrame
+  std::optional<int> stepsPerFrame;  ///< replaces integrator.timestep or integrator.stepsPerFrame
+  std::optional<int> frameCount;     ///< replaces frames.count
+};
+
+/// Applies overrides to the scene's keys and resolves scene.timing again, with the
+/// errors of resolveFrameTiming (named by the scene key the override replaces). Giving
+/// both timestep and stepsPerFrame is a ValidationError.
+void overrideFrameTiming(Scene& scene, const TimingOverrides& overrides);
 
 /// Reads and parses a scene file. Relative paths in it resolve against its folder.
 /// Throws asyncfem::ParseError "FILE:LINE: invalid JSON ..." for malformed JSON, and

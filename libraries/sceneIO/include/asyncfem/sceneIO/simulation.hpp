@@ -44,12 +44,16 @@ std::shared_ptr<const Problem> buildProblem(const Scene& scene);
 /// builds another mesh or other fixed vertices than the run had (fingerprint).
 std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& header, const std::string& fileName);
 
-/// The context registry factories get for scene (timing, mass type, contact, names for
-/// messages); mesh and system are left for the caller to fill.
+/// The context registry factories get for scene at the given timing (timestep, frame
+/// rate), with its mass type, contact and names for messages; mesh and system are left
+/// for the caller to fill. A program that asks about another timestep than the scene's
+/// (suggestRegions --dt) passes a FrameTiming with that timestep.
+IntegratorContext integratorContext(const Scene& scene, const FrameTiming& timing);
+/// integratorContext(scene, frameTimingOf(scene)).
 IntegratorContext integratorContext(const Scene& scene);
 
 /// A scene ready to run: the problem, the integrator (which owns the state, starting at
-/// rest at t = 0), the run monitor and the frame timing.
+/// rest at t = 0, and the timestep), the run monitor and the frame timing.
 struct Simulation {
   std::shared_ptr<const Problem> problem;
   /// The problem's mesh (shared, for the many callers that only need it).
@@ -57,9 +61,13 @@ struct Simulation {
   std::unique_ptr<Integrator> integrator;
   std::optional<RunMonitor> monitor;
 
-  double timestep = 0.0;       ///< h of the integrator
-  double frameInterval = 0.0;  ///< 1 / frames.rate
-  int stepsPerFrame = 0;       ///< frameInterval / h, an integer
+  /// The scene's frame timing (frameTimingOf): steps per frame and frame count for the
+  /// run loop; timing.timestep is the integrator's timestep().
+  FrameTiming timing;
+  /// Copies of timing.timestep, timing.frameInterval and timing.frameCount for the Python
+  /// module, which reads them under these names; new code reads timing.
+  double timestep = 0.0;
+  double frameInterval = 0.0;
   int numFrames = 0;
 
   std::vector<int> fixedVertices;  ///< sorted, 0-based (the problem's)

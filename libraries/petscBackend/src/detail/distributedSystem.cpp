@@ -1,0 +1,335 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "detail/distributedSystem.hpp"
+
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/corotationalLinearFEM/polarDecomposition.hpp>
+#include <asyncfem/petscBackend/partition.hpp>
+#include <climits>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "detail/petscCall.hpp"
+
+namespace asyncfem::detail {
+
+namespace {
+
+using RowMajorElementMatrix = Eigen::Matrix<double, 12, 12, Eigen::RowMajor>;
+
+/// Rest data of element e; ValidationError for a degenerate element, with the same
+/// criterion as the single-process assembly (|V| <= 1e-14 L^3, L the longest edge).
+ElementData elementData(const TetMesh& mesh, int e, bool cacheStiffness) {
+  ElementData data;
+  data.rest = mesh.elementRestPositions(e);
+  data.gradients = shapeFunctionGradients(data.rest, &data.volume);
+  double longestSquared = 0.0;
+  for (int a = 0; a < 4; ++a) {
+    for (int b = a + 1; b < 4; ++b) {
+      longestSquared = std::max(longestSquared, (data.rest.col(a) - data.rest.col(b)).squaredNorm());
+    }
+  }
+  const double longest = std::sqrt(longestSquared);
+  if (!(std::abs(data.volume) > 1e-14 * longest * longest * longest) || !std::isfinite(data.volume)) {
+    std::ostringstream message;
+    message << "PETSc backend: element " << e << " is degenerate (signed volume " << data.volume << ", longest edge "
+            << longest << ")";
+    throw ValidationError(message.str());
+  }
+  const Material& material = mesh.elementMaterial(e);
+  data.density = material.density;
+  if (cacheStiffness) data.stiffness = linearElementStiffness(data.rest, material.youngsModulus, material.poissonRatio);
+  return data;
+}
+
+/// Corotated element (Mueller & Gross 2004, as CorotationalLinearFEM): F = x G^T, R its
+/// polar rotation, force R K_e (R^T x - X) and simple tangent R K_e R^T.
+void corotatedElement(const ElementData& data, const ElementPositions& current, ElementVector& force,
+                      ElementMatrix& tangent) {
+  const Eigen::Matrix3d deformationGradient = current * data.gradients.transpose();
+  const Eigen::Matrix3d rotation = polarDecomposition(deformationGradient).rotation;
+  const ElementPositions corotated = (rotation.transpose() * current) - data.rest;
+  const ElementVector restoring = data.stiffness * Eigen::Map<const ElementVector>(corotated.data());
+  Eigen::Map<ElementPositions>(force.data()).noalias() =
+      rotation * Eigen::Map<const ElementPositions>(restoring.data());
+  for (int b = 0; b < 4; ++b) {
+    for (int a = 0; a < 4; ++a) {
+      tangent.block<3, 3>(3 * a, 3 * b).noalias() =
+          rotation * data.stiffness.block<3, 3>(3 * a, 3 * b) * rotation.transpose();
+    }
+  }
+}
+
+ElementMatrix elementMass(const ElementData& data, MassType massType) {
+  return massType == MassType::lumped ? lumpedElementMass(data.volume, data.density)
+                                      : consistentElementMass(data.volume, data.density);
+}
+
+}  // namespace
+
+DistributedSystem::DistributedSystem(MPI_Comm communicator, const TetMesh& mesh,
+                                     const PetscSimulationSettings& settings)
+    : comm(communicator),
+      numDofs(mesh.numDofs()),
+      corotational(settings.forceModel == PetscForceModelKind::corotational) {
+  partition(mesh, settings.fixedVertices);
+  assembleMassAndStiffness(mesh, settings.massType);
+  createVectors();
+  assembleStaticForce(settings);
+  attachNearNullSpace(mesh);
+  checkPetsc(VecScatterCreateToZero(displacement.get(), toRoot.out(), rootVector.out()), "VecScatterCreateToZero");
+}
+
+// Partition on rank 0, broadcast (identical on every rank whatever METIS does); then the
+// layout and the local elements' rest data.
+void DistributedSystem::partition(const TetMesh& mesh, const std::vector<int>& fixedVertices) {
+  int rank = 0;
+  int numRanks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &numRanks);
+  std::vector<int> parts(static_cast<std::size_t>(mesh.numElements()), 0);
+  collectively(comm, [&] {
+    if (rank == 0) parts = partitionElements(mesh, numRanks);
+  });
+  if (!parts.empty()) MPI_Bcast(parts.data(), static_cast<int>(parts.size()), MPI_INT, 0, comm);
+  collectively(comm, [&] {
+    layout = buildDistributedLayout(mesh, fixedVertices, parts, rank, numRanks);
+    if (layout.numBlocks == 0) throw ValidationError("PETSc backend: every vertex is fixed, nothing to simulate");
+    elements.reserve(layout.localElements.size());
+    for (int e : layout.localElements) elements.push_back(elementData(mesh, e, corotational));
+  });
+}
+
+void DistributedSystem::createVector(VecHandle& vector) const {
+  checkPetsc(VecCreateMPI(comm, ownedDofs(), globalDofs(), vector.out()), "VecCreateMPI");
+  checkPetsc(VecSetBlockSize(vector.get(), 3), "VecSetBlockSize");
+  // Element scatters pass -1 for fixed DOFs, as MatSetValues accepts.
+  checkPetsc(VecSetOption(vector.get(), VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE), "VecSetOption");
+}
+
+void DistributedSystem::createMatrix(MatHandle& matrix) const {
+  checkPetsc(MatCreate(comm, matrix.out()), "MatCreate");
+  checkPetsc(MatSetSizes(matrix.get(), ownedDofs(), ownedDofs(), globalDofs(), globalDofs()), "MatSetSizes");
+  checkPetsc(MatSetType(matrix.get(), MATAIJ), "MatSetType");
+  checkPetsc(MatSetBlockSize(matrix.get(), 3), "MatSetBlockSize");
+  checkPetsc(MatXAIJSetPreallocation(matrix.get(), 3, layout.diagonalBlocks.data(), layout.offDiagonalBlocks.data(),
+                                     nullptr, nullptr),
+             "MatXAIJSetPreallocation");
+  // Re-assembly hits the same slots every time: let PETSc reuse the communication
+  // pattern of the off-rank entries and refuse any entry outside the preallocation.
+  checkPetsc(MatSetOption(matrix.get(), MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+  checkPetsc(MatSetOption(matrix.get(), MAT_SUBSET_OFF_PROC_ENTRIES, PETSC_TRUE), "MatSetOption");
+}
+
+/// Zeroes matrix (keeping its pattern) and adds every local element's 12x12 matrix.
+template <class ElementFunction>
+void DistributedSystem::assembleMatrix(Mat matrix, const ElementFunction& elementMatrix) {
+  checkPetsc(MatZeroEntries(matrix), "MatZeroEntries");
+  collectively(comm, [&] {
+    ElementMatrix local;
+    RowMajorElementMatrix rowMajor;
+    for (std::size_t k = 0; k < elements.size(); ++k) {
+      elementMatrix(k, local);
+      rowMajor = local;
+      const PetscInt* dofs = layout.elementDofs[k].data();
+      checkPetsc(MatSetValues(matrix, 12, dofs, 12, dofs, rowMajor.data(), ADD_VALUES), "MatSetValues");
+    }
+  });
+  checkPetsc(MatAssemblyBegin(matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  checkPetsc(MatAssemblyEnd(matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+}
+
+// M and K share the pattern; the system matrix is a value-wise combination of them.
+void DistributedSystem::assembleMassAndStiffness(const TetMesh& mesh, MassType massType) {
+  createMatrix(mass);
+  createMatrix(stiffness);
+  assembleMatrix(mass.get(), [&](std::size_t k, ElementMatrix& out) { out = elementMass(elements[k], massType); });
+  assembleMatrix(stiffness.get(), [&](std::size_t k, ElementMatrix& out) {
+    if (corotational) {
+      out = elements[k].stiffness;  // the tangent at rest (R = I)
+    } else {
+      const Material& material = mesh.elementMaterial(layout.localElements[k]);
+      out = linearElementStiffness(elements[k].rest, material.youngsModulus, material.poissonRatio);
+    }
+  });
+  checkPetsc(MatDuplicate(mass.get(), MAT_COPY_VALUES, system.out()), "MatDuplicate");
+  checkPetsc(MatSetOption(system.get(), MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+}
+
+// The displacement carries ghosts for the corotated element loop.
+void DistributedSystem::createVectors() {
+  checkPetsc(VecCreateGhost(comm, ownedDofs(), globalDofs(), static_cast<PetscInt>(layout.ghostDofs.size()),
+                            layout.ghostDofs.data(), displacement.out()),
+             "VecCreateGhost");
+  for (VecHandle* vector :
+       {&velocity, &acceleration, &staticForce, &externalForce, &internalForce, &rhs, &increment, &work, &product}) {
+    createVector(*vector);
+  }
+  checkPetsc(VecSet(displacement.get(), 0.0), "VecSet");
+  for (Vec vector : {velocity.get(), acceleration.get(), staticForce.get(), increment.get()}) {
+    checkPetsc(VecSet(vector, 0.0), "VecSet");
+  }
+}
+
+// Static external force: M g element by element (this includes the coupling of free and
+// fixed DOFs, as the restriction of the full M * stacked g does) plus the owned entries
+// of the constant force.
+void DistributedSystem::assembleStaticForce(const PetscSimulationSettings& settings) {
+  if (!settings.gravity.isZero(0.0)) {
+    collectively(comm, [&] {
+      ElementVector stackedGravity;
+      for (int a = 0; a < 4; ++a) stackedGravity.segment<3>(3 * a) = settings.gravity;
+      for (std::size_t k = 0; k < elements.size(); ++k) {
+        const ElementVector force = elementMass(elements[k], settings.massType) * stackedGravity;
+        checkPetsc(VecSetValues(staticForce.get(), 12, layout.elementDofs[k].data(), force.data(), ADD_VALUES),
+                   "VecSetValues");
+      }
+    });
+  }
+  checkPetsc(VecAssemblyBegin(staticForce.get()), "VecAssemblyBegin");
+  checkPetsc(VecAssemblyEnd(staticForce.get()), "VecAssemblyEnd");
+  if (settings.constantForce.size() != 0) {
+    VecHandle constant;
+    createVector(constant);
+    scatterOwned(settings.constantForce, constant.get());
+    checkPetsc(VecAXPY(staticForce.get(), 1.0, constant.get()), "VecAXPY");
+  }
+}
+
+// Near null space for GAMG: the six rigid-body modes from the free vertices' rest
+// positions (harmless for the other preconditioners, which ignore it).
+void DistributedSystem::attachNearNullSpace(const TetMesh& mesh) {
+  VecHandle coordinates;
+  createVector(coordinates);
+  PetscScalar* values = nullptr;
+  checkPetsc(VecGetArray(coordinates.get(), &values), "VecGetArray");
+  for (PetscInt row = 0; row < layout.ownedBlocks; ++row) {
+    const int vertex = layout.blockVertex[static_cast<std::size_t>(layout.firstBlock + row)];
+    for (int c = 0; c < 3; ++c) values[(3 * row) + c] = mesh.restPositions()(c, vertex);
+  }
+  checkPetsc(VecRestoreArray(coordinates.get(), &values), "VecRestoreArray");
+  checkPetsc(MatNullSpaceCreateRigidBody(coordinates.get(), nearNullSpace.out()), "MatNullSpaceCreateRigidBody");
+  checkPetsc(MatSetNearNullSpace(system.get(), nearNullSpace.get()), "MatSetNearNullSpace");
+  checkPetsc(MatSetNearNullSpace(mass.get(), nearNullSpace.get()), "MatSetNearNullSpace");
+}
+
+void DistributedSystem::combineSystem(double massWeight, double stiffnessWeight) {
+  checkPetsc(MatCopy(mass.get(), system.get(), SAME_NONZERO_PATTERN), "MatCopy");
+  checkPetsc(MatScale(system.get(), massWeight), "MatScale");
+  checkPetsc(MatAXPY(system.get(), stiffnessWeight, stiffness.get(), SAME_NONZERO_PATTERN), "MatAXPY");
+}
+
+/// The current positions x = X + u of local element k (u read from the ghosted form).
+ElementPositions DistributedSystem::currentPositions(std::size_t k, const PetscScalar* localDisplacement) const {
+  ElementPositions x = elements[k].rest;
+  for (int i = 0; i < 12; ++i) {
+    const PetscInt local = layout.elementLocalDofs[k][static_cast<std::size_t>(i)];
+    if (local >= 0) x(i % 3, i / 3) += localDisplacement[local];
+  }
+  return x;
+}
+
+void DistributedSystem::assembleCorotated(double time) {
+  checkPetsc(VecGhostUpdateBegin(displacement.get(), INSERT_VALUES, SCATTER_FORWARD), "VecGhostUpdateBegin");
+  checkPetsc(VecGhostUpdateEnd(displacement.get(), INSERT_VALUES, SCATTER_FORWARD), "VecGhostUpdateEnd");
+  Vec localForm = nullptr;
+  checkPetsc(VecGhostGetLocalForm(displacement.get(), &localForm), "VecGhostGetLocalForm");
+  const PetscScalar* values = nullptr;
+  checkPetsc(VecGetArrayRead(localForm, &values), "VecGetArrayRead");
+  checkPetsc(MatZeroEntries(stiffness.get()), "MatZeroEntries");
+  checkPetsc(VecSet(internalForce.get(), 0.0), "VecSet");
+  collectively(comm, [&] {
+    ElementVector force;
+    ElementMatrix tangent;
+    RowMajorElementMatrix rowMajor;
+    for (std::size_t k = 0; k < elements.size(); ++k) {
+      corotatedElement(elements[k], currentPositions(k, values), force, tangent);
+      if (!force.allFinite()) {
+        throw NumericalError("PETSc backend: non-finite corotated force in element " +
+                             std::to_string(layout.localElements[k]) + " at t = " + std::to_string(time));
+      }
+      rowMajor = tangent;
+      const PetscInt* dofs = layout.elementDofs[k].data();
+      checkPetsc(MatSetValues(stiffness.get(), 12, dofs, 12, dofs, rowMajor.data(), ADD_VALUES), "MatSetValues");
+      checkPetsc(VecSetValues(internalForce.get(), 12, dofs, force.data(), ADD_VALUES), "VecSetValues");
+    }
+  });
+  checkPetsc(VecRestoreArrayRead(localForm, &values), "VecRestoreArrayRead");
+  checkPetsc(VecGhostRestoreLocalForm(displacement.get(), &localForm), "VecGhostRestoreLocalForm");
+  checkPetsc(MatAssemblyBegin(stiffness.get(), MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  checkPetsc(VecAssemblyBegin(internalForce.get()), "VecAssemblyBegin");
+  checkPetsc(MatAssemblyEnd(stiffness.get(), MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  checkPetsc(VecAssemblyEnd(internalForce.get()), "VecAssemblyEnd");
+}
+
+void DistributedSystem::scatterOwned(const Eigen::VectorXd& full, Vec vector) const {
+  PetscScalar* values = nullptr;
+  checkPetsc(VecGetArray(vector, &values), "VecGetArray");
+  for (PetscInt row = 0; row < layout.ownedBlocks; ++row) {
+    const auto vertex =
+        static_cast<Eigen::Index>(layout.blockVertex[static_cast<std::size_t>(layout.firstBlock + row)]);
+    for (int c = 0; c < 3; ++c) values[(3 * row) + c] = full[(3 * vertex) + c];
+  }
+  checkPetsc(VecRestoreArray(vector, &values), "VecRestoreArray");
+}
+
+void DistributedSystem::evaluateExternalForce(double t,
+                                              const std::function<void(double, Eigen::VectorXd&)>& timeDependentForce) {
+  checkPetsc(VecCopy(staticForce.get(), externalForce.get()), "VecCopy");
+  if (!timeDependentForce) return;
+  Eigen::VectorXd full;
+  collectively(comm, [&] {
+    full.setZero(numDofs);
+    timeDependentForce(t, full);
+    if (full.size() != numDofs) {
+      throw ValidationError("PETSc backend: the time-dependent force returned " + std::to_string(full.size()) +
+                            " values, expected " + std::to_string(numDofs));
+    }
+    for (Eigen::Index i = 0; i < full.size(); ++i) {
+      if (!std::isfinite(full[i])) {
+        throw NumericalError("PETSc backend: the time-dependent force is not finite at t = " + std::to_string(t) +
+                             " (vertex " + std::to_string(i / 3) + ", coordinate " + std::to_string(i % 3) + ")");
+      }
+    }
+  });
+  VecHandle timeForce;
+  createVector(timeForce);
+  scatterOwned(full, timeForce.get());
+  checkPetsc(VecAXPY(externalForce.get(), 1.0, timeForce.get()), "VecAXPY");
+}
+
+Eigen::VectorXd DistributedSystem::gather(Vec vector) const {
+  checkPetsc(VecScatterBegin(toRoot.get(), vector, rootVector.get(), INSERT_VALUES, SCATTER_FORWARD),
+             "VecScatterBegin");
+  checkPetsc(VecScatterEnd(toRoot.get(), vector, rootVector.get(), INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+  if (layout.rank != 0) return {};
+  Eigen::VectorXd full = Eigen::VectorXd::Zero(numDofs);
+  const PetscScalar* values = nullptr;
+  checkPetsc(VecGetArrayRead(rootVector.get(), &values), "VecGetArrayRead");
+  for (PetscInt block = 0; block < layout.numBlocks; ++block) {
+    const auto vertex = static_cast<Eigen::Index>(layout.blockVertex[static_cast<std::size_t>(block)]);
+    for (int c = 0; c < 3; ++c) full[(3 * vertex) + c] = values[(3 * block) + c];
+  }
+  checkPetsc(VecRestoreArrayRead(rootVector.get(), &values), "VecRestoreArrayRead");
+  return full;
+}
+
+int DistributedSystem::lowestNonFiniteVertex() const {
+  int badVertex = INT_MAX;
+  for (Vec vector : {displacement.get(), velocity.get()}) {
+    const PetscScalar* values = nullptr;
+    checkPetsc(VecGetArrayRead(vector, &values), "VecGetArrayRead");
+    for (PetscInt i = 0; i < ownedDofs(); ++i) {
+      if (!std::isfinite(values[i])) {
+        badVertex = std::min(badVertex, layout.blockVertex[static_cast<std::size_t>(layout.firstBlock + (i / 3))]);
+      }
+    }
+    checkPetsc(VecRestoreArrayRead(vector, &values), "VecRestoreArrayRead");
+  }
+  int globalBad = INT_MAX;
+  MPI_Allreduce(&badVertex, &globalBad, 1, MPI_INT, MPI_MIN, comm);
+  return globalBad == INT_MAX ? -1 : globalBad;
+}
+
+}  // namespace asyncfem::detail

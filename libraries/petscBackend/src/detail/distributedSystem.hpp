@@ -1,0 +1,86 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <mpi.h>
+#include <petscmat.h>
+#include <petscvec.h>
+
+#include <Eigen/Core>
+#include <asyncfem/petscBackend/petscSimulation.hpp>
+#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <functional>
+#include <vector>
+
+#include "detail/distributedLayout.hpp"
+#include "detail/petscHandle.hpp"
+
+namespace asyncfem::detail {
+
+/// What a local element needs at every step (rest shape, material, cached K_e for the
+/// corotational model).
+struct ElementData {
+  ElementPositions rest;
+  Eigen::Matrix<double, 3, 4> gradients;  ///< shape-function gradients, rest configuration
+  double volume = 0.0;                    ///< signed
+  double density = 0.0;
+  ElementMatrix stiffness;  ///< K_e, corotational model only
+};
+
+/// The distributed body of a simulation, everything but the time stepping and the
+/// linear solvers: the layout (who owns which elements and DOFs, DistributedLayout), the
+/// local elements' rest data, the matrices M and K (K(u) for the corotational model) and
+/// the system matrix that combines them on their shared pattern, the state and work
+/// vectors (displacement ghosted), the static external force M g + constant force, and
+/// the scatter of full vectors to rank 0. Collective: every rank constructs it from the
+/// same mesh and settings.
+struct DistributedSystem {
+  /// Partitions the mesh (METIS on rank 0, broadcast), numbers the DOFs, assembles M and
+  /// K at rest, creates the vectors (u = v = 0) and the static force, and attaches the
+  /// rigid-body near null space (for GAMG) to M and the system matrix.
+  DistributedSystem(MPI_Comm comm, const TetMesh& mesh, const PetscSimulationSettings& settings);
+
+  PetscInt ownedDofs() const { return 3 * layout.ownedBlocks; }
+  PetscInt globalDofs() const { return 3 * layout.numBlocks; }
+
+  /// system = massWeight M + stiffnessWeight K (values only; the pattern is M's).
+  void combineSystem(double massWeight, double stiffnessWeight);
+  /// Corotated f_int(u) into internalForce and simple tangent K(u) into stiffness, one
+  /// polar decomposition per element; time names the state in errors.
+  void assembleCorotated(double time);
+  /// externalForce = static force + timeDependentForce(t) (if any), checked on every rank.
+  void evaluateExternalForce(double t, const std::function<void(double, Eigen::VectorXd&)>& timeDependentForce);
+  /// The full (3n, fixed DOFs 0) form of a distributed vector on rank 0; empty elsewhere.
+  Eigen::VectorXd gather(Vec vector) const;
+  /// Copies the owned entries of a full (3n, original numbering) vector into vector.
+  void scatterOwned(const Eigen::VectorXd& full, Vec vector) const;
+  /// The lowest vertex with a non-finite u or v over all ranks, or -1.
+  int lowestNonFiniteVertex() const;
+
+  MPI_Comm comm;
+  int numDofs = 0;  ///< 3n
+  bool corotational = false;
+  DistributedLayout layout;
+  std::vector<ElementData> elements;  ///< per local element
+
+  MatHandle mass, stiffness, system;
+  NullSpaceHandle nearNullSpace;
+  VecHandle displacement;  ///< ghosted
+  VecHandle velocity, acceleration, staticForce, externalForce, internalForce, rhs, increment, work, product;
+  ScatterHandle toRoot;
+  VecHandle rootVector;
+
+ private:
+  void partition(const TetMesh& mesh, const std::vector<int>& fixedVertices);
+  void createVector(VecHandle& vector) const;
+  void createMatrix(MatHandle& matrix) const;
+  template <class ElementFunction>
+  void assembleMatrix(Mat matrix, const ElementFunction& elementMatrix);
+  void assembleMassAndStiffness(const TetMesh& mesh, MassType massType);
+  void createVectors();
+  void assembleStaticForce(const PetscSimulationSettings& settings);
+  void attachNearNullSpace(const TetMesh& mesh);
+  ElementPositions currentPositions(std::size_t k, const PetscScalar* localDisplacement) const;
+};
+
+}  // namespace asyncfem::detail
