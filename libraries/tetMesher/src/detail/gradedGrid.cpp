@@ -23,8 +23,10 @@ std::uint64_t GradedGrid::packKey(const Eigen::Vector3i& d) {
 GradedGrid::GradedGrid(const Eigen::Vector3d& origin, double spacing, int levels, const Eigen::Array3i& roots,
                        long long maxCells)
     : origin_(origin), spacing_(spacing), levels_(levels), roots_(roots), maxCells_(maxCells) {
-  if (static_cast<long long>(roots.prod()) > maxCells_) {
-    throw ValidationError("stuffIsosurface: the graded lattice would have " + std::to_string(roots.prod()) +
+  // In 64 bits: up to 10^6 finest cells per side, the root count overflows an int.
+  const long long numRoots = static_cast<long long>(roots.x()) * roots.y() * roots.z();
+  if (numRoots > maxCells_) {
+    throw ValidationError("stuffIsosurface: the graded lattice would have " + std::to_string(numRoots) +
                           " root cubes (limit " + std::to_string(maxCells_) + "); use a larger spacing");
   }
   const long long rootSize = 2LL << levels;
@@ -34,7 +36,7 @@ GradedGrid::GradedGrid(const Eigen::Vector3d& origin, double spacing, int levels
           "stuffIsosurface: the graded lattice is too large for its coordinates; use a larger spacing");
     }
   }
-  cells_.reserve(static_cast<std::size_t>(roots.prod()));
+  cells_.reserve(static_cast<std::size_t>(numRoots));
   for (int k = 0; k < roots.z(); ++k)
     for (int j = 0; j < roots.y(); ++j)
       for (int i = 0; i < roots.x(); ++i)
