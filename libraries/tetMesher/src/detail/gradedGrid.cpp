@@ -183,11 +183,6 @@ std::vector<int> GradedGrid::leaves() const {
   return ids;
 }
 
-GradedGrid::Cube GradedGrid::cube(int id) const {
-  const Cell& cell = cells_[static_cast<std::size_t>(id)];
-  return {cell.corner, size(cell), cell.level};
-}
-
 int GradedGrid::numLeaves() const {
   return static_cast<int>(std::count_if(cells_.begin(), cells_.end(), [](const Cell& c) { return c.firstChild < 0; }));
 }

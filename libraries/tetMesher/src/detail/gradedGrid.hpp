@@ -43,7 +43,10 @@ class GradedGrid {
 
   /// Ids of the leaves, in increasing order.
   std::vector<int> leaves() const;
-  Cube cube(int id) const;
+  Cube cube(int id) const {
+    const Cell& cell = cells_[static_cast<std::size_t>(id)];
+    return {cell.corner, size(cell), cell.level};
+  }
   /// The leaf whose half-open box holds `point` (doubled coordinates), or -1 outside the grid.
   int leafContaining(const Eigen::Vector3i& point) const;
   int numLeaves() const;

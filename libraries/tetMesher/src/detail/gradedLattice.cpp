@@ -81,18 +81,17 @@ class GradedLatticeBuilder {
     const GradedGrid::Cube neighbour = grid_.cube(n);
     const Square square = faceCorners(cube, axis, side);
     if (neighbour.level == cube.level) {
-      if (side > 0) addSameSizeFace(leaf, n, axis, square);  // the -a face is the neighbour's +a face
+      if (side > 0) addSameSizeFace(leaf, cube, n, axis, square);  // the -a face is the neighbour's +a face
     } else if (neighbour.level < cube.level) {
-      addFaceTowardsSmaller(leaf, square);
+      addFaceTowardsSmaller(leaf, cube, square);
     } else {
-      addFaceTowardsLarger(leaf, n, axis, square);
+      addFaceTowardsLarger(leaf, cube, neighbour, n, axis, square);
     }
   }
 
   /// The red edge between the two centres with each edge of the face, bisected at a midpoint
   /// that a smaller cube put there.
-  void addSameSizeFace(int leaf, int n, int axis, const Square& square) {
-    const GradedGrid::Cube cube = grid_.cube(leaf);
+  void addSameSizeFace(int leaf, const GradedGrid::Cube& cube, int n, int axis, const Square& square) {
     const long long red = existing(centre(cube));
     const long long otherRed = required(centre(cube) + cube.size * Eigen::Vector3i::Unit(axis));
     for (std::size_t q = 0; q < 4; ++q) {
@@ -109,8 +108,8 @@ class GradedLatticeBuilder {
   }
 
   /// Smaller neighbours: eight tetrahedra at the face's centre and edge midpoints.
-  void addFaceTowardsSmaller(int leaf, const Square& square) {
-    const long long red = existing(centre(grid_.cube(leaf)));
+  void addFaceTowardsSmaller(int leaf, const GradedGrid::Cube& cube, const Square& square) {
+    const long long red = existing(centre(cube));
     const long long faceCentre = required((square[0] + square[2]) / 2);
     for (std::size_t q = 0; q < 4; ++q) {
       const Eigen::Vector3i& u = square[q];
@@ -122,9 +121,10 @@ class GradedLatticeBuilder {
   }
 
   /// A larger neighbour: split by the diagonal through the centre of its face.
-  void addFaceTowardsLarger(int leaf, int n, int axis, const Square& square) {
-    const long long red = existing(centre(grid_.cube(leaf)));
-    Eigen::Vector3i bigCentre = centre(grid_.cube(n));
+  void addFaceTowardsLarger(int leaf, const GradedGrid::Cube& cube, const GradedGrid::Cube& neighbour, int n, int axis,
+                            const Square& square) {
+    const long long red = existing(centre(cube));
+    Eigen::Vector3i bigCentre = centre(neighbour);
     bigCentre[axis] = square[0][axis];
     std::size_t k = 0;
     while (k < 4 && square[k] != bigCentre) ++k;
@@ -159,11 +159,6 @@ std::vector<LatticeEdge> GradedLattice::signChangingEdges(const std::vector<int>
       }
   }
   return edges;
-}
-
-long long GradedLattice::forEachTetrahedron(const TetrahedronVisitor& visit) const {
-  for (const auto& tet : tetrahedra) visit(tet);
-  return static_cast<long long>(tetrahedra.size());
 }
 
 std::vector<int> GradedLattice::leavesMeetingSurface(const std::vector<int>& signs) const {

@@ -47,7 +47,11 @@ struct GradedLattice {
   /// Sign-changing edges of the finest (plain) tetrahedra, lower id first, in the order of
   /// their first tetrahedron; coarse tetrahedra are never cut (leavesMeetingSurface).
   std::vector<LatticeEdge> signChangingEdges(const std::vector<int>& signs) const;
-  long long forEachTetrahedron(const TetrahedronVisitor& visit) const;
+  template <class Visit>
+  long long forEachTetrahedron(Visit&& visit) const {
+    for (const auto& tet : tetrahedra) visit(tet);
+    return static_cast<long long>(tetrahedra.size());
+  }
   /// The stencils' guarantee covers the finest tetrahedra only: every other one must lie
   /// strictly on one side of the surface, untouched by warping (signs after warping). The
   /// leaves of those that do not, sorted, to be refined; empty when the lattice is usable.

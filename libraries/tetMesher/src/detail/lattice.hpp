@@ -19,7 +19,9 @@ struct LatticeEdge {
   long long to = 0;
 };
 
-/// Visits one lattice tetrahedron (four lattice vertex ids, in the lattice's order).
+/// What forEachTetrahedron accepts (the lattices take any callable of this signature, as a
+/// template, so that the per-tetrahedron call inlines): one lattice tetrahedron, four
+/// lattice vertex ids in the lattice's order.
 using TetrahedronVisitor = std::function<void(const std::array<long long, 4>&)>;
 
 /// The one interface through which the uniform lattice (BccLattice) and the graded one

@@ -2,6 +2,7 @@
 #include "detail/stuffedMesh.hpp"
 
 #include <algorithm>
+#include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/tetMesher/meshChecks.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
@@ -124,8 +125,15 @@ TetMesh assembleStuffedMesh(const Lattice& lattice, const std::vector<double>& v
   int unwarped = 0;
   for (int attempt = 0;; ++attempt) {
     StencilBuilder<Lattice> builder(lattice, crossings);
-    const long long latticeTetrahedra =
-        lattice.forEachTetrahedron([&](const std::array<long long, 4>& tet) { builder.fill(tet); });
+    // Most lattice tetrahedra have no inside vertex: skip them before the stencil call.
+    const long long latticeTetrahedra = lattice.forEachTetrahedron([&](const std::array<long long, 4>& tet) {
+      for (long long v : tet) {
+        if (crossings.signs[static_cast<std::size_t>(v)] < 0) {
+          builder.fill(tet);
+          return;
+        }
+      }
+    });
     const StencilOutput& stencils = builder.output();
     if (stencils.elements.empty()) throwNoElement(values, spacing);
     TetMesh mesh = toTetMesh(stencils, options.material);
