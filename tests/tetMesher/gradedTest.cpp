@@ -219,6 +219,21 @@ TEST(GradedLattice, ASpacingFarTooSmallIsAnErrorNotAnExhaustedMachine) {
   }
 }
 
+TEST(GradedLattice, MoreRootCubesThanAnIntHoldsIsAnErrorNamingTheCount) {
+  // 2502 root cubes of 8e-4 per side (the bounds and a cube of margin each side): 1.57e10 of them,
+  // beyond 32 bits, are refused before any allocation, with the count in the message.
+  MesherOptions options;
+  options.gradingLevels = 3;
+  try {
+    stuffIsosurface(implicitSphere(Vector3d::Zero(), 0.5),
+                    Eigen::AlignedBox3d(Vector3d::Constant(-1.0), Vector3d::Constant(1.0)), 1e-4, options);
+    ADD_FAILURE() << "a lattice of 1.57e10 root cubes was accepted";
+  } catch (const ValidationError& e) {
+    EXPECT_NE(std::string(e.what()).find("15662530008 root cubes"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("use a larger spacing"), std::string::npos) << e.what();
+  }
+}
+
 TEST(GradedLattice, BadLevelsAreErrors) {
   const ImplicitFunction sphere = implicitSphere(Vector3d::Zero(), 1.0);
   const Eigen::AlignedBox3d box(Vector3d::Constant(-1.1), Vector3d::Constant(1.1));

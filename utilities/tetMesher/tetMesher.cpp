@@ -171,120 +171,138 @@ void printSets(const TetMesh& mesh) {
   }
 }
 
-int run(const Options& options) {
-  if (options.input.empty() == options.model.empty()) {
-    throw ValidationError("give either a surface file or --model NAME");
+/// A built-in example model at the given spacing (its own when <= 0).
+TetMesh meshModel(const Options& options, double& spacing, asyncfem::StuffingReport& stuffing) {
+  const asyncfem::ExampleModel model = asyncfem::exampleModelFromName(options.model);
+  if (options.cells > 0) throw ValidationError("--cells applies to surfaces; give --spacing for a model");
+  if (spacing <= 0.0) spacing = asyncfem::exampleModelShape(model).spacing;
+  TetMesh mesh = asyncfem::makeExampleModel(model, spacing, &stuffing, options.grade);
+  if (!options.quiet) {
+    const asyncfem::ImplicitModel shape = asyncfem::exampleModelShape(model);
+    Eigen::Vector3d at = Eigen::Vector3d::Zero();
+    const double deviation =
+        asyncfem::implicitDeviation(mesh, asyncfem::implicitUnionOfParts(shape.parts, shape.blend), &at);
+    std::printf("model: %s\n", options.model.c_str());
+    std::printf("fidelity: mesh boundary to surface at most %.4g (%.2f spacings, |f| sampled) at %s\n", deviation,
+                deviation / spacing, describe(at).c_str());
   }
-  if (options.spacing > 0.0 && options.cells > 0) throw ValidationError("give either --spacing or --cells, not both");
-  asyncfem::MesherOptions mesherOptions;
-  mesherOptions.gradingLevels = options.grade;
-  if (!options.defaultMaterial.empty()) {
-    const std::vector<double> v = parseNumbers(options.defaultMaterial, 3, "--default-material");
-    mesherOptions.material = asyncfem::Material{"default", v[0], v[1], v[2]};
-  }
+  return mesh;
+}
 
-  TetMesh mesh;
-  asyncfem::StuffingReport stuffing;
-  double spacing = options.spacing;
-  std::optional<asyncfem::SignedDistance> distance;
-  if (!options.model.empty()) {
-    const asyncfem::ExampleModel model = asyncfem::exampleModelFromName(options.model);
-    if (options.cells > 0) throw ValidationError("--cells applies to surfaces; give --spacing for a model");
-    if (spacing <= 0.0) spacing = asyncfem::exampleModelShape(model).spacing;
-    mesh = asyncfem::makeExampleModel(model, spacing, &stuffing, options.grade);
+/// The input surface, read, welded, checked and oriented outward, with how to sign it.
+struct PreparedSurface {
+  asyncfem::TriangleSurface surface;
+  asyncfem::SignMode mode = asyncfem::SignMode::Pseudonormal;
+  Eigen::AlignedBox3d inputBounds;  ///< before welding
+  double enclosed = 0.0;            ///< |divergence-theorem volume|
+};
+
+/// Zero-area triangles have no normal: an error for the pseudonormal sign, dropped (they
+/// add no winding number) for the winding number.
+void handleDegenerateTriangles(PreparedSurface& prepared, int degenerate, const Options& options) {
+  const int first = firstDegenerateTriangle(prepared.surface);
+  const Eigen::Vector3d at = prepared.surface.vertices.col(prepared.surface.triangles(0, first));
+  if (prepared.mode == asyncfem::SignMode::Pseudonormal) {
+    throw ValidationError(
+        options.input + ": " + std::to_string(degenerate) + " triangles have zero area, e.g. triangle #" +
+        std::to_string(asyncfem::inputTriangleIndex(prepared.surface, first)) + " at " + describe(at) +
+        "; their normals are undefined, so inside and outside cannot be told there (remove "
+        "them, or mesh with --repair, which ignores them)");
+  }
+  const int dropped = dropDegenerateTriangles(prepared.surface);
+  if (!options.quiet) {
+    std::printf("repair: %d zero-area triangles ignored (e.g. #%d at %s)\n", dropped,
+                asyncfem::inputTriangleIndex(prepared.surface, first), describe(at).c_str());
+  }
+}
+
+PreparedSurface prepareSurface(const Options& options) {
+  PreparedSurface prepared;
+  prepared.surface = asyncfem::readSurface(options.input);
+  asyncfem::TriangleSurface& surface = prepared.surface;
+  requireFiniteVertices(surface, options.input);
+  const int inputVertices = surface.numVertices();
+  prepared.inputBounds = surface.bounds();
+  const double diagonal = prepared.inputBounds.diagonal().norm();
+  const double tolerance = options.weldTolerance >= 0.0 ? options.weldTolerance : 1e-7 * diagonal;
+  const int welded = asyncfem::weldVertices(surface, tolerance);
+  const asyncfem::SurfaceTopology topology = asyncfem::surfaceTopology(surface);
+  if (!options.quiet) {
+    std::printf("surface: %s: %d triangles, %d vertices (%d welded away from %d at tolerance %.3g), %zu part%s\n",
+                options.input.c_str(), surface.numTriangles(), surface.numVertices(), welded, inputVertices, tolerance,
+                surface.partNames.size(), surface.partNames.size() == 1 ? "" : "s");
+  }
+  if (options.repair) prepared.mode = asyncfem::SignMode::WindingNumber;
+  if (!topology.closed()) {
+    if (!options.repair) asyncfem::requireClosedSurface(surface, options.input);
     if (!options.quiet) {
-      const asyncfem::ImplicitModel shape = asyncfem::exampleModelShape(model);
-      Eigen::Vector3d at = Eigen::Vector3d::Zero();
-      const double deviation =
-          asyncfem::implicitDeviation(mesh, asyncfem::implicitUnionOfParts(shape.parts, shape.blend), &at);
-      std::printf("model: %s\n", options.model.c_str());
-      std::printf("fidelity: mesh boundary to surface at most %.4g (%.2f spacings, |f| sampled) at %s\n", deviation,
-                  deviation / spacing, describe(at).c_str());
+      std::printf(
+          "repair: the surface is not closed (%d open, %d non-manifold, %d inconsistently oriented edges, "
+          "e.g. %s); inside/outside from the generalized winding number\n",
+          topology.boundaryEdges, topology.nonManifoldEdges, topology.misorientedEdges, topology.example.c_str());
+    }
+  }
+  if (topology.degenerateTriangles > 0) handleDegenerateTriangles(prepared, topology.degenerateTriangles, options);
+  if (topology.signedVolume < 0.0) {
+    asyncfem::flipOrientation(surface);
+    if (!options.quiet) std::printf("surface: normals pointed inward; triangles reversed\n");
+  }
+  prepared.enclosed = std::abs(topology.signedVolume);
+  return prepared;
+}
+
+/// Refuses meshes that span too much of an open input or overlap themselves; prints volume
+/// and Hausdorff distance.
+void checkAndReportSurfaceMesh(const TetMesh& mesh, const asyncfem::SignedDistance& distance,
+                               const PreparedSurface& prepared, double spacing, const Options& options) {
+  const asyncfem::SurfaceDeviation deviation = asyncfem::surfaceDeviation(mesh, distance);
+  if (prepared.mode == asyncfem::SignMode::WindingNumber) {
+    const double invented = asyncfem::requireRepairableHoles(mesh, distance, spacing, options.maxHole, options.input);
+    if (!options.quiet) {
+      std::printf("repair: %.2f%% of the boundary spans openings of the input (more than a spacing from it)\n",
+                  100.0 * invented);
     }
   } else {
-    asyncfem::TriangleSurface surface = asyncfem::readSurface(options.input);
-    requireFiniteVertices(surface, options.input);
-    const int inputVertices = surface.numVertices();
-    const Eigen::AlignedBox3d inputBounds = surface.bounds();
-    const double diagonal = inputBounds.diagonal().norm();
-    const double tolerance = options.weldTolerance >= 0.0 ? options.weldTolerance : 1e-7 * diagonal;
-    const int welded = asyncfem::weldVertices(surface, tolerance);
-    const asyncfem::SurfaceTopology topology = asyncfem::surfaceTopology(surface);
-    asyncfem::SignMode mode = asyncfem::SignMode::Pseudonormal;
-    if (!options.quiet) {
-      std::printf("surface: %s: %d triangles, %d vertices (%d welded away from %d at tolerance %.3g), %zu part%s\n",
-                  options.input.c_str(), surface.numTriangles(), surface.numVertices(), welded, inputVertices,
-                  tolerance, surface.partNames.size(), surface.partNames.size() == 1 ? "" : "s");
-    }
-    if (options.repair) mode = asyncfem::SignMode::WindingNumber;
-    if (!topology.closed()) {
-      if (!options.repair) asyncfem::requireClosedSurface(surface, options.input);
-      if (!options.quiet) {
-        std::printf(
-            "repair: the surface is not closed (%d open, %d non-manifold, %d inconsistently oriented edges, "
-            "e.g. %s); inside/outside from the generalized winding number\n",
-            topology.boundaryEdges, topology.nonManifoldEdges, topology.misorientedEdges, topology.example.c_str());
-      }
-    }
-    if (topology.degenerateTriangles > 0) {
-      const int first = firstDegenerateTriangle(surface);
-      const Eigen::Vector3d at = surface.vertices.col(surface.triangles(0, first));
-      if (mode == asyncfem::SignMode::Pseudonormal) {
-        throw ValidationError(options.input + ": " + std::to_string(topology.degenerateTriangles) +
-                              " triangles have zero area, e.g. triangle #" +
-                              std::to_string(asyncfem::inputTriangleIndex(surface, first)) + " at " + describe(at) +
-                              "; their normals are undefined, so inside and outside cannot be told there (remove "
-                              "them, or mesh with --repair, which ignores them)");
-      }
-      const int dropped = dropDegenerateTriangles(surface);
-      if (!options.quiet) {
-        std::printf("repair: %d zero-area triangles ignored (e.g. #%d at %s)\n", dropped,
-                    asyncfem::inputTriangleIndex(surface, first), describe(at).c_str());
-      }
-    }
-    if (topology.signedVolume < 0.0) {
-      asyncfem::flipOrientation(surface);
-      if (!options.quiet) std::printf("surface: normals pointed inward; triangles reversed\n");
-    }
-    const double enclosed = std::abs(topology.signedVolume);
-    if (spacing <= 0.0) spacing = inputBounds.sizes().maxCoeff() / (options.cells > 0 ? options.cells : 30);
-    distance.emplace(std::move(surface), mode);
-    const Eigen::AlignedBox3d bounds(inputBounds.min().array() - spacing, inputBounds.max().array() + spacing);
-    mesh = asyncfem::stuffIsosurface(distance->function(), bounds, spacing, mesherOptions, &stuffing);
-    const asyncfem::SurfaceDeviation deviation = asyncfem::surfaceDeviation(mesh, *distance);
-    if (mode == asyncfem::SignMode::WindingNumber) {
-      const double invented =
-          asyncfem::requireRepairableHoles(mesh, *distance, spacing, options.maxHole, options.input);
-      if (!options.quiet) {
-        std::printf("repair: %.2f%% of the boundary spans openings of the input (more than a spacing from it)\n",
-                    100.0 * invented);
-      }
-    } else {
-      asyncfem::requireNoSelfOverlap(mesh, *distance, options.input);
-    }
-    if (!options.quiet) {
-      const double volume = asyncfem::totalVolume(mesh);
-      if (mode == asyncfem::SignMode::Pseudonormal && enclosed > 0.0) {
-        std::printf("volume: mesh %.6g, surface %.6g (%+.2f%%)\n", volume, enclosed,
-                    100.0 * (volume - enclosed) / enclosed);
-      } else {
-        std::printf(
-            "volume: mesh %.6g (the open surface encloses no definite volume; its divergence-theorem "
-            "value is %.6g)\n",
-            volume, enclosed);
-      }
-      std::printf(
-          "fidelity: Hausdorff distance %.4g (%.2f spacings): mesh to surface %.4g at %s, surface to mesh %.4g at "
-          "%s (triangle #%d)\n",
-          deviation.hausdorff(), deviation.hausdorff() / spacing, deviation.meshToSurface,
-          describe(deviation.meshToSurfaceAt).c_str(), deviation.surfaceToMesh,
-          describe(deviation.surfaceToMeshAt).c_str(),
-          asyncfem::inputTriangleIndex(distance->surface(), deviation.surfaceToMeshTriangle));
-    }
-    if (options.partSets) asyncfem::addSurfaceLabelSets(mesh, *distance, asyncfem::SurfaceLabel::Part);
-    if (options.materialSets) asyncfem::addSurfaceLabelSets(mesh, *distance, asyncfem::SurfaceLabel::Material);
-    if (options.groupSets) asyncfem::addSurfaceLabelSets(mesh, *distance, asyncfem::SurfaceLabel::Group);
+    asyncfem::requireNoSelfOverlap(mesh, distance, options.input);
   }
+  if (options.quiet) return;
+  const double volume = asyncfem::totalVolume(mesh);
+  const double enclosed = prepared.enclosed;
+  if (prepared.mode == asyncfem::SignMode::Pseudonormal && enclosed > 0.0) {
+    std::printf("volume: mesh %.6g, surface %.6g (%+.2f%%)\n", volume, enclosed,
+                100.0 * (volume - enclosed) / enclosed);
+  } else {
+    std::printf(
+        "volume: mesh %.6g (the open surface encloses no definite volume; its divergence-theorem "
+        "value is %.6g)\n",
+        volume, enclosed);
+  }
+  std::printf(
+      "fidelity: Hausdorff distance %.4g (%.2f spacings): mesh to surface %.4g at %s, surface to mesh %.4g at "
+      "%s (triangle #%d)\n",
+      deviation.hausdorff(), deviation.hausdorff() / spacing, deviation.meshToSurface,
+      describe(deviation.meshToSurfaceAt).c_str(), deviation.surfaceToMesh, describe(deviation.surfaceToMeshAt).c_str(),
+      asyncfem::inputTriangleIndex(distance.surface(), deviation.surfaceToMeshTriangle));
+}
+
+/// A surface file at the given spacing (from --cells, default 30, when <= 0).
+TetMesh meshSurface(const Options& options, const asyncfem::MesherOptions& mesherOptions, double& spacing,
+                    asyncfem::StuffingReport& stuffing) {
+  PreparedSurface prepared = prepareSurface(options);
+  const Eigen::AlignedBox3d& inputBounds = prepared.inputBounds;
+  if (spacing <= 0.0) spacing = inputBounds.sizes().maxCoeff() / (options.cells > 0 ? options.cells : 30);
+  const asyncfem::SignedDistance distance(std::move(prepared.surface), prepared.mode);
+  const Eigen::AlignedBox3d bounds(inputBounds.min().array() - spacing, inputBounds.max().array() + spacing);
+  TetMesh mesh = asyncfem::stuffIsosurface(distance.function(), bounds, spacing, mesherOptions, &stuffing);
+  checkAndReportSurfaceMesh(mesh, distance, prepared, spacing, options);
+  if (options.partSets) asyncfem::addSurfaceLabelSets(mesh, distance, asyncfem::SurfaceLabel::Part);
+  if (options.materialSets) asyncfem::addSurfaceLabelSets(mesh, distance, asyncfem::SurfaceLabel::Material);
+  if (options.groupSets) asyncfem::addSurfaceLabelSets(mesh, distance, asyncfem::SurfaceLabel::Group);
+  return mesh;
+}
+
+/// --set boxes and --material assignments, in the order given.
+void addRequestedSets(TetMesh& mesh, const Options& options) {
   for (const std::string& text : options.boxSets) {
     const auto [name, numbers] = splitName(text, "--set");
     const std::vector<double> v = parseNumbers(numbers, 6, "--set " + name);
@@ -299,7 +317,24 @@ int run(const Options& options) {
     const std::vector<double> v = parseNumbers(numbers, 3, "--material " + name);
     asyncfem::assignSetMaterial(mesh, name, asyncfem::Material{name, v[0], v[1], v[2]});
   }
+}
 
+int run(const Options& options) {
+  if (options.input.empty() == options.model.empty()) {
+    throw ValidationError("give either a surface file or --model NAME");
+  }
+  if (options.spacing > 0.0 && options.cells > 0) throw ValidationError("give either --spacing or --cells, not both");
+  asyncfem::MesherOptions mesherOptions;
+  mesherOptions.gradingLevels = options.grade;
+  if (!options.defaultMaterial.empty()) {
+    const std::vector<double> v = parseNumbers(options.defaultMaterial, 3, "--default-material");
+    mesherOptions.material = asyncfem::Material{"default", v[0], v[1], v[2]};
+  }
+  asyncfem::StuffingReport stuffing;
+  double spacing = options.spacing;
+  TetMesh mesh = options.model.empty() ? meshSurface(options, mesherOptions, spacing, stuffing)
+                                       : meshModel(options, spacing, stuffing);
+  addRequestedSets(mesh, options);
   if (!options.quiet) {
     printQuality(mesh, stuffing, spacing);
     printSets(mesh);

@@ -83,36 +83,45 @@ std::vector<int> addNearestPartSets(TetMesh& mesh, const SignedDistance& distanc
   return counts;
 }
 
-std::vector<int> addSurfaceLabelSets(TetMesh& mesh, const SignedDistance& distance, SurfaceLabel kind) {
-  const TriangleSurface& surface = distance.surface();
-  const std::vector<int>* labels = nullptr;
-  const std::vector<std::string>* names = nullptr;
-  const char* what = "";
+namespace {
+
+/// One kind of triangle label of a surface: each triangle's label and the labels' names.
+struct SurfaceLabels {
+  const std::vector<int>& labels;
+  const std::vector<std::string>& names;
+};
+
+SurfaceLabels surfaceLabels(const TriangleSurface& surface, SurfaceLabel kind) {
+  const auto require = [&](const std::vector<int>& labels, const std::vector<std::string>& names, const char* what) {
+    if (labels.size() != static_cast<std::size_t>(surface.numTriangles()) || names.empty()) {
+      throw ValidationError(std::string("the surface has no ") + what + " to make element sets from");
+    }
+    return SurfaceLabels{labels, names};
+  };
   switch (kind) {
     case SurfaceLabel::Part:
-      labels = &surface.triangleParts, names = &surface.partNames, what = "parts";
-      break;
+      return require(surface.triangleParts, surface.partNames, "parts");
     case SurfaceLabel::Material:
-      labels = &surface.triangleMaterials, names = &surface.materialNames, what = "materials";
-      break;
+      return require(surface.triangleMaterials, surface.materialNames, "materials");
     case SurfaceLabel::Group:
-      labels = &surface.triangleGroups, names = &surface.groupNames, what = "named groups";
-      break;
+      return require(surface.triangleGroups, surface.groupNames, "named groups");
   }
-  if (labels->size() != static_cast<std::size_t>(surface.numTriangles()) || names->empty()) {
-    throw ValidationError(std::string("the surface has no ") + what + " to make element sets from");
-  }
-  // Every label's triangles as a surface of their own, for its winding number.
-  struct Label {
-    std::unique_ptr<SignedDistance> distance;
-    Eigen::AlignedBox3d box;
-    double volume = 0.0;
-  };
-  std::vector<Label> byLabel(names->size());
-  for (std::size_t l = 0; l < names->size(); ++l) {
+  throw ValidationError("unknown surface label");
+}
+
+/// One label's triangles as a surface of their own, for its winding number.
+struct LabelSurface {
+  std::unique_ptr<SignedDistance> distance;  ///< null for a label without triangles
+  Eigen::AlignedBox3d box;
+  double volume = 0.0;
+};
+
+std::vector<LabelSurface> labelSurfaces(const TriangleSurface& surface, const SurfaceLabels& labels) {
+  std::vector<LabelSurface> byLabel(labels.names.size());
+  for (std::size_t l = 0; l < labels.names.size(); ++l) {
     std::vector<int> keep;
     for (int t = 0; t < surface.numTriangles(); ++t)
-      if ((*labels)[static_cast<std::size_t>(t)] == static_cast<int>(l)) keep.push_back(t);
+      if (labels.labels[static_cast<std::size_t>(t)] == static_cast<int>(l)) keep.push_back(t);
     if (keep.empty()) continue;
     TriangleSurface own = surface;
     selectTriangles(own, keep);
@@ -120,28 +129,43 @@ std::vector<int> addSurfaceLabelSets(TetMesh& mesh, const SignedDistance& distan
     byLabel[l].volume = std::abs(surfaceTopology(own).signedVolume);
     byLabel[l].distance = std::make_unique<SignedDistance>(std::move(own), SignMode::WindingNumber);
   }
-  std::vector<std::vector<int>> members(names->size());
+  return byLabel;
+}
+
+/// The innermost (smallest) label surface whose winding number at x exceeds 1/2, or -1.
+int innermostLabel(const std::vector<LabelSurface>& byLabel, const Eigen::Vector3d& x) {
+  int best = -1;
+  for (std::size_t l = 0; l < byLabel.size(); ++l) {
+    const LabelSurface& label = byLabel[l];
+    if (!label.distance || !label.box.contains(x)) continue;
+    if (std::abs(label.distance->windingNumber(x)) <= 0.5) continue;
+    if (best < 0 || label.volume < byLabel[static_cast<std::size_t>(best)].volume) best = static_cast<int>(l);
+  }
+  return best;
+}
+
+}  // namespace
+
+std::vector<int> addSurfaceLabelSets(TetMesh& mesh, const SignedDistance& distance, SurfaceLabel kind) {
+  const TriangleSurface& surface = distance.surface();
+  const SurfaceLabels labels = surfaceLabels(surface, kind);
+  const std::vector<LabelSurface> byLabel = labelSurfaces(surface, labels);
+  std::vector<std::vector<int>> members(labels.names.size());
   const Eigen::Matrix3Xd centroids = elementCentroids(mesh);
   for (int e = 0; e < mesh.numElements(); ++e) {
     const Eigen::Vector3d x = centroids.col(e);
-    int best = -1;
-    for (std::size_t l = 0; l < byLabel.size(); ++l) {
-      const Label& label = byLabel[l];
-      if (!label.distance || !label.box.contains(x)) continue;
-      if (std::abs(label.distance->windingNumber(x)) <= 0.5) continue;
-      if (best < 0 || label.volume < byLabel[static_cast<std::size_t>(best)].volume) best = static_cast<int>(l);
-    }
+    int best = innermostLabel(byLabel, x);
     if (best < 0) {
       int triangle = -1;
       distance.distance(x, &triangle);
-      best = (*labels)[static_cast<std::size_t>(triangle)];
+      best = labels.labels[static_cast<std::size_t>(triangle)];
     }
     members[static_cast<std::size_t>(best)].push_back(e);
   }
   std::vector<int> counts;
   for (std::size_t l = 0; l < members.size(); ++l) {
     counts.push_back(static_cast<int>(members[l].size()));
-    if (!members[l].empty()) setElementAndVertexSet(mesh, (*names)[l], std::move(members[l]));
+    if (!members[l].empty()) setElementAndVertexSet(mesh, labels.names[l], std::move(members[l]));
   }
   return counts;
 }

@@ -138,35 +138,42 @@ ImplicitModel exampleModelShape(ExampleModel model) {
   throw ValidationError("unknown example model");
 }
 
-TetMesh makeExampleModel(ExampleModel model, double spacing, StuffingReport* report, int gradingLevels) {
-  const ImplicitModel shape = exampleModelShape(model);
-  const std::string name = exampleModelName(model);
-  MesherOptions options;
-  options.gradingLevels = gradingLevels;
-  // The soft default material of each model; the fast parts get stiffer, lighter ones.
+namespace {
+
+/// The soft default material of each model; the fast parts get stiffer, lighter ones.
+Material defaultMaterial(ExampleModel model) {
   switch (model) {
     case ExampleModel::Dinosaur:
-      options.material = Material{"body", 1000.0, 1e5, 0.45};
-      break;
+      return Material{"body", 1000.0, 1e5, 0.45};
     case ExampleModel::Flower:
-      options.material = Material{"stem", 1000.0, 2e5, 0.45};
-      break;
+      return Material{"stem", 1000.0, 2e5, 0.45};
     case ExampleModel::Dragon:
-      options.material = Material{"body", 1000.0, 1.5e5, 0.45};
-      break;
+      return Material{"body", 1000.0, 1.5e5, 0.45};
     case ExampleModel::Drop:
-      options.material = Material{"soft", 1000.0, 1e5, 0.45};
-      break;
+      return Material{"soft", 1000.0, 1e5, 0.45};
   }
-  TetMesh mesh = stuffIsosurface(implicitUnionOfParts(shape.parts, shape.blend), shape.bounds,
-                                 spacing > 0.0 ? spacing : shape.spacing, options, report);
-  const MeshCheckReport check = checkTetMesh(mesh);
-  if (check.components != 1) {
-    throw ValidationError("example model " + name + ": the mesh has " + std::to_string(check.components) +
-                          " separate pieces at spacing " + std::to_string(spacing > 0.0 ? spacing : shape.spacing) +
-                          "; use a smaller spacing");
+  throw ValidationError("unknown example model");
+}
+
+/// The dragon's nested regions s1 ... s6: the jaw plus the elements whose centroid lies
+/// within kDragonRegionRadii of the head centre.
+void addDragonRegionSets(TetMesh& mesh) {
+  const Eigen::Matrix3Xd centroids = elementCentroids(mesh);
+  const std::vector<int> jaw = mesh.elementSet("jaw");
+  for (std::size_t k = 0; k < kDragonRegionRadii.size(); ++k) {
+    std::vector<int> members = jaw;
+    for (int e = 0; e < mesh.numElements(); ++e)
+      if ((centroids.col(e) - kDragonHeadCentre).norm() <= kDragonRegionRadii[k]) members.push_back(e);
+    std::sort(members.begin(), members.end());
+    members.erase(std::unique(members.begin(), members.end()), members.end());
+    std::string setName = "s";
+    setName += std::to_string(k + 1);
+    setElementAndVertexSet(mesh, setName, std::move(members));
   }
-  addImplicitPartSets(mesh, shape.parts);
+}
+
+/// The stiff, light materials of the fast parts (and the dragon's region sets).
+void assignFastParts(TetMesh& mesh, ExampleModel model) {
   switch (model) {
     case ExampleModel::Dinosaur:
       // Wave speed sqrt(E / rho): 10 m/s in the body, 158 in head and neck (ratio ~15),
@@ -179,28 +186,36 @@ TetMesh makeExampleModel(ExampleModel model, double spacing, StuffingReport* rep
       assignSetMaterial(mesh, "petals", Material{"petals", 130.0, 4e6, 0.45});
       assignSetMaterial(mesh, "upperLeaves", Material{"upperLeaves", 150.0, 3e6, 0.45});
       break;
-    case ExampleModel::Dragon: {
+    case ExampleModel::Dragon:
       // 12 m/s in the body, 155 in the jaw (~12x).
       assignSetMaterial(mesh, "jaw", Material{"jaw", 250.0, 6e6, 0.45});
-      const Eigen::Matrix3Xd centroids = elementCentroids(mesh);
-      const std::vector<int> jaw = mesh.elementSet("jaw");
-      for (std::size_t k = 0; k < kDragonRegionRadii.size(); ++k) {
-        std::vector<int> members = jaw;
-        for (int e = 0; e < mesh.numElements(); ++e)
-          if ((centroids.col(e) - kDragonHeadCentre).norm() <= kDragonRegionRadii[k]) members.push_back(e);
-        std::sort(members.begin(), members.end());
-        members.erase(std::unique(members.begin(), members.end()), members.end());
-        std::string setName = "s";
-        setName += std::to_string(k + 1);
-        setElementAndVertexSet(mesh, setName, std::move(members));
-      }
+      addDragonRegionSets(mesh);
       break;
-    }
     case ExampleModel::Drop:
       // 10 m/s in the soft block, 100 in the stiff handle (10x).
       assignSetMaterial(mesh, "stiffPart", Material{"stiffPart", 300.0, 3e6, 0.45});
       break;
   }
+}
+
+}  // namespace
+
+TetMesh makeExampleModel(ExampleModel model, double spacing, StuffingReport* report, int gradingLevels) {
+  const ImplicitModel shape = exampleModelShape(model);
+  const std::string name = exampleModelName(model);
+  MesherOptions options;
+  options.gradingLevels = gradingLevels;
+  options.material = defaultMaterial(model);
+  TetMesh mesh = stuffIsosurface(implicitUnionOfParts(shape.parts, shape.blend), shape.bounds,
+                                 spacing > 0.0 ? spacing : shape.spacing, options, report);
+  const MeshCheckReport check = checkTetMesh(mesh);
+  if (check.components != 1) {
+    throw ValidationError("example model " + name + ": the mesh has " + std::to_string(check.components) +
+                          " separate pieces at spacing " + std::to_string(spacing > 0.0 ? spacing : shape.spacing) +
+                          "; use a smaller spacing");
+  }
+  addImplicitPartSets(mesh, shape.parts);
+  assignFastParts(mesh, model);
   return mesh;
 }
 

@@ -48,11 +48,15 @@ MeshQuality meshQuality(const TetMesh& mesh) {
   return quality;
 }
 
-MeshCheckReport checkTetMesh(const TetMesh& mesh) {
-  MeshCheckReport report;
-  auto note = [&report](const std::string& problem) {
-    if (report.firstProblem.empty()) report.firstProblem = problem;
-  };
+namespace {
+
+/// Records the first problem found; later ones only count.
+void note(MeshCheckReport& report, const std::string& problem) {
+  if (report.firstProblem.empty()) report.firstProblem = problem;
+}
+
+/// Element volumes, degenerate and inverted elements, unused vertices.
+void checkElements(const TetMesh& mesh, MeshCheckReport& report) {
   const double toDegrees = 180.0 / std::numbers::pi;
   for (int e = 0; e < mesh.numElements(); ++e) {
     const double volume = signedElementVolume(mesh, e);
@@ -64,20 +68,23 @@ MeshCheckReport checkTetMesh(const TetMesh& mesh) {
     report.elementVolume += volume;
     if (std::abs(volume) <= 1e-10 * meanEdge * meanEdge * meanEdge || q.minDihedralAngle * toDegrees < 0.01) {
       ++report.degenerateElements;
-      note("element " + std::to_string(e) + " is degenerate (volume " + std::to_string(volume) +
-           ", min dihedral angle " + std::to_string(q.minDihedralAngle * toDegrees) + " degrees) near " +
-           describePoint(x.rowwise().mean()));
+      note(report, "element " + std::to_string(e) + " is degenerate (volume " + std::to_string(volume) +
+                       ", min dihedral angle " + std::to_string(q.minDihedralAngle * toDegrees) + " degrees) near " +
+                       describePoint(x.rowwise().mean()));
     } else if (volume < 0.0) {
       ++report.invertedElements;
-      note("element " + std::to_string(e) + " is inverted near " + describePoint(x.rowwise().mean()));
+      note(report, "element " + std::to_string(e) + " is inverted near " + describePoint(x.rowwise().mean()));
     }
   }
   report.unusedVertices = static_cast<int>(unusedVertices(mesh).size());
   if (report.unusedVertices > 0) {
-    note(std::to_string(report.unusedVertices) + " vertices are used by no element, e.g. vertex " +
-         std::to_string(unusedVertices(mesh).front()));
+    note(report, std::to_string(report.unusedVertices) + " vertices are used by no element, e.g. vertex " +
+                     std::to_string(unusedVertices(mesh).front()));
   }
+}
 
+/// Boundary triangles, the volume they enclose, and how each boundary edge is traversed.
+void checkBoundary(const TetMesh& mesh, MeshCheckReport& report) {
   const std::vector<std::array<int, 3>> boundary = boundaryTriangles(mesh);
   report.boundaryTriangles = static_cast<int>(boundary.size());
   // Each undirected boundary edge: how often it is traversed a->b (a < b) and b->a.
@@ -98,26 +105,23 @@ MeshCheckReport checkTetMesh(const TetMesh& mesh) {
                               describePoint(mesh.restPosition(edge.second));
     if (count == 1) {
       ++report.openBoundaryEdges;
-      note(where + " belongs to one boundary triangle (open boundary)");
+      note(report, where + " belongs to one boundary triangle (open boundary)");
     } else if (count > 2 && use[0] == use[1]) {
       // Two (or more) sheets of the boundary touching along this edge: the solid is pinched
       // there, which the elements represent correctly (every sheet is closed and outward).
       ++report.pinchedBoundaryEdges;
     } else if (count > 2) {
       ++report.nonManifoldBoundaryEdges;
-      note(where + " belongs to " + std::to_string(count) + " boundary triangles (non-manifold)");
+      note(report, where + " belongs to " + std::to_string(count) + " boundary triangles (non-manifold)");
     } else if (use[0] != 1) {
       ++report.misorientedBoundaryEdges;
-      note(where + ": its two boundary triangles are oriented inconsistently");
+      note(report, where + ": its two boundary triangles are oriented inconsistently");
     }
   }
-  const double volumeScale = std::max(std::abs(report.elementVolume), std::numeric_limits<double>::min());
-  if (report.firstProblem.empty() && std::abs(report.boundaryVolume - report.elementVolume) > 1e-9 * volumeScale) {
-    note("the boundary encloses volume " + std::to_string(report.boundaryVolume) + " but the elements have " +
-         std::to_string(report.elementVolume) + " (boundary not oriented outward)");
-  }
+}
 
-  // Components: union elements that share a face (sorted face keys next to each other).
+/// Components: union elements that share a face (sorted face keys next to each other).
+int countComponents(const TetMesh& mesh) {
   std::vector<int> parent(static_cast<std::size_t>(mesh.numElements()));
   std::iota(parent.begin(), parent.end(), 0);
   std::vector<std::pair<std::array<int, 3>, int>> faces;
@@ -139,9 +143,25 @@ MeshCheckReport checkTetMesh(const TetMesh& mesh) {
       parent[static_cast<std::size_t>(find(parent, faces[i].second))] = find(parent, faces[i - 1].second);
     }
   }
+  int components = 0;
   for (int e = 0; e < mesh.numElements(); ++e)
-    if (find(parent, e) == e) ++report.components;
-  if (mesh.numElements() == 0) note("the mesh has no elements");
+    if (find(parent, e) == e) ++components;
+  return components;
+}
+
+}  // namespace
+
+MeshCheckReport checkTetMesh(const TetMesh& mesh) {
+  MeshCheckReport report;
+  checkElements(mesh, report);
+  checkBoundary(mesh, report);
+  const double volumeScale = std::max(std::abs(report.elementVolume), std::numeric_limits<double>::min());
+  if (report.firstProblem.empty() && std::abs(report.boundaryVolume - report.elementVolume) > 1e-9 * volumeScale) {
+    note(report, "the boundary encloses volume " + std::to_string(report.boundaryVolume) + " but the elements have " +
+                     std::to_string(report.elementVolume) + " (boundary not oriented outward)");
+  }
+  report.components = countComponents(mesh);
+  if (mesh.numElements() == 0) note(report, "the mesh has no elements");
   return report;
 }
 
