@@ -4,37 +4,24 @@
 
 #include <Eigen/Dense>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
-#include <asyncfem/forceModel/linearForceModel.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
-#include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/problem/problem.hpp>
 #include <cmath>
-#include <memory>
-#include <random>
+#include <utility>
+#include <vector>
+
+#include "../common/testProblems.hpp"
 
 namespace asyncfem::test {
 
-/// A 8 x 2 x 2-cell bar [0,1] x [0,0.25] x [0,0.25], fixed at x = 0, with a stiff light
-/// part for x > 0.75, random initial state and a time-varying pull on the x = 1 face.
-struct TestSystem {
-  TetMesh mesh;
-  DynamicSystem system;
+/// The stiff-end bar of testProblems.hpp ([0,1] x [0,0.25] x [0,0.25], 8 x 2 x 2 cubes,
+/// clamped at x = 0, stiff and light for x > 0.75) pulled on its x = 1 face ("xmax") by
+/// f_y = -0.5 cos(40 t), f_z = 0.2 sin(25 t) N per vertex, from a random state (u0, v0).
+struct TestSystem : TestBody {
   Eigen::VectorXd u0, v0;
 };
 
-inline TestSystem makeTestSystem(double alpha, double beta, unsigned seed = 7) {
-  BoxMeshSpec spec;
-  spec.size = Eigen::Vector3d(1.0, 0.25, 0.25);
-  spec.cells = Eigen::Vector3i(8, 2, 2);
-  spec.material = Material{"soft", 1000.0, 1e5, 0.4};
-  spec.regions.push_back(
-      {"stiff", Eigen::Vector3d(0.75, -1, -1), Eigen::Vector3d(2, 2, 2), Material{"stiff", 200.0, 5e6, 0.3}});
-  TestSystem ts{makeBoxMesh(spec), {}, {}, {}};
-  MatrixAssembler assembler(ts.mesh);
-  ts.system.forceModel = std::make_shared<LinearForceModel>(linearStiffnessMatrix(ts.mesh, assembler));
-  ts.system.mass = massMatrix(ts.mesh, assembler, MassType::consistent);
-  ts.system.freeDofs = FreeDofs::fromFixedVertices(ts.mesh.numVertices(), ts.mesh.vertexSet("xmin"));
-  ts.system.rayleighMass = alpha;
-  ts.system.rayleighStiffness = beta;
+inline TestSystem makeTestSystem(const ProblemSettings& settings, unsigned seed = 7) {
+  TestSystem ts{TestBody(stiffEndBarProblem(settings)), {}, {}};
   const std::vector<int> pulled = ts.mesh.vertexSet("xmax");
   ts.system.externalForce = [pulled](double t, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& f) {
     for (int v : pulled) {
@@ -42,19 +29,15 @@ inline TestSystem makeTestSystem(double alpha, double beta, unsigned seed = 7) {
       f[3 * v + 2] += 0.2 * std::sin(25.0 * t);
     }
   };
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  const int n = ts.mesh.numDofs();
-  ts.u0.resize(n);
-  ts.v0.resize(n);
-  for (int k = 0; k < n; ++k) {
-    ts.u0[k] = 1e-3 * uniform(rng);
-    ts.v0[k] = 1e-2 * uniform(rng);
-  }
-  for (int k = 0; k < n; ++k) {
-    if (ts.system.freeDofs.isFixed(k)) ts.u0[k] = ts.v0[k] = 0.0;
-  }
+  RandomState state = randomState(ts.system.freeDofs, seed, FixedDofDraws::drawnThenZeroed);
+  ts.u0 = std::move(state.displacement);
+  ts.v0 = std::move(state.velocity);
   return ts;
+}
+
+/// Linear FEM, consistent mass, Rayleigh damping D = alpha M + beta K (alpha in 1/s, beta in s).
+inline TestSystem makeTestSystem(double alpha, double beta, unsigned seed = 7) {
+  return makeTestSystem(testSettings(ForceModelType::linear, alpha, beta), seed);
 }
 
 /// Dense single-rate backward Euler on the free DOFs (design note, paper Eq. 5), the

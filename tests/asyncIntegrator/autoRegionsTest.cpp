@@ -5,10 +5,9 @@
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/problem/problem.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
-#include <asyncfem/volumetricMesh/readers.hpp>
-#include <filesystem>
 #include <random>
 #include <sstream>
 
@@ -20,13 +19,12 @@ namespace {
 // The element bound is >= the assembled system's highest frequency (element eigenvalue
 // inequality), checked against a dense generalized eigen-solve with lumped mass.
 TEST(AutoRegions, ElementFrequenciesBoundTheSystem) {
-  const test::TestSystem ts = test::makeTestSystem(0, 0);
-  MatrixAssembler assembler(ts.mesh);
-  const Eigen::MatrixXd K = Eigen::MatrixXd(linearStiffnessMatrix(ts.mesh, assembler));
-  const Eigen::MatrixXd M = Eigen::MatrixXd(massMatrix(ts.mesh, assembler, MassType::lumped));
+  const Problem bar = test::stiffEndBarProblem(test::testSettings(ForceModelType::linear, 0.0, 0.0, MassType::lumped));
+  const Eigen::MatrixXd K = Eigen::MatrixXd(bar.stiffnessMatrix());
+  const Eigen::MatrixXd M = Eigen::MatrixXd(bar.massMatrix());
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eigen(K, M, Eigen::EigenvaluesOnly);
   const double systemOmega = std::sqrt(eigen.eigenvalues().maxCoeff());
-  const double bound = elementMaxFrequencies(ts.mesh).maxCoeff();
+  const double bound = elementMaxFrequencies(bar.mesh()).maxCoeff();
   EXPECT_GE(bound, systemOmega * (1 - 1e-10));
   // ... and not absurdly loose (a factor 4 would make the proposals useless).
   EXPECT_LT(bound, 4 * systemOmega);
@@ -108,8 +106,9 @@ TEST(AutoRegions, RelativeModeFindsTheStiffPartAtAnyTimestep) {
 // bending mode of the whole beam with at most a quarter of its modal mass in the tip, so
 // the region is withdrawn and the scene runs single-rate at hL.
 TEST(AutoRegions, ModalCheckWithdrawsTheTipOfTheDefaultBeam) {
-  const TetMesh mesh = readMesh(std::filesystem::path(ASYNCFEM_MODELS_DIR) / "beam" / "beam.veg");
-  const FreeDofs freeDofs = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("root"));
+  const Problem beam = test::defaultBeamProblem();
+  const TetMesh& mesh = beam.mesh();
+  const FreeDofs& freeDofs = beam.freeDofs();
   const VibrationMatrices matrices = vibrationMatrices(mesh, MassType::consistent);
   AutoRegionOptions options;
   options.largeTimestep = 1.0 / 120.0;

@@ -4,8 +4,9 @@
 
 #include <Eigen/Geometry>
 #include <asyncfem/contact/penaltyContact.hpp>
-#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
+#include <asyncfem/problem/problem.hpp>
+#include <asyncfem/volumetricMesh/generators.hpp>
 #include <memory>
 #include <utility>
 
@@ -18,9 +19,7 @@ using test::relativeDifference;
 
 /// The test system of asyncTestSystem.hpp with a corotational force model instead.
 test::TestSystem makeCorotationalSystem(double alpha, double beta) {
-  test::TestSystem ts = test::makeTestSystem(alpha, beta);
-  ts.system.forceModel = std::make_shared<CorotationalLinearFEM>(ts.mesh, TangentKind::simple);
-  return ts;
+  return test::makeTestSystem(test::testSettings(ForceModelType::corotational, alpha, beta));
 }
 
 // m = 1: the nonlinear asynchronous step equals a corotational single-rate (linearized)
@@ -188,31 +187,24 @@ TEST(NonlinearAsync, DroppedBodyRestsOnTheGround) {
   spec.material = Material{"soft", 1000.0, 2e5, 0.4};
   spec.regions.push_back(
       {"stiff", Eigen::Vector3d(0.2, -1, -1), Eigen::Vector3d(1, 1, 1), Material{"stiff", 500.0, 5e6, 0.3}});
-  const TetMesh mesh = makeBoxMesh(spec);
-  MatrixAssembler assembler(mesh);
-  DynamicSystem system;
-  system.forceModel = std::make_shared<CorotationalLinearFEM>(mesh, TangentKind::simple);
-  system.mass = massMatrix(mesh, assembler, MassType::consistent);
-  system.freeDofs = FreeDofs(mesh.numDofs(), {});
+  const auto mesh = std::make_shared<const TetMesh>(makeBoxMesh(spec));
   const Eigen::Vector3d g(0.0, -9.81, 0.0);
-  const Eigen::VectorXd gravity = system.mass * g.replicate(mesh.numVertices(), 1);
   PenaltyContactParameters parameters;
   parameters.stiffness = 2e3;
   parameters.damping = 5.0;
-  auto contact = std::make_shared<PenaltyContact>(mesh.restPositions(), std::vector<ContactPlane>{ContactPlane{}},
+  auto contact = std::make_shared<PenaltyContact>(mesh->restPositions(), std::vector<ContactPlane>{ContactPlane{}},
                                                   std::vector<ContactSphere>{}, parameters);
-  system.externalForce = [gravity, contact](double, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
-                                            Eigen::VectorXd& f) {
-    f += gravity;
-    contact->addForces(u, v, f);
-  };
-  std::vector<AsyncRegion> regions{{"stiff", test::verticesBeyond(mesh, 0.25), 4}};
-  AsyncBackwardEuler async(mesh, system, 2e-3, regions);
+  ProblemSettings settings = test::testSettings(ForceModelType::corotational);
+  settings.gravity = g;
+  const Problem problem(mesh, {}, settings, {}, contact);
+  const Eigen::VectorXd gravity = problem.massMatrix() * g.replicate(mesh->numVertices(), 1);
+  std::vector<AsyncRegion> regions{{"stiff", test::verticesBeyond(*mesh, 0.25), 4}};
+  AsyncBackwardEuler async(problem.dynamicSystem(), 2e-3, regions);
   auto energy = [&]() {
     const Eigen::VectorXd& u = async.displacement();
     double penalty = 0.0;
-    for (int v = 0; v < mesh.numVertices(); ++v) {
-      const double depth = -(mesh.restPosition(v).y() + u[3 * v + 1]);
+    for (int v = 0; v < mesh->numVertices(); ++v) {
+      const double depth = -(mesh->restPosition(v).y() + u[3 * v + 1]);
       if (depth > 0) penalty += 0.5 * parameters.stiffness * depth * depth;
     }
     return async.mechanicalEnergy() - gravity.dot(u) + penalty;

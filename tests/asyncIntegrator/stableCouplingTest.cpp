@@ -9,9 +9,9 @@
 #include <Eigen/SparseCholesky>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
+#include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
-#include <asyncfem/volumetricMesh/readers.hpp>
 #include <cstdio>
 #include <map>
 #include <random>
@@ -239,8 +239,7 @@ TEST(StableCoupling, PaperCouplingViolatesTheDefinition) {
 // paper coupling, which needs no K_I, still accepts it.
 TEST(StableCoupling, RefusesAMatrixModelThatIsNotTheMeshStiffness) {
   test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
-  MatrixAssembler assembler(ts.mesh);
-  ts.system.forceModel = std::make_shared<LinearForceModel>(2.0 * linearStiffnessMatrix(ts.mesh, assembler));
+  ts.system.forceModel = std::make_shared<LinearForceModel>(2.0 * ts.problem->stiffnessMatrix());
   const std::vector<AsyncRegion> regions = testPartitions(ts.mesh)[0];
   try {
     AsyncBackwardEuler stable(ts.mesh, ts.system, 2e-3, regions, withCoupling(AsyncCoupling::stable));
@@ -254,10 +253,8 @@ TEST(StableCoupling, RefusesAMatrixModelThatIsNotTheMeshStiffness) {
 
 /// The test system (or a copy with lumped mass / no fixed vertex) with no load.
 test::TestSystem freeSystem(MassType mass, bool fixed) {
-  test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  test::TestSystem ts = test::makeTestSystem(test::testSettings(ForceModelType::linear, 0.0, 0.0, mass));
   ts.system.externalForce = nullptr;
-  MatrixAssembler assembler(ts.mesh);
-  ts.system.mass = massMatrix(ts.mesh, assembler, mass);
   if (!fixed) {
     ts.system.freeDofs = FreeDofs::fromFixedVertices(ts.mesh.numVertices(), {});
     test::TestSystem unfixed = test::makeTestSystem(0.0, 0.0, 11);  // random state on every DOF
@@ -345,22 +342,12 @@ TEST(StableCoupling, LinearMomentumIsConservedForAFreeBody) {
   }
 }
 
-/// The default scene's beam (models/beam/beam.veg, root fixed, tip region), no load.
-struct Beam {
-  TetMesh mesh;
-  DynamicSystem system;
+/// The default scene's beam (testProblems.hpp: models/beam/beam.veg, root fixed), no load,
+/// and its tip region.
+struct Beam : test::TestBody {
+  Beam() : TestBody(test::defaultBeamProblem()), tip(mesh.vertexSet("tip")) {}
   std::vector<int> tip;
 };
-
-Beam defaultBeam() {
-  Beam beam{readMesh(std::string(ASYNCFEM_MODELS_DIR) + "/beam/beam.veg"), {}, {}};
-  MatrixAssembler assembler(beam.mesh);
-  beam.system.forceModel = std::make_shared<LinearForceModel>(linearStiffnessMatrix(beam.mesh, assembler));
-  beam.system.mass = massMatrix(beam.mesh, assembler, MassType::consistent);
-  beam.system.freeDofs = FreeDofs::fromFixedVertices(beam.mesh.numVertices(), beam.mesh.vertexSet("root"));
-  beam.tip = beam.mesh.vertexSet("tip");
-  return beam;
-}
 
 /// The beam pulled down at the tip by a static load (the default scene's pull), at rest:
 /// the state it is released from, u = K^{-1} f on the free DOFs.
@@ -385,7 +372,7 @@ Eigen::VectorXd pulledBeam(const Beam& beam) {
 // in the hundreds or thousands at m = 200, depending on the random velocity). This test
 // also shows the energy check can fail.
 TEST(StableCoupling, DefaultBeamDecaysWhereThePaperCouplingGrows) {
-  const Beam beam = defaultBeam();
+  const Beam beam;
   const Eigen::VectorXd u0 = pulledBeam(beam);
   std::mt19937 generator(3);
   std::uniform_real_distribution<double> uniform(-1e-3, 1e-3);
@@ -424,9 +411,8 @@ TEST(StableCoupling, DefaultBeamDecaysWhereThePaperCouplingGrows) {
 // with relative tolerance 1e-10 of E (energies of ~1e3-1e4 terms summed). The run must
 // really be nonlinear: some eps_k must be non-negligible (> 1e-8 E).
 TEST(StableCoupling, CorotationalEnergyGainIsBoundedByTheLinearizationError) {
-  test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  test::TestSystem ts = test::makeTestSystem(test::testSettings(ForceModelType::corotational));
   ts.system.externalForce = nullptr;
-  ts.system.forceModel = std::make_shared<CorotationalLinearFEM>(ts.mesh, TangentKind::simple);
   CorotationalLinearFEM evaluator(ts.mesh, TangentKind::simple);
   // A large bend: each vertex rotated about z by 0.6 x (its rest x) rad, up to 0.6 rad at the tip.
   Eigen::VectorXd u0 = Eigen::VectorXd::Zero(ts.mesh.numDofs());

@@ -5,7 +5,7 @@
 
 #include <asyncfem/asyncIntegrator/stepGrowth.hpp>
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
+#include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
 #include <cstdio>
 
@@ -128,7 +128,8 @@ TEST(StepGrowth, RejectsSystemsWhoseStepIsNotLinear) {
 
   // A corotational model: rejected as it is, replaced by its tangent at rest.
   DynamicSystem corotational = homogeneous;
-  corotational.forceModel = std::make_shared<CorotationalLinearFEM>(ts.mesh, TangentKind::simple);
+  corotational.forceModel =
+      test::withSettings(*ts.problem, test::testSettings(ForceModelType::corotational)).makeForceModel();
   BackwardEuler nonlinear(corotational, 0.01);
   EXPECT_THROW(estimateStepGrowth(nonlinear), Error);
   BackwardEuler linearized(homogeneousLinearSystem(corotational), 0.01);

@@ -3,41 +3,28 @@
 // tangents for the coupling) with a hyperelastic force model.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
-#include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
-#include <asyncfem/stiffnessMatrix/dofs.hpp>
-#include <memory>
+#include <asyncfem/problem/problem.hpp>
 #include <vector>
 
-#include "testHelpers.hpp"
+#include "../common/testProblems.hpp"
 
 namespace asyncfem {
 namespace {
 
-struct Bar {
-  TetMesh mesh;
-  DynamicSystem system;
+// The rubber cantilever of testProblems.hpp at 8 x 2 x 2 cubes (1 x 0.2 x 0.2, x = 0 fixed),
+// neo-Hookean, swinging at v_y = 2 x (displacements of about 0.1 within a few steps:
+// visibly nonlinear).
+struct Bar : test::TestBody {
+  using TestBody::TestBody;
   std::vector<int> tip;  // vertices with x > 0.75
   Eigen::VectorXd velocity;
 };
 
-// A 1 x 0.2 x 0.2 neo-Hookean bar, x = 0 fixed, swinging at v_y = 2 x (displacements
-// of about 0.1 within a few steps: visibly nonlinear).
 Bar makeBar(double alpha, double beta) {
-  Bar bar;
-  BoxMeshSpec spec;
-  spec.size = Eigen::Vector3d(1.0, 0.2, 0.2);
-  spec.cells = Eigen::Vector3i(8, 2, 2);
-  spec.material = Material{"rubber", 1000.0, 1e6, 0.45};
-  bar.mesh = makeBoxMesh(spec);
-  auto assembler = std::make_shared<const MatrixAssembler>(bar.mesh);
-  bar.system.forceModel = makeHyperelasticForceModel(bar.mesh, HyperelasticMaterialKind::neoHookean, {}, assembler);
-  bar.system.mass = massMatrix(bar.mesh, *assembler, MassType::consistent);
-  bar.system.freeDofs = FreeDofs::fromFixedVertices(bar.mesh.numVertices(), bar.mesh.vertexSet("xmin"));
-  bar.system.rayleighMass = alpha;
-  bar.system.rayleighStiffness = beta;
+  Bar bar(test::rubberBarProblem(test::testSettings(ForceModelType::neoHookean, alpha, beta), {8, 2, 2}));
   bar.velocity = Eigen::VectorXd::Zero(bar.mesh.numDofs());
   for (int v = 0; v < bar.mesh.numVertices(); ++v) {
     const double x = bar.mesh.restPosition(v).x();
@@ -56,7 +43,7 @@ double relativeDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 TEST(AsyncHyperelastic, RatioOneEqualsBackwardEuler) {
   Bar bar = makeBar(0.2, 1e-3);
   const double h = 5e-3;
-  AsyncBackwardEuler async(bar.mesh, bar.system, h, {{"tip", bar.tip, 1}});
+  AsyncBackwardEuler async(bar.system, h, {{"tip", bar.tip, 1}});
   BackwardEuler single(bar.system, h);
   const Eigen::VectorXd rest = Eigen::VectorXd::Zero(bar.mesh.numDofs());
   async.setState(rest, bar.velocity);
@@ -79,8 +66,8 @@ TEST(AsyncHyperelastic, StructuredEqualsNaiveWithSubsteps) {
   std::vector<AsyncRegion> regions{{"tip", bar.tip, 4}};
   AsyncOptions naiveOptions;
   naiveOptions.method = AsyncSolveMethod::naive;
-  AsyncBackwardEuler structured(bar.mesh, bar.system, h, regions);
-  AsyncBackwardEuler naive(bar.mesh, bar.system, h, regions, naiveOptions);
+  AsyncBackwardEuler structured(bar.system, h, regions);
+  AsyncBackwardEuler naive(bar.system, h, regions, naiveOptions);
   BackwardEuler single(bar.system, h);
   const Eigen::VectorXd rest = Eigen::VectorXd::Zero(bar.mesh.numDofs());
   structured.setState(rest, bar.velocity);

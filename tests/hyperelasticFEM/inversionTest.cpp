@@ -7,8 +7,7 @@
 #include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <asyncfem/hyperelasticFEM/isotropicHyperelasticFEM.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
-#include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <asyncfem/problem/problem.hpp>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -167,18 +166,16 @@ TEST(HyperelasticInversion, FlatElementWithoutHandlingIsReportedNotReturned) {
 // inverted element is indefinite and the step is solved by Cholesky.
 double releaseInvertedTet(HyperelasticOptions options) {
   options.enforceSPD = true;
-  const TetMesh mesh = test::unitTet();
-  const MatrixAssembler assembler(mesh);
-  DynamicSystem system;
-  system.forceModel = makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::neoHookean, options,
-                                                 std::make_shared<const MatrixAssembler>(mesh));
-  system.mass = massMatrix(mesh, assembler, MassType::lumped);
-  system.freeDofs = FreeDofs::fromFixedVertices(mesh.numVertices(), {});
-  system.rayleighMass = 20.0;
+  const Problem problem(std::make_shared<const TetMesh>(test::unitTet()), {},
+                        {.mass = MassType::lumped,
+                         .forceModel = ForceModelType::neoHookean,
+                         .hyperelastic = options,
+                         .rayleighAlpha = 20.0});
+  const TetMesh& mesh = problem.mesh();
   IntegratorOptions integratorOptions;
   integratorOptions.maxIterations = 20;
   integratorOptions.tolerance = 1e-10;
-  BackwardEuler integrator(std::move(system), 2e-3, integratorOptions);
+  BackwardEuler integrator(problem.dynamicSystem(), 2e-3, integratorOptions);
   Eigen::VectorXd u = Eigen::VectorXd::Zero(mesh.numDofs());
   u[11] = -1.6;  // vertex 3 from z = 1 to z = -0.6: det F = -0.6
   integrator.setState(u, Eigen::VectorXd::Zero(mesh.numDofs()));

@@ -3,22 +3,21 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
-#include <memory>
+#include <asyncfem/problem/problem.hpp>
+#include <utility>
+#include <vector>
 
 #include "testSystems.hpp"
 
 namespace asyncfem::test {
 namespace {
 
-DynamicSystem corotationalSystem(const TetMesh& mesh, const std::vector<int>& fixedVertices, TangentKind tangent) {
-  auto assembler = std::make_shared<const MatrixAssembler>(mesh);
-  DynamicSystem system;
-  system.forceModel = std::make_shared<CorotationalLinearFEM>(mesh, assembler, tangent);
-  system.mass = massMatrix(mesh, *assembler, MassType::consistent);
-  system.freeDofs = FreeDofs::fromFixedVertices(mesh.numVertices(), fixedVertices);
-  return system;
+/// The rubber bar of makeBar() with corotational forces, fixedVertices held.
+DynamicSystem corotationalSystem(const BarBody& bar, std::vector<int> fixedVertices, TangentKind tangent) {
+  ProblemSettings settings = testSettings(ForceModelType::corotational);
+  settings.tangent = tangent;
+  return Problem(bar.problem->sharedMesh(), std::move(fixedVertices), settings).dynamicSystem();
 }
 
 // A free-floating bar rotated rigidly by 40 degrees and released at rest feels no
@@ -27,7 +26,7 @@ DynamicSystem corotationalSystem(const TetMesh& mesh, const std::vector<int>& fi
 // the system matrix has condition number ~1e5.
 TEST(CorotationalBackwardEuler, RigidRotationStaysPut) {
   const BarBody bar = makeBar();
-  const DynamicSystem system = corotationalSystem(bar.mesh, {}, TangentKind::simple);
+  const DynamicSystem system = corotationalSystem(bar, {}, TangentKind::simple);
   const Eigen::Matrix3d rotation = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 2.0, 0.5).normalized()).matrix();
   Eigen::VectorXd u(bar.mesh.numDofs());
   for (int vertex = 0; vertex < bar.mesh.numVertices(); ++vertex) {
@@ -46,7 +45,7 @@ TEST(CorotationalBackwardEuler, RigidRotationStaysPut) {
 // displacement: the relative difference of the trajectories is O(amplitude).
 TEST(CorotationalBackwardEuler, MatchesLinearAtSmallDeformation) {
   const BarBody bar = makeBar();
-  const DynamicSystem system = corotationalSystem(bar.mesh, bar.mesh.vertexSet("xmin"), TangentKind::simple);
+  const DynamicSystem system = corotationalSystem(bar, bar.mesh.vertexSet("xmin"), TangentKind::simple);
   Eigen::VectorXd u0 = Eigen::VectorXd::Zero(bar.mesh.numDofs());
   for (int vertex = 0; vertex < bar.mesh.numVertices(); ++vertex) {
     const double x = bar.mesh.restPosition(vertex).x();
@@ -71,7 +70,7 @@ TEST(CorotationalBackwardEuler, MatchesLinearAtSmallDeformation) {
 // With the exact tangent Newton converges on the corotational backward Euler equations.
 TEST(CorotationalBackwardEuler, NewtonConvergesWithExactTangent) {
   const BarBody bar = makeBar();
-  const DynamicSystem system = corotationalSystem(bar.mesh, bar.mesh.vertexSet("xmin"), TangentKind::exact);
+  const DynamicSystem system = corotationalSystem(bar, bar.mesh.vertexSet("xmin"), TangentKind::exact);
   Eigen::VectorXd u0 = Eigen::VectorXd::Zero(bar.mesh.numDofs());
   for (int vertex = 0; vertex < bar.mesh.numVertices(); ++vertex) {
     const double x = bar.mesh.restPosition(vertex).x();

@@ -4,22 +4,17 @@
 #include <gtest/gtest.h>
 
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
-#include <memory>
+#include <asyncfem/problem/problem.hpp>
 
 #include "testSystems.hpp"
 
 namespace asyncfem::test {
 namespace {
 
+/// The rubber cantilever of bar (x = 0 fixed) with corotational forces.
 DynamicSystem swingingBar(const BarBody& bar) {
-  auto assembler = std::make_shared<const MatrixAssembler>(bar.mesh);
-  DynamicSystem system;
-  system.forceModel = std::make_shared<CorotationalLinearFEM>(bar.mesh, assembler, TangentKind::simple);
-  system.mass = massMatrix(bar.mesh, *assembler, MassType::consistent);
-  system.freeDofs = bar.freeDofs;
-  return system;
+  return withSettings(*bar.problem, testSettings(ForceModelType::corotational)).dynamicSystem();
 }
 
 // The bar starts bent well out of the linear range (tip displaced by 40% of its length)

@@ -4,43 +4,31 @@
 #include <gtest/gtest.h>
 
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
-#include <asyncfem/stiffnessMatrix/dofs.hpp>
-#include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/problem/problem.hpp>
 #include <cmath>
-#include <memory>
 #include <vector>
+
+#include "../common/testProblems.hpp"
 
 namespace asyncfem {
 namespace {
 
-// A 1 x 0.2 x 0.2 neo-Hookean bar (4 x 1 x 1 cubes), the x = 0 face fixed, whose
-// material moves at v_y = speed * x: a fast swing that a step of h = 0.05 s (about the
-// bar's first period) turns into a large rotation.
-struct SwingingBar {
-  TetMesh mesh;
-  DynamicSystem system;
+// The rubber cantilever of testProblems.hpp (1 x 0.2 x 0.2, 4 x 1 x 1 cubes, the x = 0 face
+// fixed), neo-Hookean, whose material moves at v_y = speed * x: a fast swing that a step
+// of h = 0.05 s (about the bar's first period) turns into a large rotation.
+struct SwingingBar : test::TestBody {
+  using TestBody::TestBody;
   Eigen::VectorXd initialVelocity;
 };
 
 SwingingBar makeSwingingBar(double speed, double beta = 0.0, bool enforceSPD = true) {
-  SwingingBar bar;
-  BoxMeshSpec spec;
-  spec.size = Eigen::Vector3d(1.0, 0.2, 0.2);
-  spec.cells = Eigen::Vector3i(4, 1, 1);
-  spec.material = Material{"rubber", 1000.0, 1e6, 0.45};
-  bar.mesh = makeBoxMesh(spec);
-  auto assembler = std::make_shared<const MatrixAssembler>(bar.mesh);
   HyperelasticOptions options;
   options.inversionThreshold = 0.2;
   options.enforceSPD = enforceSPD;  // Cholesky needs a positive definite system for large steps
-  bar.system.forceModel =
-      makeHyperelasticForceModel(bar.mesh, HyperelasticMaterialKind::neoHookean, options, assembler);
-  bar.system.mass = massMatrix(bar.mesh, *assembler, MassType::consistent);
-  bar.system.freeDofs = FreeDofs::fromFixedVertices(bar.mesh.numVertices(), bar.mesh.vertexSet("xmin"));
-  bar.system.rayleighStiffness = beta;
+  ProblemSettings settings = test::testSettings(ForceModelType::neoHookean, 0.0, beta);
+  settings.hyperelastic = options;
+  SwingingBar bar(test::rubberBarProblem(settings));
   bar.initialVelocity = Eigen::VectorXd::Zero(bar.mesh.numDofs());
   for (int v = 0; v < bar.mesh.numVertices(); ++v) {
     if (bar.mesh.restPosition(v).x() > 0.0) bar.initialVelocity[(3 * v) + 1] = speed * bar.mesh.restPosition(v).x();

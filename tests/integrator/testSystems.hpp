@@ -4,46 +4,37 @@
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
-#include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/integrator/integrator.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/problem/problem.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
-#include <asyncfem/volumetricMesh/generators.hpp>
 #include <cmath>
-#include <memory>
+#include <utility>
 #include <vector>
+
+#include "../common/testProblems.hpp"
 
 // Small bodies with closed-form (modal) solutions shared by the integrator tests.
 namespace asyncfem::test {
 
-/// A 1 x 0.2 x 0.2 bar of 4 x 1 x 1 cubes (24 tets, 20 vertices), the x = 0 face fixed:
-/// 48 free DOFs, small enough for dense generalized eigen-solves.
-struct BarBody {
-  TetMesh mesh;
-  Eigen::SparseMatrix<double> stiffness;  ///< full K
-  Eigen::SparseMatrix<double> mass;       ///< full M
-  FreeDofs freeDofs;
-  DynamicSystem system;
+/// The rubber cantilever of testProblems.hpp (1 x 0.2 x 0.2, 4 x 1 x 1 cubes by default,
+/// the x = 0 face fixed: 48 free DOFs, small enough for dense generalized eigen-solves),
+/// linear FEM, with its matrices at hand.
+struct BarBody : TestBody {
+  explicit BarBody(Problem bar)
+      : TestBody(std::move(bar)),
+        stiffness(this->problem->stiffnessMatrix()),
+        mass(this->problem->massMatrix()),
+        freeDofs(this->problem->freeDofs()) {}
+
+  const Eigen::SparseMatrix<double>& stiffness;  ///< full K (N/m)
+  const Eigen::SparseMatrix<double>& mass;       ///< full M (kg)
+  const FreeDofs& freeDofs;
 };
 
+/// Rayleigh damping D = alpha M + beta K (alpha in 1/s, beta in s).
 inline BarBody makeBar(MassType massType = MassType::consistent, double alpha = 0.0, double beta = 0.0,
-                       Eigen::Vector3i cells = Eigen::Vector3i(4, 1, 1)) {
-  BarBody body;
-  BoxMeshSpec spec;
-  spec.size = Eigen::Vector3d(1.0, 0.2, 0.2);
-  spec.cells = cells;
-  spec.material = Material{"rubber", 1000.0, 1e6, 0.45};
-  body.mesh = makeBoxMesh(spec);
-  MatrixAssembler assembler(body.mesh);
-  body.stiffness = linearStiffnessMatrix(body.mesh, assembler);
-  body.mass = massMatrix(body.mesh, assembler, massType);
-  body.freeDofs = FreeDofs::fromFixedVertices(body.mesh.numVertices(), body.mesh.vertexSet("xmin"));
-  body.system.forceModel = std::make_shared<LinearForceModel>(body.stiffness);
-  body.system.mass = body.mass;
-  body.system.freeDofs = body.freeDofs;
-  body.system.rayleighMass = alpha;
-  body.system.rayleighStiffness = beta;
-  return body;
+                       const Eigen::Vector3i& cells = Eigen::Vector3i(4, 1, 1)) {
+  return BarBody(rubberBarProblem(testSettings(ForceModelType::linear, alpha, beta, massType), cells));
 }
 
 /// Rows and columns of the free DOFs of a sparse matrix, dense.

@@ -3,59 +3,45 @@
 // backward Euler steps at hS, and for m > 1 it differs from the asynchronous method.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
-#include <asyncfem/sceneIO/scene.hpp>
-#include <asyncfem/sceneIO/simulation.hpp>
-#include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <asyncfem/integrator/registry.hpp>
+#include <asyncfem/problem/problem.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <cmath>
+#include <memory>
 #include <nlohmann/json.hpp>
-#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "../common/testProblems.hpp"
 
 namespace asyncfem {
 namespace {
 
-// A bar fixed at x = 0 with a stiff light end (x > 0.75), a time-varying pull on its free
-// face and a random initial state, so that every term of the step is exercised.
-struct Bar {
-  TetMesh mesh;
-  DynamicSystem system;
+// The stiff-end bar of testProblems.hpp (fixed at x = 0, stiff light end x > 0.75) with a
+// time-varying pull on its free face and a random initial state, so that every term of
+// the step is exercised.
+struct Bar : test::TestBody {
+  using TestBody::TestBody;
   Eigen::VectorXd u0, v0;
   std::vector<int> stiffVertices;
 };
 
 Bar makeBar(double alpha, double beta) {
-  BoxMeshSpec spec;
-  spec.size = Eigen::Vector3d(1.0, 0.25, 0.25);
-  spec.cells = Eigen::Vector3i(8, 2, 2);
-  spec.material = Material{"soft", 1000.0, 1e5, 0.4};
-  spec.regions.push_back(
-      {"stiff", Eigen::Vector3d(0.75, -1, -1), Eigen::Vector3d(2, 2, 2), Material{"stiff", 200.0, 5e6, 0.3}});
-  Bar bar{makeBoxMesh(spec), {}, {}, {}, {}};
-  MatrixAssembler assembler(bar.mesh);
-  bar.system.forceModel = std::make_shared<LinearForceModel>(linearStiffnessMatrix(bar.mesh, assembler));
-  bar.system.mass = massMatrix(bar.mesh, assembler, MassType::consistent);
-  bar.system.freeDofs = FreeDofs::fromFixedVertices(bar.mesh.numVertices(), bar.mesh.vertexSet("xmin"));
-  bar.system.rayleighMass = alpha;
-  bar.system.rayleighStiffness = beta;
+  Bar bar(test::stiffEndBarProblem(test::testSettings(ForceModelType::linear, alpha, beta)));
   const std::vector<int> pulled = bar.mesh.vertexSet("xmax");
   bar.system.externalForce = [pulled](double t, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd& f) {
     for (const int v : pulled) f[3 * v + 1] -= 0.5 * std::cos(40.0 * t);
   };
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  const int n = bar.mesh.numDofs();
-  bar.u0.resize(n);
-  bar.v0.resize(n);
-  for (int k = 0; k < n; ++k) {
-    const bool fixed = bar.system.freeDofs.isFixed(k);
-    bar.u0[k] = fixed ? 0.0 : 1e-3 * uniform(rng);
-    bar.v0[k] = fixed ? 0.0 : 1e-2 * uniform(rng);
-  }
+  test::RandomState state = test::randomState(bar.system.freeDofs, 11, test::FixedDofDraws::skipped);
+  bar.u0 = std::move(state.displacement);
+  bar.v0 = std::move(state.velocity);
   bar.stiffVertices = bar.mesh.vertexSet("stiff");
   return bar;
 }
@@ -70,7 +56,7 @@ TEST(UncoupledMultirate, RatioOneIsBackwardEulerAtTheLargeStep) {
   for (const auto& [alpha, beta] : {std::pair{0.0, 0.0}, std::pair{0.3, 2e-3}}) {
     Bar bar = makeBar(alpha, beta);
     const double hL = 4e-3;
-    UncoupledMultirate multirate(bar.mesh, bar.system, hL, {{"stiff", bar.stiffVertices, 1}});
+    UncoupledMultirate multirate(bar.system, hL, {{"stiff", bar.stiffVertices, 1}});
     BackwardEuler single(bar.system, hL);
     multirate.setState(bar.u0, bar.v0);
     single.setState(bar.u0, bar.v0);
@@ -92,7 +78,7 @@ TEST(UncoupledMultirate, EverythingFastIsBackwardEulerAtTheSmallStep) {
   for (int v = 0; v < bar.mesh.numVertices(); ++v) all.push_back(v);
   const double hL = 8e-3;
   const int m = 4;
-  UncoupledMultirate multirate(bar.mesh, bar.system, hL, {{"all", all, m}});
+  UncoupledMultirate multirate(bar.system, hL, {{"all", all, m}});
   BackwardEuler single(bar.system, hL / m);
   multirate.setState(bar.u0, bar.v0);
   single.setState(bar.u0, bar.v0);
@@ -108,8 +94,8 @@ TEST(UncoupledMultirate, DiffersFromAsyncForRatiosAboveOne) {
   Bar bar = makeBar(0.0, 0.0);
   const double hL = 8e-3;
   for (const int m : {2, 8}) {
-    UncoupledMultirate multirate(bar.mesh, bar.system, hL, {{"stiff", bar.stiffVertices, m}});
-    AsyncBackwardEuler async(bar.mesh, bar.system, hL, {{"stiff", bar.stiffVertices, m}});
+    UncoupledMultirate multirate(bar.system, hL, {{"stiff", bar.stiffVertices, m}});
+    AsyncBackwardEuler async(bar.system, hL, {{"stiff", bar.stiffVertices, m}});
     BackwardEuler fine(bar.system, hL / (16 * m));
     multirate.setState(bar.u0, bar.v0);
     async.setState(bar.u0, bar.v0);
@@ -132,23 +118,33 @@ TEST(UncoupledMultirate, DiffersFromAsyncForRatiosAboveOne) {
   }
 }
 
-TEST(UncoupledMultirate, IsRegisteredForScenesAndRejectsAsyncOnlyKeys) {
-  nlohmann::json json = {{"mesh", {{"generator", "beam"}, {"cellsAlongLength", 5}}},
-                         {"fixed", {{"sets", {"root"}}}},
-                         {"forces", {{{"type", "pull"}, {"set", "tip"}, {"force", {0, -1, 0}}, {"window", {0, 0.1}}}}},
-                         {"integrator",
-                          {{"name", "multirate-uncoupled"},
-                           {"timestep", 0.01},
-                           {"options", {{"regions", {{{"name", "tip"}, {"ratio", 4}, {"elementSets", {"tip"}}}}}}}}},
-                         {"frames", {{"rate", 50}, {"count", 2}}}};
-  Simulation simulation = buildSimulation(parseScene(json, ".", "multirate.json"));
-  EXPECT_EQ(simulation.integrator->name(), "multirate-uncoupled");
-  advanceFrame(simulation, 0);
-  EXPECT_GT(simulation.integrator->displacement().norm(), 0.0);
+// Registered by registerMultirateIntegrators() (which scenes use): built from its options
+// on the beam generator's mesh pulled at the tip for 0.1 s, and async-only keys rejected
+// by name.
+TEST(UncoupledMultirate, IsRegisteredAndRejectsAsyncOnlyKeys) {
+  BeamSpec spec;
+  spec.cellsAlongLength = 5;
+  const auto mesh = std::make_shared<const TetMesh>(makeBeamMesh(spec));
+  const std::vector<int>& tip = mesh->vertexSet("tip");
+  const Problem problem(mesh, mesh->vertexSet("root"), {},
+                        {VertexLoad{tip, Eigen::Vector3d(0.0, -1.0 / static_cast<double>(tip.size()), 0.0), 0.0, 0.1}});
+  IntegratorRegistry registry;
+  registerMultirateIntegrators(registry);
+  IntegratorContext context;
+  context.mesh = mesh;
+  context.system = problem.dynamicSystem();
+  context.timestep = 0.01;
+  context.frameRate = 50.0;
+  context.sourceName = "multirate.json";
+  nlohmann::json options = {{"regions", {{{"name", "tip"}, {"ratio", 4}, {"elementSets", {"tip"}}}}}};
+  const std::unique_ptr<Integrator> integrator = registry.create("multirate-uncoupled", context, options);
+  EXPECT_EQ(integrator->name(), "multirate-uncoupled");
+  for (int k = 0; k < 2; ++k) integrator->step();  // one frame at 50 frames/s
+  EXPECT_GT(integrator->displacement().norm(), 0.0);
 
-  json["integrator"]["options"]["schur"] = "symmetric";
+  options["schur"] = "symmetric";
   try {
-    buildSimulation(parseScene(json, ".", "multirate.json"));
+    registry.create("multirate-uncoupled", context, options);
     FAIL() << "expected a ValidationError";
   } catch (const ValidationError& error) {
     EXPECT_NE(std::string(error.what()).find("integrator.options.schur"), std::string::npos) << error.what();
