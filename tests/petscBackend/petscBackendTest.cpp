@@ -237,8 +237,8 @@ TEST(PetscProblemSettings, FollowTheProblem) {
     EXPECT_EQ(forces[(3 * 7) + 2], expected) << "t = " << t;
     EXPECT_EQ(forces.cwiseAbs().sum(), 2.0 * expected) << "t = " << t;
   }
-  EXPECT_FALSE(petscSettingsForProblem(Problem(mesh, {0}, ProblemSettings{}), "backward-euler", kTimestep)
-                   .timeDependentForce);
+  EXPECT_FALSE(
+      petscSettingsForProblem(Problem(mesh, {0}, ProblemSettings{}), "backward-euler", kTimestep).timeDependentForce);
 }
 
 TEST(PetscProblemSettings, NameWhatTheBackendCannotRun) {

@@ -21,9 +21,10 @@ Simulation build(const nlohmann::json& json, const std::filesystem::path& base =
   return asyncfem::buildSimulation(asyncfem::parseScene(json, base, "scene.json"));
 }
 
-// The frame timing parseScene resolves (nothing is built).
+// The frame timing of a scene (nothing is built); a timestep that does not divide the
+// frame interval is reported here, where the timing is used.
 asyncfem::FrameTiming timingOf(const nlohmann::json& json) {
-  return asyncfem::parseScene(json, "", "scene.json").timing;
+  return asyncfem::frameTimingOf(asyncfem::parseScene(json, "", "scene.json"));
 }
 
 // f_ext(t) of a built simulation at rest (size 3n; zero when it has no external force).
@@ -138,8 +139,7 @@ TEST(BuildSimulation, TimingOverridesAreResolvedAgain) {
         << error.what();
   }
   EXPECT_THROW(asyncfem::overrideFrameTiming(scene, overrides({}, {}, 0)), asyncfem::ValidationError);
-  EXPECT_THROW(asyncfem::overrideFrameTiming(scene, overrides(0.02, 5, {})),
-               asyncfem::ValidationError);
+  EXPECT_THROW(asyncfem::overrideFrameTiming(scene, overrides(0.02, 5, {})), asyncfem::ValidationError);
 }
 
 // A Scene built or edited in code (its timing not resolved from its keys) is resolved

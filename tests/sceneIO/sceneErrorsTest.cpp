@@ -160,11 +160,13 @@ const ErrorCase cases[] = {
      "scene.json: integrator.timestep: 0.03 does not divide the frame interval 1/10 s (frames.rate 10) into whole "
      "steps: 3.33333333333 steps per frame; the nearest valid timesteps are 1/30 s = 0.0333333333 s (3 steps per "
      "frame) and 1/40 s = 0.025 s (4 steps per frame); or give the steps per frame instead "
-     "(integrator.stepsPerFrame)"},
+     "(integrator.stepsPerFrame)",
+     true},
     {"StepLongerThanFrame", R"({"integrator": {"timestep": 0.2}})",
      "scene.json: integrator.timestep: 0.2 does not divide the frame interval 1/10 s (frames.rate 10) into whole "
      "steps: 0.5 steps per frame; the timestep is longer than a frame; the longest valid timestep is 1/10 s = 0.1 s "
-     "(1 step per frame)"},
+     "(1 step per frame)",
+     true},
     {"TimestepAndStepsPerFrame", R"({"integrator": {"stepsPerFrame": 4}})",
      "scene.json: integrator: give either \"timestep\" or \"stepsPerFrame\""},
     {"StepsPerFrameNotPositive", R"({"integrator": {"timestep": null, "stepsPerFrame": 0}})",

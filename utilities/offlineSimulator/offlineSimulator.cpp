@@ -241,8 +241,7 @@ void printRunHeader(std::ostream& out, const asyncfem::Scene& scene, const async
   out << ", " << (simulation.integrator->stats().steps - record.before.steps) << " steps of h = " << std::defaultfloat
       << std::setprecision(9) << simulation.integrator->timestep() << std::setprecision(3) << " ("
       << timing.stepsPerFrame << " per frame), " << std::fixed
-      << (record.setupSeconds + record.loopSeconds + (couplingCheck ? couplingCheck->estimate.seconds : 0.0))
-      << " s\n";
+      << (record.setupSeconds + record.loopSeconds + (couplingCheck ? couplingCheck->estimate.seconds : 0.0)) << " s\n";
   out << "  mesh        " << simulation.mesh->numVertices() << " vertices, " << simulation.mesh->numElements()
       << " elements, " << simulation.fixedVertices.size() << " fixed vertices\n";
   out << "  model       " << asyncfem::toString(simulation.problem->settings().forceModel)
@@ -262,8 +261,8 @@ void printRunHeader(std::ostream& out, const asyncfem::Scene& scene, const async
     }
   }
   for (const std::string& line : simulation.integrator->report().lines) out << "  integrator  " << line << "\n";
-  out << "  setup       " << record.setupSeconds << " s (mesh, matrices, first factorization: "
-      << record.before.factorizationSeconds << " s)\n";
+  out << "  setup       " << record.setupSeconds
+      << " s (mesh, matrices, first factorization: " << record.before.factorizationSeconds << " s)\n";
   if (couplingCheck) {
     const asyncfem::StepGrowthEstimate& estimate = couplingCheck->estimate;
     out << "  stability   paper coupling, " << couplingCheck->regions << ": step growth estimate " << std::defaultfloat
@@ -321,9 +320,8 @@ void printRunTrailer(std::ostream& out, const asyncfem::Scene& scene, const asyn
                           : std::string("not evaluated (see skipped)"))
       << "\n";
   out << "  output      " << scene.output.file.string() << " (" << simulation.timing.frameCount << " frames, "
-      << record.outputBytes << " bytes; " << record.checkpointsWritten << " checkpoints, "
-      << record.schedule.describe() << " and at the end, in "
-      << asyncfem::checkpointPathFor(scene.output.file).string() << ")";
+      << record.outputBytes << " bytes; " << record.checkpointsWritten << " checkpoints, " << record.schedule.describe()
+      << " and at the end, in " << asyncfem::checkpointPathFor(scene.output.file).string() << ")";
   if (!scene.output.vtuFolder.empty()) {
     out << ", .vtu files in " << scene.output.vtuFolder.string();
   }
@@ -360,7 +358,8 @@ asyncfem::PetscSimulationSettings petscSettings(const CommandLine& options, cons
                                                 const asyncfem::Problem& problem) {
   asyncfem::PetscSimulationSettings settings;
   try {
-    settings = asyncfem::petscSettingsForProblem(problem, scene.integrator.name, scene.timing.timestep);
+    settings =
+        asyncfem::petscSettingsForProblem(problem, scene.integrator.name, asyncfem::frameTimingOf(scene).timestep);
   } catch (const asyncfem::ValidationError& error) {
     throw asyncfem::Error(petscPrefix + scene.sourceName + ": " + error.what());
   }
@@ -370,7 +369,7 @@ asyncfem::PetscSimulationSettings petscSettings(const CommandLine& options, cons
 
 void printPetscSummary(const asyncfem::Scene& scene, const asyncfem::PetscRunStats& stats, double setupSeconds,
                        double loopSeconds) {
-  const asyncfem::FrameTiming& timing = scene.timing;
+  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
   std::ostringstream out;
   out.setf(std::ios::fixed);
   out.precision(3);
@@ -396,7 +395,7 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   asyncfem::Stopwatch setupWatch;
   setupWatch.start();
   asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
-  const asyncfem::FrameTiming& timing = scene.timing;
+  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
   const std::shared_ptr<const asyncfem::Problem> problem = asyncfem::buildProblem(scene);
   asyncfem::PetscSimulation simulation(problem->mesh(), petscSettings(options, scene, *problem));
   const bool root = simulation.rank() == 0;
@@ -519,9 +518,9 @@ RunOutput openOutput(const CommandLine& options, const asyncfem::Scene& scene, a
   if (!scene.output.vtuFolder.empty()) output.vtuSeries.emplace(scene.output.vtuFolder, scene.output.vtuEncoding);
   output.header = outputHeader(options, scene, simulation);
   const asyncfem::SimulationWriter::Options writerOptions{scene.output.sync};
-  output.fingerprint = asyncfem::runFingerprint(fingerprintText(options.scene), scene.integrator.name,
-                                                output.header.timestep, output.header.frameInterval,
-                                                *simulation.problem);
+  output.fingerprint =
+      asyncfem::runFingerprint(fingerprintText(options.scene), scene.integrator.name, output.header.timestep,
+                               output.header.frameInterval, *simulation.problem);
   output.checkpointFile = asyncfem::checkpointPathFor(scene.output.file);
   if (options.resume) {
     record.firstFrame = static_cast<int>(asyncfem::resumeFromCheckpoint(

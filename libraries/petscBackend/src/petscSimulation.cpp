@@ -303,7 +303,9 @@ void PetscSimulation::setState(const Eigen::VectorXd& displacement, const Eigen:
   s.accelerationStale = true;
 }
 
-Eigen::VectorXd PetscSimulation::gatherDisplacement() const { return impl_->body.gather(impl_->body.displacement.get()); }
+Eigen::VectorXd PetscSimulation::gatherDisplacement() const {
+  return impl_->body.gather(impl_->body.displacement.get());
+}
 Eigen::VectorXd PetscSimulation::gatherVelocity() const { return impl_->body.gather(impl_->body.velocity.get()); }
 double PetscSimulation::time() const { return impl_->time(); }
 double PetscSimulation::timestep() const { return impl_->settings.timestep; }

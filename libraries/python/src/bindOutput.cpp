@@ -9,7 +9,12 @@ namespace asyncfem::python {
 void bindOutput(py::module_& module) {
   py::class_<SimulationFileHeader>(module, "SimulationFileHeader")
       .def(py::init([](std::int64_t numVertices, double frameInterval, double timestep, bool hasVelocities) {
-             return SimulationFileHeader{numVertices, frameInterval, timestep, hasVelocities};
+             SimulationFileHeader header;
+             header.numVertices = numVertices;
+             header.frameInterval = frameInterval;
+             header.timestep = timestep;
+             header.hasVelocities = hasVelocities;
+             return header;
            }),
            py::arg("num_vertices"), py::arg("frame_interval"), py::arg("timestep") = 0.0,
            py::arg("has_velocities") = false)

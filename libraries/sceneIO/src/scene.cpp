@@ -587,18 +587,37 @@ Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePa
   parseFrames(top, scene);
   parseOutput(top, scene);
   top.finish();
-  scene.timing = resolveFrameTiming(scene);
-  // For programs that still read the key rather than timing.
-  scene.integrator.timestep = scene.timing.timestep;
+  checkTimingKeys(scene);
+  // A timestep that does not divide the frame interval is reported where the timing is
+  // used (frameTimingOf: buildSimulation, integratorContext), so that tools which only need
+  // the scene's mesh (afsimTool, frameRenderer) still read such a scene; timing then stays
+  // unresolved.
+  try {
+    scene.timing = resolveFrameTiming(scene);
+    // For programs that still read the key rather than timing.
+    scene.integrator.timestep = scene.timing.timestep;
+  } catch (const Error&) {
+    scene.timing = FrameTiming{};
+  }
   return scene;
 }
 
-FrameTiming resolveFrameTiming(const Scene& scene) {
+void checkTimingKeys(const Scene& scene) {
   const double rate = scene.frames.rate;
   if (!(rate > 0.0) || !std::isfinite(rate)) {
     throwSceneError(scene, "frames.rate", "expected a number > 0");
   }
   if (scene.frames.count < 1) throwSceneError(scene, "frames.count", "expected a count >= 1");
+  if (scene.integrator.stepsPerFrame > 0) return;
+  const double h = scene.integrator.timestep;
+  if (!(h > 0.0) || !std::isfinite(h)) {
+    throwSceneError(scene, "integrator.timestep", "expected a number > 0");
+  }
+}
+
+FrameTiming resolveFrameTiming(const Scene& scene) {
+  checkTimingKeys(scene);
+  const double rate = scene.frames.rate;
   FrameTiming timing;
   timing.frameRate = rate;
   timing.frameInterval = 1.0 / rate;
@@ -609,9 +628,6 @@ FrameTiming resolveFrameTiming(const Scene& scene) {
     return timing;
   }
   const double h = scene.integrator.timestep;
-  if (!(h > 0.0) || !std::isfinite(h)) {
-    throwSceneError(scene, "integrator.timestep", "expected a number > 0");
-  }
   const double ratio = timing.frameInterval / h;
   const double steps = std::round(ratio);
   // |h - T / N| / (T / N) = |N - ratio| / ratio.

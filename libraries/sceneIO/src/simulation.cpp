@@ -321,7 +321,8 @@ void requireKnownIntegrator(const Scene& scene, const IntegratorRegistry& regist
   if (registry.find(scene.integrator.name) != nullptr) return;
   std::string known;
   for (const std::string& name : registry.names()) known += (known.empty() ? "" : ", ") + name;
-  throwSceneError(scene, "integrator.name", "unknown integrator \"" + scene.integrator.name + "\" (known: " + known + ")");
+  throwSceneError(scene, "integrator.name",
+                  "unknown integrator \"" + scene.integrator.name + "\" (known: " + known + ")");
 }
 
 // What the builder leaves out and what the user should know before the run.
@@ -329,8 +330,7 @@ void noteSkippedAndWarnings(const Scene& scene, Simulation& simulation) {
   const Problem& problem = *simulation.problem;
   simulation.skipped = problem.skipped();
   if (simulation.contact) {
-    simulation.warnings =
-        contactStepWarnings(scene, problem.mesh(), problem.massMatrix(), simulation.timing.timestep);
+    simulation.warnings = contactStepWarnings(scene, problem.mesh(), problem.massMatrix(), simulation.timing.timestep);
   }
   if (scene.output.vtuFolder.empty()) simulation.skipped.emplace_back("vtu output (output.vtu not set)");
   if (!scene.output.velocities) simulation.skipped.emplace_back("velocity output (output.velocities = false)");

@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <asyncfem/core/enumNames.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/warping/modalWarping.hpp>
 #include <asyncfem/warping/rotationStrainWarping.hpp>
@@ -29,25 +30,16 @@ class IdentityWarping final : public Warping {
 
 }  // namespace
 
-std::string toString(WarpingKind kind) {
-  switch (kind) {
-    case WarpingKind::none:
-      return "none";
-    case WarpingKind::rotationStrain:
-      return "rotation-strain";
-    case WarpingKind::modal:
-      return "modal";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<WarpingKind> kWarpingNames[] = {
+    {WarpingKind::none, "none"}, {WarpingKind::rotationStrain, "rotation-strain"}, {WarpingKind::modal, "modal"}};
+}  // namespace
+
+std::string toString(WarpingKind kind) { return std::string(findEnumName(kWarpingNames, kind).value_or("unknown")); }
 
 WarpingKind parseWarpingKind(const std::string& name) {
-  for (const WarpingKind kind : {WarpingKind::none, WarpingKind::rotationStrain, WarpingKind::modal}) {
-    if (toString(kind) == name) {
-      return kind;
-    }
-  }
-  throw Error("unknown warping \"" + name + "\" (expected none, rotation-strain or modal)");
+  if (const std::optional<WarpingKind> kind = findEnumValue(kWarpingNames, name)) return *kind;
+  throw Error("unknown warping \"" + name + "\" (expected " + joinEnumNames(kWarpingNames, ", ", " or ") + ")");
 }
 
 std::unique_ptr<Warping> makeWarping(WarpingKind kind, const TetMesh& mesh, const std::vector<int>& fixedVertices) {

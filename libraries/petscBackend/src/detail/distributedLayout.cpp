@@ -33,9 +33,8 @@ std::vector<bool> fixedMask(const std::vector<int>& fixedVertices, int numVertic
 
 // Part sizes, this rank's elements, each vertex's owner (the lowest part among its
 // elements; INT_MAX for none) and the vertex -> element adjacency.
-std::vector<int> assignOwners(const TetMesh& mesh, const std::vector<bool>& fixed,
-                              const std::vector<int>& elementPart, DistributedLayout& layout,
-                              VertexElements& adjacency) {
+std::vector<int> assignOwners(const TetMesh& mesh, const std::vector<bool>& fixed, const std::vector<int>& elementPart,
+                              DistributedLayout& layout, VertexElements& adjacency) {
   const int numVertices = mesh.numVertices();
   const Eigen::Matrix4Xi& elements = mesh.elements();
   std::vector<int> owner(static_cast<std::size_t>(numVertices), INT_MAX);

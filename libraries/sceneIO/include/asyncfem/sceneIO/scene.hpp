@@ -161,6 +161,10 @@ inline constexpr double timestepDivisorTolerance = 1e-9;
 /// "<scene>: integrator.timestep: ..." naming the frame interval and the two nearest valid
 /// timesteps with their steps per frame when it is not, "<scene>: frames.rate: ..." for a
 /// bad rate and "<scene>: frames.count: ..." for a count below 1.
+/// Throws asyncfem::ValidationError naming the key for a frames.rate or frames.count out
+/// of range, or a timestep that is not > 0 (when no stepsPerFrame is given); parseScene
+/// checks these, resolveFrameTiming also whether the timestep divides the frame interval.
+void checkTimingKeys(const Scene& scene);
 FrameTiming resolveFrameTiming(const Scene& scene);
 
 /// scene.timing when it is the timing of the scene's keys (as parseScene and
