@@ -213,7 +213,7 @@ void AsyncBackwardEuler::assembleBlocks() {
 // Z, the Schur corrections and the H^{LL*} factor from the current blocks.
 void AsyncBackwardEuler::fullSchurRebuild() {
   Impl& d = *impl_;
-  const bool setUpBuild = d.settingUp || (runStats_.rebuilds == 0 && runStats_.steps == 0);
+  const bool setUpBuild = d.settingUp;
   Stopwatch factor;
   const detail::CorrectionRun run = detail::computeCorrections(d.regions, options_, system_.damped());
   stats_.factorizations += run.helperFactorizations;
@@ -303,7 +303,9 @@ void AsyncBackwardEuler::evaluateStartOfStep() {
   const bool first = runStats_.rebuilds == 0 && runStats_.steps == 0;
   d.schurLagging = options_.laggedSchur && !d.linear && d.schur.factored() && !d.schur.refreshRequested() &&
                    options_.method == AsyncSolveMethod::structured;
+  d.settingUp = first;
   refactor();
+  d.settingUp = false;
   d.factorsCurrent = true;
   const double seconds = rebuild.stop();
   if (first) {
@@ -392,8 +394,8 @@ void AsyncBackwardEuler::addInterfaceVelocityTerms() {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& pos = partition_.interfacePositions(i);
     if (pos.empty()) continue;
-    rb.xSum = detail::gather(v0, partition_.regionDofs(i));           // scratch: v^S_0
-    rb.yInterface = detail::gather(v0, partition_.interfaceDofs(i));  // scratch: v^I_0
+    detail::gatherInto(v0, partition_.regionDofs(i), rb.xSum);           // scratch: v^S_0
+    detail::gatherInto(v0, partition_.interfaceDofs(i), rb.yInterface);  // scratch: v^I_0
     rb.interfaceRow.resize(static_cast<Eigen::Index>(pos.size()));
     rb.interfaceRow.noalias() = rb.Kis * rb.xSum;
     rb.interfaceRow.noalias() += rb.interfaceStiffness * rb.yInterface;
@@ -478,7 +480,7 @@ void AsyncBackwardEuler::recoverRegion(int i) {
     rb.substituted = true;
     return;
   }
-  rb.yInterface = detail::gather(d.Y, pos);
+  detail::gatherInto(d.Y, pos, rb.yInterface);
   if (rb.useDenseZ && !observer_ && !d.schurLagging) {
     rb.xLast = rb.y.col(rb.ratio - 1);
     rb.xLast.noalias() -= rb.zLast * rb.yInterface;
@@ -562,7 +564,7 @@ void AsyncBackwardEuler::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& o
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& pos = partition_.interfacePositions(i);
     if (pos.empty()) return;
-    rb.yInterface = detail::gather(y, pos);
+    detail::gatherInto(y, pos, rb.yInterface);
     const detail::CouplingCoefficients& k = rb.coupling;
     rb.couplingProducts(damped);
     rb.probe.resize(rb.massY.size(), rb.ratio);

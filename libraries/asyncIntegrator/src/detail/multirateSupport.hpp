@@ -23,6 +23,13 @@ inline Eigen::VectorXd gather(const Eigen::VectorXd& full, const std::vector<int
   return out;
 }
 
+/// out = the entries of full at the listed global DOFs, without allocating when out
+/// already has that size (per-step buffers).
+inline void gatherInto(const Eigen::VectorXd& full, const std::vector<int>& dofs, Eigen::VectorXd& out) {
+  out.resize(static_cast<Eigen::Index>(dofs.size()));
+  for (std::size_t k = 0; k < dofs.size(); ++k) out[static_cast<Eigen::Index>(k)] = full[dofs[k]];
+}
+
 /// sub = full(rows, cols) through the extractor: cut (pattern and values) the first time,
 /// values only once `alreadyCut`.
 inline void updateBlock(const SubmatrixExtractor& extractor, const Eigen::SparseMatrix<double>& full,
