@@ -43,6 +43,7 @@ const std::vector<Documented>& documented() {
        148.17,
        {"jaw", "s1", "s2", "s3", "s4", "s5", "s6", "head", "neck", "body", "tail", "feet"}},
       {ExampleModel::Drop, 1097, 4507, 19.40, 138.33, {"stiffPart", "soft"}},
+      {ExampleModel::Ball, 1506, 6798, 22.94, 125.82, {"ball"}},
   };
   return table;
 }

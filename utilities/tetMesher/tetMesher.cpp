@@ -5,7 +5,7 @@
 //   tetMesher SURFACE --output OUT.veg [--spacing H | --cells N] [--set NAME:x0,y0,z0,x1,y1,z1]...
 //             [--part-sets] [--material SET:rho,E,nu]... [--default-material rho,E,nu]
 //             [--repair] [--weld-tolerance T] [--quiet]
-//   tetMesher --model dinosaur|flower|dragon|drop --output OUT.veg [--spacing H] [--set ...]
+//   tetMesher --model dinosaur|flower|dragon|drop|ball --output OUT.veg [--spacing H] [--set ...]
 //
 // The report goes to stdout; errors print "tetMesher: <message>" on stderr and exit 1
 // (2 for unusable command-line options). docs/tet-mesher.md describes everything.
@@ -358,7 +358,7 @@ int main(int argc, char** argv) {
   Options options;
   app.add_option("surface", options.input,
                  "Closed triangle surface (any format assimp reads: OBJ, STL, PLY, OFF, ...)");
-  app.add_option("--model", options.model, "Built-in example model: dinosaur, flower, dragon, drop");
+  app.add_option("--model", options.model, "Built-in example model: dinosaur, flower, dragon, drop, ball");
   app.add_option("-o,--output", options.output, "Output mesh (.veg, or .vtu for ParaView)")->required();
   app.add_option("--spacing", options.spacing, "BCC lattice spacing (length units of the input)")
       ->check(asyncfem::cli::positive());

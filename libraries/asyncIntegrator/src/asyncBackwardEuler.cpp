@@ -13,6 +13,7 @@
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "detail/fastRegion.hpp"
@@ -81,7 +82,28 @@ struct AsyncBackwardEuler::Impl {
   }
 };
 
+// A set-up kept for reuse by run-time regions (the most recently used first).
+struct AsyncBackwardEuler::CachedSetUp {
+  std::vector<std::pair<int, std::vector<int>>> key;  // (ratio, vertices) of every region, sorted
+  RegionPartition partition;
+  std::unique_ptr<Impl> impl;
+  AsyncRunStats sizes;  // fastDofs, interfaceDofs, largeDofs
+  double timestep = 0.0;
+};
+
 namespace {
+std::vector<std::pair<int, std::vector<int>>> partitionKey(const RegionPartition& partition) {
+  std::vector<std::pair<int, std::vector<int>>> key;
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    std::vector<int> vertices = partition.region(i).vertices;
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    key.emplace_back(partition.ratio(i), std::move(vertices));
+  }
+  std::sort(key.begin(), key.end());
+  return key;
+}
+
 /// Time of substep r of a region with `ratio` substeps in the large step [t0, t1]; the last
 /// one is exactly t1.
 double substepTime(double t0, double t1, int r, int ratio, double smallStep) {
@@ -97,11 +119,8 @@ AsyncBackwardEuler::AsyncBackwardEuler(DynamicSystem system, double largeTimeste
                                        AsyncOptions options)
     : PartitionedIntegrator("async", std::move(system), largeTimestep, std::move(regions)),
       options_(options),
-      impl_(std::make_unique<Impl>()) {
-  Impl& d = *impl_;
-  d.linear = system_.forceModel->isLinear();
-  d.stiffness = system_.forceModel->createStiffnessMatrix();
-  d.stiffness.makeCompressed();
+      impl_(freshImpl()) {
+  const Impl& d = *impl_;
   if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
   if (d.linear)
     stats_.skipped.push_back("per-step refactorization (linear forces: blocks, Z and H^{LL*} factored once)");
@@ -111,6 +130,95 @@ AsyncBackwardEuler::AsyncBackwardEuler(DynamicSystem system, double largeTimeste
 }
 
 AsyncBackwardEuler::~AsyncBackwardEuler() = default;
+
+std::unique_ptr<AsyncBackwardEuler::Impl> AsyncBackwardEuler::freshImpl() const {
+  auto impl = std::make_unique<Impl>();
+  impl->linear = system_.forceModel->isLinear();
+  impl->stiffness = system_.forceModel->createStiffnessMatrix();
+  impl->stiffness.makeCompressed();
+  return impl;
+}
+
+void AsyncBackwardEuler::setAdaptiveRegions(AdaptiveRegionOptions options) {
+  if (options.contact && !system_.obstacleProximity) {
+    throw ValidationError(
+        "async integrator: adaptive regions: the contact policy needs obstacles (a \"contact\" section)");
+  }
+  policy_ = std::make_unique<AdaptiveRegionPolicy>(*system_.mesh, system_.freeDofs, std::move(options));
+  stepsKept_ = 0;
+  maybeRepartition();
+}
+
+// At a large-step boundary the state is synchronous: a new partition needs no transfer.
+void AsyncBackwardEuler::maybeRepartition() {
+  if (!policy_) return;
+  std::vector<AsyncRegion> current;
+  for (int i = 0; i < partition_.numRegions(); ++i) current.push_back(partition_.region(i));
+  std::string reason;
+  std::optional<std::vector<AsyncRegion>> next = policy_->decide(
+      time(), timestep(), displacement_, velocity_, system_.obstacleProximity, current, stepsKept_, reason);
+  if (next) repartition(std::move(*next), reason);
+}
+
+void AsyncBackwardEuler::repartition(std::vector<AsyncRegion> regions, const std::string& reason) {
+  Stopwatch watch;
+  RepartitionRecord record;
+  record.time = time();
+  record.step = runStats_.steps;
+  record.reason = reason;
+  const std::vector<int> before = partition_.vertexRegion();
+  const std::vector<int> beforeRatio = [&] {
+    std::vector<int> ratio(before.size(), 1);
+    for (std::size_t v = 0; v < before.size(); ++v)
+      if (before[v] >= 0) ratio[v] = partition_.ratio(before[v]);
+    return ratio;
+  }();
+  RegionPartition next(*system_.mesh, system_.freeDofs, std::move(regions));
+  auto key = partitionKey(next);
+  auto hit = std::find_if(cache_.begin(), cache_.end(), [&](const CachedSetUp& c) { return c.key == key; });
+  if (hit == cache_.end() && policy_) {
+    // A cached partition that covers what the policy needs (a contact patch like one
+    // seen before) serves as well as the new one, at no set-up.
+    std::vector<AsyncRegion> proposal;
+    for (int i = 0; i < next.numRegions(); ++i) proposal.push_back(next.region(i));
+    hit = std::find_if(cache_.begin(), cache_.end(), [&](const CachedSetUp& c) {
+      std::vector<AsyncRegion> cached;
+      for (int i = 0; i < c.partition.numRegions(); ++i) cached.push_back(c.partition.region(i));
+      return policy_->canServe(cached, proposal, time(), timestep(), displacement_, velocity_,
+                               system_.obstacleProximity);
+    });
+  }
+  CachedSetUp outgoing{partitionKey(partition_), std::move(partition_), std::move(impl_), runStats_, timestep()};
+  const double setupBefore = runStats_.setupSeconds;
+  if (hit != cache_.end()) {
+    partition_ = std::move(hit->partition);
+    impl_ = std::move(hit->impl);
+    runStats_.fastDofs = hit->sizes.fastDofs;
+    runStats_.interfaceDofs = hit->sizes.interfaceDofs;
+    runStats_.largeDofs = hit->sizes.largeDofs;
+    if (hit->timestep != timestep()) impl_->factorsCurrent = false;
+    cache_.erase(hit);
+    record.reused = true;
+  } else {
+    partition_ = RegionPartition(*system_.mesh, system_.freeDofs, {});  // placeholder until setUp
+    impl_ = freshImpl();
+    setUp(std::move(next));
+  }
+  const int keep = policy_ ? policy_->options().cacheSize : 0;
+  if (keep > 0) cache_.insert(cache_.begin(), std::move(outgoing));
+  if (static_cast<int>(cache_.size()) > keep) cache_.erase(cache_.begin() + keep, cache_.end());
+  stepsKept_ = 0;
+  const std::vector<int>& after = partition_.vertexRegion();
+  for (std::size_t v = 0; v < after.size(); ++v) {
+    const int ratio = after[v] >= 0 ? partition_.ratio(after[v]) : 1;
+    if (ratio != beforeRatio[v]) ++record.movedVertices;
+    if (after[v] >= 0) ++record.fastVertices;
+  }
+  record.regions = partition_.numRegions();
+  record.interfaceDofs = runStats_.interfaceDofs;
+  record.seconds = record.reused ? watch.stop() : runStats_.setupSeconds - setupBefore;
+  repartitions_.push_back(record);
+}
 
 void AsyncBackwardEuler::checkPartitionFits(const RegionPartition& partition) const {
   std::size_t partitioned = partition.largeDofs().size();
@@ -267,6 +375,7 @@ void AsyncBackwardEuler::subtractInterfaceStiffness() {
 }
 
 void AsyncBackwardEuler::step() {
+  maybeRepartition();
   Impl& d = *impl_;
   Stopwatch whole;
   const double rebuildBefore = runStats_.setupSeconds + runStats_.rebuildSeconds;
@@ -288,6 +397,7 @@ void AsyncBackwardEuler::step() {
   commitStep(d.newU, d.newV);
   countSolves();
   ++runStats_.steps;
+  ++stepsKept_;
   runStats_.stepSeconds += whole.stop() - (runStats_.setupSeconds + runStats_.rebuildSeconds - rebuildBefore);
 }
 
@@ -644,6 +754,7 @@ RunReport AsyncBackwardEuler::report() const {
                   r.laggedSteps, r.schurIterations, r.largestSchurResidual);
     lines.emplace_back(line);
   }
+  if (policy_) appendRepartitionLines(repartitions_, lines);
   return report;
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
@@ -72,16 +73,7 @@ std::vector<char> fastVertices(const TetMesh& mesh, const Eigen::VectorXd& omega
     if (omega[e] * hL > target)
       for (int a = 0; a < 4; ++a) fast[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
   }
-  for (int layer = 0; layer < growLayers; ++layer) {
-    std::vector<char> grown = fast;
-    for (int e = 0; e < mesh.numElements(); ++e) {
-      bool any = false;
-      for (int a = 0; a < 4; ++a) any = any || fast[static_cast<std::size_t>(mesh.elements()(a, e))];
-      if (any)
-        for (int a = 0; a < 4; ++a) grown[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
-    }
-    fast.swap(grown);
-  }
+  growByRings(mesh, fast, growLayers);
   return fast;
 }
 

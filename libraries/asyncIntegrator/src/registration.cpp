@@ -24,12 +24,18 @@ std::vector<std::string> stringList(JsonObjectReader& reader, const std::string&
   return out;
 }
 
+// One region object; with window set (a scheduled region) also its "start" and "end".
 AsyncRegion parseRegion(const std::string& sourceName, const TetMesh& mesh, const nlohmann::json& value,
-                        const std::string& path) {
+                        const std::string& path, ScheduledRegion* window = nullptr) {
   JsonObjectReader reader(value, path, sourceName);
   AsyncRegion region;
   region.name = reader.string("name", "");
   region.ratio = reader.integer("ratio", 1, 1, 100000);
+  if (window) {
+    window->start = reader.number("start", 0.0);
+    window->end = reader.number("end", window->end);
+    if (!(window->end > window->start)) reader.fail("end", "must be after \"start\"");
+  }
   RegionSelector selector;
   selector.vertexSets = stringList(reader, "vertexSets");
   selector.elementSets = stringList(reader, "elementSets");
@@ -118,6 +124,47 @@ AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
   return solver;
 }
 
+// "adaptive": {"contact": {...}, "schedule": [...], "minDwell", "shrink", "cache"}.
+AdaptiveRegionOptions parseAdaptive(const IntegratorContext& context, const nlohmann::json& value,
+                                    const std::string& path) {
+  const std::string& sourceName = context.sourceName;
+  JsonObjectReader reader(value, path, sourceName);
+  AdaptiveRegionOptions out;
+  if (const nlohmann::json* contact = reader.find("contact")) {
+    if (!context.hasContact) reader.fail("contact", "needs obstacles: add a \"contact\" section to the scene");
+    JsonObjectReader c(*contact, reader.keyPath("contact"), sourceName);
+    out.contact = true;
+    out.contactRatio = c.integer("ratio", out.contactRatio, 2, 100000);
+    out.contactMargin = c.number("margin", out.contactMargin);
+    if (!(out.contactMargin >= 0.0)) c.fail("margin", "must be >= 0 (a length)");
+    out.contactLookahead = c.number("lookahead", out.contactLookahead);
+    if (!(out.contactLookahead >= 0.0)) c.fail("lookahead", "must be >= 0 (large steps)");
+    out.contactRings = c.integer("rings", out.contactRings, 0, 100);
+    c.finish();
+  }
+  if (const nlohmann::json* schedule = reader.find("schedule")) {
+    if (!schedule->is_array()) reader.fail("schedule", "expected an array of regions with \"start\" and \"end\"");
+    for (std::size_t i = 0; i < schedule->size(); ++i) {
+      ScheduledRegion window;
+      AsyncRegion region =
+          parseRegion(sourceName, *context.mesh, (*schedule)[i], reader.elementPath("schedule", i), &window);
+      window.name = region.name;
+      window.ratio = region.ratio;
+      window.vertices = std::move(region.vertices);
+      out.schedule.push_back(std::move(window));
+    }
+  }
+  if (!out.contact && out.schedule.empty()) {
+    JsonObjectReader::failAt(sourceName, path, "give at least one policy: \"contact\" or \"schedule\"");
+  }
+  out.minDwell = reader.integer("minDwell", out.minDwell, 0, 1000000);
+  out.shrinkFactor = reader.number("shrink", out.shrinkFactor);
+  if (!(out.shrinkFactor >= 1.0)) reader.fail("shrink", "must be >= 1");
+  out.cacheSize = reader.integer("cache", out.cacheSize, 0, 64);
+  reader.finish();
+  return out;
+}
+
 // "regions" (default "auto") and "auto" into out: the explicit regions, or the automatic
 // settings (the proposal runs after the keys are checked).
 void parseRegions(JsonObjectReader& reader, const IntegratorContext& context, const nlohmann::json& options,
@@ -134,14 +181,21 @@ void parseRegions(JsonObjectReader& reader, const IntegratorContext& context, co
     out.automaticRegions = true;
     out.automatic = parseAutoRegionOptions(context, options);
     (void)reader.find("auto");  // read by parseAutoRegionOptions
+  } else if (regions.is_object()) {
+    if (reader.find("auto")) reader.fail("auto", "only with \"regions\": \"auto\"");
+    JsonObjectReader object(regions, regionsPath, sourceName);
+    out.adaptiveSource = object.required("adaptive");
+    out.adaptive = parseAdaptive(context, out.adaptiveSource, object.keyPath("adaptive"));
+    object.finish();
   } else if (regions.is_array()) {
     if (reader.find("auto")) reader.fail("auto", "only with \"regions\": \"auto\"");
     for (std::size_t i = 0; i < regions.size(); ++i) {
       out.regions.push_back(parseRegion(sourceName, *context.mesh, regions[i], reader.elementPath("regions", i)));
     }
   } else {
-    JsonObjectReader::failAt(sourceName, regionsPath,
-                             "expected \"auto\" or an array of regions, got " + JsonObjectReader::describe(regions));
+    JsonObjectReader::failAt(
+        sourceName, regionsPath,
+        "expected \"auto\", an array of regions or {\"adaptive\": ...}, got " + JsonObjectReader::describe(regions));
   }
 }
 
@@ -235,7 +289,8 @@ nlohmann::json asyncSettingsJson(const AsyncSettings& settings) {
   }
   if (solver.laggedSchur != defaults.laggedSchur) out["laggedSchur"] = solver.laggedSchur;
   if (solver.threads != defaults.threads) out["threads"] = solver.threads;
-  out["regions"] = asyncRegionsJson(settings.regions);
+  out["regions"] =
+      settings.adaptive ? nlohmann::json{{"adaptive", settings.adaptiveSource}} : asyncRegionsJson(settings.regions);
   return out;
 }
 
@@ -250,8 +305,10 @@ void registerMultirateIntegrators(IntegratorRegistry& registry) {
       "async",
       [](IntegratorContext context, const nlohmann::json& options) -> std::unique_ptr<Integrator> {
         const AsyncSettings parsed = parseAsyncSettings(context, options);
-        return std::make_unique<AsyncBackwardEuler>(*context.mesh, std::move(context.system), context.timestep,
-                                                    parsed.regions, parsed.solver);
+        auto integrator = std::make_unique<AsyncBackwardEuler>(*context.mesh, std::move(context.system),
+                                                               context.timestep, parsed.regions, parsed.solver);
+        if (parsed.adaptive) integrator->setAdaptiveRegions(*parsed.adaptive);
+        return integrator;
       },
       asyncOptionKeys());
   registry.add("multirate-uncoupled",
@@ -283,6 +340,10 @@ void registerMultirateIntegrators(IntegratorRegistry& registry) {
                    regionOptions.erase("compoundSolver");
                  }
                  const AsyncSettings parsed = parseAsyncSettings(context, regionOptions);
+                 if (parsed.adaptive) {
+                   JsonObjectReader::failAt(context.sourceName, path + ".regions",
+                                            "run-time (adaptive) regions are available with \"async\" only");
+                 }
                  solverOptions.regionSolver = parsed.solver.regionSolver;
                  return std::make_unique<UncoupledMultirate>(*context.mesh, std::move(context.system), context.timestep,
                                                              parsed.regions, solverOptions);

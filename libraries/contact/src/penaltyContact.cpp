@@ -35,7 +35,7 @@ PenaltyContact::PenaltyContact(Eigen::Matrix3Xd restPositions, std::vector<Conta
 
 template <class Visitor>
 void PenaltyContact::forEachContact(const Eigen::VectorXd& displacement, const std::vector<int>* vertices,
-                                    Visitor&& visit) const {
+                                    Visitor&& visit, double margin) const {
   const int n = static_cast<int>(restPositions_.cols());
   const int count = vertices ? static_cast<int>(vertices->size()) : n;
   for (int k = 0; k < count; ++k) {
@@ -43,13 +43,13 @@ void PenaltyContact::forEachContact(const Eigen::VectorXd& displacement, const s
     const Eigen::Vector3d x = restPositions_.col(v) + displacement.segment<3>(3 * v);
     for (const ContactPlane& plane : planes_) {
       const double depth = plane.offset - plane.normal.dot(x);
-      if (depth > 0.0) visit(v, depth, plane.normal);
+      if (depth > -margin) visit(v, depth, plane.normal);
     }
     for (const ContactSphere& sphere : spheres_) {
       const Eigen::Vector3d r = x - sphere.center;
       const double distance = r.norm();
       const double depth = sphere.radius - distance;
-      if (depth > 0.0) {
+      if (depth > -margin) {
         const Eigen::Vector3d normal = distance > 0.0 ? Eigen::Vector3d(r / distance) : Eigen::Vector3d::UnitY();
         visit(v, depth, normal);
       }
@@ -82,6 +82,17 @@ double PenaltyContact::maxPenetration(const Eigen::VectorXd& displacement) const
   forEachContact(displacement, nullptr,
                  [&](int, double depth, const Eigen::Vector3d&) { worst = std::max(worst, depth); });
   return worst;
+}
+
+std::vector<int> PenaltyContact::verticesWithin(const Eigen::VectorXd& displacement, double margin) const {
+  std::vector<int> out;
+  forEachContact(
+      displacement, nullptr,
+      [&](int v, double, const Eigen::Vector3d&) {
+        if (out.empty() || out.back() != v) out.push_back(v);
+      },
+      std::max(0.0, margin));
+  return out;
 }
 
 int PenaltyContact::activeContacts(const Eigen::VectorXd& displacement) const {

@@ -136,6 +136,12 @@ DynamicSystem Problem::dynamicSystem() const {
       external->addTo(time, displacement, velocity, forces);
     };
   }
+  if (contact_) {
+    system.obstacleProximity = [contact = contact_](const Eigen::VectorXd& displacement, double margin,
+                                                    std::vector<int>& vertices) {
+      vertices = contact->verticesWithin(displacement, margin);
+    };
+  }
   return system;
 }
 

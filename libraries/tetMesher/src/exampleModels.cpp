@@ -100,13 +100,21 @@ ImplicitModel drop() {
   return model;
 }
 
+ImplicitModel ball() {
+  ImplicitModel model;
+  model.parts.push_back({"ball", implicitSphere(Vector3d(0.0, 0.45, 0.0), 0.2)});
+  model.bounds = Eigen::AlignedBox3d(Vector3d(-0.25, 0.2, -0.25), Vector3d(0.25, 0.7, 0.25));
+  model.spacing = 0.04;
+  return model;
+}
+
 /// Radii of the nested dragon regions s1 ... s6 around the head centre.
 constexpr std::array<double, 6> kDragonRegionRadii{0.15, 0.22, 0.3, 0.4, 0.52, 0.66};
 
 }  // namespace
 
 const std::vector<std::string>& exampleModelNames() {
-  static const std::vector<std::string> names{"dinosaur", "flower", "dragon", "drop"};
+  static const std::vector<std::string> names{"dinosaur", "flower", "dragon", "drop", "ball"};
   return names;
 }
 
@@ -134,6 +142,8 @@ ImplicitModel exampleModelShape(ExampleModel model) {
       return dragon();
     case ExampleModel::Drop:
       return drop();
+    case ExampleModel::Ball:
+      return ball();
   }
   throw ValidationError("unknown example model");
 }
@@ -151,6 +161,8 @@ Material defaultMaterial(ExampleModel model) {
       return Material{"body", 1000.0, 1.5e5, 0.45};
     case ExampleModel::Drop:
       return Material{"soft", 1000.0, 1e5, 0.45};
+    case ExampleModel::Ball:
+      return Material{"rubber", 1000.0, 2e5, 0.45};
   }
   throw ValidationError("unknown example model");
 }
@@ -195,6 +207,8 @@ void assignFastParts(TetMesh& mesh, ExampleModel model) {
       // 10 m/s in the soft block, 100 in the stiff handle (10x).
       assignSetMaterial(mesh, "stiffPart", Material{"stiffPart", 300.0, 3e6, 0.45});
       break;
+    case ExampleModel::Ball:
+      break;  // one material: fast regions come from contact at run time
   }
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/asyncOptions.hpp>
 #include <asyncfem/asyncIntegrator/partitionedIntegrator.hpp>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
@@ -50,6 +51,15 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   /// the next step on: every block, factor and analysis of the old one is dropped.
   void setUp(RegionPartition partition);
 
+  /// Regions chosen at run time from the next step on (docs/asynchronous-integrator.md,
+  /// "Run-time regions"): at every large-step boundary the policy may replace the
+  /// partition (setUp with the new one, or a cached set-up of an earlier identical one).
+  /// Throws asyncfem::ValidationError for options AdaptiveRegionPolicy rejects, and for the
+  /// contact policy on a system without obstacles (DynamicSystem::obstacleProximity).
+  void setAdaptiveRegions(AdaptiveRegionOptions options);
+  /// Every change of partition so far, in order.
+  const std::vector<RepartitionRecord>& repartitions() const { return repartitions_; }
+
   std::string name() const override { return "async"; }
   void step() override;
   void setTimestep(double timestep) override;
@@ -85,6 +95,10 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
 
  private:
   struct Impl;
+  struct CachedSetUp;
+  std::unique_ptr<Impl> freshImpl() const;
+  void maybeRepartition();
+  void repartition(std::vector<AsyncRegion> regions, const std::string& reason);
   void refactor();
   void assembleBlocks();
   void subtractInterfaceStiffness();
@@ -107,6 +121,10 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   SchurMode schurModeUsed_ = SchurMode::lowRank;
   AsyncRunStats runStats_;
   std::unique_ptr<Impl> impl_;
+  std::unique_ptr<AdaptiveRegionPolicy> policy_;
+  std::vector<RepartitionRecord> repartitions_;
+  long long stepsKept_ = 0;  // large steps since the last change of partition
+  std::vector<CachedSetUp> cache_;
 };
 
 }  // namespace asyncfem

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/integrator/registry.hpp>
@@ -21,6 +22,10 @@ struct AsyncSettings {
   std::vector<AsyncRegion> regions;  ///< explicit regions, or those the automatic proposal kept
   /// The automatic proposal (regions "auto"), for reports: what was proposed, withdrawn, why.
   std::optional<AutoRegionProposal> proposal;
+  /// Run-time regions ("regions": {"adaptive": {...}}): the policy, and the object as given
+  /// (written back by asyncSettingsJson).
+  std::optional<AdaptiveRegionOptions> adaptive;
+  nlohmann::json adaptiveSource;
 };
 
 /// The option keys "async" reads.

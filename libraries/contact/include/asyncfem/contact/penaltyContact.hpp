@@ -58,12 +58,18 @@ class PenaltyContact {
   double maxPenetration(const Eigen::VectorXd& displacement) const;
   /// Number of vertices in contact at u.
   int activeContacts(const Eigen::VectorXd& displacement) const;
+  /// Vertices (ascending) in contact at u or closer than margin (length, >= 0) to an
+  /// obstacle: what a contact-following fast region needs.
+  std::vector<int> verticesWithin(const Eigen::VectorXd& displacement, double margin) const;
 
   const PenaltyContactParameters& parameters() const { return parameters_; }
 
  private:
   template <class Visitor>
-  void forEachContact(const Eigen::VectorXd& displacement, const std::vector<int>* vertices, Visitor&& visit) const;
+  /// visit(vertex, depth, normal) for every vertex and obstacle with depth > -margin
+  /// (margin 0: the vertices in contact), vertices in ascending order.
+  void forEachContact(const Eigen::VectorXd& displacement, const std::vector<int>* vertices, Visitor&& visit,
+                      double margin = 0.0) const;
 
   Eigen::Matrix3Xd restPositions_;
   std::vector<ContactPlane> planes_;

@@ -8,6 +8,7 @@
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <functional>
 #include <memory>
+#include <vector>
 
 namespace asyncfem {
 
@@ -16,6 +17,11 @@ namespace asyncfem {
 /// (penalty contact, springs) depend on it; time-only loads ignore them.
 using ExternalForceFunction = std::function<void(double time, const Eigen::VectorXd& displacement,
                                                  const Eigen::VectorXd& velocity, Eigen::VectorXd& forces)>;
+
+/// The vertices (ascending) closer than margin (a length) to an obstacle of the external
+/// force at displacement u, into vertices: what lets an integrator follow contact.
+using ObstacleProximity =
+    std::function<void(const Eigen::VectorXd& displacement, double margin, std::vector<int>& vertices)>;
 
 /// The body an integrator advances: M a + D v + f_int(u) = f_ext(t), with
 /// D = alpha M + beta K (K the tangent stiffness at the start of a step) and the DOFs in
@@ -28,6 +34,8 @@ struct DynamicSystem {
   double rayleighMass = 0.0;            ///< alpha (1/s)
   double rayleighStiffness = 0.0;       ///< beta (s)
   ExternalForceFunction externalForce;  ///< may be empty: no external force
+  /// Where the external force's obstacles are (penalty contact); empty without obstacles.
+  ObstacleProximity obstacleProximity;
   /// The mesh the matrices were built from (n vertices). Integrators that partition the
   /// body by vertices or elements (the multirate ones) need it; single-rate ones do not,
   /// so it may be null for a system built from matrices alone.

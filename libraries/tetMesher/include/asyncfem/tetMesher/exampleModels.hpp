@@ -18,9 +18,10 @@ enum class ExampleModel {
   Flower,    ///< "base", "stem", two "upperLeaves", five "petals" around a centre
   Dragon,    ///< dragon-like body, stiff "jaw", nested head regions "s1" ... "s6"
   Drop,      ///< soft rounded block ("soft") with a stiff knob ("stiffPart"), above the ground
+  Ball,      ///< rubber ball ("ball", radius 0.2) centred 0.45 above the ground
 };
 
-/// "dinosaur", "flower", "dragon", "drop", in enum order.
+/// "dinosaur", "flower", "dragon", "drop", "ball", in enum order.
 const std::vector<std::string>& exampleModelNames();
 std::string exampleModelName(ExampleModel model);
 /// Inverse of exampleModelName; ValidationError listing the names for an unknown one.

@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Fast regions chosen at run time: where contact is, or when the user's schedule says.
+#pragma once
+
+#include <Eigen/Core>
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
+#include <asyncfem/dynamics/dynamicSystem.hpp>
+#include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace asyncfem {
+
+/// A fast region the user schedules: `vertices` at ratio m from `start` (inclusive) to
+/// `end` (exclusive), in seconds.
+struct ScheduledRegion {
+  std::string name;
+  double start = 0.0;
+  double end = std::numeric_limits<double>::infinity();
+  std::vector<int> vertices;
+  int ratio = 1;
+};
+
+/// The policies of run-time regions and their hysteresis (docs/asynchronous-integrator.md,
+/// "Run-time regions"). Policies combine: the regions wanted at a large-step boundary are
+/// the contact region and every active scheduled region, merged where they touch (an
+/// element with vertices in both) at the larger ratio.
+struct AdaptiveRegionOptions {
+  /// Contact policy: the vertices in contact or within contactMargin (a length) of an
+  /// obstacle, at the step's start state or at the state predicted contactLookahead large
+  /// steps ahead (u + k hL v), grown by contactRings element rings, at ratio contactRatio.
+  bool contact = false;
+  int contactRatio = 8;
+  double contactMargin = 0.0;
+  double contactLookahead = 1.0;
+  int contactRings = 1;
+  /// Schedule policy.
+  std::vector<ScheduledRegion> schedule;
+  /// Hysteresis. A contact region that no longer covers what the policy needs is replaced
+  /// at once, grown by one ring more than needed (so small moves stay inside it); one that
+  /// covers it is kept for at least minDwell large steps, then replaced by a smaller one
+  /// when it holds more than shrinkFactor times the vertices needed (or none is needed).
+  int minDwell = 8;
+  double shrinkFactor = 2.0;
+  /// Set-ups kept for reuse: with linear forces a partition that comes back (the same
+  /// contact patch at the next bounce, the end of a scheduled window) costs no rebuild.
+  int cacheSize = 4;
+};
+
+/// One change of partition at a large-step boundary.
+struct RepartitionRecord {
+  double time = 0.0;      ///< seconds
+  long long step = 0;     ///< large steps taken before it
+  std::string reason;     ///< which policy asked and why
+  int regions = 0;        ///< fast regions after it
+  int fastVertices = 0;   ///< vertices in fast regions after it
+  int interfaceDofs = 0;  ///< sum_i |I_i| after it
+  int movedVertices = 0;  ///< vertices that changed region
+  double seconds = 0.0;   ///< set-up time it cost (0 when reused)
+  bool reused = false;    ///< taken from the set-up cache
+};
+
+/// Decides, at each large-step boundary, which fast regions a run needs.
+class AdaptiveRegionPolicy {
+ public:
+  /// Throws asyncfem::ValidationError for a ratio < 1, a negative margin, lookahead or
+  /// ring count, minDwell < 0, shrinkFactor < 1, a schedule window with end <= start or
+  /// vertices out of range, or contact requested for a system without obstacles
+  /// (checked by the integrator).
+  AdaptiveRegionPolicy(const TetMesh& mesh, const FreeDofs& freeDofs, AdaptiveRegionOptions options);
+
+  /// The regions wanted now (time t, start state u, v, large step hL), merged and with
+  /// vertices that have no free DOF left out. Empty: no fast region.
+  std::vector<AsyncRegion> wanted(double time, double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                                  const ObstacleProximity& proximity) const;
+  /// Given the regions in use (kept for stepsKept large steps), the new regions to set up,
+  /// or nothing to keep them; reason says why.
+  std::optional<std::vector<AsyncRegion>> decide(double time, double largeStep, const Eigen::VectorXd& u,
+                                                 const Eigen::VectorXd& v, const ObstacleProximity& proximity,
+                                                 const std::vector<AsyncRegion>& current, long long stepsKept,
+                                                 std::string& reason);
+
+  /// Whether `regions` give every vertex the policy needs now at least the ratio it
+  /// wants, and hold at most shrinkFactor times the vertices it would choose: a set-up
+  /// that can serve the next steps in place of `proposal`. Never with a schedule (its
+  /// windows open and close exactly).
+  bool canServe(const std::vector<AsyncRegion>& regions, const std::vector<AsyncRegion>& proposal, double time,
+                double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                const ObstacleProximity& proximity) const;
+
+  const AdaptiveRegionOptions& options() const { return options_; }
+
+ private:
+  std::vector<char> contactVertices(double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                                    const ObstacleProximity& proximity, int rings) const;
+  std::vector<AsyncRegion> assemble(double time, const std::vector<char>& contact) const;
+  std::vector<int> activeWindows(double time) const;
+
+  const TetMesh* mesh_;
+  std::vector<char> hasFreeDof_;
+  AdaptiveRegionOptions options_;
+  std::vector<int> lastWindows_;
+  bool started_ = false;
+};
+
+/// Summary lines for a run's re-partitions: the count, how many came from the cache, the
+/// set-up time they cost, then one line each (the first and last ten when there are more).
+void appendRepartitionLines(const std::vector<RepartitionRecord>& records, std::vector<std::string>& lines);
+
+/// Marks every vertex that shares an element with a marked one, `rings` times.
+void growByRings(const TetMesh& mesh, std::vector<char>& marked, int rings);
+
+}  // namespace asyncfem

@@ -1,0 +1,267 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Run-time regions: docs/asynchronous-integrator.md, section "Run-time regions".
+#include <algorithm>
+#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
+#include <asyncfem/core/error.hpp>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <string>
+
+namespace asyncfem {
+
+void growByRings(const TetMesh& mesh, std::vector<char>& marked, int rings) {
+  for (int ring = 0; ring < rings; ++ring) {
+    std::vector<char> grown = marked;
+    for (int e = 0; e < mesh.numElements(); ++e) {
+      bool any = false;
+      for (int a = 0; a < 4; ++a) any = any || marked[static_cast<std::size_t>(mesh.elements()(a, e))];
+      if (any)
+        for (int a = 0; a < 4; ++a) grown[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
+    }
+    marked.swap(grown);
+  }
+}
+
+namespace {
+
+/// Ratio of every vertex under `regions` (0: L).
+std::vector<int> vertexRatios(int numVertices, const std::vector<AsyncRegion>& regions) {
+  std::vector<int> ratio(static_cast<std::size_t>(numVertices), 0);
+  for (const AsyncRegion& region : regions)
+    for (int v : region.vertices) ratio[static_cast<std::size_t>(v)] = region.ratio;
+  return ratio;
+}
+
+int countFast(const std::vector<AsyncRegion>& regions) {
+  int count = 0;
+  for (const AsyncRegion& region : regions) count += static_cast<int>(region.vertices.size());
+  return count;
+}
+
+int findRoot(std::vector<int>& parent, int i) {
+  while (parent[static_cast<std::size_t>(i)] != i) {
+    parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    i = parent[static_cast<std::size_t>(i)];
+  }
+  return i;
+}
+
+/// Regions that share a vertex or an element merged into one (vertices united, the larger
+/// ratio, names joined by "+"), in order of their first member.
+std::vector<AsyncRegion> mergeTouching(const TetMesh& mesh, const std::vector<AsyncRegion>& regions) {
+  const auto count = static_cast<int>(regions.size());
+  std::vector<int> parent(static_cast<std::size_t>(count));
+  std::iota(parent.begin(), parent.end(), 0);
+  std::vector<int> owner(static_cast<std::size_t>(mesh.numVertices()), -1);
+  const auto unite = [&](int a, int b) { parent[static_cast<std::size_t>(findRoot(parent, a))] = findRoot(parent, b); };
+  for (int i = 0; i < count; ++i)
+    for (int v : regions[static_cast<std::size_t>(i)].vertices) {
+      int& o = owner[static_cast<std::size_t>(v)];
+      if (o >= 0) unite(i, o);
+      o = i;
+    }
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    int first = -1;
+    for (int a = 0; a < 4; ++a) {
+      const int o = owner[static_cast<std::size_t>(mesh.elements()(a, e))];
+      if (o < 0) continue;
+      if (first < 0) {
+        first = o;
+      } else {
+        unite(first, o);
+      }
+    }
+  }
+  std::vector<AsyncRegion> merged;
+  std::vector<int> slot(static_cast<std::size_t>(count), -1);
+  for (int i = 0; i < count; ++i) {
+    const int root = findRoot(parent, i);
+    const AsyncRegion& region = regions[static_cast<std::size_t>(i)];
+    int& s = slot[static_cast<std::size_t>(root)];
+    if (s < 0) {
+      s = static_cast<int>(merged.size());
+      merged.push_back(region);
+      continue;
+    }
+    AsyncRegion& into = merged[static_cast<std::size_t>(s)];
+    into.name += "+" + region.name;
+    into.ratio = std::max(into.ratio, region.ratio);
+    into.vertices.insert(into.vertices.end(), region.vertices.begin(), region.vertices.end());
+  }
+  for (AsyncRegion& region : merged) {
+    std::sort(region.vertices.begin(), region.vertices.end());
+    region.vertices.erase(std::unique(region.vertices.begin(), region.vertices.end()), region.vertices.end());
+  }
+  return merged;
+}
+
+}  // namespace
+
+AdaptiveRegionPolicy::AdaptiveRegionPolicy(const TetMesh& mesh, const FreeDofs& freeDofs, AdaptiveRegionOptions options)
+    : mesh_(&mesh), options_(std::move(options)) {
+  const AdaptiveRegionOptions& o = options_;
+  if (o.contactRatio < 1) throw ValidationError("adaptive regions: contact ratio must be >= 1");
+  if (!(o.contactMargin >= 0.0) || !(o.contactLookahead >= 0.0) || o.contactRings < 0) {
+    throw ValidationError("adaptive regions: contact margin, lookahead and rings must be >= 0");
+  }
+  if (o.minDwell < 0 || !(o.shrinkFactor >= 1.0) || o.cacheSize < 0) {
+    throw ValidationError("adaptive regions: minDwell and cache must be >= 0 and shrink >= 1");
+  }
+  for (std::size_t w = 0; w < o.schedule.size(); ++w) {
+    const ScheduledRegion& window = o.schedule[w];
+    const std::string where = "adaptive regions: schedule[" + std::to_string(w) + "]";
+    if (!(window.end > window.start)) throw ValidationError(where + ": end must be after start");
+    if (window.ratio < 1) throw ValidationError(where + ": ratio must be >= 1");
+    for (int v : window.vertices) {
+      if (v < 0 || v >= mesh.numVertices()) {
+        throw ValidationError(where + ": vertex " + std::to_string(v) + " out of range (the mesh has " +
+                              std::to_string(mesh.numVertices()) + " vertices)");
+      }
+    }
+  }
+  hasFreeDof_.assign(static_cast<std::size_t>(mesh.numVertices()), 0);
+  const std::vector<int>& fullToFree = freeDofs.fullToFree();
+  for (std::size_t dof = 0; dof < fullToFree.size(); ++dof)
+    if (fullToFree[dof] >= 0) hasFreeDof_[dof / 3] = 1;
+}
+
+std::vector<char> AdaptiveRegionPolicy::contactVertices(double largeStep, const Eigen::VectorXd& u,
+                                                        const Eigen::VectorXd& v, const ObstacleProximity& proximity,
+                                                        int rings) const {
+  std::vector<char> marked(static_cast<std::size_t>(mesh_->numVertices()), 0);
+  if (!options_.contact || !proximity) return marked;
+  std::vector<int> near;
+  proximity(u, options_.contactMargin, near);
+  for (int vertex : near) marked[static_cast<std::size_t>(vertex)] = 1;
+  if (options_.contactLookahead > 0.0) {
+    const Eigen::VectorXd predicted = u + (options_.contactLookahead * largeStep) * v;
+    proximity(predicted, options_.contactMargin, near);
+    for (int vertex : near) marked[static_cast<std::size_t>(vertex)] = 1;
+  }
+  if (std::find(marked.begin(), marked.end(), 1) != marked.end()) growByRings(*mesh_, marked, rings);
+  return marked;
+}
+
+std::vector<int> AdaptiveRegionPolicy::activeWindows(double time) const {
+  std::vector<int> active;
+  for (std::size_t w = 0; w < options_.schedule.size(); ++w) {
+    const ScheduledRegion& window = options_.schedule[w];
+    if (time >= window.start && time < window.end) active.push_back(static_cast<int>(w));
+  }
+  return active;
+}
+
+std::vector<AsyncRegion> AdaptiveRegionPolicy::assemble(double time, const std::vector<char>& contact) const {
+  std::vector<AsyncRegion> regions;
+  for (int w : activeWindows(time)) {
+    const ScheduledRegion& window = options_.schedule[static_cast<std::size_t>(w)];
+    regions.push_back(
+        {window.name.empty() ? "schedule" + std::to_string(w) : window.name, window.vertices, window.ratio});
+  }
+  AsyncRegion touching{"contact", {}, options_.contactRatio};
+  for (std::size_t vertex = 0; vertex < contact.size(); ++vertex)
+    if (contact[vertex]) touching.vertices.push_back(static_cast<int>(vertex));
+  if (!touching.vertices.empty()) regions.push_back(std::move(touching));
+  std::vector<AsyncRegion> merged = mergeTouching(*mesh_, regions);
+  // Vertices without a free DOF take no substeps; a region of only such vertices is none.
+  std::vector<AsyncRegion> out;
+  for (AsyncRegion& region : merged) {
+    region.vertices.erase(std::remove_if(region.vertices.begin(), region.vertices.end(),
+                                         [&](int vertex) { return !hasFreeDof_[static_cast<std::size_t>(vertex)]; }),
+                          region.vertices.end());
+    if (!region.vertices.empty() && region.ratio > 1) out.push_back(std::move(region));
+  }
+  return out;
+}
+
+std::vector<AsyncRegion> AdaptiveRegionPolicy::wanted(double time, double largeStep, const Eigen::VectorXd& u,
+                                                      const Eigen::VectorXd& v,
+                                                      const ObstacleProximity& proximity) const {
+  return assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings));
+}
+
+namespace {
+/// Whether every vertex gets at least the ratio `needed` gives it under `regions`.
+bool covers(int numVertices, const std::vector<AsyncRegion>& regions, const std::vector<AsyncRegion>& needed) {
+  const std::vector<int> have = vertexRatios(numVertices, regions);
+  const std::vector<int> want = vertexRatios(numVertices, needed);
+  for (std::size_t vertex = 0; vertex < have.size(); ++vertex)
+    if (have[vertex] < want[vertex]) return false;
+  return true;
+}
+}  // namespace
+
+bool AdaptiveRegionPolicy::canServe(const std::vector<AsyncRegion>& regions, const std::vector<AsyncRegion>& proposal,
+                                    double time, double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                                    const ObstacleProximity& proximity) const {
+  if (static_cast<double>(countFast(regions)) > options_.shrinkFactor * countFast(proposal)) return false;
+  if (!options_.schedule.empty()) return false;  // windows open and close exactly: no stand-ins
+  return covers(mesh_->numVertices(), regions,
+                assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings)));
+}
+
+std::optional<std::vector<AsyncRegion>> AdaptiveRegionPolicy::decide(double time, double largeStep,
+                                                                     const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                                                                     const ObstacleProximity& proximity,
+                                                                     const std::vector<AsyncRegion>& current,
+                                                                     long long stepsKept, std::string& reason) {
+  const int n = mesh_->numVertices();
+  const std::vector<char> needed = contactVertices(largeStep, u, v, proximity, options_.contactRings);
+  std::vector<char> generous = needed;
+  if (std::find(generous.begin(), generous.end(), 1) != generous.end()) growByRings(*mesh_, generous, 1);
+  std::vector<AsyncRegion> proposal = assemble(time, generous);
+  const std::vector<int> windows = activeWindows(time);
+  const std::vector<int> currentRatio = vertexRatios(n, current);
+  const std::vector<int> proposedRatio = vertexRatios(n, proposal);
+  if (currentRatio == proposedRatio) {
+    started_ = true;
+    lastWindows_ = windows;
+    return std::nullopt;
+  }
+  if (!started_ || windows != lastWindows_) {
+    reason = started_ ? "schedule window opens or closes" : "initial regions";
+  } else {
+    // Replace at once when the regions in use miss a vertex the policy needs (or give it
+    // fewer substeps); otherwise only after the dwell, and only to shrink by a margin.
+    if (!covers(n, current, assemble(time, needed))) {
+      reason = "contact region grows";
+    } else if (stepsKept >= options_.minDwell &&
+               static_cast<double>(countFast(current)) > options_.shrinkFactor * countFast(proposal)) {
+      reason = proposal.empty() ? "contact ends" : "contact region shrinks";
+    } else {
+      return std::nullopt;
+    }
+  }
+  started_ = true;
+  lastWindows_ = windows;
+  return proposal;
+}
+
+void appendRepartitionLines(const std::vector<RepartitionRecord>& records, std::vector<std::string>& lines) {
+  int reused = 0;
+  double seconds = 0.0;
+  for (const RepartitionRecord& r : records) {
+    reused += r.reused ? 1 : 0;
+    seconds += r.seconds;
+  }
+  char line[320];
+  std::snprintf(line, sizeof(line), "adaptive regions: %zu re-partitions (%d from the set-up cache), %.3f s of set-up",
+                records.size(), reused, seconds);
+  lines.emplace_back(line);
+  constexpr std::size_t kShown = 10;
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    if (records.size() > 2 * kShown && k == kShown) {
+      lines.push_back("  ... " + std::to_string(records.size() - 2 * kShown) + " more ...");
+      k = records.size() - kShown;
+    }
+    const RepartitionRecord& r = records[k];
+    std::snprintf(line, sizeof(line),
+                  "  t = %.4f s (step %lld): %s -> %d region(s), %d fast vertices, |I| %d DOFs, %d moved, %s %.1f ms",
+                  r.time, r.step, r.reason.c_str(), r.regions, r.fastVertices, r.interfaceDofs, r.movedVertices,
+                  r.reused ? "reused," : "set-up", 1000.0 * r.seconds);
+    lines.emplace_back(line);
+  }
+}
+
+}  // namespace asyncfem

@@ -1,0 +1,237 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Run-time regions: AdaptiveRegionPolicy's decisions and AsyncBackwardEuler's
+// re-partitions (fresh and cached set-ups), against integrators set up by hand.
+#include <gtest/gtest.h>
+
+#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
+#include <asyncfem/asyncIntegrator/registration.hpp>
+#include <asyncfem/core/error.hpp>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "asyncTestSystem.hpp"
+
+namespace asyncfem {
+namespace {
+
+constexpr double kLargeStep = 5e-3;
+
+void expectSameState(const Integrator& a, const Integrator& b) {
+  EXPECT_EQ(a.time(), b.time());
+  EXPECT_EQ((a.displacement() - b.displacement()).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((a.velocity() - b.velocity()).cwiseAbs().maxCoeff(), 0.0);
+}
+
+AdaptiveRegionOptions scheduleOf(std::vector<ScheduledRegion> windows) {
+  AdaptiveRegionOptions options;
+  options.schedule = std::move(windows);
+  return options;
+}
+
+// A window open over the whole run is a fixed region: the adaptive run equals the fixed
+// one bit for bit (the same set-up, then the same steps).
+TEST(AdaptiveRegions, AnAlwaysOpenWindowEqualsTheFixedRegion) {
+  const test::TestSystem ts = test::makeTestSystem(0.3, 2e-3);
+  const std::vector<int> tip = test::verticesBeyond(ts.mesh, 0.75);
+  AsyncBackwardEuler fixed(ts.mesh, ts.system, kLargeStep, {{"tip", tip, 4}});
+  AsyncBackwardEuler adaptive(ts.mesh, ts.system, kLargeStep, {});
+  fixed.setState(ts.u0, ts.v0);
+  adaptive.setState(ts.u0, ts.v0);
+  adaptive.setAdaptiveRegions(scheduleOf({{"tip", 0.0, 1.0, tip, 4}}));
+  ASSERT_EQ(adaptive.partition().numRegions(), 1);
+  for (int k = 0; k < 5; ++k) {
+    fixed.step();
+    adaptive.step();
+  }
+  expectSameState(fixed, adaptive);
+  ASSERT_EQ(adaptive.repartitions().size(), 1U);
+  EXPECT_EQ(adaptive.repartitions()[0].reason, "initial regions");
+  EXPECT_EQ(adaptive.repartitions()[0].fastVertices, static_cast<int>(tip.size()));
+}
+
+// A window [2 hL, 4 hL) opens and closes exactly at those large-step boundaries, and the
+// run equals one whose partitions are set by hand at the same steps; the second opening of
+// the same window takes the cached set-up, with the same result as a fresh one.
+TEST(AdaptiveRegions, WindowsSwitchAtTheirBoundariesAndTheCacheChangesNothing) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 1e-3);
+  const std::vector<int> tip = test::verticesBeyond(ts.mesh, 0.75);
+  const std::vector<AsyncRegion> fast{{"tip", tip, 4}};
+  AsyncBackwardEuler adaptive(ts.mesh, ts.system, kLargeStep, {});
+  AsyncBackwardEuler byHand(ts.mesh, ts.system, kLargeStep, {});
+  adaptive.setState(ts.u0, ts.v0);
+  byHand.setState(ts.u0, ts.v0);
+  // Boundaries half a step away from the step times, so rounding cannot move them.
+  adaptive.setAdaptiveRegions(scheduleOf(
+      {{"tip", 1.5 * kLargeStep, 3.5 * kLargeStep, tip, 4}, {"tip", 5.5 * kLargeStep, 7.5 * kLargeStep, tip, 4}}));
+  const std::vector<int> switchAt{2, 4, 6, 8};
+  for (int k = 0; k < 9; ++k) {
+    for (std::size_t s = 0; s < switchAt.size(); ++s)
+      if (k == switchAt[s]) {
+        byHand.setUp(RegionPartition(ts.mesh, ts.system.freeDofs, s % 2 == 0 ? fast : std::vector<AsyncRegion>{}));
+      }
+    adaptive.step();
+    byHand.step();
+    expectSameState(adaptive, byHand);
+  }
+  const std::vector<RepartitionRecord>& records = adaptive.repartitions();
+  ASSERT_EQ(records.size(), 4U);
+  for (std::size_t s = 0; s < records.size(); ++s) {
+    EXPECT_EQ(records[s].step, switchAt[s]);
+    EXPECT_EQ(records[s].regions, s % 2 == 0 ? 1 : 0);
+    EXPECT_EQ(records[s].movedVertices, static_cast<int>(tip.size()));
+  }
+  // The first opening and closing build; the second ones reuse both set-ups.
+  EXPECT_FALSE(records[0].reused);
+  EXPECT_TRUE(records[1].reused);  // the empty partition of the constructor
+  EXPECT_TRUE(records[2].reused);
+  EXPECT_TRUE(records[3].reused);
+}
+
+// The contact policy through a stand-in obstacle: the vertices with x above a threshold
+// that the test moves. The region appears at once, grown by rings, stays while what is
+// needed stays inside it, and goes only after the dwell.
+TEST(AdaptiveRegions, ContactRegionGrowsAtOnceAndShrinksAfterTheDwell) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  double threshold = 2.0;  // nothing near
+  const ObstacleProximity proximity = [&](const Eigen::VectorXd&, double, std::vector<int>& out) {
+    out = test::verticesBeyond(ts.mesh, threshold);
+  };
+  AdaptiveRegionOptions options;
+  options.contact = true;
+  options.contactRatio = 6;
+  options.contactRings = 1;
+  options.contactLookahead = 0.0;
+  options.minDwell = 3;
+  AdaptiveRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(ts.system.numDofs());
+  std::vector<AsyncRegion> current;
+  std::string reason;
+  EXPECT_FALSE(policy.decide(0.0, kLargeStep, zero, zero, proximity, current, 0, reason));
+  threshold = 0.99;  // the x = 1 face
+  auto next = policy.decide(0.0, kLargeStep, zero, zero, proximity, current, 1, reason);
+  ASSERT_TRUE(next);
+  EXPECT_EQ(reason, "contact region grows");
+  ASSERT_EQ(next->size(), 1U);
+  EXPECT_EQ((*next)[0].ratio, 6);
+  // The face grown by one ring (needed) and one more (hysteresis): x >= 0.75 on this mesh
+  // of 1/8 cubes.
+  EXPECT_EQ((*next)[0].vertices, test::verticesBeyond(ts.mesh, 0.75));
+  current = *next;
+  threshold = 0.85;  // still inside the region: kept
+  EXPECT_FALSE(policy.decide(0.0, kLargeStep, zero, zero, proximity, current, 1, reason));
+  threshold = 2.0;  // contact over: kept until the dwell has passed
+  EXPECT_FALSE(policy.decide(0.0, kLargeStep, zero, zero, proximity, current, 2, reason));
+  next = policy.decide(0.0, kLargeStep, zero, zero, proximity, current, 3, reason);
+  ASSERT_TRUE(next);
+  EXPECT_TRUE(next->empty());
+  EXPECT_EQ(reason, "contact ends");
+  current = *next;
+  threshold = 0.6;  // beyond the old region: grows at once whatever the dwell
+  next = policy.decide(0.0, kLargeStep, zero, zero, proximity, current, 0, reason);
+  ASSERT_TRUE(next);
+  EXPECT_EQ(reason, "contact region grows");
+}
+
+// Regions that touch (an element with vertices in both) are merged at the larger ratio,
+// and vertices without a free DOF are left out (the clamped face x = 0 here).
+TEST(AdaptiveRegions, TouchingWindowsMergeAndFixedVerticesAreLeftOut) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  std::vector<int> clampedEnd, nextLayer;
+  for (int v = 0; v < ts.mesh.numVertices(); ++v) {
+    const double x = ts.mesh.restPosition(v).x();
+    if (x < 1e-9) clampedEnd.push_back(v);
+    if (std::abs(x - 0.125) < 1e-9) nextLayer.push_back(v);
+  }
+  AdaptiveRegionPolicy policy(ts.mesh, ts.system.freeDofs,
+                              scheduleOf({{"a", 0.0, 1.0, clampedEnd, 2}, {"b", 0.0, 1.0, nextLayer, 5}}));
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(ts.system.numDofs());
+  const std::vector<AsyncRegion> wanted = policy.wanted(0.0, kLargeStep, zero, zero, nullptr);
+  ASSERT_EQ(wanted.size(), 1U);
+  EXPECT_EQ(wanted[0].name, "a+b");
+  EXPECT_EQ(wanted[0].ratio, 5);
+  EXPECT_EQ(wanted[0].vertices, nextLayer);
+  // The merged region is a valid partition.
+  EXPECT_NO_THROW(RegionPartition(ts.mesh, ts.system.freeDofs, wanted));
+}
+
+TEST(AdaptiveRegions, BadOptionsAreErrors) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  const auto expectError = [&](const AdaptiveRegionOptions& options, const std::string& part) {
+    try {
+      AdaptiveRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
+      FAIL() << "expected a ValidationError mentioning " << part;
+    } catch (const ValidationError& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+  };
+  AdaptiveRegionOptions options = scheduleOf({{"w", 1.0, 1.0, {0}, 2}});
+  expectError(options, "schedule[0]: end must be after start");
+  options = scheduleOf({{"w", 0.0, 1.0, {ts.mesh.numVertices()}, 2}});
+  expectError(options, "out of range");
+  options = AdaptiveRegionOptions{};
+  options.shrinkFactor = 0.5;
+  expectError(options, "shrink");
+  // The contact policy needs obstacles.
+  AsyncBackwardEuler async(ts.mesh, ts.system, kLargeStep, {});
+  AdaptiveRegionOptions contact;
+  contact.contact = true;
+  EXPECT_THROW(async.setAdaptiveRegions(contact), ValidationError);
+}
+
+IntegratorContext barContext(bool hasContact) {
+  test::TestSystem ts = test::makeTestSystem(0, 0);
+  IntegratorContext context;
+  context.mesh = std::make_shared<const TetMesh>(ts.mesh);
+  context.system = std::move(ts.system);
+  context.timestep = kLargeStep;
+  context.hasContact = hasContact;
+  context.sourceName = "scene.json";
+  return context;
+}
+
+std::string parseError(const IntegratorContext& context, const nlohmann::json& options) {
+  try {
+    (void)parseAsyncSettings(context, options);
+  } catch (const ValidationError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The scene's "regions": {"adaptive": ...}: read, written back, and its errors name the key.
+TEST(AdaptiveRegions, SceneKeys) {
+  const nlohmann::json options = nlohmann::json::parse(R"({"regions": {"adaptive": {
+      "schedule": [{"name": "tip", "ratio": 4, "start": 0.1, "end": 0.2, "boxes": [{"min": [0.74, -1, -1], "max": [2, 2, 2]}]}],
+      "minDwell": 5, "shrink": 3, "cache": 2}}})");
+  const AsyncSettings parsed = parseAsyncSettings(barContext(false), options);
+  ASSERT_TRUE(parsed.adaptive);
+  ASSERT_EQ(parsed.adaptive->schedule.size(), 1U);
+  EXPECT_EQ(parsed.adaptive->schedule[0].start, 0.1);
+  EXPECT_EQ(parsed.adaptive->schedule[0].end, 0.2);
+  EXPECT_EQ(parsed.adaptive->schedule[0].ratio, 4);
+  EXPECT_EQ(parsed.adaptive->minDwell, 5);
+  EXPECT_EQ(parsed.adaptive->cacheSize, 2);
+  EXPECT_FALSE(parsed.adaptive->contact);
+  EXPECT_EQ(asyncSettingsJson(parsed)["regions"], options["regions"]);
+
+  const IntegratorContext bar = barContext(false);
+  EXPECT_NE(parseError(bar, nlohmann::json::parse(R"({"regions": {"adaptive": {"contact": {}}}})"))
+                .find("scene.json: integrator.options.regions.adaptive.contact: needs obstacles"),
+            std::string::npos);
+  EXPECT_NE(parseError(bar, nlohmann::json::parse(R"({"regions": {"adaptive": {}}})")).find("give at least one policy"),
+            std::string::npos);
+  EXPECT_NE(
+      parseError(bar, nlohmann::json::parse(
+                          R"({"regions": {"adaptive": {"schedule": [{"ratio": 2, "vertices": [1], "strat": 0}]}}})"))
+          .find("schedule[0].strat"),
+      std::string::npos);
+  EXPECT_NE(
+      parseError(barContext(true), nlohmann::json::parse(R"({"regions": {"adaptive": {"contact": {"ratio": 1}}}})"))
+          .find("contact.ratio"),
+      std::string::npos);
+}
+
+}  // namespace
+}  // namespace asyncfem

@@ -1,0 +1,200 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Run-time (adaptive) regions on a bouncing scene, printed as a Markdown table: single-rate
+// backward Euler over a ladder of steps, async with a fixed region and async with the
+// contact region the scene asks for, each against a converged reference (single-rate at a
+// fine step everywhere). Every ratio compares runs of the same process.
+//
+//   benchmarkAdaptive [--scene models/ball/ball.json] [--frames 90] [--repeats 1]
+//                     [--reference-steps 64] [--ladder 1,2,4,8,16]
+//
+// The frames are sampled at the scene's large step (one step per frame), so penetration
+// and rebound are seen at every large step. Figures per run:
+//   ms/frame  median wall time per frame (frames 1.., re-partitions included)
+//   rebound   highest centre of mass (mass-weighted) between the first and second contact,
+//             and its error against the reference's
+//   pen.      deepest penetration below the ground over the run, and its error
+//   COM err   relative L2 error of the centre-of-mass height over all frames
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <asyncfem/benchmarkTools/benchmarkRun.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/threading.hpp>
+#include <asyncfem/sceneIO/scene.hpp>
+#include <asyncfem/sceneIO/simulation.hpp>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace asyncfem;
+
+struct Measures {
+  std::vector<double> comHeight;  // per frame
+  double rebound = 0.0;           // highest COM between the first two contacts
+  double penetration = 0.0;       // deepest vertex below the ground
+};
+
+Measures measure(const Trajectory& frames, const TetMesh& mesh, const Eigen::VectorXd& vertexMass, double ground) {
+  Measures out;
+  const double totalMass = vertexMass.sum();
+  std::vector<char> inContact;
+  for (const Eigen::VectorXd& u : frames) {
+    double com = 0.0, lowest = std::numeric_limits<double>::infinity();
+    for (int v = 0; v < mesh.numVertices(); ++v) {
+      const double y = mesh.restPosition(v).y() + u[3 * v + 1];
+      com += vertexMass[v] * y;
+      lowest = std::min(lowest, y);
+    }
+    out.comHeight.push_back(com / totalMass);
+    out.penetration = std::max(out.penetration, ground - lowest);
+    inContact.push_back(lowest < ground ? 1 : 0);
+  }
+  // The rebound: after the first contact ends, the highest COM until the next contact.
+  std::size_t k = 0;
+  while (k < inContact.size() && !inContact[k]) ++k;
+  while (k < inContact.size() && inContact[k]) ++k;
+  for (; k < inContact.size() && !inContact[k]; ++k) out.rebound = std::max(out.rebound, out.comHeight[k]);
+  return out;
+}
+
+double relativeL2(const std::vector<double>& a, const std::vector<double>& reference) {
+  double diff = 0.0, norm = 0.0;
+  const std::size_t n = std::min(a.size(), reference.size());
+  for (std::size_t k = 0; k < n; ++k) {
+    diff += (a[k] - reference[k]) * (a[k] - reference[k]);
+    norm += reference[k] * reference[k];
+  }
+  return norm > 0.0 ? std::sqrt(diff / norm) : 0.0;
+}
+
+struct Row {
+  BenchmarkRun run;
+  Measures measures;
+  double reboundError = 0.0, penetrationError = 0.0, comError = 0.0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Run-time (adaptive) async regions on a bouncing scene against single-rate backward Euler"};
+  std::string scenePath = "models/ball/ball.json";
+  int frames = 90, repeats = 1, referenceSteps = 64;
+  std::vector<int> ladder{1, 2, 4, 8, 16};
+  app.add_option("--scene", scenePath, "Scene with a contact section and adaptive async regions");
+  app.add_option("--frames", frames, "Large steps to run (one per frame)")->check(CLI::PositiveNumber);
+  app.add_option("--repeats", repeats, "Timed repeats per configuration")->check(CLI::PositiveNumber);
+  app.add_option("--reference-steps", referenceSteps, "Reference: single-rate steps per large step");
+  app.add_option("--ladder", ladder, "Single-rate steps per large step to compare")->delimiter(',');
+  CLI11_PARSE(app, argc, argv);
+  configureThreading();
+  try {
+    Scene scene = loadScene(scenePath);
+    const FrameTiming timing = frameTimingOf(scene);
+    const double hL = timing.timestep;
+    // One frame per large step.
+    scene.frames.rate = 1.0 / hL;
+    scene.frames.count = frames;
+    const Simulation baseline = buildSimulation(scene);
+    const TetMesh& mesh = *baseline.mesh;
+    const Eigen::VectorXd lumped = baseline.problem->massMatrix() * Eigen::VectorXd::Ones(mesh.numDofs());
+    Eigen::VectorXd vertexMass(mesh.numVertices());
+    for (int v = 0; v < mesh.numVertices(); ++v) vertexMass[v] = lumped[3 * v + 1];
+    const double ground = scene.contact.planes.empty() ? 0.0 : scene.contact.planes.front().offset;
+
+    std::vector<BenchmarkConfiguration> configurations;
+    configurations.push_back(
+        {"reference: backward Euler, hL/" + std::to_string(referenceSteps), "backward-euler", referenceSteps});
+    for (int steps : ladder) {
+      configurations.push_back({"backward Euler, hL/" + std::to_string(steps), "backward-euler", steps});
+    }
+    nlohmann::json adaptiveOptions = scene.integrator.options;
+    const nlohmann::json contact = adaptiveOptions["regions"]["adaptive"]["contact"];
+    const int ratio = contact.value("ratio", 8);
+    configurations.push_back({"async, adaptive contact region (as shipped)", "async", 1, 0.0, adaptiveOptions});
+    // The fixed region a user would draw without run-time regions: the lower cap that the
+    // adaptive runs ever made fast (every vertex below the highest adaptive fast vertex).
+    nlohmann::json fixedOptions = adaptiveOptions;
+    double capHeight = 0.0;
+    {
+      Simulation probe = buildSimulation(configuredScene(scene, configurations.back(), frames));
+      for (int k = 0; k < frames; ++k) {
+        advanceFrame(probe, k);
+        const MultirateIntegrator* multirate = probe.integrator->multirate();
+        for (int v = 0; v < mesh.numVertices(); ++v)
+          if (multirate && multirate->regionOfVertex(v) >= 0) capHeight = std::max(capHeight, mesh.restPosition(v).y());
+      }
+    }
+    fixedOptions["regions"] =
+        nlohmann::json::array({{{"name", "cap"},
+                                {"ratio", ratio},
+                                {"boxes", {{{"min", {-1e9, -1e9, -1e9}}, {"max", {1e9, capHeight, 1e9}}}}}}});
+    configurations.push_back({"async, fixed lower cap", "async", 1, 0.0, fixedOptions});
+
+    std::vector<Row> rows;
+    for (const BenchmarkConfiguration& configuration : configurations) {
+      Row row;
+      row.run = runConfiguration(scene, configuration, frames, repeats);
+      row.measures = measure(row.run.frames, mesh, vertexMass, ground);
+      rows.push_back(std::move(row));
+      std::fprintf(stderr, "ran %s\n", configuration.label.c_str());
+    }
+    const Measures& reference = rows.front().measures;
+    for (Row& row : rows) {
+      row.reboundError = std::abs(row.measures.rebound - reference.rebound) / std::max(1e-12, reference.rebound);
+      row.penetrationError =
+          std::abs(row.measures.penetration - reference.penetration) / std::max(1e-12, reference.penetration);
+      row.comError = relativeL2(row.measures.comHeight, reference.comHeight);
+    }
+    const double singleRateHL = rows[1].run.medianSecondsPerFrame;
+    std::printf(
+        "scene %s, %d large steps of hL = %s, %d vertices, contact region ratio %d, fixed cap below y = %.3f\n\n",
+        scenePath.c_str(), frames, formatTimestep(hL).c_str(), mesh.numVertices(), ratio, capHeight);
+    std::printf(
+        "| configuration | ms / large step | x single-rate hL | completed | rebound apex (m) | rebound error | max "
+        "penetration (m) | penetration error | COM height error |\n|---|---|---|---|---|---|---|---|---|\n");
+    for (const Row& row : rows) {
+      std::printf("| %s | %.3f | %.2f | %s | %.4f | %.3f | %.4f | %.3f | %.2e |\n", row.run.configuration.label.c_str(),
+                  1000.0 * row.run.medianSecondsPerFrame, row.run.medianSecondsPerFrame / singleRateHL,
+                  row.run.completed ? "yes" : ("no: " + row.run.failure).c_str(), row.measures.rebound,
+                  row.reboundError, row.measures.penetration, row.penetrationError, row.comError);
+    }
+    // Equal cost: the single-rate run closest in time at or below the adaptive run's;
+    // equal error: the cheapest single-rate run at or below the adaptive run's error.
+    const Row& adaptive = rows[rows.size() - 2];
+    const Row* equalCost = nullptr;
+    const Row* equalError = nullptr;
+    for (std::size_t i = 1; i < rows.size() - 2; ++i) {
+      const Row& r = rows[i];
+      if (r.run.medianSecondsPerFrame <= adaptive.run.medianSecondsPerFrame) equalCost = &r;
+      if (!equalError && r.run.completed && r.reboundError <= adaptive.reboundError &&
+          r.penetrationError <= adaptive.penetrationError)
+        equalError = &r;
+    }
+    std::printf("\n");
+    if (equalCost) {
+      std::printf(
+          "equal cost: %s (%.2fx the adaptive run's time) has rebound error %.3f and penetration error %.3f "
+          "against the adaptive run's %.3f and %.3f\n",
+          equalCost->run.configuration.label.c_str(),
+          equalCost->run.medianSecondsPerFrame / adaptive.run.medianSecondsPerFrame, equalCost->reboundError,
+          equalCost->penetrationError, adaptive.reboundError, adaptive.penetrationError);
+    } else {
+      std::printf("equal cost: every single-rate run of the ladder costs more than the adaptive run\n");
+    }
+    if (equalError) {
+      std::printf("equal error: %s reaches the adaptive run's rebound and penetration errors at %.2fx its time\n",
+                  equalError->run.configuration.label.c_str(),
+                  equalError->run.medianSecondsPerFrame / adaptive.run.medianSecondsPerFrame);
+    } else {
+      std::printf("equal error: no single-rate run of the ladder reaches the adaptive run's errors\n");
+    }
+  } catch (const Error& e) {
+    std::fprintf(stderr, "benchmarkAdaptive: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
