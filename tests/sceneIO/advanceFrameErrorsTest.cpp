@@ -56,6 +56,32 @@ TEST(AdvanceFrameErrors, BlowUpUnderTheUncoupledMultirateSchemeNamesTheRegion) {
   EXPECT_NE(message.find(" in fast region S_1 'end' (vertex set 'xmax')"), std::string::npos) << message;
 }
 
+TEST(AdvanceFrameErrors, SchroederSubstepAboveItsLimitFailsBeforeAnyFrame) {
+  // schroeder2011's outer layer is explicit in its elastic forces: a substep above its
+  // limit is refused when the simulation is built (no frame is computed or written), with
+  // the region and the largest stable substep in the message.
+  auto json = smallScene();
+  json["mesh"]["material"]["youngsModulus"] = 1e9;
+  json["integrator"] = nlohmann::json::parse(R"({"name": "schroeder2011", "timestep": 0.01,
+      "options": {"regions": [{"name": "end", "ratio": 2, "vertexSets": ["xmax"]}]}})");
+  try {
+    asyncfem::buildSimulation(asyncfem::parseScene(json, "", "scene.json"));
+    FAIL() << "no error";
+  } catch (const asyncfem::TimestepError& error) {
+    const std::string message = error.what();
+    EXPECT_EQ(message.rfind("scene.json: integrator.timestep: schroeder2011: fast region S_1 'end'", 0), 0U) << message;
+    EXPECT_NE(message.find("the largest stable substep"), std::string::npos) << message;
+  }
+  // Forced past the check, the run fails within its first frames (the energy check),
+  // naming the region.
+  json["integrator"]["options"]["force"] = true;
+  json["forces"] = nlohmann::json::parse(R"([{"type": "pull", "set": "xmax", "force": [0, -1, 0]}])");
+  const std::string message = failureOf(json);
+  EXPECT_EQ(message.rfind("frame ", 0), 0U) << message;
+  EXPECT_NE(message.find("in fast region S_1 'end'"), std::string::npos) << message;
+  EXPECT_NE(message.find("the simulation is unstable"), std::string::npos) << message;
+}
+
 TEST(AdvanceFrameErrors, UnstableExplicitRunNamesTheFrameAndTheMesh) {
   // Central differences forced far above its stable timestep: the state grows by orders
   // of magnitude per step until the blow-up check stops it.

@@ -356,7 +356,7 @@ void printSceneModes(const Scene& scene, const Simulation& baseline, int count) 
 // The configurations of the command line (file, then specs), else the scene's defaults.
 // Every one is built once before the reference is computed (the expensive part), so a bad
 // one (unknown integrator or option, a timestep that does not divide the frame interval)
-// fails at once.
+// fails at once; a timestep the integrator refuses as unstable is run and reported.
 std::vector<BenchmarkConfiguration> configurationsOf(const CommandLine& options, const Scene& scene,
                                                      const Simulation& baseline) {
   std::vector<BenchmarkConfiguration> configs;
@@ -368,6 +368,9 @@ std::vector<BenchmarkConfiguration> configurationsOf(const CommandLine& options,
   for (const BenchmarkConfiguration& c : configs) {
     try {
       (void)buildSimulation(configuredScene(scene, c, 1));
+    } catch (const TimestepError&) {
+      // A step its integrator refuses is a result (a configuration failing before its
+      // first frame, with the message), not a bad command line.
     } catch (const Error& error) {
       throw Error("configuration \"" + c.label + "\": " + error.what());
     }

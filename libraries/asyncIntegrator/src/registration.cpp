@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/registration.hpp>
+#include <asyncfem/asyncIntegrator/schroeder2011.hpp>
 #include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
@@ -199,6 +200,22 @@ void parseRegions(JsonObjectReader& reader, const IntegratorContext& context, co
   }
 }
 
+// The other multirate integrators read the regions as "async" does; its solver keys have
+// no meaning there: reject them by name rather than silently ignoring a setting the user
+// expects to matter. options must be an object.
+void rejectAsyncOnlyKeys(const IntegratorContext& context, const nlohmann::json& options, const std::string& name) {
+  const std::string& path = context.optionsPath;
+  if (!options.is_object()) {
+    JsonObjectReader::failAt(context.sourceName, path,
+                             "expected an object, got " + JsonObjectReader::describe(options));
+  }
+  for (const char* key : {"coupling", "schur", "method", "recovery", "substepContact"}) {
+    if (options.contains(key)) {
+      JsonObjectReader::failAt(context.sourceName, path + "." + key, "used by \"async\" only, not by \"" + name + "\"");
+    }
+  }
+}
+
 }  // namespace
 
 AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const nlohmann::json& options) {
@@ -314,18 +331,7 @@ void registerMultirateIntegrators(IntegratorRegistry& registry) {
   registry.add("multirate-uncoupled",
                [](IntegratorContext context, const nlohmann::json& options) -> std::unique_ptr<Integrator> {
                  const std::string& path = context.optionsPath;
-                 if (!options.is_object()) {
-                   JsonObjectReader::failAt(context.sourceName, path,
-                                            "expected an object, got " + JsonObjectReader::describe(options));
-                 }
-                 // Keys of the async integrator that have no meaning here: reject them by name
-                 // rather than silently ignoring a setting the user expects to matter.
-                 for (const char* key : {"coupling", "schur", "method", "recovery", "substepContact"}) {
-                   if (options.contains(key)) {
-                     JsonObjectReader::failAt(context.sourceName, path + "." + key,
-                                              "used by \"async\" only, not by \"multirate-uncoupled\"");
-                   }
-                 }
+                 rejectAsyncOnlyKeys(context, options, "multirate-uncoupled");
                  UncoupledMultirateOptions solverOptions;
                  nlohmann::json regionOptions = options;  // what parseAsyncSettings reads
                  if (const auto it = options.find("compoundSolver"); it != options.end()) {
@@ -349,6 +355,35 @@ void registerMultirateIntegrators(IntegratorRegistry& registry) {
                                                              parsed.regions, solverOptions);
                },
                {"compoundSolver", "regionSolver", "regions", "auto"});
+  registry.add("schroeder2011",
+               [](IntegratorContext context, const nlohmann::json& options) -> std::unique_ptr<Integrator> {
+                 const std::string& path = context.optionsPath;
+                 rejectAsyncOnlyKeys(context, options, "schroeder2011");
+                 // Its own keys are read here; the rest (regions, auto, regionSolver) as "async" reads them.
+                 Schroeder2011Options solverOptions;
+                 nlohmann::json regionOptions = options;
+                 nlohmann::json own = nlohmann::json::object();
+                 for (const char* key : {"compoundSolver", "rigidity", "force"}) {
+                   if (const auto it = options.find(key); it != options.end()) {
+                     own[key] = *it;
+                     regionOptions.erase(key);
+                   }
+                 }
+                 JsonObjectReader reader(own, path, context.sourceName);
+                 const std::string compound = reader.choice("compoundSolver", "umfpack", {"umfpack", "eigen-lu"});
+                 solverOptions.compoundSolver = parseSolverKind(compound);
+                 solverOptions.rigidity = reader.number("rigidity", solverOptions.rigidity);
+                 if (!(solverOptions.rigidity >= 0.0 && solverOptions.rigidity <= 1.0)) {
+                   reader.fail("rigidity", "expected a number in [0, 1]");
+                 }
+                 solverOptions.force = reader.boolean("force", solverOptions.force);
+                 reader.finish();
+                 const AsyncSettings parsed = parseAsyncSettings(context, regionOptions);
+                 solverOptions.regionSolver = parsed.solver.regionSolver;
+                 return std::make_unique<Schroeder2011>(*context.mesh, std::move(context.system), context.timestep,
+                                                        parsed.regions, solverOptions);
+               },
+               {"compoundSolver", "regionSolver", "rigidity", "force", "regions", "auto"});
 }
 
 }  // namespace asyncfem

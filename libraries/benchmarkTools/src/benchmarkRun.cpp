@@ -6,11 +6,14 @@
 #include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/sceneIO/asyncScene.hpp>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace asyncfem {
 
-bool isMultirate(const std::string& integrator) { return integrator == "async" || integrator == "multirate-uncoupled"; }
+bool isMultirate(const std::string& integrator) {
+  return integrator == "async" || integrator == "multirate-uncoupled" || integrator == "schroeder2011";
+}
 
 Scene configuredScene(const Scene& scene, const BenchmarkConfiguration& configuration, int frames) {
   Scene out = scene;
@@ -28,7 +31,8 @@ std::vector<AsyncRegion> configurationRegions(const Scene& scene, const Simulati
                                               const BenchmarkConfiguration& configuration) {
   if (!isMultirate(configuration.integrator)) return {};
   nlohmann::json options = configuration.options;
-  options.erase("compoundSolver");  // multirate-uncoupled's own key; the regions are read as async reads them
+  // The other multirate integrators' own keys; the regions are read as async reads them.
+  for (const char* key : {"compoundSolver", "rigidity", "force"}) options.erase(key);
   return parseAsyncOptions(configuredScene(scene, configuration, 1), *baseline.mesh,
                            baseline.integrator->system().freeDofs, options)
       .regions;
@@ -46,11 +50,24 @@ struct Repeat {
 // the machine-independent costs into result.
 Repeat timedRepeat(const Scene& configured, int frames, bool first, BenchmarkRun& result) {
   Stopwatch setup;
-  Simulation simulation = buildSimulation(configured);
+  Repeat repeat;
+  std::optional<Simulation> built;
+  try {
+    built.emplace(buildSimulation(configured));
+  } catch (const TimestepError& error) {
+    // A step the integrator refuses (schroeder2011's substeps above their explicit
+    // limit): reported as a configuration that fails before its first frame.
+    if (first) {
+      result.failedFrame = 0;
+      result.failure = error.what();
+    }
+    repeat.failed = true;
+    return repeat;
+  }
+  Simulation& simulation = *built;
   const double setupSeconds = setup.stop();
   Integrator& integrator = *simulation.integrator;
   IntegratorStats afterWarmUp;
-  Repeat repeat;
   for (int frame = 0; frame < frames; ++frame) {
     Stopwatch watch;
     try {

@@ -61,7 +61,8 @@ nlohmann::json asyncRegionsJson(const std::vector<AsyncRegion>& regions);
 /// step any of them takes; 1 when there are none (everything runs at hL).
 int largestRatio(const std::vector<AsyncRegion>& regions);
 
-/// Adds "async" (AsyncBackwardEuler) and "multirate-uncoupled" (UncoupledMultirate).
+/// Adds "async" (AsyncBackwardEuler), "multirate-uncoupled" (UncoupledMultirate) and
+/// "schroeder2011" (Schroeder2011).
 void registerMultirateIntegrators(IntegratorRegistry& registry);
 
 }  // namespace asyncfem

@@ -24,7 +24,8 @@ struct BenchmarkConfiguration {
   bool plotTrajectory = false;                        ///< draw its vertex curve in the trajectory plot
 };
 
-/// Multirate integrators (their options carry regions): "async" and "multirate-uncoupled".
+/// Multirate integrators (their options carry regions): "async", "multirate-uncoupled" and
+/// "schroeder2011".
 bool isMultirate(const std::string& integrator);
 
 /// The scene with the configuration's integrator, timestep, options and frame count, and
