@@ -195,6 +195,24 @@ TEST(AutoRegions, ModalCheckKeepsARegionWhoseModesLiveInIt) {
   EXPECT_FALSE(proposal.modalReport->visibleModesTruncated) << table.str();
   for (int v : proposal.regions[0].region.vertices) EXPECT_GE(mesh.restPosition(v).z(), 0.1 - 1e-12);
 
+  // The ratio is the one the kept modes need, not the element criterion's: every mode
+  // that lives in the region and is damped at hL (omega hL >= 0.5) is resolved at hS
+  // (omega hS <= 0.1), so the verdict is that async keeps them. Without the modal check
+  // the element criterion's ratio alone is proposed, which is lower here.
+  const ProposedRegion& region = proposal.regions[0];
+  EXPECT_EQ(proposal.modalReport->verdict, ModalVerdict::asyncKeepsModes) << table.str();
+  for (const ModeInRegions& mode : proposal.modalReport->modes) {
+    if (mode.livesInFastRegions && mode.omegaLargeStep >= modalCriteria::minDampedOmegaLargeStep) {
+      EXPECT_LE(mode.omegaSubstep[0], modalCriteria::maxResolvedOmegaSubstep) << table.str();
+    }
+  }
+  AutoRegionOptions elementsOnly = options;
+  elementsOnly.modalCheck = false;
+  const AutoRegionProposal byElements = suggestRegions(mesh, freeDofs, elementsOnly);
+  ASSERT_EQ(byElements.regions.size(), 1u);
+  EXPECT_LT(byElements.regions[0].region.ratio, region.region.ratio);
+  EXPECT_EQ(region.ratioFromElements, byElements.regions[0].region.ratio);
+
   options.frameRate = -1.0;
   EXPECT_THROW(suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass), ValidationError);
 }

@@ -202,6 +202,13 @@ void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const A
   if (proposal.modalReport) {
     std::printf("modal check (%zu lowest modes, %.3g s): %s\n", proposal.modalReport->modes.size(),
                 proposal.modalSeconds, proposal.modalReport->verdictText().c_str());
+    for (const ProposedRegion& r : proposal.regions) {
+      if (r.ratioFromElements > 0) {
+        std::printf(
+            "ratio of %s raised from %d (element criterion) to %d: the modes living in it need omega*hS <= %g\n",
+            r.region.name.c_str(), r.ratioFromElements, r.region.ratio, modalCriteria::maxResolvedOmegaSubstep);
+      }
+    }
     if (!proposal.withdrawnRegions.empty()) {
       std::printf(
           "no fast region proposed: the asynchronous integrator runs single-rate at hL "

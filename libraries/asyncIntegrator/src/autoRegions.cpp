@@ -345,6 +345,29 @@ std::vector<ModalRegion> modalRegions(const std::vector<AsyncRegion>& regions) {
   return out;
 }
 
+namespace {
+/// Raises each region's ratio so that every visible mode living in S (mainly in that
+/// region) and damped at hL is resolved at hS (omega hS <= maxResolvedOmegaSubstep),
+/// capped at options.maxRatio. Returns whether a ratio changed (noted in ratioRaised).
+bool raiseRatiosForModes(const AutoRegionOptions& options, AutoRegionProposal& proposal) {
+  bool raised = false;
+  for (const ModeInRegions& mode : proposal.modalReport->modes) {
+    if (!mode.livesInFastRegions || mode.omegaLargeStep < modalCriteria::minDampedOmegaLargeStep) continue;
+    const auto main = static_cast<std::size_t>(std::max_element(mode.regionShare.begin(), mode.regionShare.end()) -
+                                               mode.regionShare.begin());
+    ProposedRegion& region = proposal.regions[main];
+    const int needed = std::min(
+        options.maxRatio, static_cast<int>(std::ceil(mode.omegaLargeStep / modalCriteria::maxResolvedOmegaSubstep)));
+    if (needed > region.region.ratio) {
+      if (region.ratioFromElements == 0) region.ratioFromElements = region.region.ratio;
+      region.region.ratio = needed;
+      raised = true;
+    }
+  }
+  return raised;
+}
+}  // namespace
+
 AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
                                   const Eigen::SparseMatrix<double>& stiffness,
                                   const Eigen::SparseMatrix<double>& mass) {
@@ -372,6 +395,20 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   }
   proposal.modalReport =
       analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep, options.frameRate);
+  if (proposal.modalReport->verdict == ModalVerdict::unresolvedAtSubstep && raiseRatiosForModes(options, proposal)) {
+    // The element criterion's ratios leave the modes that live in S damped at hS: take
+    // the ratios those modes need, then report and cost the raised proposal.
+    proposal.modalReport = analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep,
+                                              options.frameRate);
+    if (options.costCheck) {
+      proposal.cost = estimateAsyncCost(mesh, freeDofs, proposal.asyncRegions(), options.nonlinear, options.costMargin);
+      if (!proposal.cost.asyncCheaper) {
+        proposal.costWithdrawnRegions = std::move(proposal.regions);
+        proposal.regions.clear();
+        return proposal;
+      }
+    }
+  }
   if (proposal.modalReport->verdict == ModalVerdict::noVisibleModeInFast) {
     proposal.withdrawnRegions = std::move(proposal.regions);
     proposal.regions.clear();

@@ -19,6 +19,7 @@
 #include <asyncfem/benchmarkTools/benchmarkRun.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/threading.hpp>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <cmath>
@@ -80,6 +81,7 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
+  asyncfem::preferPassiveThreadWaiting(argv);
   CLI::App app{"Run-time (adaptive) async regions on a bouncing scene against single-rate backward Euler"};
   std::string scenePath = "models/ball/ball.json";
   int frames = 90, repeats = 1, referenceSteps = 64;
@@ -90,7 +92,6 @@ int main(int argc, char** argv) {
   app.add_option("--reference-steps", referenceSteps, "Reference: single-rate steps per large step");
   app.add_option("--ladder", ladder, "Single-rate steps per large step to compare")->delimiter(',');
   CLI11_PARSE(app, argc, argv);
-  configureThreading();
   try {
     Scene scene = loadScene(scenePath);
     const FrameTiming timing = frameTimingOf(scene);

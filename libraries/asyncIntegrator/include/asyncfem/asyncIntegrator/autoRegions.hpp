@@ -86,6 +86,9 @@ struct ProposedRegion {
   double maxFrequency = 0.0;  ///< max omega_e over its elements (rad/s)
   int numElements = 0;        ///< elements with every vertex in the region
   int numInterfaceDofs = 0;   ///< |I| of the region once partitioned
+  /// The element criterion's ratio when the modal check raised it (the modes living in the
+  /// region needed more substeps); 0 when it was kept.
+  int ratioFromElements = 0;
 };
 
 struct AutoRegionProposal {
@@ -130,7 +133,12 @@ AutoRegionCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs, 
 /// The same proposal, followed by the modal check when options.modalCheck is set:
 /// lowestModes() of stiffness and mass (full 3n x 3n, e.g. vibrationMatrices()) and
 /// analyseRegionModes() of the proposed regions at hL = options.largeTimestep; when its
-/// verdict is ModalVerdict::noVisibleModeInFast the regions move to withdrawnRegions.
+/// verdict is ModalVerdict::noVisibleModeInFast the regions move to withdrawnRegions. When
+/// it is unresolvedAtSubstep (modes live in S and are damped at hL, but the element
+/// criterion's ratio leaves them damped at hS too) each region's ratio is raised to what its
+/// modes need (omega hS <= modalCriteria::maxResolvedOmegaSubstep, at most maxRatio;
+/// ProposedRegion::ratioFromElements keeps the old one), and the report and the cost check
+/// are redone for the raised proposal.
 /// The mode counts are clamped to the free DOFs - 1. Throws ValidationError for frameRate <= 0
 /// or counts out of order, and what lowestModes() throws.
 AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
