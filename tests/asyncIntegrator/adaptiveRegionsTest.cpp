@@ -89,6 +89,26 @@ TEST(AdaptiveRegions, WindowsSwitchAtTheirBoundariesAndTheCacheChangesNothing) {
   EXPECT_TRUE(records[3].reused);
 }
 
+// With room for one set-up, the empty partition (what every contact returns to) is the one
+// kept: after A and then B, going back to no region takes the cached set-up.
+TEST(AdaptiveRegions, TheEmptyPartitionStaysCached) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  AdaptiveRegionOptions options =
+      scheduleOf({{"a", 1.5 * kLargeStep, 2.5 * kLargeStep, test::verticesBeyond(ts.mesh, 0.75), 4},
+                  {"b", 2.5 * kLargeStep, 3.5 * kLargeStep, test::verticesBeyond(ts.mesh, 0.5), 2}});
+  options.cacheSize = 1;
+  AsyncBackwardEuler adaptive(ts.mesh, ts.system, kLargeStep, {});
+  adaptive.setState(ts.u0, ts.v0);
+  adaptive.setAdaptiveRegions(options);
+  for (int k = 0; k < 5; ++k) adaptive.step();
+  const std::vector<RepartitionRecord>& records = adaptive.repartitions();
+  ASSERT_EQ(records.size(), 3U);
+  EXPECT_FALSE(records[0].reused);
+  EXPECT_FALSE(records[1].reused);
+  EXPECT_EQ(records[2].regions, 0);
+  EXPECT_TRUE(records[2].reused);
+}
+
 // The contact policy through a stand-in obstacle: the vertices with x above a threshold
 // that the test moves. The region appears at once, grown by rings, stays while what is
 // needed stays inside it, and goes only after the dwell.

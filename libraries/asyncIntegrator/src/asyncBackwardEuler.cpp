@@ -206,7 +206,13 @@ void AsyncBackwardEuler::repartition(std::vector<AsyncRegion> regions, const std
   }
   const int keep = policy_ ? policy_->options().cacheSize : 0;
   if (keep > 0) cache_.insert(cache_.begin(), std::move(outgoing));
-  if (static_cast<int>(cache_.size()) > keep) cache_.erase(cache_.begin() + keep, cache_.end());
+  // Least recently used out first, but the empty partition (single-rate at hL between
+  // contacts) stays while it fits: it is the one every contact returns to.
+  while (static_cast<int>(cache_.size()) > keep) {
+    auto victim = cache_.end() - 1;
+    if (victim->key.empty() && cache_.size() > 1) --victim;
+    cache_.erase(victim);
+  }
   stepsKept_ = 0;
   const std::vector<int>& after = partition_.vertexRegion();
   for (std::size_t v = 0; v < after.size(); ++v) {
