@@ -48,6 +48,14 @@ TEST(AdaptiveRegions, AnAlwaysOpenWindowEqualsTheFixedRegion) {
   expectSameState(fixed, adaptive);
   ASSERT_EQ(adaptive.repartitions().size(), 1U);
   EXPECT_EQ(adaptive.repartitions()[0].reason, "initial regions");
+  // The summary lists the re-partition, and a resumed run is told that the partition is
+  // chosen afresh (it is not in the checkpoint).
+  const RunReport report = adaptive.report();
+  bool listed = false;
+  for (const std::string& line : report.lines) listed = listed || line.find("initial regions") != std::string::npos;
+  EXPECT_TRUE(listed);
+  EXPECT_NE(report.resumeCaveat.find("adaptive regions"), std::string::npos) << report.resumeCaveat;
+  EXPECT_TRUE(fixed.report().resumeCaveat.empty()) << fixed.report().resumeCaveat;
   EXPECT_EQ(adaptive.repartitions()[0].fastVertices, static_cast<int>(tip.size()));
 }
 

@@ -745,6 +745,13 @@ RunReport AsyncBackwardEuler::report() const {
         "refactors at its first step; its frames match an uninterrupted run to about the Schur tolerance (" +
         std::to_string(options_.laggedSchurTolerance) + "), not bit for bit";
   }
+  if (policy_) {
+    if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
+    report.resumeCaveat +=
+        "adaptive regions: the partition in use and how long it has been kept are not in the checkpoint, so the "
+        "resumed run chooses its regions afresh from the resumed state and its frames can differ from an "
+        "uninterrupted run's (by as much as two partitions' trajectories differ)";
+  }
   std::vector<std::string>& lines = report.lines;
   std::snprintf(line, sizeof(line),
                 "async set-up %.3f s (Z %.3f s over %lld right-hand sides on %d threads, H^LL* %.3f s); |S| %d, "
