@@ -93,3 +93,23 @@ def test_suggested_regions(beam):
     assert checked.has_modal_report and checked.modal_seconds > 0
     with pytest.raises(ValueError, match="give both"):
         af.suggest_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler))
+
+
+def test_schedule_policy_from_python(beam):
+    """A scheduled window opens and closes the fast region at its large-step boundaries."""
+    system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))
+    tip = af.region_vertices(beam, element_sets=["tip"])
+    integrator = af.AsyncBackwardEuler(beam, system, 0.01, [])
+    options = af.AdaptiveRegionOptions()
+    options.schedule = [af.ScheduledRegion("tip", tip, 4, start=0.015, end=0.035)]
+    integrator.set_adaptive_regions(options)
+    assert integrator.partition.num_regions == 0
+    integrator.step(5)
+    records = integrator.repartitions
+    assert [r.step for r in records] == [2, 4]
+    assert [r.regions for r in records] == [1, 0]
+    assert records[0].fast_vertices == len(tip) and records[1].reused
+    with pytest.raises(af.ValidationError):
+        bad = af.AdaptiveRegionOptions()
+        bad.contact = True  # this system has no obstacles
+        integrator.set_adaptive_regions(bad)

@@ -5,6 +5,7 @@
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <integrators.hpp>
+#include <limits>
 
 namespace asyncfem::python {
 
@@ -122,6 +123,41 @@ void bindAsync(py::module_& module) {
       .def_readwrite("region_solver", &AsyncOptions::regionSolver)
       .def_readwrite("substep_state_prediction", &AsyncOptions::substepStatePrediction);
 
+  py::class_<ScheduledRegion>(module, "ScheduledRegion",
+                              "A fast region of the schedule policy: vertices at ratio from start to end (s)")
+      .def(py::init([](std::string name, const py::handle& vertices, int ratio, double start, double end) {
+             return ScheduledRegion{std::move(name), start, end, indexListArgument(vertices, "vertices"), ratio};
+           }),
+           py::arg("name"), py::arg("vertices"), py::arg("ratio"), py::arg("start") = 0.0,
+           py::arg("end") = std::numeric_limits<double>::infinity())
+      .def_readwrite("name", &ScheduledRegion::name)
+      .def_readwrite("start", &ScheduledRegion::start)
+      .def_readwrite("end", &ScheduledRegion::end)
+      .def_readwrite("ratio", &ScheduledRegion::ratio)
+      .def_property_readonly("vertices", [](const ScheduledRegion& r) { return intArray(r.vertices); });
+  py::class_<AdaptiveRegionOptions>(module, "AdaptiveRegionOptions",
+                                    "Policies of run-time regions (docs/asynchronous-integrator.md, Run-time regions)")
+      .def(py::init<>())
+      .def_readwrite("contact", &AdaptiveRegionOptions::contact, "follow contact (needs obstacles in the system)")
+      .def_readwrite("contact_ratio", &AdaptiveRegionOptions::contactRatio)
+      .def_readwrite("contact_margin", &AdaptiveRegionOptions::contactMargin, "length")
+      .def_readwrite("contact_lookahead", &AdaptiveRegionOptions::contactLookahead, "large steps")
+      .def_readwrite("contact_rings", &AdaptiveRegionOptions::contactRings)
+      .def_readwrite("schedule", &AdaptiveRegionOptions::schedule, "list of ScheduledRegion")
+      .def_readwrite("min_dwell", &AdaptiveRegionOptions::minDwell, "large steps")
+      .def_readwrite("shrink_factor", &AdaptiveRegionOptions::shrinkFactor)
+      .def_readwrite("cache_size", &AdaptiveRegionOptions::cacheSize);
+  py::class_<RepartitionRecord>(module, "RepartitionRecord", "One change of partition at a large-step boundary")
+      .def_readonly("time", &RepartitionRecord::time)
+      .def_readonly("step", &RepartitionRecord::step)
+      .def_readonly("reason", &RepartitionRecord::reason)
+      .def_readonly("regions", &RepartitionRecord::regions)
+      .def_readonly("fast_vertices", &RepartitionRecord::fastVertices)
+      .def_readonly("interface_dofs", &RepartitionRecord::interfaceDofs)
+      .def_readonly("moved_vertices", &RepartitionRecord::movedVertices)
+      .def_readonly("seconds", &RepartitionRecord::seconds)
+      .def_readonly("reused", &RepartitionRecord::reused);
+
   py::class_<AsyncBackwardEuler, Integrator>(
       module, "AsyncBackwardEuler",
       "Asynchronous implicit backward Euler: fast regions take ratio substeps per large step, coupled implicitly")
@@ -149,7 +185,14 @@ void bindAsync(py::module_& module) {
       .def_property_readonly("schur_mode_used", &AsyncBackwardEuler::schurModeUsed)
       .def("solve_floor_seconds", &AsyncBackwardEuler::solveFloorSeconds, py::arg("repeats") = 5,
            py::call_guard<py::gil_scoped_release>())
-      .def_property_readonly("factor_non_zeros", &AsyncBackwardEuler::factorNonZeros);
+      .def_property_readonly("factor_non_zeros", &AsyncBackwardEuler::factorNonZeros)
+      .def("set_up", &AsyncBackwardEuler::setUp, py::arg("partition"), py::call_guard<py::gil_scoped_release>(),
+           "take another partition of the same mesh from the next step on")
+      .def("set_adaptive_regions", &AsyncBackwardEuler::setAdaptiveRegions, py::arg("options"),
+           py::call_guard<py::gil_scoped_release>(),
+           "choose the regions at every large-step boundary with these policies (AdaptiveRegionOptions)")
+      .def_property_readonly("repartitions", &AsyncBackwardEuler::repartitions,
+                             "every change of partition so far (RepartitionRecord)");
 
   // Automatic regions (what a scene's "regions": "auto" and suggestRegions use).
   module.def("element_max_frequencies", &elementMaxFrequencies, py::arg("mesh"),
