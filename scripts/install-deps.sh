@@ -13,7 +13,9 @@ packages=(
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-scipy python3-pytest python3-matplotlib
 )
 if [[ "${1:-}" != "--no-render" ]]; then
-  packages+=(libosmesa6-dev libassimp-dev libpng-dev)
+  # assimp-testmodels: real surfaces for the mesher's property test
+  # (StuffingProperties.RealSurfacesFromAssimpTestModels), which skips without them.
+  packages+=(libosmesa6-dev libassimp-dev libpng-dev assimp-testmodels)
 fi
 
 missing=()

@@ -57,7 +57,28 @@ fs::path writeInput(const std::string& name, const std::uint8_t* data, std::size
   return path;
 }
 
-void readMeshQuietly(const fs::path& path,
+// The outcome of a rejected input: the error's class and its message, with the scratch
+// folder (which holds the process id) replaced by "<scratch>".
+std::string rejected(const Error& error) {
+  const char* kind = "Error";
+  if (dynamic_cast<const TimestepError*>(&error) != nullptr) {
+    kind = "TimestepError";
+  } else if (dynamic_cast<const ValidationError*>(&error) != nullptr) {
+    kind = "ValidationError";
+  } else if (dynamic_cast<const ParseError*>(&error) != nullptr) {
+    kind = "ParseError";
+  } else if (dynamic_cast<const NumericalError*>(&error) != nullptr) {
+    kind = "NumericalError";
+  }
+  std::string message = error.what();
+  const std::string folder = scratchFolder().string();
+  for (std::size_t at = message.find(folder); at != std::string::npos; at = message.find(folder, at)) {
+    message.replace(at, folder.size(), "<scratch>");
+  }
+  return "rejected: " + std::string(kind) + ": " + message;
+}
+
+std::string readMesh(const fs::path& path,
                      TetMesh (*reader)(const fs::path&, const MeshReadOptions&, MeshReadReport*)) {
   try {
     MeshReadReport report;
@@ -65,19 +86,21 @@ void readMeshQuietly(const fs::path& path,
     // A mesh that reads is valid (the TetMesh constructor checks it); touch it so that a
     // broken one would show up under the sanitizers.
     if (mesh.numElements() <= 0 || !mesh.restPositions().allFinite()) std::abort();
-  } catch (const Error&) {
+    return "accepted: " + std::to_string(mesh.numVertices()) + " vertices, " + std::to_string(mesh.numElements()) +
+           " elements";
+  } catch (const Error& error) {
     // Rejected with a documented error: expected for most inputs.
+    return rejected(error);
   }
 }
 
 }  // namespace
 
-int fuzzVeg(const std::uint8_t* data, std::size_t size) {
-  readMeshQuietly(writeInput("input.veg", data, size), readVeg);
-  return 0;
+std::string vegOutcome(const std::uint8_t* data, std::size_t size) {
+  return readMesh(writeInput("input.veg", data, size), readVeg);
 }
 
-int fuzzTetGen(const std::uint8_t* data, std::size_t size) {
+std::string tetGenOutcome(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   constexpr std::string_view separator = "@@ele\n";
   std::size_t split = text.find(separator);
@@ -85,58 +108,94 @@ int fuzzTetGen(const std::uint8_t* data, std::size_t size) {
   if (split == std::string_view::npos) split = size;
   writeInput("input.node", data, split);
   writeInput("input.ele", data + eleStart, size - eleStart);
-  readMeshQuietly(scratchFolder() / "input.node", readTetGen);
+  return readMesh(scratchFolder() / "input.node", readTetGen);
+}
+
+std::string gmshOutcome(const std::uint8_t* data, std::size_t size) {
+  return readMesh(writeInput("input.msh", data, size), readGmsh);
+}
+
+std::string simulationFileOutcome(const std::uint8_t* data, std::size_t size) {
+  const fs::path path = writeInput("input.afsim", data, size);
+  std::string outcome = "reader: ";
+  try {
+    SimulationReader reader(path);
+    SimulationFrame frame;
+    std::int64_t good = 0;
+    std::string bad;
+    for (std::int64_t k = 0; k < reader.numFrames(); ++k) {
+      try {
+        reader.readFrame(k, frame);
+        ++good;
+      } catch (const ParseError& error) {
+        // A corrupted record is reported; the reader stays usable for the others.
+        bad += "; frame " + std::to_string(k) + ": " + rejected(error);
+      }
+    }
+    outcome += "accepted: " + std::to_string(reader.numVertices()) + " vertices, " + std::to_string(good) + " of " +
+               std::to_string(reader.numFrames()) + " frames read" + bad;
+  } catch (const Error& error) {
+    outcome += rejected(error);
+  }
+  outcome += "; checkpoint: ";
+  try {
+    const SimulationCheckpoint checkpoint = parseCheckpoint(data, size, "input.checkpoint");
+    if (checkpoint.displacement.size() != checkpoint.velocity.size()) std::abort();
+    outcome += "accepted: " + checkpoint.integrator + ", " + std::to_string(checkpoint.frames) + " frames, " +
+               std::to_string(checkpoint.displacement.size()) + " state entries";
+  } catch (const Error& error) {
+    outcome += rejected(error);
+  }
+  return outcome;
+}
+
+std::string sceneOutcome(const std::uint8_t* data, std::size_t size) {
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(data, data + size, nullptr, true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::exception& error) {
+    // Not JSON: loadScene reports it as a ParseError before parseScene runs.
+    return std::string("not JSON: ") + error.what();
+  }
+  try {
+    const Scene scene = parseScene(json, scratchFolder(), "fuzz.json");
+    return "accepted: integrator " + scene.integrator.name;
+  } catch (const Error& error) {
+    return rejected(error);
+  }
+}
+
+int fuzzVeg(const std::uint8_t* data, std::size_t size) {
+  static_cast<void>(vegOutcome(data, size));
+  return 0;
+}
+
+int fuzzTetGen(const std::uint8_t* data, std::size_t size) {
+  static_cast<void>(tetGenOutcome(data, size));
   return 0;
 }
 
 int fuzzGmsh(const std::uint8_t* data, std::size_t size) {
-  readMeshQuietly(writeInput("input.msh", data, size), readGmsh);
+  static_cast<void>(gmshOutcome(data, size));
   return 0;
 }
 
 int fuzzSimulationFile(const std::uint8_t* data, std::size_t size) {
-  const fs::path path = writeInput("input.afsim", data, size);
-  try {
-    SimulationReader reader(path);
-    SimulationFrame frame;
-    for (std::int64_t k = 0; k < reader.numFrames(); ++k) {
-      try {
-        reader.readFrame(k, frame);
-      } catch (const ParseError&) {
-        // A corrupted record is reported; the reader stays usable for the others.
-      }
-    }
-  } catch (const Error&) {
-  }
-  try {
-    const SimulationCheckpoint checkpoint = parseCheckpoint(data, size, "input.checkpoint");
-    if (checkpoint.displacement.size() != checkpoint.velocity.size()) std::abort();
-  } catch (const Error&) {
-  }
+  static_cast<void>(simulationFileOutcome(data, size));
   return 0;
 }
 
 int fuzzScene(const std::uint8_t* data, std::size_t size) {
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(data, data + size, nullptr, true, /*ignore_comments=*/true);
-  } catch (const nlohmann::json::exception&) {
-    return 0;  // not JSON: loadScene reports it as a ParseError before parseScene runs
-  }
-  try {
-    const Scene scene = parseScene(json, scratchFolder(), "fuzz.json");
-    static_cast<void>(scene);
-  } catch (const Error&) {
-  }
+  static_cast<void>(sceneOutcome(data, size));
   return 0;
 }
 
 std::vector<Harness> allHarnesses() {
-  return {{"veg", fuzzVeg},
-          {"tetgen", fuzzTetGen},
-          {"gmsh", fuzzGmsh},
-          {"simulationFile", fuzzSimulationFile},
-          {"scene", fuzzScene}};
+  return {{"veg", fuzzVeg, vegOutcome},
+          {"tetgen", fuzzTetGen, tetGenOutcome},
+          {"gmsh", fuzzGmsh, gmshOutcome},
+          {"simulationFile", fuzzSimulationFile, simulationFileOutcome},
+          {"scene", fuzzScene, sceneOutcome}};
 }
 
 }  // namespace asyncfem::fuzz

@@ -29,10 +29,25 @@ int fuzzSimulationFile(const std::uint8_t* data, std::size_t size);
 /// JSON scene text (nlohmann::json::parse, then parseScene).
 int fuzzScene(const std::uint8_t* data, std::size_t size);
 
+/// What each harness made of an input, as one line for the corpus replay (the expected
+/// outcome of every seed is stored in tests/fuzz/corpus/<harness>.expected):
+/// "accepted: ..." with a summary of what was read, or "rejected: <ErrorClass>: <message>"
+/// (ErrorClass: ParseError, ValidationError, TimestepError, NumericalError or Error),
+/// with the scratch folder the input went through written as "<scratch>". The fuzz*
+/// functions above call these and discard the text.
+std::string vegOutcome(const std::uint8_t* data, std::size_t size);
+std::string tetGenOutcome(const std::uint8_t* data, std::size_t size);
+std::string gmshOutcome(const std::uint8_t* data, std::size_t size);
+/// "reader: ...; frame K: ...(each frame that is rejected); checkpoint: ...".
+std::string simulationFileOutcome(const std::uint8_t* data, std::size_t size);
+/// "not JSON: <parser message>", or the outcome of parseScene.
+std::string sceneOutcome(const std::uint8_t* data, std::size_t size);
+
 /// A harness by name: "veg", "tetgen", "gmsh", "simulationFile", "scene".
 struct Harness {
   std::string name;
   int (*function)(const std::uint8_t*, std::size_t);
+  std::string (*outcome)(const std::uint8_t*, std::size_t);
 };
 std::vector<Harness> allHarnesses();
 

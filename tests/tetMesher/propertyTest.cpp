@@ -218,7 +218,10 @@ TEST(StuffingProperties, RealSurfacesFromAssimpTestModels) {
   for (const char* relative : {"Collada/duck.dae", "3DS/fels.3ds", "FBX/huesitos.fbx", "OBJ/WusonOBJ.obj",
                                "OBJ/spider.obj", "glTF/CesiumMilkTruck/CesiumMilkTruck.gltf"}) {
     const std::filesystem::path path = models / relative;
-    if (!std::filesystem::exists(path)) continue;
+    if (!std::filesystem::exists(path)) {
+      ADD_FAILURE() << path.string() << " is missing from assimp-testmodels";
+      continue;
+    }
     TriangleSurface surface = readSurface(path);
     const Eigen::AlignedBox3d bounds = surface.bounds();
     weldVertices(surface, 1e-7 * bounds.diagonal().norm());

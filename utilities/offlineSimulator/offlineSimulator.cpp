@@ -160,6 +160,16 @@ std::string resumeCommand(int argc, char** argv) {
   return command;
 }
 
+// The folder of the output file, created if needed; an error names it and the cause.
+void createOutputFolder(const fs::path& output) {
+  if (!output.has_parent_path()) return;
+  std::error_code error;
+  fs::create_directories(output.parent_path(), error);
+  if (error) {
+    throw asyncfem::Error(output.parent_path().string() + ": cannot create the output folder: " + error.message());
+  }
+}
+
 // Command-line values replace the scene's; paths given here are relative to the
 // current folder, not the scene's.
 void applyOverrides(const CommandLine& options, asyncfem::Scene& scene) {
@@ -401,7 +411,7 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   const bool root = simulation.rank() == 0;
   std::unique_ptr<asyncfem::SimulationWriter> writer;
   if (root) {
-    if (scene.output.file.has_parent_path()) fs::create_directories(scene.output.file.parent_path());
+    createOutputFolder(scene.output.file);
     asyncfem::SimulationFileHeader header;
     header.numVertices = problem->mesh().numVertices();
     header.frameInterval = timing.frameInterval;
@@ -513,7 +523,7 @@ asyncfem::SimulationFileHeader outputHeader(const CommandLine& options, const as
 // run continues the file from its checkpoint and sets record.firstFrame.
 RunOutput openOutput(const CommandLine& options, const asyncfem::Scene& scene, asyncfem::Simulation& simulation,
                      RunRecord& record) {
-  if (scene.output.file.has_parent_path()) fs::create_directories(scene.output.file.parent_path());
+  createOutputFolder(scene.output.file);
   RunOutput output;
   if (!scene.output.vtuFolder.empty()) output.vtuSeries.emplace(scene.output.vtuFolder, scene.output.vtuEncoding);
   output.header = outputHeader(options, scene, simulation);
@@ -586,6 +596,8 @@ int runFrames(const CommandLine& options, const asyncfem::Scene& scene, asyncfem
     }
   } catch (const asyncfem::Error& error) {
     progress.finish();
+    // A storage fault closed the file, and its message says what the file holds.
+    if (!output.writer->isOpen()) throw;
     // The frames before the failing one are complete, checksummed records.
     throw asyncfem::Error(std::string(error.what()) + "; the " + std::to_string(output.writer->numFrames()) +
                           " frames before it are kept in " + scene.output.file.string());
@@ -663,5 +675,8 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   asyncfem::preferPassiveThreadWaiting(argv);
+  // Past a file size limit (ulimit -f), a write fails with EFBIG, reported like a full
+  // disk, instead of SIGXFSZ ending the process.
+  std::signal(SIGXFSZ, SIG_IGN);
   return asyncfem::cli::run("offlineSimulator", [&] { return run(argc, argv); });
 }

@@ -273,7 +273,13 @@ std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const Sim
   if (!fs::exists(checkpointFile)) {
     throw Error("cannot resume: no checkpoint " + checkpointFile.string() + " next to " + output.string() + restart);
   }
-  const SimulationCheckpoint checkpoint = readCheckpoint(checkpointFile);
+  SimulationCheckpoint checkpoint;
+  try {
+    checkpoint = readCheckpoint(checkpointFile);
+  } catch (const Error& error) {
+    // A damaged checkpoint leaves the output as it is; the message says what is wrong.
+    throw Error("cannot resume: " + std::string(error.what()) + "; " + output.string() + " is left as it is" + restart);
+  }
   SimulationReader reader(output);
   const SimulationFileHeader& stored = reader.header();
   const std::vector<std::string> differences =

@@ -112,20 +112,25 @@ void replaceFile(const std::filesystem::path& path, const std::vector<unsigned c
   const std::string temporaryName = temporary.string();
   Descriptor fd(::open(temporaryName.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
   if (fd.get() < 0) throw Error(temporaryName + ": cannot create: " + systemMessage());
+  // On failure the partial temporary file goes; the previous checkpoint stays as it was.
+  const auto fail = [&](const std::string& message) {
+    const std::string cause = systemMessage();
+    if (fd.get() >= 0) ::close(fd.release());
+    ::unlink(temporaryName.c_str());
+    throw Error(message + ": " + cause + "; the previous checkpoint " + name + " is unchanged");
+  };
   std::size_t written = 0;
   while (written < bytes.size()) {
     const ssize_t n = ::write(fd.get(), bytes.data() + written, bytes.size() - written);
     if (n < 0) {
       if (errno == EINTR) continue;
-      throw Error(temporaryName + ": write failed: " + systemMessage());
+      fail(temporaryName + ": write failed");
     }
     written += static_cast<std::size_t>(n);
   }
-  if (sync && ::fsync(fd.get()) != 0) throw Error(temporaryName + ": fsync failed: " + systemMessage());
-  if (::close(fd.release()) != 0) throw Error(temporaryName + ": cannot close: " + systemMessage());
-  if (std::rename(temporaryName.c_str(), name.c_str()) != 0) {
-    throw Error(name + ": cannot rename " + temporaryName + " to it: " + systemMessage());
-  }
+  if (sync && ::fsync(fd.get()) != 0) fail(temporaryName + ": fsync failed");
+  if (::close(fd.release()) != 0) fail(temporaryName + ": cannot close");
+  if (std::rename(temporaryName.c_str(), name.c_str()) != 0) fail(name + ": cannot rename " + temporaryName + " to it");
 }
 
 /// Checks a checkpoint's fixed header: size, magic, version, header size, checksum.

@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <fcntl.h>
+#include <stdio_ext.h>
+#include <sys/stat.h>
 #include <sys/types.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/simulationIO/crc32.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
@@ -32,6 +36,29 @@ void SimulationWriter::FileCloser::operator()(std::FILE* file) const { std::fclo
 namespace {
 
 std::string systemMessage() { return std::strerror(errno); }
+
+std::string framesText(std::int64_t frames) {
+  return std::to_string(frames) + (frames == 1 ? " complete frame" : " complete frames");
+}
+
+// Writes the first `bytes` bytes of the open file `from` to a new file at `path` (which
+// must not exist). Returns false, with errno set, when it cannot.
+bool copyBack(int from, const std::filesystem::path& path, std::int64_t bytes) {
+  const int to = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (to < 0) return false;
+  std::vector<char> block(1 << 16);
+  bool ok = true;
+  for (std::int64_t offset = 0; ok && offset < bytes;) {
+    const auto want = static_cast<std::size_t>(std::min<std::int64_t>(bytes - offset, std::ssize(block)));
+    const ssize_t got = ::pread(from, block.data(), want, static_cast<off_t>(offset));
+    ok = got > 0 && ::write(to, block.data(), static_cast<std::size_t>(got)) == got;
+    offset += got > 0 ? got : 0;
+  }
+  const int saved = errno;
+  ok = ::close(to) == 0 && ok;
+  if (!ok) errno = saved;
+  return ok;
+}
 
 void checkHeader(const std::string& name, const SimulationFileHeader& header) {
   if (header.numVertices <= 0 || header.numVertices > maxSimulationFileVertices) {
@@ -79,14 +106,23 @@ SimulationWriter::SimulationWriter(const std::filesystem::path& path, const Simu
     : path_(path), header_(header), options_(options) {
   const std::string name = path.string();
   checkHeader(name, header);
-  file_.reset(std::fopen(name.c_str(), "wb"));
-  if (!file_) {
+  // Opened for reading too, so that a file deleted under the run can be written back, and
+  // appending, so that a record written after something truncated the file lands at its
+  // new end (where the next check sees it) instead of leaving a hole of zeros.
+  const int fd = ::open(name.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
+  if (fd < 0) {
     throw Error(name + ": cannot create: " + systemMessage());
+  }
+  file_.reset(::fdopen(fd, "a+b"));
+  if (!file_) {
+    const std::string cause = systemMessage();
+    ::close(fd);
+    throw Error(name + ": cannot open: " + cause);
   }
 
   const std::vector<unsigned char> bytes = encodeHeader(header);
   if (std::fwrite(bytes.data(), 1, bytes.size(), file_.get()) != bytes.size() || std::fflush(file_.get()) != 0) {
-    throw Error(name + ": cannot write the header: " + systemMessage());
+    failWrite(name, "cannot write the header", errno);
   }
   buffer_.resize(static_cast<std::size_t>(header.recordBytes()));
 }
@@ -117,8 +153,10 @@ SimulationWriter::SimulationWriter(const std::filesystem::path& path, const Simu
                 std::to_string(complete) + " complete frames");
   }
   const std::int64_t keepBytes = header.headerBytes() + (keepFrames * header.recordBytes());
-  if (std::fflush(file_.get()) != 0 || ::ftruncate(::fileno(file_.get()), static_cast<off_t>(keepBytes)) != 0 ||
-      ::fseeko(file_.get(), static_cast<off_t>(keepBytes), SEEK_SET) != 0) {
+  const int fd = ::fileno(file_.get());
+  if (std::fflush(file_.get()) != 0 || ::ftruncate(fd, static_cast<off_t>(keepBytes)) != 0 ||
+      ::fseeko(file_.get(), static_cast<off_t>(keepBytes), SEEK_SET) != 0 ||
+      ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) | O_APPEND) != 0) {
     throw Error(name + ": cannot cut the file after frame " + std::to_string(keepFrames) + ": " + systemMessage());
   }
   numFrames_ = keepFrames;
@@ -133,10 +171,76 @@ std::unique_ptr<SimulationWriter> SimulationWriter::continueFile(const std::file
 
 SimulationWriter::~SimulationWriter() = default;
 
+std::int64_t SimulationWriter::completeBytes() const {
+  return header_.headerBytes() + (numFrames_ * header_.recordBytes());
+}
+
+void SimulationWriter::checkFileIntact(const std::string& where) {
+  const int fd = ::fileno(file_.get());
+  struct stat open {};
+  if (::fstat(fd, &open) != 0) throw Error(where + ": cannot check the file: " + systemMessage());
+  const std::int64_t expected = completeBytes();
+  std::string problem;
+  if (open.st_nlink == 0) {
+    problem = "the file was deleted while the run was writing it; ";
+    struct stat there {};
+    if (::stat(path_.c_str(), &there) == 0) {
+      problem += "another file is there now, so its " + framesText(numFrames_) + " are lost";
+    } else if (copyBack(fd, path_, expected)) {
+      problem += "its " + framesText(numFrames_) + " are written back to " + path_.string();
+    } else {
+      problem += "writing its " + framesText(numFrames_) + " back failed: " + systemMessage();
+    }
+  } else if (struct stat there{};
+             ::stat(path_.c_str(), &there) != 0 || there.st_ino != open.st_ino || there.st_dev != open.st_dev) {
+    problem = "the file was renamed or replaced while the run was writing it (" + framesText(numFrames_) +
+              " are in the file this run opened)";
+  } else if (static_cast<std::int64_t>(open.st_size) != expected) {
+    problem = "the file is " + std::to_string(open.st_size) + " bytes, " + std::to_string(expected) +
+              " expected: something else " + (open.st_size < expected ? "truncated" : "wrote to") +
+              " it while the run was writing it; ";
+  }
+  if (problem.empty()) return;
+  std::FILE* file = file_.release();
+  __fpurge(file);
+  std::fclose(file);
+  if (problem.back() == ' ') {
+    // What a reader still finds in the damaged file: the leading records that check out.
+    try {
+      SimulationReader reader(path_);
+      problem += "it keeps " + framesText(reader.scanRecords().goodFrames) + " of " + std::to_string(numFrames_);
+    } catch (const Error& error) {
+      problem += std::string("no frame is readable (") + error.what() + ")";
+    }
+  }
+  throw Error(where + ": " + problem);
+}
+
+void SimulationWriter::failWrite(const std::string& where, const std::string& what, int error) {
+  // What stdio still buffers would land after the cut at fclose: drop it first.
+  std::FILE* file = file_.release();
+  __fpurge(file);
+  // Never longer than it is (a header that failed leaves fewer bytes than it claims).
+  struct stat now {};
+  const bool sized = ::fstat(::fileno(file), &now) == 0;
+  const std::int64_t keep = sized ? std::min<std::int64_t>(completeBytes(), now.st_size) : completeBytes();
+  const bool regular = sized && S_ISREG(now.st_mode);  // not, e.g., /dev/full
+  const bool cut = regular && ::ftruncate(::fileno(file), static_cast<off_t>(keep)) == 0;
+  std::fclose(file);
+  std::string message = where + ": " + what + ": " + std::strerror(error);
+  if (!cut && (regular || !sized)) {
+    message += " (and cutting the file back to its " + framesText(numFrames_) + " failed)";
+  } else if (numFrames_ > 0) {
+    message += "; the file keeps its " + framesText(numFrames_);
+  }
+  throw Error(message);
+}
+
 void SimulationWriter::close() {
   if (!file_) {
     return;
   }
+  checkFileIntact(path_.string() + ": after frame " + std::to_string(numFrames_));
   std::FILE* file = file_.release();
   const bool flushed = std::fflush(file) == 0;
   const bool closed = std::fclose(file) == 0;
@@ -168,6 +272,7 @@ void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::V
   if (!file_) {
     throw Error(where + ": the file is closed");
   }
+  checkFileIntact(where);
   const Eigen::Index size = 3 * header_.numVertices;
   if (displacement.size() != size || (velocity != nullptr && velocity->size() != size)) {
     throw Error(where + ": expected vectors of size " + std::to_string(size) + ", got " +
@@ -194,10 +299,10 @@ void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::V
   detail::putU32(out + offset + 4, 0);
 
   if (std::fwrite(out, 1, buffer_.size(), file_.get()) != buffer_.size() || std::fflush(file_.get()) != 0) {
-    throw Error(where + ": write failed: " + systemMessage());
+    failWrite(where, "write failed", errno);
   }
   if (options_.syncEachFrame && ::fsync(::fileno(file_.get())) != 0) {
-    throw Error(where + ": fsync failed: " + systemMessage());
+    failWrite(where, "fsync failed", errno);
   }
   ++numFrames_;
 }

@@ -79,7 +79,11 @@ struct SimulationFrame {
 /// process killed at any point leaves every previously appended frame readable.
 ///
 /// Errors (cannot create, write failure, wrong vector size, non-finite values) throw
-/// asyncfem::Error naming the file.
+/// asyncfem::Error naming the file. Storage faults (docs/robustness.md): a failed write
+/// (a full file system, a file size limit) cuts the file back to its complete frames
+/// before throwing; before every frame and at close() the writer checks that nothing else
+/// deleted, replaced or truncated the file, and throws if something did (a deleted file
+/// first gets its complete frames written back to the path).
 class SimulationWriter {
  public:
   struct Options {
@@ -112,9 +116,14 @@ class SimulationWriter {
 
   /// Frames appended so far.
   std::int64_t numFrames() const { return numFrames_; }
+  /// False after close() and after a storage fault closed the file (the error said what
+  /// the file holds then).
+  bool isOpen() const { return file_ != nullptr; }
   const SimulationFileHeader& header() const { return header_; }
   const std::filesystem::path& path() const { return path_; }
-  /// Flushes and closes; further appends throw. The destructor closes too (silently).
+  /// Checks that the file is still the one this writer created, at its full length,
+  /// then flushes and closes; further appends throw. The destructor closes too
+  /// (silently, without the check).
   void close();
 
  private:
@@ -126,6 +135,14 @@ class SimulationWriter {
                    std::int64_t keepFrames, ContinueTag);
   void appendRecord(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
                     const Eigen::Ref<const Eigen::VectorXd>* velocity);
+  /// Bytes of the header and the complete frames written so far.
+  std::int64_t completeBytes() const;
+  /// Throws (and closes the file) when something else deleted, replaced or truncated the
+  /// file since the last frame; a deleted file gets its complete frames written back.
+  void checkFileIntact(const std::string& where);
+  /// After a failed write: drops what is buffered, cuts the file back to its complete
+  /// frames, closes it and throws naming the cause.
+  [[noreturn]] void failWrite(const std::string& where, const std::string& what, int error);
 
   std::filesystem::path path_;
   SimulationFileHeader header_;
