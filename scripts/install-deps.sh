@@ -9,7 +9,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libmetis-dev libopenblas-dev
   nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format-14
-  libpetsc-real-dev openmpi-bin
+  libpetsc-real-dev openmpi-bin ffmpeg
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-scipy python3-pytest python3-matplotlib
 )
 if [[ "${1:-}" != "--no-render" ]]; then

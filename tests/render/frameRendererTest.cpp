@@ -292,4 +292,105 @@ TEST_F(FrameRendererTest, RecordedSceneGivesTheMeshAndIsChecked) {
   EXPECT_EQ(run("sim.afsim --scene scene.json --frames 2 -q -o out3").exitCode, 0);
 }
 
+// Runs a shell command in folder, its output (stdout and stderr) returned.
+std::string commandOutput(const fs::path& folder, const std::string& command) {
+  const std::string full = "cd '" + folder.string() + "' && " + command + " > command.txt 2>&1";
+  if (std::system(full.c_str()) != 0) return "failed: " + readText(folder / "command.txt");
+  return readText(folder / "command.txt");
+}
+
+bool onPath(const std::string& program) { return std::system(("command -v " + program + " > /dev/null").c_str()) == 0; }
+
+bool leftoverPartialFiles(const fs::path& folder) {
+  for (const auto& entry : fs::recursive_directory_iterator(folder)) {
+    if (entry.path().filename().string().find(".frameRenderer-") != std::string::npos) return true;
+  }
+  return false;
+}
+
+TEST_F(FrameRendererTest, VideoHoldsEveryDrawnFrame) {
+  if (!onPath("ffmpeg") || !onPath("ffprobe")) {
+    GTEST_SKIP() << "SKIP: ffmpeg/ffprobe not installed (Debian: apt-get install ffmpeg)";
+  }
+  // An odd width: H.264 in yuv420p needs even sizes, the frames are padded.
+  const RunResult r =
+      run("run.afsim --mesh bar.veg --frames 0:6:1 --width 97 --height 64 -o out --video movie.mp4 "
+          "--fps 12");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("video movie.mp4 (6 frames at 12 per s, ffmpeg)"), std::string::npos) << r.out;
+  ASSERT_TRUE(fs::exists(folder_ / "movie.mp4"));
+  EXPECT_GT(fs::file_size(folder_ / "movie.mp4"), 1000U);
+  const std::string probe = commandOutput(
+      folder_,
+      "ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames,width,height,codec_name "
+      "-of default=noprint_wrappers=1 movie.mp4");
+  EXPECT_NE(probe.find("nb_read_frames=6"), std::string::npos) << probe;
+  EXPECT_NE(probe.find("codec_name=h264"), std::string::npos) << probe;
+  EXPECT_NE(probe.find("width=98"), std::string::npos) << probe;
+  EXPECT_FALSE(leftoverPartialFiles(folder_));
+  // A selection with a step: the video holds the selected frames only.
+  ASSERT_EQ(
+      run("run.afsim --mesh bar.veg --frames 0:6:2 --width 64 --height 48 -q -o out2 --video sub/two.mkv").exitCode, 0);
+  EXPECT_NE(commandOutput(folder_,
+                          "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                          "stream=nb_read_frames -of default=noprint_wrappers=1 sub/two.mkv")
+                .find("nb_read_frames=3"),
+            std::string::npos);
+}
+
+TEST_F(FrameRendererTest, VideoFailuresLeaveNoVideoBehind) {
+  // Without ffmpeg on PATH: a clear error before any frame is drawn.
+  const std::string command = "cd '" + folder_.string() + "' && PATH=/nonexistent '" + rendererPath +
+                              "' run.afsim --mesh bar.veg -o out --video movie.mp4 > stdout.txt 2> stderr.txt";
+  const int status = std::system(command.c_str());
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 1);
+  const std::string err = readText(folder_ / "stderr.txt");
+  EXPECT_NE(err.find("frameRenderer: --video needs ffmpeg, which is not on PATH"), std::string::npos) << err;
+  EXPECT_NE(err.find("apt-get install ffmpeg"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(folder_ / "movie.mp4"));
+  EXPECT_FALSE(fs::exists(folder_ / "out"));
+  EXPECT_EQ(run("run.afsim --mesh bar.veg -o out --fps 10").exitCode, 1);  // --fps without --video
+  if (!onPath("ffmpeg")) {
+    GTEST_SKIP() << "SKIP: ffmpeg not installed, its failure is not tried";
+  }
+  // ffmpeg fails (a container it does not know): an error with its message, no file claimed.
+  const RunResult r =
+      run("run.afsim --mesh bar.veg --frames 0:2 --width 32 --height 32 -q -o out --video bad.notavideo");
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.err.find("ffmpeg failed to encode bad.notavideo"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(folder_ / "bad.notavideo"));
+  EXPECT_FALSE(leftoverPartialFiles(folder_));
+}
+
+TEST_F(FrameRendererTest, ContactSheetIsAGridOfLabelledFrames) {
+  const RunResult r =
+      run("run.afsim --mesh bar.veg --frames 0:5 --width 80 --height 60 -o out --contact-sheet "
+          "sheet.png --sheet-columns 2");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const int bar = 14;  // label bar under each 60-pixel tile
+  const Image sheet = readPng(folder_ / "sheet.png");
+  EXPECT_EQ(sheet.width, 2 * 80);
+  EXPECT_EQ(sheet.height, 3 * (60 + bar));  // five frames in two columns
+  EXPECT_NE(r.out.find("contact sheet sheet.png (5 frames, 160 x 222)"), std::string::npos) << r.out;
+  // Tile 3 (row 1, column 1) is frame 3 as drawn; its label bar holds dark text.
+  const Image frame3 = readPng(folder_ / "out" / "frame_00003.png");
+  bool same = true;
+  for (int y = 1; y < 60 && same; ++y) {
+    for (int x = 1; x < 80 && same; ++x) same = sheet.at(80 + x, (60 + bar) + y) == frame3.at(x, y);
+  }
+  EXPECT_TRUE(same);
+  int dark = 0;
+  for (int y = 60; y < 60 + bar; ++y) {
+    for (int x = 0; x < 80; ++x) dark += sheet.at(x, y).r < 128 ? 1 : 0;
+  }
+  EXPECT_GT(dark, 20);  // "t = 0.1 s"
+  // Four columns by default: one row of four.
+  ASSERT_EQ(
+      run("run.afsim --mesh bar.veg --frames 0:4 --width 40 --height 30 -q -o out2 --contact-sheet s2.png").exitCode,
+      0);
+  const Image row = readPng(folder_ / "s2.png");
+  EXPECT_EQ(row.width, 4 * 40);
+  EXPECT_EQ(row.height, 30 + 14);
+}
+
 }  // namespace

@@ -3,9 +3,12 @@
 //
 //   frameRenderer SIM.afsim (--mesh MESH | --scene SCENE.json) [--output DIR] [--frames start:stop:step]
 //                 [--width W] [--height H] [--warp none|rotation-strain|modal] [--tint-set NAME]
-//                 [--render-mesh FILE] [--ground] [--compare OTHER.afsim --labels "a,b"] ...
+//                 [--render-mesh FILE] [--ground] [--compare OTHER.afsim --labels "a,b"]
+//                 [--video OUT.mp4 [--fps F]] [--contact-sheet SHEET.png [--sheet-columns N]] ...
 //
-// Writes DIR/frame_NNNNN.png (NNNNN = the frame's index in the file). Progress on stderr,
+// Writes DIR/frame_NNNNN.png (NNNNN = the frame's index in the file); with --video also a
+// video of them encoded by ffmpeg, with --contact-sheet a grid of them labelled with their
+// times. Progress on stderr,
 // a summary on stdout. Errors print "frameRenderer: <message>" on stderr and exit with
 // status 1 (2 for unusable command-line options). Reference: docs/rendering.md.
 
@@ -40,6 +43,7 @@
 #include <vector>
 
 #include "commandLine.hpp"
+#include "frameMedia.hpp"
 #include "progress.hpp"
 
 namespace {
@@ -72,6 +76,10 @@ struct CommandLine {
   int threads = 0;
   bool progress = false;
   bool quiet = false;
+  std::optional<std::string> video;
+  double fps = 30.0;
+  std::optional<std::string> contactSheet;
+  int sheetColumns = 4;
 };
 
 Eigen::Vector3d toVector(const std::vector<double>& values) { return {values[0], values[1], values[2]}; }
@@ -191,6 +199,21 @@ void addInputOptions(CLI::App& app, CommandLine& options) {
   app.add_option("--labels", options.labels, "Labels of the two runs with --compare, \"left,right\"");
 }
 
+/// The options of what is made of the frames besides the PNG files (in --help order, third part).
+void addMediaOptions(CLI::App& app, CommandLine& options) {
+  app.add_option("--video", options.video,
+                 "Also encode the drawn frames into this video (.mp4, .mkv, .webm, .gif) with ffmpeg");
+  app.add_option("--fps", options.fps, "Frames per second of --video")
+      ->check(asyncfem::cli::inRange(0.1, 1000.0))
+      ->capture_default_str();
+  app.add_option(
+      "--contact-sheet", options.contactSheet,
+      "Also write the drawn frames as one PNG grid, each labelled with its time (choose them with --frames)");
+  app.add_option("--sheet-columns", options.sheetColumns, "Columns of --contact-sheet")
+      ->check(asyncfem::cli::inRange(1, 64))
+      ->capture_default_str();
+}
+
 /// The options of the camera, the image quality and the console (in --help order, second part).
 void addViewOptions(CLI::App& app, CommandLine& options) {
   app.add_option("--camera-position", options.cameraPosition, "Eye position x,y,z (with --camera-target)")
@@ -228,6 +251,9 @@ void checkOptionCombinations(const CommandLine& options) {
   }
   if (options.labels && !options.compare) {
     throw Error("--labels needs --compare");
+  }
+  if (options.fps != 30.0 && !options.video) {
+    throw Error("--fps needs --video");
   }
 }
 
@@ -502,6 +528,7 @@ std::optional<int> parseCommandLine(int argc, char** argv, CommandLine& options)
   CLI::App app{"Draws the frames of an .afsim simulation file (docs/simulation-output.md) as PNG images."};
   addInputOptions(app, options);
   addViewOptions(app, options);
+  addMediaOptions(app, options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -536,6 +563,40 @@ Shared openInputs(const CommandLine& options, const Eigen::Vector3f& surfaceColo
   return shared;
 }
 
+/// The video and the contact sheet of the drawn frames, as asked for; a line each on stdout
+/// unless quiet.
+void writeMedia(const CommandLine& options, const Shared& shared, const std::vector<std::int64_t>& frames,
+                const fs::path& ffmpeg) {
+  std::vector<fs::path> files;
+  for (const std::int64_t k : frames) files.push_back(fs::path(options.output) / frameName(k));
+  if (options.video) {
+    media::encodeVideo(ffmpeg, files, *options.video, options.fps);
+    if (!options.quiet) {
+      std::cout << "frameRenderer: video " << *options.video << " (" << frames.size() << " frames at " << options.fps
+                << " per s, ffmpeg)\n";
+    }
+  }
+  if (options.contactSheet) {
+    SimulationReader reader(shared.runs.front().file);
+    std::vector<Image> tiles;
+    std::vector<std::string> labels;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      tiles.push_back(readPng(files[i]));
+      char label[64];
+      std::snprintf(label, sizeof(label), "t = %.4g s", reader.readFrame(frames[i]).time);
+      labels.emplace_back(label);
+    }
+    const Image sheet = media::contactSheet(tiles, labels, options.sheetColumns);
+    const fs::path sheetPath(*options.contactSheet);
+    if (sheetPath.has_parent_path()) fs::create_directories(sheetPath.parent_path());
+    writePng(sheetPath, sheet, PngCompression::standard);
+    if (!options.quiet) {
+      std::cout << "frameRenderer: contact sheet " << *options.contactSheet << " (" << frames.size() << " frames, "
+                << sheet.width << " x " << sheet.height << ")\n";
+    }
+  }
+}
+
 int run(int argc, char** argv) {
   CommandLine options;
   if (const std::optional<int> status = parseCommandLine(argc, argv, options)) {
@@ -547,6 +608,7 @@ int run(int argc, char** argv) {
   std::int64_t numFrames = 0;
   std::vector<std::int64_t> frames;
   const Shared shared = openInputs(options, style.surfaceColor, numFrames, frames);
+  const fs::path ffmpeg = options.video ? media::requireFfmpeg() : fs::path();  // before any drawing
 
   const int maxThreads = std::max(
       1, options.threads > 0 ? options.threads : static_cast<int>(std::min(8U, std::thread::hardware_concurrency())));
@@ -569,6 +631,7 @@ int run(int argc, char** argv) {
   if (!options.quiet) {
     printSummary(options, shared, frames.size(), threads, total.stop(), boundsSeconds, times);
   }
+  writeMedia(options, shared, frames, ffmpeg);
   return 0;
 }
 

@@ -12,6 +12,8 @@
 // linear scenes, else a fine trapezoidal run), per vertex group (each fast region, L,
 // all). Then the equal-cost and equal-error single-rate answers for every multirate
 // configuration, CSV files and PNG plots. docs/benchmarks.md describes the output.
+#include <sys/wait.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
@@ -21,14 +23,13 @@
 #include <asyncfem/benchmarkTools/errorMetrics.hpp>
 #include <asyncfem/benchmarkTools/modalReference.hpp>
 #include <asyncfem/benchmarkTools/multirateComparison.hpp>
-#include <asyncfem/benchmarkTools/plot.hpp>
 #include <asyncfem/benchmarkTools/sceneReference.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/threading.hpp>
-#include <asyncfem/image/png.hpp>
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
 #include <asyncfem/modalAnalysis/regionModes.hpp>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -75,14 +76,6 @@ ReferenceKind referenceKind(const std::string& name) {
   return name == "modal"         ? ReferenceKind::modal
          : name == "trapezoidal" ? ReferenceKind::trapezoidal
                                  : ReferenceKind::automatic;
-}
-
-std::string family(const BenchmarkConfiguration& c) {
-  std::string name = c.integrator;
-  for (const char* key : {"coupling", "schur", "method"}) {
-    if (c.options.contains(key)) name += " " + c.options[key].get<std::string>();
-  }
-  return name;
 }
 
 void writeResultsCsv(const fs::path& path, const std::vector<BenchmarkRun>& results,
@@ -199,50 +192,33 @@ void printEqualAnswers(const std::vector<BenchmarkRun>& results, const std::vect
   for (const EqualAnswers& a : equalAnswers(results, answerGroups)) printEqualAnswer(a, equalCsv);
 }
 
-void plotPareto(const fs::path& path, const std::vector<BenchmarkRun>& results, const std::string& group,
-                const std::string& sceneName) {
-  PlotSpec spec;
-  spec.title = "Error vs time per frame: " + sceneName + " (" + group + ")";
-  spec.xLabel = "wall time per frame (s, median)";
-  spec.yLabel = "relative L2 error of u over the frames (" + group + ")";
-  spec.logX = spec.logY = true;
-  std::map<std::string, std::size_t> seriesOf;
-  for (const BenchmarkRun& r : results) {
-    const auto it = r.errors.find(group);
-    if (!r.completed || it == r.errors.end()) continue;
-    const std::string name = family(r.configuration);
-    if (!seriesOf.count(name)) {
-      seriesOf[name] = spec.series.size();
-      const int index = static_cast<int>(spec.series.size());
-      spec.series.push_back({name, {}, {}, paletteColor(index), paletteMarker(index), name == "backward-euler"});
-    }
-    PlotSeries& s = spec.series[seriesOf[name]];
-    s.x.push_back(r.medianSecondsPerFrame);
-    s.y.push_back(it->second);
+/// A figure's curves in long form, series,time,value (what scripts/plot-benchmark.py reads).
+class SeriesCsv {
+ public:
+  explicit SeriesCsv(const fs::path& path) : out_(path) {
+    out_ << "series,time,value\n";
+    out_.precision(10);
   }
-  // Points keep the configuration order (backward Euler: increasing steps per frame), so
-  // the connected single-rate curve follows the timestep even where timing noise reorders it.
-  writePng(path, renderPlot(spec, 1100, 650), PngCompression::standard);
-}
+  void add(const std::string& series, const std::vector<double>& times, const std::vector<double>& values) {
+    for (std::size_t i = 0; i < times.size() && i < values.size(); ++i) {
+      out_ << '"' << series << "\"," << times[i] << ',' << values[i] << "\n";
+    }
+  }
 
-void plotVertex(const fs::path& path, const std::vector<BenchmarkRun>& results, const BenchmarkReference& reference,
-                const Scene& scene, int vertex, const std::string& sceneName) {
-  PlotSpec spec;
-  spec.title = "Displacement of vertex " + std::to_string(vertex) + ": " + sceneName;
-  spec.xLabel = "time (s)";
-  spec.yLabel = "|u| of vertex " + std::to_string(vertex);
-  const std::vector<double> times = frameTimes(scene, static_cast<int>(reference.frames.size()));
-  spec.series.push_back(
-      {"reference", times, vertexDisplacementNorms(reference.frames, vertex), {0, 0, 0}, Marker::none, true});
-  int index = 0;
+ private:
+  std::ofstream out_;
+};
+
+void writeVertexCsv(const fs::path& path, const std::vector<BenchmarkRun>& results, const BenchmarkReference& reference,
+                    const Scene& scene, int vertex) {
+  SeriesCsv csv(path);
+  csv.add("reference", frameTimes(scene, static_cast<int>(reference.frames.size())),
+          vertexDisplacementNorms(reference.frames, vertex));
   for (const BenchmarkRun& r : results) {
     if (!r.configuration.plotTrajectory || r.frames.empty()) continue;
-    const std::vector<double> t = frameTimes(scene, static_cast<int>(r.frames.size()));
-    spec.series.push_back(
-        {r.configuration.label, t, vertexDisplacementNorms(r.frames, vertex), paletteColor(index), Marker::none, true});
-    ++index;
+    csv.add(r.configuration.label, frameTimes(scene, static_cast<int>(r.frames.size())),
+            vertexDisplacementNorms(r.frames, vertex));
   }
-  writePng(path, renderPlot(spec, 1100, 650), PngCompression::standard);
 }
 
 /// The table of motion kept at `vertex` after the loads end (keptMotionComparison), for
@@ -284,9 +260,9 @@ void printMotionKept(const std::vector<BenchmarkRun>& results, const Trajectory&
 /// coordinate that moves most in the reference, over time, for the reference and the runs
 /// of equalCostFigureRuns(). Nothing is drawn without a completed multirate run and two
 /// backward Euler runs.
-void plotVertexAgainstEqualCost(const fs::path& path, const std::vector<BenchmarkRun>& results,
-                                const BenchmarkReference& reference, const Scene& scene, int vertex,
-                                const std::string& sceneName, const std::vector<int>& sceneRatios) {
+void writeVertexEqualCostCsv(const fs::path& path, const std::vector<BenchmarkRun>& results,
+                             const BenchmarkReference& reference, const Scene& scene, int vertex,
+                             const std::vector<int>& sceneRatios) {
   const EqualCostFigureRuns figure = equalCostFigureRuns(results, sceneRatios);
   if (!figure.multirate || !figure.coarse || !figure.equalCost) return;
   int coordinate = 0;
@@ -298,27 +274,17 @@ void plotVertexAgainstEqualCost(const fs::path& path, const std::vector<Benchmar
     for (const Eigen::VectorXd& u : frames) values.push_back(u[3 * vertex + coordinate]);
     return values;
   };
-  PlotSpec spec;
+  SeriesCsv csv(path);
   const char* axis = coordinate == 0 ? "x" : coordinate == 1 ? "y" : "z";
-  spec.title = "Vertex " + std::to_string(vertex) + ", " + axis + " displacement: " + sceneName;
-  spec.xLabel = "time (s)";
-  spec.yLabel = std::string("u_") + axis + " of vertex " + std::to_string(vertex);
-  spec.series.push_back({"exact",
-                         frameTimes(scene, static_cast<int>(reference.frames.size())),
-                         component(reference.frames),
-                         {0, 0, 0},
-                         Marker::none,
-                         true});
+  csv.add(std::string("exact (u_") + axis + ")", frameTimes(scene, static_cast<int>(reference.frames.size())),
+          component(reference.frames));
   const std::vector<std::pair<const BenchmarkRun*, std::string>> runs{
       {figure.coarse, figure.coarse->configuration.label + " (largest step)"},
       {figure.equalCost, figure.equalCost->configuration.label + " (nearest wall time)"},
       {figure.multirate, figure.multirate->configuration.label}};
-  int index = 0;
   for (const auto& [run, label] : runs) {
-    spec.series.push_back({label, frameTimes(scene, static_cast<int>(run->frames.size())), component(run->frames),
-                           paletteColor(index++), Marker::none, true});
+    csv.add(label, frameTimes(scene, static_cast<int>(run->frames.size())), component(run->frames));
   }
-  writePng(path, renderPlot(spec, 1100, 650), PngCompression::standard);
 }
 
 // The regions the scene itself runs with, resolved as the integrator resolves them
@@ -428,24 +394,44 @@ struct PlotInputs {
   std::string sceneName;
 };
 
+/// scripts/plot-benchmark.py as the build (or an install) puts it next to this program.
+fs::path plotScript() {
+  std::error_code error;
+  const fs::path self = fs::read_symlink("/proc/self/exe", error);
+  return error ? fs::path("plot-benchmark.py") : self.parent_path() / "plot-benchmark.py";
+}
+
+/// The figures' data as CSV, and the figures drawn from it by scripts/plot-benchmark.py
+/// with matplotlib (PNG and PDF); without matplotlib (or python3) a message says how to
+/// get them and the CSV files stay.
 void writePlots(const fs::path& outFolder, const std::vector<BenchmarkRun>& results, const PlotInputs& in) {
-  if (!pngSupported()) {
-    std::cout << "\nNo plots: this build has no PNG support (libpng was not found when it was configured); CSV only.\n";
+  writeVertexCsv(outFolder / "vertex-displacement.csv", results, in.reference, in.scene, in.vertex);
+  const fs::path focus = outFolder / "vertex-equal-cost.csv";
+  // An older run's figure must not survive a run that draws none.
+  for (const char* stale : {"vertex-equal-cost.csv", "vertex-equal-cost.png", "vertex-equal-cost.pdf"}) {
+    fs::remove(outFolder / stale);
+  }
+  writeVertexEqualCostCsv(focus, results, in.reference, in.scene, in.vertex, in.sceneRatios);
+  const fs::path script = plotScript();
+  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  const std::string drawLater = "draw them later with: " + python + " scripts/plot-benchmark.py " + outFolder.string();
+  if (!fs::exists(script)) {
+    std::cout << "\nNo figures: " << script.string() << " is missing; the CSV files are written, " << drawLater << "\n";
     return;
   }
-  for (const VertexGroup& g : in.groups) {
-    if (g.name != "all" && g.name != in.groups.front().name) continue;
-    const fs::path path = outFolder / ("pareto-" + g.name + ".png");
-    plotPareto(path, results, g.name, in.sceneName);
-    std::cout << "\nWrote " << path.string();
+  std::cout << "\nFigures (vertex " << in.vertex << ", matplotlib):\n" << std::flush;
+  const std::string command =
+      "'" + python + "' '" + script.string() + "' '" + outFolder.string() + "' --title '" + in.sceneName + "'";
+  const int status = std::system(command.c_str());
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (code == 3) {
+    std::cout << "No figures: matplotlib is missing (Debian: sudo apt-get install python3-matplotlib, or "
+                 "scripts/install-deps.sh); the CSV files are written, "
+              << drawLater << "\n";
+  } else if (code != 0) {
+    std::cout << "No figures: " << script.string() << " failed (exit status " << code
+              << "); the CSV files are written\n";
   }
-  const fs::path path = outFolder / "vertex-displacement.png";
-  plotVertex(path, results, in.reference, in.scene, in.vertex, in.sceneName);
-  std::cout << "\nWrote " << path.string() << " (vertex " << in.vertex << ")\n";
-  const fs::path focus = outFolder / "vertex-equal-cost.png";
-  fs::remove(focus);  // an older run's figure must not survive a run that draws none
-  plotVertexAgainstEqualCost(focus, results, in.reference, in.scene, in.vertex, in.sceneName, in.sceneRatios);
-  if (fs::exists(focus)) std::cout << "Wrote " << focus.string() << "\n";
 }
 
 int runBenchmark(const CommandLine& options) {
