@@ -8,6 +8,7 @@
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
 #include <cmath>
+#include <sstream>
 
 #include "sceneTestUtilities.hpp"
 
@@ -231,6 +232,47 @@ TEST(BuildSimulation, FileMeshMatchesTheGenerator) {
   const Eigen::MatrixXd massDifference =
       Eigen::MatrixXd(fromFile.integrator->system().mass) - Eigen::MatrixXd(generated.integrator->system().mass);
   EXPECT_LE(massDifference.cwiseAbs().maxCoeff(), 1e-12);
+}
+
+// A TetGen mesh with a stray vertex that no tetrahedron uses (as Gmsh and TetGen files with
+// a leftover surface have): the scene runs, the stray vertex stays at rest, and every
+// reader warning reaches Simulation::warnings with the scene key and the file.
+TEST(BuildSimulation, VertexInNoElementIsHeldAndTheReaderWarningsArrive) {
+  const asyncfem::test::ScratchFolder folder;
+  asyncfem::BoxMeshSpec spec;
+  spec.size = Eigen::Vector3d(2, 1, 1);
+  spec.cells = Eigen::Vector3i(2, 1, 1);
+  const asyncfem::TetMesh box = makeBoxMesh(spec);
+  std::ostringstream node;
+  node << box.numVertices() + 1 << " 3 0 0\n";
+  for (int v = 0; v < box.numVertices(); ++v) {
+    node << v + 1 << ' ' << box.restPosition(v).transpose() << '\n';
+  }
+  node << box.numVertices() + 1 << " 5 5 5\n";
+  std::ostringstream ele;
+  ele << box.numElements() << " 4 0\n";
+  for (int e = 0; e < box.numElements(); ++e) ele << e + 1 << ' ' << (box.element(e).array() + 1).transpose() << '\n';
+  folder.write("box.node", node.str());
+  folder.write("box.ele", ele.str());
+  auto json = smallScene();
+  json["mesh"] = {{"file", "box.node"}};
+  json["fixed"] = nlohmann::json::parse(R"({"boxes": [{"min": [-0.1, -1, -1], "max": [0.1, 2, 2]}]})");
+  json["gravity"] = {0, -9.81, 0};
+  Simulation simulation = build(json, folder.path());
+  const int stray = box.numVertices();
+  EXPECT_EQ(simulation.problem->unusedVertices(), std::vector<int>{stray});
+  EXPECT_EQ(simulation.fixedVertices.size(), 4U);  // the unused vertex is held, not fixed
+  EXPECT_EQ(simulation.integrator->system().freeDofs.numFree(), 3 * (box.numVertices() - 4));
+  const std::string prefix = "scene.json: mesh.file: " + (folder.path() / "box.node").string() + ": ";
+  EXPECT_TRUE(contains(simulation.warnings,
+                       prefix + "1 vertex(es) belong to no element (first: vertex " + std::to_string(stray + 1) + ")"))
+      << ::testing::PrintToString(simulation.warnings);
+  EXPECT_TRUE(contains(simulation.warnings, prefix + "the file has no materials"))
+      << ::testing::PrintToString(simulation.warnings);
+  asyncfem::advanceFrame(simulation, 0);  // before: "cholmod: matrix is not positive definite"
+  const Eigen::VectorXd& u = simulation.integrator->displacement();
+  EXPECT_TRUE(u.segment<3>(3 * stray).isZero(0.0));
+  EXPECT_LT(u[(3 * box.vertexSet("xmax")[0]) + 1], 0.0);  // the free end sags
 }
 
 TEST(BuildSimulation, FixedBySetBoxAndBou) {

@@ -96,19 +96,21 @@ std::optional<TetMesh> loadMesh(const CommandLine& options, const SimulationRead
   if (options.mesh && options.scene) throw Error("give the mesh with --mesh FILE or --scene SCENE.json, not both");
   std::optional<TetMesh> mesh;
   std::string name;
+  std::vector<std::string> warnings;
   if (options.mesh) {
-    mesh = readMesh(*options.mesh);
+    mesh = readMeshCollectingWarnings(*options.mesh, warnings);
     name = *options.mesh;
   } else if (options.scene) {
-    mesh = buildSceneMesh(loadScene(*options.scene));
+    mesh = buildSceneMesh(loadScene(*options.scene), &warnings);
     name = *options.scene;
   } else if (!reader.header().scenePath.empty()) {
     // The scene the run recorded (checked against its fingerprint).
-    mesh = recordedSceneProblem(reader.header(), reader.path().string())->mesh();
+    mesh = recordedSceneProblem(reader.header(), reader.path().string(), &warnings)->mesh();
     name = reader.header().scenePath;
   } else {
     return mesh;
   }
+  for (const std::string& warning : warnings) std::cerr << "afsimTool: warning: " << warning << '\n';
   if (mesh->numVertices() != reader.numVertices()) {
     throw Error(reader.path().string() + " has " + std::to_string(reader.numVertices()) + " vertices but the mesh (" +
                 name + ") has " + std::to_string(mesh->numVertices()) + ": the simulation did not run on this mesh");

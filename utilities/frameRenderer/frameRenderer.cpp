@@ -286,21 +286,25 @@ RunsExtent checkRuns(const std::vector<Run>& runs, bool quiet) {
 /// The mesh, and the vertices held fixed in the simulation: from --scene, from the scene
 /// the file records, or from --mesh. Only the problem is built: no matrix, no factorization.
 void loadMesh(const CommandLine& options, std::int64_t numVertices, Shared& shared) {
+  std::vector<std::string> warnings;
   if (options.scene || !options.mesh) {
     const std::shared_ptr<const Problem> problem =
-        options.scene ? buildProblem(loadScene(*options.scene))
+        options.scene ? buildProblem(loadScene(*options.scene), &warnings)
                       : recordedSceneProblem(SimulationReader(shared.runs.front().file).header(),
-                                             shared.runs.front().file.string());
+                                             shared.runs.front().file.string(), &warnings);
     shared.mesh = problem->sharedMesh();
     shared.fixedVertices = problem->fixedVertices();
     shared.assemblies = problem->assemblies();
   } else {
-    auto mesh = std::make_shared<TetMesh>(readMesh(*options.mesh));
+    auto mesh = std::make_shared<TetMesh>(readMeshCollectingWarnings(*options.mesh, warnings));
     for (const std::string& set : options.fixedSets) {
       const std::vector<int> vertices = mesh->setVertices(set);
       shared.fixedVertices.insert(shared.fixedVertices.end(), vertices.begin(), vertices.end());
     }
     shared.mesh = std::move(mesh);
+  }
+  if (!options.quiet) {
+    for (const std::string& warning : warnings) std::cerr << "frameRenderer: warning: " << warning << '\n';
   }
   const std::string meshName = options.scene ? *options.scene : options.mesh ? *options.mesh : "the recorded scene";
   if (shared.mesh->numVertices() != numVertices) {

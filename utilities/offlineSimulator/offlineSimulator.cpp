@@ -396,9 +396,13 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   setupWatch.start();
   asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
   const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
-  const std::shared_ptr<const asyncfem::Problem> problem = asyncfem::buildProblem(scene);
+  std::vector<std::string> warnings;
+  const std::shared_ptr<const asyncfem::Problem> problem = asyncfem::buildProblem(scene, &warnings);
   asyncfem::PetscSimulation simulation(problem->mesh(), petscSettings(options, scene, *problem));
   const bool root = simulation.rank() == 0;
+  if (root) {
+    for (const std::string& warning : warnings) std::cerr << "offlineSimulator: warning: " << warning << "\n";
+  }
   std::unique_ptr<asyncfem::SimulationWriter> writer;
   if (root) {
     if (scene.output.file.has_parent_path()) fs::create_directories(scene.output.file.parent_path());

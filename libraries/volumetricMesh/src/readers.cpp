@@ -26,6 +26,14 @@ TetMesh readMesh(const std::filesystem::path& path, const MeshReadOptions& optio
               "' (expected .veg, .node, .ele or .msh, or the base name of a TetGen .node/.ele pair)");
 }
 
+TetMesh readMeshCollectingWarnings(const std::filesystem::path& path, std::vector<std::string>& warnings,
+                                   const MeshReadOptions& options) {
+  MeshReadReport report;
+  TetMesh mesh = readMesh(path, options, &report);
+  for (const std::string& warning : report.warnings) warnings.push_back(path.string() + ": " + warning);
+  return mesh;
+}
+
 std::vector<int> readBou(const std::filesystem::path& path, int numVertices) {
   if (numVertices < 0) throw Error("readBou: negative vertex count for '" + path.string() + "'");
   const detail::FlatText flat = detail::loadFlatText(path, false);

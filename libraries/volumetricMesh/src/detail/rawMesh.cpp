@@ -114,7 +114,8 @@ void reportUnusedVertices(const RawMesh& raw, const std::vector<char>& used, Mes
   if (unused > 0) {
     report.warnings.push_back(std::to_string(unused) + " vertex(es) belong to no element (first: vertex " +
                               std::to_string(firstUnused) +
-                              "); they have no mass or stiffness, so fix them or remove them");
+                              "); they have no mass or stiffness, so a simulation holds them at their rest positions "
+                              "(remove them from the file to drop them)");
   }
 }
 

@@ -39,6 +39,11 @@ struct MeshReadReport {
 TetMesh readMesh(const std::filesystem::path& path, const MeshReadOptions& options = {},
                  MeshReadReport* report = nullptr);
 
+/// readMesh for programs that print what the reader noticed: appends each of the report's
+/// warnings to warnings as "<path>: <warning>".
+TetMesh readMeshCollectingWarnings(const std::filesystem::path& path, std::vector<std::string>& warnings,
+                                   const MeshReadOptions& options = {});
+
 /// Vega .veg, tetrahedral subset (docs/file-formats.md): *VERTICES, *ELEMENTS (TET only),
 /// *MATERIAL with `ENU, density, E, nu`, *SET (1-based element ids), *REGION `set, material`
 /// (later lines win where sets overlap), *INCLUDE (relative to the including file, also
