@@ -234,15 +234,20 @@ TEST(BuildSimulation, FileMeshMatchesTheGenerator) {
   EXPECT_LE(massDifference.cwiseAbs().maxCoeff(), 1e-12);
 }
 
+// The mesh of smallScene(): a 2 x 1 x 1 box of 2 x 1 x 1 cells, for writing in other formats.
+asyncfem::TetMesh smallBox() {
+  asyncfem::BoxMeshSpec spec;
+  spec.size = Eigen::Vector3d(2, 1, 1);
+  spec.cells = Eigen::Vector3i(2, 1, 1);
+  return makeBoxMesh(spec);
+}
+
 // A TetGen mesh with a stray vertex that no tetrahedron uses (as Gmsh and TetGen files with
 // a leftover surface have): the scene runs, the stray vertex stays at rest, and every
 // reader warning reaches Simulation::warnings with the scene key and the file.
 TEST(BuildSimulation, VertexInNoElementIsHeldAndTheReaderWarningsArrive) {
   const asyncfem::test::ScratchFolder folder;
-  asyncfem::BoxMeshSpec spec;
-  spec.size = Eigen::Vector3d(2, 1, 1);
-  spec.cells = Eigen::Vector3i(2, 1, 1);
-  const asyncfem::TetMesh box = makeBoxMesh(spec);
+  const asyncfem::TetMesh box = smallBox();
   std::ostringstream node;
   node << box.numVertices() + 1 << " 3 0 0\n";
   for (int v = 0; v < box.numVertices(); ++v) {
@@ -273,6 +278,37 @@ TEST(BuildSimulation, VertexInNoElementIsHeldAndTheReaderWarningsArrive) {
   const Eigen::VectorXd& u = simulation.integrator->displacement();
   EXPECT_TRUE(u.segment<3>(3 * stray).isZero(0.0));
   EXPECT_LT(u[(3 * box.vertexSet("xmax")[0]) + 1], 0.0);  // the free end sags
+}
+
+// A boundary tagged in Gmsh as the physical surface "root" fixes its vertices by name.
+TEST(BuildSimulation, GmshPhysicalSurfaceFixesByName) {
+  const asyncfem::test::ScratchFolder folder;
+  const asyncfem::TetMesh box = smallBox();
+  std::vector<std::array<int, 3>> rootTriangles;
+  for (const std::array<int, 3>& triangle : asyncfem::boundaryTriangles(box)) {
+    if (std::all_of(triangle.begin(), triangle.end(), [&](int v) { return box.restPosition(v).x() == 0.0; })) {
+      rootTriangles.push_back(triangle);
+    }
+  }
+  std::ostringstream msh;
+  msh << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 1 \"root\"\n$EndPhysicalNames\n$Nodes\n"
+      << box.numVertices() << '\n';
+  for (int v = 0; v < box.numVertices(); ++v) msh << v + 1 << ' ' << box.restPosition(v).transpose() << '\n';
+  msh << "$EndNodes\n$Elements\n" << rootTriangles.size() + static_cast<std::size_t>(box.numElements()) << '\n';
+  int tag = 1;
+  for (const std::array<int, 3>& t : rootTriangles) {
+    msh << tag++ << " 2 2 1 1 " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+  }
+  for (int e = 0; e < box.numElements(); ++e) {
+    msh << tag++ << " 4 2 0 1 " << (box.element(e).array() + 1).transpose() << '\n';
+  }
+  msh << "$EndElements\n";
+  folder.write("box.msh", msh.str());
+  auto json = smallScene();
+  json["mesh"] = {{"file", "box.msh"}};
+  json["fixed"] = {{"sets", {"root"}}};
+  const Simulation simulation = build(json, folder.path());
+  EXPECT_EQ(simulation.fixedVertices, box.vertexSet("xmin"));
 }
 
 TEST(BuildSimulation, FixedBySetBoxAndBou) {
