@@ -206,10 +206,16 @@ TEST(SceneErrorsFile, InvalidJsonNamesFileAndLine) {
 TEST(SceneErrorsFile, FolderOrMeshInsteadOfASceneIsNamed) {
   const asyncfem::test::ScratchFolder folder;
   const auto mesh = folder.write("beam.veg", "*VERTICES\n");
+  const auto surface = folder.write("bunny.stl", "solid bunny\n");
   for (const auto& [path, expected] :
        {std::pair{folder.path(), folder.path().string() + ": is a directory, not a scene file"},
         std::pair{mesh, mesh.string() + ": is a mesh file, not a scene (scenes are JSON; see docs/scene-format.md); "
-                                        "to look at a mesh use meshInfo"}}) {
+                                        "to look at a mesh use meshInfo"},
+        std::pair{surface, surface.string() +
+                               ": is a surface mesh, not a scene (scenes are JSON; see "
+                               "docs/scene-format.md); make a tetrahedral mesh of it with tetMesher "
+                               "(tetMesher " +
+                               surface.string() + " --output bunny.veg; docs/tet-mesher.md)"}}) {
     try {
       (void)asyncfem::loadScene(path);
       FAIL() << "expected an error for " << path;
