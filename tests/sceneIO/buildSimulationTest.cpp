@@ -311,6 +311,33 @@ TEST(BuildSimulation, GmshPhysicalSurfaceFixesByName) {
   EXPECT_EQ(simulation.fixedVertices, box.vertexSet("xmin"));
 }
 
+// An explicit step above the stable limit: the message says which steps per frame work,
+// and they do (one fewer does not).
+TEST(BuildSimulation, UnstableExplicitStepNamesTheStepsPerFrameThatWork) {
+  auto json = smallScene();
+  json["mesh"]["material"]["youngsModulus"] = 1e8;
+  json["integrator"]["name"] = "central-differences";
+  std::string message;
+  try {
+    (void)build(json);
+  } catch (const asyncfem::TimestepError& error) {
+    message = error.what();
+  }
+  const std::string key = "at frames.rate 10 the stable steps per frame are ";
+  const std::size_t at = message.find(key);
+  ASSERT_NE(at, std::string::npos) << message;
+  const int steps = std::stoi(message.substr(at + key.size()));
+  EXPECT_NE(message.find(std::to_string(steps) + " or more (integrator.stepsPerFrame: " + std::to_string(steps) +
+                         " gives a timestep of "),
+            std::string::npos)
+      << message;
+  json["integrator"].erase("timestep");
+  json["integrator"]["stepsPerFrame"] = steps;
+  EXPECT_NO_THROW((void)build(json));
+  json["integrator"]["stepsPerFrame"] = steps - 1;
+  EXPECT_THROW((void)build(json), asyncfem::TimestepError);
+}
+
 TEST(BuildSimulation, FixedBySetBoxAndBou) {
   const asyncfem::test::ScratchFolder folder;
   const Simulation bySet = build(smallScene());

@@ -169,6 +169,8 @@ const ErrorCase cases[] = {
      true},
     {"TimestepAndStepsPerFrame", R"({"integrator": {"stepsPerFrame": 4}})",
      "scene.json: integrator: give either \"timestep\" or \"stepsPerFrame\""},
+    {"TimestepMisspelt", R"({"integrator": {"timestep": null, "timestpe": 0.01}})",
+     "scene.json: integrator.timestpe: unknown key (known here: name, timestep, stepsPerFrame, options)"},
     {"StepsPerFrameNotPositive", R"({"integrator": {"timestep": null, "stepsPerFrame": 0}})",
      "scene.json: integrator.stepsPerFrame: expected an integer in [1, "},
     {"FramesRate", R"({"frames": {"rate": 0}})", "scene.json: frames.rate: expected a number > 0"},

@@ -139,22 +139,22 @@ void printHeader(const std::string& simulation, const SimulationReader& reader) 
             << "record      " << header.recordBytes() << " bytes\n";
 }
 
-/// The checkpoint lines of info: the .afsim stores no scene; the checkpoint next to it
-/// identifies the run.
-void printCheckpoint(const std::string& simulation) {
+/// The checkpoint lines of info; a version-1 file records no scene (printHeader prints a
+/// recorded one), and then the checkpoint's run fingerprint identifies the run.
+void printCheckpoint(const std::string& simulation, const SimulationFileHeader& header) {
   const fs::path checkpointFile = checkpointPathFor(simulation);
-  std::cout << "scene       not recorded in the .afsim file";
+  if (header.scenePath.empty()) std::cout << "scene       not recorded in the .afsim file\n";
   if (!fs::exists(checkpointFile)) {
-    std::cout << "\ncheckpoint  none (" << checkpointFile.string() << " does not exist)\n";
+    std::cout << "checkpoint  none (" << checkpointFile.string() << " does not exist)\n";
     return;
   }
   try {
     const SimulationCheckpoint checkpoint = readCheckpoint(checkpointFile);
-    std::cout << "; run fingerprint " << hex(checkpoint.fingerprint) << " (scene, mesh, timestep)\n"
-              << "checkpoint  " << checkpointFile.string() << ": after frame " << checkpoint.frames
-              << ", t = " << exact(checkpoint.time) << ", integrator " << checkpoint.integrator << '\n';
+    std::cout << "checkpoint  " << checkpointFile.string() << ": after frame " << checkpoint.frames
+              << ", t = " << exact(checkpoint.time) << ", integrator " << checkpoint.integrator << "; run fingerprint "
+              << hex(checkpoint.fingerprint) << " (scene, mesh, timestep)\n";
   } catch (const Error& error) {
-    std::cout << "\ncheckpoint  " << checkpointFile.string() << ": unreadable: " << error.what() << '\n';
+    std::cout << "checkpoint  " << checkpointFile.string() << ": unreadable: " << error.what() << '\n';
   }
 }
 
@@ -169,7 +169,7 @@ int info(const CommandLine& options) {
   std::cout << "checksums   "
             << (scan.badFrame ? "BAD: " + scan.badMessage : "ok (" + std::to_string(reader->numFrames()) + " frames)")
             << '\n';
-  printCheckpoint(options.simulation);
+  printCheckpoint(options.simulation, reader->header());
   if (scan.badFrame) {
     std::cerr << "afsimTool: " << scan.badMessage << '\n';
     return 1;

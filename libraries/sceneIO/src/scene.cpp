@@ -325,6 +325,9 @@ void parseIntegrator(JsonObjectReader& top, Scene& scene) {
   }
   const bool hasTimestep = reader.has("timestep");
   if (hasTimestep == reader.has("stepsPerFrame")) {
+    // A misspelt key ("timestpe") is the likelier mistake: name it first.
+    (void)reader.find("options");
+    reader.finish();
     JsonObjectReader::failAt(scene.sourceName, "integrator",
                              "give either \"timestep\" or \"stepsPerFrame\" (steps per frame of 1 / frames.rate)");
   }

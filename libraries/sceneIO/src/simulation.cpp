@@ -354,6 +354,28 @@ void noteSkippedAndWarnings(const Scene& scene, Simulation& simulation) {
   if (!scene.output.velocities) simulation.skipped.emplace_back("velocity output (output.velocities = false)");
 }
 
+// A timestep above an explicit integrator's stable limit: the integrator names the limit,
+// which may not divide the frame interval, so the scene's advice is the steps per frame
+// that do give a stable step. The limit comes from the same integrator built with the
+// option force (its stableTimestepEstimate()); "" when that cannot be had.
+std::string stableStepsPerFrameAdvice(const Scene& scene, const IntegratorRegistry& registry,
+                                      const IntegratorContext& context, const FrameTiming& timing) {
+  nlohmann::json options = scene.integrator.options;
+  options["force"] = true;
+  double limit = 0.0;
+  try {
+    limit = registry.create(scene.integrator.name, context, options)->stableTimestepEstimate();
+  } catch (const Error&) {
+    return "";
+  }
+  if (!(limit > 0.0) || !std::isfinite(limit) || !(timing.frameInterval > 0.0)) return "";
+  auto steps = static_cast<long long>(std::ceil(timing.frameInterval / limit));
+  while (timing.frameInterval / static_cast<double>(steps) > limit) ++steps;
+  return "; at frames.rate " + formatNumber(timing.frameRate) + " the stable steps per frame are " +
+         std::to_string(steps) + " or more (integrator.stepsPerFrame: " + std::to_string(steps) +
+         " gives a timestep of " + formatNumber(timing.frameInterval / static_cast<double>(steps)) + ")";
+}
+
 }  // namespace
 
 Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registry) {
@@ -375,7 +397,11 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
   IntegratorContext context = integratorContext(scene, simulation.timing);
   context.mesh = problem.sharedMesh();
   context.system = problem.dynamicSystem();
-  simulation.integrator = registry.create(scene.integrator.name, std::move(context), scene.integrator.options);
+  try {
+    simulation.integrator = registry.create(scene.integrator.name, context, scene.integrator.options);
+  } catch (const TimestepError& error) {
+    throw TimestepError(error.what() + stableStepsPerFrameAdvice(scene, registry, context, simulation.timing));
+  }
   simulation.monitor.emplace(problem);
   for (const std::string& item : simulation.monitor->skipped()) simulation.skipped.push_back(item);
   return simulation;
