@@ -180,6 +180,13 @@ void applyOverrides(const CommandLine& options, asyncfem::Scene& scene) {
   asyncfem::overrideFrameTiming(scene, {options.timestep, options.stepsPerFrame, options.frames});
   if (options.vtuFolder) {
     scene.output.vtuFolder = *options.vtuFolder;
+  } else if (options.output && !scene.output.vtuFolder.empty()) {
+    // The scene's .vtu series follows --output (OUT.afsim -> OUT_vtu/), so that two runs
+    // of one scene with different outputs do not write one series over the other.
+    fs::path folder = *options.output;
+    folder.replace_extension();
+    folder += "_vtu";
+    scene.output.vtuFolder = folder;
   }
   if (scene.output.file.empty()) {
     throw asyncfem::Error("no output file: set output.file in " + scene.sourceName + " or pass --output FILE");

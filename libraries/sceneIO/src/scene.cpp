@@ -380,6 +380,7 @@ void parseContactPlanes(JsonObjectReader& reader, const std::string& source, Sce
     plane.offset = groundReader.number("height", 0.0);
     groundReader.finish();
     out.planes.push_back(plane);
+    out.ground = plane;
   }
   const json* planes = reader.find("planes");
   if (planes == nullptr) return;
