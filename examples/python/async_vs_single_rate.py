@@ -46,7 +46,7 @@ def run(integrator, seconds, dof, sample_every):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("--seconds", type=float, default=2.0, help="simulated time")
     parser.add_argument("--output", default="tip.png")
     args = parser.parse_args()

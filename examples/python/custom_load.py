@@ -36,7 +36,7 @@ class Gust:
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("--frames", type=int, default=60, help="frames at 30 per second")
     parser.add_argument("--output", default="gust", help="folder for the .vtu series")
     args = parser.parse_args()

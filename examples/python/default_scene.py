@@ -13,7 +13,7 @@ import numpy as np
 import asyncfem as af
 
 MODELS = pathlib.Path(__file__).resolve().parents[2] / "models"
-parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
 parser.add_argument("--frames", type=int, default=120, help="frames at 30 per second")
 parser.add_argument("--output", default="beam.afsim")
 args = parser.parse_args()

@@ -36,7 +36,7 @@ def simulate(youngs_modulus, cells, times, step):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("--small", action="store_true", help="coarse meshes, small images (for the tests)")
     parser.add_argument("--output", default="sweep.png")
     args = parser.parse_args()

@@ -69,6 +69,42 @@ TEST(Problem, RefusesBadBoundaries) {
   EXPECT_THROW(Problem(mesh, {}, ProblemSettings{}, {load}), ValidationError);
 }
 
+// A vertex that no element uses has no mass or stiffness: it is held at rest (not a free
+// DOF, so the matrices stay definite) without being counted as fixed; a mesh whose every
+// vertex is fixed or unused is refused.
+TEST(Problem, VerticesInNoElementAreHeldNotFixed) {
+  const auto beamMesh = beam();
+  Eigen::Matrix3Xd x(3, beamMesh->numVertices() + 1);
+  x << beamMesh->restPositions(), Eigen::Vector3d(9, 9, 9);
+  auto mesh = std::make_shared<TetMesh>(x, beamMesh->elements(), beamMesh->materials(), beamMesh->elementMaterials());
+  const int stray = beamMesh->numVertices();
+  const std::vector<int>& root = beamMesh->vertexSets().at("root");
+  const Problem problem(mesh, root, ProblemSettings{});
+  EXPECT_EQ(problem.unusedVertices(), std::vector<int>{stray});
+  EXPECT_EQ(problem.fixedVertices(), root);
+  EXPECT_EQ(problem.freeDofs().numFixed(), 3 * static_cast<int>(root.size() + 1));
+  EXPECT_TRUE(problem.freeDofs().isFixed(3 * stray + 2));
+  std::vector<int> held = root;
+  held.push_back(stray);
+  EXPECT_EQ(problem.heldVertices(), held);
+  const std::vector<std::string> skipped = problem.skipped();
+  EXPECT_NE(std::find(skipped.begin(), skipped.end(), "free DOFs of 1 vertex(es) that no element uses (held at rest)"),
+            skipped.end());
+  // Backward Euler factors M + h^2 K on the free DOFs: it steps (a zero row would not).
+  VertexLoad pull;
+  pull.vertices = beamMesh->vertexSets().at("tip");
+  pull.perVertex = Eigen::Vector3d(0, 10.0, 0);
+  const Problem pulled(mesh, root, ProblemSettings{}, {pull});
+  auto integrator = makeIntegrator("backward-euler", pulled.dynamicSystem(), 0.01);
+  integrator->step();
+  EXPECT_GT(integrator->displacement()[3 * pull.vertices.front() + 1], 0.0);
+  EXPECT_TRUE(integrator->displacement().segment<3>(3 * stray).isZero(0.0));
+
+  std::vector<int> allUsed(static_cast<std::size_t>(stray));
+  for (int v = 0; v < stray; ++v) allUsed[static_cast<std::size_t>(v)] = v;
+  EXPECT_THROW(Problem(mesh, allUsed, ProblemSettings{}), ValidationError);
+}
+
 TEST(Problem, SkippedWorkIsListed) {
   const auto mesh = beam();
   const Problem problem(mesh, {}, ProblemSettings{});

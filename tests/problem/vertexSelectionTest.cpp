@@ -50,6 +50,12 @@ TEST(VertexSelection, ErrorsNameThePartAndIndex) {
   VertexSelection unknown;
   unknown.sets = {"root", "nope"};
   EXPECT_EQ(failure(unknown).rfind("sets[1]: unknown set \"nope\"", 0), 0u) << failure(unknown);
+  // The message lists the sets and says where sets come from in each format.
+  EXPECT_NE(failure(unknown).find("(vertex sets: root, tip, xmax"), std::string::npos) << failure(unknown);
+  EXPECT_NE(failure(unknown).find("vertex sets come from Gmsh physical surfaces, curves and points, TetGen .face "
+                                  "markers (marker_<k>)"),
+            std::string::npos)
+      << failure(unknown);
   VertexSelection emptyBox;
   emptyBox.boxes.push_back({Eigen::Vector3d(50, 50, 50), Eigen::Vector3d(60, 60, 60)});
   EXPECT_EQ(failure(emptyBox), "boxes[0]: selects no vertex");

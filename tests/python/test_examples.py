@@ -44,3 +44,13 @@ def test_custom_load(tmp_path):
     text = run("custom_load.py", "--frames", 4, "--output", tmp_path / "gust", cwd=tmp_path)
     assert "evaluated 32 times" in text  # 4 frames x 8 steps, one call per backward Euler step
     assert (tmp_path / "gust" / "frames.pvd").exists() and (tmp_path / "gust" / "frame_00003.vtu").exists()
+
+
+def test_help_describes_each_example_in_whole_sentences(tmp_path):
+    """--help gives the docstring's whole first paragraph, not its first line cut mid-sentence."""
+    for name in ("default_scene.py", "async_vs_single_rate.py", "custom_load.py", "parameter_sweep.py"):
+        text = run(name, "--help", cwd=tmp_path)
+        description = " ".join(text.split("\n\n")[1].split())
+        assert description.endswith("."), (name, description)
+        first_line = (EXAMPLES / name).read_text().split('"""')[1].splitlines()[0]
+        assert description.startswith(first_line) and len(description) > len(first_line), (name, description)

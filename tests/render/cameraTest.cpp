@@ -44,6 +44,18 @@ TEST(Camera, FittedCameraShowsEveryCornerWithTheMargin) {
   EXPECT_THROW(fitCamera(box, 1.0, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitY()), Error);
 }
 
+// groundAt puts the floor at a given height along up (a scene's contact.ground), centred
+// under the box and sized like groundBelow's (1e-12: round-off of the projections).
+TEST(GroundPlane, GroundAtIsAtTheGivenHeightUnderTheBox) {
+  const BoundingBox box{Eigen::Vector3d(0.0, 1.0, 0.0), Eigen::Vector3d(2.0, 3.0, 4.0)};
+  const GroundPlane at = groundAt(box, Eigen::Vector3d(0.0, 3.0, 0.0), -0.5);
+  EXPECT_NEAR((at.center - Eigen::Vector3d(1.0, -0.5, 2.0)).norm(), 0.0, 1e-12);
+  const GroundPlane below = groundBelow(box, Eigen::Vector3d::UnitY());
+  EXPECT_EQ(at.halfSize, below.halfSize);
+  EXPECT_EQ(at.tileSize, below.tileSize);
+  EXPECT_LT(below.center.y(), 1.0);  // groundBelow: under the box, not at a given height
+}
+
 TEST(GroundPlane, LiesJustBelowTheLowestCornerAlongUp) {
   // Diagonal 3 (sides 1, 2, 2): the plane sits 0.06 below the lowest corner, tiles near
   // 3/6 = 0.5 round to 0.5, and the plane reaches 4 diagonals to each side.

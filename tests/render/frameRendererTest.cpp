@@ -254,6 +254,29 @@ TEST_F(FrameRendererTest, SceneGivesTheMesh) {
   EXPECT_TRUE(fs::exists(folder_ / "out" / "frame_00000.png"));
 }
 
+// --ground puts the floor at the scene's contact.ground: two heights give two images, and a
+// scene without contact draws the floor where --mesh does (under the lowest point).
+TEST_F(FrameRendererTest, GroundFollowsTheScenesContactGround) {
+  const auto writeScene = [&](const std::string& name, const std::string& contact) {
+    std::ofstream(folder_ / name) << R"({"mesh": {"file": "bar.veg"}, "fixed": {"sets": ["xmin"]},)" << contact
+                                  << R"("integrator": {"name": "backward-euler", "timestep": 0.01},
+      "frames": {"rate": 10, "count": 6}})";
+  };
+  writeScene("low.json", R"("contact": {"ground": {"height": -2}},)");
+  writeScene("lower.json", R"("contact": {"ground": {"height": -4}},)");
+  writeScene("none.json", "");
+  const std::string common = "run.afsim --frames 0 --width 64 --height 48 --ground -q -j 1 -o ";
+  for (const char* name : {"low", "lower", "none"}) {
+    const RunResult r = run(common + name + " --scene " + name + ".json");
+    ASSERT_EQ(r.exitCode, 0) << name << ": " << r.err;
+  }
+  ASSERT_EQ(run(common + "mesh --mesh bar.veg").exitCode, 0);
+  const std::string low = readText(folder_ / "low" / "frame_00000.png");
+  EXPECT_NE(low, readText(folder_ / "lower" / "frame_00000.png"));
+  EXPECT_NE(low, readText(folder_ / "none" / "frame_00000.png"));
+  EXPECT_EQ(readText(folder_ / "none" / "frame_00000.png"), readText(folder_ / "mesh" / "frame_00000.png"));
+}
+
 // offlineSimulator records the scene (absolute path and the fingerprint of the mesh and
 // fixed vertices it built) in the .afsim header: frameRenderer then needs neither --scene
 // nor --mesh, builds only the problem (no matrix, no factorization: the summary says so),

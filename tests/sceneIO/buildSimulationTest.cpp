@@ -8,6 +8,7 @@
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
 #include <cmath>
+#include <sstream>
 
 #include "sceneTestUtilities.hpp"
 
@@ -231,6 +232,110 @@ TEST(BuildSimulation, FileMeshMatchesTheGenerator) {
   const Eigen::MatrixXd massDifference =
       Eigen::MatrixXd(fromFile.integrator->system().mass) - Eigen::MatrixXd(generated.integrator->system().mass);
   EXPECT_LE(massDifference.cwiseAbs().maxCoeff(), 1e-12);
+}
+
+// The mesh of smallScene(): a 2 x 1 x 1 box of 2 x 1 x 1 cells, for writing in other formats.
+asyncfem::TetMesh smallBox() {
+  asyncfem::BoxMeshSpec spec;
+  spec.size = Eigen::Vector3d(2, 1, 1);
+  spec.cells = Eigen::Vector3i(2, 1, 1);
+  return makeBoxMesh(spec);
+}
+
+// A TetGen mesh with a stray vertex that no tetrahedron uses (as Gmsh and TetGen files with
+// a leftover surface have): the scene runs, the stray vertex stays at rest, and every
+// reader warning reaches Simulation::warnings with the scene key and the file.
+TEST(BuildSimulation, VertexInNoElementIsHeldAndTheReaderWarningsArrive) {
+  const asyncfem::test::ScratchFolder folder;
+  const asyncfem::TetMesh box = smallBox();
+  std::ostringstream node;
+  node << box.numVertices() + 1 << " 3 0 0\n";
+  for (int v = 0; v < box.numVertices(); ++v) {
+    node << v + 1 << ' ' << box.restPosition(v).transpose() << '\n';
+  }
+  node << box.numVertices() + 1 << " 5 5 5\n";
+  std::ostringstream ele;
+  ele << box.numElements() << " 4 0\n";
+  for (int e = 0; e < box.numElements(); ++e) ele << e + 1 << ' ' << (box.element(e).array() + 1).transpose() << '\n';
+  folder.write("box.node", node.str());
+  folder.write("box.ele", ele.str());
+  auto json = smallScene();
+  json["mesh"] = {{"file", "box.node"}};
+  json["fixed"] = nlohmann::json::parse(R"({"boxes": [{"min": [-0.1, -1, -1], "max": [0.1, 2, 2]}]})");
+  json["gravity"] = {0, -9.81, 0};
+  Simulation simulation = build(json, folder.path());
+  const int stray = box.numVertices();
+  EXPECT_EQ(simulation.problem->unusedVertices(), std::vector<int>{stray});
+  EXPECT_EQ(simulation.fixedVertices.size(), 4U);  // the unused vertex is held, not fixed
+  EXPECT_EQ(simulation.integrator->system().freeDofs.numFree(), 3 * (box.numVertices() - 4));
+  const std::string prefix = "scene.json: mesh.file: " + (folder.path() / "box.node").string() + ": ";
+  EXPECT_TRUE(contains(simulation.warnings,
+                       prefix + "1 vertex(es) belong to no element (first: vertex " + std::to_string(stray + 1) + ")"))
+      << ::testing::PrintToString(simulation.warnings);
+  EXPECT_TRUE(contains(simulation.warnings, prefix + "the file has no materials"))
+      << ::testing::PrintToString(simulation.warnings);
+  asyncfem::advanceFrame(simulation, 0);  // before: "cholmod: matrix is not positive definite"
+  const Eigen::VectorXd& u = simulation.integrator->displacement();
+  EXPECT_TRUE(u.segment<3>(3 * stray).isZero(0.0));
+  EXPECT_LT(u[(3 * box.vertexSet("xmax")[0]) + 1], 0.0);  // the free end sags
+}
+
+// A boundary tagged in Gmsh as the physical surface "root" fixes its vertices by name.
+TEST(BuildSimulation, GmshPhysicalSurfaceFixesByName) {
+  const asyncfem::test::ScratchFolder folder;
+  const asyncfem::TetMesh box = smallBox();
+  std::vector<std::array<int, 3>> rootTriangles;
+  for (const std::array<int, 3>& triangle : asyncfem::boundaryTriangles(box)) {
+    if (std::all_of(triangle.begin(), triangle.end(), [&](int v) { return box.restPosition(v).x() == 0.0; })) {
+      rootTriangles.push_back(triangle);
+    }
+  }
+  std::ostringstream msh;
+  msh << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 1 \"root\"\n$EndPhysicalNames\n$Nodes\n"
+      << box.numVertices() << '\n';
+  for (int v = 0; v < box.numVertices(); ++v) msh << v + 1 << ' ' << box.restPosition(v).transpose() << '\n';
+  msh << "$EndNodes\n$Elements\n" << rootTriangles.size() + static_cast<std::size_t>(box.numElements()) << '\n';
+  int tag = 1;
+  for (const std::array<int, 3>& t : rootTriangles) {
+    msh << tag++ << " 2 2 1 1 " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+  }
+  for (int e = 0; e < box.numElements(); ++e) {
+    msh << tag++ << " 4 2 0 1 " << (box.element(e).array() + 1).transpose() << '\n';
+  }
+  msh << "$EndElements\n";
+  folder.write("box.msh", msh.str());
+  auto json = smallScene();
+  json["mesh"] = {{"file", "box.msh"}};
+  json["fixed"] = {{"sets", {"root"}}};
+  const Simulation simulation = build(json, folder.path());
+  EXPECT_EQ(simulation.fixedVertices, box.vertexSet("xmin"));
+}
+
+// An explicit step above the stable limit: the message says which steps per frame work,
+// and they do (one fewer does not).
+TEST(BuildSimulation, UnstableExplicitStepNamesTheStepsPerFrameThatWork) {
+  auto json = smallScene();
+  json["mesh"]["material"]["youngsModulus"] = 1e8;
+  json["integrator"]["name"] = "central-differences";
+  std::string message;
+  try {
+    (void)build(json);
+  } catch (const asyncfem::TimestepError& error) {
+    message = error.what();
+  }
+  const std::string key = "at frames.rate 10 the stable steps per frame are ";
+  const std::size_t at = message.find(key);
+  ASSERT_NE(at, std::string::npos) << message;
+  const int steps = std::stoi(message.substr(at + key.size()));
+  EXPECT_NE(message.find(std::to_string(steps) + " or more (integrator.stepsPerFrame: " + std::to_string(steps) +
+                         " gives a timestep of "),
+            std::string::npos)
+      << message;
+  json["integrator"].erase("timestep");
+  json["integrator"]["stepsPerFrame"] = steps;
+  EXPECT_NO_THROW((void)build(json));
+  json["integrator"]["stepsPerFrame"] = steps - 1;
+  EXPECT_THROW((void)build(json), asyncfem::TimestepError);
 }
 
 TEST(BuildSimulation, FixedBySetBoxAndBou) {

@@ -169,6 +169,8 @@ const ErrorCase cases[] = {
      true},
     {"TimestepAndStepsPerFrame", R"({"integrator": {"stepsPerFrame": 4}})",
      "scene.json: integrator: give either \"timestep\" or \"stepsPerFrame\""},
+    {"TimestepMisspelt", R"({"integrator": {"timestep": null, "timestpe": 0.01}})",
+     "scene.json: integrator.timestpe: unknown key (known here: name, timestep, stepsPerFrame, options)"},
     {"StepsPerFrameNotPositive", R"({"integrator": {"timestep": null, "stepsPerFrame": 0}})",
      "scene.json: integrator.stepsPerFrame: expected an integer in [1, "},
     {"FramesRate", R"({"frames": {"rate": 0}})", "scene.json: frames.rate: expected a number > 0"},
@@ -206,10 +208,16 @@ TEST(SceneErrorsFile, InvalidJsonNamesFileAndLine) {
 TEST(SceneErrorsFile, FolderOrMeshInsteadOfASceneIsNamed) {
   const asyncfem::test::ScratchFolder folder;
   const auto mesh = folder.write("beam.veg", "*VERTICES\n");
+  const auto surface = folder.write("bunny.stl", "solid bunny\n");
   for (const auto& [path, expected] :
        {std::pair{folder.path(), folder.path().string() + ": is a directory, not a scene file"},
         std::pair{mesh, mesh.string() + ": is a mesh file, not a scene (scenes are JSON; see docs/scene-format.md); "
-                                        "to look at a mesh use meshInfo"}}) {
+                                        "to look at a mesh use meshInfo"},
+        std::pair{surface, surface.string() +
+                               ": is a surface mesh, not a scene (scenes are JSON; see "
+                               "docs/scene-format.md); make a tetrahedral mesh of it with tetMesher "
+                               "(tetMesher " +
+                               surface.string() + " --output bunny.veg; docs/tet-mesher.md)"}}) {
     try {
       (void)asyncfem::loadScene(path);
       FAIL() << "expected an error for " << path;

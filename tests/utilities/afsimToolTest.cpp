@@ -95,6 +95,28 @@ TEST_F(AfsimToolTest, InfoPrintsHeaderTimesChecksumsAndTheCheckpoint) {
   EXPECT_NE(withCheckpoint.out.find("after frame 5, t = 0.25, integrator backward-euler"), std::string::npos)
       << withCheckpoint.out;
 
+  EXPECT_NE(withCheckpoint.out.find("scene       not recorded in the .afsim file\n"), std::string::npos)
+      << withCheckpoint.out;
+
+  // A version-2 file names its scene once and never says it is not recorded.
+  asyncfem::SimulationFileHeader recorded;
+  recorded.numVertices = mesh_.numVertices();
+  recorded.frameInterval = 0.05;
+  recorded.timestep = 0.01;
+  recorded.scenePath = "/scenes/box.json";
+  recorded.sceneFingerprint = 0xabcU;
+  {
+    asyncfem::SimulationWriter writer(folder_ / "recorded.afsim", recorded);
+    writer.appendFrame(0.05, displacement(0));
+  }
+  const RunResult v2 = run("info recorded.afsim");
+  ASSERT_EQ(v2.exitCode, 0) << v2.err;
+  EXPECT_NE(v2.out.find("scene       /scenes/box.json (mesh and fixed vertices fingerprint 00000abc)\n"),
+            std::string::npos)
+      << v2.out;
+  EXPECT_EQ(v2.out.find("not recorded"), std::string::npos) << v2.out;
+  EXPECT_NE(v2.out.find("checkpoint  none"), std::string::npos) << v2.out;
+
   // One flipped byte in frame 2's displacement: info names it and exits 1.
   const std::int64_t record = 24 + 24 * static_cast<std::int64_t>(mesh_.numVertices());
   {

@@ -752,4 +752,23 @@ TEST_F(OfflineSimulatorTest, VtuFramesComeWithAPvdCollection) {
   EXPECT_EQ(ascii.find("AppendedData"), std::string::npos);
 }
 
+// The scene's .vtu folder follows --output (OUT.afsim -> OUT_vtu/): two runs of one scene
+// with different outputs keep two series; --vtu still chooses the folder.
+TEST_F(OfflineSimulatorTest, VtuFolderFollowsTheOutput) {
+  auto json = smallScene();
+  json["output"]["vtu"] = {{"folder", "vtu"}};
+  const fs::path scene = writeScene(json);
+  for (const char* name : {"a", "b"}) {
+    const RunResult r = run(quoted(scene) + " --quiet --output " + quoted(folder_ / name) + ".afsim");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(fs::exists(folder_ / (std::string(name) + "_vtu") / "frames.pvd")) << name;
+  }
+  EXPECT_FALSE(fs::exists(folder_ / "vtu"));
+  const RunResult chosen =
+      run(quoted(scene) + " --quiet --output " + quoted(folder_ / "c.afsim") + " --vtu " + quoted(folder_ / "mine"));
+  ASSERT_EQ(chosen.exitCode, 0) << chosen.err;
+  EXPECT_TRUE(fs::exists(folder_ / "mine" / "frames.pvd"));
+  EXPECT_FALSE(fs::exists(folder_ / "c_vtu"));
+}
+
 }  // namespace

@@ -77,6 +77,9 @@ TEST(GmshReader, Version22MixedElementsAndPhysicalGroups) {
   EXPECT_EQ(mesh.elementSet("solid part"), std::vector<int>{0});
   EXPECT_EQ(mesh.elementSet("physical_8"), std::vector<int>{1});
   EXPECT_EQ(mesh.elementSets().count("unused"), 0u);
+  // The triangle in physical surface 3 ("skin"): its nodes 10 20 30 are vertices 0 1 2.
+  EXPECT_EQ(mesh.vertexSet("skin"), (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(mesh.vertexSets().size(), 1u);  // the point and line are in no group (tag 0)
   // Tags 20 30 40 55 map to vertices 1 2 3 4.
   EXPECT_EQ(mesh.element(1), Eigen::Vector4i(1, 2, 3, 4));
   EXPECT_EQ(mesh.restPosition(4), Eigen::Vector3d(1, 1, 1));
@@ -102,6 +105,29 @@ TEST(GmshReader, Version41EntityBlocks) {
   EXPECT_EQ(mesh.elementSet("solid"), (std::vector<int>{0, 1}));
   EXPECT_EQ(mesh.element(1), Eigen::Vector4i(1, 2, 3, 4));
   EXPECT_DOUBLE_EQ(totalVolume(mesh), 0.5);
+  // The triangle of surface entity 3, in physical surface 5 ("skin").
+  EXPECT_EQ(mesh.vertexSet("skin"), (std::vector<int>{0, 1, 2}));
+}
+
+// Physical points, curves and surfaces become vertex sets (the nodes of their elements),
+// named from $PhysicalNames or physical_point_<tag>, physical_curve_<tag>,
+// physical_surface_<tag>; tags are per dimension, so surface 7 and volume 7 differ.
+TEST(GmshReader, LowerDimensionalPhysicalGroupsBecomeVertexSets) {
+  test::ScratchDir dir;
+  std::string text = replaced(kMsh22, "1 15 2 0 1 10\n", "1 15 2 4 1 55\n");
+  text = replaced(text, "2 1 2 0 1 10 20\n", "2 1 2 6 1 10 40\n");
+  text = replaced(text, "3 2 2 3 1 10 20 30\n", "3 2 2 7 1 10 20 30\n");
+  const TetMesh mesh = readGmsh(dir.write("m.msh", text));
+  EXPECT_EQ(mesh.vertexSet("physical_point_4"), std::vector<int>{4});
+  EXPECT_EQ(mesh.vertexSet("physical_curve_6"), (std::vector<int>{0, 3}));
+  EXPECT_EQ(mesh.vertexSet("physical_surface_7"), (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(mesh.elementSet("solid part"), std::vector<int>{0});  // volume 7 is still the tet
+  // 4.1: a point entity carries its physical tags after x y z.
+  std::string text41 = replaced(kMsh41, "0 0 1 1\n", "1 0 1 1\n9 1 1 1 1 2\n");
+  text41 = replaced(text41, "2 3 1 3\n", "3 4 1 4\n0 9 15 1\n4 50\n");
+  const TetMesh mesh41 = readGmsh(dir.write("m41.msh", text41));
+  EXPECT_EQ(mesh41.vertexSet("physical_point_2"), std::vector<int>{4});
+  EXPECT_EQ(mesh41.vertexSet("skin"), (std::vector<int>{0, 1, 2}));
 }
 
 TEST(GmshReader, Version41UnnamedPhysicalGroup) {

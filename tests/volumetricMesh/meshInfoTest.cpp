@@ -53,7 +53,9 @@ TEST(MeshInfo, PrintsSummaryOfShippedBeam) {
   EXPECT_NE(r.output.find("format: veg"), std::string::npos);
   EXPECT_NE(r.output.find("tip: density 200"), std::string::npos);
   EXPECT_NE(r.output.find("root: 49"), std::string::npos);
-  EXPECT_NE(r.output.find("min dihedral angle"), std::string::npos);
+  // The beam's cube tets have dihedral angles of 45, 60 and 90 degrees only (printed with round-off).
+  EXPECT_NE(r.output.find("dihedral angles (degrees): min 44.9999"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("elements with a dihedral angle below 10.0 degrees: 0\n"), std::string::npos) << r.output;
 }
 
 TEST(MeshInfo, JsonOutput) {
@@ -67,7 +69,49 @@ TEST(MeshInfo, JsonOutput) {
   EXPECT_NEAR(j["volume"].get<double>(), 0.04, 1e-12);
   // body 1000 * 0.032 + tip 200 * 0.008
   EXPECT_NEAR(j["mass"].get<double>(), 33.6, 1e-9);
-  EXPECT_NEAR(j["quality"]["minDihedralAngleDegrees"]["min"].get<double>(), 45.0, 1e-9);
+  // Angles of the cube's tets: 45, 60 and 90 degrees (1e-9: round-off of acos/atan2).
+  const nlohmann::json& quality = j["quality"];
+  EXPECT_NEAR(quality["dihedralAngleDegrees"]["min"].get<double>(), 45.0, 1e-9);
+  EXPECT_NEAR(quality["dihedralAngleDegrees"]["max"].get<double>(), 90.0, 1e-9);
+  EXPECT_NEAR(quality["meanElementMinDihedralAngleDegrees"].get<double>(), 45.0, 1e-9);
+  EXPECT_EQ(quality["elementsBelowAngle"]["count"], 0);
+  // --angle-threshold 50: every element has its 45 degree angle below it.
+  const RunResult strict = runMeshInfo("--json --angle-threshold 50 " + quoted(kBeam), false);
+  ASSERT_EQ(strict.exitCode, 0) << strict.output;
+  const nlohmann::json s = nlohmann::json::parse(strict.output)["quality"]["elementsBelowAngle"];
+  EXPECT_EQ(s["thresholdDegrees"], 50.0);
+  EXPECT_EQ(s["count"], 6480);
+}
+
+// A Gmsh group name with a space cannot go into .veg: the error says how to rename it, and
+// --rename-set does; --default-material replaces the format's default material.
+TEST(MeshInfo, RenameSetAndDefaultMaterial) {
+  test::ScratchDir dir;
+  const auto msh = dir.write("g.msh",
+                             "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 3 \"fixed face\"\n"
+                             "$EndPhysicalNames\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n"
+                             "$Elements\n2\n1 2 2 3 1 1 2 3\n2 4 2 0 1 1 2 3 4\n$EndElements\n");
+  const auto out = dir.path() / "g.veg";
+  const RunResult refused = runMeshInfo(quoted(msh.string()) + " --write " + quoted(out.string()));
+  EXPECT_EQ(refused.exitCode, 1);
+  EXPECT_NE(
+      refused.output.find("vertex set name 'fixed face' cannot be written to .veg (it must be one token "
+                          "without spaces, commas or '#'); rename it with meshInfo --rename-set 'fixed face=NEW'"),
+      std::string::npos)
+      << refused.output;
+  const RunResult renamed = runMeshInfo(quoted(msh.string()) + " --write " + quoted(out.string()) +
+                                        " --rename-set 'fixed face=fixedFace' --default-material 1100,2e5,0.3");
+  ASSERT_EQ(renamed.exitCode, 0) << renamed.output;
+  EXPECT_EQ(renamed.output.find("the file has no materials"), std::string::npos) << renamed.output;
+  const TetMesh written = readVeg(out);
+  EXPECT_EQ(written.vertexSet("fixedFace"), (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(written.materials().at(0), (Material{"default", 1100, 2e5, 0.3}));
+  const RunResult unknown = runMeshInfo(quoted(msh.string()) + " --rename-set nope=x");
+  EXPECT_EQ(unknown.exitCode, 1);
+  EXPECT_NE(unknown.output.find("unknown set 'nope' (vertex sets: fixed face;"), std::string::npos) << unknown.output;
+  const RunResult malformed = runMeshInfo(quoted(msh.string()) + " --rename-set nope");
+  EXPECT_EQ(malformed.exitCode, 2);
+  EXPECT_NE(malformed.output.find("--rename-set 'nope': expected OLD=NEW"), std::string::npos) << malformed.output;
 }
 
 TEST(MeshInfo, GenerateAndWrite) {

@@ -168,9 +168,11 @@ TEST(MeshQueries, FlattenedTetHasWorseQuality) {
 }
 
 TEST(MeshQueries, QualitySummarySpansTheElements) {
-  // The regular tet and a flattened one: the minimum and maximum of the elements' minimum
-  // dihedral angles are the two elements' own, the mean lies halfway, the aspect ratio is
-  // the flattened one's. Tolerances: a few ulps of the per-element values.
+  // The regular tet and a flattened one: the smallest dihedral angle is the flattened
+  // one's smallest, the largest its largest (not the largest of the elements' smallest
+  // angles, which is the regular tet's acos(1/3)); the mean of the elements' smallest
+  // angles lies halfway; only the flattened one is below 10 degrees. Tolerances: a few
+  // ulps of the per-element values.
   Eigen::Matrix3Xd x(3, 8);
   x << 1, 1, -1, -1, 10, 11, 10, 10.3,  //
       1, -1, 1, -1, 0, 0, 1, 0.3,       //
@@ -181,12 +183,19 @@ TEST(MeshQueries, QualitySummarySpansTheElements) {
   const std::vector<ElementQuality> each = elementQualities(mesh);
   const double toDegrees = 180.0 / std::acos(-1.0);
   const QualitySummary s = summarizeQuality(mesh);
-  EXPECT_NEAR(s.maxDihedralDegrees, std::acos(1.0 / 3.0) * toDegrees, 1e-12);
+  const double regular = std::acos(1.0 / 3.0) * toDegrees;
   EXPECT_NEAR(s.minDihedralDegrees, each[1].minDihedralAngle * toDegrees, 1e-12);
-  EXPECT_NEAR(s.meanDihedralDegrees, 0.5 * (s.minDihedralDegrees + s.maxDihedralDegrees), 1e-12);
+  EXPECT_NEAR(s.maxDihedralDegrees, each[1].maxDihedralAngle * toDegrees, 1e-12);
+  EXPECT_GT(s.maxDihedralDegrees, 170.0);
+  EXPECT_NEAR(s.meanMinDihedralDegrees, 0.5 * (s.minDihedralDegrees + regular), 1e-12);
+  EXPECT_EQ(s.thresholdDegrees, 10.0);
+  EXPECT_EQ(s.elementsBelowThreshold, 1);
+  EXPECT_EQ(summarizeQuality(mesh, regular + 1.0).elementsBelowThreshold, 2);
+  EXPECT_EQ(summarizeQuality(mesh, 0.0).elementsBelowThreshold, 0);
   EXPECT_DOUBLE_EQ(s.worstAspectRatio, each[1].aspectRatio);
   const QualitySummary none = summarizeQuality(TetMesh());
   EXPECT_EQ(none.minDihedralDegrees, 0.0);
+  EXPECT_EQ(none.maxDihedralDegrees, 0.0);
   EXPECT_EQ(none.worstAspectRatio, 0.0);
 }
 

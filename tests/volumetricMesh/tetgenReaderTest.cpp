@@ -106,6 +106,38 @@ TEST(TetGenReader, TenNodeTetsUseCornersAndDropEdgeNodes) {
   EXPECT_TRUE(mentioned);
 }
 
+// TetGen -f writes the boundary faces with their markers: the vertices of the faces of
+// marker k become the vertex set "marker_k"; marker 0 (unmarked) makes no set; the -nn
+// columns (adjacent tetrahedra) after the marker are accepted.
+TEST(TetGenReader, FaceMarkersBecomeVertexSets) {
+  test::ScratchDir dir;
+  dir.write("m.node", kNodes1);
+  dir.write("m.ele", kEle1);
+  dir.write("m.face",
+            "# boundary faces\n"
+            "3 1\n"
+            "1 1 2 3 5\n"
+            "2 2 3 5 0\n"
+            "3 2 4 5 -2\n");
+  const TetMesh mesh = readMesh(dir.path() / "m.node");
+  EXPECT_EQ(mesh.vertexSet("marker_5"), (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(mesh.vertexSet("marker_-2"), (std::vector<int>{1, 3, 4}));
+  EXPECT_EQ(mesh.vertexSets().size(), 2u);
+  dir.write("m.face", "2 1\n1 1 2 3 5 1 -1\n2 2 4 5 5 2 -1\n");
+  EXPECT_EQ(readMesh(dir.path() / "m.node").vertexSet("marker_5"), (std::vector<int>{0, 1, 2, 3, 4}));
+  // Without markers no set; a vertex out of range names the face and the line.
+  dir.write("m.face", "1 0\n1 1 2 3\n");
+  EXPECT_TRUE(readMesh(dir.path() / "m.node").vertexSets().empty());
+  dir.write("m.face", "1 1\n1 1 2 9 4\n");
+  try {
+    (void)readMesh(dir.path() / "m.node");
+    FAIL() << "expected an error";
+  } catch (const ParseError& error) {
+    EXPECT_NE(std::string(error.what()).find("m.face:2: face 1 references vertex 9, outside [1, 5]"), std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(TetGenReader, FirstIndexMustBeZeroOrOne) {
   test::ScratchDir dir;
   dir.write("m.node", "2 3 0 0\n2 0 0 0\n3 1 0 0\n");

@@ -47,13 +47,34 @@ TEST(VegErrors, UnreadableFileIsAnErrorNamingThePath) {
   EXPECT_THROW(readVeg(dir.path()), Error);  // a directory
 }
 
-TEST(VegErrors, UnknownExtension) {
+// The message of readMesh(path) (empty when it reads).
+std::string readMeshError(const std::string& path) {
   try {
-    readMesh("mesh.stl");
-    FAIL();
+    (void)readMesh(path);
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(".stl"), std::string::npos) << e.what();
+    return e.what();
   }
+  return "";
+}
+
+TEST(VegErrors, UnknownExtension) {
+  EXPECT_EQ(readMeshError("mesh.xyz"),
+            "cannot read mesh 'mesh.xyz': unknown extension '.xyz' (expected a .veg, .node, .ele or .msh file, or "
+            "the base name of a TetGen .node/.ele pair)");
+  // A surface format points to tetMesher, with the command for this file.
+  for (const std::string surface : {"mesh.stl", "mesh.off", "mesh.OBJ"}) {
+    const std::string message = readMeshError(surface);
+    EXPECT_NE(message.find("is a surface format, and a simulation needs a tetrahedral mesh: make one with "
+                           "tetMesher (tetMesher " +
+                           surface + " --output mesh.veg; docs/tet-mesher.md)"),
+              std::string::npos)
+        << message;
+  }
+  // No extension: a TetGen base name, and the message says which files it looked for.
+  EXPECT_EQ(readMeshError("cube"),
+            "cannot read mesh 'cube': there is no TetGen pair 'cube.node' + 'cube.ele' (a name without an extension "
+            "is taken as a TetGen base name); give a .veg, .node, .ele or .msh file, or the base name of a TetGen "
+            ".node/.ele pair");
 }
 
 TEST(VegErrors, ElementVertexOutOfRange) {

@@ -96,19 +96,21 @@ std::optional<TetMesh> loadMesh(const CommandLine& options, const SimulationRead
   if (options.mesh && options.scene) throw Error("give the mesh with --mesh FILE or --scene SCENE.json, not both");
   std::optional<TetMesh> mesh;
   std::string name;
+  std::vector<std::string> warnings;
   if (options.mesh) {
-    mesh = readMesh(*options.mesh);
+    mesh = readMeshCollectingWarnings(*options.mesh, warnings);
     name = *options.mesh;
   } else if (options.scene) {
-    mesh = buildSceneMesh(loadScene(*options.scene));
+    mesh = buildSceneMesh(loadScene(*options.scene), &warnings);
     name = *options.scene;
   } else if (!reader.header().scenePath.empty()) {
     // The scene the run recorded (checked against its fingerprint).
-    mesh = recordedSceneProblem(reader.header(), reader.path().string())->mesh();
+    mesh = recordedSceneProblem(reader.header(), reader.path().string(), &warnings)->mesh();
     name = reader.header().scenePath;
   } else {
     return mesh;
   }
+  for (const std::string& warning : warnings) std::cerr << "afsimTool: warning: " << warning << '\n';
   if (mesh->numVertices() != reader.numVertices()) {
     throw Error(reader.path().string() + " has " + std::to_string(reader.numVertices()) + " vertices but the mesh (" +
                 name + ") has " + std::to_string(mesh->numVertices()) + ": the simulation did not run on this mesh");
@@ -137,22 +139,22 @@ void printHeader(const std::string& simulation, const SimulationReader& reader) 
             << "record      " << header.recordBytes() << " bytes\n";
 }
 
-/// The checkpoint lines of info: the .afsim stores no scene; the checkpoint next to it
-/// identifies the run.
-void printCheckpoint(const std::string& simulation) {
+/// The checkpoint lines of info; a version-1 file records no scene (printHeader prints a
+/// recorded one), and then the checkpoint's run fingerprint identifies the run.
+void printCheckpoint(const std::string& simulation, const SimulationFileHeader& header) {
   const fs::path checkpointFile = checkpointPathFor(simulation);
-  std::cout << "scene       not recorded in the .afsim file";
+  if (header.scenePath.empty()) std::cout << "scene       not recorded in the .afsim file\n";
   if (!fs::exists(checkpointFile)) {
-    std::cout << "\ncheckpoint  none (" << checkpointFile.string() << " does not exist)\n";
+    std::cout << "checkpoint  none (" << checkpointFile.string() << " does not exist)\n";
     return;
   }
   try {
     const SimulationCheckpoint checkpoint = readCheckpoint(checkpointFile);
-    std::cout << "; run fingerprint " << hex(checkpoint.fingerprint) << " (scene, mesh, timestep)\n"
-              << "checkpoint  " << checkpointFile.string() << ": after frame " << checkpoint.frames
-              << ", t = " << exact(checkpoint.time) << ", integrator " << checkpoint.integrator << '\n';
+    std::cout << "checkpoint  " << checkpointFile.string() << ": after frame " << checkpoint.frames
+              << ", t = " << exact(checkpoint.time) << ", integrator " << checkpoint.integrator << "; run fingerprint "
+              << hex(checkpoint.fingerprint) << " (scene, mesh, timestep)\n";
   } catch (const Error& error) {
-    std::cout << "\ncheckpoint  " << checkpointFile.string() << ": unreadable: " << error.what() << '\n';
+    std::cout << "checkpoint  " << checkpointFile.string() << ": unreadable: " << error.what() << '\n';
   }
 }
 
@@ -167,7 +169,7 @@ int info(const CommandLine& options) {
   std::cout << "checksums   "
             << (scan.badFrame ? "BAD: " + scan.badMessage : "ok (" + std::to_string(reader->numFrames()) + " frames)")
             << '\n';
-  printCheckpoint(options.simulation);
+  printCheckpoint(options.simulation, reader->header());
   if (scan.badFrame) {
     std::cerr << "afsimTool: " << scan.badMessage << '\n';
     return 1;

@@ -97,9 +97,10 @@ struct Shared {
   std::vector<int> fixedVertices;
   WarpingKind warping = WarpingKind::none;
   SurfaceEmbedding surface;
-  std::optional<Eigen::Matrix3Xf> colors;  // per surface vertex, when a set is tinted
-  std::vector<Run> runs;                   // one, or two with --compare
-  int assemblies = 0;                      // matrices the problem assembled (none: only the mesh is needed)
+  std::optional<Eigen::Matrix3Xf> colors;   // per surface vertex, when a set is tinted
+  std::vector<Run> runs;                    // one, or two with --compare
+  int assemblies = 0;                       // matrices the problem assembled (none: only the mesh is needed)
+  std::optional<ContactPlane> sceneGround;  // the scene's contact.ground, where --ground draws the floor
 };
 
 /// A worker's own state: readers of every run and warping objects (neither is
@@ -312,21 +313,26 @@ RunsExtent checkRuns(const std::vector<Run>& runs, bool quiet) {
 /// The mesh, and the vertices held fixed in the simulation: from --scene, from the scene
 /// the file records, or from --mesh. Only the problem is built: no matrix, no factorization.
 void loadMesh(const CommandLine& options, std::int64_t numVertices, Shared& shared) {
+  std::vector<std::string> warnings;
   if (options.scene || !options.mesh) {
+    const SimulationFileHeader header = SimulationReader(shared.runs.front().file).header();
     const std::shared_ptr<const Problem> problem =
-        options.scene ? buildProblem(loadScene(*options.scene))
-                      : recordedSceneProblem(SimulationReader(shared.runs.front().file).header(),
-                                             shared.runs.front().file.string());
+        options.scene ? buildProblem(loadScene(*options.scene), &warnings)
+                      : recordedSceneProblem(header, shared.runs.front().file.string(), &warnings);
+    shared.sceneGround = loadScene(options.scene ? *options.scene : header.scenePath).contact.ground;
     shared.mesh = problem->sharedMesh();
     shared.fixedVertices = problem->fixedVertices();
     shared.assemblies = problem->assemblies();
   } else {
-    auto mesh = std::make_shared<TetMesh>(readMesh(*options.mesh));
+    auto mesh = std::make_shared<TetMesh>(readMeshCollectingWarnings(*options.mesh, warnings));
     for (const std::string& set : options.fixedSets) {
       const std::vector<int> vertices = mesh->setVertices(set);
       shared.fixedVertices.insert(shared.fixedVertices.end(), vertices.begin(), vertices.end());
     }
     shared.mesh = std::move(mesh);
+  }
+  if (!options.quiet) {
+    for (const std::string& warning : warnings) std::cerr << "frameRenderer: warning: " << warning << '\n';
   }
   const std::string meshName = options.scene ? *options.scene : options.mesh ? *options.mesh : "the recorded scene";
   if (shared.mesh->numVertices() != numVertices) {
@@ -409,6 +415,22 @@ Camera chooseCamera(const CommandLine& options, const BoundingBox& box, const Pa
   const Eigen::Vector3d direction =
       options.viewDirection.empty() ? defaultViewDirection() : toVector(options.viewDirection);
   return fitCamera(box, static_cast<double>(layout.leftWidth) / layout.panelHeight, direction, up, options.fieldOfView);
+}
+
+/// The floor of --ground: at the scene's contact.ground when it has one perpendicular to
+/// the camera's up direction (so bodies rest on their shadow), else under the lowest point
+/// of all frames.
+GroundPlane chooseGround(const Shared& shared, const BoundingBox& box, const Eigen::Vector3d& up, bool quiet) {
+  if (shared.sceneGround) {
+    if (shared.sceneGround->normal.dot(up.normalized()) > 1.0 - 1e-9) {
+      return groundAt(box, up, shared.sceneGround->offset);
+    }
+    if (!quiet) {
+      std::cerr << "frameRenderer: warning: the scene's contact.ground is not perpendicular to --camera-up; the "
+                   "floor is drawn under the lowest point of all frames instead\n";
+    }
+  }
+  return groundBelow(box, up);
 }
 
 /// Seconds spent drawing the frames: wall time, and summed over the threads the time
@@ -624,7 +646,7 @@ int run(int argc, char** argv) {
   }
   const Camera camera = chooseCamera(options, box, layout, up);
   if (options.ground) {
-    style.ground = groundBelow(box, up);
+    style.ground = chooseGround(shared, box, up, options.quiet);
   }
 
   const RenderTimes times = renderFrames(options, shared, frames, threads, {layout, camera, style});

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // meshInfo: reads (or generates) a tetrahedral mesh and prints what it contains.
 //
-//   meshInfo FILE [--json] [--write OUT.veg|OUT.vtu]
+//   meshInfo FILE [--json] [--write OUT.veg|OUT.vtu] [--rename-set OLD=NEW]... [--angle-threshold DEG]
+//            [--default-material rho,E,nu]
 //   meshInfo --generate beam|box|antenna|snail [--cells N] [--json] [--write OUT]
 //
 // Text goes to stdout, reader warnings to stderr; errors print "meshInfo: <message>"
@@ -20,6 +21,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commandLine.hpp"
@@ -28,7 +30,8 @@ namespace {
 
 using asyncfem::TetMesh;
 
-nlohmann::json describe(const TetMesh& mesh, const std::string& source, const asyncfem::MeshReadReport& report) {
+nlohmann::json describe(const TetMesh& mesh, const std::string& source, const asyncfem::MeshReadReport& report,
+                        double angleThreshold) {
   nlohmann::json j;
   j["file"] = source;
   j["format"] = report.format;
@@ -55,10 +58,12 @@ nlohmann::json describe(const TetMesh& mesh, const std::string& source, const as
   const asyncfem::BoundingBox box = asyncfem::boundingBox(mesh);
   j["boundingBox"] = {{"min", {box.min.x(), box.min.y(), box.min.z()}},
                       {"max", {box.max.x(), box.max.y(), box.max.z()}}};
-  const asyncfem::QualitySummary q = asyncfem::summarizeQuality(mesh);
-  j["quality"] = {{"minDihedralAngleDegrees",
-                   {{"min", q.minDihedralDegrees}, {"mean", q.meanDihedralDegrees}, {"max", q.maxDihedralDegrees}}},
-                  {"worstAspectRatio", q.worstAspectRatio}};
+  const asyncfem::QualitySummary q = asyncfem::summarizeQuality(mesh, angleThreshold);
+  j["quality"] = {
+      {"dihedralAngleDegrees", {{"min", q.minDihedralDegrees}, {"max", q.maxDihedralDegrees}}},
+      {"meanElementMinDihedralAngleDegrees", q.meanMinDihedralDegrees},
+      {"elementsBelowAngle", {{"thresholdDegrees", q.thresholdDegrees}, {"count", q.elementsBelowThreshold}}},
+      {"worstAspectRatio", q.worstAspectRatio}};
   j["reorientedElements"] = report.reorientedElements;
   j["unusedVertices"] = report.unusedVertices;
   j["ignoredElements"] = report.ignoredElements;
@@ -86,10 +91,14 @@ void printText(const nlohmann::json& j) {
             << "boundary triangles: " << j["boundaryTriangles"] << '\n'
             << "bounding box: [" << box["min"][0] << ", " << box["min"][1] << ", " << box["min"][2] << "] - ["
             << box["max"][0] << ", " << box["max"][1] << ", " << box["max"][2] << "]\n";
-  const auto& dihedral = j["quality"]["minDihedralAngleDegrees"];
-  std::cout << "min dihedral angle (degrees): min " << dihedral["min"] << ", mean " << dihedral["mean"] << ", max "
-            << dihedral["max"] << '\n'
-            << "worst aspect ratio: " << j["quality"]["worstAspectRatio"] << '\n'
+  const auto& quality = j["quality"];
+  const auto& below = quality["elementsBelowAngle"];
+  std::cout << "dihedral angles (degrees): min " << quality["dihedralAngleDegrees"]["min"] << ", max "
+            << quality["dihedralAngleDegrees"]["max"] << " (mean of each element's smallest "
+            << quality["meanElementMinDihedralAngleDegrees"] << ")\n"
+            << "elements with a dihedral angle below " << below["thresholdDegrees"] << " degrees: " << below["count"]
+            << '\n'
+            << "worst aspect ratio: " << quality["worstAspectRatio"] << '\n'
             << "reoriented elements: " << j["reorientedElements"] << '\n';
 }
 
@@ -101,6 +110,9 @@ struct Options {
   int cells = 0;
   std::vector<int> blockCells;
   bool json = false;
+  std::vector<std::string> renames;     ///< OLD=NEW
+  double angleThreshold = 10.0;         ///< degrees
+  std::vector<double> defaultMaterial;  ///< rho, E, nu
 };
 
 void addOptions(CLI::App& app, Options& options) {
@@ -120,6 +132,26 @@ void addOptions(CLI::App& app, Options& options) {
       ->check(asyncfem::cli::inRange(1, 1000));
   app.add_flag("--json", options.json, "print a JSON object instead of text");
   app.add_option("--write", options.output, "also write the mesh to OUT.veg or OUT.vtu");
+  app.add_option("--rename-set", options.renames,
+                 "rename a set before writing, OLD=NEW (repeatable); .veg names cannot hold spaces, commas or '#'");
+  app.add_option("--angle-threshold", options.angleThreshold,
+                 "count the elements with a dihedral angle below this many degrees")
+      ->check(asyncfem::cli::inRange(0.0, 180.0))
+      ->capture_default_str();
+  app.add_option("--default-material", options.defaultMaterial,
+                 "material rho,E,nu of the elements the file gives none (TetGen, Gmsh; .veg elements outside every "
+                 "*REGION), instead of the default density 1000, E 1e6, nu 0.45")
+      ->delimiter(',')
+      ->expected(3);
+}
+
+/// The two names of a --rename-set OLD=NEW.
+std::pair<std::string, std::string> splitRename(const std::string& rename) {
+  const std::size_t equals = rename.find('=');
+  if (equals == std::string::npos || equals == 0 || equals + 1 == rename.size()) {
+    throw asyncfem::cli::UsageError("--rename-set '" + rename + "': expected OLD=NEW");
+  }
+  return {rename.substr(0, equals), rename.substr(equals + 1)};
 }
 
 /// Checked before any work, so a typo does not cost a mesh generation or read.
@@ -134,6 +166,9 @@ void checkOptions(const Options& options) {
   if (options.cells != 0 && options.generate.empty()) throw asyncfem::Error("--cells only applies to --generate");
   if (!options.blockCells.empty() && options.generate != "antenna")
     throw asyncfem::Error("--block-cells only applies to --generate antenna");
+  for (const std::string& rename : options.renames) (void)splitRename(rename);
+  if (!options.defaultMaterial.empty() && !options.generate.empty())
+    throw asyncfem::Error("--default-material only applies to a mesh file");
 }
 
 /// The mesh --generate names, with its description in source.
@@ -181,11 +216,20 @@ int run(int argc, char** argv) {
     report.format = "generated";
     mesh = generateMesh(options, source);
   } else {
-    mesh = asyncfem::readMesh(options.input, {}, &report);
+    asyncfem::MeshReadOptions readOptions;
+    if (!options.defaultMaterial.empty()) {
+      readOptions.defaultMaterial = asyncfem::Material{"default", options.defaultMaterial[0],
+                                                       options.defaultMaterial[1], options.defaultMaterial[2]};
+    }
+    mesh = asyncfem::readMesh(options.input, readOptions, &report);
+  }
+  for (const std::string& rename : options.renames) {
+    const auto [from, to] = splitRename(rename);
+    mesh.renameSet(from, to);
   }
   for (const std::string& warning : report.warnings) std::cerr << "meshInfo: warning: " << warning << '\n';
 
-  const nlohmann::json description = describe(mesh, source, report);
+  const nlohmann::json description = describe(mesh, source, report, options.angleThreshold);
   if (options.json) {
     std::cout << description.dump(2) << '\n';
   } else {

@@ -190,6 +190,13 @@ void applyOverrides(const CommandLine& options, asyncfem::Scene& scene) {
   asyncfem::overrideFrameTiming(scene, {options.timestep, options.stepsPerFrame, options.frames});
   if (options.vtuFolder) {
     scene.output.vtuFolder = *options.vtuFolder;
+  } else if (options.output && !scene.output.vtuFolder.empty()) {
+    // The scene's .vtu series follows --output (OUT.afsim -> OUT_vtu/), so that two runs
+    // of one scene with different outputs do not write one series over the other.
+    fs::path folder = *options.output;
+    folder.replace_extension();
+    folder += "_vtu";
+    scene.output.vtuFolder = folder;
   }
   if (scene.output.file.empty()) {
     throw asyncfem::Error("no output file: set output.file in " + scene.sourceName + " or pass --output FILE");
@@ -406,9 +413,13 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   setupWatch.start();
   asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
   const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
-  const std::shared_ptr<const asyncfem::Problem> problem = asyncfem::buildProblem(scene);
+  std::vector<std::string> warnings;
+  const std::shared_ptr<const asyncfem::Problem> problem = asyncfem::buildProblem(scene, &warnings);
   asyncfem::PetscSimulation simulation(problem->mesh(), petscSettings(options, scene, *problem));
   const bool root = simulation.rank() == 0;
+  if (root) {
+    for (const std::string& warning : warnings) std::cerr << "offlineSimulator: warning: " << warning << "\n";
+  }
   std::unique_ptr<asyncfem::SimulationWriter> writer;
   if (root) {
     createOutputFolder(scene.output.file);

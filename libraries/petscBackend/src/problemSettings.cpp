@@ -38,7 +38,7 @@ PetscSimulationSettings petscSettingsForProblem(const Problem& problem, const st
   settings.timestep = timestep;
   settings.rayleighMass = physics.rayleighAlpha;
   settings.rayleighStiffness = physics.rayleighBeta;
-  settings.fixedVertices = problem.fixedVertices();
+  settings.fixedVertices = problem.heldVertices();
   settings.gravity = physics.gravity;
   // The windowed loads through Loads::addTo (gravity is the backend's own, settings.gravity).
   auto timeLoads = std::make_shared<Loads>();

@@ -5,6 +5,8 @@
 #include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <asyncfem/problem/problem.hpp>
+#include <asyncfem/volumetricMesh/queries.hpp>
+#include <iterator>
 
 namespace asyncfem {
 
@@ -28,6 +30,11 @@ Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVert
   if (!fixedVertices_.empty() && static_cast<int>(fixedVertices_.size()) == n) {
     throw ValidationError("problem: every vertex is fixed: nothing would move");
   }
+  unusedVertices_ = asyncfem::unusedVertices(*mesh_);
+  const std::vector<int> held = heldVertices();
+  if (static_cast<int>(held.size()) == n && n > 0) {
+    throw ValidationError("problem: every vertex is fixed or in no element: nothing would move");
+  }
   for (const VertexLoad& load : windows_) {
     for (const int v : load.vertices) {
       if (v < 0 || v >= n) {
@@ -36,7 +43,15 @@ Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVert
       }
     }
   }
-  freeDofs_ = FreeDofs::fromFixedVertices(n, fixedVertices_);
+  freeDofs_ = FreeDofs::fromFixedVertices(n, held);
+}
+
+std::vector<int> Problem::heldVertices() const {
+  std::vector<int> held;
+  held.reserve(fixedVertices_.size() + unusedVertices_.size());
+  std::set_union(fixedVertices_.begin(), fixedVertices_.end(), unusedVertices_.begin(), unusedVertices_.end(),
+                 std::back_inserter(held));
+  return held;
 }
 
 const std::shared_ptr<const MatrixAssembler>& Problem::assembler() const {
@@ -152,6 +167,10 @@ std::vector<std::string> Problem::skipped() const {
   }
   if (settings_.gravity.isZero(0.0)) skipped.emplace_back("gravity load (gravity is zero)");
   if (!contact_) skipped.emplace_back("contact (no obstacles)");
+  if (!unusedVertices_.empty()) {
+    skipped.push_back("free DOFs of " + std::to_string(unusedVertices_.size()) +
+                      " vertex(es) that no element uses (held at rest)");
+  }
   if (settings_.gravity.isZero(0.0) && windows_.empty() && !contact_) {
     skipped.emplace_back("external force evaluation (no gravity, no loads)");
   }

@@ -93,16 +93,21 @@ Camera fitCamera(const BoundingBox& box, double aspect, const Eigen::Vector3d& v
   return camera;
 }
 
-GroundPlane groundBelow(const BoundingBox& box, const Eigen::Vector3d& up) {
+GroundPlane groundAt(const BoundingBox& box, const Eigen::Vector3d& up, double height) {
   const double diagonal = std::max((box.max - box.min).norm(), 1e-12);
   const Eigen::Vector3d center = 0.5 * (box.min + box.max);
+  const Eigen::Vector3d n = up.normalized();
+  return GroundPlane{center + ((height - n.dot(center)) * n), 4.0 * diagonal, roundLength(diagonal / 6.0), true};
+}
+
+GroundPlane groundBelow(const BoundingBox& box, const Eigen::Vector3d& up) {
+  const double diagonal = std::max((box.max - box.min).norm(), 1e-12);
   const Eigen::Vector3d n = up.normalized();
   double lowest = std::numeric_limits<double>::infinity();
   for (int corner = 0; corner < 8; ++corner) {
     lowest = std::min(lowest, n.dot(boxCorner(box, corner)));
   }
-  return GroundPlane{center + ((lowest - n.dot(center) - (0.02 * diagonal)) * n), 4.0 * diagonal,
-                     roundLength(diagonal / 6.0), true};
+  return groundAt(box, up, lowest - (0.02 * diagonal));
 }
 
 }  // namespace asyncfem

@@ -325,6 +325,9 @@ void parseIntegrator(JsonObjectReader& top, Scene& scene) {
   }
   const bool hasTimestep = reader.has("timestep");
   if (hasTimestep == reader.has("stepsPerFrame")) {
+    // A misspelt key ("timestpe") is the likelier mistake: name it first.
+    (void)reader.find("options");
+    reader.finish();
     JsonObjectReader::failAt(scene.sourceName, "integrator",
                              "give either \"timestep\" or \"stepsPerFrame\" (steps per frame of 1 / frames.rate)");
   }
@@ -377,6 +380,7 @@ void parseContactPlanes(JsonObjectReader& reader, const std::string& source, Sce
     plane.offset = groundReader.number("height", 0.0);
     groundReader.finish();
     out.planes.push_back(plane);
+    out.ground = plane;
   }
   const json* planes = reader.find("planes");
   if (planes == nullptr) return;
@@ -669,11 +673,20 @@ Scene loadScene(const std::filesystem::path& path) {
   std::string extension = path.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  for (const char* meshExtension : {".veg", ".node", ".ele", ".msh", ".vtu", ".obj", ".stl", ".off", ".ply"}) {
+  for (const char* meshExtension : {".veg", ".node", ".ele", ".msh", ".vtu"}) {
     if (extension == meshExtension) {
       throw Error(name +
                   ": is a mesh file, not a scene (scenes are JSON; see docs/scene-format.md); to look at a mesh use "
                   "meshInfo");
+    }
+  }
+  for (const char* surfaceExtension : {".obj", ".stl", ".off", ".ply", ".gltf", ".glb"}) {
+    if (extension == surfaceExtension) {
+      throw Error(name +
+                  ": is a surface mesh, not a scene (scenes are JSON; see docs/scene-format.md); make a tetrahedral "
+                  "mesh of it with tetMesher (tetMesher " +
+                  name + " --output " + path.stem().string() +
+                  ".veg; docs/tet-mesher.md) and name that in a scene's mesh.file");
     }
   }
   std::ifstream in(path, std::ios::binary);

@@ -28,7 +28,7 @@ std::vector<std::string> switchIntegrator(Scene& scene, const IntegratorRegistry
 
 namespace {
 
-TetMesh loadMesh(const Scene& scene) {
+TetMesh loadMesh(const Scene& scene, std::vector<std::string>* warnings) {
   switch (scene.mesh.source) {
     case Scene::MeshSource::beam:
       return makeBeamMesh(scene.mesh.beam);
@@ -37,8 +37,14 @@ TetMesh loadMesh(const Scene& scene) {
     case Scene::MeshSource::file:
       break;
   }
+  std::vector<std::string> readerWarnings;
   try {
-    return readMesh(scene.mesh.file);
+    TetMesh mesh = readMeshCollectingWarnings(scene.mesh.file, readerWarnings);
+    if (warnings != nullptr) {
+      for (const std::string& warning : readerWarnings)
+        warnings->push_back(scene.sourceName + ": mesh.file: " + warning);
+    }
+    return mesh;
   } catch (const Error& error) {
     throw ValidationError(scene.sourceName + ": mesh.file: " + error.what());
   }
@@ -151,6 +157,12 @@ std::vector<int> collectFixedVertices(const Scene& scene, const TetMesh& mesh) {
   if (!fixed.empty() && static_cast<int>(fixed.size()) == mesh.numVertices()) {
     throwSceneError(scene, "fixed", "every vertex is fixed: nothing would move");
   }
+  std::vector<int> held = unusedVertices(mesh);
+  held.insert(held.end(), fixed.begin(), fixed.end());
+  std::sort(held.begin(), held.end());
+  if (std::unique(held.begin(), held.end()) - held.begin() == mesh.numVertices()) {
+    throwSceneError(scene, "fixed", "every vertex is fixed or in no element: nothing would move");
+  }
   return fixed;
 }
 
@@ -260,10 +272,12 @@ std::vector<std::string> contactStepWarnings(const Scene& scene, const TetMesh& 
 
 }  // namespace
 
-TetMesh buildSceneMesh(const Scene& scene) { return applyMaterialOverrides(scene, loadMesh(scene)); }
+TetMesh buildSceneMesh(const Scene& scene, std::vector<std::string>* warnings) {
+  return applyMaterialOverrides(scene, loadMesh(scene, warnings));
+}
 
-std::shared_ptr<const Problem> buildProblem(const Scene& scene) {
-  auto mesh = std::make_shared<const TetMesh>(buildSceneMesh(scene));
+std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std::string>* warnings) {
+  auto mesh = std::make_shared<const TetMesh>(buildSceneMesh(scene, warnings));
   std::vector<int> fixed = collectFixedVertices(scene, *mesh);
   std::vector<VertexLoad> loads = collectLoads(scene, *mesh, frameTimingOf(scene).timestep);
   ProblemSettings settings;
@@ -282,7 +296,8 @@ std::shared_ptr<const Problem> buildProblem(const Scene& scene) {
   return std::make_shared<const Problem>(mesh, std::move(fixed), settings, std::move(loads), std::move(contact));
 }
 
-std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& header, const std::string& fileName) {
+std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& header, const std::string& fileName,
+                                                    std::vector<std::string>* warnings) {
   if (header.scenePath.empty()) {
     throw Error(fileName +
                 " does not record its scene (written before format version 2, or by a program that gave none): "
@@ -290,7 +305,7 @@ std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& 
   }
   std::shared_ptr<const Problem> problem;
   try {
-    problem = buildProblem(loadScene(header.scenePath));
+    problem = buildProblem(loadScene(header.scenePath), warnings);
   } catch (const Error& error) {
     throw Error(fileName + " was written from the scene " + header.scenePath +
                 ", which cannot be used now: " + error.what() + " (give --scene or --mesh)");
@@ -330,10 +345,35 @@ void noteSkippedAndWarnings(const Scene& scene, Simulation& simulation) {
   const Problem& problem = *simulation.problem;
   simulation.skipped = problem.skipped();
   if (simulation.contact) {
-    simulation.warnings = contactStepWarnings(scene, problem.mesh(), problem.massMatrix(), simulation.timing.timestep);
+    for (std::string& warning :
+         contactStepWarnings(scene, problem.mesh(), problem.massMatrix(), simulation.timing.timestep)) {
+      simulation.warnings.push_back(std::move(warning));
+    }
   }
   if (scene.output.vtuFolder.empty()) simulation.skipped.emplace_back("vtu output (output.vtu not set)");
   if (!scene.output.velocities) simulation.skipped.emplace_back("velocity output (output.velocities = false)");
+}
+
+// A timestep above an explicit integrator's stable limit: the integrator names the limit,
+// which may not divide the frame interval, so the scene's advice is the steps per frame
+// that do give a stable step. The limit comes from the same integrator built with the
+// option force (its stableTimestepEstimate()); "" when that cannot be had.
+std::string stableStepsPerFrameAdvice(const Scene& scene, const IntegratorRegistry& registry,
+                                      const IntegratorContext& context, const FrameTiming& timing) {
+  nlohmann::json options = scene.integrator.options;
+  options["force"] = true;
+  double limit = 0.0;
+  try {
+    limit = registry.create(scene.integrator.name, context, options)->stableTimestepEstimate();
+  } catch (const Error&) {
+    return "";
+  }
+  if (!(limit > 0.0) || !std::isfinite(limit) || !(timing.frameInterval > 0.0)) return "";
+  auto steps = static_cast<long long>(std::ceil(timing.frameInterval / limit));
+  while (timing.frameInterval / static_cast<double>(steps) > limit) ++steps;
+  return "; at frames.rate " + formatNumber(timing.frameRate) + " the stable steps per frame are " +
+         std::to_string(steps) + " or more (integrator.stepsPerFrame: " + std::to_string(steps) +
+         " gives a timestep of " + formatNumber(timing.frameInterval / static_cast<double>(steps)) + ")";
 }
 
 }  // namespace
@@ -347,7 +387,7 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
   simulation.frameInterval = simulation.timing.frameInterval;
   simulation.numFrames = simulation.timing.frameCount;
 
-  simulation.problem = buildProblem(scene);
+  simulation.problem = buildProblem(scene, &simulation.warnings);
   const Problem& problem = *simulation.problem;
   simulation.mesh = problem.sharedMesh();
   simulation.fixedVertices = problem.fixedVertices();
@@ -357,7 +397,11 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
   IntegratorContext context = integratorContext(scene, simulation.timing);
   context.mesh = problem.sharedMesh();
   context.system = problem.dynamicSystem();
-  simulation.integrator = registry.create(scene.integrator.name, std::move(context), scene.integrator.options);
+  try {
+    simulation.integrator = registry.create(scene.integrator.name, context, scene.integrator.options);
+  } catch (const TimestepError& error) {
+    throw TimestepError(error.what() + stableStepsPerFrameAdvice(scene, registry, context, simulation.timing));
+  }
   simulation.monitor.emplace(problem);
   for (const std::string& item : simulation.monitor->skipped()) simulation.skipped.push_back(item);
   return simulation;

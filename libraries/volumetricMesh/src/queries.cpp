@@ -159,20 +159,22 @@ std::vector<ElementQuality> elementQualities(const TetMesh& mesh) {
   return qualities;
 }
 
-QualitySummary summarizeQuality(const TetMesh& mesh) {
+QualitySummary summarizeQuality(const TetMesh& mesh, double thresholdDegrees) {
   QualitySummary s;
+  s.thresholdDegrees = thresholdDegrees;
   if (mesh.numElements() == 0) return s;
   const double toDegrees = 180.0 / std::numbers::pi;
   s.minDihedralDegrees = std::numeric_limits<double>::infinity();
   double sum = 0.0;
   for (const ElementQuality& q : elementQualities(mesh)) {
-    const double angle = q.minDihedralAngle * toDegrees;
-    s.minDihedralDegrees = std::min(s.minDihedralDegrees, angle);
-    s.maxDihedralDegrees = std::max(s.maxDihedralDegrees, angle);
-    sum += angle;
+    const double smallest = q.minDihedralAngle * toDegrees;
+    s.minDihedralDegrees = std::min(s.minDihedralDegrees, smallest);
+    s.maxDihedralDegrees = std::max(s.maxDihedralDegrees, q.maxDihedralAngle * toDegrees);
+    sum += smallest;
+    if (smallest < thresholdDegrees) ++s.elementsBelowThreshold;
     s.worstAspectRatio = std::max(s.worstAspectRatio, q.aspectRatio);
   }
-  s.meanDihedralDegrees = sum / mesh.numElements();
+  s.meanMinDihedralDegrees = sum / mesh.numElements();
   return s;
 }
 

@@ -22,8 +22,29 @@ TetMesh readMesh(const std::filesystem::path& path, const MeshReadOptions& optio
   node += ".node";
   std::error_code ignored;
   if (std::filesystem::is_regular_file(node, ignored)) return readTetGen(node, options, report);
-  throw Error("cannot read mesh '" + path.string() + "': unknown extension '" + extension +
-              "' (expected .veg, .node, .ele or .msh, or the base name of a TetGen .node/.ele pair)");
+  const std::string expected = "a .veg, .node, .ele or .msh file, or the base name of a TetGen .node/.ele pair";
+  for (const char* surface : {".off", ".stl", ".obj", ".ply", ".gltf", ".glb", ".fbx", ".dae", ".3ds"}) {
+    if (detail::equalsIgnoreCase(extension, surface)) {
+      throw Error("cannot read mesh '" + path.string() + "': " + extension +
+                  " is a surface format, and a simulation needs a tetrahedral mesh: make one with tetMesher (" +
+                  "tetMesher " + path.string() + " --output " + path.stem().string() +
+                  ".veg; docs/tet-mesher.md), then give " + expected);
+    }
+  }
+  if (extension.empty()) {
+    throw Error("cannot read mesh '" + path.string() + "': there is no TetGen pair '" + node.string() + "' + '" +
+                path.string() + ".ele' (a name without an extension is taken as a TetGen base name); give " + expected);
+  }
+  throw Error("cannot read mesh '" + path.string() + "': unknown extension '" + extension + "' (expected " + expected +
+              ")");
+}
+
+TetMesh readMeshCollectingWarnings(const std::filesystem::path& path, std::vector<std::string>& warnings,
+                                   const MeshReadOptions& options) {
+  MeshReadReport report;
+  TetMesh mesh = readMesh(path, options, &report);
+  for (const std::string& warning : report.warnings) warnings.push_back(path.string() + ": " + warning);
+  return mesh;
 }
 
 std::vector<int> readBou(const std::filesystem::path& path, int numVertices) {

@@ -138,6 +138,25 @@ std::vector<int> TetMesh::setVertices(const std::string& name) const {
                         "; element sets: " + list(elementSets_) + ")");
 }
 
+void TetMesh::renameSet(const std::string& from, const std::string& to) {
+  if (to.empty()) throw ValidationError("renaming set '" + from + "': the new name is empty");
+  const bool element = elementSets_.count(from) > 0;
+  const bool vertex = vertexSets_.count(from) > 0;
+  if (!element && !vertex) (void)setVertices(from);  // throws, naming the known sets
+  if (from == to) return;
+  for (auto* sets : {element ? &elementSets_ : nullptr, vertex ? &vertexSets_ : nullptr}) {
+    if (sets != nullptr && sets->count(to) > 0) {
+      throw ValidationError("renaming set '" + from + "' to '" + to + "': a set called '" + to + "' exists");
+    }
+  }
+  for (auto* sets : {element ? &elementSets_ : nullptr, vertex ? &vertexSets_ : nullptr}) {
+    if (sets == nullptr) continue;
+    auto node = sets->extract(from);
+    node.key() = to;
+    sets->insert(std::move(node));
+  }
+}
+
 void TetMesh::setElementSet(const std::string& name, std::vector<int> elements) {
   if (name.empty()) throw ValidationError("element set with an empty name");
   for (int e : elements) {

@@ -22,7 +22,10 @@ void appendSetVertices(const TetMesh& mesh, const std::vector<std::string>& sets
     if (!mesh.vertexSets().count(name) && !mesh.elementSets().count(name)) {
       throw SelectionError("sets", static_cast<int>(i),
                            "unknown set \"" + name + "\" (vertex sets: " + setNames(mesh.vertexSets()) +
-                               "; element sets: " + setNames(mesh.elementSets()) + ")");
+                               "; element sets: " + setNames(mesh.elementSets()) +
+                               "); vertex sets come from Gmsh physical surfaces, curves and points, TetGen .face "
+                               "markers (marker_<k>) and .veg *VERTEXSET, element sets from Gmsh physical volumes, "
+                               "TetGen regions and .veg *SET (docs/file-formats.md)");
     }
     const std::vector<int> members = mesh.setVertices(name);
     if (members.empty()) throw SelectionError("sets", static_cast<int>(i), "set \"" + name + "\" is empty");

@@ -51,9 +51,12 @@ void writeAtomically(const std::filesystem::path& path, const std::string& text)
 void checkVegName(const std::string& name, const std::string& what) {
   bool ok = !name.empty() && name.front() != '*';
   for (char c : name) ok = ok && c != ',' && c != '#' && c != ' ' && c != '\t' && c != '\n' && c != '\r';
-  if (!ok)
+  if (!ok) {
+    // Sets come from other formats (Gmsh group names may have spaces); meshInfo renames them.
+    const std::string hint = what == "material" ? "" : "; rename it with meshInfo --rename-set '" + name + "=NEW'";
     throw ValidationError("writeVeg: " + what + " name '" + name +
-                          "' cannot be written to .veg (it must be one token without spaces, commas or '#')");
+                          "' cannot be written to .veg (it must be one token without spaces, commas or '#')" + hint);
+  }
 }
 
 void writeIdList(std::ostringstream& out, const std::vector<int>& ids) {

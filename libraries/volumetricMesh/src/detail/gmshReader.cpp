@@ -8,6 +8,7 @@
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "detail/rawMesh.hpp"
@@ -26,6 +27,44 @@ constexpr long long kQuadraticTet = 11;  // 10-node tetrahedron
 // them linear in the file size.
 constexpr std::size_t kMaxPhysicalTagsPerEntity = 64;
 
+/// The dimension of a Gmsh element type: 0 for the point, 1 for lines, 2 for triangles
+/// and quadrangles (of any order), 3 for the rest (volumes).
+int elementTypeDimension(long long type) {
+  switch (type) {
+    case 15:
+      return 0;
+    case 1:
+    case 8:
+    case 26:
+    case 27:
+    case 28:
+      return 1;
+    case 2:
+    case 3:
+    case 9:
+    case 10:
+    case 16:
+    case 20:
+    case 21:
+    case 22:
+    case 23:
+    case 24:
+    case 25:
+      return 2;
+    default:
+      return 3;
+  }
+}
+
+/// A physical group of Gmsh: its dimension and tag (tags are per dimension).
+using PhysicalGroup = std::pair<long long, long long>;
+
+/// The name of a physical group without a $PhysicalNames entry.
+std::string unnamedGroup(const PhysicalGroup& group) {
+  static const char* const kinds[] = {"physical_point_", "physical_curve_", "physical_surface_", "physical_"};
+  return kinds[group.first] + std::to_string(group.second);
+}
+
 class GmshParser {
  public:
   explicit GmshParser(const detail::FlatText& flat) : cursor_(flat, false) {}
@@ -41,9 +80,11 @@ class GmshParser {
     readSections();
     reportIgnoredElements(report);
     for (const auto& [tag, members] : physicalElements_) {
-      auto it = physicalNames_.find(tag);
-      const std::string name = it != physicalNames_.end() ? it->second : "physical_" + std::to_string(tag);
-      auto& set = raw_.elementSets[name];
+      auto& set = raw_.elementSets[groupName({3, tag})];
+      set.insert(set.end(), members.begin(), members.end());
+    }
+    for (const auto& [group, members] : physicalVertices_) {
+      auto& set = raw_.vertexSets[groupName(group)];
       set.insert(set.end(), members.begin(), members.end());
     }
     return detail::finishMesh(std::move(raw_), cursor_, options, report, detail::MissingMaterialPolicy::FormatDefault);
@@ -97,6 +138,12 @@ class GmshParser {
     if (raw_.elements.empty() && ignoredByType_.count(kQuadraticTet)) {
       cursor_.failAtEnd("only 10-node tetrahedra (type 11) found: export a first-order mesh (Mesh.ElementOrder = 1)");
     }
+  }
+
+  /// The set name of a physical group: its $PhysicalNames name, or unnamedGroup().
+  std::string groupName(const PhysicalGroup& group) const {
+    auto it = physicalNames_.find(group);
+    return it != physicalNames_.end() ? it->second : unnamedGroup(group);
   }
 
   std::vector<std::string_view> nextRecord(const std::string& what) {
@@ -158,7 +205,8 @@ class GmshParser {
       rest = detail::trim(rest);
       if (rest.size() >= 2 && rest.front() == '"' && rest.back() == '"') rest = rest.substr(1, rest.size() - 2);
       if (rest.empty()) cursor_.fail("physical group " + std::to_string(tag) + " has an empty name");
-      if (dim == 3) physicalNames_[tag] = std::string(rest);
+      if (dim < 0 || dim > 3) cursor_.fail("physical name dimension must be 0..3, got " + std::to_string(dim));
+      physicalNames_[{dim, tag}] = std::string(rest);
     }
     expectEnd("PhysicalNames", "$PhysicalNames has more lines than its count " + std::to_string(count));
   }
@@ -174,31 +222,58 @@ class GmshParser {
       lower += counts[i];
     }
     cursor_.checkCountFits(lower, 7, "entities");
-    for (long long i = 0; i < counts[0] + counts[1] + counts[2]; ++i) nextRecord("an entity line");
-    for (long long i = 0; i < counts[3]; ++i) {
-      const auto tokens = nextRecord("a volume entity line");
-      if (tokens.size() < 8)
-        cursor_.fail("volume entity line needs 'tag minX minY minZ maxX maxY maxZ numPhysicalTags ...'");
-      const long long tag = detail::integerAt(cursor_, tokens[0], "volume entity tag");
-      for (std::size_t c = 1; c < 7; ++c) detail::doubleAt(cursor_, tokens[c], "volume entity bounding box");
-      const long long numPhysicals = detail::integerAt(cursor_, tokens[7], "volume entity physical tag count");
-      if (numPhysicals < 0 || static_cast<std::size_t>(numPhysicals) > tokens.size() - 8) {
-        cursor_.fail("volume entity " + std::to_string(tag) + " claims " + std::to_string(numPhysicals) +
-                     " physical tags but the line has fewer");
-      }
-      auto& physicals = volumePhysicals_[tag];
-      for (std::size_t p = 0; p < static_cast<std::size_t>(numPhysicals); ++p) {
-        physicals.push_back(detail::integerAt(cursor_, tokens[8 + p], "physical tag"));
-      }
-      // A tag listed twice (or an entity listed twice) adds nothing.
-      std::sort(physicals.begin(), physicals.end());
-      physicals.erase(std::unique(physicals.begin(), physicals.end()), physicals.end());
-      if (physicals.size() > kMaxPhysicalTagsPerEntity) {
-        cursor_.fail("volume entity " + std::to_string(tag) + " is in " + std::to_string(physicals.size()) +
-                     " physical groups; at most " + std::to_string(kMaxPhysicalTagsPerEntity) + " are supported");
-      }
+    for (long long dim = 0; dim < 4; ++dim) {
+      for (long long i = 0; i < counts[dim]; ++i) readEntity(dim);
     }
     expectEnd("Entities", "$Entities has more lines than its counts");
+  }
+
+  /// One entity line of $Entities: a point is 'tag x y z numPhysicalTags tags...', a curve,
+  /// surface or volume 'tag minX minY minZ maxX maxY maxZ numPhysicalTags tags... (bounding
+  /// entities)'. Keeps the entity's physical tags.
+  void readEntity(long long dim) {
+    static const char* const kinds[] = {"point", "curve", "surface", "volume"};
+    const std::string kind = std::string(kinds[dim]) + " entity";
+    const std::size_t coordinates = dim == 0 ? 3 : 6;
+    const auto tokens = nextRecord("a " + kind + " line");
+    if (tokens.size() < coordinates + 2) {
+      cursor_.fail(kind + " line needs 'tag " + (dim == 0 ? "x y z" : "minX minY minZ maxX maxY maxZ") +
+                   " numPhysicalTags ...'");
+    }
+    const long long tag = detail::integerAt(cursor_, tokens[0], kind + " tag");
+    for (std::size_t c = 1; c <= coordinates; ++c) detail::doubleAt(cursor_, tokens[c], kind + " coordinates");
+    const std::size_t first = coordinates + 2;
+    const long long numPhysicals = detail::integerAt(cursor_, tokens[first - 1], kind + " physical tag count");
+    if (numPhysicals < 0 || static_cast<std::size_t>(numPhysicals) > tokens.size() - first) {
+      cursor_.fail(kind + " " + std::to_string(tag) + " claims " + std::to_string(numPhysicals) +
+                   " physical tags but the line has fewer");
+    }
+    auto& physicals = entityPhysicals_[{dim, tag}];
+    for (std::size_t p = 0; p < static_cast<std::size_t>(numPhysicals); ++p) {
+      physicals.push_back(detail::integerAt(cursor_, tokens[first + p], "physical tag"));
+    }
+    // A tag listed twice (or an entity listed twice) adds nothing.
+    std::sort(physicals.begin(), physicals.end());
+    physicals.erase(std::unique(physicals.begin(), physicals.end()), physicals.end());
+    if (physicals.size() > kMaxPhysicalTagsPerEntity) {
+      cursor_.fail(kind + " " + std::to_string(tag) + " is in " + std::to_string(physicals.size()) +
+                   " physical groups; at most " + std::to_string(kMaxPhysicalTagsPerEntity) + " are supported");
+    }
+  }
+
+  /// Adds the nodes of an element of dimension dim < 3 to the vertex sets of its physical
+  /// groups (Gmsh physical surfaces, curves and points name boundary vertices).
+  void addGroupNodes(long long dim, const std::vector<long long>& physicals, const std::string_view* nodeTokens,
+                     std::size_t numNodes, long long elementTag) {
+    for (std::size_t a = 0; a < numNodes; ++a) {
+      const long long nodeTag = detail::integerAt(cursor_, nodeTokens[a], "element node");
+      auto it = nodeIndex_.find(nodeTag);
+      if (it == nodeIndex_.end()) {
+        cursor_.fail("element " + std::to_string(elementTag) + " references node " + std::to_string(nodeTag) +
+                     ", which $Nodes does not define");
+      }
+      for (long long p : physicals) physicalVertices_[{dim, p}].push_back(it->second);
+    }
   }
 
   void addNode(long long tag, const std::string_view* coordinates) {
@@ -337,6 +412,13 @@ class GmshParser {
       }
       if (type != kTetrahedron) {
         ignore(type);
+        const long long dim = elementTypeDimension(type);
+        if (numTags >= 1 && dim < 3) {
+          const long long physical =
+              detail::integerAt(cursor_, tokens[3], "element " + std::to_string(tag) + " physical tag");
+          const std::size_t nodesAt = 3 + static_cast<std::size_t>(numTags);
+          if (physical != 0) addGroupNodes(dim, {physical}, &tokens[nodesAt], tokens.size() - nodesAt, tag);
+        }
         continue;
       }
       const std::size_t expected = 3 + static_cast<std::size_t>(numTags) + 4;
@@ -388,20 +470,22 @@ class GmshParser {
     if (read + inBlock > count)
       cursor_.failAt(headerAt, "$Elements says " + std::to_string(count) + " elements, but its blocks hold more");
     const std::vector<long long>* physicals = nullptr;
-    if (dim == 3) {
-      if (auto it = volumePhysicals_.find(entity); it != volumePhysicals_.end()) physicals = &it->second;
-    }
+    if (auto it = entityPhysicals_.find({dim, entity}); it != entityPhysicals_.end()) physicals = &it->second;
     for (long long i = 0; i < inBlock; ++i) {
       const auto tokens = nextRecord("an element line");
       if (type != kTetrahedron) {
         ignore(type);
+        if (physicals && dim >= 0 && dim < 3 && tokens.size() > 1) {
+          const long long tag = detail::integerAt(cursor_, tokens[0], "element tag");
+          addGroupNodes(dim, *physicals, &tokens[1], tokens.size() - 1, tag);
+        }
         continue;
       }
       if (tokens.size() != 5)
         cursor_.fail("4-node tetrahedron line needs 'tag n1 n2 n3 n4', got " + std::to_string(tokens.size()) +
                      " fields");
       addTet(detail::integerAt(cursor_, tokens[0], "element tag"), &tokens[1]);
-      if (physicals) {
+      if (physicals && dim == 3) {
         for (long long p : *physicals) physicalElements_[p].push_back(static_cast<int>(raw_.elements.size()) - 1);
       }
     }
@@ -413,9 +497,10 @@ class GmshParser {
   bool version41_ = false;
   std::unordered_map<long long, int> nodeIndex_;
   std::unordered_set<long long> elementTags_;
-  std::map<long long, std::string> physicalNames_;
-  std::map<long long, std::vector<long long>> volumePhysicals_;
-  std::map<long long, std::vector<int>> physicalElements_;
+  std::map<PhysicalGroup, std::string> physicalNames_;
+  std::map<PhysicalGroup, std::vector<long long>> entityPhysicals_;  ///< (dim, entity tag) -> physical tags
+  std::map<long long, std::vector<int>> physicalElements_;           ///< volume group tag -> elements
+  std::map<PhysicalGroup, std::vector<int>> physicalVertices_;       ///< lower-dimensional group -> nodes
   std::map<long long, long long> ignoredByType_;
   int ignoredTotal_ = 0;
 };

@@ -57,7 +57,10 @@ void assignMissingMaterials(RawMesh& raw, const LineCursor& cursor, const MeshRe
     report.warnings.push_back(
         "the file has no materials: every element gets the default material '" + fallbackMaterial.name + "' (density " +
         formatDouble(fallbackMaterial.density) + ", E " + formatDouble(fallbackMaterial.youngsModulus) + ", nu " +
-        formatDouble(fallbackMaterial.poissonRatio) + "); pass a default material to choose another");
+        formatDouble(fallbackMaterial.poissonRatio) +
+        "); to choose another, override it in the scene (\"materials\": [{\"set\": \"allElements\", "
+        "\"density\": ..., \"youngsModulus\": ..., \"poissonRatio\": ...}]), or give meshInfo "
+        "--default-material rho,E,nu (MeshReadOptions::defaultMaterial in C++)");
   } else {
     cursor.failAt(raw.elementLocations[firstMissing],
                   "element " + std::to_string(raw.elementFileIds[firstMissing]) +
@@ -114,7 +117,8 @@ void reportUnusedVertices(const RawMesh& raw, const std::vector<char>& used, Mes
   if (unused > 0) {
     report.warnings.push_back(std::to_string(unused) + " vertex(es) belong to no element (first: vertex " +
                               std::to_string(firstUnused) +
-                              "); they have no mass or stiffness, so fix them or remove them");
+                              "); they have no mass or stiffness, so a simulation holds them at their rest positions "
+                              "(remove them from the file to drop them)");
   }
 }
 

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // TetGen .node/.ele reader; see docs/file-formats.md.
+#include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -175,6 +177,53 @@ void readElementVertices(const LineCursor& cursor, const std::vector<std::string
   }
 }
 
+/// Reads a TetGen .face file (header '<count> <boundaryMarker 0|1>', then
+/// 'index a b c [3 edge nodes of -o2] [marker] [2 adjacent tets of -nn]'): the vertices of
+/// the faces with marker k != 0 form the vertex set "marker_<k>".
+void readFaces(LineCursor& cursor, long long base, detail::RawMesh& raw) {
+  const auto header = headerTokens(cursor, "<count> <boundaryMarker 0|1>");
+  const detail::Location headerAt = cursor.location();
+  if (header.empty() || header.size() > 2)
+    cursor.fail(".face header needs '<count> <boundaryMarker 0|1>', got " + std::to_string(header.size()) + " fields");
+  const long long count = headerField(cursor, header, 0, 0, ".face count");
+  const long long markers = headerField(cursor, header, 1, 0, ".face boundary marker flag");
+  if (markers != 0 && markers != 1)
+    cursor.fail(".face boundary marker flag must be 0 or 1, got " + std::to_string(markers));
+  cursor.checkCountFits(count, 7, "faces");
+  const auto numVertices = static_cast<long long>(raw.vertexFileIds.size());
+  for (long long i = 0; i < count; ++i) {
+    if (!cursor.next()) {
+      cursor.failAt(headerAt, ".face header says " + std::to_string(count) + " faces, but the file has only " +
+                                  std::to_string(i));
+    }
+    const auto tokens = detail::splitTokens(cursor.line(), false);
+    // Beyond 'index a b c' and the marker: 0, 2 (-nn), 3 (-o2) or 5 (both) fields.
+    const long long extra = static_cast<long long>(tokens.size()) - 4 - markers;
+    if (extra != 0 && extra != 2 && extra != 3 && extra != 5) {
+      cursor.fail("face line needs 'index a b c" + std::string(markers ? " marker" : "") +
+                  "' (with 3 edge nodes of -o2 before the marker and 2 adjacent tetrahedra of -nn after it), got " +
+                  std::to_string(tokens.size()) + " fields");
+    }
+    const std::string name = "face " + std::string(tokens[0]);
+    std::array<int, 3> vertices{};
+    for (std::size_t a = 0; a < 3; ++a) {
+      const long long v = detail::integerAt(cursor, tokens[a + 1], name + " vertex");
+      if (v < base || v >= base + numVertices) {
+        cursor.fail(name + " references vertex " + std::to_string(v) + ", outside [" + std::to_string(base) + ", " +
+                    std::to_string(base + numVertices - 1) + "]");
+      }
+      vertices[a] = static_cast<int>(v - base);
+    }
+    if (!markers) continue;
+    const std::size_t markerAt = 4 + ((extra == 3 || extra == 5) ? 3 : 0);
+    const long long marker = detail::integerAt(cursor, tokens[markerAt], name + " boundary marker");
+    if (marker == 0) continue;
+    auto& set = raw.vertexSets["marker_" + std::to_string(marker)];
+    set.insert(set.end(), vertices.begin(), vertices.end());
+  }
+  if (cursor.next()) cursor.fail(".face header says " + std::to_string(count) + " faces, but there are more lines");
+}
+
 /// Linear elements use only the corners of 10-node tetrahedra; vertices that only ever
 /// were edge nodes would carry no mass or stiffness, so they are dropped and the rest
 /// renumbered (with a warning in report).
@@ -197,6 +246,13 @@ void dropEdgeOnlyVertices(detail::RawMesh& raw, const VertexRoles& roles, MeshRe
   raw.positions.resize(3 * static_cast<std::size_t>(kept));
   for (auto& t : raw.elements)
     for (int& v : t) v = newIndex[static_cast<std::size_t>(v)];
+  for (auto& [name, members] : raw.vertexSets) {
+    std::vector<int> kept;
+    for (const int v : members) {
+      if (newIndex[static_cast<std::size_t>(v)] >= 0) kept.push_back(newIndex[static_cast<std::size_t>(v)]);
+    }
+    members = std::move(kept);
+  }
   report.warnings.push_back(
       "10-node (quadratic) tetrahedra: using the 4 corner vertices of each element and "
       "dropping the " +
@@ -261,6 +317,14 @@ TetMesh readTetGen(const std::filesystem::path& path, const MeshReadOptions& opt
   const detail::FlatText nodeText = detail::loadFlatText(nodePath, false);
   LineCursor nodeCursor(nodeText, true);
   const long long numberingBase = readNodes(nodeCursor, raw);
+  // The .face file is optional: TetGen writes it with -f, its markers name boundary parts.
+  const std::filesystem::path facePath = base.string() + ".face";
+  std::error_code ignored;
+  if (std::filesystem::is_regular_file(facePath, ignored)) {
+    const detail::FlatText faceText = detail::loadFlatText(facePath, false);
+    LineCursor faceCursor(faceText, true);
+    readFaces(faceCursor, numberingBase, raw);
+  }
   const detail::FlatText eleText = detail::loadFlatText(elePath, false);
   LineCursor eleCursor(eleText, true);
   readTets(eleCursor, raw, numberingBase, out);

@@ -43,16 +43,25 @@ struct ProblemSettings {
 ///
 /// The time-dependent operator of M a + D v + f_int(u) = f_ext(t, u, v): integrators get
 /// it as a DynamicSystem (dynamicSystem()), whose external force evaluates loads().
+///
+/// Vertices that no element uses (a stray surface in a Gmsh or TetGen file) carry no
+/// mass and no stiffness, so as free DOFs they would make every system matrix singular:
+/// they are left out of the free DOFs and stay at their rest positions, without being
+/// counted among the fixed vertices (unusedVertices()).
 class Problem {
  public:
   /// Throws asyncfem::ValidationError for a fixed vertex out of range or when every
-  /// vertex is fixed, and for load vertices out of range.
+  /// vertex is fixed or unused, and for load vertices out of range.
   Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVertices, ProblemSettings settings,
           std::vector<VertexLoad> windows = {}, std::shared_ptr<const PenaltyContact> contact = nullptr);
 
   const TetMesh& mesh() const { return *mesh_; }
   const std::shared_ptr<const TetMesh>& sharedMesh() const { return mesh_; }
   const std::vector<int>& fixedVertices() const { return fixedVertices_; }  ///< sorted, unique
+  /// The vertices no element uses, sorted: not free DOFs, held at rest like fixed ones.
+  const std::vector<int>& unusedVertices() const { return unusedVertices_; }
+  /// fixedVertices() and unusedVertices() together, sorted: every vertex without free DOFs.
+  std::vector<int> heldVertices() const;
   const FreeDofs& freeDofs() const { return freeDofs_; }
   const ProblemSettings& settings() const { return settings_; }
   int numDofs() const { return 3 * mesh_->numVertices(); }
@@ -83,6 +92,7 @@ class Problem {
  private:
   std::shared_ptr<const TetMesh> mesh_;
   std::vector<int> fixedVertices_;
+  std::vector<int> unusedVertices_;
   FreeDofs freeDofs_;
   ProblemSettings settings_;
   std::vector<VertexLoad> windows_;

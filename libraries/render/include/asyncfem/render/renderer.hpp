@@ -33,6 +33,9 @@ struct GroundPlane {
 /// box's centre, 4 diagonals to each side, tiles of 1, 2 or 5 times a power of ten near a
 /// sixth of the diagonal, with a shadow.
 GroundPlane groundBelow(const BoundingBox& box, const Eigen::Vector3d& up);
+/// The ground {x : up.normalized() . x = height} (a scene's contact ground), centred under
+/// box's centre and sized and tiled as groundBelow's.
+GroundPlane groundAt(const BoundingBox& box, const Eigen::Vector3d& up, double height);
 
 /// How a frame looks. Colours are RGB in [0, 1].
 struct RenderStyle {

@@ -102,7 +102,8 @@ struct Scene {
   ForceModelKind forceModel = ForceModelKind::linear;
   /// Penalty contact with static obstacles (docs/scene-format.md, "contact").
   struct Contact {
-    std::vector<ContactPlane> planes;  ///< the ground is one of them
+    std::vector<ContactPlane> planes;    ///< the ground is one of them
+    std::optional<ContactPlane> ground;  ///< contact.ground when given (also in planes), for renderers
     std::vector<ContactSphere> spheres;
     PenaltyContactParameters parameters;
     bool enabled() const { return !planes.empty() || !spheres.empty(); }

@@ -29,20 +29,25 @@ std::vector<std::string> switchIntegrator(Scene& scene, const IntegratorRegistry
 
 /// The mesh a scene runs on: its file or generator with the material overrides applied,
 /// without assembling anything. Throws asyncfem::ValidationError naming the scene key.
-TetMesh buildSceneMesh(const Scene& scene);
+/// When warnings is given, the mesh reader's warnings (default material, ignored
+/// elements, reoriented elements, unused vertices) are appended to it as
+/// "<scene>: mesh.file: <file>: <warning>".
+TetMesh buildSceneMesh(const Scene& scene, std::vector<std::string>* warnings = nullptr);
 
 /// The problem a scene describes (mesh, fixed vertices from sets, boxes and .bou, physics,
 /// loads), with nothing assembled: matrices come when asked for (Problem). Throws
 /// asyncfem::ValidationError "<scene>: <key path>: message" when the scene does not fit the
 /// mesh (unknown set, vertex id out of range, a box selecting no vertex, every vertex
-/// fixed).
-std::shared_ptr<const Problem> buildProblem(const Scene& scene);
+/// fixed). warnings: as for buildSceneMesh.
+std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std::string>* warnings = nullptr);
 
 /// The problem of the scene an .afsim file recorded (header.scenePath, version 2), for
 /// readers of the frames that were given no --scene or --mesh. Throws asyncfem::Error
 /// naming fileName when the file records no scene, the scene cannot be loaded, or it now
 /// builds another mesh or other fixed vertices than the run had (fingerprint).
-std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& header, const std::string& fileName);
+/// warnings: as for buildSceneMesh.
+std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& header, const std::string& fileName,
+                                                    std::vector<std::string>* warnings = nullptr);
 
 /// The context registry factories get for scene at the given timing (timestep, frame
 /// rate), with its mass type, contact and names for messages; mesh and system are left
@@ -77,8 +82,9 @@ struct Simulation {
   /// Work the scene made unnecessary and the builder therefore did not do; the
   /// integrator's own list is in integrator->stats().skipped.
   std::vector<std::string> skipped;
-  /// Things that will run but that the user should know about (printed by the utilities),
-  /// e.g. an explicit contact stiffness too high for the timestep.
+  /// Things that will run but that the user should know about (printed by the utilities):
+  /// the mesh reader's warnings (buildSceneMesh), an explicit contact stiffness too high
+  /// for the timestep.
   std::vector<std::string> warnings;
 };
 

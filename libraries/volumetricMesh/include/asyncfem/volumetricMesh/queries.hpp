@@ -61,17 +61,21 @@ ElementQuality elementQuality(const TetMesh& mesh, int e);
 /// elementQuality for every element, in element order.
 std::vector<ElementQuality> elementQualities(const TetMesh& mesh);
 
-/// The spread of element quality over a mesh: the smallest, mean and largest of the
-/// elements' minimum dihedral angles (degrees) and the worst (largest) aspect ratio. All
-/// zero for a mesh without elements.
+/// The spread of element quality over a mesh: the smallest and the largest dihedral angle
+/// of any element, the mean of the elements' smallest dihedral angles, how many elements
+/// have a dihedral angle below a threshold, and the worst (largest) aspect ratio. All zero
+/// for a mesh without elements.
 struct QualitySummary {
-  double minDihedralDegrees = 0.0;   ///< smallest min dihedral angle over elements
-  double meanDihedralDegrees = 0.0;  ///< mean over elements of the min dihedral angle
-  double maxDihedralDegrees = 0.0;   ///< largest min dihedral angle over elements
+  double minDihedralDegrees = 0.0;      ///< smallest dihedral angle of any element
+  double maxDihedralDegrees = 0.0;      ///< largest dihedral angle of any element
+  double meanMinDihedralDegrees = 0.0;  ///< mean over elements of each element's smallest dihedral angle
+  double thresholdDegrees = 0.0;        ///< the threshold elementsBelowThreshold counts against
+  int elementsBelowThreshold = 0;       ///< elements whose smallest dihedral angle is below thresholdDegrees
   double worstAspectRatio = 0.0;
 };
-/// QualitySummary of elementQualities(mesh).
-QualitySummary summarizeQuality(const TetMesh& mesh);
+/// QualitySummary of elementQualities(mesh), counting the elements with a dihedral angle
+/// below thresholdDegrees (10 by default: tetMesher's guard, docs/tet-mesher.md).
+QualitySummary summarizeQuality(const TetMesh& mesh, double thresholdDegrees = 10.0);
 
 /// Vertices referenced by no element.
 std::vector<int> unusedVertices(const TetMesh& mesh);

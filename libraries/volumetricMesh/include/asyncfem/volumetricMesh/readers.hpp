@@ -39,6 +39,11 @@ struct MeshReadReport {
 TetMesh readMesh(const std::filesystem::path& path, const MeshReadOptions& options = {},
                  MeshReadReport* report = nullptr);
 
+/// readMesh for programs that print what the reader noticed: appends each of the report's
+/// warnings to warnings as "<path>: <warning>".
+TetMesh readMeshCollectingWarnings(const std::filesystem::path& path, std::vector<std::string>& warnings,
+                                   const MeshReadOptions& options = {});
+
 /// Vega .veg, tetrahedral subset (docs/file-formats.md): *VERTICES, *ELEMENTS (TET only),
 /// *MATERIAL with `ENU, density, E, nu`, *SET (1-based element ids), *REGION `set, material`
 /// (later lines win where sets overlap), *INCLUDE (relative to the including file, also
@@ -50,15 +55,18 @@ TetMesh readVeg(const std::filesystem::path& path, const MeshReadOptions& option
 /// TetGen .node/.ele; path may be the .node file, the .ele file or the common base name.
 /// The first vertex index (0 or 1) sets the numbering of both files. Attributes and
 /// boundary markers are checked and ignored; a region attribute r puts the element into
-/// the element set "region_<r>". 10-node tetrahedra keep their 4 corners; vertices used
-/// only as edge nodes are dropped (a warning says so). TetGen has no materials: elements
-/// get options.defaultMaterial or else Material{"default", 1000, 1e6, 0.45} with a warning.
+/// the element set "region_<r>". An optional .face file next to them (TetGen -f) gives the
+/// vertex set "marker_<k>" of the vertices of the faces with boundary marker k != 0. 10-node tetrahedra keep their 4
+/// corners; vertices used only as edge nodes are dropped (a warning says so). TetGen has no materials: elements get
+/// options.defaultMaterial or else Material{"default", 1000, 1e6, 0.45} with a warning.
 TetMesh readTetGen(const std::filesystem::path& path, const MeshReadOptions& options = {},
                    MeshReadReport* report = nullptr);
 /// Gmsh .msh ASCII 2.2 or 4.1. Only 4-node tetrahedra (type 4) are read; other element
 /// types are counted in MeshReadReport::ignoredElements with one warning. Node tags may be
 /// any positive integers. A physical volume group becomes an element set named from
-/// $PhysicalNames, or "physical_<tag>" without a name. Binary files and other versions are
+/// $PhysicalNames, or "physical_<tag>" without a name; a physical surface, curve or point
+/// becomes a vertex set (its elements' nodes) named likewise, or "physical_surface_<tag>",
+/// "physical_curve_<tag>", "physical_point_<tag>". Binary files and other versions are
 /// ParseErrors. Materials as for readTetGen.
 TetMesh readGmsh(const std::filesystem::path& path, const MeshReadOptions& options = {},
                  MeshReadReport* report = nullptr);

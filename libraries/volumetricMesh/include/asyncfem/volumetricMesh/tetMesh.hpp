@@ -126,6 +126,10 @@ class TetMesh {
   /// Adds or replaces a set; members are sorted and de-duplicated, range-checked.
   void setElementSet(const std::string& name, std::vector<int> elements);
   void setVertexSet(const std::string& name, std::vector<int> vertices);
+  /// Renames the element set and/or the vertex set called from to to (e.g. a Gmsh group
+  /// name with a space, which .veg cannot hold). Throws ValidationError when no set is
+  /// called from (listing the sets), when to is empty or names a set of the same kind.
+  void renameSet(const std::string& from, const std::string& to);
 
   /// Replaces the vertex order of element e (used by readers to fix orientation).
   void setElement(int e, const Eigen::Vector4i& vertices);
