@@ -119,6 +119,13 @@ TEST_F(UtilityErrorsTest, SuggestRegionsHonoursTheScenesAutoSettings) {
   const RunResult wider = run("suggestRegions", "scene.json --json --max-ratio 64");
   ASSERT_EQ(wider.exitCode, 0) << wider.err;
   EXPECT_GT(nlohmann::json::parse(wider.out).at("regions").at(0).at("ratio").get<int>(), 2) << wider.out;
+  // With --modes the modal report is part of the one JSON document (nothing else on stdout).
+  const RunResult withModes = run("suggestRegions", "scene.json --json --modes 3");
+  ASSERT_EQ(withModes.exitCode, 0) << withModes.err;
+  const nlohmann::json document = nlohmann::json::parse(withModes.out);
+  ASSERT_EQ(document.at("modes").at("modes").size(), 3U) << withModes.out;
+  EXPECT_GT(document.at("modes").at("modes").at(0).at("omega").get<double>(), 0.0);
+  EXPECT_FALSE(document.at("modes").at("verdict").get<std::string>().empty());
 
   std::ofstream(folder_ / "typo.json") << R"({
     "mesh": {"generator": "box", "size": [1, 0.25, 0.25], "cells": [8, 2, 2]},

@@ -169,15 +169,33 @@ std::vector<AsyncRegion> withdrawnRegions(const AutoRegionProposal& proposal) {
   return regions;
 }
 
-void printJson(const AutoRegionProposal& proposal, double largeTimestep) {
-  std::cout << nlohmann::json{{"largeTimestep", largeTimestep},
-                              {"target", proposal.targetOmegaH},
-                              {"largeRegionOmegaH", proposal.largeRegionMaxFrequency * largeTimestep},
-                              {"regions", asyncRegionsJson(proposal.asyncRegions())},
-                              {"withdrawnRegions", asyncRegionsJson(withdrawnRegions(proposal))},
-                              {"modalVerdict", proposal.modalReport ? proposal.modalReport->verdictText() : ""}}
-                   .dump(2)
-            << "\n";
+/// The per-mode rows of a report (--modes with --json).
+nlohmann::json modesJson(const RegionModeReport& report) {
+  nlohmann::json modes = nlohmann::json::array();
+  for (const ModeInRegions& mode : report.modes) {
+    modes.push_back({{"omega", mode.omega},
+                     {"hertz", mode.hertz},
+                     {"omegaLargeStep", mode.omegaLargeStep},
+                     {"omegaSubstep", mode.omegaSubstep},
+                     {"regionShare", mode.regionShare},
+                     {"fastShare", mode.fastShare},
+                     {"visible", mode.visible},
+                     {"livesInFastRegions", mode.livesInFastRegions},
+                     {"keepable", mode.keepable}});
+  }
+  return {
+      {"regions", report.regionNames}, {"ratios", report.ratios}, {"modes", modes}, {"verdict", report.verdictText()}};
+}
+
+void printJson(const AutoRegionProposal& proposal, double largeTimestep, const std::optional<RegionModeReport>& modes) {
+  nlohmann::json out{{"largeTimestep", largeTimestep},
+                     {"target", proposal.targetOmegaH},
+                     {"largeRegionOmegaH", proposal.largeRegionMaxFrequency * largeTimestep},
+                     {"regions", asyncRegionsJson(proposal.asyncRegions())},
+                     {"withdrawnRegions", asyncRegionsJson(withdrawnRegions(proposal))},
+                     {"modalVerdict", proposal.modalReport ? proposal.modalReport->verdictText() : ""}};
+  if (modes) out["modes"] = modesJson(*modes);
+  std::cout << out.dump(2) << "\n";
 }
 
 void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const AutoRegionOptions& options) {
@@ -217,16 +235,20 @@ void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const A
   }
 }
 
-// The modal table of the scene's given regions, else of the proposal (withdrawn or not).
-void printModes(const CommandLine& cl, const Input& in, const AutoRegionProposal& proposal,
-                const VibrationMatrices& matrices) {
+// The modal report of the scene's given regions, else of the proposal (withdrawn or not),
+// printed as a table unless --json (the caller then puts it in the JSON document).
+RegionModeReport printModes(const CommandLine& cl, const Input& in, const AutoRegionProposal& proposal,
+                            const VibrationMatrices& matrices) {
   const bool given = !in.givenRegions.empty();
   const std::vector<AsyncRegion> regions =
       given ? in.givenRegions : (proposal.regions.empty() ? withdrawnRegions(proposal) : proposal.asyncRegions());
   ModalOptions modal;
   modal.count = std::min(cl.modeCount, in.freeDofs.numFree() - 1);
   const ModalResult modes = lowestModes(matrices.stiffness, matrices.mass, in.freeDofs, modal);
-  std::ostream& out = cl.json ? std::cerr : std::cout;
+  RegionModeReport report =
+      analyseRegionModes(modes, matrices.mass, modalRegions(regions), cl.largeTimestep, cl.frameRate);
+  if (cl.json) return report;  // printed in the JSON document, nothing on the console
+  std::ostream& out = std::cout;
   out << "\nmodes of " << (given ? "the scene's regions" : "the proposed regions") << ": " << modal.count
       << " lowest of K phi = omega^2 M phi (" << in.freeDofs.numFree() << " free DOFs, linear K, "
       << (in.massType == MassType::lumped ? "lumped" : "consistent") << " M"
@@ -235,8 +257,8 @@ void printModes(const CommandLine& cl, const Input& in, const AutoRegionProposal
   std::snprintf(line, sizeof line, "eigensolve: %.3g s (factorization %.3g s, %d solves, %d restarts, shift %.3g)\n",
                 modes.solveSeconds, modes.factorSeconds, modes.operatorApplications, modes.iterations, modes.shift);
   out << line;
-  printRegionModeReport(
-      out, analyseRegionModes(modes, matrices.mass, modalRegions(regions), cl.largeTimestep, cl.frameRate));
+  printRegionModeReport(out, report);
+  return report;
 }
 
 // The proposed regions to writePath, through a temporary file so a failed write leaves
@@ -262,12 +284,10 @@ int run(CommandLine& cl) {
   }
   const VibrationMatrices matrices = vibrationMatrices(*in.mesh, in.massType);
   const AutoRegionProposal proposal = suggestRegions(*in.mesh, in.freeDofs, options, matrices.stiffness, matrices.mass);
-  if (cl.json) {
-    printJson(proposal, cl.largeTimestep);
-  } else {
-    printTable(proposal, *in.mesh, options);
-  }
-  if (cl.modeCount > 0) printModes(cl, in, proposal, matrices);
+  if (!cl.json) printTable(proposal, *in.mesh, options);
+  std::optional<RegionModeReport> modes;
+  if (cl.modeCount > 0) modes = printModes(cl, in, proposal, matrices);
+  if (cl.json) printJson(proposal, cl.largeTimestep, modes);
   if (!cl.writePath.empty()) {
     writeRegions(cl.writePath, proposal);
     if (!cl.json) std::printf("regions written to %s\n", cl.writePath.c_str());
