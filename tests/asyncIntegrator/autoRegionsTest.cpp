@@ -127,6 +127,13 @@ TEST(AutoRegions, ModalCheckWithdrawsTheTipOfTheDefaultBeam) {
   EXPECT_FALSE(checked.modalReport->visibleModesTruncated);
   // The proposal (no region) is still a valid partition.
   EXPECT_NO_THROW(RegionPartition(mesh, freeDofs, checked.asyncRegions()));
+  // The run summary's line says what was decided and why, in both cases.
+  const std::string withdrawn = autoRegionSummary(checked);
+  EXPECT_NE(withdrawn.find("no fast region kept, single-rate at hL: the modal check withdrew 1 region(s): no mode"),
+            std::string::npos)
+      << withdrawn;
+  const std::string kept = autoRegionSummary(unchecked);
+  EXPECT_NE(kept.find("1 region(s) kept: auto1 ("), std::string::npos) << kept;
 }
 
 // The design note's antenna on a block, coarsely: a 0.5 x 0.5 x 0.2 block (rho 1000) with a

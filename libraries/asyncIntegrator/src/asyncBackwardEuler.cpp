@@ -753,6 +753,7 @@ RunReport AsyncBackwardEuler::report() const {
         "uninterrupted run's (by as much as two partitions' trajectories differ)";
   }
   std::vector<std::string>& lines = report.lines;
+  if (!regionNote_.empty()) lines.push_back("regions " + regionNote_);
   std::snprintf(line, sizeof(line),
                 "async set-up %.3f s (Z %.3f s over %lld right-hand sides on %d threads, H^LL* %.3f s); |S| %d, "
                 "|I| %d, |L| %d DOFs",

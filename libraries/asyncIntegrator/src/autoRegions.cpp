@@ -416,4 +416,33 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   return proposal;
 }
 
+std::string autoRegionSummary(const AutoRegionProposal& proposal) {
+  const std::string prefix = "\"auto\": ";
+  if (!proposal.regions.empty()) {
+    std::string line = prefix + std::to_string(proposal.regions.size()) + " region(s) kept:";
+    for (const ProposedRegion& r : proposal.regions) {
+      line += " " + r.region.name + " (" + std::to_string(r.region.vertices.size()) +
+              " vertices, m = " + std::to_string(r.region.ratio);
+      if (r.ratioFromElements > 0)
+        line += ", raised from " + std::to_string(r.ratioFromElements) + " by the modal check";
+      line += ")";
+    }
+    return line;
+  }
+  if (!proposal.withdrawnRegions.empty()) {
+    return prefix + "no fast region kept, single-rate at hL: the modal check withdrew " +
+           std::to_string(proposal.withdrawnRegions.size()) +
+           " region(s): " + (proposal.modalReport ? proposal.modalReport->verdictText() : std::string());
+  }
+  if (!proposal.costWithdrawnRegions.empty()) {
+    return prefix + "no fast region kept, single-rate at hL: the cost check withdrew " +
+           std::to_string(proposal.costWithdrawnRegions.size()) + " region(s): " + proposal.cost.decision;
+  }
+  char line[200];
+  std::snprintf(line, sizeof line,
+                "no fast region needed, single-rate at hL: every element meets the target omega*hL = %.3g",
+                proposal.targetOmegaH);
+  return prefix + line;
+}
+
 }  // namespace asyncfem

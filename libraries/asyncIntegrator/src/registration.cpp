@@ -325,6 +325,7 @@ void registerMultirateIntegrators(IntegratorRegistry& registry) {
         auto integrator = std::make_unique<AsyncBackwardEuler>(*context.mesh, std::move(context.system),
                                                                context.timestep, parsed.regions, parsed.solver);
         if (parsed.adaptive) integrator->setAdaptiveRegions(*parsed.adaptive);
+        if (parsed.automaticRegions && parsed.proposal) integrator->setRegionNote(autoRegionSummary(*parsed.proposal));
         return integrator;
       },
       asyncOptionKeys());

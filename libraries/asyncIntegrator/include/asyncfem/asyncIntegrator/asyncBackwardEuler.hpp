@@ -57,6 +57,9 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   /// Throws asyncfem::ValidationError for options AdaptiveRegionPolicy rejects, and for the
   /// contact policy on a system without obstacles (DynamicSystem::obstacleProximity).
   void setAdaptiveRegions(AdaptiveRegionOptions options);
+  /// A line the run summary (report().lines) starts with, e.g. what an automatic region
+  /// proposal decided (autoRegionSummary); empty: none.
+  void setRegionNote(std::string note) { regionNote_ = std::move(note); }
   /// Every change of partition so far, in order.
   const std::vector<RepartitionRecord>& repartitions() const { return repartitions_; }
 
@@ -125,6 +128,7 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   std::vector<RepartitionRecord> repartitions_;
   long long stepsKept_ = 0;  // large steps since the last change of partition
   std::vector<CachedSetUp> cache_;
+  std::string regionNote_;
 };
 
 }  // namespace asyncfem

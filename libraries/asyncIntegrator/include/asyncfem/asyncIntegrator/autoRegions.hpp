@@ -145,6 +145,12 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
                                   const Eigen::SparseMatrix<double>& stiffness,
                                   const Eigen::SparseMatrix<double>& mass);
 
+/// One line for a run summary saying what the automatic proposal decided and why: the
+/// regions kept (vertices, m, and a ratio the modal check raised), or that none was kept
+/// and which check withdrew them (the modal verdict, the cost decision), or that every
+/// element meets the target.
+std::string autoRegionSummary(const AutoRegionProposal& proposal);
+
 /// The regions as the modal report takes them (name, vertices, ratio).
 std::vector<ModalRegion> modalRegions(const std::vector<AsyncRegion>& regions);
 
