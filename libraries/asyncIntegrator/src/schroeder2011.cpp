@@ -190,7 +190,35 @@ Schroeder2011::Schroeder2011(DynamicSystem system, double largeTimestep, std::ve
   d.lastU.resize(static_cast<std::size_t>(numRegions));
   d.lastV.resize(static_cast<std::size_t>(numRegions));
 
-  // The interface elements of every region, with their I-local DOF indices.
+  collectInterfaceElements();
+  Eigen::Matrix<double, 12, 12> probe;
+  d.perElementTangents =
+      mesh.numElements() > 0 && system_.forceModel->elementTangent(Eigen::VectorXd::Zero(mesh.numDofs()), 0, probe);
+  if (!d.perElementTangents && !d.linear) {
+    throw ValidationError(std::string(kName) +
+                          ": the interface elements' stiffness is needed per element, and this nonlinear force model "
+                          "gives no element tangent (ForceModel::elementTangent)");
+  }
+  checkInterfaceStiffness();
+
+  // The outer layer's omega_max (S7), from the tangent at rest.
+  d.maxFrequency.assign(static_cast<std::size_t>(numRegions), 0.0);
+  for (int i = 0; i < numRegions; ++i) {
+    const detail::FastRegion& region = d.regions[static_cast<std::size_t>(i)];
+    d.maxFrequency[static_cast<std::size_t>(i)] = estimateMaxFrequency(region.Kss, region.Mss);
+  }
+  checkSubsteps(timestep());
+  if (!system_.damped()) stats_.skipped.push_back("damping terms (alpha = beta = 0)");
+  if (d.linear) stats_.skipped.push_back("per-step refactorization (linear forces: factored once)");
+}
+
+Schroeder2011::~Schroeder2011() = default;
+
+// The interface elements of every region, with their I-local DOF indices.
+void Schroeder2011::collectInterfaceElements() {
+  Impl& d = *impl_;
+  const TetMesh& mesh = *system_.mesh;
+  const int numRegions = partition_.numRegions();
   d.interfaceElements.resize(static_cast<std::size_t>(numRegions));
   d.interfaceStiffness.resize(static_cast<std::size_t>(numRegions));
   std::vector<std::vector<int>> interfaceIndex(static_cast<std::size_t>(numRegions));
@@ -213,19 +241,17 @@ Schroeder2011::Schroeder2011(DynamicSystem system, double largeTimestep, std::ve
             interfaceIndex[static_cast<std::size_t>(fast)][static_cast<std::size_t>((3 * vertices[a]) + c)];
     d.interfaceElements[static_cast<std::size_t>(fast)].push_back(element);
   }
-  Eigen::Matrix<double, 12, 12> probe;
-  d.perElementTangents =
-      mesh.numElements() > 0 && system_.forceModel->elementTangent(Eigen::VectorXd::Zero(mesh.numDofs()), 0, probe);
-  if (!d.perElementTangents && !d.linear) {
-    throw ValidationError(std::string(kName) +
-                          ": the interface elements' stiffness is needed per element, and this nonlinear force model "
-                          "gives no element tangent (ForceModel::elementTangent)");
-  }
-  // The interface elements' K^{SI} block must be the model's (S rows of K come from
-  // elements touching S, all of them outer-layer or interface elements): checks that
-  // the element tangents (or, for a matrix-built linear model, the mesh's linear FEM
-  // elements) are the model's. 1e-10 relative: the same element matrices summed in
-  // another order differ by ~1e-15; another material differs by far more.
+}
+
+// The interface elements' K^{SI} block must be the model's (S rows of K come from
+// elements touching S, all of them outer-layer or interface elements): checks that
+// the element tangents (or, for a matrix-built linear model, the mesh's linear FEM
+// elements) are the model's. 1e-10 relative: the same element matrices summed in
+// another order differ by ~1e-15; another material differs by far more.
+void Schroeder2011::checkInterfaceStiffness() const {
+  const Impl& d = *impl_;
+  const TetMesh& mesh = *system_.mesh;
+  const int numRegions = partition_.numRegions();
   for (int i = 0; i < numRegions; ++i) {
     const std::vector<int>& s = partition_.regionDofs(i);
     std::vector<int> sIndex(static_cast<std::size_t>(mesh.numDofs()), -1);
@@ -259,19 +285,7 @@ Schroeder2011::Schroeder2011(DynamicSystem system, double largeTimestep, std::ve
                             "); a force model built from a matrix must be the mesh's linear FEM stiffness");
     }
   }
-
-  // The outer layer's omega_max (S7), from the tangent at rest.
-  d.maxFrequency.assign(static_cast<std::size_t>(numRegions), 0.0);
-  for (int i = 0; i < numRegions; ++i) {
-    const detail::FastRegion& region = d.regions[static_cast<std::size_t>(i)];
-    d.maxFrequency[static_cast<std::size_t>(i)] = estimateMaxFrequency(region.Kss, region.Mss);
-  }
-  checkSubsteps(timestep());
-  if (!system_.damped()) stats_.skipped.push_back("damping terms (alpha = beta = 0)");
-  if (d.linear) stats_.skipped.push_back("per-step refactorization (linear forces: factored once)");
 }
-
-Schroeder2011::~Schroeder2011() = default;
 
 void Schroeder2011::interfaceTangent(const Eigen::VectorXd& u, int element,
                                      Eigen::Matrix<double, 12, 12>& tangent) const {
@@ -330,18 +344,12 @@ void Schroeder2011::setTimestep(double timestep) {
 
 // The coupled matrix of (S6) on the free DOFs, the substep matrices of (S3) and the
 // interface elements' K_if^{II} at the current tangent.
-void Schroeder2011::rebuild() {
-  Impl& d = *impl_;
+// M and K of the free DOFs, each entry weighted with the steps of its row and column (S6).
+void Schroeder2011::appendSteppedBlocks(std::vector<Eigen::Triplet<double>>& triplets) const {
+  const Impl& d = *impl_;
   const double hL = timestep();
   const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
-  Stopwatch assembly, factor;
-  assembly.start();
-  updateBlock(d.freeStiffness, d.stiffness, d.Kff, d.cutFree);
-  d.cutFree = true;
-  const std::vector<int>& fullToFree = system_.freeDofs.fullToFree();
   auto stepOf = [&](int region) { return region < 0 ? hL : hL / partition_.ratio(region); };
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(d.Mff.nonZeros() + d.Kff.nonZeros()));
   // Mass: (1 + h alpha) with h the row's step. Stiffness: rows of S (hS h_col + hS beta)
   // with h_col = hS on S columns and hL on L columns; rows of L (hS^2 + hS beta) on
   // S columns and (hL^2 + hL beta) on L columns, corrected on I x I below.
@@ -366,6 +374,20 @@ void Schroeder2011::rebuild() {
       triplets.emplace_back(static_cast<int>(it.row()), c, weight * it.value());
     }
   }
+}
+
+void Schroeder2011::rebuild() {
+  Impl& d = *impl_;
+  const double hL = timestep();
+  const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
+  Stopwatch assembly, factor;
+  assembly.start();
+  updateBlock(d.freeStiffness, d.stiffness, d.Kff, d.cutFree);
+  d.cutFree = true;
+  const std::vector<int>& fullToFree = system_.freeDofs.fullToFree();
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(d.Mff.nonZeros() + d.Kff.nonZeros()));
+  appendSteppedBlocks(triplets);
   const Eigen::VectorXd& u0 = displacement_;
   for (int i = 0; i < partition_.numRegions(); ++i) {
     detail::FastRegion& region = d.regions[static_cast<std::size_t>(i)];

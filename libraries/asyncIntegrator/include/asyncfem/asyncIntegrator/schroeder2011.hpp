@@ -115,6 +115,9 @@ class Schroeder2011 final : public PartitionedIntegrator {
   RunReport report() const override;
 
  private:
+  void collectInterfaceElements();
+  void checkInterfaceStiffness() const;
+  void appendSteppedBlocks(std::vector<Eigen::Triplet<double>>& triplets) const;
   struct Impl;
   void rebuild();
   void checkSubsteps(double largeTimestep) const;
