@@ -136,6 +136,36 @@ TEST(HyperelasticFEM, ForcesAreTheEnergyGradientAndTangentsTheirJacobian) {
   }
 }
 
+TEST(HyperelasticFEM, InvariantPathEqualsPrincipalStretchPath) {
+  // The invariant path (no SVD) and the principal-stretch path are the same derivatives of
+  // the same energy wherever no stretch is clamped, so they differ by rounding only: a few
+  // hundred flops each, entries of size E, relative rounding about 1e-15 per operation
+  // chain; 1e-11 of the largest entry leaves margin while any wrong term (size stress / E
+  // ~ 1e-2 relative) fails. Elements at or below the threshold take the principal-stretch
+  // path in both models, so equality must hold for them exactly as well.
+  const TetMesh mesh = test::smallBox(2);
+  std::mt19937 random(29);
+  for (const ModelCase& c : allModelCases()) {
+    if (c.kind == HyperelasticMaterialKind::stvk && c.options.stvkFormulation == StVKFormulation::greenStrain) continue;
+    SCOPED_TRACE(c.label);
+    HyperelasticOptions principal = c.options;
+    principal.invariantPath = false;
+    auto fast = makeHyperelasticForceModel(mesh, c.kind, c.options);
+    auto reference = makeHyperelasticForceModel(mesh, c.kind, principal);
+    Eigen::Matrix3d squeezed = Eigen::Matrix3d::Identity();
+    squeezed(2, 2) = 0.15;  // below the 0.2 threshold: the principal-stretch path in both
+    for (const Eigen::VectorXd& u : {test::deformedDisplacement(mesh, test::randomRotation(random), 0.1, random),
+                                     test::deformedDisplacement(mesh, test::randomRotation(random), 0.25, random),
+                                     test::homogeneousDisplacement(mesh, Eigen::Vector3d(0.7, 0.8, 0.9).asDiagonal()),
+                                     test::homogeneousDisplacement(mesh, squeezed)}) {
+      EXPECT_LE(relativeDifference(test::forces(*fast, u), test::forces(*reference, u)), 1e-11);
+      EXPECT_LE(relativeDifference(test::tangent(*fast, u), test::tangent(*reference, u)), 1e-11);
+      EXPECT_NEAR(fast->elasticEnergy(u), reference->elasticEnergy(u),
+                  1e-11 * std::max(1.0, std::abs(reference->elasticEnergy(u))));
+    }
+  }
+}
+
 TEST(HyperelasticFEM, SmallStrainTangentEqualsLinearFEM) {
   const TetMesh mesh = test::smallBox(2);
   const MatrixAssembler assembler(mesh);

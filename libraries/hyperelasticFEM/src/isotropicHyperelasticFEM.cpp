@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "detail/invariantKernel.hpp"
 #include "detail/isotropicMaterials.hpp"
 
 namespace asyncfem {
@@ -334,6 +335,10 @@ void IsotropicHyperelasticFEM::computeElement(int element, const Eigen::Matrix3d
   const auto e = static_cast<std::size_t>(element);
   const IsotropicMaterialConstants& constants = constants_[static_cast<std::size_t>(elementMaterials_[e])];
   const double volume = geometry().volumes[e];
+  if (options_.invariantPath && !options_.enforceSPD && detail::invariantPathApplies(deformationGradient, options_)) {
+    computeElementFromInvariants(element, deformationGradient, energy, force, tangent);
+    return;
+  }
   const SignedSvd svd = signedSvd(deformationGradient);
   StretchTerms terms = stretchTerms(kind_, constants, options_, {svd.stretches[0], svd.stretches[1], svd.stretches[2]},
                                     tangent != nullptr);
@@ -352,6 +357,27 @@ void IsotropicHyperelasticFEM::computeElement(int element, const Eigen::Matrix3d
 
   const Eigen::Matrix<double, 9, 12> d = rotatedFrameDifferentials(svd.u, rotatedGradients);
   tangent->noalias() = volume * (d.transpose() * applyRotatedTangent(terms, d));
+  symmetrizeElementMatrix(*tangent);
+}
+
+void IsotropicHyperelasticFEM::computeElementFromInvariants(int element, const Eigen::Matrix3d& deformationGradient,
+                                                            double* energy, ElementVector* force,
+                                                            ElementMatrix* tangent) const {
+  const auto e = static_cast<std::size_t>(element);
+  const double volume = geometry().volumes[e];
+  double density = 0.0;
+  Eigen::Matrix3d stress;
+  Eigen::Matrix<double, 9, 9> dStressdF;
+  detail::invariantStress(kind_, constants_[static_cast<std::size_t>(elementMaterials_[e])], deformationGradient,
+                          density, stress, tangent != nullptr ? &dStressdF : nullptr);
+  if (energy != nullptr) *energy = volume * density;
+  if (force != nullptr) {
+    // f_a = |V| P g_a, as on the principal-stretch path.
+    const Eigen::Matrix<double, 3, 4> nodal = volume * (stress * geometry().shapeGradients[e]);
+    *force = Eigen::Map<const ElementVector>(nodal.data());
+  }
+  if (tangent == nullptr) return;
+  detail::elementTangentFromStressDerivative(dStressdF, geometry().shapeGradients[e], volume, *tangent);
   symmetrizeElementMatrix(*tangent);
 }
 

@@ -2,7 +2,9 @@
 // forcesAndTangent() of each hyperelastic model on a deformed box of 6 * cells^3 tets,
 // against CorotationalLinearFEM (simple tangent, Vega's default) measured on the same mesh
 // and displacement in the same process. Counters: us_per_element (time per call / tets)
-// and vs_corotational (time per call / corotational time per call).
+// and vs_corotational (time per call / corotational time per call). The *ThroughSvd rows
+// turn HyperelasticOptions::invariantPath off (every element through its SVD), the
+// baseline of the invariant path in the same run.
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -62,11 +64,12 @@ double corotationalSeconds(int cells) {
   return best;
 }
 
-enum class Variant { corotational, stvkGreen, stvk, neoHookean, mooneyRivlin, neoHookeanHandled };
+enum class Variant { corotational, stvkGreen, stvk, neoHookean, mooneyRivlin, neoHookeanThreshold, neoHookeanHandled };
 
-std::unique_ptr<ForceModel> makeModel(Variant variant, const TetMesh& mesh) {
+std::unique_ptr<ForceModel> makeModel(Variant variant, const TetMesh& mesh, bool invariantPath) {
   HyperelasticOptions options;
   options.stvkFormulation = StVKFormulation::principalStretches;
+  options.invariantPath = invariantPath;
   switch (variant) {
     case Variant::corotational:
       return std::make_unique<CorotationalLinearFEM>(mesh);
@@ -78,6 +81,10 @@ std::unique_ptr<ForceModel> makeModel(Variant variant, const TetMesh& mesh) {
       return makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::neoHookean, options);
     case Variant::mooneyRivlin:
       return makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::mooneyRivlin, options);
+    case Variant::neoHookeanThreshold:
+      options.inversionThreshold = 0.2;
+      options.enableCompressionResistance = true;
+      return makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::neoHookean, options);
     case Variant::neoHookeanHandled:
       options.inversionThreshold = 0.2;
       options.enforceSPD = true;
@@ -86,11 +93,11 @@ std::unique_ptr<ForceModel> makeModel(Variant variant, const TetMesh& mesh) {
   return nullptr;
 }
 
-void forcesAndTangent(benchmark::State& state, Variant variant) {
+void forcesAndTangent(benchmark::State& state, Variant variant, bool invariantPath) {
   const int cells = static_cast<int>(state.range(0));
   const Setup& s = setup(cells);
   const double baseline = corotationalSeconds(cells);
-  auto model = makeModel(variant, s.mesh);
+  auto model = makeModel(variant, s.mesh, invariantPath);
   Eigen::VectorXd forces;
   Eigen::SparseMatrix<double> stiffness = model->createStiffnessMatrix();
   model->forcesAndTangent(s.displacement, forces, stiffness);  // sizes the outputs
@@ -109,12 +116,27 @@ void forcesAndTangent(benchmark::State& state, Variant variant) {
   state.counters["vs_corotational"] = perCall / baseline;
 }
 
-BENCHMARK_CAPTURE(forcesAndTangent, corotational, Variant::corotational)->Arg(12)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(forcesAndTangent, stvkGreenStrain, Variant::stvkGreen)->Arg(12)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(forcesAndTangent, stvkPrincipalStretches, Variant::stvk)->Arg(12)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(forcesAndTangent, neoHookean, Variant::neoHookean)->Arg(12)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(forcesAndTangent, mooneyRivlin, Variant::mooneyRivlin)->Arg(12)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(forcesAndTangent, neoHookeanThresholdSPD, Variant::neoHookeanHandled)
+BENCHMARK_CAPTURE(forcesAndTangent, corotational, Variant::corotational, true)->Arg(12)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, stvkGreenStrain, Variant::stvkGreen, true)->Arg(12)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, stvkPrincipalStretches, Variant::stvk, true)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, stvkThroughSvd, Variant::stvk, false)->Arg(12)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, neoHookean, Variant::neoHookean, true)->Arg(12)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, neoHookeanThroughSvd, Variant::neoHookean, false)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, mooneyRivlin, Variant::mooneyRivlin, true)->Arg(12)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, mooneyRivlinThroughSvd, Variant::mooneyRivlin, false)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, neoHookeanThresholdCompression, Variant::neoHookeanThreshold, true)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, neoHookeanThresholdCompressionThroughSvd, Variant::neoHookeanThreshold, false)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, neoHookeanThresholdSPD, Variant::neoHookeanHandled, true)
     ->Arg(12)
     ->Unit(benchmark::kMillisecond);
 

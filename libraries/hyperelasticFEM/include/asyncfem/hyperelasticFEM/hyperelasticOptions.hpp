@@ -78,6 +78,13 @@ struct HyperelasticOptions {
   /// Mooney-Rivlin parameters for every element, overriding the mesh's; without it each
   /// element's material must carry a MooneyRivlinParameters block.
   std::optional<MooneyRivlinParameters> mooneyRivlin;
+  /// Elements whose stretches are all above the inversion threshold (all elements when
+  /// inversion handling is off), with det F > 0 and without enforceSPD, are computed from F
+  /// through the invariants of C, without a singular value decomposition: the same
+  /// derivatives of the same energy, equal to the principal-stretch path to rounding and
+  /// 2-3x faster (docs/benchmarks.md, "Hyperelastic element kernels"). false: every element
+  /// through principal stretches (for comparisons).
+  bool invariantPath = true;
 
   /// True when a finite threshold is set.
   bool inversionHandlingEnabled() const { return inversionThreshold > -std::numeric_limits<double>::max(); }

@@ -64,6 +64,10 @@ class IsotropicHyperelasticFEM final : public ElementForceModel {
                       ElementMatrix* tangent) const override;
 
  private:
+  /// computeElement for an element where options_.invariantPath applies (invariantKernel.hpp).
+  void computeElementFromInvariants(int element, const Eigen::Matrix3d& deformationGradient, double* energy,
+                                    ElementVector* force, ElementMatrix* tangent) const;
+
   HyperelasticMaterialKind kind_;
   HyperelasticOptions options_;
   std::vector<detail::IsotropicMaterialConstants> constants_;  // per material of the mesh
