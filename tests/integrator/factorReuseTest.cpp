@@ -34,7 +34,9 @@ TEST(FactorReuseBackwardEuler, TrajectoryFollowsTheExactPathWithFewerFactorizati
   IntegratorOptions reuseOptions;
   reuseOptions.reuseFactor = true;
   reuseOptions.pcgTolerance = 1e-10;
-  BackwardEuler exact(swingingBar(bar), 2e-3);
+  IntegratorOptions exactOptions;
+  exactOptions.reuseFactor = false;
+  BackwardEuler exact(swingingBar(bar), 2e-3, exactOptions);
   BackwardEuler reused(swingingBar(bar), 2e-3, reuseOptions);
   exact.setState(u0, Eigen::VectorXd::Zero(u0.size()));
   reused.setState(u0, Eigen::VectorXd::Zero(u0.size()));
@@ -68,6 +70,7 @@ TEST(FactorReuseBackwardEuler, NewtonIterationsConvergeWithReusedFactors) {
   IntegratorOptions options;
   options.maxIterations = 8;
   options.tolerance = 1e-8;
+  options.reuseFactor = false;
   IntegratorOptions reuseOptions = options;
   reuseOptions.reuseFactor = true;
   reuseOptions.pcgTolerance = 1e-10;

@@ -94,7 +94,9 @@ std::vector<Eigen::VectorXd> computeCholmodTrajectory(const TetMesh& mesh, Petsc
                                         Eigen::VectorXd& forces) { forces += gravityForce; };
   std::unique_ptr<Integrator> reference;
   if (integrator == PetscIntegratorKind::backwardEuler) {
-    reference = std::make_unique<BackwardEuler>(system, kTimestep);
+    IntegratorOptions exact;  // exact solves, as MUMPS gives (not the default kept factor)
+    exact.reuseFactor = false;
+    reference = std::make_unique<BackwardEuler>(system, kTimestep, exact);
   } else {
     reference = std::make_unique<Trapezoidal>(system, kTimestep);
   }

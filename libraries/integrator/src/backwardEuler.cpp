@@ -4,6 +4,7 @@
 #include <asyncfem/integrator/backwardEuler.hpp>
 #include <asyncfem/integrator/stepFormula.hpp>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -79,15 +80,26 @@ void BackwardEuler::assembleAndFactor() {
 
 const FactorReuseStats* BackwardEuler::factorReuseStats() const { return reuse_ ? &reuse_->stats() : nullptr; }
 
+void BackwardEuler::restartPoint() {
+  if (reuse_) reuse_->requestRefactorization();
+}
+
 RunReport BackwardEuler::report() const {
   RunReport report;
   report.factorNonZeros = free_->solver().stats().factorNonZeros;
-  if (!reuse_) return report;
+  if (linear_) return report;
   std::ostringstream text;
-  text << "reuseFactor: the factor kept as PCG preconditioner is not in the checkpoint, so the resumed run "
-          "refactors at its first step; its frames match an uninterrupted run to about the PCG tolerance ("
-       << options_.pcgTolerance << "), not bit for bit";
-  report.resumeCaveat = text.str();
+  if (!reuse_) {
+    text << "linear solves: exact, one factorization per Newton iteration (reuseFactor off)";
+  } else {
+    const FactorReuseStats& reuse = reuse_->stats();
+    const long long steps = std::max<long long>(stats_.steps, 1);
+    text << "linear solves: kept factor as PCG preconditioner (reuseFactor, relative residual " << options_.pcgTolerance
+         << "): " << reuse.refactorizations << " factorizations in " << stats_.steps << " steps, "
+         << std::setprecision(3) << static_cast<double>(reuse.pcgIterations) / static_cast<double>(steps)
+         << " PCG iterations per step; refactored at every frame start, so a resumed run continues bit for bit";
+  }
+  report.lines.push_back(text.str());
   return report;
 }
 

@@ -409,6 +409,8 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
 
 void advanceFrame(Simulation& simulation, int frame) {
   if (!simulation.monitor) throw Error("advanceFrame: the simulation has no run monitor (use buildSimulation)");
+  // Every frame starts a point a checkpoint may resume from (Integrator::restartPoint()).
+  simulation.integrator->restartPoint();
   simulation.monitor->advanceFrame(*simulation.integrator, frame, simulation.timing.stepsPerFrame);
 }
 

@@ -57,11 +57,12 @@ class FreeSystem;
 /// line search then acts on the linearized first update only (the later ones solve
 /// equations that are no potential's gradient and are taken in full, as in Vega).
 ///
-/// options.reuseFactor (nonlinear models): the system matrix is still assembled at every
-/// step, but solved by a FactorReusingSolver: PCG to options.pcgTolerance preconditioned
-/// by the last numeric factor, refactoring when the iteration count says the factor is
-/// stale. Its counters are factorReuseStats(); refactorizations are also counted in
-/// stats().factorizations.
+/// options.reuseFactor (nonlinear models, the default): the system matrix is still
+/// assembled at every step, but solved by a FactorReusingSolver: PCG to
+/// options.pcgTolerance preconditioned by the last numeric factor, refactoring when the
+/// iteration count says the factor is stale and at every restartPoint() (so a run resumed
+/// at a frame start continues bit for bit). Its counters are factorReuseStats();
+/// refactorizations are also counted in stats().factorizations.
 class BackwardEuler final : public Integrator {
  public:
   /// system: validated; h > 0. Factors at once for linear force models.
@@ -71,6 +72,9 @@ class BackwardEuler final : public Integrator {
   std::string name() const override { return "backward-euler"; }
   void step() override;
   void setTimestep(double timestep) override;
+  /// With a kept factor (reuseFactor): the next step factors its own matrix, so it and the
+  /// steps after it do not depend on the matrices of earlier steps.
+  void restartPoint() override;
 
   const IntegratorOptions& options() const { return options_; }
   /// Newton iterations (factorizations) used by the last step: 1 for the linearized step.
@@ -84,8 +88,8 @@ class BackwardEuler final : public Integrator {
   int lastLineSearchHalvings() const { return lastLineSearchHalvings_; }
   /// PCG and refactorization counters when options().reuseFactor is in effect, else null.
   const FactorReuseStats* factorReuseStats() const;
-  /// The factor non-zeros, and with reuseFactor the caveat that resumed frames match to
-  /// the PCG tolerance only.
+  /// The factor non-zeros and, for nonlinear models, a summary line saying which linear
+  /// solve path ran (exact factorizations, or the kept factor with its counts).
   RunReport report() const override;
 
  private:

@@ -93,6 +93,14 @@ class Integrator {
   const Eigen::VectorXd& velocity() const { return velocity_; }
   double time() const { return time_; }
   double timestep() const { return timestep_; }
+  /// Marks a point a run may later be resumed from (drivers call it at the start of every
+  /// frame, where checkpoints are taken): an integrator whose steps depend on history that
+  /// no checkpoint holds (backward Euler's kept factor with IntegratorOptions::reuseFactor)
+  /// lets go of it here, so the steps that follow depend only on (u, v, t) and
+  /// internalState(), and a run resumed at this point continues bit for bit. Default:
+  /// nothing.
+  virtual void restartPoint() {}
+
   /// Changes h; implicit integrators refactor lazily at the next step.
   virtual void setTimestep(double timestep);
 

@@ -95,7 +95,8 @@ struct Simulation {
 /// or options (IntegratorRegistry::create()).
 Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registry = defaultIntegratorRegistry());
 
-/// Advances the simulation by one frame (stepsPerFrame steps) under its RunMonitor:
+/// Advances the simulation by one frame (stepsPerFrame steps) under its RunMonitor, the
+/// frame's start being a restart point of the integrator (Integrator::restartPoint()):
 /// throws asyncfem::NumericalError with the frame, step, time, vertex and region (as
 /// fields and in the message) for a non-finite state, a blow-up or energy growth. The
 /// state is then unusable; the caller must not store it.
