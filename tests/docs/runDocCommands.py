@@ -61,7 +61,7 @@ DATA_FOLDERS = ["models", "tests/benchmarks/scenes", "tests/data"]
 SHELL_LANGUAGES = {"sh", "bash", "shell", "console"}
 RUN_LANGUAGES = SHELL_LANGUAGES | {"python", "json"}
 MARKER = re.compile(r"^\s*<!--\s*docs-test:\s*(\w+)\b\s?(.*?)\s*-->\s*$")
-ANY_MARKER = re.compile(r"<!--\s*docs-test:")
+ANY_MARKER = re.compile(r"^\s*<!--\s*docs-test:")
 FENCE = re.compile(r"^(\s*)(```+|~~~+)\s*([^\s`]*)")
 SKIPPED = 77
 
