@@ -23,9 +23,8 @@ SubstepObserver observerFromPython(const py::object& callable) {
   };
 }
 
-}  // namespace
-
-void bindAsync(py::module_& module) {
+// The asynchronous integrator's regions, their vertex selection and the partition.
+void bindRegions(py::module_& module) {
   py::class_<AsyncRegion>(module, "AsyncRegion", "A fast region S_i: vertices stepped at hL / ratio")
       .def(py::init([](std::string name, const py::handle& vertices, int ratio) {
              return AsyncRegion{std::move(name), indexListArgument(vertices, "vertices"), ratio};
@@ -93,7 +92,10 @@ void bindAsync(py::module_& module) {
       .def_property_readonly(
           "vertex_region", [](const RegionPartition& p) { return intArray(p.vertexRegion()); },
           "region of every vertex: i for S_i, -1 for L");
+}
 
+// The asynchronous integrator's solver options and run-time region policies.
+void bindAsyncOptions(py::module_& module) {
   py::enum_<SchurMode>(module, "SchurMode",
                        "How the Schur complement of the interface is formed: low-rank update, LU or symmetric")
       .value("low_rank", SchurMode::lowRank)
@@ -163,7 +165,10 @@ void bindAsync(py::module_& module) {
       .def_readonly("moved_vertices", &RepartitionRecord::movedVertices)
       .def_readonly("seconds", &RepartitionRecord::seconds)
       .def_readonly("reused", &RepartitionRecord::reused);
+}
 
+// The asynchronous integrator itself.
+void bindAsyncIntegrator(py::module_& module) {
   py::class_<AsyncBackwardEuler, Integrator>(
       module, "AsyncBackwardEuler",
       "Asynchronous implicit backward Euler: fast regions take ratio substeps per large step, coupled implicitly")
@@ -200,7 +205,11 @@ void bindAsync(py::module_& module) {
            "choose the regions at every large-step boundary with these policies (AdaptiveRegionOptions)")
       .def_property_readonly("repartitions", &AsyncBackwardEuler::repartitions,
                              "every change of partition so far (RepartitionRecord)");
+}
 
+// Automatic regions: the options and the proposal (what a scene's "regions": "auto" and
+// suggestRegions use).
+void bindAutoRegions(py::module_& module) {
   // Automatic regions (what a scene's "regions": "auto" and suggestRegions use).
   module.def("element_max_frequencies", &elementMaxFrequencies, py::arg("mesh"),
              py::call_guard<py::gil_scoped_release>(), "omega_e per element (rad/s), lumped element mass");
@@ -269,6 +278,10 @@ void bindAsync(py::module_& module) {
       .def_readonly("cost", &AutoRegionProposal::cost, "the cost check (AutoRegionCost)")
       .def("summary", &autoRegionSummary, "one line: the regions kept, or which check withdrew them and why")
       .def("async_regions", &AutoRegionProposal::asyncRegions, "the proposed regions, ready for AsyncBackwardEuler");
+}
+
+// suggest_regions, the proposal itself.
+void bindSuggestRegions(py::module_& module) {
   module.def(
       "suggest_regions",
       [](const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
@@ -284,6 +297,16 @@ void bindAsync(py::module_& module) {
       py::arg("mesh"), py::arg("free_dofs"), py::arg("options") = AutoRegionOptions{},
       py::arg("stiffness") = py::none(), py::arg("mass") = py::none(),
       "fast regions and ratios from the element frequencies (modal check with K and M, full 3n matrices)");
+}
+
+}  // namespace
+
+void bindAsync(py::module_& module) {
+  bindRegions(module);
+  bindAsyncOptions(module);
+  bindAsyncIntegrator(module);
+  bindAutoRegions(module);
+  bindSuggestRegions(module);
 }
 
 }  // namespace asyncfem::python
