@@ -11,6 +11,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format-14
   libpetsc-real-dev openmpi-bin ffmpeg
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-scipy python3-pytest python3-matplotlib
+  python3-pip python3-venv python3-setuptools python3-wheel  # pip install . (pyproject.toml, setup.py)
 )
 if [[ "${1:-}" != "--no-render" ]]; then
   # assimp-testmodels: real surfaces for the mesher's property test

@@ -23,9 +23,8 @@ SubstepObserver observerFromPython(const py::object& callable) {
   };
 }
 
-}  // namespace
-
-void bindAsync(py::module_& module) {
+// The asynchronous integrator's regions, their vertex selection and the partition.
+void bindRegions(py::module_& module) {
   py::class_<AsyncRegion>(module, "AsyncRegion", "A fast region S_i: vertices stepped at hL / ratio")
       .def(py::init([](std::string name, const py::handle& vertices, int ratio) {
              return AsyncRegion{std::move(name), indexListArgument(vertices, "vertices"), ratio};
@@ -72,43 +71,52 @@ void bindAsync(py::module_& module) {
             checkIndex(i, partition.numRegions(), "region");
             return partition.region(i);
           },
-          py::arg("index"))
+          py::arg("index"), "the AsyncRegion i")
       .def(
           "region_dofs",
           [](const RegionPartition& partition, int i) {
             checkIndex(i, partition.numRegions(), "region");
             return intArray(partition.regionDofs(i));
           },
-          py::arg("index"))
+          py::arg("index"), "the free DOFs of region S_i (full numbering)")
       .def(
           "interface_dofs",
           [](const RegionPartition& partition, int i) {
             checkIndex(i, partition.numRegions(), "region");
             return intArray(partition.interfaceDofs(i));
           },
-          py::arg("index"))
+          py::arg("index"), "the interface DOFs I_i of region i: DOFs of L in elements touching S_i")
       .def_property_readonly("large_dofs", [](const RegionPartition& p) { return intArray(p.largeDofs()); })
       .def_property_readonly("interface_elements",
                              [](const RegionPartition& p) { return intArray(p.interfaceElements()); })
       .def_property_readonly(
           "vertex_region", [](const RegionPartition& p) { return intArray(p.vertexRegion()); },
           "region of every vertex: i for S_i, -1 for L");
+}
 
-  py::enum_<SchurMode>(module, "SchurMode")
+// The asynchronous integrator's solver options and run-time region policies.
+void bindAsyncOptions(py::module_& module) {
+  py::enum_<SchurMode>(module, "SchurMode",
+                       "How the Schur complement of the interface is formed: low-rank update, LU or symmetric")
       .value("low_rank", SchurMode::lowRank)
       .value("lu", SchurMode::lu)
       .value("symmetric", SchurMode::symmetric);
-  py::enum_<AsyncSolveMethod>(module, "AsyncSolveMethod")
+  py::enum_<AsyncSolveMethod>(module, "AsyncSolveMethod",
+                              "structured (block elimination, the default) or naive (one big solve, for reference)")
       .value("structured", AsyncSolveMethod::structured)
       .value("naive", AsyncSolveMethod::naive);
-  py::enum_<RecoveryMode>(module, "RecoveryMode")
+  py::enum_<RecoveryMode>(module, "RecoveryMode",
+                          "How the fast regions' states are recovered after the interface solve")
       .value("automatic", RecoveryMode::automatic)
       .value("substitution", RecoveryMode::substitution)
       .value("dense_z", RecoveryMode::denseZ);
-  py::enum_<AsyncCoupling>(module, "AsyncCoupling")
+  py::enum_<AsyncCoupling>(module, "AsyncCoupling",
+                           "stable (energy never grows, the default) or paper (the publication's coupling)")
       .value("stable", AsyncCoupling::stable)
       .value("paper", AsyncCoupling::paper);
-  py::class_<AsyncOptions>(module, "AsyncOptions")
+  py::class_<AsyncOptions>(
+      module, "AsyncOptions",
+      "Solver options of AsyncBackwardEuler: coupling, Schur mode, method, recovery, region solver")
       .def(py::init([](AsyncCoupling coupling, SchurMode schur, AsyncSolveMethod method, RecoveryMode recovery,
                        SolverKind regionSolver, bool prediction) {
              return AsyncOptions{coupling, schur, method, recovery, regionSolver, prediction};
@@ -157,7 +165,10 @@ void bindAsync(py::module_& module) {
       .def_readonly("moved_vertices", &RepartitionRecord::movedVertices)
       .def_readonly("seconds", &RepartitionRecord::seconds)
       .def_readonly("reused", &RepartitionRecord::reused);
+}
 
+// The asynchronous integrator itself.
+void bindAsyncIntegrator(py::module_& module) {
   py::class_<AsyncBackwardEuler, Integrator>(
       module, "AsyncBackwardEuler",
       "Asynchronous implicit backward Euler: fast regions take ratio substeps per large step, coupled implicitly")
@@ -184,7 +195,8 @@ void bindAsync(py::module_& module) {
       .def_property_readonly("z_column_seconds", &AsyncBackwardEuler::zColumnSeconds)
       .def_property_readonly("schur_mode_used", &AsyncBackwardEuler::schurModeUsed)
       .def("solve_floor_seconds", &AsyncBackwardEuler::solveFloorSeconds, py::arg("repeats") = 5,
-           py::call_guard<py::gil_scoped_release>())
+           py::call_guard<py::gil_scoped_release>(),
+           "seconds of the solves one large step cannot avoid (median of repeats), the floor a step is compared with")
       .def_property_readonly("factor_non_zeros", &AsyncBackwardEuler::factorNonZeros)
       .def("set_up", &AsyncBackwardEuler::setUp, py::arg("partition"), py::call_guard<py::gil_scoped_release>(),
            "take another partition of the same mesh from the next step on")
@@ -193,36 +205,83 @@ void bindAsync(py::module_& module) {
            "choose the regions at every large-step boundary with these policies (AdaptiveRegionOptions)")
       .def_property_readonly("repartitions", &AsyncBackwardEuler::repartitions,
                              "every change of partition so far (RepartitionRecord)");
+}
 
+// Automatic regions: the options and the proposal (what a scene's "regions": "auto" and
+// suggestRegions use).
+void bindAutoRegions(py::module_& module) {
   // Automatic regions (what a scene's "regions": "auto" and suggestRegions use).
   module.def("element_max_frequencies", &elementMaxFrequencies, py::arg("mesh"),
              py::call_guard<py::gil_scoped_release>(), "omega_e per element (rad/s), lumped element mass");
-  py::class_<AutoRegionOptions>(module, "AutoRegionOptions")
+  py::class_<AutoRegionOptions>(module, "AutoRegionOptions",
+                                "Settings of suggest_regions (the scene's integrator.options.auto)")
       .def(py::init<>())
       .def_readwrite("large_timestep", &AutoRegionOptions::largeTimestep, "hL (s)")
-      .def_readwrite("target_omega_h", &AutoRegionOptions::targetOmegaH)
-      .def_readwrite("relative_threshold", &AutoRegionOptions::relativeThreshold)
-      .def_readwrite("grow_layers", &AutoRegionOptions::growLayers)
-      .def_readwrite("max_ratio", &AutoRegionOptions::maxRatio)
-      .def_readwrite("modal_check", &AutoRegionOptions::modalCheck)
-      .def_readwrite("frame_rate", &AutoRegionOptions::frameRate)
-      .def_readwrite("modal_count", &AutoRegionOptions::modalCount)
-      .def_readwrite("max_modal_count", &AutoRegionOptions::maxModalCount);
-  py::class_<ProposedRegion>(module, "ProposedRegion")
-      .def_readonly("region", &ProposedRegion::region)
-      .def_readonly("max_frequency", &ProposedRegion::maxFrequency)
-      .def_readonly("num_elements", &ProposedRegion::numElements)
-      .def_readonly("num_interface_dofs", &ProposedRegion::numInterfaceDofs);
-  py::class_<AutoRegionProposal>(module, "AutoRegionProposal")
-      .def_readonly("regions", &AutoRegionProposal::regions)
-      .def_readonly("withdrawn_regions", &AutoRegionProposal::withdrawnRegions)
-      .def_readonly("large_region_max_frequency", &AutoRegionProposal::largeRegionMaxFrequency)
-      .def_readonly("large_timestep", &AutoRegionProposal::largeTimestep)
-      .def_readonly("target_omega_h", &AutoRegionProposal::targetOmegaH)
-      .def_readonly("modal_seconds", &AutoRegionProposal::modalSeconds)
-      .def_property_readonly("has_modal_report",
-                             [](const AutoRegionProposal& proposal) { return proposal.modalReport.has_value(); })
+      .def_readwrite("target_omega_h", &AutoRegionOptions::targetOmegaH,
+                     "target omega h in every region; <= 0: relative mode")
+      .def_readwrite("relative_threshold", &AutoRegionOptions::relativeThreshold,
+                     "relative mode: elements above this multiple of the median element frequency become fast")
+      .def_readwrite("grow_layers", &AutoRegionOptions::growLayers, "vertex rings added around each region")
+      .def_readwrite("max_ratio", &AutoRegionOptions::maxRatio, "largest ratio m proposed")
+      .def_readwrite("modal_check", &AutoRegionOptions::modalCheck,
+                     "withdraw the regions when no visible mode lives in them (needs stiffness and mass)")
+      .def_readwrite("frame_rate", &AutoRegionOptions::frameRate, "frames per second, for the visibility test")
+      .def_readwrite("modal_count", &AutoRegionOptions::modalCount, "modes computed first by the modal check")
+      .def_readwrite("max_modal_count", &AutoRegionOptions::maxModalCount,
+                     "modes computed at most (doubled while the highest is still visible)")
+      .def_readwrite("max_regions", &AutoRegionOptions::maxRegions,
+                     "regions kept at most; the others move to capped_regions")
+      .def_readwrite("cost_check", &AutoRegionOptions::costCheck,
+                     "withdraw the regions unless async is estimated cheaper than single-rate")
+      .def_readwrite("cost_margin", &AutoRegionOptions::costMargin, "async must cost below this times single-rate")
+      .def_readwrite("nonlinear", &AutoRegionOptions::nonlinear,
+                     "corotational forces: both sides refactor every step in the cost model");
+  py::class_<ProposedRegion>(module, "ProposedRegion", "One region of an AutoRegionProposal with its statistics")
+      .def_readonly("region", &ProposedRegion::region, "the AsyncRegion")
+      .def_readonly("max_frequency", &ProposedRegion::maxFrequency, "max omega_e over its elements (rad/s)")
+      .def_readonly("num_elements", &ProposedRegion::numElements, "elements with every vertex in the region")
+      .def_readonly("num_interface_dofs", &ProposedRegion::numInterfaceDofs, "|I| once partitioned")
+      .def_readonly("ratio_from_elements", &ProposedRegion::ratioFromElements,
+                    "the element criterion's ratio when the modal check raised it, else 0");
+  py::class_<AutoRegionCost>(module, "AutoRegionCost",
+                             "The cost check of a proposal: flops per large step of async against single-rate")
+      .def_readonly("evaluated", &AutoRegionCost::evaluated, "whether the check ran")
+      .def_readonly("free_dofs", &AutoRegionCost::freeDofs, "free DOFs of the problem")
+      .def_readonly("large_dofs", &AutoRegionCost::largeDofs, "|L| once the regions are taken out")
+      .def_readonly("interface_dofs", &AutoRegionCost::interfaceDofs, "sum of |I_i|")
+      .def_readonly("single_rate_substeps", &AutoRegionCost::singleRateSubsteps,
+                    "single-rate steps per large step (the largest ratio)")
+      .def_readonly("single_rate_flops", &AutoRegionCost::singleRateFlops, "per large step")
+      .def_readonly("async_flops", &AutoRegionCost::asyncFlops, "per large step, steady state")
+      .def_readonly("async_cheaper", &AutoRegionCost::asyncCheaper, "the verdict of the check")
+      .def_readonly("decision", &AutoRegionCost::decision, "one line: the numbers and what was decided")
+      .def("ratio", &AutoRegionCost::ratio, "async flops / single-rate flops");
+  py::class_<AutoRegionProposal>(module, "AutoRegionProposal",
+                                 "What suggest_regions proposes, withdraws and why (as_dict: the suggestRegions "
+                                 "--json document)")
+      .def_readonly("regions", &AutoRegionProposal::regions, "the kept regions (ProposedRegion)")
+      .def_readonly("withdrawn_regions", &AutoRegionProposal::withdrawnRegions,
+                    "regions the modal check withdrew (no visible mode lives in them)")
+      .def_readonly("cost_withdrawn_regions", &AutoRegionProposal::costWithdrawnRegions,
+                    "regions the cost check withdrew")
+      .def_readonly("capped_regions", &AutoRegionProposal::cappedRegions, "regions beyond max_regions")
+      .def_readonly("large_region_max_frequency", &AutoRegionProposal::largeRegionMaxFrequency,
+                    "max omega_e over the elements left in L (rad/s)")
+      .def_readonly("large_timestep", &AutoRegionProposal::largeTimestep, "hL (s)")
+      .def_readonly("target_omega_h", &AutoRegionProposal::targetOmegaH, "the target omega h in effect")
+      .def_readonly("modal_seconds", &AutoRegionProposal::modalSeconds, "time of the modal check's eigensolves")
+      .def_property_readonly(
+          "has_modal_report", [](const AutoRegionProposal& proposal) { return proposal.modalReport.has_value(); },
+          "whether the modal check ran")
+      .def_readonly("modal_report", &AutoRegionProposal::modalReport,
+                    "the modal check's RegionModeReport of the proposed regions, or None")
+      .def_readonly("cost", &AutoRegionProposal::cost, "the cost check (AutoRegionCost)")
+      .def("summary", &autoRegionSummary, "one line: the regions kept, or which check withdrew them and why")
       .def("async_regions", &AutoRegionProposal::asyncRegions, "the proposed regions, ready for AsyncBackwardEuler");
+}
+
+// suggest_regions, the proposal itself.
+void bindSuggestRegions(py::module_& module) {
   module.def(
       "suggest_regions",
       [](const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
@@ -238,6 +297,16 @@ void bindAsync(py::module_& module) {
       py::arg("mesh"), py::arg("free_dofs"), py::arg("options") = AutoRegionOptions{},
       py::arg("stiffness") = py::none(), py::arg("mass") = py::none(),
       "fast regions and ratios from the element frequencies (modal check with K and M, full 3n matrices)");
+}
+
+}  // namespace
+
+void bindAsync(py::module_& module) {
+  bindRegions(module);
+  bindAsyncOptions(module);
+  bindAsyncIntegrator(module);
+  bindAutoRegions(module);
+  bindSuggestRegions(module);
 }
 
 }  // namespace asyncfem::python

@@ -124,9 +124,10 @@ void bindForceModels(py::module_& module) {
       "forces_and_tangent(u) -> (f, K), elastic_energy(u). Call ForceModel.__init__(self) first. Every "
       "evaluation is a Python call that converts u, f and K: slow, for prototyping only.")
       .def(py::init_alias<>())
-      .def("num_dofs", &ForceModel::numDofs)
-      .def("is_linear", &ForceModel::isLinear)
-      .def("create_stiffness_matrix", &ForceModel::createStiffnessMatrix)
+      .def("num_dofs", &ForceModel::numDofs, "3n, the length of u and f")
+      .def("is_linear", &ForceModel::isLinear, "True when the tangent does not depend on u")
+      .def("create_stiffness_matrix", &ForceModel::createStiffnessMatrix,
+           "a csc_matrix with the pattern every tangent has (values zero)")
       .def(
           "internal_forces",
           [](ForceModel& model, const py::handle& u) {
@@ -168,7 +169,7 @@ void bindForceModels(py::module_& module) {
             py::gil_scoped_release release;
             return model.elasticEnergy(displacement);
           },
-          py::arg("displacement"))
+          py::arg("displacement"), "the elastic energy at displacement u")
       .def(
           "element_tangent",
           [](const ForceModel& model, const py::handle& u, int element) -> py::object {
@@ -190,7 +191,10 @@ void bindForceModels(py::module_& module) {
       .def(py::init<Sparse>(), py::arg("stiffness"))
       .def_property_readonly("stiffness", &LinearForceModel::stiffness);
 
-  py::enum_<TangentKind>(module, "TangentKind").value("simple", TangentKind::simple).value("exact", TangentKind::exact);
+  py::enum_<TangentKind>(module, "TangentKind",
+                         "Corotational tangent: simple (R K0 R^T) or exact (with the rotation's derivative)")
+      .value("simple", TangentKind::simple)
+      .value("exact", TangentKind::exact);
   py::class_<CorotationalLinearFEM, ForceModel, std::shared_ptr<CorotationalLinearFEM>>(
       module, "CorotationalLinearFEM", "Corotated linear FEM (Mueller & Gross 2004) with the simple or exact tangent")
       .def(py::init<const TetMesh&, TangentKind>(), py::arg("mesh"), py::arg("tangent_kind") = TangentKind::simple,

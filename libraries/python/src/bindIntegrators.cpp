@@ -114,9 +114,13 @@ void bindIntegrators(py::module_& module) {
           "callable f(time, u, v) -> (3n,) array or None, added to the external force; one Python call per "
           "evaluation (slow for large meshes)")
       .def_property_readonly("num_dofs", [](const PythonDynamicSystem& s) { return s.system.numDofs(); })
-      .def("validate", [](const PythonDynamicSystem& s) { (void)checkedSystem(s); });
+      .def(
+          "validate", [](const PythonDynamicSystem& s) { (void)checkedSystem(s); },
+          "checks that the parts fit together (ValueError naming the field)");
 
-  py::class_<IntegratorOptions>(module, "IntegratorOptions")
+  py::class_<IntegratorOptions>(
+      module, "IntegratorOptions",
+      "Options of the single-rate integrators: solver, Newton iterations and tolerance, line search, factor reuse")
       .def(py::init([](SolverKind solver, int maxIterations, double tolerance, double maxFrequency, bool force,
                        bool lineSearch, bool rayleighStiffnessAtIterate, bool reuseFactor, double pcgTolerance) {
              IntegratorOptions options;  // by name: the struct gains fields over time
@@ -145,7 +149,8 @@ void bindIntegrators(py::module_& module) {
       .def_readwrite("pcg_tolerance", &IntegratorOptions::pcgTolerance)
       .def_readwrite("force", &IntegratorOptions::force);
 
-  py::class_<IntegratorStats>(module, "IntegratorStats")
+  py::class_<IntegratorStats>(module, "IntegratorStats",
+                              "Time and work of an integrator so far: seconds per phase, steps, factorizations, flops")
       .def_readonly("force_seconds", &IntegratorStats::forceSeconds)
       .def_readonly("assembly_seconds", &IntegratorStats::assemblySeconds)
       .def_readonly("factorization_seconds", &IntegratorStats::factorizationSeconds)
@@ -161,7 +166,8 @@ void bindIntegrators(py::module_& module) {
       .def_property_readonly("name", &Integrator::name)
       .def("step", &stepIntegrator, py::arg("count") = 1,
            "advances by count steps (large steps for async), without the GIL")
-      .def("stable_timestep_estimate", &Integrator::stableTimestepEstimate)
+      .def("stable_timestep_estimate", &Integrator::stableTimestepEstimate,
+           "estimate of the largest stable timestep (infinity for unconditionally stable schemes)")
       .def(
           "set_state",
           [](Integrator& integrator, const py::handle& u, const py::handle& v, double time) {
@@ -172,13 +178,14 @@ void bindIntegrators(py::module_& module) {
           },
           py::arg("displacement"), py::arg("velocity"), py::arg("time") = 0.0,
           "sets u, v (3n; fixed entries zeroed) and the time")
-      .def("internal_state", &Integrator::internalState)
+      .def("internal_state", &Integrator::internalState,
+           "state beyond (u, v, t) needed to continue exactly (trapezoidal a_k; empty for most)")
       .def(
           "set_internal_state",
           [](Integrator& integrator, const py::handle& state) {
             integrator.setInternalState(toVector(state, "state"));
           },
-          py::arg("state"))
+          py::arg("state"), "restores internal_state() (with set_state) to continue a run exactly")
       .def_property_readonly(
           "displacement",
           [](py::object self) { return readOnlyVectorView(self.cast<const Integrator&>().displacement(), self); },
@@ -190,7 +197,8 @@ void bindIntegrators(py::module_& module) {
       .def_property_readonly("time", &Integrator::time)
       .def_property("timestep", &Integrator::timestep, &Integrator::setTimestep,
                     "h; setting it refactors implicit integrators at the next step")
-      .def("set_timestep", &Integrator::setTimestep, py::arg("timestep"))
+      .def("set_timestep", &Integrator::setTimestep, py::arg("timestep"),
+           "sets h; implicit integrators refactor at the next step")
       .def("mechanical_energy", &Integrator::mechanicalEnergy, py::call_guard<py::gil_scoped_release>(),
            "v^T M v / 2 + elastic energy")
       .def_property_readonly("stats", &Integrator::stats)
@@ -219,7 +227,8 @@ void bindIntegrators(py::module_& module) {
         py::gil_scoped_release release;
         return makeIntegrator(name, std::move(copy), timestep, options);
       },
-      py::arg("name"), py::arg("system"), py::arg("timestep"), py::arg("options") = IntegratorOptions{});
+      py::arg("name"), py::arg("system"), py::arg("timestep"), py::arg("options") = IntegratorOptions{},
+      "the integrator registered under name (integrator_names()) for this system and timestep");
 
   module.def("estimate_max_frequency", py::overload_cast<const TetMesh&, MassType>(&estimateMaxFrequency),
              py::arg("mesh"), py::arg("mass_type"), py::call_guard<py::gil_scoped_release>(),

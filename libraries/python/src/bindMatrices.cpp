@@ -25,7 +25,9 @@ void checkAssembler(const TetMesh& mesh, const MatrixAssembler& assembler) {
 }  // namespace
 
 void bindMatrices(py::module_& module) {
-  py::enum_<MassType>(module, "MassType").value("consistent", MassType::consistent).value("lumped", MassType::lumped);
+  py::enum_<MassType>(module, "MassType", "Mass matrix: consistent (the FEM integral) or lumped (diagonal)")
+      .value("consistent", MassType::consistent)
+      .value("lumped", MassType::lumped);
 
   py::class_<MatrixAssembler, std::shared_ptr<MatrixAssembler>>(
       module, "MatrixAssembler",
@@ -95,8 +97,10 @@ void bindMatrices(py::module_& module) {
       py::arg("rest_positions"), "(3 x 4 gradients, signed volume) of a tet with vertex columns rest_positions");
   module.def("linear_element_stiffness", &linearElementStiffness, py::arg("rest_positions"), py::arg("youngs_modulus"),
              py::arg("poisson_ratio"), "12 x 12 V B^T C B");
-  module.def("consistent_element_mass", &consistentElementMass, py::arg("volume"), py::arg("density"));
-  module.def("lumped_element_mass", &lumpedElementMass, py::arg("volume"), py::arg("density"));
+  module.def("consistent_element_mass", &consistentElementMass, py::arg("volume"), py::arg("density"),
+             "12 x 12 consistent mass matrix of a tet of this volume and density");
+  module.def("lumped_element_mass", &lumpedElementMass, py::arg("volume"), py::arg("density"),
+             "12 x 12 lumped (diagonal) mass matrix of a tet of this volume and density");
 
   py::class_<FreeDofs>(module, "FreeDofs", "Split of the 3n DOFs into fixed and free ones")
       .def(py::init([](int numDofs, const py::handle& fixed) {
@@ -120,7 +124,7 @@ void bindMatrices(py::module_& module) {
             checkIndex(dof, dofs.numDofs(), "DOF");
             return dofs.isFixed(dof);
           },
-          py::arg("dof"))
+          py::arg("dof"), "whether a DOF (0 to 3n - 1) is fixed")
       .def(
           "restrict",
           [](const FreeDofs& dofs, const py::handle& full) {

@@ -111,14 +111,14 @@ void bindMesh(py::module_& module) {
             checkVertex(mesh, v);
             return Eigen::Vector3d(mesh.restPosition(v));
           },
-          py::arg("vertex"))
+          py::arg("vertex"), "rest position of a vertex (3,)")
       .def(
           "element",
           [](const TetMesh& mesh, int e) {
             checkElement(mesh, e);
             return Eigen::Vector4i(mesh.element(e));
           },
-          py::arg("element"))
+          py::arg("element"), "the four vertex ids of an element")
       .def(
           "element_rest_positions",
           [](const TetMesh& mesh, int e) {
@@ -134,19 +134,20 @@ void bindMesh(py::module_& module) {
             checkElement(mesh, e);
             return mesh.elementMaterial(e);
           },
-          py::arg("element"))
+          py::arg("element"), "the Material of an element")
       .def("find_material", &TetMesh::findMaterial, py::arg("name"), "index of the material, or -1")
       .def("add_material", &TetMesh::addMaterial, py::arg("material"),
            "adds (or replaces the one with the same name) and returns its index")
-      .def("assign_material", &TetMesh::assignMaterial, py::arg("element_set"), py::arg("material_index"))
+      .def("assign_material", &TetMesh::assignMaterial, py::arg("element_set"), py::arg("material_index"),
+           "gives the elements of a set the material at material_index")
       .def_property_readonly("element_sets", [](const TetMesh& mesh) { return setsDict(mesh.elementSets()); })
       .def_property_readonly("vertex_sets", [](const TetMesh& mesh) { return setsDict(mesh.vertexSets()); })
       .def(
           "element_set", [](const TetMesh& mesh, const std::string& name) { return intArray(mesh.elementSet(name)); },
-          py::arg("name"))
+          py::arg("name"), "element ids of a named element set")
       .def(
           "vertex_set", [](const TetMesh& mesh, const std::string& name) { return intArray(mesh.vertexSet(name)); },
-          py::arg("name"))
+          py::arg("name"), "vertex ids of a named vertex set")
       .def(
           "set_vertices", [](const TetMesh& mesh, const std::string& name) { return intArray(mesh.setVertices(name)); },
           py::arg("name"), "the vertex set called name, else the vertices of the element set called name")
@@ -155,27 +156,29 @@ void bindMesh(py::module_& module) {
           [](TetMesh& mesh, const std::string& name, const py::handle& members) {
             mesh.setElementSet(name, indexListArgument(members, "elements"));
           },
-          py::arg("name"), py::arg("elements"))
+          py::arg("name"), py::arg("elements"), "creates or replaces an element set")
       .def(
           "set_vertex_set",
           [](TetMesh& mesh, const std::string& name, const py::handle& members) {
             mesh.setVertexSet(name, indexListArgument(members, "vertices"));
           },
-          py::arg("name"), py::arg("vertices"))
+          py::arg("name"), py::arg("vertices"), "creates or replaces a vertex set")
       .def(
           "set_element",
           [](TetMesh& mesh, int e, const Eigen::Vector4i& vertices) {
             checkElement(mesh, e);
             mesh.setElement(e, vertices);
           },
-          py::arg("element"), py::arg("vertices"))
+          py::arg("element"), py::arg("vertices"), "replaces the four vertex ids of an element")
       .def("__repr__", [](const TetMesh& mesh) {
         return "TetMesh(" + std::to_string(mesh.numVertices()) + " vertices, " + std::to_string(mesh.numElements()) +
                " elements, " + std::to_string(mesh.materials().size()) + " materials)";
       });
 
   // Readers.
-  py::class_<MeshReadOptions>(module, "MeshReadOptions")
+  py::class_<MeshReadOptions>(
+      module, "MeshReadOptions",
+      "Options of the mesh readers: default material, reorientation of inverted elements, degenerate volume tolerance")
       .def(py::init([](std::optional<Material> defaultMaterial, bool reorient, double tolerance) {
              return MeshReadOptions{std::move(defaultMaterial), reorient, tolerance};
            }),
@@ -184,7 +187,9 @@ void bindMesh(py::module_& module) {
       .def_readwrite("default_material", &MeshReadOptions::defaultMaterial)
       .def_readwrite("reorient_inverted_elements", &MeshReadOptions::reorientInvertedElements)
       .def_readwrite("degenerate_volume_tolerance", &MeshReadOptions::degenerateVolumeTolerance);
-  py::class_<MeshReadReport>(module, "MeshReadReport")
+  py::class_<MeshReadReport>(
+      module, "MeshReadReport",
+      "What a mesh reader noticed: format, warnings, reoriented elements, unused vertices, ignored elements")
       .def(py::init<>())
       .def_readonly("format", &MeshReadReport::format)
       .def_readonly("warnings", &MeshReadReport::warnings)
@@ -219,7 +224,9 @@ void bindMesh(py::module_& module) {
       py::arg("path"), py::arg("num_vertices"), "Vega .bou: sorted unique 0-based vertex ids");
 
   // Writers.
-  py::enum_<VtuEncoding>(module, "VtuEncoding").value("binary", VtuEncoding::binary).value("ascii", VtuEncoding::ascii);
+  py::enum_<VtuEncoding>(module, "VtuEncoding", ".vtu data encoding: binary (raw appended) or ascii")
+      .value("binary", VtuEncoding::binary)
+      .value("ascii", VtuEncoding::ascii);
   module.def("write_veg", &writeVeg, py::arg("path"), py::arg("mesh"), Release(),
              "Vega .veg that read_veg reads back exactly");
   module.def(
@@ -256,15 +263,19 @@ void bindMesh(py::module_& module) {
             py::gil_scoped_release release;
             writer.writeFrame(frame, time, mesh, u);
           },
-          py::arg("frame"), py::arg("time"), py::arg("mesh"), py::arg("displacement"))
-      .def("add_existing_frame", &VtuSeriesWriter::addExistingFrame, py::arg("frame"), py::arg("time"))
-      .def("write_collection", &VtuSeriesWriter::writeCollection)
+          py::arg("frame"), py::arg("time"), py::arg("mesh"), py::arg("displacement"),
+          "writes FOLDER/frame_NNNNN.vtu (rest positions and the displacement array) and rewrites frames.pvd")
+      .def("add_existing_frame", &VtuSeriesWriter::addExistingFrame, py::arg("frame"), py::arg("time"),
+           "lists a frame already on disk in frames.pvd (for resumed runs)")
+      .def("write_collection", &VtuSeriesWriter::writeCollection,
+           "writes the .pvd collection of the frames written so far")
       .def_property_readonly("folder", &VtuSeriesWriter::folder)
       .def_property_readonly("collection_path", &VtuSeriesWriter::collectionPath)
-      .def_static("frame_file_name", &VtuSeriesWriter::frameFileName, py::arg("frame"));
+      .def_static("frame_file_name", &VtuSeriesWriter::frameFileName, py::arg("frame"),
+                  "the file name of frame k (frame_NNNNN.vtu)");
 
   // Generators.
-  py::class_<BoxRegion>(module, "BoxRegion")
+  py::class_<BoxRegion>(module, "BoxRegion", "A box of a generated mesh whose elements get their own material and set")
       .def(py::init([](std::string name, const Eigen::Vector3d& min, const Eigen::Vector3d& max, Material material) {
              return BoxRegion{std::move(name), min, max, std::move(material)};
            }),
@@ -273,7 +284,7 @@ void bindMesh(py::module_& module) {
       .def_readwrite("min", &BoxRegion::min)
       .def_readwrite("max", &BoxRegion::max)
       .def_readwrite("material", &BoxRegion::material);
-  py::class_<BoxMeshSpec>(module, "BoxMeshSpec")
+  py::class_<BoxMeshSpec>(module, "BoxMeshSpec", "Settings of make_box_mesh: origin, size, cells, material, regions")
       .def(py::init<>())
       .def_readwrite("origin", &BoxMeshSpec::origin)
       .def_readwrite("size", &BoxMeshSpec::size)
@@ -282,7 +293,8 @@ void bindMesh(py::module_& module) {
       .def_readwrite("regions", &BoxMeshSpec::regions);
   module.def("make_box_mesh", &makeBoxMesh, py::arg("spec"), Release(),
              "box cut into cubes of six tets; vertex sets xmin..zmax, plus the regions' sets");
-  py::class_<BeamSpec>(module, "BeamSpec")
+  py::class_<BeamSpec>(module, "BeamSpec",
+                       "Settings of make_beam_mesh: the default scene's cantilever with a stiff tip")
       .def(py::init<>())
       .def_readwrite("length", &BeamSpec::length)
       .def_readwrite("height", &BeamSpec::height)
@@ -293,7 +305,8 @@ void bindMesh(py::module_& module) {
       .def_readwrite("tip", &BeamSpec::tip);
   module.def("make_beam_mesh", &makeBeamMesh, py::arg("spec") = BeamSpec{}, Release(),
              "cantilever along +x: sets 'root' (x = 0), 'tip' (stiff, light last tip_fraction)");
-  py::class_<CellBlock>(module, "CellBlock")
+  py::class_<CellBlock>(module, "CellBlock",
+                        "A block of lattice cells [begin, end) with a material and a set name (make_cell_mesh)")
       .def(py::init([](std::string name, const Eigen::Vector3i& begin, const Eigen::Vector3i& end, Material material) {
              return CellBlock{std::move(name), begin, end, std::move(material)};
            }),
@@ -302,7 +315,8 @@ void bindMesh(py::module_& module) {
       .def_readwrite("begin", &CellBlock::begin)
       .def_readwrite("end", &CellBlock::end)
       .def_readwrite("material", &CellBlock::material);
-  py::class_<CellVertexRing>(module, "CellVertexRing")
+  py::class_<CellVertexRing>(module, "CellVertexRing",
+                             "A vertex set of rings of vertices around element sets (make_cell_mesh)")
       .def(py::init([](std::string name, std::vector<std::string> around, int rings) {
              return CellVertexRing{std::move(name), std::move(around), rings};
            }),
@@ -310,29 +324,32 @@ void bindMesh(py::module_& module) {
       .def_readwrite("name", &CellVertexRing::name)
       .def_readwrite("around", &CellVertexRing::around)
       .def_readwrite("rings", &CellVertexRing::rings);
-  py::class_<CellMeshSpec>(module, "CellMeshSpec")
+  py::class_<CellMeshSpec>(module, "CellMeshSpec",
+                           "Settings of make_cell_mesh: cell size, origin, blocks, vertex rings")
       .def(py::init<>())
       .def_readwrite("origin", &CellMeshSpec::origin)
       .def_readwrite("cell_size", &CellMeshSpec::cellSize)
       .def_readwrite("blocks", &CellMeshSpec::blocks)
       .def_readwrite("vertex_rings", &CellMeshSpec::vertexRings);
   module.def("make_cell_mesh", &makeCellMesh, py::arg("spec"), Release(), "union of lattice cells, conforming");
-  py::class_<AntennaSpec>(module, "AntennaSpec")
+  py::class_<AntennaSpec>(module, "AntennaSpec", "Settings of make_antenna_mesh: a light rod on a heavy block")
       .def(py::init<>())
       .def_readwrite("cell_size", &AntennaSpec::cellSize)
       .def_readwrite("block_cells", &AntennaSpec::blockCells)
       .def_readwrite("rod_cells", &AntennaSpec::rodCells)
       .def_readwrite("block", &AntennaSpec::block)
       .def_readwrite("rod", &AntennaSpec::rod);
-  module.def("make_antenna_mesh", &makeAntennaMesh, py::arg("spec") = AntennaSpec{}, Release());
-  py::class_<SnailSpec>(module, "SnailSpec")
+  module.def("make_antenna_mesh", &makeAntennaMesh, py::arg("spec") = AntennaSpec{}, Release(),
+             "the antenna mesh (models/antenna): a light, soft rod on a heavy block");
+  py::class_<SnailSpec>(module, "SnailSpec", "Settings of make_snail_mesh: a heavy shell with light eye tentacles")
       .def(py::init<>())
       .def_readwrite("cell_size", &SnailSpec::cellSize)
       .def_readwrite("tentacle_cells", &SnailSpec::tentacleCells)
       .def_readwrite("body", &SnailSpec::body)
       .def_readwrite("shell", &SnailSpec::shell)
       .def_readwrite("tentacles", &SnailSpec::tentacles);
-  module.def("make_snail_mesh", &makeSnailMesh, py::arg("spec") = SnailSpec{}, Release());
+  module.def("make_snail_mesh", &makeSnailMesh, py::arg("spec") = SnailSpec{}, Release(),
+             "the snail mesh (models/snail): a heavy shell with light eye tentacles");
 
   // Queries.
   module.def(
@@ -341,10 +358,10 @@ void bindMesh(py::module_& module) {
         checkElement(mesh, e);
         return signedElementVolume(mesh, e);
       },
-      py::arg("mesh"), py::arg("element"));
+      py::arg("mesh"), py::arg("element"), "signed volume of an element (negative when inverted)");
   module.def("element_volumes", &elementVolumes, py::arg("mesh"), Release(), "|V| per element");
-  module.def("total_volume", &totalVolume, py::arg("mesh"), Release());
-  module.def("total_mass", &totalMass, py::arg("mesh"), Release());
+  module.def("total_volume", &totalVolume, py::arg("mesh"), Release(), "total volume of the mesh");
+  module.def("total_mass", &totalMass, py::arg("mesh"), Release(), "total mass of the mesh (densities times volumes)");
   module.def(
       "boundary_triangles",
       [](const TetMesh& mesh) {
@@ -363,7 +380,7 @@ void bindMesh(py::module_& module) {
         return py::make_tuple(intArray(adjacency.offsets), intArray(adjacency.elements));
       },
       py::arg("mesh"), "(offsets, elements): the elements of vertex v are elements[offsets[v]:offsets[v+1]]");
-  py::class_<BoundingBox>(module, "BoundingBox")
+  py::class_<BoundingBox>(module, "BoundingBox", "An axis-aligned box (min, max corners)")
       .def(py::init([](const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
              return BoundingBox{min, max};
            }),
@@ -376,8 +393,9 @@ void bindMesh(py::module_& module) {
         return boundingBox(
             mesh, displacement.is_none() ? Eigen::VectorXd() : toVector(displacement, "displacement", mesh.numDofs()));
       },
-      py::arg("mesh"), py::arg("displacement") = py::none());
-  py::class_<ElementQuality>(module, "ElementQuality")
+      py::arg("mesh"), py::arg("displacement") = py::none(), "the axis-aligned bounding box of the rest positions");
+  py::class_<ElementQuality>(module, "ElementQuality",
+                             "Quality of one element: smallest and largest dihedral angle, aspect ratio")
       .def_readonly("min_dihedral_angle", &ElementQuality::minDihedralAngle, "radians")
       .def_readonly("max_dihedral_angle", &ElementQuality::maxDihedralAngle, "radians")
       .def_readonly("aspect_ratio", &ElementQuality::aspectRatio, "1 for the regular tetrahedron");
@@ -387,7 +405,7 @@ void bindMesh(py::module_& module) {
         checkElement(mesh, e);
         return elementQuality(mesh, e);
       },
-      py::arg("mesh"), py::arg("element"));
+      py::arg("mesh"), py::arg("element"), "dihedral angles and aspect ratio of one element");
   module.def(
       "element_qualities",
       [](const TetMesh& mesh) {
@@ -408,7 +426,8 @@ void bindMesh(py::module_& module) {
       },
       py::arg("mesh"), "dict of per-element arrays: min_dihedral_angle, max_dihedral_angle, aspect_ratio");
   module.def(
-      "unused_vertices", [](const TetMesh& mesh) { return intArray(unusedVertices(mesh)); }, py::arg("mesh"));
+      "unused_vertices", [](const TetMesh& mesh) { return intArray(unusedVertices(mesh)); }, py::arg("mesh"),
+      "ids of the vertices no element uses");
 }
 
 }  // namespace asyncfem::python

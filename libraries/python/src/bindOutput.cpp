@@ -7,7 +7,8 @@
 namespace asyncfem::python {
 
 void bindOutput(py::module_& module) {
-  py::class_<SimulationFileHeader>(module, "SimulationFileHeader")
+  py::class_<SimulationFileHeader>(module, "SimulationFileHeader",
+                                   "Header of an .afsim file: vertices, frame interval, timestep, velocities")
       .def(py::init([](std::int64_t numVertices, double frameInterval, double timestep, bool hasVelocities) {
              SimulationFileHeader header;
              header.numVertices = numVertices;
@@ -24,7 +25,8 @@ void bindOutput(py::module_& module) {
       .def_readwrite("has_velocities", &SimulationFileHeader::hasVelocities)
       .def_property_readonly("record_bytes", &SimulationFileHeader::recordBytes);
 
-  py::class_<SimulationFrame>(module, "SimulationFrame")
+  py::class_<SimulationFrame>(module, "SimulationFrame",
+                              "One frame read from an .afsim file: index, time, displacement (and velocity)")
       .def_readonly("index", &SimulationFrame::index)
       .def_readonly("time", &SimulationFrame::time)
       .def_readonly("displacement", &SimulationFrame::displacement)
@@ -52,11 +54,12 @@ void bindOutput(py::module_& module) {
               writer.appendFrame(time, asVector(u), asVector(v));
             }
           },
-          py::arg("time"), py::arg("displacement"), py::arg("velocity") = py::none())
+          py::arg("time"), py::arg("displacement"), py::arg("velocity") = py::none(),
+          "appends one frame (time, displacement 3n, optional velocity) and flushes it")
       .def_property_readonly("num_frames", &SimulationWriter::numFrames)
       .def_property_readonly("header", &SimulationWriter::header)
       .def_property_readonly("path", &SimulationWriter::path)
-      .def("close", &SimulationWriter::close)
+      .def("close", &SimulationWriter::close, "closes the file (frames already appended stay readable)")
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](SimulationWriter& writer, const py::args&) { writer.close(); });
 
@@ -67,7 +70,7 @@ void bindOutput(py::module_& module) {
       .def_property_readonly("num_vertices", &SimulationReader::numVertices)
       .def_property_readonly("num_frames", &SimulationReader::numFrames)
       .def_property_readonly("truncated_trailing_bytes", &SimulationReader::truncatedTrailingBytes)
-      .def("refresh", &SimulationReader::refresh)
+      .def("refresh", &SimulationReader::refresh, "re-reads the file size, for a file another process is still writing")
       .def(
           "read_frame",
           [](SimulationReader& reader, std::int64_t k) {
@@ -75,8 +78,9 @@ void bindOutput(py::module_& module) {
             py::gil_scoped_release release;
             return reader.readFrame(k);
           },
-          py::arg("frame"))
-      .def("verify_all", &SimulationReader::verifyAll, py::call_guard<py::gil_scoped_release>())
+          py::arg("frame"), "frame k, its checksum and index verified (ParseError naming the frame otherwise)")
+      .def("verify_all", &SimulationReader::verifyAll, py::call_guard<py::gil_scoped_release>(),
+           "checks the checksum of every complete frame (ParseError naming the first bad one)")
       .def("__len__", &SimulationReader::numFrames)
       .def(
           "displacements",

@@ -94,7 +94,7 @@ void bindRender(py::module_& module) {
              py::arg("view_direction") = defaultViewDirection(), py::arg("up") = Eigen::Vector3d::UnitY(),
              py::arg("vertical_field_of_view_degrees") = 30.0, py::arg("margin") = 0.08,
              "camera that sees the whole box (aspect = width / height)");
-  py::class_<GroundPlane>(module, "GroundPlane")
+  py::class_<GroundPlane>(module, "GroundPlane", "A checkered ground square under the mesh, optionally with its shadow")
       .def(py::init([](const Eigen::Vector3d& center, double halfSize, double tileSize, bool shadow) {
              return GroundPlane{center, halfSize, tileSize, shadow};
            }),

@@ -47,7 +47,7 @@ void bindProblem(py::module_& module) {
       .def_readonly("start", &VertexLoad::start)
       .def_readonly("end", &VertexLoad::end)
       .def_readonly("left_open", &VertexLoad::leftOpen)
-      .def("active", &VertexLoad::active, py::arg("time"));
+      .def("active", &VertexLoad::active, py::arg("time"), "whether the load acts at this time");
 
   py::class_<ProblemSettings>(module, "ProblemSettings", "Physics of a problem beyond its mesh, boundary and loads")
       .def(py::init(
@@ -84,11 +84,19 @@ void bindProblem(py::module_& module) {
       .def_property_readonly("settings", &Problem::settings)
       .def_property_readonly("loads", &Problem::windows)
       .def_property_readonly("assemblies", &Problem::assemblies)
-      .def("mass_matrix", &Problem::massMatrix, py::call_guard<py::gil_scoped_release>())
-      .def("stiffness_matrix", &Problem::stiffnessMatrix, py::call_guard<py::gil_scoped_release>())
-      .def("breakpoints", [](const Problem& p) { return p.loads()->breakpoints(); })
-      .def("last_change", [](const Problem& p) { return p.loads()->lastChange(); })
-      .def("constant_load", [](const Problem& p) { return Eigen::VectorXd(p.loads()->constantPart(p.numDofs())); })
+      .def("mass_matrix", &Problem::massMatrix, py::call_guard<py::gil_scoped_release>(),
+           "M (3n x 3n), assembled on first use")
+      .def("stiffness_matrix", &Problem::stiffnessMatrix, py::call_guard<py::gil_scoped_release>(),
+           "K at rest (3n x 3n), assembled on first use")
+      .def(
+          "breakpoints", [](const Problem& p) { return p.loads()->breakpoints(); },
+          "times at which a load starts, stops or is delivered")
+      .def(
+          "last_change", [](const Problem& p) { return p.loads()->lastChange(); },
+          "the time after which no load changes any more")
+      .def(
+          "constant_load", [](const Problem& p) { return Eigen::VectorXd(p.loads()->constantPart(p.numDofs())); },
+          "the part of the external force that never changes (3n), e.g. gravity")
       .def(
           "external_force",
           [](const Problem& p, double time) {
@@ -106,7 +114,7 @@ void bindProblem(py::module_& module) {
             return system;
           },
           "The DynamicSystem integrators take (assembles M and K on first use)")
-      .def("skipped", &Problem::skipped);
+      .def("skipped", &Problem::skipped, "what the problem left out and why (lines for a run summary)");
 
   module.def(
       "load_problem",

@@ -37,7 +37,8 @@ auto matrixStep(void (SparseSolver::*step)(const Sparse&)) {
 }  // namespace
 
 void bindSolvers(py::module_& module) {
-  py::enum_<SolverKind>(module, "SolverKind")
+  py::enum_<SolverKind>(module, "SolverKind",
+                        "Sparse solver: cholmod (supernodal Cholesky), umfpack (LU), eigen_ldlt, eigen_lu")
       .value("cholmod", SolverKind::cholmod)
       .value("umfpack", SolverKind::umfpack)
       .value("eigen_ldlt", SolverKind::eigenLDLT)
@@ -45,9 +46,11 @@ void bindSolvers(py::module_& module) {
   module.def("parse_solver_kind", &parseSolverKind, py::arg("name"),
              "'cholmod', 'umfpack', 'eigen-ldlt', 'eigen-lu' -> SolverKind");
   module.def(
-      "solver_kind_name", [](SolverKind kind) { return toString(kind); }, py::arg("kind"));
+      "solver_kind_name", [](SolverKind kind) { return toString(kind); }, py::arg("kind"),
+      "SolverKind -> its name ('cholmod', ...)");
 
-  py::class_<SolverStats>(module, "SolverStats")
+  py::class_<SolverStats>(module, "SolverStats",
+                          "Work of a sparse solver: factor non-zeros, flops, factorizations, solves and their seconds")
       .def_readonly("factor_non_zeros", &SolverStats::factorNonZeros)
       .def_readonly("factor_flops", &SolverStats::factorFlops)
       .def_readonly("solve_flops_per_rhs", &SolverStats::solveFlopsPerRhs)
@@ -66,8 +69,10 @@ void bindSolvers(py::module_& module) {
              return Solver{makeSparseSolver(parsed)};
            }),
            py::arg("kind") = SolverKind::cholmod, "kind: SolverKind or its name ('cholmod', 'umfpack', ...)")
-      .def("analyze_pattern", matrixStep(&SparseSolver::analyzePattern), py::arg("matrix"))
-      .def("factorize", matrixStep(&SparseSolver::factorize), py::arg("matrix"))
+      .def("analyze_pattern", matrixStep(&SparseSolver::analyzePattern), py::arg("matrix"),
+           "symbolic analysis (ordering) of the matrix's pattern")
+      .def("factorize", matrixStep(&SparseSolver::factorize), py::arg("matrix"),
+           "numeric factorization of a matrix with the analysed pattern")
       .def("compute", matrixStep(&SparseSolver::compute), py::arg("matrix"), "analyze_pattern + factorize")
       .def(
           "solve",
@@ -95,7 +100,8 @@ void bindSolvers(py::module_& module) {
       .def_property_readonly("kind", [](const Solver& solver) { return solver.solver->kind(); })
       .def_property_readonly("ordering", [](const Solver& solver) { return solver.solver->ordering(); })
       .def_property_readonly("stats", [](const Solver& solver) { return solver.solver->stats(); })
-      .def("reset_stats", [](Solver& solver) { solver.solver->resetStats(); });
+      .def(
+          "reset_stats", [](Solver& solver) { solver.solver->resetStats(); }, "sets the statistics back to zero");
 }
 
 }  // namespace asyncfem::python

@@ -28,6 +28,7 @@ void bindSolvers(py::module_& module);
 void bindForceModels(py::module_& module);
 void bindIntegrators(py::module_& module);
 void bindAsync(py::module_& module);
+void bindModal(py::module_& module);
 void bindOutput(py::module_& module);
 void bindRender(py::module_& module);
 void bindScene(py::module_& module);
