@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Dense>
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/multirateIntegrator.hpp>
@@ -22,6 +23,24 @@ std::string formatNumber(double value, int precision = 6) {
   return out.str();
 }
 
+/// det (x1 - x0, x2 - x0, x3 - x0) of element e at positions rest + u.
+double edgeDeterminant(const TetMesh& mesh, int e, const Eigen::VectorXd* displacement) {
+  const auto position = [&](int corner) {
+    const int v = mesh.elements()(corner, e);
+    Eigen::Vector3d x = mesh.restPositions().col(v);
+    if (displacement != nullptr) x += displacement->segment<3>(3 * static_cast<Eigen::Index>(v));
+    return x;
+  };
+  const Eigen::Vector3d x0 = position(0);
+  Eigen::Matrix3d edges;
+  for (int c = 1; c < 4; ++c) edges.col(c - 1) = position(c) - x0;
+  return edges.determinant();
+}
+
+bool isHyperelastic(ForceModelType type) {
+  return type == ForceModelType::stvk || type == ForceModelType::neoHookean || type == ForceModelType::mooneyRivlin;
+}
+
 template <typename T>
 std::uint32_t crcOf(const T& value, std::uint32_t crc) {
   return crc32(&value, sizeof(value), crc);
@@ -37,6 +56,14 @@ RunMonitor::RunMonitor(const Problem& problem, Settings settings) : mesh_(&probl
     const Loads& loads = *problem.loads();
     energyCheckFrom_ = loads.lastChange();
     constantLoad_ = loads.constantPart(problem.numDofs());
+  }
+  const ProblemSettings& physics = problem.settings();
+  if (isHyperelastic(physics.forceModel) && !physics.hyperelastic.inversionHandlingEnabled()) {
+    inversionCheckModel_ = toString(physics.forceModel);
+    restVolumes_.resize(static_cast<std::size_t>(mesh_->numElements()));
+    for (int e = 0; e < mesh_->numElements(); ++e) {
+      restVolumes_[static_cast<std::size_t>(e)] = edgeDeterminant(*mesh_, e, nullptr);
+    }
   }
 }
 
@@ -146,6 +173,25 @@ void RunMonitor::checkState(const Integrator& integrator, long long frame, long 
                              describeVertex(integrator, vertex) + " exceeds " + formatNumber(settings_.blowUpFactor) +
                              " x the bounding-box diagonal (" + formatNumber(boundingBoxDiagonal_) +
                              "); the simulation is unstable",
+                         location);
+  }
+  if (!inversionCheckModel_.empty()) checkInversion(integrator, frame, step, stepEnd, where);
+}
+
+void RunMonitor::checkInversion(const Integrator& integrator, long long frame, long long step, double stepEnd,
+                                const std::string& where) const {
+  const Eigen::VectorXd& u = integrator.displacement();
+  for (int e = 0; e < mesh_->numElements(); ++e) {
+    const double rest = restVolumes_[static_cast<std::size_t>(e)];
+    const double j = edgeDeterminant(*mesh_, e, &u) / rest;  // det F
+    if (j > 0.0) continue;
+    const int vertex = mesh_->elements()(0, e);
+    NumericalErrorLocation location = locate(integrator, frame, step, stepEnd, vertex);
+    throw NumericalError(where + ": element " + std::to_string(e) +
+                             " (first vertex: " + describeVertex(integrator, vertex) +
+                             ") inverted (J = det F = " + formatNumber(j) + ") under the " + inversionCheckModel_ +
+                             " model, which has no inversion handling; set forceModel.inversionThreshold (e.g. 0.1) "
+                             "or reduce the step or the load",
                          location);
   }
 }

@@ -18,6 +18,9 @@ namespace asyncfem {
 /// Watches a run for numerical failure, so that no unstable state is ever stored:
 /// - after every step, u and v finite and max |u| <= blowUpFactor x the rest bounding-box
 ///   diagonal;
+/// - after every step, for a hyperelastic model without inversion handling (no
+///   inversionThreshold), no element inverted (det F <= 0): such a model's energy only
+///   sees J^2, so an inverted element would go on as if it were a mirrored one;
 /// - after every frame, once no load changes any more (Loads::lastChange(); never with
 ///   contact), the total energy E = kinetic + elastic - constant loads . u has not grown
 ///   by more than 9 times its size at the start of that free phase (a stable integrator
@@ -58,6 +61,9 @@ class RunMonitor {
   /// Throws when u or v is not finite or max |u| exceeds the blow-up limit.
   void checkState(const Integrator& integrator, long long frame, long long step, double stepEnd,
                   const std::string& where) const;
+  /// Throws when an element inverted under a model that cannot handle it.
+  void checkInversion(const Integrator& integrator, long long frame, long long step, double stepEnd,
+                      const std::string& where) const;
   /// The energy check at the end of a frame.
   void checkEnergy(const Integrator& integrator, long long frame);
 
@@ -70,6 +76,10 @@ class RunMonitor {
   bool haveFreeEnergy_ = false;
   double freeEnergy_ = 0.0, freeEnergyScale_ = 0.0, freeEnergyTime_ = 0.0;
   long long energyEvaluations_ = 0;
+  /// The force model's name when the inversion check runs, empty otherwise.
+  std::string inversionCheckModel_;
+  /// det of each element's rest edge matrix (x1 - x0, x2 - x0, x3 - x0).
+  std::vector<double> restVolumes_;
 };
 
 /// When a run writes its checkpoint: every `everyFrames` frames (0: not by frames) and/or
