@@ -77,6 +77,24 @@ std::vector<std::string> RunMonitor::skipped() const {
   return skipped;
 }
 
+Eigen::VectorXd RunMonitor::state() const {
+  if (!haveFreeEnergy_) return {};
+  return Eigen::Vector3d(freeEnergy_, freeEnergyScale_, freeEnergyTime_);
+}
+
+void RunMonitor::setState(const Eigen::VectorXd& state) {
+  if (state.size() != 0 && state.size() != 3) {
+    throw Error("RunMonitor::setState: expected 0 or 3 values (the energy reference), got " +
+                std::to_string(state.size()));
+  }
+  haveFreeEnergy_ = state.size() == 3;
+  if (haveFreeEnergy_) {
+    freeEnergy_ = state[0];
+    freeEnergyScale_ = state[1];
+    freeEnergyTime_ = state[2];
+  }
+}
+
 std::string RunMonitor::describeVertex(const Integrator& integrator, int vertex) const {
   std::ostringstream out;
   out << "vertex " << vertex;
@@ -262,7 +280,8 @@ std::uint32_t problemFingerprint(const Problem& problem) {
   return crc32(fixed.data(), sizeof(int) * fixed.size(), crc);
 }
 
-SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_t frames, std::uint32_t fingerprint) {
+SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_t frames, std::uint32_t fingerprint,
+                                       const RunMonitor* monitor) {
   SimulationCheckpoint checkpoint;
   checkpoint.frames = frames;
   checkpoint.time = integrator.time();
@@ -271,6 +290,7 @@ SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_
   checkpoint.displacement = integrator.displacement();
   checkpoint.velocity = integrator.velocity();
   checkpoint.internalState = integrator.internalState();
+  if (monitor != nullptr) checkpoint.monitorState = monitor->state();
   return checkpoint;
 }
 
@@ -309,7 +329,8 @@ std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, 
 }
 
 std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const SimulationFileHeader& header,
-                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator) {
+                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator,
+                                  RunMonitor* monitor) {
   namespace fs = std::filesystem;
   const fs::path checkpointFile = checkpointPathFor(output);
   const std::string restart = "; run without --resume to start over";
@@ -357,6 +378,7 @@ std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const Sim
   }
   integrator.setState(checkpoint.displacement, checkpoint.velocity, checkpoint.time);
   integrator.setInternalState(checkpoint.internalState);
+  if (monitor != nullptr) monitor->setState(checkpoint.monitorState);
   return checkpoint.frames;
 }
 

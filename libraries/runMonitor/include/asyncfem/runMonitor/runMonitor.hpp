@@ -52,6 +52,13 @@ class RunMonitor {
   long long energyEvaluations() const { return energyEvaluations_; }
   /// Checks the settings or the problem made unnecessary, for run summaries.
   std::vector<std::string> skipped() const;
+  /// What the checks carry from frame to frame: the energy check's reference (energy,
+  /// scale, time) once the free phase has begun, else empty. A resumed run restores it
+  /// with setState(), so that its energy check compares with the same reference as an
+  /// uninterrupted run's (and stops at the same frame).
+  Eigen::VectorXd state() const;
+  /// Restores state(); asyncfem::Error for a vector of another size (0 or 3).
+  void setState(const Eigen::VectorXd& state);
 
  private:
   NumericalErrorLocation locate(const Integrator& integrator, long long frame, long long step, double time,
@@ -111,8 +118,10 @@ std::uint32_t runFingerprint(const std::string& sceneText, const std::string& in
 /// elements and fixed vertices (CRC-32). Stored in the .afsim header next to the scene path.
 std::uint32_t problemFingerprint(const Problem& problem);
 
-/// The checkpoint of integrator's state after `frames` finished frames.
-SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_t frames, std::uint32_t fingerprint);
+/// The checkpoint of integrator's state after `frames` finished frames, with the
+/// monitor's state when one is given.
+SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_t frames, std::uint32_t fingerprint,
+                                       const RunMonitor* monitor = nullptr);
 
 /// What differs between the run that wrote an output (its header `stored` and its
 /// checkpoint) and this one (`integrator`, `header`), one "what (there ..., here ...)"
@@ -125,9 +134,11 @@ std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, 
 /// checks that output and checkpoint were written by this run (runDifferences against
 /// header and fingerprint), that requestedFrames is not below the frames already finished,
 /// and that the output's last kept record holds exactly the checkpoint's state; then
-/// restores the state into integrator and returns the frames to keep. Throws
+/// restores the state into integrator (and the monitor's, when one is given) and returns
+/// the frames to keep. Throws
 /// asyncfem::Error "cannot resume: ..." naming what differs or what is missing.
 std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const SimulationFileHeader& header,
-                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator);
+                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator,
+                                  RunMonitor* monitor = nullptr);
 
 }  // namespace asyncfem
