@@ -78,29 +78,65 @@ TEST(RunMonitor, BlowUpBeyondTheLimitIsAnError) {
   }
 }
 
-TEST(RunMonitor, EnergyGrowthAfterTheLoadsIsAnErrorAndNotBefore) {
-  const auto mesh = beam();
-  VertexLoad pull;
-  pull.vertices = mesh->vertexSets().at("tip");
-  pull.perVertex = Eigen::Vector3d(0, 1, 0);
-  pull.end = 0.1;
-  const Problem problem(mesh, mesh->vertexSets().at("root"), ProblemSettings{}, {pull});
-  RunMonitor monitor(problem);
-  EXPECT_NEAR(monitor.energyCheckFrom(), 0.1, 1e-15);
+/// A beam pulled up at its tip until t = 0.1, whose scripted step then sets one tip
+/// velocity that grows 1.5 x per step: kinetic energy grows 2.25 x per step.
+struct GrowingEnergyRun {
+  static VertexLoad tipPull(const TetMesh& mesh) {
+    VertexLoad pull;
+    pull.vertices = mesh.vertexSets().at("tip");
+    pull.perVertex = Eigen::Vector3d(0, 1, 0);
+    pull.end = 0.1;
+    return pull;
+  }
+  std::shared_ptr<const TetMesh> mesh = beam();
+  VertexLoad pull = tipPull(*mesh);
+  Problem problem{mesh, mesh->vertexSets().at("root"), ProblemSettings{}, {pull}};
   double speed = 1.0;
-  ScriptedIntegrator integrator(problem.dynamicSystem(), 0.01, [&](long long, auto&, Eigen::VectorXd& v) {
-    v = Eigen::VectorXd::Zero(v.size());
-    v[3 * pull.vertices.front()] = speed;
-    speed *= 1.5;  // kinetic energy grows by 2.25 per step
-  });
+  ScriptedIntegrator integrator{problem.dynamicSystem(), 0.01, [this](long long, Eigen::VectorXd&, Eigen::VectorXd& v) {
+                                  v = Eigen::VectorXd::Zero(v.size());
+                                  v[3 * pull.vertices.front()] = speed;
+                                  speed *= 1.5;
+                                }};
+};
+
+TEST(RunMonitor, EnergyGrowthAfterTheLoadsIsAnErrorAndNotBefore) {
+  GrowingEnergyRun run;
+  RunMonitor monitor(run.problem);
+  EXPECT_NEAR(monitor.energyCheckFrom(), 0.1, 1e-15);
   // While the load acts (t < 0.1) energy may grow: no check.
-  for (int frame = 0; frame < 10; ++frame) monitor.advanceFrame(integrator, frame, 1);
+  for (int frame = 0; frame < 10; ++frame) monitor.advanceFrame(run.integrator, frame, 1);
   EXPECT_EQ(monitor.energyEvaluations(), 0);
-  monitor.advanceFrame(integrator, 10, 1);  // the first free frame: the reference
+  monitor.advanceFrame(run.integrator, 10, 1);  // the first free frame: the reference
   EXPECT_EQ(monitor.energyEvaluations(), 1);
-  monitor.advanceFrame(integrator, 11, 1);                                // 2.25 x: below 10 x
-  monitor.advanceFrame(integrator, 12, 1);                                // 5.1 x
-  EXPECT_THROW(monitor.advanceFrame(integrator, 13, 1), NumericalError);  // 11.4 x
+  monitor.advanceFrame(run.integrator, 11, 1);                                // 2.25 x: below 10 x
+  monitor.advanceFrame(run.integrator, 12, 1);                                // 5.1 x
+  EXPECT_THROW(monitor.advanceFrame(run.integrator, 13, 1), NumericalError);  // 11.4 x
+}
+
+TEST(RunMonitor, EnergyReferenceCarriedThroughStateStopsAResumedRunAtTheSameFrame) {
+  // A resumed run continues with a new monitor: with the state of the one before (what the
+  // checkpoint holds), its energy check stops at the frame the uninterrupted run stops at;
+  // a monitor that takes its reference afresh after the resume would let the run go on.
+  GrowingEnergyRun run;
+  RunMonitor before(run.problem);
+  EXPECT_EQ(before.state().size(), 0);  // no reference before the free phase
+  for (int frame = 0; frame <= 11; ++frame) before.advanceFrame(run.integrator, frame, 1);  // reference at frame 10
+  const Eigen::VectorXd state = before.state();
+  ASSERT_EQ(state.size(), 3);
+  EXPECT_NEAR(state[2], 0.11, 1e-12);  // the time of the reference
+
+  RunMonitor resumed(run.problem);
+  resumed.setState(state);
+  EXPECT_TRUE(resumed.state() == state);
+  const double speedAtResume = run.speed;
+  resumed.advanceFrame(run.integrator, 12, 1);                                // 5.1 x the reference
+  EXPECT_THROW(resumed.advanceFrame(run.integrator, 13, 1), NumericalError);  // 11.4 x: as without the stop
+
+  run.speed = speedAtResume;  // the same frames with a monitor that lost the reference
+  RunMonitor forgetful(run.problem);
+  forgetful.advanceFrame(run.integrator, 12, 1);
+  EXPECT_NO_THROW(forgetful.advanceFrame(run.integrator, 13, 1));
+  EXPECT_THROW(resumed.setState(Eigen::VectorXd::Zero(2)), Error);
 }
 
 /// A scripted integrator that reports one fast region holding the "tip" vertices, as

@@ -94,6 +94,38 @@ TEST_F(CheckpointTest, RoundTripIsExact) {
   EXPECT_EQ(asyncfem::readCheckpoint(path).internalState.size(), 0);
 }
 
+TEST_F(CheckpointTest, MonitorStateRoundTripsAndVersionOneIsStillRead) {
+  const fs::path path = directory_ / "monitor.checkpoint";
+  SimulationCheckpoint written = sample();
+  written.monitorState = Eigen::Vector3d(0.25, 1.5, 0.35);
+  asyncfem::writeCheckpoint(path, written);
+  // 64 header + 16 name + 39 doubles + 8 suffix.
+  EXPECT_EQ(fs::file_size(path), 64U + 16U + (39U * 8U) + 8U);
+  EXPECT_TRUE(asyncfem::readCheckpoint(path).monitorState == written.monitorState);
+  written.monitorState = Eigen::VectorXd::Zero(1025);
+  EXPECT_THROW(asyncfem::writeCheckpoint(path, written), asyncfem::Error);
+
+  // A version 1 file (no monitor state; bytes 56..59 were reserved, 0) reads as before.
+  SimulationCheckpoint old = sample();
+  asyncfem::writeCheckpoint(path, old);
+  std::vector<char> bytes = readBytes(path);
+  bytes[8] = 1;
+  const auto putCrc = [&](std::size_t offset, std::size_t length) {
+    const std::uint32_t crc = asyncfem::crc32(bytes.data(), length);
+    for (int b = 0; b < 4; ++b) bytes[offset + b] = static_cast<char>((crc >> (8 * b)) & 0xffU);
+  };
+  putCrc(60, 60);
+  putCrc(bytes.size() - 8, bytes.size() - 8);
+  writeBytes(path, bytes);
+  const SimulationCheckpoint read = asyncfem::readCheckpoint(path);
+  EXPECT_EQ(read.monitorState.size(), 0);
+  EXPECT_TRUE(read.internalState == old.internalState);
+  bytes[8] = 3;
+  putCrc(60, 60);
+  writeBytes(path, bytes);
+  EXPECT_NE(errorOf(path).find("unsupported checkpoint version 3"), std::string::npos) << errorOf(path);
+}
+
 TEST_F(CheckpointTest, WriterRefusesBadCheckpoints) {
   const fs::path path = directory_ / "bad.checkpoint";
   SimulationCheckpoint checkpoint = sample();

@@ -87,11 +87,7 @@ class StorageFaultsTest : public asyncfem::test::UtilityTest {
       }
       command.push_back(simulatorPath);
       command.insert(command.end(), arguments.begin(), arguments.end());
-      std::vector<char*> argv;
-      for (std::string& argument : command) argv.push_back(argument.data());
-      argv.push_back(nullptr);
-      ::execv(argv[0], argv.data());
-      ::_exit(127);
+      asyncfem::test::execCommand(std::move(command));
     }
     return child;
   }

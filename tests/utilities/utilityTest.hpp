@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace asyncfem::test {
 
@@ -25,6 +26,16 @@ inline std::string readText(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();
+}
+
+/// In a forked child: replaces the process with command[0] run with the arguments
+/// command[1..]; exits with status 127 if that fails.
+[[noreturn]] inline void execCommand(std::vector<std::string> command) {
+  std::vector<char*> argv;
+  for (std::string& argument : command) argv.push_back(argument.data());
+  argv.push_back(nullptr);
+  ::execv(argv[0], argv.data());
+  ::_exit(127);
 }
 
 /// A fixture with a fresh folder_ (removed after the test) named after the test.

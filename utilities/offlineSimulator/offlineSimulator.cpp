@@ -508,8 +508,10 @@ struct RunOutput {
   std::int64_t checkpointFrames = 0;  ///< frames the last checkpoint holds
   std::chrono::steady_clock::time_point lastCheckpoint = std::chrono::steady_clock::now();
 
-  void checkpoint(const asyncfem::Integrator& integrator, std::int64_t frames, bool sync, RunRecord& record) {
-    asyncfem::writeCheckpoint(checkpointFile, asyncfem::captureCheckpoint(integrator, frames, fingerprint), sync);
+  void checkpoint(const asyncfem::Simulation& simulation, std::int64_t frames, bool sync, RunRecord& record) {
+    const asyncfem::RunMonitor* monitor = simulation.monitor ? &*simulation.monitor : nullptr;
+    asyncfem::writeCheckpoint(checkpointFile,
+                              asyncfem::captureCheckpoint(*simulation.integrator, frames, fingerprint, monitor), sync);
     checkpointFrames = frames;
     ++record.checkpointsWritten;
     lastCheckpoint = std::chrono::steady_clock::now();
@@ -545,7 +547,8 @@ RunOutput openOutput(const CommandLine& options, const asyncfem::Scene& scene, a
   output.checkpointFile = asyncfem::checkpointPathFor(scene.output.file);
   if (options.resume) {
     record.firstFrame = static_cast<int>(asyncfem::resumeFromCheckpoint(
-        scene.output.file, output.header, output.fingerprint, simulation.timing.frameCount, *simulation.integrator));
+        scene.output.file, output.header, output.fingerprint, simulation.timing.frameCount, *simulation.integrator,
+        simulation.monitor ? &*simulation.monitor : nullptr));
     output.writer =
         asyncfem::SimulationWriter::continueFile(scene.output.file, output.header, record.firstFrame, writerOptions);
     const std::string caveat = simulation.integrator->report().resumeCaveat;
@@ -578,7 +581,7 @@ void writeFrame(RunOutput& output, const asyncfem::Scene& scene, const asyncfem:
   const double sinceLast =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - output.lastCheckpoint).count();
   if (record.schedule.due(done, sinceLast) || done == simulation.timing.frameCount || stopSignal != 0) {
-    output.checkpoint(integrator, done, scene.output.sync, record);
+    output.checkpoint(simulation, done, scene.output.sync, record);
   }
   if (output.vtuSeries && frame % scene.output.vtuEvery == 0) {
     output.vtuSeries->writeFrame(frame, integrator.time(), *simulation.mesh, integrator.displacement());
@@ -639,7 +642,7 @@ int runLocal(int argc, char** argv, const CommandLine& options, const asyncfem::
   const int frame = runFrames(options, scene, simulation, output, record);
   if (stopSignal != 0 && output.checkpointFrames != output.writer->numFrames()) {
     // The signal came after the last frame's checkpoint decision.
-    output.checkpoint(*simulation.integrator, output.writer->numFrames(), scene.output.sync, record);
+    output.checkpoint(simulation, output.writer->numFrames(), scene.output.sync, record);
   }
   output.writer->close();
   if (stopSignal != 0 && frame < simulation.timing.frameCount) {

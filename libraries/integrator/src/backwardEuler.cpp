@@ -130,6 +130,7 @@ void BackwardEuler::solveWithReuse(const Eigen::VectorXd& rhs, Eigen::VectorXd& 
 }
 
 void BackwardEuler::step() {
+  free_->stepTime = stepEndTime();
   if (linear_) {
     stepLinear();
   } else {
@@ -262,7 +263,11 @@ int BackwardEuler::newtonIterations(double rhsNorm, Eigen::VectorXd& internal) {
     const Eigen::SparseMatrix<double>& dampingStiffness = dampingAtIterate ? free.iterateStiffness : free.stiffness;
     iterateResidual(internal, dampingStiffness, newVelocity, residual);
     lastRelativeResidual_ = residual.norm() / scale;
-    if (lastRelativeResidual_ <= options_.tolerance || !mayIterate) return iterations;
+    if (lastRelativeResidual_ <= options_.tolerance) return iterations;
+    if (!mayIterate) {
+      detail::checkNewtonDiverged(name(), lastRelativeResidual_, iterations, residual, system_.freeDofs, stepEndTime());
+      return iterations;
+    }
     solveNewtonCorrection(dampingStiffness, residual, correction);
     // With D at the iterate R is not the potential's gradient, so Phi is no merit
     // function for these updates: they are taken in full, as Vega FEM does.

@@ -102,6 +102,7 @@ void Trapezoidal::computeAcceleration() {
 }
 
 void Trapezoidal::step() {
+  free_->stepTime = stepEndTime();
   const double h = timestep_;
   const FreeDofs& dofs = system_.freeDofs;
   if (accelerationStale_) computeAcceleration();
@@ -187,7 +188,11 @@ int Trapezoidal::newtonIterations(double rhsNorm) {
       if (beta != 0.0) residual.noalias() += beta * (free.stiffness * newVelocity);
     }
     lastRelativeResidual_ = residual.norm() / scale;
-    if (lastRelativeResidual_ <= options_.tolerance || !mayIterate) return iterations;
+    if (lastRelativeResidual_ <= options_.tolerance) return iterations;
+    if (!mayIterate) {
+      detail::checkNewtonDiverged(name(), lastRelativeResidual_, iterations, residual, system_.freeDofs, stepEndTime());
+      return iterations;
+    }
     // J = (1 + h alpha/2) M + h beta/2 K(u_k) + h^2/4 K(u_{k+1}^{(i)})
     free.assemble({1.0 + (0.5 * h * alpha), 0.5 * h * beta, 0.25 * h * h},
                   {&free.mass, &free.stiffness, &free.iterateStiffness}, stats_);

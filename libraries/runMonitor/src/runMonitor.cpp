@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/Dense>
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/multirateIntegrator.hpp>
@@ -22,6 +23,24 @@ std::string formatNumber(double value, int precision = 6) {
   return out.str();
 }
 
+/// det (x1 - x0, x2 - x0, x3 - x0) of element e at positions rest + u.
+double edgeDeterminant(const TetMesh& mesh, int e, const Eigen::VectorXd* displacement) {
+  const auto position = [&](int corner) {
+    const int v = mesh.elements()(corner, e);
+    Eigen::Vector3d x = mesh.restPositions().col(v);
+    if (displacement != nullptr) x += displacement->segment<3>(3 * static_cast<Eigen::Index>(v));
+    return x;
+  };
+  const Eigen::Vector3d x0 = position(0);
+  Eigen::Matrix3d edges;
+  for (int c = 1; c < 4; ++c) edges.col(c - 1) = position(c) - x0;
+  return edges.determinant();
+}
+
+bool isHyperelastic(ForceModelType type) {
+  return type == ForceModelType::stvk || type == ForceModelType::neoHookean || type == ForceModelType::mooneyRivlin;
+}
+
 template <typename T>
 std::uint32_t crcOf(const T& value, std::uint32_t crc) {
   return crc32(&value, sizeof(value), crc);
@@ -38,6 +57,14 @@ RunMonitor::RunMonitor(const Problem& problem, Settings settings) : mesh_(&probl
     energyCheckFrom_ = loads.lastChange();
     constantLoad_ = loads.constantPart(problem.numDofs());
   }
+  const ProblemSettings& physics = problem.settings();
+  if (isHyperelastic(physics.forceModel) && !physics.hyperelastic.inversionHandlingEnabled()) {
+    inversionCheckModel_ = toString(physics.forceModel);
+    restVolumes_.resize(static_cast<std::size_t>(mesh_->numElements()));
+    for (int e = 0; e < mesh_->numElements(); ++e) {
+      restVolumes_[static_cast<std::size_t>(e)] = edgeDeterminant(*mesh_, e, nullptr);
+    }
+  }
 }
 
 std::vector<std::string> RunMonitor::skipped() const {
@@ -48,6 +75,24 @@ std::vector<std::string> RunMonitor::skipped() const {
     skipped.emplace_back("energy blow-up check (contact forces do work)");
   }
   return skipped;
+}
+
+Eigen::VectorXd RunMonitor::state() const {
+  if (!haveFreeEnergy_) return {};
+  return Eigen::Vector3d(freeEnergy_, freeEnergyScale_, freeEnergyTime_);
+}
+
+void RunMonitor::setState(const Eigen::VectorXd& state) {
+  if (state.size() != 0 && state.size() != 3) {
+    throw Error("RunMonitor::setState: expected 0 or 3 values (the energy reference), got " +
+                std::to_string(state.size()));
+  }
+  haveFreeEnergy_ = state.size() == 3;
+  if (haveFreeEnergy_) {
+    freeEnergy_ = state[0];
+    freeEnergyScale_ = state[1];
+    freeEnergyTime_ = state[2];
+  }
 }
 
 std::string RunMonitor::describeVertex(const Integrator& integrator, int vertex) const {
@@ -148,6 +193,25 @@ void RunMonitor::checkState(const Integrator& integrator, long long frame, long 
                              "); the simulation is unstable",
                          location);
   }
+  if (!inversionCheckModel_.empty()) checkInversion(integrator, frame, step, stepEnd, where);
+}
+
+void RunMonitor::checkInversion(const Integrator& integrator, long long frame, long long step, double stepEnd,
+                                const std::string& where) const {
+  const Eigen::VectorXd& u = integrator.displacement();
+  for (int e = 0; e < mesh_->numElements(); ++e) {
+    const double rest = restVolumes_[static_cast<std::size_t>(e)];
+    const double j = edgeDeterminant(*mesh_, e, &u) / rest;  // det F
+    if (j > 0.0) continue;
+    const int vertex = mesh_->elements()(0, e);
+    NumericalErrorLocation location = locate(integrator, frame, step, stepEnd, vertex);
+    throw NumericalError(where + ": element " + std::to_string(e) +
+                             " (first vertex: " + describeVertex(integrator, vertex) +
+                             ") inverted (J = det F = " + formatNumber(j) + ") under the " + inversionCheckModel_ +
+                             " model, which has no inversion handling; set forceModel.inversionThreshold (e.g. 0.1) "
+                             "or reduce the step or the load",
+                         location);
+  }
 }
 
 void RunMonitor::checkEnergy(const Integrator& integrator, long long frame) {
@@ -216,7 +280,8 @@ std::uint32_t problemFingerprint(const Problem& problem) {
   return crc32(fixed.data(), sizeof(int) * fixed.size(), crc);
 }
 
-SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_t frames, std::uint32_t fingerprint) {
+SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_t frames, std::uint32_t fingerprint,
+                                       const RunMonitor* monitor) {
   SimulationCheckpoint checkpoint;
   checkpoint.frames = frames;
   checkpoint.time = integrator.time();
@@ -225,6 +290,7 @@ SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_
   checkpoint.displacement = integrator.displacement();
   checkpoint.velocity = integrator.velocity();
   checkpoint.internalState = integrator.internalState();
+  if (monitor != nullptr) checkpoint.monitorState = monitor->state();
   return checkpoint;
 }
 
@@ -263,7 +329,8 @@ std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, 
 }
 
 std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const SimulationFileHeader& header,
-                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator) {
+                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator,
+                                  RunMonitor* monitor) {
   namespace fs = std::filesystem;
   const fs::path checkpointFile = checkpointPathFor(output);
   const std::string restart = "; run without --resume to start over";
@@ -311,6 +378,7 @@ std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const Sim
   }
   integrator.setState(checkpoint.displacement, checkpoint.velocity, checkpoint.time);
   integrator.setInternalState(checkpoint.internalState);
+  if (monitor != nullptr) monitor->setState(checkpoint.monitorState);
   return checkpoint.frames;
 }
 

@@ -31,6 +31,8 @@ constexpr std::size_t offsetNumDofs = 32;
 constexpr std::size_t offsetInternal = 40;
 constexpr std::size_t offsetFingerprint = 48;
 constexpr std::size_t offsetNameLength = 52;
+constexpr std::size_t offsetMonitor = 56;  // reserved (0) in version 1
+constexpr std::uint64_t maxMonitorState = 1024;
 constexpr std::size_t offsetHeaderCrc = 60;
 constexpr std::size_t maxNameLength = 64;
 constexpr std::size_t suffixBytes = 8;
@@ -71,17 +73,21 @@ void checkStorable(const std::string& name, const SimulationCheckpoint& checkpoi
                 " and " + std::to_string(checkpoint.velocity.size()) + ")");
   }
   if (checkpoint.frames < 0 || !std::isfinite(checkpoint.time) || !checkpoint.displacement.allFinite() ||
-      !checkpoint.velocity.allFinite() || !checkpoint.internalState.allFinite()) {
-    throw Error(name + ": refusing to store a negative frame count or non-finite values");
+      !checkpoint.velocity.allFinite() || !checkpoint.internalState.allFinite() ||
+      !checkpoint.monitorState.allFinite() ||
+      static_cast<std::uint64_t>(checkpoint.monitorState.size()) > maxMonitorState) {
+    throw Error(name + ": refusing to store a negative frame count, non-finite values or over 1024 monitor values");
   }
 }
 
-/// The bytes of a checkpoint file: header, integrator name, the three vectors, checksum.
+/// The bytes of a checkpoint file: header, integrator name, the four vectors, checksum.
 std::vector<unsigned char> encodeCheckpoint(const SimulationCheckpoint& checkpoint) {
   const std::size_t nameLength = checkpoint.integrator.size();
   const auto numDofs = static_cast<std::size_t>(checkpoint.displacement.size());
   const auto internal = static_cast<std::size_t>(checkpoint.internalState.size());
-  const std::size_t total = headerBytes + paddedName(nameLength) + (8 * (2 * numDofs + internal)) + suffixBytes;
+  const auto monitor = static_cast<std::size_t>(checkpoint.monitorState.size());
+  const std::size_t total =
+      headerBytes + paddedName(nameLength) + (8 * (2 * numDofs + internal + monitor)) + suffixBytes;
   std::vector<unsigned char> bytes(total, 0);
   unsigned char* out = bytes.data();
   std::memcpy(out, checkpointMagic, sizeof(checkpointMagic));
@@ -93,10 +99,12 @@ std::vector<unsigned char> encodeCheckpoint(const SimulationCheckpoint& checkpoi
   detail::putU64(out + offsetInternal, internal);
   detail::putU32(out + offsetFingerprint, checkpoint.fingerprint);
   detail::putU32(out + offsetNameLength, static_cast<std::uint32_t>(nameLength));
+  detail::putU32(out + offsetMonitor, static_cast<std::uint32_t>(monitor));
   detail::putU32(out + offsetHeaderCrc, crc32(out, offsetHeaderCrc));
   std::memcpy(out + headerBytes, checkpoint.integrator.data(), nameLength);
   std::size_t offset = headerBytes + paddedName(nameLength);
-  for (const Eigen::VectorXd* values : {&checkpoint.displacement, &checkpoint.velocity, &checkpoint.internalState}) {
+  for (const Eigen::VectorXd* values :
+       {&checkpoint.displacement, &checkpoint.velocity, &checkpoint.internalState, &checkpoint.monitorState}) {
     for (Eigen::Index i = 0; i < values->size(); ++i, offset += 8) detail::putF64(out + offset, (*values)[i]);
   }
   detail::putU32(out + offset, crc32(out, offset));
@@ -142,7 +150,7 @@ void checkCheckpointHeader(const unsigned char* data, std::size_t size, const st
     throw ParseError(name, 0, "not an AsyncFEM checkpoint (bad magic)");
   }
   const std::uint32_t version = detail::getU32(data + offsetVersion);
-  if (version != checkpointFileVersion) {
+  if (version != 1 && version != checkpointFileVersion) {  // version 1: no monitor state
     throw ParseError(name, 0, "unsupported checkpoint version " + std::to_string(version));
   }
   if (detail::getU32(data + offsetHeaderBytes) != headerBytes) {
@@ -158,6 +166,7 @@ struct CheckpointCounts {
   std::uint64_t frames = 0;
   std::uint64_t numDofs = 0;
   std::uint64_t internal = 0;
+  std::uint64_t monitor = 0;
   std::uint32_t nameLength = 0;
 };
 
@@ -169,6 +178,7 @@ CheckpointCounts checkedCounts(const unsigned char* data, std::size_t size, cons
   counts.numDofs = detail::getU64(data + offsetNumDofs);
   counts.internal = detail::getU64(data + offsetInternal);
   counts.nameLength = detail::getU32(data + offsetNameLength);
+  counts.monitor = detail::getU32(data + offsetMonitor);
   if (counts.frames > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
     throw ParseError(name, 0, "checkpoint claims a negative frame count");
   }
@@ -178,13 +188,15 @@ CheckpointCounts checkedCounts(const unsigned char* data, std::size_t size, cons
         "checkpoint integrator name has " + std::to_string(counts.nameLength) + " characters (expected 1 to 64)");
   }
   const std::uint64_t limit = 3 * static_cast<std::uint64_t>(maxSimulationFileVertices);
-  if (counts.numDofs > limit || counts.numDofs % 3 != 0 || counts.internal > 4 * limit) {
+  if (counts.numDofs > limit || counts.numDofs % 3 != 0 || counts.internal > 4 * limit ||
+      counts.monitor > maxMonitorState) {
     throw ParseError(name, 0,
-                     "checkpoint claims " + std::to_string(counts.numDofs) + " state entries and " +
-                         std::to_string(counts.internal) + " internal ones");
+                     "checkpoint claims " + std::to_string(counts.numDofs) + " state entries, " +
+                         std::to_string(counts.internal) + " internal ones and " + std::to_string(counts.monitor) +
+                         " monitor values");
   }
-  const std::uint64_t expected =
-      headerBytes + paddedName(counts.nameLength) + (8 * ((2 * counts.numDofs) + counts.internal)) + suffixBytes;
+  const std::uint64_t expected = headerBytes + paddedName(counts.nameLength) +
+                                 (8 * ((2 * counts.numDofs) + counts.internal + counts.monitor)) + suffixBytes;
   if (expected != size) {
     throw ParseError(name, 0,
                      "checkpoint is " + std::to_string(size) + " bytes, its header implies " +
@@ -226,8 +238,9 @@ SimulationCheckpoint parseCheckpoint(const unsigned char* data, std::size_t size
   read(checkpoint.displacement, counts.numDofs);
   read(checkpoint.velocity, counts.numDofs);
   read(checkpoint.internalState, counts.internal);
+  read(checkpoint.monitorState, counts.monitor);
   if (!std::isfinite(checkpoint.time) || !checkpoint.displacement.allFinite() || !checkpoint.velocity.allFinite() ||
-      !checkpoint.internalState.allFinite()) {
+      !checkpoint.internalState.allFinite() || !checkpoint.monitorState.allFinite()) {
     throw ParseError(name, 0, "checkpoint holds non-finite values");
   }
   return checkpoint;

@@ -108,9 +108,13 @@ class CholmodSolver final : public SolverBase {
       // L->Perm maps it back to the caller's column.
       const std::size_t step = factor_->minor;
       const int column = step < factor_->n ? static_cast<const int*>(factor_->Perm)[step] : -1;
+      // The column goes into location().dof, so that callers can name what it stands for.
+      NumericalErrorLocation location;
+      location.dof = column;
       throw NumericalError("cholmod: matrix is not positive definite: non-positive pivot at column " +
-                           std::to_string(column) + " (elimination step " + std::to_string(step) + " of " +
-                           std::to_string(factor_->n) + ")");
+                               std::to_string(column) + " (elimination step " + std::to_string(step) + " of " +
+                               std::to_string(factor_->n) + ")",
+                           location);
     }
     recordFactorCosts();
     endFactorize(watch);

@@ -58,6 +58,7 @@ FreeSystem::FreeSystem(const DynamicSystem& system, SolverKind solverKind) : sol
   fullStiffness_ = system.forceModel->createStiffnessMatrix();
   fullStiffness_.makeCompressed();
   const std::vector<int>& free = system.freeDofs.freeToFull();
+  freeToFull_ = free;
   extractor_ = SubmatrixExtractor(fullStiffness_, free, free);
   Eigen::SparseMatrix<double> fullMass = embedInPattern(system.mass, fullStiffness_, "mass matrix");
   mass = extractor_.extract(fullMass);
@@ -65,11 +66,51 @@ FreeSystem::FreeSystem(const DynamicSystem& system, SolverKind solverKind) : sol
   systemMatrix = stiffness;
 }
 
+void checkNewtonDiverged(const std::string& integratorName, double relativeResidual, int iterations,
+                         const Eigen::VectorXd& residual, const FreeDofs& dofs, double time) {
+  if (!(relativeResidual > 1.0)) return;  // converged, or still closer than the linearized step
+  Eigen::Index largest = 0;
+  if (residual.allFinite()) residual.cwiseAbs().maxCoeff(&largest);
+  NumericalErrorLocation location;
+  location.time = time;
+  location.dof = dofs.freeToFull()[static_cast<std::size_t>(largest)];
+  location.vertex = location.dof / 3;
+  throw NumericalError(integratorName + ": Newton's iteration diverged in the step to time " + std::to_string(time) +
+                           ": after " + std::to_string(iterations) + " iterations its residual is " +
+                           std::to_string(relativeResidual) + " times the step's initial one, largest at DOF " +
+                           std::to_string(location.dof) + " (vertex " + std::to_string(location.vertex) +
+                           "); the state was left at the start of the step; enable lineSearch or reduce the step",
+                       location);
+}
+
+namespace {
+
+/// A force model's forces must be finite: a NaN would spread through the solve to every
+/// DOF, and the integrator's own check could then only name the first of them.
+void checkForcesFinite(const Eigen::VectorXd& forces, double stepTime) {
+  for (Eigen::Index i = 0; i < forces.size(); ++i) {
+    if (std::isfinite(forces[i])) continue;
+    NumericalErrorLocation location;
+    location.time = stepTime;
+    location.dof = static_cast<int>(i);
+    location.vertex = location.dof / 3;
+    const std::string when = std::isfinite(stepTime) ? " in the step to time " + std::to_string(stepTime) : "";
+    throw NumericalError("the force model returned a non-finite internal force (" + std::to_string(forces[i]) + ")" +
+                             when + " at DOF " + std::to_string(location.dof) + " (vertex " +
+                             std::to_string(location.vertex) + ", coordinate " + "xyz"[location.dof % 3] +
+                             "); the state was left at the start of the step",
+                         location);
+  }
+}
+
+}  // namespace
+
 void FreeSystem::evaluateForcesAndTangent(const DynamicSystem& system, const Eigen::VectorXd& displacement,
                                           Eigen::SparseMatrix<double>& into, IntegratorStats& stats) {
   {
     TimeInto timer(stats.forceSeconds);
     system.forceModel->forcesAndTangent(displacement, fullForces_, fullStiffness_);
+    checkForcesFinite(fullForces_, stepTime);
   }
   TimeInto timer(stats.assemblySeconds);
   if (into.nonZeros() != stiffness.nonZeros()) into = stiffness;
@@ -80,6 +121,7 @@ void FreeSystem::evaluateForces(const DynamicSystem& system, const Eigen::Vector
                                 IntegratorStats& stats) {
   TimeInto timer(stats.forceSeconds);
   system.forceModel->internalForces(displacement, fullForces_);
+  checkForcesFinite(fullForces_, stepTime);
 }
 
 void FreeSystem::assemble(const std::vector<double>& coefficients,
@@ -94,7 +136,19 @@ void FreeSystem::factorize(IntegratorStats& stats) {
     solver_->analyzePattern(systemMatrix);
     analyzed_ = true;
   }
-  solver_->factorize(systemMatrix);
+  try {
+    solver_->factorize(systemMatrix);
+  } catch (const NumericalError& error) {
+    const int column = error.location().dof;
+    if (column < 0 || column >= static_cast<int>(freeToFull_.size())) throw;
+    NumericalErrorLocation location = error.location();
+    location.dof = freeToFull_[static_cast<std::size_t>(column)];
+    location.vertex = location.dof / 3;
+    throw NumericalError(std::string(error.what()) + ", which is DOF " + std::to_string(location.dof) + " (vertex " +
+                             std::to_string(location.vertex) + ", coordinate " + "xyz"[location.dof % 3] +
+                             ") of the mesh",
+                         location);
+  }
   ++stats.factorizations;
   stats.factorFlops += solver_->stats().factorFlops;
 }

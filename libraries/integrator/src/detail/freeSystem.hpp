@@ -7,6 +7,7 @@
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -59,7 +60,9 @@ class FreeSystem {
   /// systemMatrix = sum_i coefficients[i] * matrices[i] (free matrices of this object).
   void assemble(const std::vector<double>& coefficients,
                 const std::vector<const Eigen::SparseMatrix<double>*>& matrices, IntegratorStats& stats);
-  /// Numeric factorization of systemMatrix (symbolic analysis the first time only).
+  /// Numeric factorization of systemMatrix (symbolic analysis the first time only). A
+  /// solver's NumericalError that names a column (location().dof) is thrown again with
+  /// the mesh DOF and vertex that column stands for.
   void factorize(IntegratorStats& stats);
   /// x = systemMatrix^{-1} rhs with the last factorization.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, IntegratorStats& stats);
@@ -71,6 +74,10 @@ class FreeSystem {
   Eigen::SparseMatrix<double> stiffness;         ///< K on the free DOFs (constant, or tangent at step start)
   Eigen::SparseMatrix<double> iterateStiffness;  ///< K at a Newton iterate (free)
   Eigen::SparseMatrix<double> systemMatrix;      ///< the combination last assembled
+  /// The end time of the step being computed, for messages (NaN: not in a step). The
+  /// evaluate functions throw NumericalError naming it and the DOF when the force model
+  /// returns a non-finite force.
+  double stepTime = std::numeric_limits<double>::quiet_NaN();
 
  private:
   SubmatrixExtractor extractor_;
@@ -79,7 +86,15 @@ class FreeSystem {
   std::unique_ptr<SparseSolver> solver_;
   bool analyzed_ = false;
   Eigen::MatrixXd solution_;
+  std::vector<int> freeToFull_;  ///< free index -> mesh DOF
 };
+
+/// Throws NumericalError when a Newton iteration that stopped unconverged (after its
+/// iterations) diverged: its residual grew beyond the step's initial one
+/// (relativeResidual > 1). Names the integrator, the step's end time, the iterations and
+/// the vertex with the largest residual (residual on the free DOFs of dofs).
+void checkNewtonDiverged(const std::string& integratorName, double relativeResidual, int iterations,
+                         const Eigen::VectorXd& residual, const FreeDofs& dofs, double time);
 
 /// Solves M x = b on the free DOFs: a division for a diagonal (lumped) M, otherwise a
 /// sparse Cholesky factored once.

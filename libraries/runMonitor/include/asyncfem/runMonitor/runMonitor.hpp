@@ -18,6 +18,9 @@ namespace asyncfem {
 /// Watches a run for numerical failure, so that no unstable state is ever stored:
 /// - after every step, u and v finite and max |u| <= blowUpFactor x the rest bounding-box
 ///   diagonal;
+/// - after every step, for a hyperelastic model without inversion handling (no
+///   inversionThreshold), no element inverted (det F <= 0): such a model's energy only
+///   sees J^2, so an inverted element would go on as if it were a mirrored one;
 /// - after every frame, once no load changes any more (Loads::lastChange(); never with
 ///   contact), the total energy E = kinetic + elastic - constant loads . u has not grown
 ///   by more than 9 times its size at the start of that free phase (a stable integrator
@@ -49,6 +52,13 @@ class RunMonitor {
   long long energyEvaluations() const { return energyEvaluations_; }
   /// Checks the settings or the problem made unnecessary, for run summaries.
   std::vector<std::string> skipped() const;
+  /// What the checks carry from frame to frame: the energy check's reference (energy,
+  /// scale, time) once the free phase has begun, else empty. A resumed run restores it
+  /// with setState(), so that its energy check compares with the same reference as an
+  /// uninterrupted run's (and stops at the same frame).
+  Eigen::VectorXd state() const;
+  /// Restores state(); asyncfem::Error for a vector of another size (0 or 3).
+  void setState(const Eigen::VectorXd& state);
 
  private:
   NumericalErrorLocation locate(const Integrator& integrator, long long frame, long long step, double time,
@@ -58,6 +68,9 @@ class RunMonitor {
   /// Throws when u or v is not finite or max |u| exceeds the blow-up limit.
   void checkState(const Integrator& integrator, long long frame, long long step, double stepEnd,
                   const std::string& where) const;
+  /// Throws when an element inverted under a model that cannot handle it.
+  void checkInversion(const Integrator& integrator, long long frame, long long step, double stepEnd,
+                      const std::string& where) const;
   /// The energy check at the end of a frame.
   void checkEnergy(const Integrator& integrator, long long frame);
 
@@ -70,6 +83,10 @@ class RunMonitor {
   bool haveFreeEnergy_ = false;
   double freeEnergy_ = 0.0, freeEnergyScale_ = 0.0, freeEnergyTime_ = 0.0;
   long long energyEvaluations_ = 0;
+  /// The force model's name when the inversion check runs, empty otherwise.
+  std::string inversionCheckModel_;
+  /// det of each element's rest edge matrix (x1 - x0, x2 - x0, x3 - x0).
+  std::vector<double> restVolumes_;
 };
 
 /// When a run writes its checkpoint: every `everyFrames` frames (0: not by frames) and/or
@@ -101,8 +118,10 @@ std::uint32_t runFingerprint(const std::string& sceneText, const std::string& in
 /// elements and fixed vertices (CRC-32). Stored in the .afsim header next to the scene path.
 std::uint32_t problemFingerprint(const Problem& problem);
 
-/// The checkpoint of integrator's state after `frames` finished frames.
-SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_t frames, std::uint32_t fingerprint);
+/// The checkpoint of integrator's state after `frames` finished frames, with the
+/// monitor's state when one is given.
+SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_t frames, std::uint32_t fingerprint,
+                                       const RunMonitor* monitor = nullptr);
 
 /// What differs between the run that wrote an output (its header `stored` and its
 /// checkpoint) and this one (`integrator`, `header`), one "what (there ..., here ...)"
@@ -115,9 +134,11 @@ std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, 
 /// checks that output and checkpoint were written by this run (runDifferences against
 /// header and fingerprint), that requestedFrames is not below the frames already finished,
 /// and that the output's last kept record holds exactly the checkpoint's state; then
-/// restores the state into integrator and returns the frames to keep. Throws
+/// restores the state into integrator (and the monitor's, when one is given) and returns
+/// the frames to keep. Throws
 /// asyncfem::Error "cannot resume: ..." naming what differs or what is missing.
 std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const SimulationFileHeader& header,
-                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator);
+                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator,
+                                  RunMonitor* monitor = nullptr);
 
 }  // namespace asyncfem

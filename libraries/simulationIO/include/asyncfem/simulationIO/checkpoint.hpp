@@ -14,7 +14,7 @@ namespace asyncfem {
 ///
 ///     offset  size  field
 ///          0     8  magic "AFEMCKP\0"
-///          8     4  format version (u32, currently 1)
+///          8     4  format version (u32, currently 2; version 1 has no monitor state)
 ///         12     4  header size in bytes (u32, 64)
 ///         16     8  frames: finished frames, i.e. records 0 .. frames-1 of the output (i64)
 ///         24     8  simulated time t after those frames (f64)
@@ -22,11 +22,12 @@ namespace asyncfem {
 ///         40     8  internal-state length m (u64)
 ///         48     4  fingerprint of the run (u32, chosen by the writer of the file)
 ///         52     4  length L of the integrator name (u32, 1 to 64)
-///         56     4  reserved (0)
+///         56     4  monitor-state length k (u32, at most 1024; 0 in version 1)
 ///         60     4  CRC-32 of bytes 0..59
 ///         64     L  integrator name, padded with zeros to a multiple of 8
 ///                   then u (numDofs f64), v (numDofs f64), internal state (m f64),
-///                   CRC-32 of every preceding byte (u32), reserved (u32, 0)
+///                   monitor state (k f64), CRC-32 of every preceding byte (u32),
+///                   reserved (u32, 0)
 struct SimulationCheckpoint {
   std::int64_t frames = 0;        ///< finished frames (records 0 .. frames-1 of the output)
   double time = 0.0;              ///< simulated time after them
@@ -36,10 +37,13 @@ struct SimulationCheckpoint {
   Eigen::VectorXd velocity;       ///< v, size 3n
   /// Integrator::internalState(): what the next step needs beyond (u, v, t); may be empty.
   Eigen::VectorXd internalState;
+  /// RunMonitor::state(): what the run's checks carry from frame to frame (the energy
+  /// check's reference); may be empty.
+  Eigen::VectorXd monitorState;
 };
 
 /// Current checkpoint format version.
-inline constexpr std::uint32_t checkpointFileVersion = 1;
+inline constexpr std::uint32_t checkpointFileVersion = 2;
 
 /// The checkpoint that belongs to an output file: the output's path with ".checkpoint"
 /// appended ("run.afsim" -> "run.afsim.checkpoint").

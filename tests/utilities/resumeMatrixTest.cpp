@@ -1,0 +1,365 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The resume matrix (docs/robustness.md, "The resume matrix"): every integrator x every
+// force model x every option that keeps state between steps, stopped by SIGINT or killed
+// with SIGKILL at a frame drawn from a seeded generator, then resumed with --resume. The
+// resumed file must equal an uninterrupted run bit for bit or, where the simulator said
+// before resuming which state it could not restore (a "resume:" line), stay within a
+// stated bound of it.
+//
+// ctest runs a seeded subset (instantiation "Seeded": every integrator, force model and
+// option at least once); the whole matrix is the instantiation "Full", run with
+//   build/bin/resumeMatrixTests --gtest_filter='Full/*'
+// or, configured with -DASYNCFEM_RESUME_MATRIX_FULL=ON, `ctest -L resume-matrix-full`.
+// ASYNCFEM_RESUME_MATRIX_SEED=N draws other interruption frames (and another subset).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/simulationIO/checkpoint.hpp>
+#include <asyncfem/simulationIO/simulationFile.hpp>
+#include <chrono>
+#include <csignal>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "utilityTest.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string simulatorPath = std::string(ASYNCFEM_BIN_DIR) + "/offlineSimulator";
+
+using asyncfem::test::readText;
+
+/// One combination: integrator, force model, stateful option, how the run is stopped.
+struct MatrixCase {
+  std::string integrator;  ///< backwardEuler, trapezoidal, ..., multirateUncoupled
+  std::string model;       ///< linear, corotational, stvk, neoHookean, mooneyRivlin
+  std::string option;      ///< plain, lineSearch, reuseFactor, noLaggedSchur, contact, substepContact
+  bool kill9 = false;      ///< SIGKILL instead of SIGINT
+
+  std::string name() const { return integrator + "_" + model + "_" + option + (kill9 ? "_kill9" : "_sigint"); }
+};
+
+// gtest prints a parameter in test listings and failures: the case's name.
+void PrintTo(const MatrixCase& c, std::ostream* out) { *out << c.name(); }
+
+const std::vector<std::string> integrators = {"backwardEuler", "trapezoidal", "centralDifferences", "symplecticEuler",
+                                              "asyncStable",   "asyncPaper",  "multirateUncoupled"};
+const std::vector<std::string> models = {"linear", "corotational", "stvk", "neoHookean", "mooneyRivlin"};
+
+bool isAsync(const std::string& integrator) { return integrator == "asyncStable" || integrator == "asyncPaper"; }
+
+/// The options an integrator reads that keep state between steps (or change how a step
+/// is solved); combinations where the option does nothing are not generated.
+std::vector<std::string> optionsFor(const std::string& integrator, const std::string& model) {
+  const bool nonlinear = model != "linear";
+  std::vector<std::string> options = {"plain", "contact"};
+  if (integrator == "backwardEuler" && nonlinear) {
+    options.emplace_back("lineSearch");
+    options.emplace_back("reuseFactor");
+  }
+  if (isAsync(integrator)) {
+    if (nonlinear) options.emplace_back("noLaggedSchur");  // "plain" has laggedSchur on, the default
+    options.emplace_back("substepContact");
+  }
+  return options;
+}
+
+std::vector<MatrixCase> allCases() {
+  std::vector<MatrixCase> cases;
+  for (const std::string& integrator : integrators) {
+    for (const std::string& model : models) {
+      for (const std::string& option : optionsFor(integrator, model)) {
+        for (const bool kill9 : {false, true}) cases.push_back({integrator, model, option, kill9});
+      }
+    }
+  }
+  return cases;
+}
+
+std::uint64_t matrixSeed() {
+  const char* text = std::getenv("ASYNCFEM_RESUME_MATRIX_SEED");
+  return text != nullptr ? std::strtoull(text, nullptr, 10) : 20261202ULL;
+}
+
+/// FNV-1a: a hash that is the same in every build, so a case's frame is reproducible.
+std::uint64_t stableHash(const std::string& text) {
+  std::uint64_t hash = 14695981039346656037ULL;
+  for (const char c : text) hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
+  return hash;
+}
+
+/// Every integrator twice (once per way of stopping), then one more case for each force
+/// model and option not drawn yet: 14 to 20 cases, drawn from the seed.
+std::vector<MatrixCase> seededCases() {
+  std::vector<MatrixCase> all = allCases();
+  std::mt19937_64 random(matrixSeed());
+  std::shuffle(all.begin(), all.end(), random);
+  std::vector<MatrixCase> chosen;
+  std::set<std::string> taken, models, options;
+  const auto take = [&](const MatrixCase& c) {
+    if (!taken.insert(c.name()).second) return;
+    chosen.push_back(c);
+    models.insert(c.model);
+    options.insert(c.option);
+  };
+  for (const std::string& integrator : integrators) {
+    for (const bool kill9 : {false, true}) {
+      const auto it = std::find_if(all.begin(), all.end(),
+                                   [&](const MatrixCase& c) { return c.integrator == integrator && c.kill9 == kill9; });
+      take(*it);
+    }
+  }
+  for (const MatrixCase& c : all) {
+    if (models.count(c.model) == 0 || options.count(c.option) == 0) take(c);
+  }
+  return chosen;
+}
+
+/// A 3 x 1 x 1 bar of 6 x 2 x 2 cells (63 vertices, 120 tetrahedra), fixed at x = 0 and
+/// pulled down at x = 3 for 0.15 s (the tip moves about a quarter of the bar's height, far
+/// enough for the nonlinear models to differ from the linear one), 20 frames per second.
+nlohmann::json sceneFor(const MatrixCase& c) {
+  nlohmann::json scene = nlohmann::json::parse(R"({
+    "mesh": {"generator": "box", "size": [3, 1, 1], "cells": [6, 2, 2],
+             "material": {"density": 1000, "youngsModulus": 1e6, "poissonRatio": 0.4}},
+    "fixed": {"sets": ["xmin"]},
+    "forces": [{"type": "pull", "set": "xmax", "force": [0, -8000, 0], "window": [0, 0.15]}],
+    "frames": {"rate": 20, "count": 100000},
+    "output": {"file": "out.afsim", "velocities": true}
+  })");
+  static const std::map<std::string, std::string> modelTypes = {{"linear", "linear"},
+                                                                {"corotational", "corotational"},
+                                                                {"stvk", "stvk"},
+                                                                {"neoHookean", "neo-hookean"},
+                                                                {"mooneyRivlin", "mooney-rivlin"}};
+  scene["forceModel"] = {{"type", modelTypes.at(c.model)}};
+  if (c.model == "mooneyRivlin") {
+    // Shear modulus 2 (mu01 + mu10) = 3.6e5, as E = 1e6 and nu = 0.4 give the others.
+    scene["forceModel"]["mooneyRivlin"] = {{"mu01", 3e4}, {"mu10", 1.5e5}, {"v1", 1e6}};
+  }
+  const bool explicitMethod = c.integrator == "centralDifferences" || c.integrator == "symplecticEuler";
+  nlohmann::json options = nlohmann::json::object();
+  const bool nonlinear = c.model != "linear";
+  if (c.integrator == "backwardEuler" && nonlinear && c.option != "reuseFactor") options["maxIterations"] = 3;
+  if (c.option == "lineSearch") options["lineSearch"] = true;
+  if (c.option == "reuseFactor") {
+    options["reuseFactor"] = true;
+    options["pcgTolerance"] = 1e-10;
+  }
+  if (isAsync(c.integrator) || c.integrator == "multirateUncoupled") {
+    options["regions"] = {{{"name", "tip"}, {"ratio", 4}, {"vertexSets", {"xmax"}}}};
+  }
+  if (c.integrator == "asyncPaper") options["coupling"] = "paper";
+  if (c.option == "noLaggedSchur") options["laggedSchur"] = false;
+  if (c.option == "substepContact") options["substepContact"] = true;
+  static const std::map<std::string, std::string> names = {{"backwardEuler", "backward-euler"},
+                                                           {"trapezoidal", "trapezoidal"},
+                                                           {"centralDifferences", "central-differences"},
+                                                           {"symplecticEuler", "symplectic-euler"},
+                                                           {"asyncStable", "async"},
+                                                           {"asyncPaper", "async"},
+                                                           {"multirateUncoupled", "multirate-uncoupled"}};
+  scene["integrator"] = {
+      {"name", names.at(c.integrator)}, {"stepsPerFrame", explicitMethod ? 100 : 5}, {"options", options}};
+  if (c.option == "contact" || c.option == "substepContact") {
+    // The bar sags onto a ground just below it and rubs on it (friction keeps v in the force).
+    scene["gravity"] = {0, -9.81, 0};
+    scene["contact"] = {
+        {"ground", {{"height", -0.15}, {"up", {0, 1, 0}}}}, {"stiffness", 2e5}, {"damping", 50}, {"friction", 0.3}};
+  }
+  return scene;
+}
+
+/// The bound for a resume the simulator announced as inexact: the kept factors it cannot
+/// restore are preconditioners of iterations run to a relative residual of 1e-10
+/// (pcgTolerance here, laggedSchur's fixed tolerance), so each frame after the resume
+/// differs from the uninterrupted run by about that much relative to the motion; over the
+/// few frames compared, 1e-6 of the largest |u| (and |v|) leaves room for growth and still
+/// catches any state that was really lost (those differ by percents).
+constexpr double caveatBound = 1e-6;
+
+struct Child {
+  pid_t pid = -1;
+  int status = 0;
+  bool done = false;
+};
+
+class ResumeMatrixTest : public asyncfem::test::UtilityTest, public ::testing::WithParamInterface<MatrixCase> {
+ protected:
+  /// Starts the simulator, one OpenMP thread (multi-threaded reductions are not
+  /// bit-reproducible run to run), stdout and stderr to files named by `tag`.
+  Child start(const std::vector<std::string>& arguments, const std::string& tag) const {
+    const std::string out = (folder_ / (tag + ".out")).string();
+    const std::string err = (folder_ / (tag + ".err")).string();
+    Child child;
+    child.pid = ::fork();
+    if (child.pid == 0) {
+      const int devNull = ::open("/dev/null", O_RDONLY);
+      const int outFd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      const int errFd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(devNull, STDIN_FILENO);
+      ::dup2(outFd, STDOUT_FILENO);
+      ::dup2(errFd, STDERR_FILENO);
+      ::setenv("OMP_NUM_THREADS", "1", 1);
+      std::vector<std::string> command{simulatorPath};
+      command.insert(command.end(), arguments.begin(), arguments.end());
+      asyncfem::test::execCommand(std::move(command));
+    }
+    return child;
+  }
+
+  /// Non-blocking: has the child ended?
+  static bool ended(Child& child) {
+    if (!child.done && ::waitpid(child.pid, &child.status, WNOHANG) == child.pid) child.done = true;
+    return child.done;
+  }
+
+  /// Waits for the child, killing it after `seconds` (a test never hangs).
+  static void finish(Child& child, double seconds) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (!ended(child)) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        ::kill(child.pid, SIGKILL);
+        ::waitpid(child.pid, &child.status, 0);
+        child.done = true;
+        ADD_FAILURE() << "offlineSimulator did not end within " << seconds << " s";
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+
+  /// Runs the simulator to its end; its exit status (-1 if it did not exit normally).
+  int runToEnd(const std::vector<std::string>& arguments, const std::string& tag) const {
+    Child child = start(arguments, tag);
+    finish(child, 120.0);
+    return WIFEXITED(child.status) ? WEXITSTATUS(child.status) : -1;
+  }
+
+  std::string printed(const std::string& tag, const char* stream) const {
+    return readText(folder_ / (tag + "." + stream));
+  }
+
+  /// Polls the output until it holds `frames` complete frames; false if the run ended
+  /// first or 60 s passed.
+  static bool waitForFrames(const fs::path& file, std::int64_t frames, Child& child) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (std::chrono::steady_clock::now() < deadline && !ended(child)) {
+      std::error_code ignored;
+      if (fs::exists(file, ignored)) {
+        try {
+          if (asyncfem::SimulationReader(file).numFrames() >= frames) return true;
+        } catch (const asyncfem::Error&) {
+          // the header is not complete yet
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+  }
+};
+
+/// The largest difference between the frames of two files, and the largest values.
+struct Difference {
+  double displacement = 0.0;
+  double velocity = 0.0;
+  double largestDisplacement = 0.0;
+  double largestVelocity = 0.0;
+  bool sameTimes = true;
+};
+
+Difference compareFrames(const fs::path& a, const fs::path& b, std::int64_t frames) {
+  asyncfem::SimulationReader ra(a), rb(b);
+  Difference d;
+  for (std::int64_t k = 0; k < frames; ++k) {
+    const asyncfem::SimulationFrame fa = ra.readFrame(k), fb = rb.readFrame(k);
+    d.sameTimes = d.sameTimes && fa.time == fb.time;
+    d.displacement = std::max(d.displacement, (fa.displacement - fb.displacement).cwiseAbs().maxCoeff());
+    d.velocity = std::max(d.velocity, (fa.velocity - fb.velocity).cwiseAbs().maxCoeff());
+    d.largestDisplacement = std::max(d.largestDisplacement, fb.displacement.cwiseAbs().maxCoeff());
+    d.largestVelocity = std::max(d.largestVelocity, fb.velocity.cwiseAbs().maxCoeff());
+  }
+  return d;
+}
+
+TEST_P(ResumeMatrixTest, ResumedRunMatchesAnUninterruptedOne) {
+  const MatrixCase& c = GetParam();
+  const std::uint64_t seed = matrixSeed();
+  std::mt19937_64 random(seed ^ stableHash(c.name()));
+  const int stopAfter = std::uniform_int_distribution<int>(1, 6)(random);
+  std::cout << "resume matrix: seed " << seed << " (ASYNCFEM_RESUME_MATRIX_SEED), " << c.name()
+            << ": interrupted once frame " << stopAfter << " is on disk\n";
+  const fs::path scene = folder_ / "scene.json";
+  std::ofstream(scene) << sceneFor(c).dump(2);
+  const fs::path output = folder_ / "out.afsim";
+
+  // The interrupted run: checkpoints every 3 frames, so SIGKILL makes the resume recompute.
+  Child child = start({scene.string(), "--quiet", "--checkpoint-every", "3"}, "interrupted");
+  const bool reached = waitForFrames(output, stopAfter, child);
+  ::kill(child.pid, c.kill9 ? SIGKILL : SIGINT);
+  finish(child, 60.0);
+  ASSERT_TRUE(reached) << "frame " << stopAfter << " never appeared: " << printed("interrupted", "err");
+  if (c.kill9) {
+    ASSERT_TRUE(WIFSIGNALED(child.status)) << "the run ended before it was killed";
+  } else {
+    ASSERT_TRUE(WIFEXITED(child.status)) << "SIGINT was not handled";
+    ASSERT_EQ(WEXITSTATUS(child.status), 128 + SIGINT) << printed("interrupted", "err");
+  }
+  const std::int64_t onDisk = asyncfem::SimulationReader(output).numFrames();
+  const std::int64_t checkpointed = asyncfem::readCheckpoint(asyncfem::checkpointPathFor(output)).frames;
+  ASSERT_GE(onDisk, stopAfter);
+  if (!c.kill9) {
+    EXPECT_EQ(checkpointed, onDisk) << "SIGINT must checkpoint the last finished frame";
+  }
+  const std::int64_t frames = onDisk + 3;
+
+  const std::string count = std::to_string(frames);
+  ASSERT_EQ(runToEnd({scene.string(), "--resume", "--frames", count, "--checkpoint-every", "3"}, "resumed"), 0)
+      << printed("resumed", "err");
+  const fs::path reference = folder_ / "reference.afsim";
+  ASSERT_EQ(runToEnd({scene.string(), "--quiet", "--frames", count, "--output", reference.string()}, "reference"), 0)
+      << printed("reference", "err");
+
+  const std::string resumedOut = printed("resumed", "out");
+  const std::size_t caveat = resumedOut.find("resume: ");
+  const Difference d = compareFrames(output, reference, frames);
+  std::cout << "  interrupted after frame " << onDisk << " (checkpoint " << checkpointed << "), compared " << frames
+            << " frames: max |du| " << d.displacement << " of max |u| " << d.largestDisplacement << ", max |dv| "
+            << d.velocity << (caveat == std::string::npos ? ", no caveat" : ", with caveat") << "\n";
+  ASSERT_GT(d.largestDisplacement, 1e-3) << "the bar did not move";
+  EXPECT_TRUE(d.sameTimes);
+  if (caveat == std::string::npos) {
+    // No caveat: bit for bit, every byte of the file.
+    EXPECT_TRUE(readText(output) == readText(reference))
+        << "the resumed run differs from the uninterrupted one without a caveat: max |du| = " << d.displacement
+        << ", max |dv| = " << d.velocity;
+  } else {
+    // The caveat comes before the resumed run's summary, i.e. before any frame.
+    EXPECT_LT(caveat, resumedOut.find("offlineSimulator: ")) << resumedOut;
+    EXPECT_LE(d.displacement, caveatBound * d.largestDisplacement) << resumedOut;
+    EXPECT_LE(d.velocity, caveatBound * d.largestVelocity) << resumedOut;
+  }
+}
+
+std::string caseName(const ::testing::TestParamInfo<MatrixCase>& info) { return info.param.name(); }
+
+INSTANTIATE_TEST_SUITE_P(Seeded, ResumeMatrixTest, ::testing::ValuesIn(seededCases()), caseName);
+INSTANTIATE_TEST_SUITE_P(Full, ResumeMatrixTest, ::testing::ValuesIn(allCases()), caseName);
+
+}  // namespace
