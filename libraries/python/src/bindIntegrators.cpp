@@ -137,8 +137,8 @@ void bindIntegrators(py::module_& module) {
            }),
            py::arg("solver") = SolverKind::cholmod, py::arg("max_iterations") = 1, py::arg("tolerance") = 1e-8,
            py::arg("max_frequency") = 0.0, py::arg("force") = false, py::arg("line_search") = true,
-           py::arg("rayleigh_stiffness_at_iterate") = false, py::arg("reuse_factor") = false,
-           py::arg("pcg_tolerance") = 1e-8)
+           py::arg("rayleigh_stiffness_at_iterate") = false, py::arg("reuse_factor") = true,
+           py::arg("pcg_tolerance") = 1e-10)
       .def_readwrite("solver", &IntegratorOptions::solver)
       .def_readwrite("max_iterations", &IntegratorOptions::maxIterations)
       .def_readwrite("tolerance", &IntegratorOptions::tolerance)
