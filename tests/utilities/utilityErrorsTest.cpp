@@ -2,6 +2,7 @@
 // The error conventions every utility shares (docs/utilities.md): "PROGRAM: message" on
 // stderr, status 2 for usage errors found before any work, 1 for other errors; outputs
 // that are inputs refused. Runs the built executables.
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -139,6 +140,51 @@ TEST_F(UtilityErrorsTest, SuggestRegionsHonoursTheScenesAutoSettings) {
   const RunResult simulator = run("offlineSimulator", "typo.json -o out.afsim");
   EXPECT_EQ(simulator.exitCode, 1);
   EXPECT_NE(simulator.err.find("typo.json: integrator.options.auto.maxRatoi"), std::string::npos) << simulator.err;
+}
+
+// A bare mesh is fixed by a box or a Vega .bou file as well as by a named set: the three
+// ways give the same proposal when they select the same vertices (the beam's root face,
+// x = 0), and a box selecting nothing or a missing .bou file is named by its option.
+TEST_F(UtilityErrorsTest, SuggestRegionsFixesABareMeshByBoxOrBouFile) {
+  const std::string beam = "'" + std::string(ASYNCFEM_MODELS_DIR) + "/beam/beam.veg' --dt 0.0083333 --json";
+  const RunResult bySet = run("suggestRegions", beam + " --fixed-set xmin");
+  ASSERT_EQ(bySet.exitCode, 0) << bySet.err;
+  const RunResult byBox = run("suggestRegions", beam + " --fixed-box -1 -1 -1 1e-9 1 1");
+  ASSERT_EQ(byBox.exitCode, 0) << byBox.err;
+  // The .bou file of the same vertices: Vega's 1-based ids, one a line.
+  std::ofstream bou(folder_ / "root.bou");
+  std::ifstream veg(std::string(ASYNCFEM_MODELS_DIR) + "/beam/beam.veg");
+  std::string line;
+  bool vertices = false;
+  while (std::getline(veg, line)) {
+    if (line.rfind("*VERTICES", 0) == 0) {
+      vertices = true;
+      std::getline(veg, line);  // the count line
+      continue;
+    }
+    if (line.rfind("*", 0) == 0) vertices = false;
+    int id = 0;
+    double x = 1.0;
+    if (vertices && std::sscanf(line.c_str(), "%d %lf", &id, &x) == 2 && x == 0.0) bou << id << "\n";
+  }
+  bou.close();
+  const RunResult byBou = run("suggestRegions", beam + " --fixed-bou root.bou");
+  ASSERT_EQ(byBou.exitCode, 0) << byBou.err;
+  EXPECT_EQ(byBox.out, bySet.out);
+  EXPECT_EQ(byBou.out, bySet.out);
+  // A scene fixes its vertices with its own "fixed" key: the options are refused there.
+  writeScene();
+  const RunResult scene = run("suggestRegions", "scene.json --fixed-box 0 0 0 1 1 1");
+  EXPECT_EQ(scene.exitCode, 1);
+  EXPECT_NE(scene.err.find("mesh inputs only"), std::string::npos) << scene.err;
+
+  const RunResult empty = run("suggestRegions", beam + " --fixed-box 5 5 5 6 6 6");
+  EXPECT_EQ(empty.exitCode, 1);
+  EXPECT_NE(empty.err.find("--fixed-box #1: "), std::string::npos) << empty.err;
+  const RunResult missing = run("suggestRegions", beam + " --fixed-bou missing.bou");
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_NE(missing.err.find("--fixed-bou: "), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("missing.bou"), std::string::npos) << missing.err;
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
+#include <asyncfem/volumetricMesh/vertexSelection.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -33,6 +34,8 @@ struct CommandLine {
   double largeTimestep = 0.0;
   AutoRegionOptions options;
   std::vector<std::string> fixedSets;
+  std::vector<std::vector<double>> fixedBoxes;  // min x y z, max x y z each
+  std::string fixedBou;
   bool json = false;
   int modeCount = 0;
   double frameRate = 0.0;
@@ -72,6 +75,11 @@ void addOptions(CLI::App& app, CommandLine& cl) {
       ->check(cli::inRange(1, 100000))
       ->capture_default_str();
   app.add_option("--fixed-set", cl.fixedSets, "vertex set to treat as fixed (mesh input only)");
+  app.add_option("--fixed-box", cl.fixedBoxes,
+                 "box MINX MINY MINZ MAXX MAXY MAXZ whose vertices are fixed (mesh input only; repeatable)")
+      ->expected(6)
+      ->allow_extra_args(false);
+  app.add_option("--fixed-bou", cl.fixedBou, "Vega .bou file of fixed vertices, 1-based (mesh input only)");
   app.add_option("--write", cl.writePath, "write the regions as JSON, ready for integrator.options.regions");
   app.add_flag("--json", cl.json, "print the proposal as JSON instead of a table");
   app.add_option("--modes", cl.modeCount,
@@ -92,6 +100,11 @@ void addOptions(CLI::App& app, CommandLine& cl) {
 // A scene: its mesh and constraints (the problem, nothing assembled), timestep, frame rate
 // and mass, and its regions as the simulator reads them.
 Input readScene(CommandLine& cl) {
+  if (!cl.fixedSets.empty() || !cl.fixedBoxes.empty() || !cl.fixedBou.empty()) {
+    throw ValidationError(
+        "--fixed-set, --fixed-box and --fixed-bou apply to mesh inputs only: a scene fixes its vertices with its "
+        "\"fixed\" key (docs/scene-format.md)");
+  }
   Scene scene = loadScene(cl.input);
   if (!cl.writePath.empty()) {
     std::vector<cli::NamedPath> inputs{{"the scene", cl.input}};
@@ -122,7 +135,27 @@ Input readScene(CommandLine& cl) {
   return in;
 }
 
-// A mesh file, with the --fixed-set vertices fixed and --mass.
+// The vertices --fixed-set, --fixed-box and --fixed-bou name, with errors naming the option.
+std::vector<int> fixedVertices(const CommandLine& cl, const TetMesh& mesh) {
+  VertexSelection selection;
+  selection.sets = cl.fixedSets;
+  for (const std::vector<double>& b : cl.fixedBoxes) {
+    selection.boxes.push_back({Eigen::Vector3d(b[0], b[1], b[2]), Eigen::Vector3d(b[3], b[4], b[5])});
+  }
+  if (!cl.fixedBou.empty()) selection.bouFile = cl.fixedBou;
+  if (selection.empty()) return {};
+  try {
+    return selectVertices(mesh, selection);
+  } catch (const SelectionError& error) {
+    const std::string option = error.part() == "sets"    ? "--fixed-set"
+                               : error.part() == "boxes" ? "--fixed-box"
+                                                         : "--fixed-bou";
+    const std::string which = error.index() >= 0 ? " #" + std::to_string(error.index() + 1) : "";
+    throw ValidationError(option + which + ": " + error.what());
+  }
+}
+
+// A mesh file, with the --fixed-set, --fixed-box and --fixed-bou vertices fixed and --mass.
 Input readMesh(const CommandLine& cl) {
   if (!cl.writePath.empty()) {
     cli::refuseOutputOverInputs({"--write", cl.writePath}, {{"the mesh", cl.input}},
@@ -132,14 +165,9 @@ Input readMesh(const CommandLine& cl) {
   MeshReadReport report;
   auto loaded = std::make_shared<TetMesh>(readMesh(cl.input, {}, &report));
   for (const std::string& w : report.warnings) std::cerr << "suggestRegions: warning: " << w << "\n";
-  std::vector<int> fixed;
-  for (const std::string& set : cl.fixedSets) {
-    const std::vector<int> vertices = loaded->setVertices(set);
-    fixed.insert(fixed.end(), vertices.begin(), vertices.end());
-  }
   Input in;
   in.massType = cl.massName == "lumped" ? MassType::lumped : MassType::consistent;
-  in.freeDofs = FreeDofs::fromFixedVertices(loaded->numVertices(), fixed);
+  in.freeDofs = FreeDofs::fromFixedVertices(loaded->numVertices(), fixedVertices(cl, *loaded));
   in.mesh = loaded;
   return in;
 }
@@ -210,13 +238,18 @@ void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const A
               "omega*hS");
   for (const std::vector<ProposedRegion>* list : {&proposal.regions, &proposal.withdrawnRegions}) {
     for (const ProposedRegion& r : *list) {
-      std::printf("%-8s %8d %10zu %10d %12d %14.4g %12.3g%s\n", r.region.name.c_str(), r.region.ratio,
+      std::printf("%-8s %8d %10zu %10d %12d %14.3g %12.3g%s\n", r.region.name.c_str(), r.region.ratio,
                   r.region.vertices.size(), r.numElements, r.numInterfaceDofs, r.maxFrequency,
                   r.maxFrequency * largeTimestep / r.region.ratio,
                   list == &proposal.withdrawnRegions ? "  (withdrawn by the modal check)" : "");
     }
   }
-  if (proposal.cost.evaluated) std::printf("cost check: %s\n", proposal.cost.decision.c_str());
+  // The cost check ran first; when the modal check then withdrew the regions, say so on the
+  // same line, so that "kept" is never read as the final answer.
+  if (proposal.cost.evaluated) {
+    std::printf("cost check: %s%s\n", proposal.cost.decision.c_str(),
+                proposal.withdrawnRegions.empty() ? "" : " (then withdrawn by the modal check below)");
+  }
   if (proposal.modalReport) {
     std::printf("modal check (%zu lowest modes, %.3g s): %s\n", proposal.modalReport->modes.size(),
                 proposal.modalSeconds, proposal.modalReport->verdictText().c_str());

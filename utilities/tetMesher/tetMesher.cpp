@@ -278,8 +278,9 @@ void checkAndReportSurfaceMesh(const TetMesh& mesh, const asyncfem::SignedDistan
         volume, enclosed);
   }
   std::printf(
-      "fidelity: Hausdorff distance %.4g (%.2f spacings): mesh to surface %.4g at %s, surface to mesh %.4g at "
-      "%s (triangle #%d)\n",
+      "fidelity: sampled Hausdorff distance %.4g (%.2f spacings; at the triangles' vertices, edge midpoints and "
+      "centroids, a lower bound of the exact distance): mesh to surface %.4g at %s, surface to mesh %.4g at %s "
+      "(triangle #%d)\n",
       deviation.hausdorff(), deviation.hausdorff() / spacing, deviation.meshToSurface,
       describe(deviation.meshToSurfaceAt).c_str(), deviation.surfaceToMesh, describe(deviation.surfaceToMeshAt).c_str(),
       asyncfem::inputTriangleIndex(distance.surface(), deviation.surfaceToMeshTriangle));

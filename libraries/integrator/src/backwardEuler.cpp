@@ -110,9 +110,11 @@ void BackwardEuler::assembleForReuse() {
 
 void BackwardEuler::updateReusedMatrix() {
   const long long before = reuse_->stats().refactorizations;
-  {
+  try {
     TimeInto timer(stats_.factorizationSeconds);
     reuse_->setMatrix(free_->systemMatrix);
+  } catch (const NumericalError& error) {
+    free_->rethrowWithMeshDof(error);
   }
   stats_.factorizations += reuse_->stats().refactorizations - before;
 }
@@ -122,8 +124,13 @@ void BackwardEuler::solveWithReuse(const Eigen::VectorXd& rhs, Eigen::VectorXd& 
   {
     TimeInto timer(stats_.solveSeconds);
     // solution still holds the previous solve's result (dv of the previous step): a
-    // starting point PCG takes when it is closer than 0.
-    reuse_->solve(rhs, solution, solution);
+    // starting point PCG takes when it is closer than 0. A PCG run that does not converge
+    // refactors, which may fail like any factorization.
+    try {
+      reuse_->solve(rhs, solution, solution);
+    } catch (const NumericalError& error) {
+      free_->rethrowWithMeshDof(error);
+    }
   }
   stats_.factorizations += reuse_->stats().refactorizations - before;
   ++stats_.solvedRightHandSides;

@@ -130,6 +130,18 @@ void FreeSystem::assemble(const std::vector<double>& coefficients,
   combine(coefficients, matrices, systemMatrix);
 }
 
+void FreeSystem::rethrowWithMeshDof(const NumericalError& error) const {
+  const int column = error.location().dof;
+  if (column < 0 || column >= static_cast<int>(freeToFull_.size())) throw error;
+  NumericalErrorLocation location = error.location();
+  location.dof = freeToFull_[static_cast<std::size_t>(column)];
+  location.vertex = location.dof / 3;
+  throw NumericalError(std::string(error.what()) + ", which is DOF " + std::to_string(location.dof) + " (vertex " +
+                           std::to_string(location.vertex) + ", coordinate " + "xyz"[location.dof % 3] +
+                           ") of the mesh",
+                       location);
+}
+
 void FreeSystem::factorize(IntegratorStats& stats) {
   TimeInto timer(stats.factorizationSeconds);
   if (!analyzed_) {
@@ -139,15 +151,7 @@ void FreeSystem::factorize(IntegratorStats& stats) {
   try {
     solver_->factorize(systemMatrix);
   } catch (const NumericalError& error) {
-    const int column = error.location().dof;
-    if (column < 0 || column >= static_cast<int>(freeToFull_.size())) throw;
-    NumericalErrorLocation location = error.location();
-    location.dof = freeToFull_[static_cast<std::size_t>(column)];
-    location.vertex = location.dof / 3;
-    throw NumericalError(std::string(error.what()) + ", which is DOF " + std::to_string(location.dof) + " (vertex " +
-                             std::to_string(location.vertex) + ", coordinate " + "xyz"[location.dof % 3] +
-                             ") of the mesh",
-                         location);
+    rethrowWithMeshDof(error);
   }
   ++stats.factorizations;
   stats.factorFlops += solver_->stats().factorFlops;

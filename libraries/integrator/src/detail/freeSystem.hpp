@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
@@ -64,6 +65,9 @@ class FreeSystem {
   /// solver's NumericalError that names a column (location().dof) is thrown again with
   /// the mesh DOF and vertex that column stands for.
   void factorize(IntegratorStats& stats);
+  /// Throws error again, with the mesh DOF and vertex of the free column it names
+  /// (location().dof) added to its message and location; as is when it names none.
+  [[noreturn]] void rethrowWithMeshDof(const NumericalError& error) const;
   /// x = systemMatrix^{-1} rhs with the last factorization.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, IntegratorStats& stats);
 
