@@ -49,7 +49,7 @@ using asyncfem::test::readText;
 struct MatrixCase {
   std::string integrator;  ///< backwardEuler, trapezoidal, ..., multirateUncoupled
   std::string model;       ///< linear, corotational, stvk, neoHookean, mooneyRivlin
-  std::string option;      ///< plain, lineSearch, reuseFactor, noLaggedSchur, contact, substepContact
+  std::string option;      ///< plain, lineSearch, reuseFactor, exactSolves, noLaggedSchur, contact, substepContact
   bool kill9 = false;      ///< SIGKILL instead of SIGINT
 
   std::string name() const { return integrator + "_" + model + "_" + option + (kill9 ? "_kill9" : "_sigint"); }
@@ -71,7 +71,8 @@ std::vector<std::string> optionsFor(const std::string& integrator, const std::st
   std::vector<std::string> options = {"plain", "contact"};
   if (integrator == "backwardEuler" && nonlinear) {
     options.emplace_back("lineSearch");
-    options.emplace_back("reuseFactor");
+    options.emplace_back("reuseFactor");  // the default kept factor, linearized steps
+    options.emplace_back("exactSolves");  // reuseFactor off: one factorization per iteration
   }
   if (isAsync(integrator)) {
     if (nonlinear) options.emplace_back("noLaggedSchur");  // "plain" has laggedSchur on, the default
@@ -162,6 +163,7 @@ nlohmann::json sceneFor(const MatrixCase& c) {
     options["reuseFactor"] = true;
     options["pcgTolerance"] = 1e-10;
   }
+  if (c.option == "exactSolves") options["reuseFactor"] = false;
   if (isAsync(c.integrator) || c.integrator == "multirateUncoupled") {
     options["regions"] = {{{"name", "tip"}, {"ratio", 4}, {"vertexSets", {"xmax"}}}};
   }
