@@ -203,7 +203,12 @@ class GmshParser {
       // The name is the rest of the line, in quotes, and may contain spaces.
       std::string_view rest = cursor_.line().substr(static_cast<std::size_t>(tokens[2].data() - cursor_.line().data()));
       rest = detail::trim(rest);
-      if (rest.size() >= 2 && rest.front() == '"' && rest.back() == '"') rest = rest.substr(1, rest.size() - 2);
+      if (!rest.empty() && rest.front() == '"') {
+        if (rest.size() < 2 || rest.back() != '"') {
+          cursor_.fail("physical group " + std::to_string(tag) + ": its name has no closing quote");
+        }
+        rest = rest.substr(1, rest.size() - 2);
+      }
       if (rest.empty()) cursor_.fail("physical group " + std::to_string(tag) + " has an empty name");
       if (dim < 0 || dim > 3) cursor_.fail("physical name dimension must be 0..3, got " + std::to_string(dim));
       physicalNames_[{dim, tag}] = std::string(rest);
