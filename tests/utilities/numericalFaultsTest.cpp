@@ -47,7 +47,7 @@ class NumericalFaultsTest : public asyncfem::test::UtilityTest {
   struct Fault {
     std::string message;
     long long frame = -1;
-    double time = 0.0;
+    double t = 0.0;  ///< the simulated time the message names (not a wall-clock figure)
   };
 
   /// Runs the scene, expects exit status 1 and the "frame N (step S, t = T)" prefix, and
@@ -65,13 +65,13 @@ class NumericalFaultsTest : public asyncfem::test::UtilityTest {
       return fault;
     }
     fault.frame = std::stoll(where[1].str());
-    fault.time = std::stod(where[3].str());
+    fault.t = std::stod(where[3].str());
     // Frame N covers the times (N / 20, (N + 1) / 20]; a fault before the load (backward
     // Euler feels it in the step to t = 0.1) would mean the scene, not the fault, is broken.
-    EXPECT_GE(fault.time, 0.1 - 1e-12);
+    EXPECT_GE(fault.t, 0.1 - 1e-12);
     EXPECT_GE(fault.frame, 1) << "at least one frame before the fault";
-    EXPECT_GT(fault.time, static_cast<double>(fault.frame) / 20.0 - 1e-12);
-    EXPECT_LE(fault.time, static_cast<double>(fault.frame + 1) / 20.0 + 1e-12);
+    EXPECT_GT(fault.t, static_cast<double>(fault.frame) / 20.0 - 1e-12);
+    EXPECT_LE(fault.t, static_cast<double>(fault.frame + 1) / 20.0 + 1e-12);
     EXPECT_NE(r.err.find("the " + std::to_string(fault.frame) + " frames before it are kept in"), std::string::npos)
         << r.err;
     asyncfem::SimulationReader reader(folder_ / "fault.afsim");
