@@ -304,7 +304,25 @@ void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::V
   if (options_.syncEachFrame && ::fsync(::fileno(file_.get())) != 0) {
     failWrite(where, "fsync failed", errno);
   }
+  takeBackIfInterleaved(where);
   ++numFrames_;
+}
+
+void SimulationWriter::takeBackIfInterleaved(const std::string& where) {
+  // A change between checkFileIntact() and the write (e.g. a truncation while the record was
+  // being encoded) put this record after foreign bytes: the append was the last write, so
+  // cutting it off leaves the file as the other writer left it, and the change is reported.
+  const int fd = ::fileno(file_.get());
+  const auto record = static_cast<std::int64_t>(buffer_.size());
+  struct stat after {};
+  if (::fstat(fd, &after) != 0 || after.st_nlink == 0) return;  // a deleted file: the next check
+  const auto size = static_cast<std::int64_t>(after.st_size);
+  if (size == completeBytes() + record) return;
+  if (size >= record && ::ftruncate(fd, static_cast<off_t>(size - record)) != 0) {
+    throw Error(where + ": the file changed while this frame was written, and taking the frame back failed: " +
+                systemMessage());
+  }
+  checkFileIntact(where);
 }
 
 }  // namespace asyncfem

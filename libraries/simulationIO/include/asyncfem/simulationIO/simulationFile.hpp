@@ -140,6 +140,10 @@ class SimulationWriter {
   /// Throws (and closes the file) when something else deleted, replaced or truncated the
   /// file since the last frame; a deleted file gets its complete frames written back.
   void checkFileIntact(const std::string& where);
+  /// After a frame's write: when the file is not the complete frames plus this record
+  /// (something changed it between the check and the write), cuts the record back off and
+  /// throws as checkFileIntact() does.
+  void takeBackIfInterleaved(const std::string& where);
   /// After a failed write: drops what is buffered, cuts the file back to its complete
   /// frames, closes it and throws naming the cause.
   [[noreturn]] void failWrite(const std::string& where, const std::string& what, int error);
