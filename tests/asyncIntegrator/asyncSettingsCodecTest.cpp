@@ -15,16 +15,6 @@
 namespace asyncfem {
 namespace {
 
-IntegratorContext barContext() {
-  test::TestSystem ts = test::makeTestSystem(0, 0);
-  IntegratorContext context;
-  context.mesh = std::make_shared<const TetMesh>(ts.mesh);
-  context.system = std::move(ts.system);
-  context.timestep = 0.01;
-  context.frameRate = 30.0;
-  return context;
-}
-
 void expectSameSolverOptions(const AsyncOptions& a, const AsyncOptions& b) {
   EXPECT_EQ(a.coupling, b.coupling);
   EXPECT_EQ(a.schur, b.schur);
@@ -48,7 +38,7 @@ void expectSameRegions(const std::vector<AsyncRegion>& a, const std::vector<Asyn
 // Every non-default value of every solver key, with regions given by a selector and by
 // ids, comes back unchanged (the regions as resolved vertex lists).
 TEST(AsyncSettingsCodec, ExplicitSettingsRoundTrip) {
-  const IntegratorContext context = barContext();
+  const IntegratorContext context = test::barContext();
   std::vector<int> midBarVertices;  // the cross-section at x = 0.5, away from the stiff end
   for (int v = 0; v < context.mesh->numVertices(); ++v) {
     if (std::abs(context.mesh->restPosition(v).x() - 0.5) < 1e-9) midBarVertices.push_back(v);
@@ -85,7 +75,7 @@ TEST(AsyncSettingsCodec, DefaultsWriteRegionsAlone) {
 // Automatic regions are written as the regions the proposal kept: reading them back runs
 // no proposal and gives the same partition.
 TEST(AsyncSettingsCodec, AutomaticRegionsAreWrittenResolved) {
-  const IntegratorContext context = barContext();
+  const IntegratorContext context = test::barContext();
   const nlohmann::json options = {{"regions", "auto"}, {"auto", {{"modalCheck", false}, {"costCheck", false}}}};
   const AsyncSettings parsed = parseAsyncSettings(context, options);
   ASSERT_TRUE(parsed.automaticRegions);

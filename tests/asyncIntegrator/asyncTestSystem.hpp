@@ -4,8 +4,10 @@
 
 #include <Eigen/Dense>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/integrator/registry.hpp>
 #include <asyncfem/problem/problem.hpp>
 #include <cmath>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -38,6 +40,18 @@ inline TestSystem makeTestSystem(const ProblemSettings& settings, unsigned seed 
 /// Linear FEM, consistent mass, Rayleigh damping D = alpha M + beta K (alpha in 1/s, beta in s).
 inline TestSystem makeTestSystem(double alpha, double beta, unsigned seed = 7) {
   return makeTestSystem(testSettings(ForceModelType::linear, alpha, beta), seed);
+}
+
+/// The undamped test system as an integrator registry's context (hL = 0.01, 30 frames/s),
+/// for the scene-settings parsers.
+inline IntegratorContext barContext() {
+  TestSystem ts = makeTestSystem(0, 0);
+  IntegratorContext context;
+  context.mesh = std::make_shared<const TetMesh>(ts.mesh);
+  context.system = std::move(ts.system);
+  context.timestep = 0.01;
+  context.frameRate = 30.0;
+  return context;
 }
 
 /// Dense single-rate backward Euler on the free DOFs (design note, paper Eq. 5), the

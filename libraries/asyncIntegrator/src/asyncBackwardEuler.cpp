@@ -23,6 +23,7 @@
 #include "detail/parallelTasks.hpp"
 #include "detail/schurSolver.hpp"
 #include "detail/sparseBlocks.hpp"
+#include "detail/wholeSystemFactor.hpp"
 
 namespace asyncfem {
 
@@ -45,6 +46,10 @@ struct AsyncBackwardEuler::Impl {
   detail::NaiveSolver naive;
   // This step refactored A^S but keeps Z and H^{LL*} from an earlier tangent (laggedSchur).
   bool schurLagging = false;
+  // Quick set-up (AsyncOptions::quickSetUp): L's system is solved on the whole system's
+  // factor until the iterations' extra time reaches the estimated cost of the rebuild.
+  bool quick = false;
+  double quickExtraFlops = 0.0;
   // Linear forces with a symmetric K (checked once): f_int(u_0) = K u_0 and K v_0 are taken
   // row by row (row i = column i) on the DOFs that need them, and L's rows need only
   // K (u_0 + (beta + hL) v_0), as in single-rate backward Euler.
@@ -92,6 +97,43 @@ struct AsyncBackwardEuler::CachedSetUp {
 };
 
 namespace {
+/// Most doubles the quick set-up's deflation directions and their products may hold (64 MiB).
+constexpr double kMaxDeflationEntries = 8.0 * 1024 * 1024;
+/// What a flop of a supernodal factorization, or of a solve with many right-hand sides
+/// (Z's columns in blocks), costs against one of a single solve (BLAS 3 against memory-
+/// bound substitutions): CHOLMOD on this project's 2-core machine, one thread, factored at
+/// 7.0-8.6 GFlop/s and solved single right-hand sides at 3.2-4.8 GFlop/s (benchmarkAsync
+/// --study setup on dragon meshes of 2k and 10k vertices and the dinosaur).
+constexpr double kBlockedFlopWeight = 0.4;
+/// The fixed cost of one solve call (wrapping, scatter and gather, CHOLMOD's workspace) in
+/// flops of a solve, which dominates the small A^S solves of a forward substitution.
+constexpr double kSolveCallFlops = 1e5;
+
+/// Flop prices of the quick set-up's rent-or-buy rule (Eq. Q4).
+struct QuickCosts {
+  double iteration = 0.0;   ///< one preconditioner solve and one product with H^{LL*}
+  double exactSolve = 0.0;  ///< what a step with a factor of H^{LL*} spends instead (one solve)
+  double rebuild = 0.0;     ///< Z and the factor of H^{LL*}
+};
+
+QuickCosts quickCosts(const std::vector<FastRegion>& regions, const SparseMatrix& largeSystem,
+                      const RegionPartition& partition, const detail::WholeSystemFactor& whole) {
+  QuickCosts costs;
+  costs.exactSolve = whole.solveFlops() + kSolveCallFlops;
+  costs.iteration = costs.exactSolve + 2.0 * static_cast<double>(largeSystem.nonZeros());
+  costs.rebuild = kBlockedFlopWeight * whole.factorFlops();
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    const FastRegion& rb = regions[i];
+    // A forward substitution: m_i solves with A^S and m_i products with G; Z is |I_i| of
+    // them, in blocks of columns.
+    const double substitution = rb.ratio * (rb.solver->stats().solveFlopsPerRhs + 2.0 * double(rb.G.nonZeros()));
+    costs.iteration += substitution + rb.ratio * kSolveCallFlops;
+    costs.rebuild +=
+        kBlockedFlopWeight * substitution * static_cast<double>(partition.interfaceDofs(static_cast<int>(i)).size());
+  }
+  return costs;
+}
+
 std::vector<std::pair<int, std::vector<int>>> partitionKey(const RegionPartition& partition) {
   std::vector<std::pair<int, std::vector<int>>> key;
   for (int i = 0; i < partition.numRegions(); ++i) {
@@ -266,6 +308,9 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   d.schur.reset();
   d.naive.reset();
   d.schurLagging = false;
+  d.quick = options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
+            options_.method == AsyncSolveMethod::structured;
+  d.quickExtraFlops = 0.0;
   d.factorsCurrent = false;
   if (d.linear) {
     // K is constant: build and factor everything now, so the first step costs a steady one.
@@ -298,7 +343,28 @@ void AsyncBackwardEuler::refactor() {
   for (FastRegion& rb : d.regions) rb.factorize(stats_);
   stats_.factorizationSeconds += factor.stop();
   if (d.schurLagging) return;
+  if (d.quick) {
+    borrowWholeFactor();
+    return;
+  }
   fullSchurRebuild();
+}
+
+// Quick set-up: the whole single-rate system's factor, made once per hL (nonlinear forces:
+// from the first tangent, then kept as a preconditioner) and shared by every partition.
+void AsyncBackwardEuler::borrowWholeFactor() {
+  Impl& d = *impl_;
+  if (!whole_) whole_ = std::make_unique<detail::WholeSystemFactor>();
+  if (!whole_->factoredFor(timestep())) {
+    Stopwatch factor;
+    whole_->factor(system_.mass, d.stiffness, system_.freeDofs.freeToFull(), timestep(), system_.rayleighMass,
+                   system_.rayleighStiffness, stats_);
+    const double seconds = factor.stop();
+    stats_.factorizationSeconds += seconds;
+    if (d.settingUp) runStats_.setupSchurSeconds += seconds;
+  }
+  if (!d.schur.borrowing()) d.schur.borrow(whole_.get(), &partition_.largeDofs());
+  if (!d.linear) d.schur.forgetDirections();  // a new tangent: H^{LL*} changed
 }
 
 // Blocks of M are constant: cut once. Blocks of K are updated in place (values only) and
@@ -573,16 +639,66 @@ void AsyncBackwardEuler::solveStructured() {
   const auto apply = [this](const Eigen::VectorXd& y, Eigen::VectorXd& out) { applySchur(y, out); };
   if (partition_.largeDofs().empty()) {
     d.Y.resize(0);
+  } else if (d.schur.borrowing()) {
+    solveOnWholeFactor();
   } else if (!d.schurLagging) {
     d.schur.solve(d.rhsSchur, d.Y);
-  } else if (!d.schur.refine(d.rhsSchur, d.Y, apply, options_.coupling == AsyncCoupling::stable, options_, runStats_)) {
-    // The old factor no longer preconditions well enough: rebuild now (exact solve).
-    Stopwatch rebuild;
-    fullSchurRebuild();
-    runStats_.rebuildSeconds += rebuild.stop();
-    d.schur.solve(d.rhsSchur, d.Y);
+  } else {
+    const detail::SchurSolver::Refinement result =
+        d.schur.refine(d.rhsSchur, d.Y, apply, options_.coupling == AsyncCoupling::stable,
+                       options_.laggedSchurIterations, options_.laggedSchurTolerance);
+    runStats_.schurIterations += result.iterations;
+    if (result.converged && !result.zeroRightHandSide) {
+      ++runStats_.laggedSteps;
+      runStats_.largestSchurResidual = std::max(runStats_.largestSchurResidual, result.residual);
+    }
+    if (!result.converged) {
+      // The old factor no longer preconditions well enough: rebuild now (exact solve).
+      Stopwatch rebuild;
+      fullSchurRebuild();
+      runStats_.rebuildSeconds += rebuild.stop();
+      d.schur.solve(d.rhsSchur, d.Y);
+    }
   }
   detail::parallelTasks(numRegions, threads, [&](int i) { recoverRegion(i); });
+}
+
+// Quick set-up (Eqs. Q1-Q3): deflated conjugate gradients on H^{LL*}, preconditioned by the
+// Schur complement of the whole single-rate system on L. Exact with no region (H^{LL*} =
+// A). The time beyond one solve is what the missing factor costs; once it adds up to the
+// rebuild's estimate, or the iterations do not converge, Z and H^{LL*} are built (the rent-
+// or-buy rule: at most about twice what knowing the partition's lifetime would have cost).
+void AsyncBackwardEuler::solveOnWholeFactor() {
+  Impl& d = *impl_;
+  if (partition_.numRegions() == 0) {
+    d.schur.solve(d.rhsSchur, d.Y);
+    return;
+  }
+  const auto apply = [this](const Eigen::VectorXd& y, Eigen::VectorXd& out) { applySchur(y, out); };
+  // H^{LL*} - (Schur complement of A) lies on I x I, so the iterations after the first
+  // live in a space of at most |I| dimensions: that many kept directions (64 MiB at most)
+  // deflate it whole.
+  const double perDirection = 2.0 * static_cast<double>(d.rhsSchur.size());
+  const int keep = static_cast<int>(std::min(runStats_.interfaceDofs + 16.0, kMaxDeflationEntries / perDirection));
+  Stopwatch watch;
+  const detail::SchurSolver::Refinement result =
+      d.schur.solveDeflated(d.rhsSchur, d.Y, apply, options_.quickSetUpIterations, options_.laggedSchurTolerance, keep);
+  const double seconds = watch.stop();
+  runStats_.quickIterations += result.iterations;
+  if (result.converged) {
+    ++runStats_.quickSteps;
+    runStats_.largestQuickResidual = std::max(runStats_.largestQuickResidual, result.residual);
+    const QuickCosts costs = quickCosts(d.regions, d.largeSystem, partition_, *whole_);
+    const double deflation = 2.0 * static_cast<double>(d.schur.keptDirections()) * static_cast<double>(d.Y.size());
+    d.quickExtraFlops += result.iterations * (costs.iteration + 2.0 * deflation) + 3.0 * deflation - costs.exactSolve;
+    if (d.quickExtraFlops < costs.rebuild || !options_.quickSetUpRebuild) return;
+  }
+  Stopwatch rebuild;
+  d.quick = false;
+  fullSchurRebuild();
+  ++runStats_.quickEnds;
+  runStats_.rebuildSeconds += rebuild.stop();
+  if (!result.converged) d.schur.solve(d.rhsSchur, d.Y);
 }
 
 // X_m and sum_r X_r from the stored Z_m and sum_r Z_r, or every X_r by a second forward
@@ -597,7 +713,7 @@ void AsyncBackwardEuler::recoverRegion(int i) {
     return;
   }
   detail::gatherInto(d.Y, pos, rb.yInterface);
-  if (rb.useDenseZ && !observer_ && !d.schurLagging) {
+  if (rb.useDenseZ && !observer_ && !d.schurLagging && !d.schur.borrowing()) {
     rb.xLast = rb.y.col(rb.ratio - 1);
     rb.xLast.noalias() -= rb.zLast * rb.yInterface;
     rb.xSum = rb.y.rowwise().sum();
@@ -745,6 +861,15 @@ RunReport AsyncBackwardEuler::report() const {
         "refactors at its first step; its frames match an uninterrupted run to about the Schur tolerance (" +
         std::to_string(options_.laggedSchurTolerance) + "), not bit for bit";
   }
+  if (options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
+      options_.method == AsyncSolveMethod::structured) {
+    if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
+    report.resumeCaveat +=
+        "quickSetUp: whether the partition still solved on the whole system's factor is not in the checkpoint, "
+        "so the resumed run starts on it again; its frames match an uninterrupted run to about the Schur "
+        "tolerance (" +
+        std::to_string(options_.laggedSchurTolerance) + "), not bit for bit";
+  }
   if (policy_) {
     if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
     report.resumeCaveat +=
@@ -766,6 +891,13 @@ RunReport AsyncBackwardEuler::report() const {
   if (r.laggedSteps > 0) {
     std::snprintf(line, sizeof(line), "async lagged Schur: %lld steps, %lld iterations, largest relative residual %.2e",
                   r.laggedSteps, r.schurIterations, r.largestSchurResidual);
+    lines.emplace_back(line);
+  }
+  if (r.quickSteps > 0 || r.quickEnds > 0) {
+    std::snprintf(line, sizeof(line),
+                  "async quick set-up: %lld steps on the whole system's factor, %lld iterations (largest relative "
+                  "residual %.2e); %lld partition(s) then built Z and H^LL*",
+                  r.quickSteps, r.quickIterations, r.largestQuickResidual, r.quickEnds);
     lines.emplace_back(line);
   }
   if (policy_) appendRepartitionLines(repartitions_, lines);

@@ -118,6 +118,7 @@ AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
   solver.regionSolver = parseSolverKind(regionSolver);
   solver.substepStatePrediction = reader.boolean("substepContact", false);
   solver.laggedSchur = reader.boolean("laggedSchur", solver.laggedSchur);
+  solver.quickSetUp = reader.boolean("quickSetUp", solver.quickSetUp);
   solver.threads = reader.integer("threads", solver.threads, 0, 1024);
   if (solver.substepStatePrediction && !hasContact) {
     reader.fail("substepContact", "only meaningful with a \"contact\" section");
@@ -244,8 +245,9 @@ AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const
 }
 
 const std::vector<std::string>& asyncOptionKeys() {
-  static const std::vector<std::string> keys{"coupling",       "schur",       "method",  "recovery", "regionSolver",
-                                             "substepContact", "laggedSchur", "threads", "regions",  "auto"};
+  static const std::vector<std::string> keys{"coupling",     "schur",          "method",      "recovery",
+                                             "regionSolver", "substepContact", "laggedSchur", "quickSetUp",
+                                             "threads",      "regions",        "auto"};
   return keys;
 }
 
@@ -305,6 +307,7 @@ nlohmann::json asyncSettingsJson(const AsyncSettings& settings) {
     out["substepContact"] = solver.substepStatePrediction;
   }
   if (solver.laggedSchur != defaults.laggedSchur) out["laggedSchur"] = solver.laggedSchur;
+  if (solver.quickSetUp != defaults.quickSetUp) out["quickSetUp"] = solver.quickSetUp;
   if (solver.threads != defaults.threads) out["threads"] = solver.threads;
   out["regions"] =
       settings.adaptive ? nlohmann::json{{"adaptive", settings.adaptiveSource}} : asyncRegionsJson(settings.regions);

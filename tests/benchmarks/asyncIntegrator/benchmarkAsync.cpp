@@ -14,6 +14,9 @@
 //                                   per scene: set-up, steady-state async step against one
 //                                   single-rate step at hL, and (--corotational) the async
 //                                   frame against corotational single-rate at hS
+//   benchmarkAsync --study setup --scenes A.json B.json ...
+//                                   per scene: set-up and re-partition cost, exact against
+//                                   AsyncOptions::quickSetUp, in single-rate steps at hL
 //   benchmarkAsync --study steady --only async|single --scenes A.json --steps N
 //                                   one configuration only, for callgrind: the steady steps
 //                                   are the only ones collected (run under
@@ -21,6 +24,7 @@
 #include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/contact/penaltyContact.hpp>
@@ -665,6 +669,128 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
   std::printf("\n");
 }
 
+struct SetUpRow {
+  std::string name;
+  int vertices = 0, fastVertices = 0, interfaceDofs = 0, ratio = 1, movedVertices = 0;
+  double singleStep = 0, singleSetup = 0, exactStep = 0;
+  // [0] exact set-up, [1] quickSetUp; for the first partition and for the re-partition.
+  std::array<double, 2> setup{}, excess{}, repartition{}, repartitionExcess{};
+  std::array<long long, 2> quickSteps{}, repartitionQuickSteps{};
+};
+
+/// Seconds of each of `count` steps.
+std::vector<double> timedSteps(Integrator& integrator, int count) {
+  std::vector<double> samples;
+  for (int k = 0; k < count; ++k) {
+    Stopwatch watch;
+    integrator.step();
+    samples.push_back(watch.stop());
+  }
+  return samples;
+}
+
+/// Seconds the steps spend beyond `steady` each.
+double excessOver(const std::vector<double>& samples, double steady) {
+  double excess = 0.0;
+  for (double s : samples) excess += s - steady;
+  return excess;
+}
+
+/// Every region grown by one ring of vertices (a re-partition that moves a few percent).
+std::vector<AsyncRegion> grownByOneRing(const TetMesh& mesh, const std::vector<AsyncRegion>& regions) {
+  std::vector<AsyncRegion> grown;
+  for (const AsyncRegion& region : regions) {
+    std::vector<char> marked(static_cast<std::size_t>(mesh.numVertices()), 0);
+    for (int v : region.vertices) marked[static_cast<std::size_t>(v)] = 1;
+    growByRings(mesh, marked, 1);
+    AsyncRegion bigger = region;
+    bigger.vertices.clear();
+    for (int v = 0; v < mesh.numVertices(); ++v)
+      if (marked[static_cast<std::size_t>(v)]) bigger.vertices.push_back(v);
+    grown.push_back(bigger);
+  }
+  return grown;
+}
+
+/// Set-up: per scene, the asynchronous integrator with the exact set-up (Z and H^{LL*}) and
+/// with AsyncOptions::quickSetUp (rent-or-buy rule on, as a user runs it): the set-up, then
+/// what the next `steps` steps spend beyond the exact integrator's steady step, for the
+/// scene's partition and for a re-partition that grows every region by one ring; all in
+/// single-rate steps at hL.
+void setUpStudy(const std::vector<std::string>& scenes, int steps) {
+  std::vector<SetUpRow> rows;
+  for (const std::string& spec : scenes) {
+    const Scene scene = steadyScene(spec, false);
+    Simulation simulation = buildSimulation(scene);
+    auto* shipped = dynamic_cast<AsyncBackwardEuler*>(simulation.integrator.get());
+    if (shipped == nullptr) throw ValidationError(spec + ": the scene's integrator is not async");
+    const DynamicSystem system = shipped->system();
+    const TetMesh& mesh = *simulation.mesh;
+    std::vector<AsyncRegion> regions;
+    for (int i = 0; i < shipped->partition().numRegions(); ++i) regions.push_back(shipped->partition().region(i));
+    const std::vector<AsyncRegion> grown = grownByOneRing(mesh, regions);
+    SetUpRow row;
+    row.name = scene.sourceName;
+    row.vertices = mesh.numVertices();
+    row.interfaceDofs = shipped->runStats().interfaceDofs;
+    row.fastVertices = shipped->runStats().fastDofs / 3;
+    for (const AsyncRegion& region : regions) row.ratio = std::max(row.ratio, region.ratio);
+    const double hL = shipped->timestep();
+    {
+      Stopwatch construction;
+      auto single = makeIntegrator("backward-euler", system, hL);
+      single->step();
+      row.singleSetup = construction.stop();
+      row.singleStep = median(timedSteps(*single, steps));
+    }
+    const RegionPartition next(mesh, system.freeDofs, grown);
+    for (std::size_t v = 0; v < next.vertexRegion().size(); ++v)
+      if ((next.vertexRegion()[v] >= 0) != (shipped->partition().vertexRegion()[v] >= 0)) ++row.movedVertices;
+    for (int kind = 0; kind < 2; ++kind) {
+      AsyncOptions options = shipped->options();
+      options.quickSetUp = kind == 1;
+      Stopwatch construction;
+      AsyncBackwardEuler async(mesh, system, hL, regions, options);
+      row.setup[kind] = construction.stop();
+      const std::vector<double> first = timedSteps(async, steps);
+      if (kind == 0) row.exactStep = median(first);
+      row.excess[kind] = excessOver(first, row.exactStep);
+      row.quickSteps[kind] = async.runStats().quickSteps;
+      Stopwatch repartition;
+      async.setUp(next);
+      row.repartition[kind] = repartition.stop();
+      const long long before = async.runStats().quickSteps;
+      row.repartitionExcess[kind] = excessOver(timedSteps(async, steps), row.exactStep);
+      row.repartitionQuickSteps[kind] = async.runStats().quickSteps - before;
+    }
+    rows.push_back(row);
+  }
+  std::printf(
+      "### Set-up: exact (Z and H^{LL*}) against quickSetUp, in single-rate steps at hL (linear forces, %d steps "
+      "after each set-up)\n\n",
+      steps);
+  std::printf(
+      "| scene | vertices | S vertices | interface DOFs | m | single-rate ms/step | single-rate set-up | exact: set-up "
+      "+ excess | quick: set-up + excess (steps on the quick path) | re-partition +1 ring: vertices moved | exact: "
+      "set-up + excess | quick: set-up + excess (quick steps) |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const SetUpRow& r : rows) {
+    const double u = r.singleStep;
+    std::printf(
+        "| %s | %d | %d | %d | %d | %.3f | %.1f | %.1f + %.1f | %.1f + %.1f (%lld) | %d (%.1f%%) | %.1f + %.1f | "
+        "%.1f + %.1f (%lld) |\n",
+        r.name.c_str(), r.vertices, r.fastVertices, r.interfaceDofs, r.ratio, 1e3 * u, r.singleSetup / u,
+        r.setup[0] / u, r.excess[0] / u, r.setup[1] / u, r.excess[1] / u, r.quickSteps[1], r.movedVertices,
+        100.0 * r.movedVertices / r.vertices, r.repartition[0] / u, r.repartitionExcess[0] / u, r.repartition[1] / u,
+        r.repartitionExcess[1] / u, r.repartitionQuickSteps[1]);
+  }
+  std::printf(
+      "\nSingle-rate set-up: its construction and first step. Excess: what the %d steps after the set-up spend beyond "
+      "as many steady steps of the exact integrator (the exact one's own excess is its first steps' noise); for the "
+      "quick set-up it includes the rebuild the rent-or-buy rule may decide.\n\n",
+      steps);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -676,9 +802,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> scenes;
   std::string only;
   bool corotational = false, collectFirst = false, rebuildSchur = false;
-  app.add_option("--study", study, "growth | ratio | schur | corotational | contact | steady | all")
-      ->check(CLI::IsMember({"growth", "ratio", "schur", "corotational", "contact", "steady", "all"}));
-  app.add_option("--scenes", scenes, "steady study: scene files, or dragon:SPACING:SET:M:HL");
+  app.add_option("--study", study, "growth | ratio | schur | corotational | contact | steady | setup | all")
+      ->check(CLI::IsMember({"growth", "ratio", "schur", "corotational", "contact", "steady", "setup", "all"}));
+  app.add_option("--scenes", scenes, "steady and setup studies: scene files, or dragon:SPACING:SET:M:HL");
   app.add_option("--only", only, "steady study: time one configuration only (for callgrind)")
       ->check(CLI::IsMember({"async", "single", "single-hs"}));
   app.add_flag("--corotational", corotational, "steady study: corotational forces");
@@ -704,6 +830,7 @@ int main(int argc, char** argv) {
     if (study == "corotational" || study == "all") corotationalStudy(ratioCells, ratio, 1.0 / 120.0);
     if (study == "contact" || study == "all") contactStudy(ratioCells, ratio, 1.0 / 120.0);
     if (study == "steady") steadyStudy(scenes, steps, corotational, only, collectFirst, rebuildSchur);
+    if (study == "setup") setUpStudy(scenes, steps);
   } catch (const asyncfem::Error& e) {
     std::fprintf(stderr, "benchmarkAsync: %s\n", e.what());
     return 1;

@@ -43,6 +43,11 @@ void SchurSolver::factor(const SparseMatrix& largeSystem, const RegionPartition&
                          double asymmetry, IntegratorStats& stats) {
   factored_ = true;
   refreshNext_ = false;
+  borrowed_ = nullptr;
+  borrowedLarge_ = nullptr;
+  kept_ = 0;
+  directions_.resize(0, 0);
+  productsOfDirections_.resize(0, 0);
   const auto numLarge = static_cast<double>(largeSystem.rows());
   if (largeSystem.rows() == 0) return;
   const std::vector<int> all = interfaceUnionOf(partition);
@@ -147,7 +152,16 @@ void SchurSolver::factorAssembled(const SparseMatrix& largeSystem, const RegionP
   factorizeCounted(*solver_, schur_, analyzed_, stats);
 }
 
+void SchurSolver::borrow(WholeSystemFactor* whole, const std::vector<int>* largeDofs) {
+  borrowed_ = whole;
+  borrowedLarge_ = largeDofs;
+}
+
 void SchurSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  if (borrowed_ != nullptr) {
+    borrowed_->solveOnLarge(*borrowedLarge_, rhs, solution);
+    return;
+  }
   solver_->solve(rhs, solution_);
   solution = solution_.col(0);
   if (modeUsed_ != SchurMode::lowRank || interfaceUnion_.empty()) return;
@@ -156,24 +170,29 @@ void SchurSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
   solution.noalias() += lowRankBasis_ * (unionCorrection_ * z);
 }
 
-bool SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, const Operator& apply, bool symmetric,
-                         const AsyncOptions& options, AsyncRunStats& runStats) {
+SchurSolver::Refinement SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution,
+                                            const Operator& apply, bool symmetric, int maxIterations,
+                                            double tolerance) {
+  Refinement result;
   const double scale = rhs.norm();
   solve(rhs, solution);
-  if (scale == 0.0) return true;
+  if (scale == 0.0) {
+    result.converged = result.zeroRightHandSide = true;
+    return result;
+  }
   apply(solution, product_);
   residual_ = rhs - product_;  // r
   double rz = 0.0;
-  for (int iteration = 1; iteration <= options.laggedSchurIterations; ++iteration) {
-    const double residual = residual_.norm() / scale;
-    if (!std::isfinite(residual)) return false;
-    if (residual <= options.laggedSchurTolerance) {
-      ++runStats.laggedSteps;
-      runStats.largestSchurResidual = std::max(runStats.largestSchurResidual, residual);
-      refreshNext_ = iteration > options.laggedSchurIterations / 2;  // slow: the next step refactors
-      return true;
+  for (int iteration = 1; iteration <= maxIterations; ++iteration) {
+    result.residual = residual_.norm() / scale;
+    if (!std::isfinite(result.residual)) return result;
+    if (result.residual <= tolerance) {
+      result.converged = true;
+      // Slow with an own factor: the next step refactors.
+      refreshNext_ = borrowed_ == nullptr && iteration > maxIterations / 2;
+      return result;
     }
-    ++runStats.schurIterations;
+    ++result.iterations;
     solve(residual_, correction_);  // z = P^{-1} r
     if (!symmetric) {
       solution += correction_;
@@ -181,21 +200,80 @@ bool SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, 
       residual_ = rhs - product_;
       continue;
     }
-    const double rzNew = residual_.dot(correction_);
-    if (iteration == 1) {
-      direction_ = correction_;
-    } else {
-      direction_ = correction_ + (rzNew / rz) * direction_;
-    }
-    rz = rzNew;
-    apply(direction_, product_);
-    const double curvature = direction_.dot(product_);
-    if (!(curvature > 0.0)) return false;
-    const double step = rz / curvature;
-    solution += step * direction_;
-    residual_ -= step * product_;
+    if (!(conjugateStep(solution, apply, iteration == 1, false, rz) > 0.0)) return result;
   }
-  return false;
+  return result;
+}
+
+// From z = correction_: the new direction p = z + beta p (deflated when asked), H p, and
+// the step along it.
+double SchurSolver::conjugateStep(Eigen::VectorXd& solution, const Operator& apply, bool first, bool deflated,
+                                  double& rz) {
+  const double rzNew = residual_.dot(correction_);
+  if (first) {
+    direction_ = correction_;
+  } else {
+    direction_ = correction_ + (rzNew / rz) * direction_;
+  }
+  rz = rzNew;
+  if (deflated && kept_ > 0) {
+    coefficients_.noalias() = productsOfDirections_.leftCols(kept_).transpose() * direction_;
+    direction_.noalias() -= directions_.leftCols(kept_) * coefficients_;
+  }
+  apply(direction_, product_);
+  const double curvature = direction_.dot(product_);
+  if (!(curvature > 0.0)) return curvature;
+  const double step = rz / curvature;
+  solution += step * direction_;
+  residual_ -= step * product_;
+  return curvature;
+}
+
+// Deflated preconditioned conjugate gradients (Saad, Yeung, Erhel & Guyomarc'h 2000) with
+// W H-orthonormal: x_0 = W W^T b, and every direction p = z + beta p - W (H W)^T z stays
+// H-orthogonal to W. The new directions, normalized, join W while there is room.
+SchurSolver::Refinement SchurSolver::solveDeflated(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution,
+                                                   const Operator& apply, int maxIterations, double tolerance,
+                                                   int keep) {
+  Refinement result;
+  const Eigen::Index n = rhs.size();
+  const double scale = rhs.norm();
+  solution.setZero(n);
+  if (scale == 0.0) {
+    result.converged = result.zeroRightHandSide = true;
+    return result;
+  }
+  if (directions_.rows() != n || directions_.cols() < keep) {
+    directions_.conservativeResize(n, keep);
+    productsOfDirections_.conservativeResize(n, keep);
+    kept_ = std::min(kept_, keep);
+  }
+  residual_ = rhs;
+  if (kept_ > 0) {
+    coefficients_.noalias() = directions_.leftCols(kept_).transpose() * rhs;
+    solution.noalias() = directions_.leftCols(kept_) * coefficients_;
+    residual_.noalias() -= productsOfDirections_.leftCols(kept_) * coefficients_;
+  }
+  double rz = 0.0;
+  for (int iteration = 1;; ++iteration) {
+    result.residual = residual_.norm() / scale;
+    if (!std::isfinite(result.residual)) return result;
+    if (result.residual <= tolerance) {
+      result.converged = true;
+      return result;
+    }
+    if (iteration > maxIterations) return result;
+    ++result.iterations;
+    solve(residual_, correction_);  // z = P^{-1} r
+    const double curvature = conjugateStep(solution, apply, iteration == 1, true, rz);
+    if (!(curvature > 0.0)) return result;
+    if (kept_ < keep) {
+      const double norm = std::sqrt(curvature);
+      directions_.col(kept_) = direction_ / norm;
+      productsOfDirections_.col(kept_) = product_ / norm;
+      ++kept_;
+    }
+  }
 }
 
 }  // namespace asyncfem::detail

@@ -15,17 +15,26 @@
 #include <vector>
 
 #include "detail/fastRegion.hpp"
+#include "detail/wholeSystemFactor.hpp"
 
 namespace asyncfem::detail {
 
 /// Factors H^{LL*} in one of three strategies (SchurMode) and solves with it; with a
 /// factor kept from an earlier tangent, solves the current Schur system by preconditioned
-/// refinement (AsyncOptions::laggedSchur).
+/// refinement (AsyncOptions::laggedSchur); or, before any factor of its own, borrows the
+/// whole single-rate system's factor as preconditioner (AsyncOptions::quickSetUp).
 class SchurSolver {
  public:
   using SparseMatrix = Eigen::SparseMatrix<double>;
   /// out = H^{LL*} y for the current blocks (|L| entries each).
   using Operator = std::function<void(const Eigen::VectorXd& y, Eigen::VectorXd& out)>;
+  /// What one refine() did.
+  struct Refinement {
+    bool converged = false;
+    int iterations = 0;     ///< preconditioned iterations after the first solve
+    double residual = 0.0;  ///< final relative residual
+    bool zeroRightHandSide = false;
+  };
 
   /// Factors H^{LL*} from largeSystem (Â^L, |L| x |L|) and the regions' corrections C_i.
   /// requested is the user's mode; the stable coupling's symmetric H^{LL*} (asymmetry of
@@ -35,14 +44,30 @@ class SchurSolver {
               SchurMode requested, AsyncCoupling coupling, double asymmetry, IntegratorStats& stats);
   /// solution = (H^{LL*})^{-1} rhs with the last factor.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
-  /// H^{LL*} solution = rhs for the operator of the current blocks, with the last factor as
-  /// preconditioner: conjugate gradients when symmetric (the stable coupling), iterative
-  /// refinement otherwise, to a relative residual of options.laggedSchurTolerance in at
-  /// most options.laggedSchurIterations iterations. Returns false when it did not get there
-  /// (the caller then refactors). Counts into runStats; a slow convergence (more than half
-  /// the iterations) asks for a refactor at the next step (refreshRequested()).
-  bool refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, const Operator& apply, bool symmetric,
-              const AsyncOptions& options, AsyncRunStats& runStats);
+  /// H^{LL*} solution = rhs for the operator of the current blocks, with the last factor
+  /// (or the borrowed one) as preconditioner: conjugate gradients when symmetric (the stable
+  /// coupling), iterative refinement otherwise, to a relative residual of tolerance in at
+  /// most maxIterations iterations. Not converged: the caller then refactors. A slow
+  /// convergence of an own factor (more than half the iterations) asks for a refactor at
+  /// the next step (refreshRequested()).
+  Refinement refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, const Operator& apply, bool symmetric,
+                    int maxIterations, double tolerance);
+
+  /// Until the next factor() or reset(), solve() applies the inverse of the Schur
+  /// complement of the whole single-rate system on L (largeDofs: global ids of L) instead
+  /// of a factor of H^{LL*}: exact when every ratio is 1, a preconditioner otherwise.
+  /// whole must outlive the borrowing.
+  void borrow(WholeSystemFactor* whole, const std::vector<int>* largeDofs);
+  bool borrowing() const { return borrowed_ != nullptr; }
+  /// H^{LL*} solution = rhs by deflated conjugate gradients (Eq. Q3) on the borrowed
+  /// preconditioner: the directions of earlier solves with the same operator (at most
+  /// `keep`) are projected out, so each solve needs fewer iterations than the one before.
+  /// Each iteration is one preconditioner solve and one product with H^{LL*}.
+  Refinement solveDeflated(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, const Operator& apply,
+                           int maxIterations, double tolerance, int keep);
+  /// Drops the kept directions (the operator changed).
+  void forgetDirections() { kept_ = 0; }
+  int keptDirections() const { return kept_; }
 
   /// Forgets the pattern, the analysis and the factor (a new partition).
   void reset();
@@ -54,6 +79,10 @@ class SchurSolver {
 
  private:
   void chooseSolver(SchurMode mode);
+  /// One conjugate-gradient update from z = correction_ and r = residual_ (rz carries
+  /// r.z between calls); deflated: the direction is made H-orthogonal to the kept ones.
+  /// Returns the direction's curvature p.Hp (not positive: nothing was updated).
+  double conjugateStep(Eigen::VectorXd& solution, const Operator& apply, bool first, bool deflated, double& rz);
   void factorLowRank(const SparseMatrix& largeSystem, const RegionPartition& partition,
                      const std::vector<FastRegion>& regions, const std::vector<int>& interfaceUnion,
                      IntegratorStats& stats);
@@ -62,6 +91,13 @@ class SchurSolver {
                        const std::vector<FastRegion>& regions, IntegratorStats& stats);
 
   SchurMode modeUsed_ = SchurMode::lowRank;
+  WholeSystemFactor* borrowed_ = nullptr;
+  const std::vector<int>* borrowedLarge_ = nullptr;
+  // Deflation space of solveDeflated: columns [0, kept_) of directions_ (W, H^{LL*}-
+  // orthonormal) and of their products (H^{LL*} W).
+  Eigen::MatrixXd directions_, productsOfDirections_;
+  int kept_ = 0;
+  Eigen::VectorXd coefficients_;
   std::unique_ptr<SparseSolver> solver_;  // of H^{LL*} (lu, symmetric) or of A^L (lowRank)
   bool analyzed_ = false;
   bool factored_ = false;

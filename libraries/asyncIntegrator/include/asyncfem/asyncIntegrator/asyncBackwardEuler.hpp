@@ -14,6 +14,9 @@
 #include <vector>
 
 namespace asyncfem {
+namespace detail {
+class WholeSystemFactor;
+}
 
 /// Asynchronous implicit backward Euler (Zhao, Li & Barbič 2016, with the equations of
 /// docs/asynchronous-integrator.md). Fast regions S_i take m_i backward Euler substeps of
@@ -106,6 +109,8 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   void assembleBlocks();
   void subtractInterfaceStiffness();
   void fullSchurRebuild();
+  void borrowWholeFactor();
+  void solveOnWholeFactor();
   void applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out);
   void evaluateStartOfStep();
   void gatherExternalForces(double t0, double t1);
@@ -124,6 +129,8 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   SchurMode schurModeUsed_ = SchurMode::lowRank;
   AsyncRunStats runStats_;
   std::unique_ptr<Impl> impl_;
+  // The whole single-rate system's factor (quickSetUp), shared by every partition.
+  std::unique_ptr<detail::WholeSystemFactor> whole_;
   std::unique_ptr<AdaptiveRegionPolicy> policy_;
   std::vector<RepartitionRecord> repartitions_;
   long long stepsKept_ = 0;  // large steps since the last change of partition

@@ -79,6 +79,20 @@ struct AsyncOptions {
   bool laggedSchur = true;
   int laggedSchurIterations = 8;
   double laggedSchurTolerance = 1e-10;
+  /// Stable coupling, structured method only (docs/asynchronous-integrator.md, "Quick
+  /// set-up"). false (default): a set-up computes Z and factors H^{LL*}, and every step
+  /// solves exactly. true: a set-up factors only the regions' A^S; L's system is solved
+  /// by conjugate gradients preconditioned with the factor of the whole single-rate system
+  /// A = M + hL D + hL^2 K (one factor for every partition, refactored only for a new hL;
+  /// exact when every ratio is 1) to a relative residual of laggedSchurTolerance. Once the
+  /// iterations have cost as much as the rebuild they put off (its estimate: the whole
+  /// factor's time plus one forward substitution per interface DOF), or when they need
+  /// more than quickSetUpIterations, Z and H^{LL*} are built as without it.
+  bool quickSetUp = false;
+  int quickSetUpIterations = 60;
+  /// false: a partition never leaves the quick path while its solves converge (studies of
+  /// the deflation; the rent-or-buy rule is off).
+  bool quickSetUpRebuild = true;
 };
 
 /// Where an asynchronous run's time went, set-up apart from the steady-state steps (the
@@ -105,6 +119,10 @@ struct AsyncRunStats {
   long long laggedSteps = 0;          ///< steps solved with the lagged H^{LL*} (AsyncOptions::laggedSchur)
   long long schurIterations = 0;      ///< iterative refinement iterations over those steps
   double largestSchurResidual = 0.0;  ///< largest final relative residual of those steps
+  long long quickSteps = 0;           ///< steps solved on the whole system's factor (quickSetUp)
+  long long quickIterations = 0;      ///< conjugate gradient iterations over those steps
+  double largestQuickResidual = 0.0;  ///< largest final relative residual of those steps
+  long long quickEnds = 0;            ///< partitions that left quick set-up for Z and H^{LL*}
   /// Mean seconds of a steady-state large step (stepSeconds / steps), and with rebuilds.
   double meanStepSeconds() const { return steps > 0 ? stepSeconds / static_cast<double>(steps) : 0.0; }
   double meanStepWithRebuildSeconds() const {
