@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/multirateIntegrator.hpp>
@@ -429,6 +430,23 @@ std::vector<int> vertexStepRatios(const Integrator& integrator, int numVertices)
     if (region >= 0 && region < std::ssize(regions)) {
       ratios[static_cast<std::size_t>(v)] = regions[static_cast<std::size_t>(region)].ratio;
     }
+  }
+  return ratios;
+}
+
+std::optional<std::vector<int>> fixedRegionRatios(const Scene& scene, const Problem& problem) {
+  const nlohmann::json& options = scene.integrator.options;
+  if (!options.is_object() || !options.contains("regions") || !options.at("regions").is_array()) return std::nullopt;
+  IntegratorContext context = integratorContext(scene);
+  context.mesh = problem.sharedMesh();
+  context.system.freeDofs = problem.freeDofs();
+  // The regions alone: the other keys belong to the integrator and are checked when it runs.
+  const AsyncSettings settings = parseAsyncSettings(context, nlohmann::json{{"regions", options.at("regions")}});
+  const RegionPartition partition(problem.mesh(), problem.freeDofs(), settings.regions);
+  std::vector<int> ratios(static_cast<std::size_t>(problem.mesh().numVertices()), 1);
+  for (int v = 0; v < problem.mesh().numVertices(); ++v) {
+    const int region = partition.regionOfVertex(v);
+    if (region >= 0) ratios[static_cast<std::size_t>(v)] = partition.ratio(region);
   }
   return ratios;
 }
