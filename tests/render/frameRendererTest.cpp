@@ -468,8 +468,8 @@ TEST_F(FrameRendererTest, TintRegionsUsesFixedRegionsOrSaysHowToRecordThem) {
   const RunResult none = run("run.afsim --mesh bar.veg --frames 5 -q -o none --tint-regions");
   EXPECT_EQ(none.exitCode, 1);
   const std::string expected =
-      "frameRenderer: --tint-regions: run.afsim does not record region ratios, and its scene has no fixed regions to "
-      "tint: record them by adding \"output\": {\"regions\": true} to the scene";
+      "frameRenderer: --tint-regions: run.afsim does not record region ratios, and --mesh gives no scene, so there "
+      "are no fixed regions to tint: record them by adding \"output\": {\"regions\": true} to the scene";
   EXPECT_NE(none.err.find(expected), std::string::npos) << none.err;
 }
 

@@ -406,10 +406,10 @@ void chooseSurfaceColors(const CommandLine& options, const Eigen::Vector3f& surf
   } else if (options.tintRegions && shared.fixedRegionRatios) {
     shared.colors = shared.surface.interpolate(tintByRatio(base, tint, *shared.fixedRegionRatios));
   } else if (options.tintRegions) {
-    throw Error("--tint-regions: " + shared.runs.front().file.string() +
-                " does not record region ratios, and its scene has no fixed regions to tint: record them by adding "
-                "\"output\": {\"regions\": true} to the scene (the default for adaptive regions) and running "
-                "offlineSimulator again");
+    throw Error("--tint-regions: " + shared.runs.front().file.string() + " does not record region ratios, and " +
+                (options.mesh ? "--mesh gives no scene, so there are" : "its scene has") +
+                " no fixed regions to tint: record them by adding \"output\": {\"regions\": true} to the scene "
+                "(the default for adaptive regions) and running offlineSimulator again");
   } else {
     shared.colors = shared.surface.interpolate(base);
   }
