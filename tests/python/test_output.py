@@ -48,3 +48,45 @@ def test_refuses_non_finite_and_reads_truncated(tmp_path):
     (tmp_path / "garbage.afsim").write_bytes(b"not a simulation file at all")
     with pytest.raises(af.ParseError):
         af.SimulationReader(tmp_path / "garbage.afsim")
+
+
+def write_region_ratio_file(path, ratios_per_frame):
+    """An .afsim file (version 1) whose records carry region ratios (flag bit 1), laid out
+    as docs/simulation-output.md says: n u16 ratios after the displacement, padded to 8 bytes."""
+    import struct
+    import zlib
+
+    n = len(ratios_per_frame[0])
+    padding = -2 * n % 8
+    record = 16 + 24 * n + 2 * n + padding + 8
+    header = b"AFEMSIM\0" + struct.pack("<IIQddQQI", 1, 64, n, 0.1, 0.025, 2, record, 0)
+    data = header + struct.pack("<I", zlib.crc32(header))
+    for k, ratios in enumerate(ratios_per_frame):
+        body = struct.pack("<qd", k, 0.1 * (k + 1)) + np.full(3 * n, 0.5 * k).astype("<f8").tobytes()
+        body += np.array(ratios, dtype="<u2").tobytes() + b"\0" * padding
+        data += body + struct.pack("<II", zlib.crc32(body), 0)
+    path.write_bytes(data)
+
+
+def test_region_ratios_read_back(tmp_path):
+    path = tmp_path / "regions.afsim"
+    ratios = [[1, 1, 8, 8, 1], [1, 8, 8, 8, 65535]]
+    write_region_ratio_file(path, ratios)
+    reader = af.SimulationReader(path)
+    assert reader.header.has_region_ratios and reader.num_frames == 2
+    np.testing.assert_array_equal(reader.read_frame(1).region_ratios, ratios[1])
+    all_ratios = reader.region_ratios()
+    assert all_ratios.dtype == np.uint16 and all_ratios.shape == (2, 5)
+    np.testing.assert_array_equal(all_ratios, ratios)
+    # A file without them: no ratios per frame, and region_ratios() says how to record them.
+    plain = tmp_path / "plain.afsim"
+    with af.SimulationWriter(plain, af.SimulationFileHeader(2, 0.5)) as writer:
+        writer.append_frame(0.5, np.zeros(6))
+    assert not af.SimulationReader(plain).header.has_region_ratios
+    assert af.SimulationReader(plain).read_frame(0).region_ratios.size == 0
+    with pytest.raises(ValueError, match=r'plain.afsim does not record region ratios .*"output": \{"regions": true\}'):
+        af.SimulationReader(plain).region_ratios()
+    # A ratio of 0 is named with its frame and vertex.
+    write_region_ratio_file(path, [[1, 1, 8, 8, 1], [1, 8, 0, 8, 1]])
+    with pytest.raises(af.ParseError, match="frame 1: vertex 2 has region ratio 0"):
+        af.SimulationReader(path).verify_all()

@@ -416,4 +416,61 @@ TEST_F(FrameRendererTest, ContactSheetIsAGridOfLabelledFrames) {
   EXPECT_EQ(row.height, 30 + 14);
 }
 
+// --tint-regions: each frame's recorded step ratios (header flag bit 1). Frame 0 has no fast
+// vertex and is drawn exactly as without the option; frame 4's region (ratio 16, x >= 1)
+// is larger than frame 2's (ratio 8, x >= 1.6), so more pixels are tinted.
+TEST_F(FrameRendererTest, TintRegionsFollowsEachFramesRecordedRegions) {
+  SimulationFileHeader header;
+  header.numVertices = mesh_.numVertices();
+  header.frameInterval = 0.1;
+  header.hasRegionRatios = true;
+  {
+    SimulationWriter writer(folder_ / "regions.afsim", header);
+    const Eigen::VectorXd bent = renderTesting::bentBar(mesh_);
+    for (int k = 0; k < 6; ++k) {
+      std::vector<int> ratios(static_cast<std::size_t>(mesh_.numVertices()), 1);
+      for (int v = 0; v < mesh_.numVertices(); ++v) {
+        const double x = mesh_.restPosition(v).x();
+        if (k == 2 && x >= 1.6 - 1e-9) ratios[static_cast<std::size_t>(v)] = 8;
+        if (k == 4 && x >= 1.0 - 1e-9) ratios[static_cast<std::size_t>(v)] = 16;
+      }
+      writer.appendFrame(0.1 * (k + 1), 0.5 * bent, ratios);
+    }
+  }
+  const std::string common = "regions.afsim --mesh bar.veg --frames 0:5:2 --width 120 --height 80 -q -j 1 ";
+  ASSERT_EQ(run(common + "-o plain").exitCode, 0);
+  const RunResult r = run(common + "-o tinted --tint-regions --contact-sheet sheet.png");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(readText(folder_ / "plain" / "frame_00000.png"), readText(folder_ / "tinted" / "frame_00000.png"));
+  const int small = orangePixels(readPng(folder_ / "tinted" / "frame_00002.png"));
+  const int large = orangePixels(readPng(folder_ / "tinted" / "frame_00004.png"));
+  EXPECT_EQ(orangePixels(readPng(folder_ / "plain" / "frame_00004.png")), 0);
+  EXPECT_GT(small, 20);
+  EXPECT_GT(large, small + 20) << "frame 2: " << small << ", frame 4: " << large;
+  EXPECT_TRUE(fs::exists(folder_ / "sheet.png"));
+}
+
+// Without recorded ratios: the scene's fixed regions, constant over the frames, or an error
+// saying how to record them.
+TEST_F(FrameRendererTest, TintRegionsUsesFixedRegionsOrSaysHowToRecordThem) {
+  std::ofstream(folder_ / "scene.json") << R"({
+    "mesh": {"file": "bar.veg"},
+    "fixed": {"sets": ["xmin"]},
+    "integrator": {"name": "async", "timestep": 0.01,
+                   "options": {"regions": [{"name": "tip", "ratio": 4, "boxes": [{"min": [1.5, -1, -1], "max": [3, 1, 1]}]}]}},
+    "frames": {"rate": 10, "count": 6}
+  })";
+  const RunResult fixed =
+      run("run.afsim --scene scene.json --frames 5 --width 120 --height 80 -q -o fixed --tint-regions");
+  ASSERT_EQ(fixed.exitCode, 0) << fixed.err;
+  EXPECT_GT(orangePixels(readPng(folder_ / "fixed" / "frame_00005.png")), 20);
+
+  const RunResult none = run("run.afsim --mesh bar.veg --frames 5 -q -o none --tint-regions");
+  EXPECT_EQ(none.exitCode, 1);
+  const std::string expected =
+      "frameRenderer: --tint-regions: run.afsim does not record region ratios, and --mesh gives no scene, so there "
+      "are no fixed regions to tint: record them by adding \"output\": {\"regions\": true} to the scene";
+  EXPECT_NE(none.err.find(expected), std::string::npos) << none.err;
+}
+
 }  // namespace

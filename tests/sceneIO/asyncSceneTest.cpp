@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <cmath>
 #include <string>
@@ -89,6 +90,35 @@ TEST(AsyncScene, AutomaticRegionsByDefault) {
   ASSERT_NE(async, nullptr);
   ASSERT_GE(async->partition().numRegions(), 1);  // the stiff, light end
   asyncfem::advanceFrame(simulation, 0);
+}
+
+// output.regions: each frame's step ratio per vertex (1 in L, m_i in S_i); on by default
+// for adaptive regions only.
+TEST(AsyncScene, RegionOutputGivesEachVertexItsStepRatio) {
+  nlohmann::json json = barScene();
+  EXPECT_FALSE(asyncfem::recordsRegionRatios(asyncfem::parseScene(json, "", "scene.json")));
+  json["output"] = {{"regions", true}};
+  const asyncfem::Scene scene = asyncfem::parseScene(json, "", "scene.json");
+  ASSERT_TRUE(asyncfem::recordsRegionRatios(scene));
+  Simulation simulation = asyncfem::buildSimulation(scene);
+  asyncfem::SimulationFileHeader header;
+  asyncfem::describeRegionOutput(scene, simulation, header);
+  EXPECT_TRUE(header.hasRegionRatios);
+  const std::vector<int> ratios = asyncfem::vertexStepRatios(*simulation.integrator, simulation.mesh->numVertices());
+  ASSERT_EQ(std::ssize(ratios), simulation.mesh->numVertices());
+  int fast = 0;
+  for (int v = 0; v < simulation.mesh->numVertices(); ++v) {
+    const int region = asyncfem::regionOfVertex(*simulation.integrator, v);
+    EXPECT_EQ(ratios[static_cast<std::size_t>(v)], region < 0 ? 1 : 4) << "vertex " << v;
+    fast += region < 0 ? 0 : 1;
+  }
+  EXPECT_GT(fast, 0);  // the stiff end is a fast region of ratio 4
+
+  json["integrator"]["options"]["regions"] = nlohmann::json::parse(R"({"adaptive": {"contact": {"ratio": 4}}})");
+  json.erase("output");
+  EXPECT_TRUE(asyncfem::recordsRegionRatios(asyncfem::parseScene(json, "", "scene.json")));
+  json["output"] = {{"regions", false}};
+  EXPECT_FALSE(asyncfem::recordsRegionRatios(asyncfem::parseScene(json, "", "scene.json")));
 }
 
 TEST(AsyncScene, ErrorsNameTheKey) {

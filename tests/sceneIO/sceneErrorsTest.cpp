@@ -184,6 +184,13 @@ const ErrorCase cases[] = {
      "scene.json: output.vtu.encoding: unknown value \"base64\" (expected one of \"binary\", \"ascii\")"},
     {"OutputVelocitiesNotBool", R"({"output": {"velocities": "yes"}})",
      "scene.json: output.velocities: expected true or false"},
+    {"OutputRegionsNotBool", R"({"output": {"regions": "yes"}})", "scene.json: output.regions: expected true or false"},
+    {"OutputRegionsMisspelt", R"({"output": {"region": true}})",
+     "scene.json: output.region: unknown key (known here: file, vtu, velocities, sync, regions)"},
+    {"OutputRegionsSingleRate", R"({"output": {"regions": true}})",
+     "scene.json: output.regions: records the fast regions of a multirate integrator, but \"backward-euler\" is "
+     "single-rate (use \"async\" with regions, or leave output.regions out)",
+     true},
     {"MeshFileMissing",
      R"({"mesh": {"generator": null, "size": null, "cells": null, "material": null, "file": "/nonexistent/m.veg"}})",
      "scene.json: mesh.file: ", true},

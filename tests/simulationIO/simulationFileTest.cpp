@@ -393,4 +393,180 @@ TEST_F(SimulationFileTest, FileSizeMatchesTheDocumentedLayout) {
   }
 }
 
+// Records with region ratios (header flag bit 1).
+SimulationFileHeader ratioHeader(int numVertices, bool velocities) {
+  SimulationFileHeader header;
+  header.numVertices = numVertices;
+  header.frameInterval = 0.1;
+  header.timestep = 0.025;
+  header.hasVelocities = velocities;
+  header.hasRegionRatios = true;
+  return header;
+}
+// Frame k's ratios: a fast region that moves by one vertex per frame, and the largest ratio.
+std::vector<int> ratiosOf(int numVertices, int k) {
+  std::vector<int> ratios(static_cast<std::size_t>(numVertices), 1);
+  ratios[static_cast<std::size_t>(k % numVertices)] = 8;
+  ratios.back() = asyncfem::maxSimulationRegionRatio;
+  return ratios;
+}
+Eigen::VectorXd valuesOf(int numVertices, int k) {
+  return Eigen::VectorXd::LinSpaced(3 * numVertices, 0.25 * k, (0.25 * k) + 1.0);
+}
+// Writes three frames of 5 vertices (no velocities) to path.
+void writeThreeFrames(const fs::path& path) {
+  SimulationWriter writer(path, ratioHeader(5, false));
+  for (int k = 0; k < 3; ++k) writer.appendFrame(0.1 * (k + 1), valuesOf(5, k), ratiosOf(5, k));
+}
+// Stores value (little-endian, size bytes) at offset.
+void putBytes(std::vector<char>& bytes, std::size_t offset, std::uint64_t value, int size) {
+  for (int i = 0; i < size; ++i) bytes[offset + static_cast<std::size_t>(i)] = static_cast<char>(value >> (8 * i));
+}
+// Gives the record at start (record bytes long) its correct checksum.
+void fixRecordCrc(std::vector<char>& bytes, std::size_t start, std::size_t record) {
+  putBytes(bytes, start + record - 8, asyncfem::crc32(bytes.data() + start, record - 8), 4);
+}
+
+TEST_F(SimulationFileTest, RoundTripIsBitExactWithAndWithoutVelocities) {
+  for (const bool velocities : {false, true}) {
+    const fs::path path = file(velocities ? "v.afsim" : "u.afsim");
+    const int n = 5;
+    {
+      SimulationWriter writer(path, ratioHeader(n, velocities));
+      for (int k = 0; k < 3; ++k) {
+        if (velocities) {
+          writer.appendFrame(0.1 * (k + 1), valuesOf(n, k), valuesOf(n, k + 7), ratiosOf(n, k));
+        } else {
+          writer.appendFrame(0.1 * (k + 1), valuesOf(n, k), ratiosOf(n, k));
+        }
+      }
+    }
+    // 16 + 24n (+ 24n) + the ratios, 2n = 10 bytes padded to 16, + 8: the documented layout.
+    const std::int64_t record = 16 + (velocities ? 48 : 24) * n + 16 + 8;
+    EXPECT_EQ(ratioHeader(n, velocities).recordBytes(), record);
+    EXPECT_EQ(static_cast<std::int64_t>(fs::file_size(path)), 64 + 3 * record);
+    SimulationReader reader(path);
+    EXPECT_TRUE(reader.header().hasRegionRatios);
+    EXPECT_EQ(reader.header().hasVelocities, velocities);
+    ASSERT_EQ(reader.numFrames(), 3);
+    for (int k = 0; k < 3; ++k) {
+      const asyncfem::SimulationFrame frame = reader.readFrame(k);
+      EXPECT_EQ(frame.displacement, valuesOf(n, k));  // stored bit for bit
+      if (velocities) {
+        EXPECT_EQ(frame.velocity, valuesOf(n, k + 7));
+      }
+      const std::vector<int> expected = ratiosOf(n, k);
+      ASSERT_EQ(frame.regionRatios.size(), expected.size());
+      for (std::size_t v = 0; v < expected.size(); ++v) EXPECT_EQ(frame.regionRatios[v], expected[v]) << v;
+    }
+  }
+}
+
+TEST_F(SimulationFileTest, FilesWithoutTheFlagCarryNoRatiosAndKeepTheirLayout) {
+  const fs::path path = file("plain.afsim");
+  SimulationFileHeader header = ratioHeader(4, false);
+  header.hasRegionRatios = false;
+  {
+    SimulationWriter writer(path, header);
+    writer.appendFrame(0.1, valuesOf(4, 0));
+    EXPECT_THROW(writer.appendFrame(0.2, valuesOf(4, 1), ratiosOf(4, 1)), asyncfem::Error);
+  }
+  EXPECT_EQ(header.recordBytes(), 24 + 24 * 4);
+  const std::vector<char> bytes = readBytes(path);
+  EXPECT_EQ(bytes[40], 0);  // flags: none
+  SimulationReader reader(path);
+  EXPECT_FALSE(reader.header().hasRegionRatios);
+  EXPECT_TRUE(reader.readFrame(0).regionRatios.empty());
+}
+
+TEST_F(SimulationFileTest, WriterRefusesMissingAndUnstorableRatios) {
+  const fs::path path = file("refuse.afsim");
+  SimulationWriter writer(path, ratioHeader(3, false));
+  const auto messageOf = [&](const std::vector<int>& ratios) -> std::string {
+    try {
+      writer.appendFrame(0.1, valuesOf(3, 0), ratios);
+    } catch (const asyncfem::Error& error) {
+      return error.what();
+    }
+    return "";
+  };
+  EXPECT_NE(messageOf({1, 70000, 1})
+                .find("frame 0: vertex 1: step ratio 70000 cannot be stored (a record holds "
+                      "ratios from 1 to 65535)"),
+            std::string::npos)
+      << messageOf({1, 70000, 1});
+  EXPECT_NE(messageOf({1, 1, 0}).find("vertex 2: step ratio 0"), std::string::npos);
+  EXPECT_NE(messageOf({1, 1}).find("expected 3 region ratios, got 2"), std::string::npos);
+  try {
+    writer.appendFrame(0.1, valuesOf(3, 0));
+    ADD_FAILURE() << "a frame without ratios was accepted";
+  } catch (const asyncfem::Error& error) {
+    EXPECT_NE(std::string(error.what()).find("the file stores region ratios, but none were given"), std::string::npos)
+        << error.what();
+  }
+  EXPECT_EQ(writer.numFrames(), 0);
+}
+
+TEST_F(SimulationFileTest, ReaderNamesTheFrameAndVertexOfARatioOfZero) {
+  const fs::path path = file("zero.afsim");
+  writeThreeFrames(path);
+  std::vector<char> bytes = readBytes(path);
+  const std::size_t record = static_cast<std::size_t>(ratioHeader(5, false).recordBytes());
+  const std::size_t frame2 = 64 + (2 * record);
+  const std::size_t ratios = frame2 + 16 + (24 * 5);
+  putBytes(bytes, ratios + (2 * 3), 0, 2);  // vertex 3's ratio (1) becomes 0
+  fixRecordCrc(bytes, frame2, record);
+  writeBytes(path, bytes);
+  const std::string message = errorOf(path);
+  EXPECT_NE(message.find("zero.afsim: frame 2: vertex 3 has region ratio 0 (step ratios are 1 or more)"),
+            std::string::npos)
+      << message;
+  // Non-zero padding after the ratios (with a matching checksum) is refused too.
+  putBytes(bytes, ratios + (2 * 3), 1, 2);
+  putBytes(bytes, ratios + 12, 7, 1);
+  fixRecordCrc(bytes, frame2, record);
+  writeBytes(path, bytes);
+  EXPECT_NE(errorOf(path).find("frame 2: the padding after the region ratios is not zero"), std::string::npos)
+      << errorOf(path);
+}
+
+TEST_F(SimulationFileTest, ReaderRefusesARecordSizeThatIgnoresTheFlag) {
+  const fs::path path = file("size.afsim");
+  writeThreeFrames(path);
+  std::vector<char> bytes = readBytes(path);
+  // The record size of the same file without ratios, with a correct header checksum.
+  patchHeader(bytes, 48, 24 + 24 * 5, 8, true);
+  writeBytes(path, bytes);
+  EXPECT_NE(errorOf(path).find("header record size 144 disagrees with 5 vertices with region ratios (expected 160)"),
+            std::string::npos)
+      << errorOf(path);
+}
+
+TEST_F(SimulationFileTest, ContinuingKeepsTheRecordSizeAndRefusesAnotherFlag) {
+  const fs::path path = file("continue.afsim");
+  writeThreeFrames(path);
+  {
+    auto writer = SimulationWriter::continueFile(path, ratioHeader(5, false), 2, {});
+    writer->appendFrame(0.3, valuesOf(5, 8), ratiosOf(5, 8));
+    writer->close();
+  }
+  SimulationReader reader(path);
+  EXPECT_EQ(reader.numFrames(), 3);
+  EXPECT_FALSE(reader.hasTruncatedFrame());
+  EXPECT_EQ(reader.readFrame(2).regionRatios[3], 8);  // ratiosOf(5, 8): vertex 8 % 5 fast
+  SimulationFileHeader without = ratioHeader(5, false);
+  without.hasRegionRatios = false;
+  try {
+    SimulationWriter::continueFile(path, without, 1, {});
+    ADD_FAILURE() << "a run without region ratios continued a file with them";
+  } catch (const asyncfem::Error& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("continue.afsim: cannot continue it: its header differs from this run's: its records carry "
+                        "region ratios (header flag bit 1) but this run's do not (output.regions)"),
+              std::string::npos)
+        << error.what();
+  }
+  EXPECT_EQ(SimulationReader(path).numFrames(), 3);  // untouched
+}
+
 }  // namespace

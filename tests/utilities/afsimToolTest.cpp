@@ -130,6 +130,31 @@ TEST_F(AfsimToolTest, InfoPrintsHeaderTimesChecksumsAndTheCheckpoint) {
   EXPECT_NE(bad.err.find("frame 2: checksum mismatch"), std::string::npos) << bad.err;
 }
 
+// Records with region ratios: info counts the fast vertices (ratio above 1) of the first
+// and the last frame; files without them say so.
+TEST_F(AfsimToolTest, InfoCountsTheFastVerticesOfTheFirstAndLastFrame) {
+  asyncfem::SimulationFileHeader header;
+  header.numVertices = mesh_.numVertices();
+  header.frameInterval = 0.05;
+  header.hasRegionRatios = true;
+  {
+    asyncfem::SimulationWriter writer(folder_ / "regions.afsim", header);
+    for (int k = 0; k < 3; ++k) {
+      std::vector<int> ratios(static_cast<std::size_t>(mesh_.numVertices()), 1);
+      for (int v = 0; v < 2 + (3 * k); ++v) ratios[static_cast<std::size_t>(v)] = 4 + k;  // 2, 5, 8 fast
+      writer.appendFrame(0.05 * (k + 1), displacement(k), ratios);
+    }
+  }
+  const RunResult r = run("info regions.afsim");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("regions     yes, each vertex's step ratio per frame: 2 fast vertices in the first frame, 8 "
+                       "in the last (frame 2)\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("checksums   ok (3 frames)"), std::string::npos) << r.out;
+  EXPECT_NE(run("info run.afsim").out.find("regions     no (the records carry no region ratios)\n"), std::string::npos);
+}
+
 TEST_F(AfsimToolTest, CsvHasTimeDisplacementAndPositionsOfTheChosenVertices) {
   const RunResult r = run("csv run.afsim --vertices 3,11 --frames 1:4:2 --mesh box.veg -o out/traj.csv");
   ASSERT_EQ(r.exitCode, 0) << r.err;

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/simulationIO/checkpoint.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
@@ -600,6 +601,55 @@ TEST_F(OfflineSimulatorTest, KilledRunResumesFromItsLastCheckpoint) {
   EXPECT_NE(resumed.out.find("(resumed after frame " + std::to_string(checkpointed) + " of "), std::string::npos)
       << resumed.out;
   expectSameAsUninterrupted(scene, frames, output, " --checkpoint-every 7");
+}
+
+/// The sets of vertices whose recorded step ratio is above 1, per frame of file.
+std::vector<std::vector<int>> fastVertexSets(const fs::path& file) {
+  asyncfem::SimulationReader reader(file);
+  std::vector<std::vector<int>> sets;
+  for (std::int64_t k = 0; k < reader.numFrames(); ++k) {
+    const asyncfem::SimulationFrame frame = reader.readFrame(k);
+    std::vector<int> fast;
+    for (std::size_t v = 0; v < frame.regionRatios.size(); ++v) {
+      if (frame.regionRatios[v] > 1) fast.push_back(static_cast<int>(v));
+    }
+    sets.push_back(fast);
+  }
+  return sets;
+}
+
+// models/ball: adaptive contact regions, recorded by default. The ball touches the ground
+// after 12 frames and its fast region follows the contact patch; a run resumed after frame
+// 10 keeps writing records with ratios, and a run without them cannot continue the file.
+TEST_F(OfflineSimulatorTest, BallRecordsItsMovingFastRegionAndResumeKeepsTheFlag) {
+  nlohmann::json json = nlohmann::json::parse(readText(fs::path(ASYNCFEM_MODELS_DIR) / "ball/ball.json"));
+  json["mesh"]["file"] = (fs::path(ASYNCFEM_MODELS_DIR) / "ball/ball.veg").string();
+  const fs::path scene = writeScene(json, "ball.json");
+  const fs::path output = folder_ / "ball.afsim";
+  ASSERT_EQ(run(quoted(scene) + " --quiet --frames 10 --output " + quoted(output)).exitCode, 0);
+  const RunResult resumed = run(quoted(scene) + " --quiet --resume --frames 15 --output " + quoted(output));
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+  {
+    asyncfem::SimulationReader reader(output);
+    EXPECT_TRUE(reader.header().hasRegionRatios);
+    EXPECT_EQ(reader.numFrames(), 15);
+    reader.verifyAll();
+  }
+  std::vector<std::vector<int>> distinct;
+  for (const std::vector<int>& fast : fastVertexSets(output)) {
+    if (!fast.empty() && std::find(distinct.begin(), distinct.end(), fast) == distinct.end()) distinct.push_back(fast);
+  }
+  EXPECT_GE(distinct.size(), 2U) << "the fast region should change between frames as the contact patch grows";
+
+  json["output"] = {{"regions", false}};
+  writeScene(json, "ball.json");
+  const RunResult refused = run(quoted(scene) + " --quiet --resume --frames 16 --output " + quoted(output));
+  EXPECT_EQ(refused.exitCode, 1);
+  EXPECT_NE(refused.err.find("ball.afsim: cannot continue it: its header differs from this run's: its records carry "
+                             "region ratios (header flag bit 1) but this run's do not (output.regions)"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_EQ(asyncfem::SimulationReader(output).numFrames(), 15);
 }
 
 TEST_F(OfflineSimulatorTest, ResumeRefusesWhatItCannotContinueExactly) {

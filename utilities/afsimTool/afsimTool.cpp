@@ -5,13 +5,15 @@
 //   afsimTool csv SIM.afsim --vertices 12,40 [--frames 0:100] [--mesh MESH | --scene SCENE.json] [-o FILE.csv]
 //   afsimTool vtu SIM.afsim (--mesh MESH | --scene SCENE.json) [--frames 10,20] [-o DIR] [--encoding binary|ascii]
 //
-// info prints the header, the frame times, whether every record's checksum matches (else
+// info prints the header, the frame times, the fast vertices of the first and last frame
+// when the records carry region ratios, whether every record's checksum matches (else
 // the first bad frame, exit status 1) and the run's checkpoint when one lies next to the
 // file. csv writes one row per frame: index, time and the chosen vertices' displacement
 // (and rest + displacement positions with a mesh). vtu writes DIR/frame_NNNNN.vtu per
 // chosen frame and DIR/frames.pvd. Errors print "afsimTool: <message>" on stderr and exit
 // with status 1. Described in docs/simulation-output.md, section "Getting results out".
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
@@ -158,6 +160,27 @@ void printCheckpoint(const std::string& simulation, const SimulationFileHeader& 
   }
 }
 
+/// The regions line of info: whether the records carry region ratios and, when they do,
+/// how many vertices were fast (ratio above 1) in the first and the last good frame.
+void printRegions(SimulationReader& reader, const RecordScan& scan) {
+  std::cout << "regions     ";
+  if (!reader.header().hasRegionRatios) {
+    std::cout << "no (the records carry no region ratios)\n";
+    return;
+  }
+  std::cout << "yes, each vertex's step ratio per frame";
+  const auto fastIn = [&](std::int64_t k) {
+    const std::vector<std::uint16_t> ratios = reader.readFrame(k).regionRatios;
+    return std::count_if(ratios.begin(), ratios.end(), [](std::uint16_t ratio) { return ratio > 1; });
+  };
+  if (scan.goodFrames > 0) {
+    const std::int64_t last = scan.goodFrames - 1;
+    std::cout << ": " << fastIn(0) << " fast vertices in the first frame, " << fastIn(last) << " in the last (frame "
+              << last << ")";
+  }
+  std::cout << '\n';
+}
+
 int info(const CommandLine& options) {
   const auto reader = openSimulation(options.simulation);
   printHeader(options.simulation, *reader);
@@ -166,6 +189,7 @@ int info(const CommandLine& options) {
   if (reader->numFrames() > 0) {
     std::cout << "times       " << exact(scan.firstTime) << " to " << exact(scan.lastTime) << '\n';
   }
+  printRegions(*reader, scan);
   std::cout << "checksums   "
             << (scan.badFrame ? "BAD: " + scan.badMessage : "ok (" + std::to_string(reader->numFrames()) + " frames)")
             << '\n';

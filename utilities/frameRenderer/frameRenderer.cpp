@@ -2,7 +2,7 @@
 // frameRenderer: draws the frames of a simulation output file (.afsim) as PNG images.
 //
 //   frameRenderer SIM.afsim (--mesh MESH | --scene SCENE.json) [--output DIR] [--frames start:stop:step]
-//                 [--width W] [--height H] [--warp none|rotation-strain|modal] [--tint-set NAME]
+//                 [--width W] [--height H] [--warp none|rotation-strain|modal] [--tint-set NAME] [--tint-regions]
 //                 [--render-mesh FILE] [--ground] [--compare OTHER.afsim --labels "a,b"]
 //                 [--video OUT.mp4 [--fps F]] [--contact-sheet SHEET.png [--sheet-columns N]] ...
 //
@@ -62,6 +62,7 @@ struct CommandLine {
   std::string warp = "none";
   std::vector<std::string> tintSets;
   std::vector<float> tintColor{0.95F, 0.45F, 0.12F};
+  bool tintRegions = false;
   std::vector<std::string> fixedSets;
   std::optional<std::string> renderMesh;
   bool ground = false;
@@ -97,10 +98,15 @@ struct Shared {
   std::vector<int> fixedVertices;
   WarpingKind warping = WarpingKind::none;
   SurfaceEmbedding surface;
-  std::optional<Eigen::Matrix3Xf> colors;   // per surface vertex, when a set is tinted
-  std::vector<Run> runs;                    // one, or two with --compare
-  int assemblies = 0;                       // matrices the problem assembled (none: only the mesh is needed)
-  std::optional<ContactPlane> sceneGround;  // the scene's contact.ground, where --ground draws the floor
+  std::optional<Eigen::Matrix3Xf> colors;  // per surface vertex, when a set or fixed regions are tinted
+  /// --tint-regions on files that record region ratios: the colours per tet vertex before
+  /// each frame's regions are tinted (surface colour and --tint-set sets), and the tint.
+  std::optional<Eigen::Matrix3Xf> regionBase;
+  Eigen::Vector3f regionTint = Eigen::Vector3f::Zero();
+  std::optional<std::vector<int>> fixedRegionRatios;  // the recorded scene's fixed regions, if any
+  std::vector<Run> runs;                              // one, or two with --compare
+  int assemblies = 0;                                 // matrices the problem assembled (none: only the mesh is needed)
+  std::optional<ContactPlane> sceneGround;            // the scene's contact.ground, where --ground draws the floor
 };
 
 /// A worker's own state: readers of every run and warping objects (neither is
@@ -186,6 +192,10 @@ void addInputOptions(CLI::App& app, CommandLine& options) {
   app.add_option("--tint-set", options.tintSets,
                  "Set (vertex or element set) drawn in a tint colour, e.g. a fast region; repeat it for several "
                  "sets: the first gets --tint-color, the next ones blue, green, purple, ...");
+  app.add_flag("--tint-regions", options.tintRegions,
+               "Tint the vertices of fast regions (step ratio above 1) in --tint-color, deeper for larger ratios "
+               "(ratio 2 light, 16 and above full): each frame's regions when the .afsim records them (scene key "
+               "\"output\": {\"regions\": true}, the default for adaptive regions), else the scene's fixed regions");
   app.add_option("--tint-color", options.tintColor, "Tint colour r,g,b in [0, 1]")
       ->delimiter(',')
       ->expected(3)
@@ -319,7 +329,9 @@ void loadMesh(const CommandLine& options, std::int64_t numVertices, Shared& shar
     const std::shared_ptr<const Problem> problem =
         options.scene ? buildProblem(loadScene(*options.scene), &warnings)
                       : recordedSceneProblem(header, shared.runs.front().file.string(), &warnings);
-    shared.sceneGround = loadScene(options.scene ? *options.scene : header.scenePath).contact.ground;
+    const Scene scene = loadScene(options.scene ? *options.scene : header.scenePath);
+    shared.sceneGround = scene.contact.ground;
+    if (options.tintRegions && !header.hasRegionRatios) shared.fixedRegionRatios = fixedRegionRatios(scene, *problem);
     shared.mesh = problem->sharedMesh();
     shared.fixedVertices = problem->fixedVertices();
     shared.assemblies = problem->assemblies();
@@ -344,8 +356,8 @@ void loadMesh(const CommandLine& options, std::int64_t numVertices, Shared& shar
 
 /// Per surface vertex colours with the --tint-set sets tinted: the first set in
 /// --tint-color, the others in colours far from it and from the surface.
-Eigen::Matrix3Xf tintedSurfaceColors(const CommandLine& options, const Shared& shared,
-                                     const Eigen::Vector3f& surfaceColor) {
+Eigen::Matrix3Xf tintedTetColors(const CommandLine& options, const Shared& shared,
+                                 const Eigen::Vector3f& surfaceColor) {
   static const Eigen::Vector3f palette[] = {
       {0.25f, 0.45f, 0.95f}, {0.2f, 0.75f, 0.3f}, {0.65f, 0.3f, 0.8f}, {0.95f, 0.8f, 0.15f}, {0.1f, 0.75f, 0.8f}};
   Eigen::Matrix3Xf tetColors = surfaceColor.replicate(1, shared.mesh->numVertices());
@@ -363,7 +375,44 @@ Eigen::Matrix3Xf tintedSurfaceColors(const CommandLine& options, const Shared& s
                                      : palette[(i - 1) % (sizeof(palette) / sizeof(palette[0]))];
     for (const int v : tinted) tetColors.col(v) = tint;
   }
-  return shared.surface.interpolate(tetColors);
+  return tetColors;
+}
+
+/// base (per tet vertex) with the vertices of step ratio above 1 tinted, deeper for larger
+/// ratios: a weight of 0.4 + 0.15 log2(ratio), from 0.55 at ratio 2 to 1 at 16 and above.
+template <typename Ratio>
+Eigen::Matrix3Xf tintByRatio(const Eigen::Matrix3Xf& base, const Eigen::Vector3f& tint,
+                             const std::vector<Ratio>& ratios) {
+  Eigen::Matrix3Xf colors = base;
+  for (Eigen::Index v = 0; v < colors.cols() && v < std::ssize(ratios); ++v) {
+    const auto ratio = static_cast<float>(ratios[static_cast<std::size_t>(v)]);
+    if (ratio <= 1.0F) continue;
+    const float weight = std::min(1.0F, 0.4F + (0.15F * std::log2(ratio)));
+    colors.col(v) = ((1.0F - weight) * base.col(v)) + (weight * tint);
+  }
+  return colors;
+}
+
+/// The colours of the drawn surface: --tint-set sets, and with --tint-regions the fixed
+/// regions of the scene or (set up here, applied per frame) the ratios each frame records.
+/// A file that records no ratios and whose scene has no fixed regions is an error.
+void chooseSurfaceColors(const CommandLine& options, const Eigen::Vector3f& surfaceColor, Shared& shared) {
+  if (options.tintSets.empty() && !options.tintRegions) return;
+  const Eigen::Matrix3Xf base = tintedTetColors(options, shared, surfaceColor);
+  const Eigen::Vector3f tint(options.tintColor[0], options.tintColor[1], options.tintColor[2]);
+  if (options.tintRegions && SimulationReader(shared.runs.front().file).header().hasRegionRatios) {
+    shared.regionBase = base;
+    shared.regionTint = tint;
+  } else if (options.tintRegions && shared.fixedRegionRatios) {
+    shared.colors = shared.surface.interpolate(tintByRatio(base, tint, *shared.fixedRegionRatios));
+  } else if (options.tintRegions) {
+    throw Error("--tint-regions: " + shared.runs.front().file.string() + " does not record region ratios, and " +
+                (options.mesh ? "--mesh gives no scene, so there are" : "its scene has") +
+                " no fixed regions to tint: record them by adding \"output\": {\"regions\": true} to the scene "
+                "(the default for adaptive regions) and running offlineSimulator again");
+  } else {
+    shared.colors = shared.surface.interpolate(base);
+  }
 }
 
 /// The box of the rest shape and of every frame of every run (so that renders of
@@ -460,8 +509,13 @@ Image drawFrame(Worker& worker, std::vector<std::unique_ptr<OffscreenRenderer>>&
                                                    options.supersampling);
     }
     const Eigen::Matrix3Xd x = worker.surfacePositions(shared, r, k);
-    panels.push_back(own[r]->render({{x, shared.surface.triangles(), shared.colors ? &*shared.colors : nullptr}},
-                                    setup.camera, setup.style));
+    std::optional<Eigen::Matrix3Xf> frameColors;  // this frame's fast regions (--tint-regions)
+    if (shared.regionBase && worker.readers[r]->header().hasRegionRatios) {
+      frameColors =
+          shared.surface.interpolate(tintByRatio(*shared.regionBase, shared.regionTint, worker.frame.regionRatios));
+    }
+    const Eigen::Matrix3Xf* colors = frameColors ? &*frameColors : shared.colors ? &*shared.colors : nullptr;
+    panels.push_back(own[r]->render({{x, shared.surface.triangles(), colors}}, setup.camera, setup.style));
   }
   if (panels.size() == 1) {
     return std::move(panels.front());
@@ -579,9 +633,7 @@ Shared openInputs(const CommandLine& options, const Eigen::Vector3f& surfaceColo
   loadMesh(options, extent.numVertices, shared);
   shared.surface = options.renderMesh ? SurfaceEmbedding::embed(*shared.mesh, loadSurfaceMesh(*options.renderMesh))
                                       : SurfaceEmbedding::boundary(*shared.mesh);
-  if (!options.tintSets.empty()) {
-    shared.colors = tintedSurfaceColors(options, shared, surfaceColor);
-  }
+  chooseSurfaceColors(options, surfaceColor, shared);
   return shared;
 }
 

@@ -528,6 +528,7 @@ asyncfem::SimulationFileHeader outputHeader(const CommandLine& options, const as
   // The scene, so that frameRenderer and afsimTool find the mesh by themselves.
   header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
   header.sceneFingerprint = asyncfem::problemFingerprint(*simulation.problem);
+  asyncfem::describeRegionOutput(scene, simulation, header);  // output.regions: the fast regions of each frame
   return header;
 }
 
@@ -572,11 +573,7 @@ RunOutput openOutput(const CommandLine& options, const asyncfem::Scene& scene, a
 void writeFrame(RunOutput& output, const asyncfem::Scene& scene, const asyncfem::Simulation& simulation, int frame,
                 RunRecord& record) {
   const asyncfem::Integrator& integrator = *simulation.integrator;
-  if (output.header.hasVelocities) {
-    output.writer->appendFrame(integrator.time(), integrator.displacement(), integrator.velocity());
-  } else {
-    output.writer->appendFrame(integrator.time(), integrator.displacement());
-  }
+  asyncfem::appendSimulationFrame(*output.writer, simulation);
   const int done = frame + 1;
   const double sinceLast =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - output.lastCheckpoint).count();

@@ -23,6 +23,10 @@ void bindOutput(py::module_& module) {
       .def_readwrite("frame_interval", &SimulationFileHeader::frameInterval)
       .def_readwrite("timestep", &SimulationFileHeader::timestep)
       .def_readwrite("has_velocities", &SimulationFileHeader::hasVelocities)
+      .def_property_readonly(
+          "has_region_ratios", [](const SimulationFileHeader& header) { return header.hasRegionRatios; },
+          "True when each record also carries every vertex's step ratio (header flag bit 1; offlineSimulator's "
+          "output.regions)")
       .def_property_readonly("record_bytes", &SimulationFileHeader::recordBytes);
 
   py::class_<SimulationFrame>(module, "SimulationFrame",
@@ -30,7 +34,15 @@ void bindOutput(py::module_& module) {
       .def_readonly("index", &SimulationFrame::index)
       .def_readonly("time", &SimulationFrame::time)
       .def_readonly("displacement", &SimulationFrame::displacement)
-      .def_readonly("velocity", &SimulationFrame::velocity);
+      .def_readonly("velocity", &SimulationFrame::velocity)
+      .def_property_readonly(
+          "region_ratios",
+          [](const SimulationFrame& frame) {
+            return py::array_t<std::uint16_t>(static_cast<py::ssize_t>(frame.regionRatios.size()),
+                                              frame.regionRatios.data());
+          },
+          "each vertex's step ratio to the large step (uint16: 1 in L, m_i in fast region S_i); empty when the "
+          "file records none");
 
   py::class_<SimulationWriter>(module, "SimulationWriter",
                                "Append-only .afsim file: one checksummed record per frame, flushed at once")
@@ -99,7 +111,31 @@ void bindOutput(py::module_& module) {
             }
             return result;
           },
-          "(frames, 3n) array of every frame's displacement");
+          "(frames, 3n) array of every frame's displacement")
+      .def(
+          "region_ratios",
+          [](SimulationReader& reader) {
+            if (!reader.header().hasRegionRatios) {
+              throw py::value_error(reader.path().string() +
+                                    " does not record region ratios (header flag bit 1): run the scene with "
+                                    "\"output\": {\"regions\": true}");
+            }
+            const auto frames = reader.numFrames();
+            const auto n = static_cast<py::ssize_t>(reader.numVertices());
+            py::array_t<std::uint16_t> result({static_cast<py::ssize_t>(frames), n});
+            std::uint16_t* out = result.mutable_data();
+            {
+              py::gil_scoped_release release;
+              SimulationFrame frame;
+              for (std::int64_t k = 0; k < frames; ++k) {
+                reader.readFrame(k, frame);
+                std::copy(frame.regionRatios.begin(), frame.regionRatios.end(), out + (k * n));
+              }
+            }
+            return result;
+          },
+          "(frames, n) uint16 array of every frame's step ratio per vertex (1 in the large-step region, m_i in fast "
+          "region S_i), for runs that record their regions; ValueError for a file without them");
 }
 
 }  // namespace asyncfem::python

@@ -367,6 +367,7 @@ void parseOutput(JsonObjectReader& top, Scene& scene) {
   }
   scene.output.velocities = reader.boolean("velocities", false);
   scene.output.sync = reader.boolean("sync", false);
+  if (reader.has("regions")) scene.output.regions = reader.boolean("regions", false);
   reader.finish();
 }
 
@@ -565,6 +566,15 @@ bool resolvedFromKeys(const Scene& scene, const FrameTiming& timing) {
 }
 
 }  // namespace
+
+bool hasAdaptiveRegions(const Scene& scene) {
+  const json& options = scene.integrator.options;
+  if (!options.is_object()) return false;
+  const auto regions = options.find("regions");
+  return regions != options.end() && regions->is_object() && regions->contains("adaptive");
+}
+
+bool recordsRegionRatios(const Scene& scene) { return scene.output.regions.value_or(hasAdaptiveRegions(scene)); }
 
 void throwSceneError(const Scene& scene, const std::string& keyPath, const std::string& message) {
   JsonObjectReader::failAt(scene.sourceName, keyPath, message);

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
@@ -330,6 +332,16 @@ IntegratorContext integratorContext(const Scene& scene, const FrameTiming& timin
   return context;
 }
 
+namespace {}  // namespace
+
+void requireMultirateForRegionOutput(const Scene& scene, const Integrator& integrator) {
+  if (recordsRegionRatios(scene) && integrator.multirate() == nullptr) {
+    throwSceneError(scene, "output.regions",
+                    "records the fast regions of a multirate integrator, but \"" + scene.integrator.name +
+                        "\" is single-rate (use \"async\" with regions, or leave output.regions out)");
+  }
+}
+
 namespace {
 
 void requireKnownIntegrator(const Scene& scene, const IntegratorRegistry& registry) {
@@ -402,9 +414,65 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
   } catch (const TimestepError& error) {
     throw TimestepError(error.what() + stableStepsPerFrameAdvice(scene, registry, context, simulation.timing));
   }
+  requireMultirateForRegionOutput(scene, *simulation.integrator);
   simulation.monitor.emplace(problem);
   for (const std::string& item : simulation.monitor->skipped()) simulation.skipped.push_back(item);
   return simulation;
+}
+
+std::vector<int> vertexStepRatios(const Integrator& integrator, int numVertices) {
+  std::vector<int> ratios(static_cast<std::size_t>(numVertices), 1);
+  const MultirateIntegrator* multirate = integrator.multirate();
+  if (multirate == nullptr) return ratios;
+  const std::vector<RegionSummary> regions = multirate->regionSummaries();
+  for (int v = 0; v < numVertices; ++v) {
+    const int region = multirate->regionOfVertex(v);
+    if (region >= 0 && region < std::ssize(regions)) {
+      ratios[static_cast<std::size_t>(v)] = regions[static_cast<std::size_t>(region)].ratio;
+    }
+  }
+  return ratios;
+}
+
+std::optional<std::vector<int>> fixedRegionRatios(const Scene& scene, const Problem& problem) {
+  const nlohmann::json& options = scene.integrator.options;
+  if (!options.is_object() || !options.contains("regions") || !options.at("regions").is_array()) return std::nullopt;
+  IntegratorContext context = integratorContext(scene);
+  context.mesh = problem.sharedMesh();
+  context.system.freeDofs = problem.freeDofs();
+  // The regions alone: the other keys belong to the integrator and are checked when it runs.
+  const AsyncSettings settings = parseAsyncSettings(context, nlohmann::json{{"regions", options.at("regions")}});
+  const RegionPartition partition(problem.mesh(), problem.freeDofs(), settings.regions);
+  std::vector<int> ratios(static_cast<std::size_t>(problem.mesh().numVertices()), 1);
+  for (int v = 0; v < problem.mesh().numVertices(); ++v) {
+    const int region = partition.regionOfVertex(v);
+    if (region >= 0) ratios[static_cast<std::size_t>(v)] = partition.ratio(region);
+  }
+  return ratios;
+}
+
+void describeRegionOutput(const Scene& scene, const Simulation& simulation, SimulationFileHeader& header) {
+  requireMultirateForRegionOutput(scene, *simulation.integrator);
+  header.hasRegionRatios = recordsRegionRatios(scene);
+}
+
+void appendSimulationFrame(SimulationWriter& writer, const Simulation& simulation) {
+  const Integrator& integrator = *simulation.integrator;
+  const SimulationFileHeader& header = writer.header();
+  if (!header.hasRegionRatios) {
+    if (header.hasVelocities) {
+      writer.appendFrame(integrator.time(), integrator.displacement(), integrator.velocity());
+    } else {
+      writer.appendFrame(integrator.time(), integrator.displacement());
+    }
+    return;
+  }
+  const std::vector<int> ratios = vertexStepRatios(integrator, static_cast<int>(header.numVertices));
+  if (header.hasVelocities) {
+    writer.appendFrame(integrator.time(), integrator.displacement(), integrator.velocity(), ratios);
+  } else {
+    writer.appendFrame(integrator.time(), integrator.displacement(), ratios);
+  }
 }
 
 void advanceFrame(Simulation& simulation, int frame) {

@@ -92,16 +92,18 @@ void readHeaderFields(const std::string& name, const unsigned char* bytes, Simul
     throw ParseError(name, 0, "header has a non-finite or negative frame interval or timestep");
   }
   const std::uint64_t flags = detail::getU64(bytes + detail::offsetFlags);
-  if ((flags & ~detail::flagVelocities) != 0) {
+  if ((flags & ~detail::knownFlags) != 0) {
     throw ParseError(name, 0, "header has unknown flags " + std::to_string(flags));
   }
   header.hasVelocities = (flags & detail::flagVelocities) != 0;
+  header.hasRegionRatios = (flags & detail::flagRegionRatios) != 0;
   const std::uint64_t recordBytes = detail::getU64(bytes + detail::offsetRecordBytes);
   if (recordBytes != static_cast<std::uint64_t>(header.recordBytes())) {
     throw ParseError(name, 0,
                      "header record size " + std::to_string(recordBytes) + " disagrees with " +
-                         std::to_string(numVertices) + " vertices (expected " + std::to_string(header.recordBytes()) +
-                         ")");
+                         std::to_string(numVertices) + " vertices" +
+                         (header.hasRegionRatios ? " with region ratios" : "") + " (expected " +
+                         std::to_string(header.recordBytes()) + ")");
   }
 }
 
@@ -118,6 +120,27 @@ void checkRecord(const std::string& name, std::int64_t k, const unsigned char* i
   const auto index = static_cast<std::int64_t>(detail::getU64(in));
   if (index != k) {
     throw ParseError(name, 0, "frame " + std::to_string(k) + ": record says it is frame " + std::to_string(index));
+  }
+}
+
+/// Reads the n region ratios of frame k at in into out; each must be at least 1, and the
+/// padding after them zero.
+void readRatios(const std::string& name, std::int64_t k, const unsigned char* in, std::int64_t numVertices,
+                std::vector<std::uint16_t>& out) {
+  out.resize(static_cast<std::size_t>(numVertices));
+  for (std::size_t v = 0; v < out.size(); ++v) {
+    out[v] = detail::getU16(in + (2 * v));
+    if (out[v] == 0) {
+      throw ParseError(name, 0,
+                       "frame " + std::to_string(k) + ": vertex " + std::to_string(v) +
+                           " has region ratio 0 (step ratios are 1 or more)");
+    }
+  }
+  for (auto b = static_cast<std::size_t>(2 * numVertices);
+       b < static_cast<std::size_t>(detail::regionRatioBytes(numVertices)); ++b) {
+    if (in[b] != 0) {
+      throw ParseError(name, 0, "frame " + std::to_string(k) + ": the padding after the region ratios is not zero");
+    }
   }
 }
 
@@ -205,6 +228,11 @@ void SimulationReader::readFrame(std::int64_t k, SimulationFrame& out) {
     }
   } else {
     out.velocity.resize(0);
+  }
+  if (header_.hasRegionRatios) {
+    readRatios(path_.string(), k, in + position, header_.numVertices, out.regionRatios);
+  } else {
+    out.regionRatios.clear();
   }
 }
 

@@ -28,7 +28,8 @@ std::int64_t SimulationFileHeader::headerBytes() const {
 std::int64_t SimulationFileHeader::recordBytes() const {
   const std::int64_t arrays = hasVelocities ? 2 : 1;
   return static_cast<std::int64_t>(detail::recordPrefixBytes + detail::recordSuffixBytes) +
-         (arrays * 3 * numVertices * static_cast<std::int64_t>(sizeof(double)));
+         (arrays * 3 * numVertices * static_cast<std::int64_t>(sizeof(double))) +
+         (hasRegionRatios ? detail::regionRatioBytes(numVertices) : 0);
 }
 
 void SimulationWriter::FileCloser::operator()(std::FILE* file) const { std::fclose(file); }
@@ -60,6 +61,21 @@ bool copyBack(int from, const std::filesystem::path& path, std::int64_t bytes) {
   return ok;
 }
 
+// n ratios, each one a u16 of at least 1.
+void checkRatios(const std::string& where, const std::vector<int>& ratios, std::int64_t numVertices) {
+  if (std::ssize(ratios) != numVertices) {
+    throw Error(where + ": expected " + std::to_string(numVertices) + " region ratios, got " +
+                std::to_string(ratios.size()));
+  }
+  for (std::size_t v = 0; v < ratios.size(); ++v) {
+    if (ratios[v] < 1 || ratios[v] > maxSimulationRegionRatio) {
+      throw Error(where + ": vertex " + std::to_string(v) + ": step ratio " + std::to_string(ratios[v]) +
+                  " cannot be stored (a record holds ratios from 1 to " + std::to_string(maxSimulationRegionRatio) +
+                  ")");
+    }
+  }
+}
+
 void checkHeader(const std::string& name, const SimulationFileHeader& header) {
   if (header.numVertices <= 0 || header.numVertices > maxSimulationFileVertices) {
     throw Error(name + ": cannot write a simulation file with " + std::to_string(header.numVertices) + " vertices");
@@ -82,7 +98,7 @@ std::vector<unsigned char> encodeHeader(const SimulationFileHeader& header) {
   detail::putU64(bytes + detail::offsetNumVertices, static_cast<std::uint64_t>(header.numVertices));
   detail::putF64(bytes + detail::offsetFrameInterval, header.frameInterval);
   detail::putF64(bytes + detail::offsetTimestep, header.timestep);
-  detail::putU64(bytes + detail::offsetFlags, header.hasVelocities ? detail::flagVelocities : 0);
+  detail::putU64(bytes + detail::offsetFlags, detail::headerFlags(header));
   detail::putU64(bytes + detail::offsetRecordBytes, static_cast<std::uint64_t>(header.recordBytes()));
   detail::putU32(bytes + detail::offsetHeaderCrc, crc32(bytes, detail::offsetHeaderCrc));
   if (!header.scenePath.empty()) {
@@ -94,6 +110,22 @@ std::vector<unsigned char> encodeHeader(const SimulationFileHeader& header) {
     detail::putU32(bytes + crcAt, crc32(scene, crcAt - simulationHeaderBytes));
   }
   return block;
+}
+
+// A file continued by a run that would write other records: the flag that differs, named.
+void checkSameFlags(const std::string& name, const unsigned char* stored, const SimulationFileHeader& header) {
+  if (std::memcmp(stored, detail::simulationMagic, sizeof(detail::simulationMagic)) != 0) return;
+  const std::uint64_t there = detail::getU64(stored + detail::offsetFlags);
+  const std::uint64_t here = detail::headerFlags(header);
+  const auto differs = [&](std::uint64_t flag, const char* what, const char* key) {
+    if ((there & flag) == (here & flag)) return;
+    throw Error(name + ": cannot continue it: its header differs from this run's: its records " +
+                ((there & flag) != 0 ? "carry " : "do not carry ") + what + " (header flag bit " +
+                (flag == detail::flagVelocities ? "0" : "1") + ") but this run's " +
+                ((here & flag) != 0 ? "do" : "do not") + " (" + key + "); run without --resume to start over");
+  };
+  differs(detail::flagRegionRatios, "region ratios", "output.regions");
+  differs(detail::flagVelocities, "velocities", "output.velocities");
 }
 
 }  // namespace
@@ -138,7 +170,9 @@ SimulationWriter::SimulationWriter(const std::filesystem::path& path, const Simu
   }
   const std::vector<unsigned char> expected = encodeHeader(header);
   std::vector<unsigned char> stored(expected.size(), 0);
-  if (std::fread(stored.data(), 1, stored.size(), file_.get()) != stored.size() || stored != expected) {
+  const bool whole = std::fread(stored.data(), 1, stored.size(), file_.get()) == stored.size();
+  if (whole) checkSameFlags(name, stored.data(), header);
+  if (!whole || stored != expected) {
     throw Error(name +
                 ": cannot continue it: its header differs from this run's (vertex count, frame interval, "
                 "timestep, velocity output or scene changed)");
@@ -249,25 +283,43 @@ void SimulationWriter::close() {
   }
 }
 
-void SimulationWriter::appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement) {
-  if (header_.hasVelocities) {
-    throw Error(path_.string() + ": frame " + std::to_string(numFrames_) +
-                ": the file stores velocities, but none were given");
+void SimulationWriter::checkArraysGiven(bool velocity, bool ratios) const {
+  const std::string where = path_.string() + ": frame " + std::to_string(numFrames_) + ": ";
+  if (header_.hasVelocities != velocity) {
+    throw Error(where + (velocity ? "velocities given, but the file was created without them"
+                                  : "the file stores velocities, but none were given"));
   }
-  appendRecord(time, displacement, nullptr);
+  if (header_.hasRegionRatios != ratios) {
+    throw Error(where + (ratios ? "region ratios given, but the file was created without them"
+                                : "the file stores region ratios, but none were given"));
+  }
+}
+
+void SimulationWriter::appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement) {
+  checkArraysGiven(false, false);
+  appendRecord(time, displacement, nullptr, nullptr);
 }
 
 void SimulationWriter::appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
                                    const Eigen::Ref<const Eigen::VectorXd>& velocity) {
-  if (!header_.hasVelocities) {
-    throw Error(path_.string() + ": frame " + std::to_string(numFrames_) +
-                ": velocities given, but the file was created without them");
-  }
-  appendRecord(time, displacement, &velocity);
+  checkArraysGiven(true, false);
+  appendRecord(time, displacement, &velocity, nullptr);
+}
+
+void SimulationWriter::appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
+                                   const std::vector<int>& ratios) {
+  checkArraysGiven(false, true);
+  appendRecord(time, displacement, nullptr, &ratios);
+}
+
+void SimulationWriter::appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
+                                   const Eigen::Ref<const Eigen::VectorXd>& velocity, const std::vector<int>& ratios) {
+  checkArraysGiven(true, true);
+  appendRecord(time, displacement, &velocity, &ratios);
 }
 
 void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
-                                    const Eigen::Ref<const Eigen::VectorXd>* velocity) {
+                                    const Eigen::Ref<const Eigen::VectorXd>* velocity, const std::vector<int>* ratios) {
   const std::string where = path_.string() + ": frame " + std::to_string(numFrames_);
   if (!file_) {
     throw Error(where + ": the file is closed");
@@ -282,6 +334,7 @@ void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::V
   if (!std::isfinite(time) || !displacement.allFinite() || (velocity != nullptr && !velocity->allFinite())) {
     throw Error(where + ": refusing to store non-finite values");
   }
+  if (ratios != nullptr) checkRatios(where, *ratios, header_.numVertices);
 
   unsigned char* out = buffer_.data();
   detail::putU64(out, static_cast<std::uint64_t>(numFrames_));
@@ -294,6 +347,13 @@ void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::V
     for (Eigen::Index i = 0; i < size; ++i, offset += 8) {
       detail::putF64(out + offset, (*velocity)[i]);
     }
+  }
+  if (ratios != nullptr) {
+    std::memset(out + offset, 0, static_cast<std::size_t>(detail::regionRatioBytes(header_.numVertices)));
+    for (std::size_t v = 0; v < ratios->size(); ++v) {
+      detail::putU16(out + offset + (2 * v), static_cast<std::uint16_t>((*ratios)[v]));
+    }
+    offset += static_cast<std::size_t>(detail::regionRatioBytes(header_.numVertices));
   }
   detail::putU32(out + offset, crc32(out, offset));
   detail::putU32(out + offset + 4, 0);

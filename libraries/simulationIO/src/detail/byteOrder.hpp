@@ -23,6 +23,13 @@ inline void putU64(unsigned char* out, std::uint64_t value) {
   }
 }
 inline void putF64(unsigned char* out, double value) { putU64(out, std::bit_cast<std::uint64_t>(value)); }
+inline void putU16(unsigned char* out, std::uint16_t value) {
+  out[0] = static_cast<unsigned char>(value);
+  out[1] = static_cast<unsigned char>(value >> 8);
+}
+inline std::uint16_t getU16(const unsigned char* in) {
+  return static_cast<std::uint16_t>(in[0] | (static_cast<unsigned>(in[1]) << 8));
+}
 
 inline std::uint32_t getU32(const unsigned char* in) {
   std::uint32_t value = 0;
@@ -43,6 +50,15 @@ inline double getF64(const unsigned char* in) { return std::bit_cast<double>(get
 // Magic bytes at offset 0.
 inline constexpr char simulationMagic[8] = {'A', 'F', 'E', 'M', 'S', 'I', 'M', '\0'};
 inline constexpr std::uint64_t flagVelocities = 1;
+inline constexpr std::uint64_t flagRegionRatios = 2;
+inline constexpr std::uint64_t knownFlags = flagVelocities | flagRegionRatios;
+
+/// The flags a header's fields give.
+inline std::uint64_t headerFlags(const SimulationFileHeader& header) {
+  return (header.hasVelocities ? flagVelocities : 0) | (header.hasRegionRatios ? flagRegionRatios : 0);
+}
+/// Bytes of the region ratios of n vertices in a record: n u16, padded to a multiple of 8.
+inline std::int64_t regionRatioBytes(std::int64_t numVertices) { return (2 * numVertices + 7) / 8 * 8; }
 
 // Header field offsets (see simulationFile.hpp).
 inline constexpr std::size_t offsetVersion = 8;

@@ -145,6 +145,10 @@ struct Scene {
     int vtuEvery = 1;                 ///< write a .vtu every this many frames
     bool velocities = false;          ///< also store velocities in the .afsim file
     bool sync = false;                ///< fsync after every frame
+    /// output.regions: each .afsim record also carries every vertex's step ratio (the fast
+    /// regions in use at that frame); unset: on exactly for adaptive (run-time) regions
+    /// (recordsRegionRatios()).
+    std::optional<bool> regions;
     /// output.vtu.encoding: how the .vtu files store their arrays
     VtuEncoding vtuEncoding = VtuEncoding::binary;
   } output;
@@ -185,6 +189,13 @@ struct TimingOverrides {
 /// errors of resolveFrameTiming (named by the scene key the override replaces). Giving
 /// both timestep and stepsPerFrame is a ValidationError.
 void overrideFrameTiming(Scene& scene, const TimingOverrides& overrides);
+
+/// Whether the scene's integrator options ask for run-time regions
+/// (integrator.options.regions = {"adaptive": ...}).
+bool hasAdaptiveRegions(const Scene& scene);
+/// Whether a run of the scene records region ratios in its .afsim records: output.regions
+/// when given, else hasAdaptiveRegions().
+bool recordsRegionRatios(const Scene& scene);
 
 /// Reads and parses a scene file. Relative paths in it resolve against its folder.
 /// Throws asyncfem::ParseError "FILE:LINE: invalid JSON ..." for malformed JSON, and

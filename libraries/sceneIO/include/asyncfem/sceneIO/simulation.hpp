@@ -6,6 +6,7 @@
 #include <asyncfem/problem/problem.hpp>
 #include <asyncfem/runMonitor/runMonitor.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
+#include <asyncfem/simulationIO/simulationFile.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -94,6 +95,31 @@ struct Simulation {
 /// timing that gives no whole number of steps per frame, and for unknown integrator names
 /// or options (IntegratorRegistry::create()).
 Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registry = defaultIntegratorRegistry());
+
+/// Each vertex's step ratio to the large step in the partition the integrator uses now: 1
+/// in the large-step region L, m_i in fast region S_i (MultirateIntegrator::regionOfVertex
+/// and regionSummaries); all 1 for a single-rate integrator.
+std::vector<int> vertexStepRatios(const Integrator& integrator, int numVertices);
+
+/// Each vertex's step ratio under the scene's fixed regions (integrator.options.regions
+/// given as an array of regions, resolved on problem's mesh as the multirate integrators
+/// resolve them): the partition of every frame of such a run. nullopt when the scene has
+/// none (single-rate, or automatic or adaptive regions). Throws asyncfem::ValidationError
+/// naming the key for regions that do not fit the mesh.
+std::optional<std::vector<int>> fixedRegionRatios(const Scene& scene, const Problem& problem);
+
+/// Throws asyncfem::ValidationError "<scene>: output.regions: ..." when the scene records
+/// region ratios (recordsRegionRatios()) and integrator is single-rate; buildSimulation()
+/// checks it.
+void requireMultirateForRegionOutput(const Scene& scene, const Integrator& integrator);
+
+/// Sets header.hasRegionRatios when a run of scene records them (recordsRegionRatios()),
+/// after requireMultirateForRegionOutput().
+void describeRegionOutput(const Scene& scene, const Simulation& simulation, SimulationFileHeader& header);
+
+/// Appends the simulation's current state (time, displacement) as the next frame of
+/// writer, with the velocities and the region ratios (vertexStepRatios) its header asks for.
+void appendSimulationFrame(SimulationWriter& writer, const Simulation& simulation);
 
 /// Advances the simulation by one frame (stepsPerFrame steps) under its RunMonitor, the
 /// frame's start being a restart point of the integrator (Integrator::restartPoint()):

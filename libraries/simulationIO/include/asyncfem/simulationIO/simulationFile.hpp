@@ -22,7 +22,8 @@ namespace asyncfem {
 ///         16     8  numVertices n (u64)
 ///         24     8  frame interval (f64, time between frames)
 ///         32     8  integrator timestep (f64, informational; 0 if unknown)
-///         40     8  flags (u64): bit 0 = records carry velocities; other bits 0
+///         40     8  flags (u64): bit 0 = records carry velocities, bit 1 = records carry
+///                   region ratios; other bits 0
 ///         48     8  record size in bytes (u64, derived from n and flags; checked)
 ///         56     4  reserved (0)
 ///         60     4  CRC-32 of bytes 0..59
@@ -40,6 +41,9 @@ struct SimulationFileHeader {
   double frameInterval = 0.0;
   double timestep = 0.0;
   bool hasVelocities = false;
+  /// Flag bit 1: each record also carries every vertex's step ratio to the large step (u16;
+  /// 1 in the large-step region L, m_i in fast region S_i), for runs whose regions move.
+  bool hasRegionRatios = false;
   /// The scene the run came from (version 2; empty: none recorded, version 1), and the
   /// fingerprint of the mesh and fixed vertices it built, so that a reader can find the
   /// mesh by itself and tell when the scene has changed since.
@@ -50,7 +54,8 @@ struct SimulationFileHeader {
   std::int64_t headerBytes() const;
 
   /// Bytes of one frame record: index (8) + time (8) + 3n doubles of displacement
-  /// (+ 3n of velocity) + CRC-32 (4) + 4 reserved bytes.
+  /// (+ 3n of velocity) (+ n u16 region ratios, zero-padded to a multiple of 8 bytes) +
+  /// CRC-32 (4) + 4 reserved bytes.
   std::int64_t recordBytes() const;
 };
 
@@ -63,14 +68,18 @@ inline constexpr std::size_t maxSimulationScenePath = 4096;
 /// Largest vertex count a header may claim: 3n must fit in an int (Eigen index), so a
 /// corrupt header can never trigger a giant allocation.
 inline constexpr std::int64_t maxSimulationFileVertices = 715827882;  // floor((2^31 - 1) / 3)
+/// Largest step ratio a record stores (u16); a writer refuses larger ones.
+inline constexpr int maxSimulationRegionRatio = 65535;
 
 /// One frame as stored: record index (0-based, consecutive), simulated time, and the
-/// stacked 3n displacement (and velocity when the file carries them, else empty).
+/// stacked 3n displacement (and velocity when the file carries them, else empty), and
+/// each vertex's step ratio when the file carries region ratios (else empty).
 struct SimulationFrame {
   std::int64_t index = 0;
   double time = 0.0;
   Eigen::VectorXd displacement;
   Eigen::VectorXd velocity;
+  std::vector<std::uint16_t> regionRatios;
 };
 
 /// Writes a simulation output file. The constructor creates (or truncates) the file and
@@ -101,7 +110,8 @@ class SimulationWriter {
   /// complete records are kept, everything after them (an interrupted append, frames
   /// past the last checkpoint) is cut off, and appendFrame() continues with frame
   /// keepFrames. Throws asyncfem::Error naming the file if it cannot be opened, its
-  /// header differs, or it holds fewer than keepFrames complete records.
+  /// header differs (a differing flag, e.g. region ratios, is named), or it holds fewer
+  /// than keepFrames complete records.
   static std::unique_ptr<SimulationWriter> continueFile(const std::filesystem::path& path,
                                                         const SimulationFileHeader& header, std::int64_t keepFrames,
                                                         Options options);
@@ -113,6 +123,12 @@ class SimulationWriter {
   void appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement);
   void appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
                    const Eigen::Ref<const Eigen::VectorXd>& velocity);
+  /// The same for a file whose header says hasRegionRatios: ratios holds every vertex's
+  /// step ratio (n values, 1 to maxSimulationRegionRatio; others are refused naming the
+  /// frame and the vertex).
+  void appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement, const std::vector<int>& ratios);
+  void appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
+                   const Eigen::Ref<const Eigen::VectorXd>& velocity, const std::vector<int>& ratios);
 
   /// Frames appended so far.
   std::int64_t numFrames() const { return numFrames_; }
@@ -133,8 +149,11 @@ class SimulationWriter {
   struct ContinueTag {};
   SimulationWriter(const std::filesystem::path& path, const SimulationFileHeader& header, Options options,
                    std::int64_t keepFrames, ContinueTag);
+  /// Throws naming the frame when the arrays given (velocity, ratios) are not the ones the
+  /// header says the records carry.
+  void checkArraysGiven(bool velocity, bool ratios) const;
   void appendRecord(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
-                    const Eigen::Ref<const Eigen::VectorXd>* velocity);
+                    const Eigen::Ref<const Eigen::VectorXd>* velocity, const std::vector<int>* ratios);
   /// Bytes of the header and the complete frames written so far.
   std::int64_t completeBytes() const;
   /// Throws (and closes the file) when something else deleted, replaced or truncated the
@@ -172,10 +191,11 @@ struct RecordScan {
 /// The constructor validates the header and throws asyncfem::ParseError naming the file
 /// for a missing or truncated header, bad magic, an unsupported version, a header
 /// checksum mismatch, unknown flags, or absurd sizes (n = 0, n > maxSimulationFileVertices,
-/// a non-finite or negative frame interval, a record size that disagrees with n). A
-/// trailing partial record (an interrupted append) is not an error: it is ignored and
-/// reported by truncatedTrailingBytes(). readFrame() verifies the record's checksum and
-/// index and throws a ParseError naming the frame if they do not match.
+/// a non-finite or negative frame interval, a record size that disagrees with n and the
+/// flags). A trailing partial record (an interrupted append) is not an error: it is
+/// ignored and reported by truncatedTrailingBytes(). readFrame() verifies the record's
+/// checksum and index (and that every region ratio is at least 1) and throws a ParseError
+/// naming the frame (and the vertex) if they do not match.
 class SimulationReader {
  public:
   explicit SimulationReader(const std::filesystem::path& path);
