@@ -201,11 +201,84 @@ TEST(AdaptiveRegions, BadOptionsAreErrors) {
   options = AdaptiveRegionOptions{};
   options.shrinkFactor = 0.5;
   expectError(options, "shrink");
+  options = AdaptiveRegionOptions{};
+  options.indicator = true;
+  options.indicatorRatio = 1;
+  expectError(options, "indicator tolerance must be > 0, ratio >= 2");
   // The contact policy needs obstacles.
   AsyncBackwardEuler async(ts.mesh, ts.system, kLargeStep, {});
   AdaptiveRegionOptions contact;
   contact.contact = true;
   EXPECT_THROW(async.setAdaptiveRegions(contact), ValidationError);
+}
+
+// The indicator (Eq. R1): a velocity history with a constant acceleration has no second
+// difference, so no region; a kick at the x = 1 face gives those vertices
+// e = |kick| / 2 against tolerance times the RMS speed, a power-of-two ratio from it
+// (capped), and the face grown by one ring of hysteresis as the region.
+TEST(AdaptiveRegions, IndicatorMarksWhereTheLargeStepErrs) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  const int n = ts.mesh.numVertices();
+  const std::vector<int> face = test::verticesBeyond(ts.mesh, 0.99);
+  const auto uniform = [&](double speed) {
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(3 * n);
+    for (int vertex = 0; vertex < n; ++vertex) v[3 * vertex] = speed;
+    return ts.system.freeDofs.expand(ts.system.freeDofs.restrict(v));  // fixed DOFs at rest
+  };
+  const auto rmsSpeed = [&](const Eigen::VectorXd& v) {
+    double sum = 0.0;
+    int moving = 0;
+    for (int vertex = 0; vertex < n; ++vertex) {
+      if (ts.system.freeDofs.fullToFree()[static_cast<std::size_t>(3 * vertex)] < 0) continue;
+      sum += v.segment<3>(3 * vertex).squaredNorm();
+      ++moving;
+    }
+    return std::sqrt(sum / moving);
+  };
+  for (const double kick : {0.6, 3.0, 50.0}) {
+    AdaptiveRegionOptions options;
+    options.indicator = true;
+    options.indicatorTolerance = 0.1;
+    options.indicatorRatio = 16;
+    options.indicatorRings = 0;
+    AdaptiveRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(3 * n);
+    std::string reason;
+    const std::vector<AsyncRegion> none;
+    // Constant acceleration: v = 1, 1.5, 2 (and 2.5 next) along x.
+    for (int k = 0; k < 3; ++k)
+      EXPECT_FALSE(policy.decide(k * kLargeStep, kLargeStep, zero, uniform(1.0 + 0.5 * k), nullptr, none, 10, reason))
+          << "step " << k;
+    Eigen::VectorXd kicked = uniform(2.5);
+    for (int vertex : face) kicked[3 * vertex + 1] += kick;
+    const auto next = policy.decide(3 * kLargeStep, kLargeStep, zero, kicked, nullptr, none, 10, reason);
+    ASSERT_TRUE(next) << "kick " << kick;
+    EXPECT_EQ(reason, "indicator region grows");
+    ASSERT_EQ(next->size(), 1U);
+    const double want = 0.5 * kick / (options.indicatorTolerance * rmsSpeed(kicked));
+    int ratio = 2;
+    while (ratio < want && ratio < options.indicatorRatio) ratio *= 2;
+    EXPECT_EQ((*next)[0].ratio, ratio) << "kick " << kick << ", wanted " << want;
+    EXPECT_EQ((*next)[0].vertices, test::verticesBeyond(ts.mesh, 0.875));
+  }
+}
+
+// A run with the indicator: a random start state (large velocity second differences) makes
+// the policy set up a region once three large-step velocities are known (step 2), and the
+// partition it chose is a valid one the run continues with.
+TEST(AdaptiveRegions, IndicatorRunsInTheIntegrator) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 1e-3);
+  AsyncBackwardEuler async(ts.mesh, ts.system, kLargeStep, {});
+  async.setState(ts.u0, ts.v0);
+  AdaptiveRegionOptions options;
+  options.indicator = true;
+  async.setAdaptiveRegions(options);
+  for (int k = 0; k < 6; ++k) async.step();
+  ASSERT_FALSE(async.repartitions().empty());
+  EXPECT_EQ(async.repartitions()[0].step, 2);
+  EXPECT_EQ(async.repartitions()[0].reason, "indicator region grows");
+  EXPECT_GT(async.repartitions()[0].fastVertices, 0);
+  EXPECT_TRUE(async.displacement().allFinite());
 }
 
 IntegratorContext barContext(bool hasContact) {
@@ -259,6 +332,20 @@ TEST(AdaptiveRegions, SceneKeys) {
       parseError(barContext(true), nlohmann::json::parse(R"({"regions": {"adaptive": {"contact": {"ratio": 1}}}})"))
           .find("contact.ratio"),
       std::string::npos);
+  const AsyncSettings indicator = parseAsyncSettings(
+      bar,
+      nlohmann::json::parse(R"({"regions": {"adaptive": {"indicator": {"tolerance": 0.2, "ratio": 8, "rings": 2}}}})"));
+  ASSERT_TRUE(indicator.adaptive);
+  EXPECT_TRUE(indicator.adaptive->indicator);
+  EXPECT_EQ(indicator.adaptive->indicatorTolerance, 0.2);
+  EXPECT_EQ(indicator.adaptive->indicatorRatio, 8);
+  EXPECT_EQ(indicator.adaptive->indicatorRings, 2);
+  EXPECT_NE(parseError(bar, nlohmann::json::parse(R"({"regions": {"adaptive": {"indicator": {"tolerance": 0}}}})"))
+                .find("indicator.tolerance: must be > 0"),
+            std::string::npos);
+  EXPECT_NE(parseError(bar, nlohmann::json::parse(R"({"regions": {"adaptive": {"indicator": {"tol": 0.1}}}})"))
+                .find("indicator.tol"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -113,3 +113,17 @@ def test_schedule_policy_from_python(beam):
         bad = af.AdaptiveRegionOptions()
         bad.contact = True  # this system has no obstacles
         integrator.set_adaptive_regions(bad)
+
+
+def test_indicator_policy_from_python(beam):
+    """The indicator policy marks where the large step errs once three velocities are known."""
+    system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))
+    integrator = af.AsyncBackwardEuler(beam, system, 0.01, [])
+    options = af.AdaptiveRegionOptions()
+    options.indicator = True
+    options.indicator_tolerance = 0.05
+    integrator.set_adaptive_regions(options)
+    integrator.step(4)
+    records = integrator.repartitions
+    assert records and records[0].step == 2 and records[0].reason == "indicator region grows"
+    assert records[0].fast_vertices > 0

@@ -96,6 +96,40 @@ std::vector<AsyncRegion> mergeTouching(const TetMesh& mesh, const std::vector<As
   return merged;
 }
 
+/// The vertices an indicator marks (ratio > 0), one region per set connected through
+/// elements, at the largest ratio its vertices want.
+std::vector<AsyncRegion> indicatorComponents(const TetMesh& mesh, const std::vector<int>& ratio) {
+  const auto n = static_cast<int>(ratio.size());
+  std::vector<int> parent(static_cast<std::size_t>(n));
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    int first = -1;
+    for (int a = 0; a < 4; ++a) {
+      const int vertex = mesh.elements()(a, e);
+      if (ratio[static_cast<std::size_t>(vertex)] == 0) continue;
+      if (first < 0) {
+        first = vertex;
+      } else {
+        parent[static_cast<std::size_t>(findRoot(parent, vertex))] = findRoot(parent, first);
+      }
+    }
+  }
+  std::vector<AsyncRegion> components;
+  std::vector<int> slot(static_cast<std::size_t>(n), -1);
+  for (int vertex = 0; vertex < n; ++vertex) {
+    if (ratio[static_cast<std::size_t>(vertex)] == 0) continue;
+    int& s = slot[static_cast<std::size_t>(findRoot(parent, vertex))];
+    if (s < 0) {
+      s = static_cast<int>(components.size());
+      components.push_back({"indicator" + std::to_string(s), {}, 1});
+    }
+    AsyncRegion& component = components[static_cast<std::size_t>(s)];
+    component.vertices.push_back(vertex);
+    component.ratio = std::max(component.ratio, ratio[static_cast<std::size_t>(vertex)]);
+  }
+  return components;
+}
+
 }  // namespace
 
 AdaptiveRegionPolicy::AdaptiveRegionPolicy(const TetMesh& mesh, const FreeDofs& freeDofs, AdaptiveRegionOptions options)
@@ -104,6 +138,9 @@ AdaptiveRegionPolicy::AdaptiveRegionPolicy(const TetMesh& mesh, const FreeDofs& 
   if (o.contactRatio < 1) throw ValidationError("adaptive regions: contact ratio must be >= 1");
   if (!(o.contactMargin >= 0.0) || !(o.contactLookahead >= 0.0) || o.contactRings < 0) {
     throw ValidationError("adaptive regions: contact margin, lookahead and rings must be >= 0");
+  }
+  if (o.indicator && (!(o.indicatorTolerance > 0.0) || o.indicatorRatio < 2 || o.indicatorRings < 0)) {
+    throw ValidationError("adaptive regions: indicator tolerance must be > 0, ratio >= 2 and rings >= 0");
   }
   if (o.minDwell < 0 || !(o.shrinkFactor >= 1.0) || o.cacheSize < 0) {
     throw ValidationError("adaptive regions: minDwell and cache must be >= 0 and shrink >= 1");
@@ -143,6 +180,63 @@ std::vector<char> AdaptiveRegionPolicy::contactVertices(double largeStep, const 
   return marked;
 }
 
+void AdaptiveRegionPolicy::recordVelocity(double time, const Eigen::VectorXd& v) {
+  if (!options_.indicator) return;
+  if (time == lastRecorded_ && !velocities_.empty()) {
+    velocities_.back() = v;  // the same boundary again (a set-up before its first step)
+    return;
+  }
+  if (time < lastRecorded_) velocities_.clear();  // not a continuation: start over
+  velocities_.push_back(v);
+  if (velocities_.size() > 3) velocities_.erase(velocities_.begin());
+  lastRecorded_ = time;
+}
+
+// Eq. (R1): e_v = |v_k - 2 v_{k-1} + v_{k-2}| / 2 against tolerance times the RMS speed.
+std::vector<int> AdaptiveRegionPolicy::indicatorRatios(int extraRings) const {
+  const auto n = static_cast<std::size_t>(mesh_->numVertices());
+  std::vector<int> ratio(n, 0);
+  if (!options_.indicator || velocities_.size() < 3) return ratio;
+  const Eigen::VectorXd& v = velocities_[2];
+  const Eigen::VectorXd change = 0.5 * (v - 2.0 * velocities_[1] + velocities_[0]);
+  double sumSquares = 0.0;
+  int moving = 0;
+  for (std::size_t vertex = 0; vertex < n; ++vertex) {
+    if (!hasFreeDof_[vertex]) continue;
+    sumSquares += v.segment<3>(3 * static_cast<Eigen::Index>(vertex)).squaredNorm();
+    ++moving;
+  }
+  const double speed = moving > 0 ? std::sqrt(sumSquares / moving) : 0.0;
+  if (!(speed > 0.0)) return ratio;
+  bool any = false;
+  for (std::size_t vertex = 0; vertex < n; ++vertex) {
+    if (!hasFreeDof_[vertex]) continue;
+    const double want =
+        change.segment<3>(3 * static_cast<Eigen::Index>(vertex)).norm() / (options_.indicatorTolerance * speed);
+    if (!(want > 1.0)) continue;
+    int m = 2;
+    while (m < options_.indicatorRatio && m < want) m *= 2;
+    ratio[vertex] = std::min(m, options_.indicatorRatio);
+    any = true;
+  }
+  if (!any) return ratio;
+  // Grow: every vertex of an element takes the largest ratio of the element's vertices.
+  for (int ring = 0; ring < options_.indicatorRings + extraRings; ++ring) {
+    std::vector<int> grown = ratio;
+    for (int e = 0; e < mesh_->numElements(); ++e) {
+      int largest = 0;
+      for (int a = 0; a < 4; ++a) largest = std::max(largest, ratio[static_cast<std::size_t>(mesh_->elements()(a, e))]);
+      if (largest == 0) continue;
+      for (int a = 0; a < 4; ++a) {
+        int& r = grown[static_cast<std::size_t>(mesh_->elements()(a, e))];
+        r = std::max(r, largest);
+      }
+    }
+    ratio.swap(grown);
+  }
+  return ratio;
+}
+
 std::vector<int> AdaptiveRegionPolicy::activeWindows(double time) const {
   std::vector<int> active;
   for (std::size_t w = 0; w < options_.schedule.size(); ++w) {
@@ -152,7 +246,8 @@ std::vector<int> AdaptiveRegionPolicy::activeWindows(double time) const {
   return active;
 }
 
-std::vector<AsyncRegion> AdaptiveRegionPolicy::assemble(double time, const std::vector<char>& contact) const {
+std::vector<AsyncRegion> AdaptiveRegionPolicy::assemble(double time, const std::vector<char>& contact,
+                                                        const std::vector<int>& indicated) const {
   std::vector<AsyncRegion> regions;
   for (int w : activeWindows(time)) {
     const ScheduledRegion& window = options_.schedule[static_cast<std::size_t>(w)];
@@ -163,6 +258,7 @@ std::vector<AsyncRegion> AdaptiveRegionPolicy::assemble(double time, const std::
   for (std::size_t vertex = 0; vertex < contact.size(); ++vertex)
     if (contact[vertex]) touching.vertices.push_back(static_cast<int>(vertex));
   if (!touching.vertices.empty()) regions.push_back(std::move(touching));
+  for (AsyncRegion& component : indicatorComponents(*mesh_, indicated)) regions.push_back(std::move(component));
   std::vector<AsyncRegion> merged = mergeTouching(*mesh_, regions);
   // Vertices without a free DOF take no substeps; a region of only such vertices is none.
   std::vector<AsyncRegion> out;
@@ -178,7 +274,7 @@ std::vector<AsyncRegion> AdaptiveRegionPolicy::assemble(double time, const std::
 std::vector<AsyncRegion> AdaptiveRegionPolicy::wanted(double time, double largeStep, const Eigen::VectorXd& u,
                                                       const Eigen::VectorXd& v,
                                                       const ObstacleProximity& proximity) const {
-  return assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings));
+  return assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings), indicatorRatios(0));
 }
 
 namespace {
@@ -198,7 +294,7 @@ bool AdaptiveRegionPolicy::canServe(const std::vector<AsyncRegion>& regions, con
   if (static_cast<double>(countFast(regions)) > options_.shrinkFactor * countFast(proposal)) return false;
   if (!options_.schedule.empty()) return false;  // windows open and close exactly: no stand-ins
   return covers(mesh_->numVertices(), regions,
-                assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings)));
+                assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings), indicatorRatios(0)));
 }
 
 std::optional<std::vector<AsyncRegion>> AdaptiveRegionPolicy::decide(double time, double largeStep,
@@ -207,10 +303,12 @@ std::optional<std::vector<AsyncRegion>> AdaptiveRegionPolicy::decide(double time
                                                                      const std::vector<AsyncRegion>& current,
                                                                      long long stepsKept, std::string& reason) {
   const int n = mesh_->numVertices();
+  recordVelocity(time, v);
   const std::vector<char> needed = contactVertices(largeStep, u, v, proximity, options_.contactRings);
+  const std::vector<int> indicated = indicatorRatios(0);
   std::vector<char> generous = needed;
   if (std::find(generous.begin(), generous.end(), 1) != generous.end()) growByRings(*mesh_, generous, 1);
-  std::vector<AsyncRegion> proposal = assemble(time, generous);
+  std::vector<AsyncRegion> proposal = assemble(time, generous, indicatorRatios(1));
   const std::vector<int> windows = activeWindows(time);
   const std::vector<int> currentRatio = vertexRatios(n, current);
   const std::vector<int> proposedRatio = vertexRatios(n, proposal);
@@ -222,13 +320,19 @@ std::optional<std::vector<AsyncRegion>> AdaptiveRegionPolicy::decide(double time
   if (!started_ || windows != lastWindows_) {
     reason = started_ ? "schedule window opens or closes" : "initial regions";
   } else {
-    // Replace at once when the regions in use miss a vertex the policy needs (or give it
+    // Replace at once when the regions in use miss a vertex a policy needs (or give it
     // fewer substeps); otherwise only after the dwell, and only to shrink by a margin.
-    if (!covers(n, current, assemble(time, needed))) {
+    const std::vector<int> none(static_cast<std::size_t>(n), 0);
+    const char* shrinks = !options_.indicator ? "contact region shrinks"
+                          : options_.contact  ? "regions shrink"
+                                              : "indicator region shrinks";
+    if (!covers(n, current, assemble(time, needed, none))) {
       reason = "contact region grows";
+    } else if (!covers(n, current, assemble(time, needed, indicated))) {
+      reason = "indicator region grows";
     } else if (stepsKept >= options_.minDwell &&
                static_cast<double>(countFast(current)) > options_.shrinkFactor * countFast(proposal)) {
-      reason = proposal.empty() ? "contact ends" : "contact region shrinks";
+      reason = proposal.empty() ? (options_.indicator ? "regions end" : "contact ends") : shrinks;
     } else {
       return std::nullopt;
     }

@@ -144,6 +144,15 @@ AdaptiveRegionOptions parseAdaptive(const IntegratorContext& context, const nloh
     out.contactRings = c.integer("rings", out.contactRings, 0, 100);
     c.finish();
   }
+  if (const nlohmann::json* indicator = reader.find("indicator")) {
+    JsonObjectReader c(*indicator, reader.keyPath("indicator"), sourceName);
+    out.indicator = true;
+    out.indicatorTolerance = c.number("tolerance", out.indicatorTolerance);
+    if (!(out.indicatorTolerance > 0.0)) c.fail("tolerance", "must be > 0 (a fraction of the RMS vertex speed)");
+    out.indicatorRatio = c.integer("ratio", out.indicatorRatio, 2, 100000);
+    out.indicatorRings = c.integer("rings", out.indicatorRings, 0, 100);
+    c.finish();
+  }
   if (const nlohmann::json* schedule = reader.find("schedule")) {
     if (!schedule->is_array()) reader.fail("schedule", "expected an array of regions with \"start\" and \"end\"");
     for (std::size_t i = 0; i < schedule->size(); ++i) {
@@ -156,8 +165,8 @@ AdaptiveRegionOptions parseAdaptive(const IntegratorContext& context, const nloh
       out.schedule.push_back(std::move(window));
     }
   }
-  if (!out.contact && out.schedule.empty()) {
-    JsonObjectReader::failAt(sourceName, path, "give at least one policy: \"contact\" or \"schedule\"");
+  if (!out.contact && !out.indicator && out.schedule.empty()) {
+    JsonObjectReader::failAt(sourceName, path, "give at least one policy: \"contact\", \"indicator\" or \"schedule\"");
   }
   out.minDwell = reader.integer("minDwell", out.minDwell, 0, 1000000);
   out.shrinkFactor = reader.number("shrink", out.shrinkFactor);

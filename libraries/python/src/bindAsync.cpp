@@ -151,6 +151,12 @@ void bindAsyncOptions(py::module_& module) {
       .def_readwrite("contact_margin", &AdaptiveRegionOptions::contactMargin, "length")
       .def_readwrite("contact_lookahead", &AdaptiveRegionOptions::contactLookahead, "large steps")
       .def_readwrite("contact_rings", &AdaptiveRegionOptions::contactRings)
+      .def_readwrite("indicator", &AdaptiveRegionOptions::indicator,
+                     "mark where the large step errs: |v_k - 2 v_(k-1) + v_(k-2)| / 2 against the tolerance")
+      .def_readwrite("indicator_tolerance", &AdaptiveRegionOptions::indicatorTolerance,
+                     "fraction of the RMS vertex speed")
+      .def_readwrite("indicator_ratio", &AdaptiveRegionOptions::indicatorRatio, "largest ratio it asks for")
+      .def_readwrite("indicator_rings", &AdaptiveRegionOptions::indicatorRings)
       .def_readwrite("schedule", &AdaptiveRegionOptions::schedule, "list of ScheduledRegion")
       .def_readwrite("min_dwell", &AdaptiveRegionOptions::minDwell, "large steps")
       .def_readwrite("shrink_factor", &AdaptiveRegionOptions::shrinkFactor)

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Fast regions chosen at run time: where contact is, or when the user's schedule says.
+// Fast regions chosen at run time: where contact is, where the large step's local error is,
+// or when the user's schedule says.
 #pragma once
 
 #include <Eigen/Core>
@@ -36,6 +37,18 @@ struct AdaptiveRegionOptions {
   double contactMargin = 0.0;
   double contactLookahead = 1.0;
   int contactRings = 1;
+  /// Indicator policy: the local error of the large step, estimated per vertex from the
+  /// last three large-step velocities as e_v = |v_k - 2 v_{k-1} + v_{k-2}| / 2 (the
+  /// velocity error of one backward Euler step, (hL^2 / 2) dv/dt^2 in differences; Eq. R1),
+  /// against indicatorTolerance times the body's RMS vertex speed. A vertex above it wants
+  /// ratio e_v / (tolerance * speed) (a step's error falls as 1/m with m substeps), rounded
+  /// up to a power of two and at most indicatorRatio; the marked vertices, grown by
+  /// indicatorRings rings, form one region per connected component at the largest ratio
+  /// its vertices want.
+  bool indicator = false;
+  double indicatorTolerance = 0.05;
+  int indicatorRatio = 16;
+  int indicatorRings = 1;
   /// Schedule policy.
   std::vector<ScheduledRegion> schedule;
   /// Hysteresis. A contact region that no longer covers what the policy needs is replaced
@@ -95,7 +108,12 @@ class AdaptiveRegionPolicy {
  private:
   std::vector<char> contactVertices(double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                                     const ObstacleProximity& proximity, int rings) const;
-  std::vector<AsyncRegion> assemble(double time, const std::vector<char>& contact) const;
+  /// Ratio every vertex wants by the indicator (0: none), grown by indicatorRings + extra.
+  std::vector<int> indicatorRatios(int extraRings) const;
+  /// Takes the velocity at a new large-step boundary into the indicator's history.
+  void recordVelocity(double time, const Eigen::VectorXd& v);
+  std::vector<AsyncRegion> assemble(double time, const std::vector<char>& contact,
+                                    const std::vector<int>& indicated) const;
   std::vector<int> activeWindows(double time) const;
 
   const TetMesh* mesh_;
@@ -103,6 +121,9 @@ class AdaptiveRegionPolicy {
   AdaptiveRegionOptions options_;
   std::vector<int> lastWindows_;
   bool started_ = false;
+  // The indicator's history: the velocities at the last three large-step boundaries.
+  std::vector<Eigen::VectorXd> velocities_;
+  double lastRecorded_ = -std::numeric_limits<double>::infinity();
 };
 
 /// Summary lines for a run's re-partitions: the count, how many came from the cache, the
