@@ -145,6 +145,22 @@ TEST_F(UtilityErrorsTest, SuggestRegionsHonoursTheScenesAutoSettings) {
 // A bare mesh is fixed by a box or a Vega .bou file as well as by a named set: the three
 // ways give the same proposal when they select the same vertices (the beam's root face,
 // x = 0), and a box selecting nothing or a missing .bou file is named by its option.
+// A scene with run-time regions: suggestRegions runs its first steps and lists every
+// partition its policies chose, with the cost model's price against single-rate at hL.
+// The ball falls for about 50 large steps before its contact patch needs a region.
+TEST_F(UtilityErrorsTest, SuggestRegionsExplainsRunTimeRegions) {
+  const RunResult result =
+      run("suggestRegions", "'" + std::string(ASYNCFEM_MODELS_DIR) + "/ball/ball.json' --adaptive-steps 70");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_NE(result.out.find("the scene chooses its regions at run time"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("\"contact\""), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("ran 70 large steps"), std::string::npos) << result.out;
+  // The first partition is the empty one (priced 1.00), a later one has the contact ratio.
+  EXPECT_NE(result.out.find("\n0-"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find(" 8 "), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("expected cost per large step"), std::string::npos) << result.out;
+}
+
 TEST_F(UtilityErrorsTest, SuggestRegionsFixesABareMeshByBoxOrBouFile) {
   const std::string beam = "'" + std::string(ASYNCFEM_MODELS_DIR) + "/beam/beam.veg' --dt 0.0083333 --json";
   const RunResult bySet = run("suggestRegions", beam + " --fixed-set xmin");

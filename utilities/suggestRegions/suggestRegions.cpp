@@ -4,6 +4,8 @@
 // --modes K prints the modal table of the given or proposed regions (see
 // docs/asynchronous-integrator.md, "Which modes can async keep?").
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/core/error.hpp>
@@ -41,6 +43,7 @@ struct CommandLine {
   double frameRate = 0.0;
   bool noModalCheck = false;
   std::string massName = "consistent";
+  int adaptiveSteps = 120;
   // Which of the automatic-region options were given (they replace a scene's own).
   bool givenTarget = false, givenRelative = false, givenGrow = false, givenMaxRatio = false;
   bool anyGiven() const { return givenTarget || givenRelative || givenGrow || givenMaxRatio; }
@@ -55,6 +58,7 @@ struct Input {
   std::vector<AsyncRegion> givenRegions;  // a scene's explicit regions
   bool corotational = false;
   std::optional<AutoRegionOptions> sceneAuto;  // an async scene with "regions": "auto"
+  std::optional<Scene> adaptiveScene;          // an async scene with "regions": {"adaptive": ...}
 };
 
 void addOptions(CLI::App& app, CommandLine& cl) {
@@ -92,6 +96,9 @@ void addOptions(CLI::App& app, CommandLine& cl) {
   app.add_flag("--no-modal-check", cl.noModalCheck,
                "keep the proposal even when no visible mode lives in it (the check is on by default, as for "
                "\"regions\": \"auto\" in scenes)");
+  app.add_option("--adaptive-steps", cl.adaptiveSteps,
+                 "a scene with run-time regions: large steps to run to see which partitions its policies choose")
+      ->check(CLI::Range(1, 100000));
   app.add_option("--mass", cl.massName, "mass matrix for a mesh input (scenes use their own)")
       ->check(CLI::IsMember({"consistent", "lumped"}))
       ->capture_default_str();
@@ -123,7 +130,9 @@ Input readScene(CommandLine& cl) {
   const nlohmann::json* regions = integrator.options.is_object() && integrator.options.contains("regions")
                                       ? &integrator.options["regions"]
                                       : nullptr;
-  if (integrator.name == "async" && regions && regions->is_array()) {
+  if (integrator.name == "async" && regions && regions->is_object() && regions->contains("adaptive")) {
+    in.adaptiveScene = scene;
+  } else if (integrator.name == "async" && regions && regions->is_array()) {
     in.givenRegions = parseAsyncOptions(scene, *in.mesh, in.freeDofs, integrator.options).regions;
   } else if (integrator.name == "async") {
     // What the simulator would run: the scene's own auto settings (command-line
@@ -307,8 +316,71 @@ void writeRegions(const std::string& writePath, const AutoRegionProposal& propos
   std::filesystem::rename(temporary, target);
 }
 
+// A scene whose regions are chosen at run time: run its first steps and explain each
+// partition its policies chose, priced by the cost model against single-rate at hL.
+void explainAdaptive(const CommandLine& cl, const Input& in) {
+  const Scene& scene = *in.adaptiveScene;
+  std::printf("settings: the scene chooses its regions at run time (integrator.options.regions.adaptive: %s)\n",
+              scene.integrator.options["regions"]["adaptive"].dump().c_str());
+  Simulation simulation = buildSimulation(scene);
+  auto* async = dynamic_cast<AsyncBackwardEuler*>(simulation.integrator.get());
+  if (async == nullptr) throw Error("the scene's integrator is not the asynchronous one");
+  struct Span {
+    long long from = 0, to = 0;
+    std::vector<AsyncRegion> regions;
+  };
+  std::vector<Span> spans;
+  for (int k = 0; k < cl.adaptiveSteps; ++k) {
+    async->step();
+    std::vector<AsyncRegion> regions;
+    for (int i = 0; i < async->partition().numRegions(); ++i) regions.push_back(async->partition().region(i));
+    if (spans.empty() || spans.back().regions.size() != regions.size() ||
+        !std::equal(regions.begin(), regions.end(), spans.back().regions.begin(),
+                    [](const AsyncRegion& a, const AsyncRegion& b) {
+                      return a.ratio == b.ratio && a.vertices == b.vertices;
+                    })) {
+      spans.push_back({k, k, regions});
+    }
+    spans.back().to = k + 1;
+  }
+  std::printf("ran %d large steps of hL = %g s: %zu partitions (%zu re-partitions, %zu from the set-up cache)\n",
+              cl.adaptiveSteps, async->timestep(), spans.size(), async->repartitions().size(),
+              static_cast<std::size_t>(std::count_if(async->repartitions().begin(), async->repartitions().end(),
+                                                     [](const RepartitionRecord& r) { return r.reused; })));
+  std::printf("%-14s %-10s %-9s %-8s %-28s\n", "steps", "vertices", "ratio", "|I|", "async / single-rate hL (model)");
+  double weighted = 0.0;
+  for (const Span& span : spans) {
+    int fast = 0, ratio = 1;
+    for (const AsyncRegion& r : span.regions) {
+      fast += static_cast<int>(r.vertices.size());
+      ratio = std::max(ratio, r.ratio);
+    }
+    double relative = 1.0;
+    int interface = 0;
+    if (!span.regions.empty()) {
+      const AutoRegionCost cost = estimateAsyncCost(*in.mesh, in.freeDofs, span.regions, in.corotational);
+      relative = cost.asyncFlops / (cost.singleRateFlops / cost.singleRateSubsteps);
+      interface = cost.interfaceDofs;
+    }
+    weighted += relative * static_cast<double>(span.to - span.from);
+    const std::string steps = std::to_string(span.from) + "-" + std::to_string(span.to);
+    std::printf("%-14s %-10d %-9d %-8d %.2f\n", steps.c_str(), fast, ratio, interface, relative);
+  }
+  std::printf(
+      "expected cost per large step (cost model, steady steps weighted by how long each partition ran): %.2fx "
+      "single-rate at hL; set-up %.3f s for %zu fresh partitions (run it: offlineSimulator prints each)\n",
+      weighted / cl.adaptiveSteps, async->runStats().setupSeconds,
+      async->repartitions().size() -
+          static_cast<std::size_t>(std::count_if(async->repartitions().begin(), async->repartitions().end(),
+                                                 [](const RepartitionRecord& r) { return r.reused; })));
+}
+
 int run(CommandLine& cl) {
   const Input in = std::filesystem::path(cl.input).extension() == ".json" ? readScene(cl) : readMesh(cl);
+  if (in.adaptiveScene && !cl.json) {
+    explainAdaptive(cl, in);
+    std::printf("\nfor comparison, fixed regions from element frequencies (what \"regions\": \"auto\" would run):\n");
+  }
   if (cl.frameRate <= 0.0) cl.frameRate = 30.0;
   const AutoRegionOptions options = proposalOptions(cl, in);
   if (in.sceneAuto && !cl.json) {
