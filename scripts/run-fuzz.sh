@@ -9,8 +9,8 @@
 # ASYNCFEM_FUZZ=ON and built if needed. Each target keeps a growing working corpus in
 # BUILD_DIR/fuzz/corpus/TARGET (seeded from tests/fuzz/corpus/TARGET, which it never
 # changes) and writes crashing, hanging or over-allocating inputs to
-# BUILD_DIR/fuzz/artifacts/TARGET/. The last lines print executions, coverage and
-# findings per target; the exit status is 1 if any target found something.
+# BUILD_DIR/fuzz/artifacts/TARGET/. The last lines print executions, coverage, corpus
+# units, peak RSS and findings per target; the exit status is 1 if any target found something.
 set -euo pipefail
 
 usage() {
@@ -62,12 +62,13 @@ for name in "${targets[@]}"; do
   rc=$?
   set -e
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || true)
+  rss=$(grep -o 'stat::peak_rss_mb: *[0-9]*' "$log" | grep -o '[0-9]*$' || true)
   last=$(grep -E '^#[0-9]+' "$log" | tail -n 1 || true)
   cov=$(grep -o 'cov: [0-9]*' <<< "$last" | grep -o '[0-9]*' || true)
   ft=$(grep -o 'ft: [0-9]*' <<< "$last" | grep -o '[0-9]*' || true)
   units=$(find "$corpus" -type f | wc -l)
   findings=$(find "$artifacts" -type f | wc -l)
-  summary+=("fuzz_$name: ${seconds} s, ${execs:-?} executions, cov ${cov:-?}, ft ${ft:-?}, corpus $units, findings $findings (exit $rc)")
+  summary+=("fuzz_$name: ${seconds} s, ${execs:-?} executions, cov ${cov:-?}, ft ${ft:-?}, corpus $units, peak RSS ${rss:-?} MB, findings $findings (exit $rc)")
   if [[ $rc -ne 0 || $findings -gt 0 ]]; then
     status=1
     grep -E 'ERROR|SUMMARY|Test unit written' "$log" | head -n 5 || true
