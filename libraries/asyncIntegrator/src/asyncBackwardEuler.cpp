@@ -363,7 +363,7 @@ void AsyncBackwardEuler::borrowWholeFactor() {
     stats_.factorizationSeconds += seconds;
     if (d.settingUp) runStats_.setupSchurSeconds += seconds;
   }
-  if (!d.schur.borrowing()) d.schur.borrow(whole_.get(), &partition_.largeDofs());
+  if (!d.schur.borrowing()) d.schur.borrow(whole_.get(), partition_.largeDofs());
   if (!d.linear) d.schur.forgetDirections();  // a new tangent: H^{LL*} changed
 }
 

@@ -44,7 +44,7 @@ void SchurSolver::factor(const SparseMatrix& largeSystem, const RegionPartition&
   factored_ = true;
   refreshNext_ = false;
   borrowed_ = nullptr;
-  borrowedLarge_ = nullptr;
+  borrowedLarge_.clear();
   kept_ = 0;
   directions_.resize(0, 0);
   productsOfDirections_.resize(0, 0);
@@ -152,14 +152,14 @@ void SchurSolver::factorAssembled(const SparseMatrix& largeSystem, const RegionP
   factorizeCounted(*solver_, schur_, analyzed_, stats);
 }
 
-void SchurSolver::borrow(WholeSystemFactor* whole, const std::vector<int>* largeDofs) {
+void SchurSolver::borrow(WholeSystemFactor* whole, std::vector<int> largeDofs) {
   borrowed_ = whole;
-  borrowedLarge_ = largeDofs;
+  borrowedLarge_ = std::move(largeDofs);
 }
 
 void SchurSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
   if (borrowed_ != nullptr) {
-    borrowed_->solveOnLarge(*borrowedLarge_, rhs, solution);
+    borrowed_->solveOnLarge(borrowedLarge_, rhs, solution);
     return;
   }
   solver_->solve(rhs, solution_);

@@ -57,7 +57,7 @@ class SchurSolver {
   /// complement of the whole single-rate system on L (largeDofs: global ids of L) instead
   /// of a factor of H^{LL*}: exact when every ratio is 1, a preconditioner otherwise.
   /// whole must outlive the borrowing.
-  void borrow(WholeSystemFactor* whole, const std::vector<int>* largeDofs);
+  void borrow(WholeSystemFactor* whole, std::vector<int> largeDofs);
   bool borrowing() const { return borrowed_ != nullptr; }
   /// H^{LL*} solution = rhs by deflated conjugate gradients (Eq. Q3) on the borrowed
   /// preconditioner: the directions of earlier solves with the same operator (at most
@@ -92,7 +92,7 @@ class SchurSolver {
 
   SchurMode modeUsed_ = SchurMode::lowRank;
   WholeSystemFactor* borrowed_ = nullptr;
-  const std::vector<int>* borrowedLarge_ = nullptr;
+  std::vector<int> borrowedLarge_;  // global ids of L (a copy: the set-up may be cached)
   // Deflation space of solveDeflated: columns [0, kept_) of directions_ (W, H^{LL*}-
   // orthonormal) and of their products (H^{LL*} W).
   Eigen::MatrixXd directions_, productsOfDirections_;
