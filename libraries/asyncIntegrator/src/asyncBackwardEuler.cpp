@@ -47,7 +47,7 @@ struct AsyncBackwardEuler::Impl {
   // This step refactored A^S but keeps Z and H^{LL*} from an earlier tangent (laggedSchur).
   bool schurLagging = false;
   // Quick set-up (AsyncOptions::quickSetUp): L's system is solved on the whole system's
-  // factor until the iterations' extra time reaches the estimated cost of the rebuild.
+  // factor until the iterations' extra flops reach the priced cost of the rebuild (Eq. Q4).
   bool quick = false;
   double quickExtraFlops = 0.0;
   // Linear forces with a symmetric K (checked once): f_int(u_0) = K u_0 and K v_0 are taken
@@ -665,9 +665,9 @@ void AsyncBackwardEuler::solveStructured() {
 
 // Quick set-up (Eqs. Q1-Q3): deflated conjugate gradients on H^{LL*}, preconditioned by the
 // Schur complement of the whole single-rate system on L. Exact with no region (H^{LL*} =
-// A). The time beyond one solve is what the missing factor costs; once it adds up to the
-// rebuild's estimate, or the iterations do not converge, Z and H^{LL*} are built (the rent-
-// or-buy rule: at most about twice what knowing the partition's lifetime would have cost).
+// A). The flops beyond one solve are what the missing factor costs; once they add up to the
+// rebuild's price, or the iterations do not converge, Z and H^{LL*} are built (the rent-
+// or-buy rule: about twice what knowing the partition's lifetime would have cost at most).
 void AsyncBackwardEuler::solveOnWholeFactor() {
   Impl& d = *impl_;
   if (partition_.numRegions() == 0) {

@@ -188,8 +188,8 @@ SchurSolver::Refinement SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::V
     if (!std::isfinite(result.residual)) return result;
     if (result.residual <= tolerance) {
       result.converged = true;
-      // Slow with an own factor: the next step refactors.
-      refreshNext_ = borrowed_ == nullptr && iteration > maxIterations / 2;
+      // Slow: the next step refactors.
+      refreshNext_ = iteration > maxIterations / 2;
       return result;
     }
     ++result.iterations;

@@ -44,12 +44,12 @@ class SchurSolver {
               SchurMode requested, AsyncCoupling coupling, double asymmetry, IntegratorStats& stats);
   /// solution = (H^{LL*})^{-1} rhs with the last factor.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
-  /// H^{LL*} solution = rhs for the operator of the current blocks, with the last factor
-  /// (or the borrowed one) as preconditioner: conjugate gradients when symmetric (the stable
-  /// coupling), iterative refinement otherwise, to a relative residual of tolerance in at
-  /// most maxIterations iterations. Not converged: the caller then refactors. A slow
-  /// convergence of an own factor (more than half the iterations) asks for a refactor at
-  /// the next step (refreshRequested()).
+  /// H^{LL*} solution = rhs for the operator of the current blocks, with the last factor as
+  /// preconditioner (laggedSchur): conjugate gradients when symmetric (the stable coupling),
+  /// iterative refinement otherwise, to a relative residual of tolerance in at most
+  /// maxIterations iterations. Not converged: the caller then refactors. A slow convergence
+  /// (more than half the iterations) asks for a refactor at the next step
+  /// (refreshRequested()).
   Refinement refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, const Operator& apply, bool symmetric,
                     int maxIterations, double tolerance);
 
