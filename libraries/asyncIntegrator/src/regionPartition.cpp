@@ -50,10 +50,10 @@ RegionPartition::RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, 
   splitFreeDofs(freeDofs, classifyElements(mesh));
 }
 
-void RegionPartition::assignVertices(int numVertices) {
-  vertexRegion_.assign(static_cast<std::size_t>(numVertices), -1);
-  for (int i = 0; i < numRegions(); ++i) {
-    AsyncRegion& r = regions_[static_cast<std::size_t>(i)];
+std::vector<int> assignRegionVertices(std::vector<AsyncRegion>& regions, int numVertices) {
+  std::vector<int> vertexRegion(static_cast<std::size_t>(numVertices), -1);
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    AsyncRegion& r = regions[i];
     if (r.name.empty()) r.name = std::string("S").append(std::to_string(i + 1));
     if (r.ratio < 1) {
       throw ValidationError("region '" + r.name + "': ratio m = " + std::to_string(r.ratio) +
@@ -65,15 +65,18 @@ void RegionPartition::assignVertices(int numVertices) {
         throw ValidationError("region '" + r.name + "': vertex " + std::to_string(v) + " outside [0, " +
                               std::to_string(numVertices) + ")");
       }
-      int& owner = vertexRegion_[static_cast<std::size_t>(v)];
+      int& owner = vertexRegion[static_cast<std::size_t>(v)];
       if (owner >= 0) {
-        throw ValidationError("regions '" + regions_[static_cast<std::size_t>(owner)].name + "' and '" + r.name +
+        throw ValidationError("regions '" + regions[static_cast<std::size_t>(owner)].name + "' and '" + r.name +
                               "' overlap: vertex " + std::to_string(v) + " is in both");
       }
-      owner = i;
+      owner = static_cast<int>(i);
     }
   }
+  return vertexRegion;
 }
+
+void RegionPartition::assignVertices(int numVertices) { vertexRegion_ = assignRegionVertices(regions_, numVertices); }
 
 int RegionPartition::fastRegionOfElement(const TetMesh& mesh, int e, bool& hasLarge) const {
   int fast = -1;

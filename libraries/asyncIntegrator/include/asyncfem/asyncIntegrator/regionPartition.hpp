@@ -33,6 +33,11 @@ struct RegionSelector {
 /// ("vertexSets", "elementSets", "boxes", "vertices") and index its position there.
 std::vector<int> regionVertices(const TetMesh& mesh, const RegionSelector& selector);
 
+/// Region of every vertex (-1: none) for regions given by their vertices: names unnamed
+/// regions "S1", "S2", ... and sorts their vertices. Throws asyncfem::ValidationError for a
+/// ratio < 1, a vertex id out of range and a vertex in two regions (naming both).
+std::vector<int> assignRegionVertices(std::vector<AsyncRegion>& regions, int numVertices);
+
 /// A validated partition of the free DOFs into fast regions S_1..S_n and the rest L,
 /// with the interface data the asynchronous solve needs.
 ///

@@ -1,0 +1,382 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Nested and touching fast regions (docs/asynchronous-integrator.md, "Nested and touching
+// regions", Eqs. N1-N6 and Theorem N): the energy theorem on random hierarchies and on the
+// dense step map, momentum, the single-rate and two-level special cases, the step system
+// against an independent per-step evaluation of its definition, corotational forces, and
+// the ratios that may not share an element.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <asyncfem/asyncIntegrator/nestedAsyncBackwardEuler.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
+#include <random>
+#include <string>
+
+#include "asyncTestSystem.hpp"
+
+namespace asyncfem {
+namespace {
+
+using test::relativeDifference;
+
+/// Up to three levels on a body: each vertex drawn into L, S1 (ratio m1) or S2 (ratio
+/// m1 m2) with the given probabilities, so regions nest, touch each other and touch L.
+struct Hierarchy {
+  std::vector<AsyncRegion> regions;
+  std::string describe() const {
+    std::string out;
+    for (const AsyncRegion& r : regions)
+      out += r.name + " ratio " + std::to_string(r.ratio) + " (" + std::to_string(r.vertices.size()) + " v) ";
+    return out;
+  }
+};
+
+Hierarchy randomHierarchy(const TetMesh& mesh, std::mt19937& random, int m1, int m2) {
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double p1 = 0.2 + 0.4 * uniform(random), p2 = 0.1 + 0.3 * uniform(random);
+  Hierarchy h{{{"S1", {}, m1}, {"S2", {}, m1 * m2}}};
+  for (int v = 0; v < mesh.numVertices(); ++v) {
+    const double draw = uniform(random);
+    if (draw < p2) {
+      h.regions[1].vertices.push_back(v);
+    } else if (draw < p1 + p2) {
+      h.regions[0].vertices.push_back(v);
+    }
+  }
+  return h;
+}
+
+/// The rubber cantilever of testProblems.hpp (4 x 1 x 1 cubes, 48 free DOFs), linear,
+/// consistent mass, undamped unless given, no load.
+test::TestBody smallBar(double alpha = 0.0, double beta = 0.0, ForceModelType model = ForceModelType::linear) {
+  return test::TestBody(test::rubberBarProblem(test::testSettings(model, alpha, beta)));
+}
+
+/// Drops regions without a free DOF (a random draw may put only clamped vertices in one).
+std::vector<AsyncRegion> withFreeDofs(const test::TestBody& body, std::vector<AsyncRegion> regions) {
+  std::vector<AsyncRegion> out;
+  for (AsyncRegion& r : regions) {
+    bool free = false;
+    for (int v : r.vertices) free = free || !body.system.freeDofs.isFixed(3 * v);
+    if (free) out.push_back(std::move(r));
+  }
+  return out;
+}
+
+// Theorem N: a free, undamped linear system never gains energy, whatever the hierarchy. The
+// energy is computed from the state alone (v^T M v / 2 + u^T K u / 2), so its one-step
+// change is the sum of round-off and the dissipation terms of Eq. N7; 1e-12 of E_0 is
+// round-off's bound for these ~1e2-unknown systems.
+TEST(NestedRegions, RandomHierarchiesNeverGainEnergy) {
+  test::TestBody body = smallBar();
+  std::mt19937 random(2026);
+  const int ratios[][2] = {{2, 2}, {4, 4}, {3, 4}, {8, 2}, {16, 16}, {2, 128}, {5, 3}, {64, 4}};
+  int cases = 0;
+  for (const auto& pair : ratios)
+    for (int draw = 0; draw < 3; ++draw) {
+      const Hierarchy h = randomHierarchy(body.mesh, random, pair[0], pair[1]);
+      const std::vector<AsyncRegion> regions = withFreeDofs(body, h.regions);
+      // hL = 1e-3 keeps most of the energy over a step (the check is sharp); 2e-2 damps the
+      // high modes (omega hL up to ~100) the way implicit steps are used.
+      NestedAsyncBackwardEuler integrator(body.system, draw == 0 ? 2e-2 : 1e-3, regions);
+      const test::RandomState start =
+          test::randomState(body.system.freeDofs, 100 + cases, test::FixedDofDraws::skipped);
+      integrator.setState(start.displacement, start.velocity);
+      double energy = integrator.mechanicalEnergy();
+      for (int k = 0; k < 4; ++k) {
+        integrator.step();
+        const double next = integrator.mechanicalEnergy();
+        EXPECT_LE(next, energy * (1.0 + 1e-12)) << h.describe() << " step " << k;
+        energy = next;
+      }
+      ++cases;
+    }
+  EXPECT_EQ(cases, 24);
+}
+
+/// The step map Phi of an undamped linear integrator on the free DOFs: [u; v]_{k+1} = Phi
+/// [u; v]_k, column by column from unit states.
+Eigen::MatrixXd stepMap(Integrator& integrator) {
+  const std::vector<int>& free = integrator.system().freeDofs.freeToFull();
+  const auto nf = static_cast<Eigen::Index>(free.size());
+  const Eigen::Index n = integrator.system().numDofs();
+  Eigen::MatrixXd phi(2 * nf, 2 * nf);
+  for (Eigen::Index c = 0; c < 2 * nf; ++c) {
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(n), v = Eigen::VectorXd::Zero(n);
+    (c < nf ? u : v)[free[static_cast<std::size_t>(c % nf)]] = 1.0;
+    integrator.setState(u, v, 0.0);
+    integrator.step();
+    for (Eigen::Index r = 0; r < nf; ++r) {
+      phi(r, c) = integrator.displacement()[free[static_cast<std::size_t>(r)]];
+      phi(nf + r, c) = integrator.velocity()[free[static_cast<std::size_t>(r)]];
+    }
+  }
+  return phi;
+}
+
+// The dense step map of small models: its worst one-step energy ratio, the largest
+// generalized eigenvalue of (Phi^T H Phi, H) with H = diag(K, M) on the free DOFs, and its
+// spectral radius are at most 1. Eigen-solver round-off on these 96 x 96 maps is ~1e-12.
+TEST(NestedRegions, DenseStepMapNeverGainsEnergy) {
+  test::TestBody body = smallBar();
+  const std::vector<int>& free = body.system.freeDofs.freeToFull();
+  const auto nf = static_cast<Eigen::Index>(free.size());
+  Eigen::SparseMatrix<double> k = body.system.forceModel->createStiffnessMatrix();
+  body.system.forceModel->tangentStiffness(Eigen::VectorXd::Zero(body.mesh.numDofs()), k);
+  const Eigen::MatrixXd fullK(k), fullM(body.system.mass);
+  Eigen::MatrixXd energy = Eigen::MatrixXd::Zero(2 * nf, 2 * nf);
+  for (Eigen::Index a = 0; a < nf; ++a)
+    for (Eigen::Index b = 0; b < nf; ++b) {
+      energy(a, b) = fullK(free[static_cast<std::size_t>(a)], free[static_cast<std::size_t>(b)]);
+      energy(nf + a, nf + b) = fullM(free[static_cast<std::size_t>(a)], free[static_cast<std::size_t>(b)]);
+    }
+  std::mt19937 random(7);
+  const int ratios[][2] = {{4, 4}, {2, 16}, {16, 16}, {8, 1}};
+  for (const auto& pair : ratios)
+    for (double hL : {1e-3, 2e-2}) {
+      const Hierarchy h = randomHierarchy(body.mesh, random, pair[0], pair[1]);
+      NestedAsyncBackwardEuler integrator(body.system, hL, withFreeDofs(body, h.regions));
+      const Eigen::MatrixXd phi = stepMap(integrator);
+      Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ratio(phi.transpose() * energy * phi, energy,
+                                                                      Eigen::EigenvaluesOnly);
+      EXPECT_LE(ratio.eigenvalues().maxCoeff(), 1.0 + 1e-10) << h.describe() << " hL " << hL;
+      const double radius = Eigen::EigenSolver<Eigen::MatrixXd>(phi, false).eigenvalues().cwiseAbs().maxCoeff();
+      EXPECT_LE(radius, 1.0 + 1e-10) << h.describe() << " hL " << hL;
+      EXPECT_GT(radius, 0.5) << "a map this contractive would mean the test measures nothing";
+    }
+}
+
+// A free body (nothing clamped, no load, stiffness-proportional damping only, which acts on
+// deformation alone) keeps its linear momentum 1^T M v per axis, to the round-off of the
+// sparse LU solve (measured 3e-13 of |M v|; bound 1e-11).
+TEST(NestedRegions, FreeBodyKeepsMomentum) {
+  test::TestBody body = smallBar(0.0, 2e-3);
+  body.system.freeDofs = FreeDofs(body.mesh.numDofs(), {});
+  std::mt19937 random(11);
+  const Hierarchy h = randomHierarchy(body.mesh, random, 4, 8);
+  NestedAsyncBackwardEuler integrator(body.system, 0.01, h.regions);
+  const test::RandomState start = test::randomState(body.system.freeDofs, 5, test::FixedDofDraws::skipped);
+  integrator.setState(start.displacement, start.velocity);
+  const auto momentum = [&](const Eigen::VectorXd& v) {
+    const Eigen::VectorXd mv = body.system.mass * v;
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (Eigen::Index i = 0; i < mv.size(); ++i) p[i % 3] += mv[i];
+    return p;
+  };
+  const Eigen::Vector3d p0 = momentum(start.velocity);
+  const double scale = (body.system.mass * start.velocity).norm();
+  for (int k = 0; k < 5; ++k) {
+    integrator.step();
+    EXPECT_LT((momentum(integrator.velocity()) - p0).norm(), 1e-11 * scale) << "step " << k;
+  }
+}
+
+// Every ratio 1 (two touching regions and L): the step is single-rate backward Euler. Both
+// solve the same equations (here by sparse LU, there by dense LU): 1e-11 relative.
+TEST(NestedRegions, AllRatiosOneIsBackwardEuler) {
+  test::TestSystem ts = test::makeTestSystem(0.3, 2e-3);
+  std::vector<AsyncRegion> regions{{"a", test::verticesBeyond(ts.mesh, 0.5), 1},
+                                   {"b", test::verticesOnPlanes(ts.mesh, {0.25, 0.375}), 1}};
+  NestedAsyncBackwardEuler nested(ts.system, 5e-3, regions);
+  nested.setState(ts.u0, ts.v0);
+  test::DenseBackwardEuler reference(ts.system);
+  Eigen::VectorXd u = ts.u0, v = ts.v0;
+  for (int k = 0; k < 5; ++k) {
+    reference.step(5e-3, k * 5e-3, u, v);
+    nested.step();
+  }
+  EXPECT_LT(relativeDifference(nested.displacement(), u), 1e-11);
+  EXPECT_LT(relativeDifference(nested.velocity(), v), 1e-11);
+}
+
+/// Five steps of the two-level stable coupling (AsyncBackwardEuler) and of the nested
+/// integrator on the same regions; the largest relative difference of u and v.
+double twoLevelDifference(const test::TestSystem& ts, const std::vector<AsyncRegion>& regions) {
+  AsyncOptions exact;
+  exact.laggedSchur = false;
+  AsyncBackwardEuler twoLevel(ts.system, 4e-3, regions, exact);
+  NestedAsyncBackwardEuler nested(ts.system, 4e-3, regions);
+  twoLevel.setState(ts.u0, ts.v0);
+  nested.setState(ts.u0, ts.v0);
+  for (int k = 0; k < 5; ++k) {
+    twoLevel.step();
+    nested.step();
+  }
+  return std::max(relativeDifference(twoLevel.displacement(), nested.displacement()),
+                  relativeDifference(twoLevel.velocity(), nested.velocity()));
+}
+
+// Two levels (regions that touch only L) are the stable coupling of Eqs. A8-A12, solved
+// there by Schur complements and here by one sparse LU: equal to round-off (1e-10 relative,
+// after five steps of systems with condition numbers ~1e6), damped, loaded at every substep,
+// linear and corotational (both linearize at the start of the large step).
+TEST(NestedRegions, TwoLevelsAreTheStableCoupling) {
+  for (ForceModelType model : {ForceModelType::linear, ForceModelType::corotational}) {
+    const test::TestSystem ts = test::makeTestSystem(test::testSettings(model, 0.2, 1e-3));
+    const std::vector<AsyncRegion> regions{{"tip", test::verticesBeyond(ts.mesh, 0.75), 8},
+                                           {"middle", test::verticesOnPlanes(ts.mesh, {0.375}), 3}};
+    EXPECT_LT(twoLevelDifference(ts, regions), 1e-10) << (model == ForceModelType::linear ? "linear" : "corotational");
+  }
+}
+
+/// The residual of Eq. N3 for every free DOF and step, written from the definition: each
+/// vertex's motion rebuilt from its step velocities (Eq. N1), each element evaluated with
+/// its own matrices on its fastest vertex's steps (Eq. N2), each impulse credited to the
+/// step it falls in. Returns max |residual| / max |term|.
+double definitionResidual(const test::TestSystem& ts, const NestedAsyncBackwardEuler& nested, const Eigen::VectorXd& u0,
+                          const Eigen::VectorXd& v0, double hL, double t0) {
+  const TetMesh& mesh = ts.mesh;
+  const DynamicSystem& system = ts.system;
+  const StepCounts& counts = nested.counts();
+  const long long units = counts.units();
+  const std::vector<int>& fullToFree = system.freeDofs.fullToFree();
+  // Velocity and displacement of DOF i at time unit t (t = 0: the start state).
+  const auto stepOf = [&](int i, long long t) {
+    const long long s = units / counts.vertexCounts()[static_cast<std::size_t>(i / 3)];
+    return std::pair<long long, long long>{(t + s - 1) / s, s};
+  };
+  const auto velocity = [&](int i, long long t) {
+    const int d = fullToFree[static_cast<std::size_t>(i)];
+    if (d < 0) return 0.0;
+    const long long j = stepOf(i, t).first;
+    return j == 0 ? v0[i] : nested.stepVelocities(d)[j - 1];
+  };
+  const auto displacement = [&](int i, long long t) {
+    const int d = fullToFree[static_cast<std::size_t>(i)];
+    if (d < 0 || t == 0) return d < 0 ? 0.0 : u0[i];
+    const auto [j, s] = stepOf(i, t);
+    const Eigen::VectorXd vs = nested.stepVelocities(d);
+    const double h = hL / static_cast<double>(units / s);
+    const double before = u0[i] + h * vs.head(j - 1).sum();
+    return before + static_cast<double>(t - (j - 1) * s) * (hL / static_cast<double>(units)) * vs[j - 1];
+  };
+  // Impulse credited to each (DOF, step): element forces, then mass and load terms.
+  std::vector<Eigen::VectorXd> impulse(static_cast<std::size_t>(mesh.numDofs()));
+  for (int i = 0; i < mesh.numDofs(); ++i)
+    impulse[static_cast<std::size_t>(i)] =
+        Eigen::VectorXd::Zero(counts.vertexCounts()[static_cast<std::size_t>(i / 3)]);
+  double scale = 0.0;
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const Material& material = mesh.elementMaterial(e);
+    double volume = 0.0;
+    shapeFunctionGradients(mesh.elementRestPositions(e), &volume);
+    const ElementMatrix ke =
+        linearElementStiffness(mesh.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
+    const ElementMatrix de =
+        system.rayleighMass * consistentElementMass(std::abs(volume), material.density) + system.rayleighStiffness * ke;
+    const int count = counts.elementCounts()[static_cast<std::size_t>(e)];
+    for (int q = 1; q <= count; ++q) {
+      const long long tq = q * (units / count);
+      Eigen::Matrix<double, 12, 1> ue, ve;
+      for (int a = 0; a < 12; ++a) {
+        const int i = 3 * mesh.element(e)[a / 3] + a % 3;
+        ue[a] = displacement(i, tq);
+        ve[a] = velocity(i, tq);
+      }
+      const Eigen::Matrix<double, 12, 1> force = -(hL / count) * (ke * ue + de * ve);
+      for (int a = 0; a < 12; ++a) {
+        const int i = 3 * mesh.element(e)[a / 3] + a % 3;
+        if (fullToFree[static_cast<std::size_t>(i)] < 0) continue;
+        impulse[static_cast<std::size_t>(i)][stepOf(i, tq).first - 1] += force[a];
+        scale = std::max(scale, std::abs(force[a]));
+      }
+    }
+  }
+  double worst = 0.0;
+  const Eigen::MatrixXd mass(system.mass);
+  for (int i = 0; i < mesh.numDofs(); ++i) {
+    if (fullToFree[static_cast<std::size_t>(i)] < 0) continue;
+    const int count = counts.vertexCounts()[static_cast<std::size_t>(i / 3)];
+    const long long s = units / count;
+    for (int j = 1; j <= count; ++j) {
+      double momentum = 0.0;
+      for (int p = 0; p < mesh.numDofs(); ++p)
+        if (mass(i, p) != 0.0) momentum += mass(i, p) * (velocity(p, j * s) - velocity(p, (j - 1) * s));
+      Eigen::VectorXd load = Eigen::VectorXd::Zero(mesh.numDofs());
+      const double t = j == count ? t0 + hL : t0 + j * (hL / count);
+      system.externalForce(t, u0, v0, load);
+      const double residual = momentum - impulse[static_cast<std::size_t>(i)][j - 1] - (hL / count) * load[i];
+      worst = std::max(worst, std::abs(residual));
+      scale = std::max(scale, std::abs(momentum));
+    }
+  }
+  return worst / scale;
+}
+
+// The sparse step system (unknowns v and w, Eqs. N4-N5) against Eq. N3 evaluated directly
+// from its solution: three nested levels (8 inside 2, and 16 touching both), damped, loaded.
+// Round-off in the sums: 1e-10 of the largest term.
+TEST(NestedRegions, StepSystemSolvesTheDefinition) {
+  test::TestSystem ts = test::makeTestSystem(0.4, 1e-3);
+  const std::vector<AsyncRegion> regions{{"outer", test::verticesBeyond(ts.mesh, 0.5), 2},
+                                         {"inner", test::verticesBeyond(ts.mesh, 0.875), 8},
+                                         {"slab", test::verticesOnPlanes(ts.mesh, {0.375}), 16}};
+  std::vector<AsyncRegion> split = regions;
+  // "outer" keeps only what "inner" does not take.
+  split[0].vertices.clear();
+  for (int v : regions[0].vertices)
+    if (ts.mesh.restPosition(v).x() < 0.875 - 1e-12) split[0].vertices.push_back(v);
+  NestedAsyncBackwardEuler nested(ts.system, 4e-3, split);
+  EXPECT_TRUE(nested.counts().touching());
+  EXPECT_EQ(nested.counts().levels(), (std::vector<int>{1, 2, 8, 16}));
+  nested.setState(ts.u0, ts.v0);
+  nested.step();
+  EXPECT_LT(definitionResidual(ts, nested, ts.u0, ts.v0, 4e-3, 0.0), 1e-10);
+  const Eigen::VectorXd u1 = nested.displacement(), v1 = nested.velocity();
+  nested.step();
+  EXPECT_LT(definitionResidual(ts, nested, u1, v1, 4e-3, 4e-3), 1e-10);
+}
+
+// Corotational forces are linearized at the start of each large step; at tiny amplitudes
+// (rotations ~|grad u| ~ 1e-5 here) the nested corotational run equals the linear one to
+// second order: 1e-5 relative is a loose bound. At 100x the amplitude the difference must
+// grow (it is relative, so about 100x): it fails if the corotational forces never acted.
+TEST(NestedRegions, CorotationalWithinTheLinearizationBound) {
+  test::TestSystem linear = test::makeTestSystem(0.1, 1e-3);
+  test::TestSystem corotational = test::makeTestSystem(test::testSettings(ForceModelType::corotational, 0.1, 1e-3));
+  linear.system.externalForce = nullptr;
+  corotational.system.externalForce = nullptr;
+  std::vector<AsyncRegion> regions{{"tip", test::verticesBeyond(linear.mesh, 0.875), 16}, {"end", {}, 4}};
+  for (int v : test::verticesBeyond(linear.mesh, 0.625))
+    if (linear.mesh.restPosition(v).x() < 0.875 - 1e-12) regions[1].vertices.push_back(v);
+  const auto difference = [&](double amplitude) {
+    NestedAsyncBackwardEuler a(linear.system, 2e-3, regions), b(corotational.system, 2e-3, regions);
+    a.setState(amplitude * linear.u0, amplitude * linear.v0);
+    b.setState(amplitude * linear.u0, amplitude * linear.v0);
+    for (int k = 0; k < 5; ++k) {
+      a.step();
+      b.step();
+    }
+    return relativeDifference(a.displacement(), b.displacement());
+  };
+  const double tiny = difference(1e-3), larger = difference(1e-1);
+  EXPECT_LT(tiny, 1e-5);
+  EXPECT_GT(larger, 10.0 * tiny) << "the corotational forces did not act at all";
+}
+
+// Ratios that share an element must divide one another (Eq. N6); regions that do not share
+// one may have any ratios.
+TEST(NestedRegions, RatiosThatShareAnElementMustDivide) {
+  test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  const std::vector<int> tip = test::verticesBeyond(ts.mesh, 0.875);
+  std::vector<int> beside;
+  for (int v : test::verticesOnPlanes(ts.mesh, {0.75})) beside.push_back(v);
+  try {
+    NestedAsyncBackwardEuler bad(ts.system, 1e-2, {{"tip", tip, 4}, {"beside", beside, 3}});
+    FAIL() << "ratios 3 and 4 on one element were accepted";
+  } catch (const ValidationError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("element "), std::string::npos) << what;
+    EXPECT_NE(what.find("'tip' (ratio 4)"), std::string::npos) << what;
+    EXPECT_NE(what.find("'beside' (ratio 3)"), std::string::npos) << what;
+  }
+  const std::vector<int> apart = test::verticesOnPlanes(ts.mesh, {0.375});
+  NestedAsyncBackwardEuler fine(ts.system, 1e-2, {{"tip", tip, 4}, {"apart", apart, 3}});
+  EXPECT_EQ(fine.counts().units(), 12);
+  EXPECT_FALSE(fine.counts().touching());
+  EXPECT_THROW(NestedAsyncBackwardEuler(ts.system, 1e-2, {{"tip", tip, 4}, {"again", {tip[0]}, 8}}), ValidationError);
+}
+
+}  // namespace
+}  // namespace asyncfem
