@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/nestedAsyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
@@ -221,6 +222,60 @@ TEST(ContactScene, ErrorsNameTheKey) {
     const std::string message = errorOf(scene);
     EXPECT_NE(message.find(expected), std::string::npos) << contact << "\nmessage: " << message;
   }
+}
+
+// Regions that touch or nest: "async" builds the nested integrator by itself, refuses what it
+// does not have by name, and names the element where the ratios do not divide.
+TEST(AsyncScene, TouchingRegionsRunTheNestedIntegrator) {
+  nlohmann::json scene = barScene();
+  scene["mesh"]["cells"] = {8, 1, 1};  // vertices every 0.5 along x
+  scene["integrator"]["options"]["regions"] = nlohmann::json::parse(R"([
+    {"name": "end", "ratio": 4, "boxes": [{"min": [3.25, -1, -1], "max": [5, 2, 2]}]},
+    {"name": "tip", "ratio": 16, "boxes": [{"min": [3.9, -1, -1], "max": [5, 2, 2]}]}])");
+  // The boxes overlap at x = 4: the tip's vertices are named twice.
+  EXPECT_NE(errorOf(scene).find("vertex"), std::string::npos) << errorOf(scene);
+  scene["integrator"]["options"]["regions"][0]["boxes"][0]["max"] = {3.6, 2, 2};
+  Simulation simulation = build(scene);
+  auto* nested = dynamic_cast<asyncfem::NestedAsyncBackwardEuler*>(simulation.integrator.get());
+  ASSERT_NE(nested, nullptr);
+  EXPECT_TRUE(nested->counts().touching());
+  EXPECT_EQ(nested->counts().levels(), (std::vector<int>{1, 4, 16}));
+  for (int frame = 0; frame < simulation.numFrames; ++frame) asyncfem::advanceFrame(simulation, frame);
+  EXPECT_GT(simulation.integrator->displacement().norm(), 0.0);
+  EXPECT_NE(simulation.integrator->report().lines.front().find("steps per large step 1, 4, 16"), std::string::npos);
+
+  nlohmann::json paper = scene;
+  paper["integrator"]["options"]["coupling"] = "paper";
+  EXPECT_NE(
+      errorOf(paper).find("integrator.options.coupling: the paper's coupling is not available when regions touch"),
+      std::string::npos)
+      << errorOf(paper);
+  nlohmann::json indivisible = scene;
+  indivisible["integrator"]["options"]["regions"][1]["ratio"] = 6;
+  const std::string error = errorOf(indivisible);
+  EXPECT_NE(error.find("integrator.options.regions"), std::string::npos) << error;
+  EXPECT_NE(error.find("must divide one another"), std::string::npos) << error;
+  nlohmann::json uncoupled = scene;
+  uncoupled["integrator"]["name"] = "multirate-uncoupled";
+  EXPECT_NE(errorOf(uncoupled).find("touching or nested regions are available with \"async\" only"), std::string::npos)
+      << errorOf(uncoupled);
+}
+
+// "method": "nested" runs the nested integrator on regions that do not touch: the same
+// trajectory as the structured two-level solve, to round-off (1e-10 relative).
+TEST(AsyncScene, NestedMethodMatchesTheStructuredSolve) {
+  nlohmann::json scene = barScene();
+  Simulation structured = build(scene);
+  scene["integrator"]["options"]["method"] = "nested";
+  Simulation nested = build(scene);
+  ASSERT_NE(dynamic_cast<asyncfem::NestedAsyncBackwardEuler*>(nested.integrator.get()), nullptr);
+  for (int frame = 0; frame < structured.numFrames; ++frame) {
+    asyncfem::advanceFrame(structured, frame);
+    asyncfem::advanceFrame(nested, frame);
+  }
+  const Eigen::VectorXd& a = structured.integrator->displacement();
+  const Eigen::VectorXd& b = nested.integrator->displacement();
+  EXPECT_LT((a - b).lpNorm<Eigen::Infinity>(), 1e-10 * a.lpNorm<Eigen::Infinity>());
 }
 
 }  // namespace

@@ -162,6 +162,9 @@ AsyncBackwardEuler::AsyncBackwardEuler(DynamicSystem system, double largeTimeste
     : PartitionedIntegrator("async", std::move(system), largeTimestep, std::move(regions)),
       options_(options),
       impl_(freshImpl()) {
+  if (options_.method == AsyncSolveMethod::nested) {
+    throw ValidationError("async integrator: the method \"nested\" is NestedAsyncBackwardEuler's; build that instead");
+  }
   const Impl& d = *impl_;
   if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
   if (d.linear)

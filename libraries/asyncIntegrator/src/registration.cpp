@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
+#include <asyncfem/asyncIntegrator/nestedAsyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/asyncIntegrator/schroeder2011.hpp>
 #include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
 #include <asyncfem/settings/jsonReader.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -82,7 +84,8 @@ const ChoiceTable<AsyncCoupling> kCouplings{{"stable", AsyncCoupling::stable}, {
 const ChoiceTable<SchurMode> kSchurModes{
     {"low-rank", SchurMode::lowRank}, {"lu", SchurMode::lu}, {"symmetric", SchurMode::symmetric}};
 const ChoiceTable<AsyncSolveMethod> kSolveMethods{{"structured", AsyncSolveMethod::structured},
-                                                  {"naive", AsyncSolveMethod::naive}};
+                                                  {"naive", AsyncSolveMethod::naive},
+                                                  {"nested", AsyncSolveMethod::nested}};
 const ChoiceTable<RecoveryMode> kRecoveryModes{{"automatic", RecoveryMode::automatic},
                                                {"substitution", RecoveryMode::substitution},
                                                {"dense-z", RecoveryMode::denseZ}};
@@ -281,14 +284,47 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
     }
     out.regions = out.proposal->asyncRegions();
   }
-  // Validate the partition here so its errors name the key.
+  // Validate the partition here so its errors name the key. Regions that touch or nest are
+  // checked by the rules of the nested integrator instead (docs/asynchronous-integrator.md,
+  // "Nested and touching regions").
   try {
     RegionPartition check(mesh, freeDofs, out.regions);
+    if (out.solver.method == AsyncSolveMethod::nested) {
+      if (out.adaptive) reader.fail("method", "\"nested\" is not available with run-time (adaptive) regions");
+      const StepCounts counts(mesh, freeDofs, out.regions);
+      out.nested = true;
+    }
   } catch (const ValidationError& e) {
-    JsonObjectReader::failAt(sourceName, regionsPath, e.what());
+    std::optional<StepCounts> counts;
+    try {
+      counts.emplace(mesh, freeDofs, out.regions);
+    } catch (const ValidationError& nestedError) {
+      JsonObjectReader::failAt(sourceName, regionsPath, nestedError.what());
+    }
+    if (!counts->touching()) JsonObjectReader::failAt(sourceName, regionsPath, e.what());
+    out.nested = true;
   }
   return out;
 }
+
+namespace {
+
+/// The nested integrator for touching or nested regions, refusing by name the options it
+/// does not have (the lagged Schur factor, recovery and Schur modes are solve strategies
+/// of the two-level solve and have no meaning for its one sparse LU).
+std::unique_ptr<Integrator> makeNested(IntegratorContext& context, const AsyncSettings& parsed) {
+  const auto refuse = [&](const char* key, const char* what) {
+    JsonObjectReader::failAt(context.sourceName, context.optionsPath + "." + key,
+                             std::string(what) + " is not available when regions touch or nest (the regions given do)");
+  };
+  if (parsed.solver.coupling != AsyncCoupling::stable) refuse("coupling", "the paper's coupling");
+  if (parsed.solver.quickSetUp) refuse("quickSetUp", "the quick set-up");
+  if (parsed.solver.substepStatePrediction) refuse("substepContact", "contact at the substeps' predicted states");
+  if (parsed.solver.method == AsyncSolveMethod::naive) refuse("method", "the naive solve method");
+  return std::make_unique<NestedAsyncBackwardEuler>(std::move(context.system), context.timestep, parsed.regions);
+}
+
+}  // namespace
 
 nlohmann::json asyncRegionJson(const AsyncRegion& region) {
   return {{"name", region.name}, {"ratio", region.ratio}, {"vertices", region.vertices}};
@@ -334,6 +370,7 @@ void registerMultirateIntegrators(IntegratorRegistry& registry) {
       "async",
       [](IntegratorContext context, const nlohmann::json& options) -> std::unique_ptr<Integrator> {
         const AsyncSettings parsed = parseAsyncSettings(context, options);
+        if (parsed.nested) return makeNested(context, parsed);
         auto integrator = std::make_unique<AsyncBackwardEuler>(*context.mesh, std::move(context.system),
                                                                context.timestep, parsed.regions, parsed.solver);
         if (parsed.adaptive) integrator->setAdaptiveRegions(*parsed.adaptive);
@@ -341,33 +378,34 @@ void registerMultirateIntegrators(IntegratorRegistry& registry) {
         return integrator;
       },
       asyncOptionKeys());
-  registry.add("multirate-uncoupled",
-               [](IntegratorContext context, const nlohmann::json& options) -> std::unique_ptr<Integrator> {
-                 const std::string& path = context.optionsPath;
-                 rejectAsyncOnlyKeys(context, options, "multirate-uncoupled");
-                 UncoupledMultirateOptions solverOptions;
-                 nlohmann::json regionOptions = options;  // what parseAsyncSettings reads
-                 if (const auto it = options.find("compoundSolver"); it != options.end()) {
-                   const std::string name =
-                       JsonObjectReader::toString(*it, path + ".compoundSolver", context.sourceName);
-                   if (name != "umfpack" && name != "eigen-lu") {
-                     JsonObjectReader::failAt(context.sourceName, path + ".compoundSolver",
-                                              "unknown value \"" + name +
-                                                  "\" (expected one of umfpack, eigen-lu: the system is unsymmetric)");
-                   }
-                   solverOptions.compoundSolver = parseSolverKind(name);
-                   regionOptions.erase("compoundSolver");
-                 }
-                 const AsyncSettings parsed = parseAsyncSettings(context, regionOptions);
-                 if (parsed.adaptive) {
-                   JsonObjectReader::failAt(context.sourceName, path + ".regions",
-                                            "run-time (adaptive) regions are available with \"async\" only");
-                 }
-                 solverOptions.regionSolver = parsed.solver.regionSolver;
-                 return std::make_unique<UncoupledMultirate>(*context.mesh, std::move(context.system), context.timestep,
-                                                             parsed.regions, solverOptions);
-               },
-               {"compoundSolver", "regionSolver", "regions", "auto"});
+  registry.add(
+      "multirate-uncoupled",
+      [](IntegratorContext context, const nlohmann::json& options) -> std::unique_ptr<Integrator> {
+        const std::string& path = context.optionsPath;
+        rejectAsyncOnlyKeys(context, options, "multirate-uncoupled");
+        UncoupledMultirateOptions solverOptions;
+        nlohmann::json regionOptions = options;  // what parseAsyncSettings reads
+        if (const auto it = options.find("compoundSolver"); it != options.end()) {
+          const std::string name = JsonObjectReader::toString(*it, path + ".compoundSolver", context.sourceName);
+          if (name != "umfpack" && name != "eigen-lu") {
+            JsonObjectReader::failAt(
+                context.sourceName, path + ".compoundSolver",
+                "unknown value \"" + name + "\" (expected one of umfpack, eigen-lu: the system is unsymmetric)");
+          }
+          solverOptions.compoundSolver = parseSolverKind(name);
+          regionOptions.erase("compoundSolver");
+        }
+        const AsyncSettings parsed = parseAsyncSettings(context, regionOptions);
+        if (parsed.adaptive || parsed.nested) {
+          JsonObjectReader::failAt(context.sourceName, path + ".regions",
+                                   std::string(parsed.adaptive ? "run-time (adaptive)" : "touching or nested") +
+                                       " regions are available with \"async\" only");
+        }
+        solverOptions.regionSolver = parsed.solver.regionSolver;
+        return std::make_unique<UncoupledMultirate>(*context.mesh, std::move(context.system), context.timestep,
+                                                    parsed.regions, solverOptions);
+      },
+      {"compoundSolver", "regionSolver", "regions", "auto"});
   registry.add("schroeder2011",
                [](IntegratorContext context, const nlohmann::json& options) -> std::unique_ptr<Integrator> {
                  const std::string& path = context.optionsPath;
@@ -392,6 +430,10 @@ void registerMultirateIntegrators(IntegratorRegistry& registry) {
                  solverOptions.force = reader.boolean("force", solverOptions.force);
                  reader.finish();
                  const AsyncSettings parsed = parseAsyncSettings(context, regionOptions);
+                 if (parsed.nested) {
+                   JsonObjectReader::failAt(context.sourceName, path + ".regions",
+                                            "touching or nested regions are available with \"async\" only");
+                 }
                  solverOptions.regionSolver = parsed.solver.regionSolver;
                  return std::make_unique<Schroeder2011>(*context.mesh, std::move(context.system), context.timestep,
                                                         parsed.regions, solverOptions);

@@ -102,8 +102,10 @@ void bindAsyncOptions(py::module_& module) {
       .value("lu", SchurMode::lu)
       .value("symmetric", SchurMode::symmetric);
   py::enum_<AsyncSolveMethod>(module, "AsyncSolveMethod",
-                              "structured (block elimination, the default) or naive (one big solve, for reference)")
+                              "structured (block elimination, the default), naive (one big solve, for reference) or "
+                              "nested (the nested integrator's sparse LU, what touching or nested regions run)")
       .value("structured", AsyncSolveMethod::structured)
+      .value("nested", AsyncSolveMethod::nested)
       .value("naive", AsyncSolveMethod::naive);
   py::enum_<RecoveryMode>(module, "RecoveryMode",
                           "How the fast regions' states are recovered after the interface solve")

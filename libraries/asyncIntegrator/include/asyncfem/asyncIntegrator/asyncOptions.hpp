@@ -27,6 +27,11 @@ enum class SchurMode {
 enum class AsyncSolveMethod {
   structured,  ///< forward substitution + Schur complement on L: O(m) per step
   naive,       ///< the whole (sum_i 3 m_i |S_i| + 3|L|) system, LU: the reference
+  /// NestedAsyncBackwardEuler's one sparse LU of the time-local step system (Eq. N5): what
+  /// regions that touch or nest always run (scenes choose it by themselves then); for other
+  /// regions the same trajectory as structured, for comparison. AsyncBackwardEuler itself
+  /// refuses it.
+  nested,
 };
 /// How the S unknowns are recovered once Y is known (structured method only).
 enum class RecoveryMode {

@@ -26,6 +26,9 @@ struct AsyncSettings {
   /// (written back by asyncSettingsJson).
   std::optional<AdaptiveRegionOptions> adaptive;
   nlohmann::json adaptiveSource;
+  /// The regions touch or nest (an element joins two fast regions), which only
+  /// NestedAsyncBackwardEuler runs; their ratios passed StepCounts' checks.
+  bool nested = false;
 };
 
 /// The option keys "async" reads.
