@@ -125,6 +125,12 @@ TEST(ExampleModels, CellGeneratorsReproduceTheShippedMeshes) {
     expectGeneratorReproduces(makeAntennaMesh(wide), readVeg(models / "antenna" / "antenna-wide.veg"));
   }
   {
+    SCOPED_TRACE("antenna-nested");
+    AntennaSpec whip;
+    whip.whipCells = 4;
+    expectGeneratorReproduces(makeAntennaMesh(whip), readVeg(models / "antenna" / "antenna-nested.veg"));
+  }
+  {
     SCOPED_TRACE("snail");
     expectGeneratorReproduces(makeSnailMesh(), readVeg(models / "snail" / "snail.veg"));
   }

@@ -136,6 +136,27 @@ TEST(CellMesh, AntennaOnABlock) {
   EXPECT_EQ(mesh.elementMaterial(mesh.elementSet("block").front()), (Material{"block", 1000.0, 1e6, 0.3}));
 }
 
+// The whip: the rod's top cells in their own lighter material, the nested regions' sets.
+TEST(CellMesh, AntennaWithAWhip) {
+  AntennaSpec spec;
+  spec.whipCells = 4;
+  const TetMesh mesh = makeAntennaMesh(spec);
+  const TetMesh plain = makeAntennaMesh();
+  EXPECT_EQ(mesh.numVertices(), plain.numVertices());
+  EXPECT_EQ(mesh.elementSet("whip").size(), 6u * 4u);
+  EXPECT_EQ(mesh.elementSet("rod").size(), 6u * 4u);
+  EXPECT_EQ(mesh.elementMaterial(mesh.elementSet("whip").front()), (Material{"whip", 10.0, 1e6, 0.3}));
+  // The whip's 5 layers of 4 vertices; its foot layer is shared with the rod.
+  EXPECT_EQ(mesh.vertexSet("whip").size(), 20u);
+  EXPECT_EQ(mesh.vertexSet("rodTip"), plain.vertexSet("rodTip"));
+  EXPECT_EQ(mesh.vertexSet("rodAndRing"), plain.vertexSet("rodAndRing"));
+  const std::vector<int>& below = mesh.vertexSet("rodAndRingBelowWhip");
+  EXPECT_EQ(below.size(), 64u - 20u);
+  for (int v : mesh.vertexSet("whip")) EXPECT_FALSE(std::binary_search(below.begin(), below.end(), v));
+  spec.whipCells = spec.rodCells;
+  EXPECT_THROW(makeAntennaMesh(spec), ValidationError);
+}
+
 TEST(CellMesh, SnailHasTwoSeparateTentaclesOnItsHead) {
   const TetMesh mesh = makeSnailMesh();
   EXPECT_LE(mesh.numVertices(), 1000);  // the dense modal reference stays affordable

@@ -109,6 +109,7 @@ struct Options {
   std::string generate;
   int cells = 0;
   std::vector<int> blockCells;
+  int whipCells = 0;
   bool json = false;
   std::vector<std::string> renames;     ///< OLD=NEW
   double angleThreshold = 10.0;         ///< degrees
@@ -130,6 +131,10 @@ void addOptions(CLI::App& app, Options& options) {
                  "(default 10 4 10)")
       ->expected(3)
       ->check(asyncfem::cli::inRange(1, 1000));
+  app.add_option("--whip-cells", options.whipCells,
+                 "with --generate antenna: the rod's top cells made a lighter \"whip\" (default 0: none), for "
+                 "nested regions")
+      ->check(asyncfem::cli::inRange(0, 1000));
   app.add_flag("--json", options.json, "print a JSON object instead of text");
   app.add_option("--write", options.output, "also write the mesh to OUT.veg or OUT.vtu");
   app.add_option("--rename-set", options.renames,
@@ -166,6 +171,8 @@ void checkOptions(const Options& options) {
   if (options.cells != 0 && options.generate.empty()) throw asyncfem::Error("--cells only applies to --generate");
   if (!options.blockCells.empty() && options.generate != "antenna")
     throw asyncfem::Error("--block-cells only applies to --generate antenna");
+  if (options.whipCells != 0 && options.generate != "antenna")
+    throw asyncfem::Error("--whip-cells only applies to --generate antenna");
   for (const std::string& rename : options.renames) (void)splitRename(rename);
   if (!options.defaultMaterial.empty() && !options.generate.empty())
     throw asyncfem::Error("--default-material only applies to a mesh file");
@@ -191,7 +198,9 @@ TetMesh generateMesh(const Options& options, std::string& source) {
     if (cells > 0) spec.rodCells = cells;
     const std::vector<int>& block = options.blockCells;
     if (!block.empty()) spec.blockCells = Eigen::Vector3i(block[0], block[1], block[2]);
+    spec.whipCells = options.whipCells;
     source = "generated antenna on a block, rod of " + std::to_string(spec.rodCells) + " cells";
+    if (spec.whipCells > 0) source += ", the top " + std::to_string(spec.whipCells) + " a lighter whip";
     return asyncfem::makeAntennaMesh(spec);
   }
   asyncfem::SnailSpec spec;

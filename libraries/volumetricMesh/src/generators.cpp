@@ -5,6 +5,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <string>
@@ -350,14 +351,31 @@ TetMesh makeAntennaMesh(const AntennaSpec& spec) {
   if ((spec.blockCells.array() < 1).any() || spec.rodCells < 1) {
     throw ValidationError("antenna: blockCells and rodCells must be >= 1");
   }
+  if (spec.whipCells < 0 || spec.whipCells >= spec.rodCells) {
+    throw ValidationError("antenna: whipCells must be in [0, rodCells)");
+  }
   CellMeshSpec cells;
   cells.cellSize = spec.cellSize;
   const Eigen::Vector3i foot(spec.blockCells.x() / 2, spec.blockCells.y(), spec.blockCells.z() / 2);
+  const Eigen::Vector3i whipFoot = foot + Eigen::Vector3i(0, spec.rodCells - spec.whipCells, 0);
   cells.blocks = {{"block", Eigen::Vector3i::Zero(), spec.blockCells, spec.block},
-                  {"rod", foot, foot + Eigen::Vector3i(1, spec.rodCells, 1), spec.rod}};
+                  {"rod", foot, whipFoot + Eigen::Vector3i(1, 0, 1), spec.rod}};
   cells.vertexRings = {{"rodAndRing", {"rod"}, 1}};
+  if (spec.whipCells > 0) {
+    cells.blocks.push_back({"whip", whipFoot, foot + Eigen::Vector3i(1, spec.rodCells, 1), spec.whip});
+    cells.vertexRings.front().around.push_back("whip");
+  }
   TetMesh mesh = makeCellMesh(cells);
-  mesh.setVertexSet("rodTip", topVertices(mesh, mesh.vertexSet("rod")));
+  if (spec.whipCells == 0) {
+    mesh.setVertexSet("rodTip", topVertices(mesh, mesh.vertexSet("rod")));
+    return mesh;
+  }
+  std::vector<int> whip = mesh.vertexSet("whip"), region = mesh.vertexSet("rodAndRing"), below;
+  mesh.setVertexSet("rodTip", topVertices(mesh, whip));
+  std::sort(whip.begin(), whip.end());
+  std::sort(region.begin(), region.end());
+  std::set_difference(region.begin(), region.end(), whip.begin(), whip.end(), std::back_inserter(below));
+  mesh.setVertexSet("rodAndRingBelowWhip", std::move(below));
   return mesh;
 }
 

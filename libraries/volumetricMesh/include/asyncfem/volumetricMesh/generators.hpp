@@ -91,12 +91,19 @@ TetMesh makeCellMesh(const CellMeshSpec& spec);
 /// Element and vertex sets "block" and "rod"; vertex sets "bottom" (to fix), "rodTip" (the
 /// rod's top four vertices) and "rodAndRing" (the rod plus one ring of block vertices
 /// around its foot: the fast region).
+///
+/// With whipCells > 0 the rod's top whipCells cells are a lighter "whip" (element and
+/// vertex set "whip", material `whip`; "rod" keeps the cells below it) for nested regions:
+/// "rodAndRing" then holds rod, whip and ring, and "rodAndRingBelowWhip" the same without
+/// the whip's vertices (the outer region when the whip is the inner one).
 struct AntennaSpec {
   double cellSize = 0.05;
   Eigen::Vector3i blockCells{10, 4, 10};
   int rodCells = 8;
   Material block{"block", 1000.0, 1e6, 0.3};
   Material rod{"rod", 100.0, 1e6, 0.3};
+  int whipCells = 0;  ///< 0 <= whipCells < rodCells
+  Material whip{"whip", 10.0, 1e6, 0.3};
 };
 TetMesh makeAntennaMesh(const AntennaSpec& spec = {});
 
