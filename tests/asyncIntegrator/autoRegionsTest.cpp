@@ -8,6 +8,8 @@
 #include <asyncfem/problem/problem.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/readers.hpp>
+#include <cmath>
 #include <random>
 #include <sstream>
 
@@ -28,6 +30,88 @@ TEST(AutoRegions, ElementFrequenciesBoundTheSystem) {
   EXPECT_GE(bound, systemOmega * (1 - 1e-10));
   // ... and not absurdly loose (a factor 4 would make the proposals useless).
   EXPECT_LT(bound, 4 * systemOmega);
+}
+
+// The element frequency as it was computed before the closed form: the largest eigenvalue
+// of the 12x12 K_e against the lumped mass rho V / 4, by a dense symmetric eigen-solve.
+double referenceElementFrequency(const ElementPositions& x, const Material& material) {
+  double volume = 0.0;
+  shapeFunctionGradients(x, &volume);
+  const ElementMatrix K = linearElementStiffness(x, material.youngsModulus, material.poissonRatio);
+  Eigen::SelfAdjointEigenSolver<ElementMatrix> eigen(K / (material.density * std::abs(volume) / 4.0),
+                                                     Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, eigen.eigenvalues().maxCoeff()));
+}
+
+// The closed form (two 3x3 eigenvalue problems) against the 12x12 eigen-solve on random
+// tets with random materials (Poisson ratios down to -0.9, where the shear eigenvalue is the
+// largest) and on badly shaped ones: needles, slivers (four nearly coplanar vertices), caps
+// and wedges, down to a height of 1e-4 of the edge length. Tolerance: relative 1e-9. Both
+// are exact up to rounding; the 12x12 solver is accurate to about 1e-15 of the largest
+// eigenvalue, the closed form loses up to about eps * sqrt(g_max / g_min) (the square roots of
+// G's eigenvalues), 1e-12 at the flattest tets here, so 1e-9 leaves room and still catches
+// any error in the formula (a wrong term moves omega by percents).
+TEST(AutoRegions, ClosedFormElementFrequencyEqualsTheElementEigenproblem) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_real_distribution<double> poisson(-0.9, 0.49);
+  std::uniform_real_distribution<double> logScale(-3.0, 3.0);
+  const auto randomMaterial = [&] {
+    return Material{"m", std::pow(10.0, 3.0 + logScale(rng)), std::pow(10.0, 6.0 + logScale(rng)), poisson(rng)};
+  };
+  const auto check = [&](const ElementPositions& x, const Material& material, const char* kind) {
+    const double reference = referenceElementFrequency(x, material);
+    EXPECT_NEAR(elementMaxFrequency(x, material), reference, 1e-9 * reference) << kind << " tet\n"
+                                                                               << x << "\nnu " << material.poissonRatio;
+  };
+  for (int k = 0; k < 200; ++k) {
+    ElementPositions x;
+    for (int a = 0; a < 4; ++a) x.col(a) = Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+    check(x, randomMaterial(), "random");
+  }
+  ElementPositions regular;
+  regular << 1, -1, -1, 1, 1, -1, 1, -1, 1, 1, -1, -1;
+  for (double height : {1e-1, 1e-2, 1e-3, 1e-4}) {
+    ElementPositions needle = regular, sliver, cap, wedge;
+    needle.col(3) = Eigen::Vector3d(0.3, 0.2, 1.0 / height);  // one vertex far away
+    sliver << 0, 1, 1, 0, 0, 0, 1, 1, 0, height, 0, height;   // a square, diagonals apart by height
+    cap << 0, 1, 0, 0.3, 0, 0, 1, 0.3, 0, 0, 0, height;       // a vertex just above a face
+    wedge << 0, 1, 0.5, 0.5, 0, 0, height, -height, 0, 0, 1, 1;
+    for (const Material& material : {randomMaterial(), Material{"nu0", 1000.0, 1e6, 0.0}}) {
+      check(needle, material, "needle");
+      check(sliver, material, "sliver");
+      check(cap, material, "cap");
+      check(wedge, material, "wedge");
+    }
+  }
+}
+
+// On every shipped mesh the closed form gives the 12x12 eigen-solve's frequencies (relative
+// 1e-9, as above) and the same decision: the same elements above the default relative
+// target (3x the median), so suggestRegions proposes what it proposed before.
+TEST(AutoRegions, ClosedFormDecidesAsTheElementEigenproblemOnShippedMeshes) {
+  for (const char* name : {"antenna/antenna", "antenna/antenna-wide", "ball/ball", "beam/beam", "dinosaur/dinosaur",
+                           "dragon/dragon", "drop/drop", "flower/flower", "snail/snail"}) {
+    const TetMesh mesh = readMesh(std::string(ASYNCFEM_MODELS_DIR) + "/" + name + ".veg");
+    const Eigen::VectorXd omega = elementMaxFrequencies(mesh);
+    Eigen::VectorXd reference(mesh.numElements());
+    for (int e = 0; e < mesh.numElements(); ++e) {
+      reference[e] = referenceElementFrequency(mesh.elementRestPositions(e), mesh.elementMaterial(e));
+      ASSERT_NEAR(omega[e], reference[e], 1e-9 * reference[e]) << name << " element " << e;
+    }
+    const auto median = [](const Eigen::VectorXd& values) {
+      std::vector<double> sorted(values.data(), values.data() + values.size());
+      std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+      return sorted[sorted.size() / 2];
+    };
+    const double target = 3.0 * median(omega), referenceTarget = 3.0 * median(reference);
+    int fast = 0;
+    for (int e = 0; e < mesh.numElements(); ++e) {
+      EXPECT_EQ(omega[e] > target, reference[e] > referenceTarget) << name << " element " << e;
+      fast += omega[e] > target ? 1 : 0;
+    }
+    RecordProperty(std::string("fast elements in ") + name, fast);
+  }
 }
 
 TEST(AutoRegions, StiffTipBecomesOneFastRegionMeetingTheTarget) {

@@ -255,6 +255,8 @@ void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const A
   }
   // The cost check ran first; when the modal check then withdrew the regions, say so on the
   // same line, so that "kept" is never read as the final answer.
+  std::printf("decided in %.3g ms (element frequencies %.3g ms)%s\n", 1e3 * proposal.decisionSeconds,
+              1e3 * proposal.frequencySeconds, proposal.modalReport ? "; the modal check below took its own time" : "");
   if (proposal.cost.evaluated) {
     std::printf("cost check: %s%s\n", proposal.cost.decision.c_str(),
                 proposal.withdrawnRegions.empty() ? "" : " (then withdrawn by the modal check below)");

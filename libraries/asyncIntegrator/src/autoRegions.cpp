@@ -4,6 +4,7 @@
 #include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
@@ -16,19 +17,36 @@
 
 namespace asyncfem {
 
+double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, const Material& material) {
+  // With u^T K_e u = V eps:C:eps, eps = sym(sum_a u_a g_a^T), C eps = 2 mu eps + lambda tr(eps) I
+  // and the lumped mass rho V / 4 on every DOF, omega_e^2 is 4 / rho times the largest
+  // eigenvalue of C^{1/2} P C^{1/2} on symmetric 3x3 tensors, P eps = sym(eps G) with
+  // G = sum_a g_a g_a^T (the non-zero eigenvalues of B^T C B and C^{1/2} B B^T C^{1/2}
+  // agree). In the eigenbasis of G (eigenvalues g_i) P scales eps_ij by (g_i + g_j) / 2
+  // and C keeps shear and normal components apart: the normal ones give the eigenvalues of
+  // N = 2 mu diag(g) + lambda sqrt(g) sqrt(g)^T, the shear ones mu (g_i + g_j). Those never
+  // exceed the largest eigenvalue of N's 2x2 block on i, j, which is larger by
+  // lambda (g_i + g_j) / 2 + sqrt(((2 mu + lambda) (g_i - g_j) / 2)^2 + lambda^2 g_i g_j) >= 0
+  // (for lambda < 0 this needs 2 mu + lambda >= -lambda, i.e. mu + lambda > 0, true for every
+  // Poisson ratio in (-1, 0.5)), so omega_e^2 = 4 / rho * lambda_max(N).
+  double volume = 0.0;
+  const Eigen::Matrix<double, 3, 4> gradients = shapeFunctionGradients(restPositions, &volume);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  eigen.computeDirect(gradients * gradients.transpose(), Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d g = eigen.eigenvalues().cwiseMax(0.0);  // G is positive semi-definite
+  const Eigen::Vector2d lame = lameParameters(material.youngsModulus, material.poissonRatio);
+  const Eigen::Vector3d root = g.cwiseSqrt();
+  Eigen::Matrix3d normal = lame[0] * root * root.transpose();
+  normal.diagonal() += 2.0 * lame[1] * g;
+  eigen.computeDirect(normal, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, 4.0 * eigen.eigenvalues().maxCoeff() / material.density));
+}
+
 Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh) {
   Eigen::VectorXd omega(mesh.numElements());
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < mesh.numElements(); ++e) {
-    const Material& material = mesh.elementMaterial(e);
-    const ElementPositions x = mesh.elementRestPositions(e);
-    double volume = 0.0;
-    shapeFunctionGradients(x, &volume);
-    const ElementMatrix K = linearElementStiffness(x, material.youngsModulus, material.poissonRatio);
-    // Lumped mass is rho V / 4 on every DOF, so the generalized problem is K / (rho V / 4).
-    const double lumped = material.density * std::abs(volume) / 4.0;
-    Eigen::SelfAdjointEigenSolver<ElementMatrix> eigen(K / lumped, Eigen::EigenvaluesOnly);
-    omega[e] = std::sqrt(std::max(0.0, eigen.eigenvalues().maxCoeff()));
+    omega[e] = elementMaxFrequency(mesh.elementRestPositions(e), mesh.elementMaterial(e));
   }
   return omega;
 }
@@ -193,8 +211,12 @@ void capRegions(int maxRegions, AutoRegionProposal& proposal) {
 
 AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options) {
   validate(options);
+  Stopwatch total;
+  total.start();
   const Eigen::VectorXd omega = elementMaxFrequencies(mesh);
   AutoRegionProposal proposal;
+  proposal.frequencySeconds = total.stop();
+  total.start();
   proposal.largeTimestep = options.largeTimestep;
   proposal.targetOmegaH = targetOmegaH(omega, options);
   const VertexElementAdjacency adjacency = vertexElementAdjacency(mesh);
@@ -217,6 +239,8 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
       proposal.regions.clear();
     }
   }
+  total.stop();
+  proposal.decisionSeconds = total.totalSeconds();
   return proposal;
 }
 
@@ -416,7 +440,8 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   return proposal;
 }
 
-std::string autoRegionSummary(const AutoRegionProposal& proposal) {
+namespace {
+std::string autoRegionDecision(const AutoRegionProposal& proposal) {
   const std::string prefix = "\"auto\": ";
   if (!proposal.regions.empty()) {
     std::string line = prefix + std::to_string(proposal.regions.size()) + " region(s) kept:";
@@ -443,6 +468,13 @@ std::string autoRegionSummary(const AutoRegionProposal& proposal) {
                 "no fast region needed, single-rate at hL: every element meets the target omega*hL = %.3g",
                 proposal.targetOmegaH);
   return prefix + line;
+}
+}  // namespace
+
+std::string autoRegionSummary(const AutoRegionProposal& proposal) {
+  char decided[80];
+  std::snprintf(decided, sizeof decided, " (decided in %.3g ms)", 1e3 * proposal.decisionSeconds);
+  return autoRegionDecision(proposal) + decided;
 }
 
 }  // namespace asyncfem
