@@ -207,6 +207,18 @@ void capRegions(int maxRegions, AutoRegionProposal& proposal) {
     proposal.regions[i].region.name = "auto" + std::to_string(i + 1);
 }
 
+/// The cost check (options.costCheck): withdraws the regions unless async is estimated
+/// cheaper than single-rate at the step their ratios stand for.
+void costCheck(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+               AutoRegionProposal& proposal) {
+  if (!options.costCheck || proposal.regions.empty()) return;
+  proposal.cost = estimateAsyncCost(mesh, freeDofs, proposal.asyncRegions(), options.nonlinear, options.costMargin);
+  if (!proposal.cost.asyncCheaper) {
+    proposal.costWithdrawnRegions = std::move(proposal.regions);
+    proposal.regions.clear();
+  }
+}
+
 }  // namespace
 
 AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options) {
@@ -218,6 +230,7 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   proposal.frequencySeconds = total.stop();
   total.start();
   proposal.largeTimestep = options.largeTimestep;
+  proposal.modeOmegaSubstep = options.modeOmegaSubstep;
   proposal.targetOmegaH = targetOmegaH(omega, options);
   const VertexElementAdjacency adjacency = vertexElementAdjacency(mesh);
   std::vector<char> fast = fastVertices(mesh, omega, proposal.largeTimestep, proposal.targetOmegaH, options.growLayers);
@@ -232,13 +245,7 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
     proposal.regions[static_cast<std::size_t>(i)].numInterfaceDofs =
         static_cast<int>(partition.interfaceDofs(i).size());
   }
-  if (options.costCheck && !proposal.regions.empty()) {
-    proposal.cost = estimateAsyncCost(mesh, freeDofs, proposal.asyncRegions(), options.nonlinear, options.costMargin);
-    if (!proposal.cost.asyncCheaper) {
-      proposal.costWithdrawnRegions = std::move(proposal.regions);
-      proposal.regions.clear();
-    }
-  }
+  costCheck(mesh, freeDofs, options, proposal);
   total.stop();
   proposal.decisionSeconds = total.totalSeconds();
   return proposal;
@@ -370,74 +377,112 @@ std::vector<ModalRegion> modalRegions(const std::vector<AsyncRegion>& regions) {
 }
 
 namespace {
-/// Raises each region's ratio so that every visible mode living in S (mainly in that
-/// region) and damped at hL is resolved at hS (omega hS <= maxResolvedOmegaSubstep),
-/// capped at options.maxRatio. Returns whether a ratio changed (noted in ratioRaised).
-bool raiseRatiosForModes(const AutoRegionOptions& options, AutoRegionProposal& proposal) {
+/// Sets each region's ratio from the modes it keeps: every visible mode living in S
+/// (mainly in that region) and damped at hL gets omega hS <= options.modeOmegaSubstep,
+/// capped at options.maxRatio, when that needs more than the element criterion's ratio
+/// (kept in ratioFromElements; modeForRatio names the fastest such mode). Returns whether
+/// a ratio changed.
+bool ratiosFromModes(const AutoRegionOptions& options, AutoRegionProposal& proposal) {
   bool raised = false;
-  for (const ModeInRegions& mode : proposal.modalReport->modes) {
+  const std::vector<ModeInRegions>& modes = proposal.modalReport->modes;
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    const ModeInRegions& mode = modes[k];
     if (!mode.livesInFastRegions || mode.omegaLargeStep < modalCriteria::minDampedOmegaLargeStep) continue;
     const auto main = static_cast<std::size_t>(std::max_element(mode.regionShare.begin(), mode.regionShare.end()) -
                                                mode.regionShare.begin());
     ProposedRegion& region = proposal.regions[main];
-    const int needed = std::min(
-        options.maxRatio, static_cast<int>(std::ceil(mode.omegaLargeStep / modalCriteria::maxResolvedOmegaSubstep)));
+    const double wanted = std::ceil(mode.omegaLargeStep / options.modeOmegaSubstep - 1e-12);
+    const int needed = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(options.maxRatio)));
     if (needed > region.region.ratio) {
       if (region.ratioFromElements == 0) region.ratioFromElements = region.region.ratio;
       region.region.ratio = needed;
+      region.modeForRatio = static_cast<int>(k);
       raised = true;
     }
   }
   return raised;
 }
-}  // namespace
 
-AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
-                                  const Eigen::SparseMatrix<double>& stiffness,
-                                  const Eigen::SparseMatrix<double>& mass) {
-  AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options);
-  if (!options.modalCheck) return proposal;
+/// The lowest modes of (stiffness, mass) on the free DOFs: options.modalCount, doubled
+/// while the highest is still below the Nyquist frequency (visible modes beyond the
+/// computed ones could live in S), up to maxModalCount.
+ModalResult modesUpToNyquist(const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                             const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
+                             double& seconds) {
+  const double nyquist = modalCriteria::nyquistPerFrameRate * options.frameRate;
+  const int largestCount = std::min(options.maxModalCount, freeDofs.numFree() - 1);
+  ModalOptions modal;
+  modal.count = std::min(options.modalCount, largestCount);
+  ModalResult modes = lowestModes(stiffness, mass, freeDofs, modal);
+  seconds = modes.solveSeconds;
+  while (modes.frequencies[modes.frequencies.size() - 1] < nyquist && modal.count < largestCount) {
+    modal.count = std::min(2 * modal.count, largestCount);
+    modes = lowestModes(stiffness, mass, freeDofs, modal);
+    seconds += modes.solveSeconds;
+  }
+  return modes;
+}
+
+/// The modal check of the element criterion's regions (options.modalCheck): ratios from
+/// the modes they keep (then priced again by the cost check), withdrawn when no visible
+/// mode lives in them.
+void checkModes(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
+                AutoRegionProposal& proposal) {
   if (!(options.frameRate > 0.0) || !std::isfinite(options.frameRate)) {
     throw ValidationError("automatic regions: the frame rate of the modal check must be positive");
   }
   if (options.modalCount < 1 || options.maxModalCount < options.modalCount) {
     throw ValidationError("automatic regions: need 1 <= modalCount <= maxModalCount for the modal check");
   }
-  if (proposal.regions.empty()) return proposal;
-  // Visible modes beyond the computed ones could live in S: compute more while the highest
-  // one is still below the Nyquist frequency.
-  const double nyquist = modalCriteria::nyquistPerFrameRate * options.frameRate;
-  const int largestCount = std::min(options.maxModalCount, freeDofs.numFree() - 1);
-  ModalOptions modal;
-  modal.count = std::min(options.modalCount, largestCount);
-  ModalResult modes = lowestModes(stiffness, mass, freeDofs, modal);
-  proposal.modalSeconds = modes.solveSeconds;
-  while (modes.frequencies[modes.frequencies.size() - 1] < nyquist && modal.count < largestCount) {
-    modal.count = std::min(2 * modal.count, largestCount);
-    modes = lowestModes(stiffness, mass, freeDofs, modal);
-    proposal.modalSeconds += modes.solveSeconds;
+  if (!(options.modeOmegaSubstep > 0.0) || !std::isfinite(options.modeOmegaSubstep)) {
+    throw ValidationError("automatic regions: modeOmegaSubstep must be positive");
   }
-  proposal.modalReport =
-      analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep, options.frameRate);
-  if (proposal.modalReport->verdict == ModalVerdict::unresolvedAtSubstep && raiseRatiosForModes(options, proposal)) {
-    // The element criterion's ratios leave the modes that live in S damped at hS: take
-    // the ratios those modes need, then report and cost the raised proposal.
-    proposal.modalReport = analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep,
-                                              options.frameRate);
-    if (options.costCheck) {
-      proposal.cost = estimateAsyncCost(mesh, freeDofs, proposal.asyncRegions(), options.nonlinear, options.costMargin);
-      if (!proposal.cost.asyncCheaper) {
-        proposal.costWithdrawnRegions = std::move(proposal.regions);
-        proposal.regions.clear();
-        return proposal;
-      }
-    }
+  if (proposal.regions.empty()) return;
+  const ModalResult modes = modesUpToNyquist(freeDofs, options, stiffness, mass, proposal.modalSeconds);
+  const auto report = [&] {
+    return analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep,
+                              options.frameRate);
+  };
+  proposal.modalReport = report();
+  if (ratiosFromModes(options, proposal)) {
+    proposal.modalReport = report();
+    costCheck(mesh, freeDofs, options, proposal);
   }
   if (proposal.modalReport->verdict == ModalVerdict::noVisibleModeInFast) {
     proposal.withdrawnRegions = std::move(proposal.regions);
     proposal.regions.clear();
   }
+}
+}  // namespace
+
+AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                                  const Eigen::SparseMatrix<double>& stiffness,
+                                  const Eigen::SparseMatrix<double>& mass) {
+  Stopwatch total;
+  total.start();
+  AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options);
+  if (options.modalCheck) checkModes(mesh, freeDofs, options, stiffness, mass, proposal);
+  total.stop();
+  proposal.decisionSeconds = total.totalSeconds();
   return proposal;
+}
+
+std::string ratioReason(const AutoRegionProposal& proposal, const ProposedRegion& region) {
+  char text[300];
+  const int m = region.region.ratio;
+  if (region.modeForRatio >= 0 && proposal.modalReport) {
+    const ModeInRegions& mode = proposal.modalReport->modes[static_cast<std::size_t>(region.modeForRatio)];
+    std::snprintf(text, sizeof text,
+                  "m = %d for mode %d (%.3g Hz, omega*hL %.3g), the fastest visible mode living in it and damped at "
+                  "hL: omega*hS %.3g <= %g (the element criterion alone gives m = %d)",
+                  m, region.modeForRatio + 1, mode.hertz, mode.omegaLargeStep, mode.omegaLargeStep / m,
+                  proposal.modeOmegaSubstep, region.ratioFromElements);
+  } else {
+    std::snprintf(text, sizeof text, "m = %d from the element criterion: max omega_e*hL %.3g against the target %.3g",
+                  m, region.maxFrequency * proposal.largeTimestep, proposal.targetOmegaH);
+  }
+  return text;
 }
 
 namespace {
@@ -446,11 +491,8 @@ std::string autoRegionDecision(const AutoRegionProposal& proposal) {
   if (!proposal.regions.empty()) {
     std::string line = prefix + std::to_string(proposal.regions.size()) + " region(s) kept:";
     for (const ProposedRegion& r : proposal.regions) {
-      line += " " + r.region.name + " (" + std::to_string(r.region.vertices.size()) +
-              " vertices, m = " + std::to_string(r.region.ratio);
-      if (r.ratioFromElements > 0)
-        line += ", raised from " + std::to_string(r.ratioFromElements) + " by the modal check";
-      line += ")";
+      line += " " + r.region.name + " (" + std::to_string(r.region.vertices.size()) + " vertices, " +
+              ratioReason(proposal, r) + ")";
     }
     return line;
   }
