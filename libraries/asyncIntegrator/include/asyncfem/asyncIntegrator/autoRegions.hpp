@@ -172,7 +172,7 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
 std::string ratioReason(const AutoRegionProposal& proposal, const ProposedRegion& region);
 
 /// One line for a run summary saying what the automatic proposal decided and why: the
-/// regions kept (vertices, m, and a ratio the modal check raised), or that none was kept
+/// regions kept (vertices, and why each has its ratio: ratioReason()), or that none was kept
 /// and which check withdrew them (the modal verdict, the cost decision), or that every
 /// element meets the target; then the time the decision took (decisionSeconds).
 std::string autoRegionSummary(const AutoRegionProposal& proposal);
