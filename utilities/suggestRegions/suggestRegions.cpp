@@ -253,6 +253,8 @@ void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const A
                   list == &proposal.withdrawnRegions ? "  (withdrawn by the modal check)" : "");
     }
   }
+  std::printf("decided in %.3g ms (element frequencies %.3g ms%s)\n", 1e3 * proposal.decisionSeconds,
+              1e3 * proposal.frequencySeconds, proposal.modalReport ? ", modal check included" : "");
   // The cost check ran first; when the modal check then withdrew the regions, say so on the
   // same line, so that "kept" is never read as the final answer.
   if (proposal.cost.evaluated) {
@@ -263,11 +265,7 @@ void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const A
     std::printf("modal check (%zu lowest modes, %.3g s): %s\n", proposal.modalReport->modes.size(),
                 proposal.modalSeconds, proposal.modalReport->verdictText().c_str());
     for (const ProposedRegion& r : proposal.regions) {
-      if (r.ratioFromElements > 0) {
-        std::printf(
-            "ratio of %s raised from %d (element criterion) to %d: the modes living in it need omega*hS <= %g\n",
-            r.region.name.c_str(), r.ratioFromElements, r.region.ratio, modalCriteria::maxResolvedOmegaSubstep);
-      }
+      std::printf("ratio of %s: %s\n", r.region.name.c_str(), ratioReason(proposal, r).c_str());
     }
     if (!proposal.withdrawnRegions.empty()) {
       std::printf(

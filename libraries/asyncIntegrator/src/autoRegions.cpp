@@ -4,6 +4,7 @@
 #include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
@@ -16,19 +17,36 @@
 
 namespace asyncfem {
 
+double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, const Material& material) {
+  // With u^T K_e u = V eps:C:eps, eps = sym(sum_a u_a g_a^T), C eps = 2 mu eps + lambda tr(eps) I
+  // and the lumped mass rho V / 4 on every DOF, omega_e^2 is 4 / rho times the largest
+  // eigenvalue of C^{1/2} P C^{1/2} on symmetric 3x3 tensors, P eps = sym(eps G) with
+  // G = sum_a g_a g_a^T (the non-zero eigenvalues of B^T C B and C^{1/2} B B^T C^{1/2}
+  // agree). In the eigenbasis of G (eigenvalues g_i) P scales eps_ij by (g_i + g_j) / 2
+  // and C keeps shear and normal components apart: the normal ones give the eigenvalues of
+  // N = 2 mu diag(g) + lambda sqrt(g) sqrt(g)^T, the shear ones mu (g_i + g_j). Those never
+  // exceed the largest eigenvalue of N's 2x2 block on i, j, which is larger by
+  // lambda (g_i + g_j) / 2 + sqrt(((2 mu + lambda) (g_i - g_j) / 2)^2 + lambda^2 g_i g_j) >= 0
+  // (for lambda < 0 this needs 2 mu + lambda >= -lambda, i.e. mu + lambda > 0, true for every
+  // Poisson ratio in (-1, 0.5)), so omega_e^2 = 4 / rho * lambda_max(N).
+  double volume = 0.0;
+  const Eigen::Matrix<double, 3, 4> gradients = shapeFunctionGradients(restPositions, &volume);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  eigen.computeDirect(gradients * gradients.transpose(), Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d g = eigen.eigenvalues().cwiseMax(0.0);  // G is positive semi-definite
+  const Eigen::Vector2d lame = lameParameters(material.youngsModulus, material.poissonRatio);
+  const Eigen::Vector3d root = g.cwiseSqrt();
+  Eigen::Matrix3d normal = lame[0] * root * root.transpose();
+  normal.diagonal() += 2.0 * lame[1] * g;
+  eigen.computeDirect(normal, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, 4.0 * eigen.eigenvalues().maxCoeff() / material.density));
+}
+
 Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh) {
   Eigen::VectorXd omega(mesh.numElements());
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < mesh.numElements(); ++e) {
-    const Material& material = mesh.elementMaterial(e);
-    const ElementPositions x = mesh.elementRestPositions(e);
-    double volume = 0.0;
-    shapeFunctionGradients(x, &volume);
-    const ElementMatrix K = linearElementStiffness(x, material.youngsModulus, material.poissonRatio);
-    // Lumped mass is rho V / 4 on every DOF, so the generalized problem is K / (rho V / 4).
-    const double lumped = material.density * std::abs(volume) / 4.0;
-    Eigen::SelfAdjointEigenSolver<ElementMatrix> eigen(K / lumped, Eigen::EigenvaluesOnly);
-    omega[e] = std::sqrt(std::max(0.0, eigen.eigenvalues().maxCoeff()));
+    omega[e] = elementMaxFrequency(mesh.elementRestPositions(e), mesh.elementMaterial(e));
   }
   return omega;
 }
@@ -189,13 +207,30 @@ void capRegions(int maxRegions, AutoRegionProposal& proposal) {
     proposal.regions[i].region.name = "auto" + std::to_string(i + 1);
 }
 
+/// The cost check (options.costCheck): withdraws the regions unless async is estimated
+/// cheaper than single-rate at the step their ratios stand for.
+void costCheck(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+               AutoRegionProposal& proposal) {
+  if (!options.costCheck || proposal.regions.empty()) return;
+  proposal.cost = estimateAsyncCost(mesh, freeDofs, proposal.asyncRegions(), options.nonlinear, options.costMargin);
+  if (!proposal.cost.asyncCheaper) {
+    proposal.costWithdrawnRegions = std::move(proposal.regions);
+    proposal.regions.clear();
+  }
+}
+
 }  // namespace
 
 AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options) {
   validate(options);
+  Stopwatch total;
+  total.start();
   const Eigen::VectorXd omega = elementMaxFrequencies(mesh);
   AutoRegionProposal proposal;
+  proposal.frequencySeconds = total.stop();
+  total.start();
   proposal.largeTimestep = options.largeTimestep;
+  proposal.modeOmegaSubstep = options.modeOmegaSubstep;
   proposal.targetOmegaH = targetOmegaH(omega, options);
   const VertexElementAdjacency adjacency = vertexElementAdjacency(mesh);
   std::vector<char> fast = fastVertices(mesh, omega, proposal.largeTimestep, proposal.targetOmegaH, options.growLayers);
@@ -210,13 +245,9 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
     proposal.regions[static_cast<std::size_t>(i)].numInterfaceDofs =
         static_cast<int>(partition.interfaceDofs(i).size());
   }
-  if (options.costCheck && !proposal.regions.empty()) {
-    proposal.cost = estimateAsyncCost(mesh, freeDofs, proposal.asyncRegions(), options.nonlinear, options.costMargin);
-    if (!proposal.cost.asyncCheaper) {
-      proposal.costWithdrawnRegions = std::move(proposal.regions);
-      proposal.regions.clear();
-    }
-  }
+  costCheck(mesh, freeDofs, options, proposal);
+  total.stop();
+  proposal.decisionSeconds = total.totalSeconds();
   return proposal;
 }
 
@@ -346,86 +377,122 @@ std::vector<ModalRegion> modalRegions(const std::vector<AsyncRegion>& regions) {
 }
 
 namespace {
-/// Raises each region's ratio so that every visible mode living in S (mainly in that
-/// region) and damped at hL is resolved at hS (omega hS <= maxResolvedOmegaSubstep),
-/// capped at options.maxRatio. Returns whether a ratio changed (noted in ratioRaised).
-bool raiseRatiosForModes(const AutoRegionOptions& options, AutoRegionProposal& proposal) {
+/// Sets each region's ratio from the modes it keeps: every visible mode living in S
+/// (mainly in that region) and damped at hL gets omega hS <= options.modeOmegaSubstep,
+/// capped at options.maxRatio, when that needs more than the element criterion's ratio
+/// (kept in ratioFromElements; modeForRatio names the fastest such mode). Returns whether
+/// a ratio changed.
+bool ratiosFromModes(const AutoRegionOptions& options, AutoRegionProposal& proposal) {
   bool raised = false;
-  for (const ModeInRegions& mode : proposal.modalReport->modes) {
+  const std::vector<ModeInRegions>& modes = proposal.modalReport->modes;
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    const ModeInRegions& mode = modes[k];
     if (!mode.livesInFastRegions || mode.omegaLargeStep < modalCriteria::minDampedOmegaLargeStep) continue;
     const auto main = static_cast<std::size_t>(std::max_element(mode.regionShare.begin(), mode.regionShare.end()) -
                                                mode.regionShare.begin());
     ProposedRegion& region = proposal.regions[main];
-    const int needed = std::min(
-        options.maxRatio, static_cast<int>(std::ceil(mode.omegaLargeStep / modalCriteria::maxResolvedOmegaSubstep)));
+    const double wanted = std::ceil(mode.omegaLargeStep / options.modeOmegaSubstep - 1e-12);
+    const int needed = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(options.maxRatio)));
     if (needed > region.region.ratio) {
       if (region.ratioFromElements == 0) region.ratioFromElements = region.region.ratio;
       region.region.ratio = needed;
+      region.modeForRatio = static_cast<int>(k);
       raised = true;
     }
   }
   return raised;
 }
-}  // namespace
 
-AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
-                                  const Eigen::SparseMatrix<double>& stiffness,
-                                  const Eigen::SparseMatrix<double>& mass) {
-  AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options);
-  if (!options.modalCheck) return proposal;
+/// The lowest modes of (stiffness, mass) on the free DOFs: options.modalCount, doubled
+/// while the highest is still below the Nyquist frequency (visible modes beyond the
+/// computed ones could live in S), up to maxModalCount.
+ModalResult modesUpToNyquist(const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                             const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
+                             double& seconds) {
+  const double nyquist = modalCriteria::nyquistPerFrameRate * options.frameRate;
+  const int largestCount = std::min(options.maxModalCount, freeDofs.numFree() - 1);
+  ModalOptions modal;
+  modal.count = std::min(options.modalCount, largestCount);
+  ModalResult modes = lowestModes(stiffness, mass, freeDofs, modal);
+  seconds = modes.solveSeconds;
+  while (modes.frequencies[modes.frequencies.size() - 1] < nyquist && modal.count < largestCount) {
+    modal.count = std::min(2 * modal.count, largestCount);
+    modes = lowestModes(stiffness, mass, freeDofs, modal);
+    seconds += modes.solveSeconds;
+  }
+  return modes;
+}
+
+/// The modal check of the element criterion's regions (options.modalCheck): ratios from
+/// the modes they keep (then priced again by the cost check), withdrawn when no visible
+/// mode lives in them.
+void checkModes(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
+                AutoRegionProposal& proposal) {
   if (!(options.frameRate > 0.0) || !std::isfinite(options.frameRate)) {
     throw ValidationError("automatic regions: the frame rate of the modal check must be positive");
   }
   if (options.modalCount < 1 || options.maxModalCount < options.modalCount) {
     throw ValidationError("automatic regions: need 1 <= modalCount <= maxModalCount for the modal check");
   }
-  if (proposal.regions.empty()) return proposal;
-  // Visible modes beyond the computed ones could live in S: compute more while the highest
-  // one is still below the Nyquist frequency.
-  const double nyquist = modalCriteria::nyquistPerFrameRate * options.frameRate;
-  const int largestCount = std::min(options.maxModalCount, freeDofs.numFree() - 1);
-  ModalOptions modal;
-  modal.count = std::min(options.modalCount, largestCount);
-  ModalResult modes = lowestModes(stiffness, mass, freeDofs, modal);
-  proposal.modalSeconds = modes.solveSeconds;
-  while (modes.frequencies[modes.frequencies.size() - 1] < nyquist && modal.count < largestCount) {
-    modal.count = std::min(2 * modal.count, largestCount);
-    modes = lowestModes(stiffness, mass, freeDofs, modal);
-    proposal.modalSeconds += modes.solveSeconds;
+  if (!(options.modeOmegaSubstep > 0.0) || !std::isfinite(options.modeOmegaSubstep)) {
+    throw ValidationError("automatic regions: modeOmegaSubstep must be positive");
   }
-  proposal.modalReport =
-      analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep, options.frameRate);
-  if (proposal.modalReport->verdict == ModalVerdict::unresolvedAtSubstep && raiseRatiosForModes(options, proposal)) {
-    // The element criterion's ratios leave the modes that live in S damped at hS: take
-    // the ratios those modes need, then report and cost the raised proposal.
-    proposal.modalReport = analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep,
-                                              options.frameRate);
-    if (options.costCheck) {
-      proposal.cost = estimateAsyncCost(mesh, freeDofs, proposal.asyncRegions(), options.nonlinear, options.costMargin);
-      if (!proposal.cost.asyncCheaper) {
-        proposal.costWithdrawnRegions = std::move(proposal.regions);
-        proposal.regions.clear();
-        return proposal;
-      }
-    }
+  if (proposal.regions.empty()) return;
+  const ModalResult modes = modesUpToNyquist(freeDofs, options, stiffness, mass, proposal.modalSeconds);
+  const auto report = [&] {
+    return analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep,
+                              options.frameRate);
+  };
+  proposal.modalReport = report();
+  if (ratiosFromModes(options, proposal)) {
+    proposal.modalReport = report();
+    costCheck(mesh, freeDofs, options, proposal);
   }
   if (proposal.modalReport->verdict == ModalVerdict::noVisibleModeInFast) {
     proposal.withdrawnRegions = std::move(proposal.regions);
     proposal.regions.clear();
   }
+}
+}  // namespace
+
+AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                                  const Eigen::SparseMatrix<double>& stiffness,
+                                  const Eigen::SparseMatrix<double>& mass) {
+  Stopwatch total;
+  total.start();
+  AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options);
+  if (options.modalCheck) checkModes(mesh, freeDofs, options, stiffness, mass, proposal);
+  total.stop();
+  proposal.decisionSeconds = total.totalSeconds();
   return proposal;
 }
 
-std::string autoRegionSummary(const AutoRegionProposal& proposal) {
+std::string ratioReason(const AutoRegionProposal& proposal, const ProposedRegion& region) {
+  char text[300];
+  const int m = region.region.ratio;
+  if (region.modeForRatio >= 0 && proposal.modalReport) {
+    const ModeInRegions& mode = proposal.modalReport->modes[static_cast<std::size_t>(region.modeForRatio)];
+    std::snprintf(text, sizeof text,
+                  "m = %d for mode %d (%.3g Hz, omega*hL %.3g), the fastest visible mode living in it and damped at "
+                  "hL: omega*hS %.3g <= %g (the element criterion alone gives m = %d)",
+                  m, region.modeForRatio + 1, mode.hertz, mode.omegaLargeStep, mode.omegaLargeStep / m,
+                  proposal.modeOmegaSubstep, region.ratioFromElements);
+  } else {
+    std::snprintf(text, sizeof text, "m = %d from the element criterion: max omega_e*hL %.3g against the target %.3g",
+                  m, region.maxFrequency * proposal.largeTimestep, proposal.targetOmegaH);
+  }
+  return text;
+}
+
+namespace {
+std::string autoRegionDecision(const AutoRegionProposal& proposal) {
   const std::string prefix = "\"auto\": ";
   if (!proposal.regions.empty()) {
     std::string line = prefix + std::to_string(proposal.regions.size()) + " region(s) kept:";
     for (const ProposedRegion& r : proposal.regions) {
-      line += " " + r.region.name + " (" + std::to_string(r.region.vertices.size()) +
-              " vertices, m = " + std::to_string(r.region.ratio);
-      if (r.ratioFromElements > 0)
-        line += ", raised from " + std::to_string(r.ratioFromElements) + " by the modal check";
-      line += ")";
+      line += " " + r.region.name + " (" + std::to_string(r.region.vertices.size()) + " vertices, " +
+              ratioReason(proposal, r) + ")";
     }
     return line;
   }
@@ -443,6 +510,13 @@ std::string autoRegionSummary(const AutoRegionProposal& proposal) {
                 "no fast region needed, single-rate at hL: every element meets the target omega*hL = %.3g",
                 proposal.targetOmegaH);
   return prefix + line;
+}
+}  // namespace
+
+std::string autoRegionSummary(const AutoRegionProposal& proposal) {
+  char decided[80];
+  std::snprintf(decided, sizeof decided, " (decided in %.3g ms)", 1e3 * proposal.decisionSeconds);
+  return autoRegionDecision(proposal) + decided;
 }
 
 }  // namespace asyncfem

@@ -12,10 +12,17 @@
 
 namespace asyncfem {
 
-/// Highest natural frequency (rad/s) of every element on its own: omega_e^2 is the largest
-/// eigenvalue of K_e v = lambda M_e v with the element's lumped mass. By the element
-/// eigenvalue inequality, max_e omega_e bounds the assembled system's highest frequency
-/// from above, so it is a safe measure of how small a timestep an element wants.
+/// Highest natural frequency (rad/s) of one linear tetrahedron on its own: omega_e^2 is the
+/// largest eigenvalue of K_e v = lambda M_e v with the element's lumped mass (rho V / 4 on
+/// every DOF). Computed in closed form, exactly (to rounding): from the eigenvalues g_i of
+/// G = sum_a grad N_a grad N_a^T, omega_e^2 = 4 / rho times the largest eigenvalue of
+/// 2 mu diag(g) + lambda sqrt(g) sqrt(g)^T (Lame constants lambda, mu): two 3x3 eigenvalue
+/// problems instead of the 12x12 one (docs/asynchronous-integrator.md, "Automatic regions").
+double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, const Material& material);
+
+/// elementMaxFrequency() of every element. By the element eigenvalue inequality,
+/// max_e omega_e bounds the assembled system's highest frequency from above, so it is a
+/// safe measure of how small a timestep an element wants.
 Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh);
 
 struct AutoRegionOptions {
@@ -44,6 +51,11 @@ struct AutoRegionOptions {
   /// Modes computed first; doubled while the highest is still visible, up to maxModalCount.
   int modalCount = 20;
   int maxModalCount = 80;
+  /// The omega hS the modal check gives the modes a region keeps (visible, living mainly
+  /// in it, damped at hL): its ratio becomes at least ceil(omega hL / modeOmegaSubstep).
+  /// 0.05 is the design note's resolution (backward Euler keeps 85% of the amplitude per
+  /// period); the check's own floor, modalCriteria::maxResolvedOmegaSubstep = 0.1, keeps 73%.
+  double modeOmegaSubstep = 0.05;
   /// At most this many regions: beyond it the regions needing the smallest ratio (then the
   /// smallest) move to AutoRegionProposal::cappedRegions and run at hL.
   int maxRegions = 4;
@@ -89,13 +101,17 @@ struct ProposedRegion {
   /// The element criterion's ratio when the modal check raised it (the modes living in the
   /// region needed more substeps); 0 when it was kept.
   int ratioFromElements = 0;
+  /// When the modal check set the ratio: the mode that needed it (0-based index into
+  /// AutoRegionProposal::modalReport->modes, the fastest one the region keeps); else -1.
+  int modeForRatio = -1;
 };
 
 struct AutoRegionProposal {
   std::vector<ProposedRegion> regions;
   double largeRegionMaxFrequency = 0.0;  ///< max omega_e over elements touching no fast vertex
   double largeTimestep = 0.0;
-  double targetOmegaH = 0.0;  ///< the target in effect (absolute, or from the relative mode)
+  double targetOmegaH = 0.0;      ///< the target in effect (absolute, or from the relative mode)
+  double modeOmegaSubstep = 0.0;  ///< options.modeOmegaSubstep (ratios from kept modes)
   /// Set when the modal check ran (there were regions to check): the report for the regions
   /// the frequency criterion proposed.
   std::optional<RegionModeReport> modalReport;
@@ -103,6 +119,11 @@ struct AutoRegionProposal {
   /// empty: the asynchronous integrator runs single-rate at hL).
   std::vector<ProposedRegion> withdrawnRegions;
   double modalSeconds = 0.0;  ///< time of the eigensolves of the modal check
+  /// Wall time of suggestRegions(): the element frequencies, and the whole call (marking,
+  /// partition, cost check, and the modal check when it ran; the K and M it is given are
+  /// assembled by the caller and not counted).
+  double frequencySeconds = 0.0;
+  double decisionSeconds = 0.0;
   /// The cost check (options.costCheck) of the regions after the cap, and the regions it
   /// withdrew (regions is then empty: single-rate at hL).
   AutoRegionCost cost;
@@ -130,25 +151,30 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
 AutoRegionCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs, const std::vector<AsyncRegion>& regions,
                                  bool nonlinear = false, double costMargin = 1.0);
 
-/// The same proposal, followed by the modal check when options.modalCheck is set:
-/// lowestModes() of stiffness and mass (full 3n x 3n, e.g. vibrationMatrices()) and
-/// analyseRegionModes() of the proposed regions at hL = options.largeTimestep; when its
-/// verdict is ModalVerdict::noVisibleModeInFast the regions move to withdrawnRegions. When
-/// it is unresolvedAtSubstep (modes live in S and are damped at hL, but the element
-/// criterion's ratio leaves them damped at hS too) each region's ratio is raised to what its
-/// modes need (omega hS <= modalCriteria::maxResolvedOmegaSubstep, at most maxRatio;
-/// ProposedRegion::ratioFromElements keeps the old one), and the report and the cost check
-/// are redone for the raised proposal.
-/// The mode counts are clamped to the free DOFs - 1. Throws ValidationError for frameRate <= 0
-/// or counts out of order, and what lowestModes() throws.
+/// The same proposal, followed by the modal check when options.modalCheck is set and
+/// regions survived the cost check: lowestModes() of stiffness and mass (full 3n x 3n,
+/// e.g. vibrationMatrices()) and analyseRegionModes() of the proposed regions at
+/// hL = options.largeTimestep. The ratio of each region is then taken from the modes it
+/// keeps (visible, living mainly in it, damped at hL: omega hS <= options.modeOmegaSubstep,
+/// at most maxRatio) where that is more than the element criterion's
+/// (ProposedRegion::ratioFromElements keeps the old one, modeForRatio names the mode), and
+/// the report and the cost check are redone for the new ratios. When the verdict is
+/// ModalVerdict::noVisibleModeInFast the regions move to withdrawnRegions.
+/// The mode counts are clamped to the free DOFs - 1. Throws ValidationError for frameRate <= 0,
+/// modeOmegaSubstep <= 0 or counts out of order, and what lowestModes() throws.
 AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
                                   const Eigen::SparseMatrix<double>& stiffness,
                                   const Eigen::SparseMatrix<double>& mass);
 
+/// Why the region has its ratio, one phrase: the mode it keeps that needed it (frequency,
+/// omega hL, omega hS against options.modeOmegaSubstep, and the element criterion's ratio),
+/// or the element criterion (max omega_e hL against the target).
+std::string ratioReason(const AutoRegionProposal& proposal, const ProposedRegion& region);
+
 /// One line for a run summary saying what the automatic proposal decided and why: the
-/// regions kept (vertices, m, and a ratio the modal check raised), or that none was kept
+/// regions kept (vertices, and why each has its ratio: ratioReason()), or that none was kept
 /// and which check withdrew them (the modal verdict, the cost decision), or that every
-/// element meets the target.
+/// element meets the target; then the time the decision took (decisionSeconds).
 std::string autoRegionSummary(const AutoRegionProposal& proposal);
 
 /// The regions as the modal report takes them (name, vertices, ratio).
