@@ -48,6 +48,7 @@
 #include <vector>
 
 #if ASYNCFEM_OFFLINE_WITH_PETSC
+#include <asyncfem/integrator/registry.hpp>
 #include <asyncfem/petscBackend/petscRuntime.hpp>
 #include <asyncfem/petscBackend/petscSimulation.hpp>
 #include <asyncfem/petscBackend/problemSettings.hpp>
@@ -369,14 +370,19 @@ void refusePetscOutputs(const CommandLine& options, const asyncfem::Scene& scene
   }
 }
 
-// The backend's settings for the scene's problem (asyncfem::petscSettingsForProblem), with
-// the solver chosen on the command line.
+// The backend's settings for the scene's problem (asyncfem::petscSettingsForProblem) and
+// its integrator's options (Newton iterations), with the solver chosen on the command line.
 asyncfem::PetscSimulationSettings petscSettings(const CommandLine& options, const asyncfem::Scene& scene,
                                                 const asyncfem::Problem& problem) {
   asyncfem::PetscSimulationSettings settings;
   try {
+    const std::string& name = scene.integrator.name;
+    const asyncfem::IntegratorOptions integratorOptions =
+        name == "backward-euler" || name == "trapezoidal"
+            ? asyncfem::parseIntegratorOptions(scene.integrator.options, "integrator.options", scene.sourceName)
+            : asyncfem::IntegratorOptions{};
     settings =
-        asyncfem::petscSettingsForProblem(problem, scene.integrator.name, asyncfem::frameTimingOf(scene).timestep);
+        asyncfem::petscSettingsForProblem(problem, name, asyncfem::frameTimingOf(scene).timestep, integratorOptions);
   } catch (const asyncfem::ValidationError& error) {
     throw asyncfem::Error(petscPrefix + scene.sourceName + ": " + error.what());
   }
@@ -399,6 +405,9 @@ void printPetscSummary(const asyncfem::Scene& scene, const asyncfem::PetscRunSta
   out << "  per frame   " << milliseconds(loopSeconds, timing.frameCount) << "   (assembly " << stats.assemblySeconds
       << " s, solves " << stats.solveSeconds << " s, " << stats.solverIterations << " iterations in " << stats.solves
       << " solves)\n";
+  if (stats.newtonIterations > stats.steps) {
+    out << "  newton      " << stats.newtonIterations << " iterations in " << stats.steps << " steps\n";
+  }
   out << "  output      " << scene.output.file.string() << " (" << timing.frameCount
       << " frames; no checkpoint on this backend)\n";
   std::cout << out.str() << std::flush;
@@ -488,7 +497,7 @@ void addRunOptions(CLI::App& app, CommandLine& options) {
                "with the paper's coupling");
   app.add_option("--backend", options.backend,
                  "Where the scene runs: local (default) or petsc (PETSc over MPI: run under mpiexec -n N; "
-                 "backward-euler or trapezoidal, linear or corotational; docs/petsc-backend.md)")
+                 "backward-euler or trapezoidal, every force model; docs/petsc-backend.md)")
       ->check(CLI::IsMember({"local", "petsc"}))
       ->capture_default_str();
   app.add_option("--petsc-solver", options.petscSolver, "With --backend petsc: cg-gamg, cg-hypre or mumps")
