@@ -24,7 +24,8 @@ compare() {  # label forceModel integratorOptions tolerance
 }
 JSON
   "$bin/offlineSimulator" scene.json -q -o local.afsim
-  "$mpiexec" -n 2 "$bin/offlineSimulator" scene.json --backend petsc --petsc-solver mumps -o petsc.afsim > petsc.txt
+  "$mpiexec" -n 2 "$bin/offlineSimulator" scene.json --backend petsc --petsc-solver mumps -o petsc.afsim \
+    > petsc.txt 2> progress.txt
   grep -q "ranks       2" petsc.txt || { echo "no 2-rank summary:"; cat petsc.txt; exit 1; }
   vertices=$(seq -s, 0 80)  # every vertex of the 9 x 3 x 3 lattice
   "$bin/afsimTool" csv local.afsim --vertices "$vertices" -o local.csv
@@ -45,6 +46,26 @@ compare corotational '{"type": "corotational"}' '{}' 1e-9
 compare neo-hookean-newton '{"type": "neo-hookean", "inversionThreshold": 0.2}' \
   '{"maxIterations": 5, "tolerance": 1e-10, "reuseFactor": false}' 1e-6
 grep -q "newton      " petsc.txt || { echo "no Newton line in the summary:"; cat petsc.txt; exit 1; }
+# Progress lines come from rank 0 only: the last frame's line once.
+[ "$(grep -c 'offlineSimulator: frame 8/8 (100%)' progress.txt)" = 1 ] || { cat progress.txt; exit 1; }
+# SIGINT sent to one rank (the last child of mpiexec) stops both ranks after the same frame,
+# without a hang (ctest's timeout would catch one): exit status 130, the frames kept intact.
+sed -i 's/"count": 8/"count": 100000/' scene.json
+"$mpiexec" -n 2 "$bin/offlineSimulator" scene.json --backend petsc --petsc-solver mumps -o long.afsim \
+  > /dev/null 2> interrupted.txt &
+launcher=$!
+for _ in $(seq 600); do  # until a frame is written (at most 60 s)
+  [ -s long.afsim ] && "$bin/afsimTool" info long.afsim 2> /dev/null | grep -q "frames      [1-9]" && break
+  sleep 0.1
+done
+rank=$(pgrep -P "$launcher" | tail -n 1)
+kill -INT "$rank"
+status=0
+wait "$launcher" || status=$?
+[ "$status" = 130 ] || { echo "exit status $status after SIGINT"; cat interrupted.txt; exit 1; }
+grep -q "interrupted by SIGINT: [0-9]* of 100000 frames are complete in long.afsim" interrupted.txt ||
+  { cat interrupted.txt; exit 1; }
+"$bin/afsimTool" info long.afsim | grep -q "checksums   ok" || { "$bin/afsimTool" info long.afsim; exit 1; }
 # What it cannot run is refused by name.
 if "$bin/offlineSimulator" scene.json --backend petsc --integrator async -o x.afsim 2> err.txt; then exit 1; fi
 grep -q 'integrator "async" is not available on the PETSc backend' err.txt || { cat err.txt; exit 1; }

@@ -10,7 +10,8 @@
 // every frame) the full state goes to FILE.afsim.checkpoint, so that --resume continues
 // an interrupted run and produces exactly the file an uninterrupted run would have.
 // SIGINT and SIGTERM stop the run after the current frame, with a checkpoint, and exit
-// with status 128 + the signal number. A scene that runs the asynchronous integrator with
+// with status 128 + the signal number (--backend petsc: every rank stops before the same
+// frame; that backend writes no checkpoint). A scene that runs the asynchronous integrator with
 // the paper's coupling gets its step growth estimated before the run (a few dozen steps
 // of the linearized scene) and a warning when a large step can grow. Errors print "offlineSimulator: <message>" on
 // stderr and exit with status 1. What it prints is described in docs/scene-format.md,
@@ -413,6 +414,35 @@ void printPetscSummary(const asyncfem::Scene& scene, const asyncfem::PetscRunSta
   std::cout << out.str() << std::flush;
 }
 
+// The frame loop of a PETSc run: every rank steps, rank 0 writes each frame to writer
+// (null elsewhere) and draws the progress. A stop signal that reached any rank stops every
+// rank before the same frame (one MPI_Allreduce per frame), so no rank waits for the others
+// in a collective call. Returns the frames completed.
+int runPetscFrames(const CommandLine& options, const asyncfem::Scene& scene, const asyncfem::PetscRuntime& runtime,
+                   asyncfem::PetscSimulation& simulation, asyncfem::SimulationWriter* writer) {
+  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
+  const bool root = simulation.rank() == 0;
+  asyncfem::cli::ProgressReporter progress(
+      "offlineSimulator",
+      root ? asyncfem::cli::chooseProgressStyle(options.quiet, options.progress) : asyncfem::cli::ProgressStyle::none,
+      timing.frameCount);
+  int frame = 0;
+  try {
+    for (; frame < timing.frameCount && runtime.maxOverRanks(static_cast<int>(stopSignal)) == 0; ++frame) {
+      for (int s = 0; s < timing.stepsPerFrame; ++s) simulation.step();  // non-finite states throw on every rank
+      const Eigen::VectorXd u = simulation.gatherDisplacement();
+      if (root) writer->appendFrame(simulation.time(), u);
+      progress.update(frame + 1);
+    }
+  } catch (const asyncfem::Error& error) {
+    progress.finish();
+    throw asyncfem::Error(std::string(error.what()) + "; the " + std::to_string(frame) +
+                          " frames before it are kept in " + scene.output.file.string());
+  }
+  progress.finish();
+  return frame;
+}
+
 // --backend petsc: the scene's problem on the PETSc backend (every rank builds the problem,
 // rank 0 writes the frames). Supports what that backend integrates: linear and
 // corotational backward Euler and trapezoidal, loads that depend on time only.
@@ -442,18 +472,22 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
                                                           asyncfem::SimulationWriter::Options{scene.output.sync});
   }
   const double setupSeconds = setupWatch.stop();
+  installStopHandlers();  // after PETSc's start, whose own handlers it replaces for these signals
   asyncfem::Stopwatch loopWatch;
   loopWatch.start();
-  for (int frame = 0; frame < timing.frameCount; ++frame) {
-    for (int s = 0; s < timing.stepsPerFrame; ++s) simulation.step();  // non-finite states throw on every rank
-    const Eigen::VectorXd u = simulation.gatherDisplacement();
-    if (root) writer->appendFrame(simulation.time(), u);
-  }
+  const int frames = runPetscFrames(options, scene, runtime, simulation, writer.get());
   const double loopSeconds = loopWatch.stop();
-  if (root) {
-    writer->close();
-    if (!options.quiet) printPetscSummary(scene, simulation.stats(), setupSeconds, loopSeconds);
+  if (root) writer->close();
+  const int signal = runtime.maxOverRanks(static_cast<int>(stopSignal));
+  if (signal != 0 && frames < timing.frameCount) {
+    if (root) {
+      std::cerr << "offlineSimulator: interrupted by " << signalName(signal) << ": " << frames << " of "
+                << timing.frameCount << " frames are complete in " << scene.output.file.string()
+                << " (the PETSc backend writes no checkpoint: run again to finish)\n";
+    }
+    return 128 + signal;
   }
+  if (root && !options.quiet) printPetscSummary(scene, simulation.stats(), setupSeconds, loopSeconds);
   return 0;
 }
 #endif
