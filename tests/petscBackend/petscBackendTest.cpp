@@ -656,6 +656,48 @@ TEST(PetscBackendFailure, NonFiniteHyperelasticElementNamesTheMeshElement) {
   }
 }
 
+// A run restored from u, v, t and the internal state (a checkpoint: the trapezoidal
+// acceleration) continues as the uninterrupted run: the same solves from the same state,
+// different only in the last bit of the step times t_0 + k h (the direct tolerance).
+// Without the acceleration it would restart from the equation of motion's a_0, which
+// differs for the corotated tangent (asserted, so the restore is exercised).
+TEST(PetscBackend, InternalStateContinuesTheRun) {
+  const TetMesh mesh = beamMesh();
+  const PetscSimulationSettings settings =
+      beamSettings(mesh, PetscIntegratorKind::trapezoidal, PetscForceModelKind::corotational, PetscSolverKind::mumps);
+  PetscSimulation whole(mesh, settings);
+  for (int k = 0; k < 3; ++k) whole.step();
+  Eigen::VectorXd u = whole.gatherDisplacement();
+  Eigen::VectorXd v = whole.gatherVelocity();
+  Eigen::VectorXd a = whole.gatherInternalState();
+  const double t = whole.time();
+  for (int k = 0; k < 3; ++k) whole.step();
+  const Eigen::VectorXd expected = whole.gatherDisplacement();
+  // Every rank restores the same full vectors (rank 0's, broadcast here).
+  for (Eigen::VectorXd* vector : {&u, &v, &a}) {
+    vector->resize(mesh.numDofs());
+    MPI_Bcast(vector->data(), mesh.numDofs(), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  }
+  const auto continued = [&](bool withAcceleration) {
+    PetscSimulation resumed(mesh, settings);
+    resumed.setState(u, v, t);
+    resumed.setInternalState(withAcceleration ? a : Eigen::VectorXd());
+    for (int k = 0; k < 3; ++k) resumed.step();
+    return resumed.gatherDisplacement();
+  };
+  const Eigen::VectorXd restored = continued(true);
+  const Eigen::VectorXd restarted = continued(false);
+  PetscSimulation backwardEuler(mesh, beamSettings(mesh, PetscIntegratorKind::backwardEuler,
+                                                   PetscForceModelKind::linear, PetscSolverKind::mumps));
+  EXPECT_THROW(backwardEuler.setInternalState(a), ValidationError);
+  EXPECT_EQ(backwardEuler.gatherInternalState().size(), 0);
+  if (worldRank() != 0) return;
+  const double scale = expected.lpNorm<Eigen::Infinity>();
+  const double tolerance = comparisonTolerance(mesh, PetscSolverKind::mumps);
+  EXPECT_LE((restored - expected).lpNorm<Eigen::Infinity>(), tolerance * scale);
+  EXPECT_GT((restarted - expected).lpNorm<Eigen::Infinity>(), 10.0 * tolerance * scale);
+}
+
 // Partition agreement across separate runs: with ASYNCFEM_PETSC_TRAJECTORY_DIR set, each
 // run (np = 1, 2, 3) stores its corotational trajectory; the ctest PetscBackend.PartitionsAgree
 // then compares them (PetscPartitions.Agree, with ASYNCFEM_PETSC_COMPARE_DIR).

@@ -492,9 +492,35 @@ void PetscSimulation::setState(const Eigen::VectorXd& displacement, const Eigen:
   });
   s.body.scatterOwned(displacement, s.body.displacement.get());
   s.body.scatterOwned(velocity, s.body.velocity.get());
-  s.timeOrigin = time;
-  s.stepIndex = 0;
+  // A time on the step grid (a checkpoint's) keeps t = k h exactly, so that a resumed run
+  // steps through the very times of the uninterrupted one (as Integrator::setState does).
+  const double gridSteps = std::round(time / s.settings.timestep);
+  const bool onGrid = std::abs(gridSteps) < 1e15 && gridSteps * s.settings.timestep == time;
+  s.timeOrigin = onGrid ? 0.0 : time;
+  s.stepIndex = onGrid ? static_cast<long long>(gridSteps) : 0;
   s.accelerationStale = true;
+}
+
+Eigen::VectorXd PetscSimulation::gatherInternalState() const {
+  const Impl& s = *impl_;
+  if (!s.trapezoidal || s.accelerationStale) return {};
+  return s.body.gather(s.body.acceleration.get());
+}
+
+void PetscSimulation::setInternalState(const Eigen::VectorXd& state) {
+  Impl& s = *impl_;
+  collectively(s.body.comm, [&] {
+    if (state.size() != 0 && (!s.trapezoidal || state.size() != s.body.numDofs)) {
+      throw ValidationError("PETSc backend: the internal state has " + std::to_string(state.size()) +
+                            " values; expected " +
+                            (s.trapezoidal ? std::to_string(s.body.numDofs) + " or none" : "none") + " for " +
+                            toString(s.settings.integrator));
+    }
+    if (!state.allFinite()) throw ValidationError("PETSc backend: the internal state is not finite");
+  });
+  if (state.size() == 0) return;
+  s.body.scatterOwned(state, s.body.acceleration.get());
+  s.accelerationStale = false;
 }
 
 Eigen::VectorXd PetscSimulation::gatherDisplacement() const {

@@ -132,6 +132,16 @@ class PetscSimulation {
   /// Sets u and v (full 3n vectors, the same on every rank; fixed entries are ignored)
   /// and the time. Throws ValidationError on a size mismatch or non-finite values.
   void setState(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, double time = 0.0);
+  /// What the next step needs beyond u, v and t, as the single-process integrators'
+  /// internalState(): the trapezoidal rule's acceleration a_k (3n, on rank 0; empty
+  /// elsewhere, and empty on every rank before the first step or after setState(), when
+  /// a_k is still to be computed); empty for backward Euler. Collective.
+  Eigen::VectorXd gatherInternalState() const;
+  /// Restores it after setState() (checkpoints): the same full vector on every rank, or
+  /// empty (a_k is then computed from the equation of motion, as after setState()).
+  /// ValidationError on a size mismatch, non-finite values or a non-empty state for
+  /// backward Euler. Collective.
+  void setInternalState(const Eigen::VectorXd& state);
   /// The full displacement / velocity (3n, fixed DOFs 0) on rank 0; empty elsewhere.
   Eigen::VectorXd gatherDisplacement() const;
   Eigen::VectorXd gatherVelocity() const;
