@@ -12,6 +12,7 @@
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
+#include <asyncfem/integrator/integratorOptions.hpp>
 #include <asyncfem/integrator/trapezoidal.hpp>
 #include <asyncfem/petscBackend/partition.hpp>
 #include <asyncfem/petscBackend/petscRuntime.hpp>
@@ -24,6 +25,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <regex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -155,8 +157,13 @@ double trajectoryDifference(const std::vector<Eigen::VectorXd>& a, const std::ve
 /// mixing of 2- and max-norms and the corotated tangent's condition number differing
 /// from the one at rest: 10 kappa 1e-10 ~ 5e-6. Direct solves are exact up to rounding,
 /// kappa * 1e-15 per solve with the same factor: ~5e-11.
-double comparisonTolerance(const TetMesh& mesh, PetscSolverKind solver) {
+double systemConditionNumberCached(const TetMesh& mesh) {
   static const double kappa = systemConditionNumber(mesh);
+  return kappa;
+}
+
+double comparisonTolerance(const TetMesh& mesh, PetscSolverKind solver) {
+  const double kappa = systemConditionNumberCached(mesh);
   const double perStep = solver == PetscSolverKind::mumps ? 1e-15 : kSolverTolerance;
   return 10.0 * kappa * perStep;
 }
@@ -245,9 +252,10 @@ TEST(PetscProblemSettings, FollowTheProblem) {
 
 TEST(PetscProblemSettings, NameWhatTheBackendCannotRun) {
   auto mesh = std::make_shared<const TetMesh>(beamMesh());
-  const auto messageOf = [&](const ProblemSettings& physics, const std::string& integrator) {
+  const auto messageOf = [&](const ProblemSettings& physics, const std::string& integrator,
+                             const IntegratorOptions& options = {}) {
     try {
-      (void)petscSettingsForProblem(Problem(mesh, {0}, physics), integrator, kTimestep);
+      (void)petscSettingsForProblem(Problem(mesh, {0}, physics), integrator, kTimestep, options);
     } catch (const ValidationError& error) {
       return std::string(error.what());
     }
@@ -257,12 +265,36 @@ TEST(PetscProblemSettings, NameWhatTheBackendCannotRun) {
             "integrator \"async\" is not available on the PETSc backend (it runs backward-euler and trapezoidal)");
   ProblemSettings neoHookean;
   neoHookean.forceModel = ForceModelType::neoHookean;
-  EXPECT_EQ(messageOf(neoHookean, "backward-euler"),
-            "forceModel: only linear and corotational (simple tangent) are available on the PETSc backend");
+  IntegratorOptions newton;
+  newton.maxIterations = 4;
+  EXPECT_EQ(messageOf(neoHookean, "backward-euler", newton), "(no error)");
+  EXPECT_EQ(messageOf(neoHookean, "trapezoidal", newton),
+            "integrator.options.maxIterations: Newton iterations run with backward-euler only on the PETSc backend "
+            "(the trapezoidal rule takes the linearized step, maxIterations 1)");
+  IntegratorOptions dampingAtIterate;
+  dampingAtIterate.rayleighStiffnessAtIterate = true;
+  EXPECT_EQ(messageOf(neoHookean, "backward-euler", dampingAtIterate),
+            "integrator.options.rayleighStiffnessAtIterate: not supported on the PETSc backend (Rayleigh damping "
+            "keeps K(u_k) of the step start)");
+  // Every force model maps to the backend's, with its tangent and options.
   ProblemSettings exactTangent;
   exactTangent.forceModel = ForceModelType::corotational;
   exactTangent.tangent = TangentKind::exact;
-  EXPECT_EQ(messageOf(exactTangent, "backward-euler"), messageOf(neoHookean, "backward-euler"));
+  const PetscSimulationSettings exact =
+      petscSettingsForProblem(Problem(mesh, {0}, exactTangent), "backward-euler", kTimestep, newton);
+  EXPECT_EQ(exact.forceModel, PetscForceModelKind::corotational);
+  EXPECT_EQ(exact.tangent, TangentKind::exact);
+  EXPECT_EQ(exact.newton.maxIterations, 4);
+  neoHookean.hyperelastic.inversionThreshold = 0.3;
+  const PetscSimulationSettings hyperelastic =
+      petscSettingsForProblem(Problem(mesh, {0}, neoHookean), "backward-euler", kTimestep);
+  EXPECT_EQ(hyperelastic.forceModel, PetscForceModelKind::neoHookean);
+  EXPECT_EQ(hyperelastic.hyperelastic.inversionThreshold, 0.3);
+  // The settings struct refuses trapezoidal Newton too (for C++ callers).
+  PetscSimulationSettings trapezoidalNewton = hyperelastic;
+  trapezoidalNewton.integrator = PetscIntegratorKind::trapezoidal;
+  trapezoidalNewton.newton.maxIterations = 3;
+  EXPECT_THROW(PetscSimulation(*mesh, trapezoidalNewton), ValidationError);
 }
 
 // Corotational and linear trajectories differ here by far more than the comparison
@@ -462,11 +494,225 @@ TEST(PetscBackendFailure, BadSettingsAreRejected) {
   EXPECT_EQ(parsePetscSolverKind("cg-hypre"), PetscSolverKind::cgHypre);
 }
 
+// Every force model of the single-process libraries on the PETSc backend: the same
+// Problem stepped by the integrator library's BackwardEuler or Trapezoidal (CHOLMOD,
+// exact solves) and by the backend with MUMPS, whose element loops run the same force
+// model kernels on each rank's elements.
+constexpr int kModelSteps = 8;
+constexpr double kNewtonTolerance = 1e-10;
+
+struct ModelCase {
+  const char* name;
+  ProblemSettings physics;
+  IntegratorOptions options;  // maxIterations, tolerance, lineSearch
+  const char* integrator;
+};
+
+ProblemSettings modelPhysics(ForceModelType type) {
+  ProblemSettings physics;
+  physics.forceModel = type;
+  physics.gravity = kGravity;
+  return physics;
+}
+
+IntegratorOptions newtonOptions() {
+  IntegratorOptions options;
+  options.maxIterations = 6;
+  options.tolerance = kNewtonTolerance;
+  options.lineSearch = true;
+  return options;
+}
+
+/// The cases: the exact corotational tangent (Vega's warp 2) and neo-Hookean with
+/// inversion handling under Newton with the line search, StVK and Mooney-Rivlin (its
+/// small-strain E, nu close to the beam's) on the linearized step.
+ModelCase modelCase(int index) {
+  switch (index) {
+    case 0: {
+      ModelCase c{"corotational_exact_newton", modelPhysics(ForceModelType::corotational), newtonOptions(),
+                  "backward-euler"};
+      c.physics.tangent = TangentKind::exact;
+      return c;
+    }
+    case 1:
+      return {"stvk_linearized", modelPhysics(ForceModelType::stvk), IntegratorOptions{}, "backward-euler"};
+    case 2: {
+      ModelCase c{"neo_hookean_inversion_newton", modelPhysics(ForceModelType::neoHookean), newtonOptions(),
+                  "backward-euler"};
+      c.physics.hyperelastic.inversionThreshold = 0.2;
+      return c;
+    }
+    default: {
+      ModelCase c{"mooney_rivlin_trapezoidal", modelPhysics(ForceModelType::mooneyRivlin), IntegratorOptions{},
+                  "trapezoidal"};
+      c.physics.hyperelastic.mooneyRivlin = MooneyRivlinParameters{5e4, 1.2e5, 1.6e6};
+      return c;
+    }
+  }
+}
+
+std::shared_ptr<const Problem> modelProblem(const ModelCase& c) {
+  auto mesh = std::make_shared<const TetMesh>(beamMesh());
+  return std::make_shared<const Problem>(mesh, mesh->vertexSet("xmin"), c.physics);
+}
+
+std::vector<Eigen::VectorXd> localModelTrajectory(const Problem& problem, const ModelCase& c) {
+  IntegratorOptions options = c.options;
+  options.reuseFactor = false;  // exact solves, as MUMPS gives
+  std::unique_ptr<Integrator> integrator;
+  if (std::string(c.integrator) == "backward-euler") {
+    integrator = std::make_unique<BackwardEuler>(problem.dynamicSystem(), kTimestep, options);
+  } else {
+    integrator = std::make_unique<Trapezoidal>(problem.dynamicSystem(), kTimestep, options);
+  }
+  std::vector<Eigen::VectorXd> trajectory;
+  for (int k = 0; k < kModelSteps; ++k) {
+    integrator->step();
+    trajectory.push_back(integrator->displacement());
+  }
+  return trajectory;
+}
+
+PetscTrajectory petscModelTrajectory(const Problem& problem, const ModelCase& c) {
+  PetscSimulationSettings settings = petscSettingsForProblem(problem, c.integrator, kTimestep, c.options);
+  settings.solver.kind = PetscSolverKind::mumps;
+  return runPetscSimulation(problem.mesh(), settings, kModelSteps);
+}
+
+/// Tolerance against the local run: direct solves on both sides, so the linearized step
+/// differs by rounding only (10 kappa 1e-15, as comparisonTolerance); with Newton each
+/// side stops at its own iterate with |R| <= 1e-10 |b_0|, an increment error of at most
+/// kappa 1e-10 relative per step, with the same factor 10 for accumulation: ~5e-6.
+double modelTolerance(const TetMesh& mesh, const ModelCase& c) {
+  return c.options.maxIterations > 1 ? 10.0 * systemConditionNumberCached(mesh) * kNewtonTolerance
+                                     : comparisonTolerance(mesh, PetscSolverKind::mumps);
+}
+
+class PetscForceModels : public ::testing::TestWithParam<int> {};
+
+TEST_P(PetscForceModels, TrajectoryMatchesTheLocalRun) {
+  const ModelCase c = modelCase(GetParam());
+  const std::shared_ptr<const Problem> problem = modelProblem(c);
+  const PetscTrajectory petsc = petscModelTrajectory(*problem, c);
+  EXPECT_EQ(petsc.stats.steps, kModelSteps);
+  if (c.options.maxIterations > 1) {
+    // Newton iterated (more linear systems than steps) and converged within the limit.
+    EXPECT_GT(petsc.stats.newtonIterations, kModelSteps);
+    EXPECT_LE(petsc.stats.newtonIterations, static_cast<long long>(kModelSteps) * c.options.maxIterations);
+  } else {
+    EXPECT_EQ(petsc.stats.newtonIterations, kModelSteps);
+  }
+  if (worldRank() != 0) return;
+  const std::vector<Eigen::VectorXd> reference = localModelTrajectory(*problem, c);
+  const double tolerance = modelTolerance(problem->mesh(), c);
+  ASSERT_GT(reference.back().lpNorm<Eigen::Infinity>(), 1e-3);  // it moved
+  // The model is not the linear one: the comparison below has teeth.
+  const PetscIntegratorKind kind = parsePetscIntegratorKind(c.integrator);
+  const std::vector<Eigen::VectorXd>& linear = cholmodTrajectory(problem->mesh(), kind, PetscForceModelKind::linear);
+  const std::vector<Eigen::VectorXd> linearPrefix(linear.begin(), linear.begin() + kModelSteps);
+  EXPECT_GT(trajectoryDifference(linearPrefix, reference), 10.0 * tolerance);
+  EXPECT_LE(trajectoryDifference(petsc.displacements, reference), tolerance)
+      << c.name << " on " << worldSize() << " ranks, " << petsc.stats.newtonIterations << " Newton iterations";
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryModel, PetscForceModels, ::testing::Range(0, 4),
+                         [](const ::testing::TestParamInfo<int>& info) { return modelCase(info.param).name; });
+
+// A hyperelastic element that fails on one rank (neo-Hookean log J of an element
+// flattened by the initial state, inversion handling off) stops every rank with the
+// mesh's element number.
+TEST(PetscBackendFailure, NonFiniteHyperelasticElementNamesTheMeshElement) {
+  const ModelCase c{"neo_hookean", modelPhysics(ForceModelType::neoHookean), IntegratorOptions{}, "backward-euler"};
+  const std::shared_ptr<const Problem> problem = modelProblem(c);
+  const TetMesh& mesh = problem->mesh();
+  PetscSimulationSettings settings = petscSettingsForProblem(*problem, c.integrator, kTimestep);
+  settings.solver.kind = PetscSolverKind::mumps;
+  PetscSimulation simulation(mesh, settings);
+  // Collapse the last element onto its first vertex (its other vertices are free: the
+  // beam's x = 1 end).
+  const int last = mesh.numElements() - 1;
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(mesh.numDofs());
+  for (int a = 1; a < 4; ++a) {
+    const int v = mesh.elements()(a, last);
+    u.segment<3>(3 * v) = mesh.restPositions().col(mesh.elements()(0, last)) - mesh.restPositions().col(v);
+  }
+  simulation.setState(u, Eigen::VectorXd::Zero(mesh.numDofs()));
+  try {
+    simulation.step();
+    ADD_FAILURE() << "no exception on rank " << worldRank();
+  } catch (const NumericalError& error) {
+    // The named element (in the mesh's numbering, whichever rank reports it) has one of
+    // the moved vertices.
+    const std::string message = error.what();
+    std::smatch match;
+    ASSERT_TRUE(std::regex_search(message, match, std::regex("^rank \\d+: .*element (\\d+) "))) << message;
+    const int named = std::stoi(match[1].str());
+    ASSERT_LT(named, mesh.numElements()) << message;
+    bool touches = false;
+    for (int a = 0; a < 4; ++a) {
+      for (int b = 1; b < 4; ++b) touches = touches || mesh.elements()(a, named) == mesh.elements()(b, last);
+    }
+    EXPECT_TRUE(touches) << message;
+  }
+}
+
+// A run restored from u, v, t and the internal state (a checkpoint: the trapezoidal
+// acceleration) continues as the uninterrupted run: the same solves from the same state,
+// different only in the last bit of the step times t_0 + k h (the direct tolerance).
+// Without the acceleration it would restart from the equation of motion's a_0, which
+// differs for the corotated tangent (asserted, so the restore is exercised).
+TEST(PetscBackend, InternalStateContinuesTheRun) {
+  const TetMesh mesh = beamMesh();
+  const PetscSimulationSettings settings =
+      beamSettings(mesh, PetscIntegratorKind::trapezoidal, PetscForceModelKind::corotational, PetscSolverKind::mumps);
+  PetscSimulation whole(mesh, settings);
+  for (int k = 0; k < 3; ++k) whole.step();
+  Eigen::VectorXd u = whole.gatherDisplacement();
+  Eigen::VectorXd v = whole.gatherVelocity();
+  Eigen::VectorXd a = whole.gatherInternalState();
+  const double t = whole.time();
+  for (int k = 0; k < 3; ++k) whole.step();
+  const Eigen::VectorXd expected = whole.gatherDisplacement();
+  // Every rank restores the same full vectors (rank 0's, broadcast here).
+  for (Eigen::VectorXd* vector : {&u, &v, &a}) {
+    vector->resize(mesh.numDofs());
+    MPI_Bcast(vector->data(), mesh.numDofs(), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  }
+  const auto continued = [&](bool withAcceleration) {
+    PetscSimulation resumed(mesh, settings);
+    resumed.setState(u, v, t);
+    resumed.setInternalState(withAcceleration ? a : Eigen::VectorXd());
+    for (int k = 0; k < 3; ++k) resumed.step();
+    return resumed.gatherDisplacement();
+  };
+  const Eigen::VectorXd restored = continued(true);
+  const Eigen::VectorXd restarted = continued(false);
+  PetscSimulation backwardEuler(mesh, beamSettings(mesh, PetscIntegratorKind::backwardEuler,
+                                                   PetscForceModelKind::linear, PetscSolverKind::mumps));
+  EXPECT_THROW(backwardEuler.setInternalState(a), ValidationError);
+  EXPECT_EQ(backwardEuler.gatherInternalState().size(), 0);
+  if (worldRank() != 0) return;
+  const double scale = expected.lpNorm<Eigen::Infinity>();
+  const double tolerance = comparisonTolerance(mesh, PetscSolverKind::mumps);
+  EXPECT_LE((restored - expected).lpNorm<Eigen::Infinity>(), tolerance * scale);
+  EXPECT_GT((restarted - expected).lpNorm<Eigen::Infinity>(), 10.0 * tolerance * scale);
+}
+
 // Partition agreement across separate runs: with ASYNCFEM_PETSC_TRAJECTORY_DIR set, each
 // run (np = 1, 2, 3) stores its corotational trajectory; the ctest PetscBackend.PartitionsAgree
 // then compares them (PetscPartitions.Agree, with ASYNCFEM_PETSC_COMPARE_DIR).
-std::string trajectoryFile(const std::string& directory, int ranks) {
-  return directory + "/petsc-trajectory-np" + std::to_string(ranks) + ".bin";
+std::string trajectoryFile(const std::string& directory, int ranks, const std::string& tag = "") {
+  return directory + "/petsc-trajectory" + tag + "-np" + std::to_string(ranks) + ".bin";
+}
+
+void storeTrajectory(const std::vector<Eigen::VectorXd>& displacements, const std::string& tag) {
+  const char* directory = std::getenv("ASYNCFEM_PETSC_TRAJECTORY_DIR");
+  if (worldRank() != 0 || directory == nullptr) return;
+  std::ofstream out(trajectoryFile(directory, worldSize(), tag), std::ios::binary);
+  for (const Eigen::VectorXd& u : displacements) {
+    out.write(reinterpret_cast<const char*>(u.data()), static_cast<std::streamsize>(u.size() * sizeof(double)));
+  }
+  ASSERT_TRUE(out.good());
 }
 
 TEST(PetscPartitions, StoreTrajectory) {
@@ -475,36 +721,46 @@ TEST(PetscPartitions, StoreTrajectory) {
       mesh,
       beamSettings(mesh, PetscIntegratorKind::backwardEuler, PetscForceModelKind::corotational, PetscSolverKind::mumps),
       kSteps);
-  const char* directory = std::getenv("ASYNCFEM_PETSC_TRAJECTORY_DIR");
-  if (worldRank() != 0 || directory == nullptr) return;
-  std::ofstream out(trajectoryFile(directory, worldSize()), std::ios::binary);
-  for (const Eigen::VectorXd& u : trajectory.displacements) {
-    out.write(reinterpret_cast<const char*>(u.data()), static_cast<std::streamsize>(u.size() * sizeof(double)));
+  storeTrajectory(trajectory.displacements, "");
+  // Neo-Hookean with inversion handling under Newton and the line search (modelCase(2)).
+  const ModelCase newton = modelCase(2);
+  storeTrajectory(petscModelTrajectory(*modelProblem(newton), newton).displacements, "-newton");
+}
+
+std::vector<std::vector<Eigen::VectorXd>> readTrajectories(const std::string& directory, int numDofs, int steps,
+                                                           const std::string& tag) {
+  std::vector<std::vector<Eigen::VectorXd>> runs;
+  for (int ranks : {1, 2, 3}) {
+    std::ifstream in(trajectoryFile(directory, ranks, tag), std::ios::binary);
+    EXPECT_TRUE(in.good()) << trajectoryFile(directory, ranks, tag);
+    std::vector<Eigen::VectorXd> trajectory(static_cast<std::size_t>(steps), Eigen::VectorXd::Zero(numDofs));
+    for (Eigen::VectorXd& u : trajectory) {
+      in.read(reinterpret_cast<char*>(u.data()), static_cast<std::streamsize>(u.size() * sizeof(double)));
+    }
+    EXPECT_TRUE(in.good()) << "short file " << trajectoryFile(directory, ranks, tag);
+    runs.push_back(std::move(trajectory));
   }
-  ASSERT_TRUE(out.good());
+  return runs;
 }
 
 // Direct solves on 1, 2 and 3 ranks differ only by the rounding of differently ordered
-// factorizations and sums: kappa * eps per step, the direct tolerance above.
+// factorizations and sums: kappa * eps per step, the direct tolerance above. Newton runs
+// may stop at different iterates: the Newton tolerance of modelTolerance().
 TEST(PetscPartitions, Agree) {
   const char* directory = std::getenv("ASYNCFEM_PETSC_COMPARE_DIR");
   ASSERT_NE(directory, nullptr) << "run through ctest (PetscBackend.PartitionsAgree)";
   const TetMesh mesh = beamMesh();
-  std::vector<std::vector<Eigen::VectorXd>> runs;
-  for (int ranks : {1, 2, 3}) {
-    std::ifstream in(trajectoryFile(directory, ranks), std::ios::binary);
-    ASSERT_TRUE(in.good()) << trajectoryFile(directory, ranks);
-    std::vector<Eigen::VectorXd> trajectory(kSteps, Eigen::VectorXd(mesh.numDofs()));
-    for (Eigen::VectorXd& u : trajectory) {
-      in.read(reinterpret_cast<char*>(u.data()), static_cast<std::streamsize>(u.size() * sizeof(double)));
-    }
-    ASSERT_TRUE(in.good()) << "short file " << trajectoryFile(directory, ranks);
-    runs.push_back(std::move(trajectory));
-  }
+  const std::vector<std::vector<Eigen::VectorXd>> runs = readTrajectories(directory, mesh.numDofs(), kSteps, "");
   const double tolerance = comparisonTolerance(mesh, PetscSolverKind::mumps);
   EXPECT_LE(trajectoryDifference(runs[1], runs[0]), tolerance) << "2 ranks vs 1";
   EXPECT_LE(trajectoryDifference(runs[2], runs[0]), tolerance) << "3 ranks vs 1";
   EXPECT_GT(runs[0].back().lpNorm<Eigen::Infinity>(), 1e-2);
+  const std::vector<std::vector<Eigen::VectorXd>> newton =
+      readTrajectories(directory, mesh.numDofs(), kModelSteps, "-newton");
+  const double newtonTolerance = modelTolerance(mesh, modelCase(2));
+  EXPECT_LE(trajectoryDifference(newton[1], newton[0]), newtonTolerance) << "Newton: 2 ranks vs 1";
+  EXPECT_LE(trajectoryDifference(newton[2], newton[0]), newtonTolerance) << "Newton: 3 ranks vs 1";
+  EXPECT_GT(newton[0].back().lpNorm<Eigen::Infinity>(), 1e-3);
 }
 
 }  // namespace

@@ -10,11 +10,11 @@
 // every frame) the full state goes to FILE.afsim.checkpoint, so that --resume continues
 // an interrupted run and produces exactly the file an uninterrupted run would have.
 // SIGINT and SIGTERM stop the run after the current frame, with a checkpoint, and exit
-// with status 128 + the signal number. A scene that runs the asynchronous integrator with
-// the paper's coupling gets its step growth estimated before the run (a few dozen steps
-// of the linearized scene) and a warning when a large step can grow. Errors print "offlineSimulator: <message>" on
-// stderr and exit with status 1. What it prints is described in docs/scene-format.md,
-// section "Running a scene".
+// with status 128 + the signal number (--backend petsc: every rank stops after the same
+// frame; rank 0 writes the checkpoint, every rank restores it with --resume). A scene that runs the asynchronous
+// integrator with the paper's coupling gets its step growth estimated before the run (a few dozen steps of the
+// linearized scene) and a warning when a large step can grow. Errors print "offlineSimulator: <message>" on stderr and
+// exit with status 1. What it prints is described in docs/scene-format.md, section "Running a scene".
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -48,6 +48,7 @@
 #include <vector>
 
 #if ASYNCFEM_OFFLINE_WITH_PETSC
+#include <asyncfem/integrator/registry.hpp>
 #include <asyncfem/petscBackend/petscRuntime.hpp>
 #include <asyncfem/petscBackend/petscSimulation.hpp>
 #include <asyncfem/petscBackend/problemSettings.hpp>
@@ -358,25 +359,27 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
 #if ASYNCFEM_OFFLINE_WITH_PETSC
 const std::string petscPrefix = "--backend petsc: ";
 
-// What the PETSc backend does not write: checkpoints (so no --resume), .vtu files, velocities.
-void refusePetscOutputs(const CommandLine& options, const asyncfem::Scene& scene) {
-  if (options.resume) {
-    throw asyncfem::Error(petscPrefix + "--resume is not supported (this backend writes no checkpoint)");
-  }
+// What the PETSc backend does not write: .vtu files, velocities.
+void refusePetscOutputs(const asyncfem::Scene& scene) {
   if (!scene.output.vtuFolder.empty() || scene.output.velocities) {
     throw asyncfem::Error(petscPrefix +
                           ".vtu output and output.velocities are not supported; the .afsim file is written");
   }
 }
 
-// The backend's settings for the scene's problem (asyncfem::petscSettingsForProblem), with
-// the solver chosen on the command line.
+// The backend's settings for the scene's problem (asyncfem::petscSettingsForProblem) and
+// its integrator's options (Newton iterations), with the solver chosen on the command line.
 asyncfem::PetscSimulationSettings petscSettings(const CommandLine& options, const asyncfem::Scene& scene,
                                                 const asyncfem::Problem& problem) {
   asyncfem::PetscSimulationSettings settings;
   try {
+    const std::string& name = scene.integrator.name;
+    const asyncfem::IntegratorOptions integratorOptions =
+        name == "backward-euler" || name == "trapezoidal"
+            ? asyncfem::parseIntegratorOptions(scene.integrator.options, "integrator.options", scene.sourceName)
+            : asyncfem::IntegratorOptions{};
     settings =
-        asyncfem::petscSettingsForProblem(problem, scene.integrator.name, asyncfem::frameTimingOf(scene).timestep);
+        asyncfem::petscSettingsForProblem(problem, name, asyncfem::frameTimingOf(scene).timestep, integratorOptions);
   } catch (const asyncfem::ValidationError& error) {
     throw asyncfem::Error(petscPrefix + scene.sourceName + ": " + error.what());
   }
@@ -399,16 +402,137 @@ void printPetscSummary(const asyncfem::Scene& scene, const asyncfem::PetscRunSta
   out << "  per frame   " << milliseconds(loopSeconds, timing.frameCount) << "   (assembly " << stats.assemblySeconds
       << " s, solves " << stats.solveSeconds << " s, " << stats.solverIterations << " iterations in " << stats.solves
       << " solves)\n";
-  out << "  output      " << scene.output.file.string() << " (" << timing.frameCount
-      << " frames; no checkpoint on this backend)\n";
+  if (stats.newtonIterations > stats.steps) {
+    out << "  newton      " << stats.newtonIterations << " iterations in " << stats.steps << " steps\n";
+  }
+  out << "  output      " << scene.output.file.string() << " (" << timing.frameCount << " frames; checkpoint in "
+      << asyncfem::checkpointPathFor(scene.output.file).string() << ")\n";
   std::cout << out.str() << std::flush;
+}
+
+// The output of a PETSc run: rank 0 writes the frames and the checkpoint (writer is null on
+// the other ranks); every rank gathers the state for a checkpoint. The checkpoint names the
+// integrator with " (PETSc)", so that a local run does not resume it, nor this one a local one.
+struct PetscOutput {
+  std::unique_ptr<asyncfem::SimulationWriter> writer;
+  asyncfem::SimulationFileHeader header;
+  fs::path checkpointFile;
+  std::uint32_t fingerprint = 0;
+  std::string integrator;
+  asyncfem::CheckpointSchedule schedule;
+  bool sync = false;
+  int checkpointFrames = 0;
+  std::chrono::steady_clock::time_point lastCheckpoint = std::chrono::steady_clock::now();
+
+  // Collective: the state after `frames` finished frames, written by rank 0.
+  void checkpoint(const asyncfem::PetscSimulation& simulation, int frames) {
+    asyncfem::SimulationCheckpoint state;
+    state.displacement = simulation.gatherDisplacement();
+    state.velocity = simulation.gatherVelocity();
+    state.internalState = simulation.gatherInternalState();
+    if (simulation.rank() == 0) {
+      state.frames = frames;
+      state.time = simulation.time();
+      state.fingerprint = fingerprint;
+      state.integrator = integrator;
+      asyncfem::writeCheckpoint(checkpointFile, state, sync);
+    }
+    checkpointFrames = frames;
+    lastCheckpoint = std::chrono::steady_clock::now();
+  }
+  // Collective: whether rank 0's schedule asks for a checkpoint after `frames` frames.
+  bool due(const asyncfem::PetscRuntime& runtime, int frames, int frameCount) const {
+    const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - lastCheckpoint).count();
+    const bool wanted = frames == frameCount || schedule.due(frames, since);
+    return runtime.maxOverRanks(runtime.rank() == 0 && wanted ? 1 : 0) != 0;
+  }
+};
+
+// Opens the output of a PETSc run: a new file with the rest state's checkpoint, or with
+// --resume the run's file continued after the frames its checkpoint has (every rank reads
+// and checks the checkpoint, restores its state, and all agree before going on). Returns
+// the frames already finished.
+int openPetscOutput(const CommandLine& options, const asyncfem::Scene& scene, const asyncfem::Problem& problem,
+                    const asyncfem::PetscRuntime& runtime, asyncfem::PetscSimulation& simulation, PetscOutput& output) {
+  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
+  output.header.numVertices = problem.mesh().numVertices();
+  output.header.frameInterval = timing.frameInterval;
+  output.header.timestep = simulation.timestep();
+  output.header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
+  output.header.sceneFingerprint = asyncfem::problemFingerprint(problem);
+  output.checkpointFile = asyncfem::checkpointPathFor(scene.output.file);
+  output.fingerprint = asyncfem::runFingerprint(fingerprintText(options.scene), scene.integrator.name,
+                                                output.header.timestep, output.header.frameInterval, problem);
+  output.integrator = scene.integrator.name + " (PETSc)";
+  output.schedule = asyncfem::CheckpointSchedule{options.checkpointEvery, options.checkpointSeconds};
+  output.sync = scene.output.sync;
+  const bool root = runtime.rank() == 0;
+  const asyncfem::SimulationWriter::Options writerOptions{scene.output.sync};
+  if (!options.resume) {
+    if (root) {
+      createOutputFolder(scene.output.file);
+      output.writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, output.header, writerOptions);
+    }
+    output.checkpoint(simulation, 0);  // the rest state: a run stopped before its first frame resumes too
+    return 0;
+  }
+  asyncfem::SimulationCheckpoint checkpoint;
+  std::string failure;
+  try {
+    checkpoint = asyncfem::checkpointToResume(scene.output.file, output.header, output.fingerprint, timing.frameCount,
+                                              output.integrator, problem.numDofs());
+  } catch (const asyncfem::Error& error) {
+    failure = error.what();
+  }
+  if (runtime.maxOverRanks(failure.empty() ? 0 : 1) != 0) {
+    throw asyncfem::Error(failure.empty() ? "cannot resume: another rank could not use the checkpoint" : failure);
+  }
+  simulation.setState(checkpoint.displacement, checkpoint.velocity, checkpoint.time);
+  simulation.setInternalState(checkpoint.internalState);
+  const auto frames = static_cast<int>(checkpoint.frames);
+  if (root) {
+    output.writer = asyncfem::SimulationWriter::continueFile(scene.output.file, output.header, frames, writerOptions);
+  }
+  output.checkpointFrames = frames;
+  return frames;
+}
+
+// The frame loop of a PETSc run from firstFrame: every rank steps, rank 0 writes each frame
+// and draws the progress; checkpoints as scheduled (rank 0's clock decides). A stop signal
+// that reached any rank stops every rank before the same frame (one MPI_Allreduce per
+// frame), so no rank waits for the others in a collective call. Returns the frames completed.
+int runPetscFrames(const CommandLine& options, const asyncfem::Scene& scene, const asyncfem::PetscRuntime& runtime,
+                   asyncfem::PetscSimulation& simulation, PetscOutput& output, int firstFrame) {
+  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
+  const bool root = simulation.rank() == 0;
+  asyncfem::cli::ProgressReporter progress(
+      "offlineSimulator",
+      root ? asyncfem::cli::chooseProgressStyle(options.quiet, options.progress) : asyncfem::cli::ProgressStyle::none,
+      timing.frameCount, firstFrame);
+  int frame = firstFrame;
+  try {
+    for (; frame < timing.frameCount && runtime.maxOverRanks(static_cast<int>(stopSignal)) == 0; ++frame) {
+      for (int s = 0; s < timing.stepsPerFrame; ++s) simulation.step();  // non-finite states throw on every rank
+      const Eigen::VectorXd u = simulation.gatherDisplacement();
+      if (root) output.writer->appendFrame(simulation.time(), u);
+      if (output.due(runtime, frame + 1, timing.frameCount)) output.checkpoint(simulation, frame + 1);
+      progress.update(frame + 1);
+    }
+  } catch (const asyncfem::Error& error) {
+    progress.finish();
+    throw asyncfem::Error(std::string(error.what()) + "; the " + std::to_string(frame) +
+                          " frames before it are kept in " + scene.output.file.string());
+  }
+  progress.finish();
+  if (frame != output.checkpointFrames) output.checkpoint(simulation, frame);  // stopped by a signal
+  return frame;
 }
 
 // --backend petsc: the scene's problem on the PETSc backend (every rank builds the problem,
 // rank 0 writes the frames). Supports what that backend integrates: linear and
 // corotational backward Euler and trapezoidal, loads that depend on time only.
 int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::Scene& scene) {
-  refusePetscOutputs(options, scene);
+  refusePetscOutputs(scene);
   asyncfem::Stopwatch setupWatch;
   setupWatch.start();
   asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
@@ -420,31 +544,27 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   if (root) {
     for (const std::string& warning : warnings) std::cerr << "offlineSimulator: warning: " << warning << "\n";
   }
-  std::unique_ptr<asyncfem::SimulationWriter> writer;
-  if (root) {
-    createOutputFolder(scene.output.file);
-    asyncfem::SimulationFileHeader header;
-    header.numVertices = problem->mesh().numVertices();
-    header.frameInterval = timing.frameInterval;
-    header.timestep = simulation.timestep();
-    header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
-    header.sceneFingerprint = asyncfem::problemFingerprint(*problem);
-    writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, header,
-                                                          asyncfem::SimulationWriter::Options{scene.output.sync});
-  }
+  PetscOutput output;
+  const int firstFrame = openPetscOutput(options, scene, *problem, runtime, simulation, output);
   const double setupSeconds = setupWatch.stop();
+  installStopHandlers();  // after PETSc's start, whose own handlers it replaces for these signals
   asyncfem::Stopwatch loopWatch;
   loopWatch.start();
-  for (int frame = 0; frame < timing.frameCount; ++frame) {
-    for (int s = 0; s < timing.stepsPerFrame; ++s) simulation.step();  // non-finite states throw on every rank
-    const Eigen::VectorXd u = simulation.gatherDisplacement();
-    if (root) writer->appendFrame(simulation.time(), u);
-  }
+  const int frames = runPetscFrames(options, scene, runtime, simulation, output, firstFrame);
   const double loopSeconds = loopWatch.stop();
-  if (root) {
-    writer->close();
-    if (!options.quiet) printPetscSummary(scene, simulation.stats(), setupSeconds, loopSeconds);
+  if (root) output.writer->close();
+  const int signal = runtime.maxOverRanks(static_cast<int>(stopSignal));
+  if (signal != 0 && frames < timing.frameCount) {
+    if (root) {
+      std::cerr << "offlineSimulator: interrupted by " << signalName(signal) << ": " << frames << " of "
+                << timing.frameCount << " frames are complete in " << scene.output.file.string()
+                << " (checkpoint after frame " << output.checkpointFrames << " in " << output.checkpointFile.string()
+                << "); continue the run with:\n  mpiexec -n " << runtime.size() << " " << resumeCommand(argc, argv)
+                << "\n";
+    }
+    return 128 + signal;
   }
+  if (root && !options.quiet) printPetscSummary(scene, simulation.stats(), setupSeconds, loopSeconds);
   return 0;
 }
 #endif
@@ -488,7 +608,7 @@ void addRunOptions(CLI::App& app, CommandLine& options) {
                "with the paper's coupling");
   app.add_option("--backend", options.backend,
                  "Where the scene runs: local (default) or petsc (PETSc over MPI: run under mpiexec -n N; "
-                 "backward-euler or trapezoidal, linear or corotational; docs/petsc-backend.md)")
+                 "backward-euler or trapezoidal, every force model; docs/petsc-backend.md)")
       ->check(CLI::IsMember({"local", "petsc"}))
       ->capture_default_str();
   app.add_option("--petsc-solver", options.petscSolver, "With --backend petsc: cg-gamg, cg-hypre or mumps")

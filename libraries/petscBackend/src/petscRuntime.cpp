@@ -22,6 +22,12 @@ PetscRuntime::PetscRuntime(int* argc, char*** argv, const std::string& options) 
   MPI_Comm_size(PETSC_COMM_WORLD, &size_);
 }
 
+int PetscRuntime::maxOverRanks(int value) const {
+  int largest = value;
+  MPI_Allreduce(&value, &largest, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD);
+  return largest;
+}
+
 PetscRuntime::~PetscRuntime() {
   if (ownsInitialization_) PetscFinalize();
 }

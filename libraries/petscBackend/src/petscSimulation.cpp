@@ -7,6 +7,7 @@
 #include <asyncfem/integrator/stepFormula.hpp>
 #include <asyncfem/petscBackend/petscSimulation.hpp>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -25,7 +26,19 @@ std::string toString(PetscIntegratorKind kind) {
 }
 
 std::string toString(PetscForceModelKind kind) {
-  return kind == PetscForceModelKind::linear ? "linear" : "corotational";
+  switch (kind) {
+    case PetscForceModelKind::linear:
+      return "linear";
+    case PetscForceModelKind::corotational:
+      return "corotational";
+    case PetscForceModelKind::stvk:
+      return "stvk";
+    case PetscForceModelKind::neoHookean:
+      return "neo-hookean";
+    case PetscForceModelKind::mooneyRivlin:
+      return "mooney-rivlin";
+  }
+  return "unknown";
 }
 
 PetscIntegratorKind parsePetscIntegratorKind(const std::string& name) {
@@ -36,10 +49,13 @@ PetscIntegratorKind parsePetscIntegratorKind(const std::string& name) {
 }
 
 PetscForceModelKind parsePetscForceModelKind(const std::string& name) {
-  for (PetscForceModelKind kind : {PetscForceModelKind::linear, PetscForceModelKind::corotational}) {
+  for (PetscForceModelKind kind :
+       {PetscForceModelKind::linear, PetscForceModelKind::corotational, PetscForceModelKind::stvk,
+        PetscForceModelKind::neoHookean, PetscForceModelKind::mooneyRivlin}) {
     if (toString(kind) == name) return kind;
   }
-  throw ValidationError("unknown PETSc backend force model '" + name + "' (expected linear or corotational)");
+  throw ValidationError("unknown PETSc backend force model '" + name +
+                        "' (expected linear, corotational, stvk, neo-hookean or mooney-rivlin)");
 }
 
 namespace {
@@ -66,6 +82,15 @@ void validateSettings(MPI_Comm comm, const TetMesh& mesh, const PetscSimulationS
     }
     if (!(settings.solver.relativeTolerance >= 0.0) || settings.solver.maxIterations < 1) {
       throw ValidationError("PETSc backend: the solver needs a relative tolerance >= 0 and maxIterations >= 1");
+    }
+    if (settings.newton.maxIterations < 1 || !(settings.newton.tolerance >= 0.0)) {
+      throw ValidationError("PETSc backend: Newton needs maxIterations >= 1 and a tolerance >= 0");
+    }
+    if (settings.newton.maxIterations > 1 && settings.integrator == PetscIntegratorKind::trapezoidal &&
+        settings.forceModel != PetscForceModelKind::linear) {
+      throw ValidationError(
+          "PETSc backend: Newton iterations (maxIterations > 1) run with backward-euler only; the trapezoidal "
+          "rule takes the linearized step (maxIterations 1)");
     }
   });
 }
@@ -107,9 +132,9 @@ struct PetscSimulation::Impl {
   double time() const { return timeOrigin + (static_cast<double>(stepIndex) * settings.timestep); }
   double stepEndTime() const { return timeOrigin + (static_cast<double>(stepIndex + 1) * settings.timestep); }
 
-  /// K(u) and f_int(u) at the current state (corotational model); marks the system stale.
+  /// K(u) and f_int(u) at the current state (nonlinear models); marks the system stale.
   void assembleTangent() {
-    body.assembleCorotated(time());
+    body.assembleNonlinear(body.displacement.get(), body.stiffness.get());
     systemStale = true;
   }
   /// The system matrix of the step, if K or the weights changed, handed to the solver.
@@ -124,6 +149,12 @@ struct PetscSimulation::Impl {
   void checkFinite() const;
   void computeAcceleration();
   void stepBackwardEuler();
+  int newtonIterations(double rhsNorm);
+  void newtonResidual(Vec dv);
+  void solveNewtonCorrection();
+  double incrementalPotential(Vec dv);
+  double backtrack(Vec dv, Vec step, double potential, double slope);
+  [[noreturn]] void throwDiverged(double relativeResidual, int iterations);
   void stepTrapezoidal();
   void collectStats(Stopwatch& setup);
 };
@@ -197,13 +228,13 @@ void PetscSimulation::Impl::buildRightHandSide(const stepFormula::RightHandSide&
   Vec work = body.work.get();
   Vec product = body.product.get();
   checkPetsc(VecCopy(body.externalForce.get(), rhs), "VecCopy");
-  if (body.corotational) checkPetsc(VecAXPY(rhs, -1.0, body.internalForce.get()), "VecAXPY");
+  if (body.nonlinear) checkPetsc(VecAXPY(rhs, -1.0, body.internalForce.get()), "VecAXPY");
   checkPetsc(VecCopy(body.velocity.get(), work), "VecCopy");
   checkPetsc(VecScale(work, recipe.velocityStiffness), "VecScale");
   if (recipe.accelerationStiffness != 0.0) {
     checkPetsc(VecAXPY(work, recipe.accelerationStiffness, body.acceleration.get()), "VecAXPY");
   }
-  if (!body.corotational) checkPetsc(VecAXPY(work, 1.0, body.displacement.get()), "VecAXPY");
+  if (!body.nonlinear) checkPetsc(VecAXPY(work, 1.0, body.displacement.get()), "VecAXPY");
   checkPetsc(MatMult(body.stiffness.get(), work, product), "MatMult");
   checkPetsc(VecAXPY(rhs, -1.0, product), "VecAXPY");
   if (alpha != 0.0) {
@@ -224,7 +255,7 @@ void PetscSimulation::Impl::computeAcceleration() {
   body.evaluateExternalForce(time(), settings.timeDependentForce);
   {
     ScopedTimer timer(assemblyWatch);
-    if (body.corotational) assembleTangent();
+    if (body.nonlinear) assembleTangent();
   }
   buildRightHandSide({1.0, settings.rayleighStiffness, 0.0, 0.0});
   solve(*massSolver, body.rhs.get(), body.acceleration.get(), "mass");
@@ -237,13 +268,175 @@ void PetscSimulation::Impl::stepBackwardEuler() {
   body.evaluateExternalForce(stepEndTime(), settings.timeDependentForce);
   {
     ScopedTimer timer(assemblyWatch);
-    if (body.corotational) assembleTangent();
+    if (body.nonlinear) assembleTangent();
     updateSystem(stepFormula::backwardEuler::systemMatrix(h, settings.rayleighMass, settings.rayleighStiffness));
   }
   buildRightHandSide(stepFormula::backwardEuler::rightHandSide(h, settings.rayleighStiffness));
   solve(solver, body.rhs.get(), body.increment.get(), "backward Euler");
+  stats.lineSearchHalvings = 0;
+  if (body.nonlinear && settings.newton.maxIterations > 1) {
+    PetscReal rhsNorm = 0.0;
+    checkPetsc(VecNorm(body.rhs.get(), NORM_2, &rhsNorm), "VecNorm");
+    stats.newtonIterations += newtonIterations(rhsNorm);
+  } else {
+    ++stats.newtonIterations;
+  }
   checkPetsc(VecAXPY(body.velocity.get(), 1.0, body.increment.get()), "VecAXPY");
   checkPetsc(VecAXPY(body.displacement.get(), h, body.velocity.get()), "VecAXPY");
+}
+
+// Newton on the backward Euler step equations after the linearized solve, as the
+// single-process BackwardEuler does (its class comment): dv = body.increment,
+//   R(dv) = M dv - h ( f_ext - f_int(u_k + h (v_k + dv)) - D (v_k + dv) ),  D = alpha M + beta K(u_k),
+//   J = (1 + h alpha) M + h beta K(u_k) + h^2 K(u_k + h (v_k + dv)),
+// until |R|_2 <= tolerance |b_0|_2 (b_0 = body.rhs, the linearized right-hand side), each
+// update shortened by backtracking on the incremental potential when lineSearch is set.
+// Returns the iterations taken, the linearized one included.
+int PetscSimulation::Impl::newtonIterations(double rhsNorm) {
+  const PetscNewtonSettings& newton = settings.newton;
+  Vec dv = body.increment.get();
+  Vec correction = body.correction.get();
+  if (newton.lineSearch) {
+    // The linearized step from dv = 0, its slope from its own right-hand side.
+    checkPetsc(VecCopy(dv, correction), "VecCopy");
+    PetscScalar slope = 0.0;
+    checkPetsc(VecDot(body.rhs.get(), correction, &slope), "VecDot");
+    checkPetsc(VecSet(dv, 0.0), "VecSet");
+    const double t = backtrack(dv, correction, incrementalPotential(dv), -slope);
+    checkPetsc(VecAXPY(dv, t, correction), "VecAXPY");
+  }
+  const double scale = rhsNorm > 0.0 ? rhsNorm : 1.0;
+  for (int iterations = 1;; ++iterations) {
+    const bool mayIterate = iterations < newton.maxIterations;
+    checkPetsc(VecWAXPY(body.trial.get(), 1.0, body.velocity.get(), dv), "VecWAXPY");
+    checkPetsc(VecAYPX(body.trial.get(), settings.timestep, body.displacement.get()), "VecAYPX");
+    {
+      ScopedTimer timer(assemblyWatch);
+      body.assembleNonlinear(body.trial.get(), mayIterate ? body.iterateStiffness.get() : nullptr);
+    }
+    newtonResidual(dv);
+    PetscReal residualNorm = 0.0;
+    checkPetsc(VecNorm(body.residual.get(), NORM_2, &residualNorm), "VecNorm");
+    const double relative = residualNorm / scale;
+    if (relative <= newton.tolerance) return iterations;
+    if (!mayIterate) {
+      if (!(relative <= 1.0)) throwDiverged(relative, iterations);
+      return iterations;
+    }
+    solveNewtonCorrection();
+    if (newton.lineSearch) {
+      PetscScalar slope = 0.0;
+      checkPetsc(VecDot(body.residual.get(), correction, &slope), "VecDot");
+      checkPetsc(VecScale(correction, backtrack(dv, correction, incrementalPotential(dv), slope)), "VecScale");
+    }
+    checkPetsc(VecAXPY(dv, 1.0, correction), "VecAXPY");
+  }
+}
+
+// residual = R(dv), with f_int of the iterate u_k + h (v_k + dv) in body.internalForce.
+void PetscSimulation::Impl::newtonResidual(Vec dv) {
+  const double h = settings.timestep;
+  const double alpha = settings.rayleighMass;
+  const double beta = settings.rayleighStiffness;
+  Vec residual = body.residual.get();
+  Vec product = body.product.get();
+  Vec newVelocity = body.work.get();
+  checkPetsc(MatMult(body.mass.get(), dv, residual), "MatMult");
+  checkPetsc(VecAXPY(residual, -h, body.externalForce.get()), "VecAXPY");
+  checkPetsc(VecAXPY(residual, h, body.internalForce.get()), "VecAXPY");
+  checkPetsc(VecWAXPY(newVelocity, 1.0, body.velocity.get(), dv), "VecWAXPY");
+  if (alpha != 0.0) {
+    checkPetsc(MatMult(body.mass.get(), newVelocity, product), "MatMult");
+    checkPetsc(VecAXPY(residual, h * alpha, product), "VecAXPY");
+  }
+  if (beta != 0.0) {
+    checkPetsc(MatMult(body.stiffness.get(), newVelocity, product), "MatMult");
+    checkPetsc(VecAXPY(residual, h * beta, product), "VecAXPY");
+  }
+}
+
+// J correction = -R with J = (1 + h alpha) M + h beta K(u_k) + h^2 K(iterate).
+void PetscSimulation::Impl::solveNewtonCorrection() {
+  const double h = settings.timestep;
+  {
+    ScopedTimer timer(assemblyWatch);
+    body.combineSystem(1.0 + (h * settings.rayleighMass), h * settings.rayleighStiffness, body.iterateStiffness.get(),
+                       h * h);
+    solver.setOperator(body.system.get());
+    systemStale = true;  // the next step's matrix is the linearized one again
+  }
+  checkPetsc(VecCopy(body.residual.get(), body.rhs.get()), "VecCopy");
+  checkPetsc(VecScale(body.rhs.get(), -1.0), "VecScale");
+  checkPetsc(VecSet(body.correction.get(), 0.0), "VecSet");
+  solve(solver, body.rhs.get(), body.correction.get(), "Newton correction");
+}
+
+// Phi(dv) = 1/2 dv^T M dv + E(u_k + h (v_k + dv)) - h f_ext^T dv + h dv^T D (v_k + dv / 2),
+// D = alpha M + beta K(u_k) (body.trial holds u_k + h (v_k + dv) afterwards).
+double PetscSimulation::Impl::incrementalPotential(Vec dv) {
+  const double h = settings.timestep;
+  Vec trial = body.trial.get();
+  Vec work = body.work.get();
+  Vec product = body.product.get();
+  checkPetsc(VecWAXPY(trial, 1.0, body.velocity.get(), dv), "VecWAXPY");
+  checkPetsc(VecAYPX(trial, h, body.displacement.get()), "VecAYPX");
+  double energy = 0.0;
+  {
+    ScopedTimer timer(assemblyWatch);
+    energy = body.elasticEnergy(trial);
+  }
+  const auto dot = [&](Mat matrix, Vec right) {
+    PetscScalar value = 0.0;
+    checkPetsc(MatMult(matrix, right, product), "MatMult");
+    checkPetsc(VecDot(dv, product, &value), "VecDot");
+    return static_cast<double>(value);
+  };
+  checkPetsc(VecWAXPY(work, 0.5, dv, body.velocity.get()), "VecWAXPY");
+  double damping = 0.0;
+  if (settings.rayleighMass != 0.0) damping += settings.rayleighMass * dot(body.mass.get(), work);
+  if (settings.rayleighStiffness != 0.0) damping += settings.rayleighStiffness * dot(body.stiffness.get(), work);
+  PetscScalar external = 0.0;
+  checkPetsc(VecDot(body.externalForce.get(), dv, &external), "VecDot");
+  return (0.5 * dot(body.mass.get(), dv)) + energy - (h * external) + (h * damping);
+}
+
+// Armijo backtracking as BackwardEuler::backtrack: the step length t in (0, 1] from dv
+// along step, halving t up to 12 times until Phi(dv + t step) <= Phi(dv) + 1e-4 t slope
+// (differences below 1e-12 |Phi| count as no increase), else the t of the lowest Phi.
+double PetscSimulation::Impl::backtrack(Vec dv, Vec step, double potential, double slope) {
+  constexpr int kMaxHalvings = 12;
+  const double roundingAllowance = 1e-12 * std::abs(potential);
+  Vec candidate = body.candidate.get();
+  double t = 1.0;
+  double bestT = 1.0;
+  double bestPotential = std::numeric_limits<double>::infinity();
+  for (int halving = 0; halving <= kMaxHalvings; ++halving) {
+    checkPetsc(VecWAXPY(candidate, t, step, dv), "VecWAXPY");
+    const double trial = incrementalPotential(candidate);
+    if (std::isfinite(trial) && trial <= potential + (1e-4 * t * std::min(slope, 0.0)) + roundingAllowance) return t;
+    if (std::isfinite(trial) && trial < bestPotential) {
+      bestPotential = trial;
+      bestT = t;
+    }
+    ++stats.lineSearchHalvings;
+    t *= 0.5;
+  }
+  return bestPotential < std::numeric_limits<double>::infinity() ? bestT : t;
+}
+
+void PetscSimulation::Impl::throwDiverged(double relativeResidual, int iterations) {
+  Vec magnitude = body.product.get();
+  checkPetsc(VecCopy(body.residual.get(), magnitude), "VecCopy");
+  checkPetsc(VecAbs(magnitude), "VecAbs");
+  PetscInt largest = 0;
+  PetscReal value = 0.0;
+  checkPetsc(VecMax(magnitude, &largest, &value), "VecMax");
+  const int vertex = largest >= 0 ? body.layout.blockVertex[static_cast<std::size_t>(largest / 3)] : -1;
+  throw NumericalError("PETSc backend: Newton's iteration diverged in the step to time " +
+                       std::to_string(stepEndTime()) + ": after " + std::to_string(iterations) +
+                       " iterations its residual is " + std::to_string(relativeResidual) +
+                       " times the step's initial one, largest at vertex " + std::to_string(vertex) +
+                       "; enable lineSearch or reduce the step");
 }
 
 void PetscSimulation::Impl::stepTrapezoidal() {
@@ -255,13 +448,14 @@ void PetscSimulation::Impl::stepTrapezoidal() {
   body.evaluateExternalForce(stepEndTime(), settings.timeDependentForce);
   {
     ScopedTimer timer(assemblyWatch);
-    if (body.corotational) assembleTangent();
+    if (body.nonlinear) assembleTangent();
     updateSystem(trapezoidalRule::systemMatrix(h, settings.rayleighMass, settings.rayleighStiffness));
   }
   buildRightHandSide(trapezoidalRule::rightHandSide(h, settings.rayleighStiffness));
   // The previous acceleration is the initial guess of the iterative solvers.
   checkPetsc(VecCopy(body.acceleration.get(), body.increment.get()), "VecCopy");
   solve(solver, body.rhs.get(), body.increment.get(), "trapezoidal");
+  ++stats.newtonIterations;
   Vec sum = body.work.get();
   checkPetsc(VecWAXPY(sum, 1.0, body.acceleration.get(), body.increment.get()), "VecWAXPY");  // a + a_{k+1}
   checkPetsc(VecAXPY(body.displacement.get(), h, body.velocity.get()), "VecAXPY");
@@ -298,9 +492,35 @@ void PetscSimulation::setState(const Eigen::VectorXd& displacement, const Eigen:
   });
   s.body.scatterOwned(displacement, s.body.displacement.get());
   s.body.scatterOwned(velocity, s.body.velocity.get());
-  s.timeOrigin = time;
-  s.stepIndex = 0;
+  // A time on the step grid (a checkpoint's) keeps t = k h exactly, so that a resumed run
+  // steps through the very times of the uninterrupted one (as Integrator::setState does).
+  const double gridSteps = std::round(time / s.settings.timestep);
+  const bool onGrid = std::abs(gridSteps) < 1e15 && gridSteps * s.settings.timestep == time;
+  s.timeOrigin = onGrid ? 0.0 : time;
+  s.stepIndex = onGrid ? static_cast<long long>(gridSteps) : 0;
   s.accelerationStale = true;
+}
+
+Eigen::VectorXd PetscSimulation::gatherInternalState() const {
+  const Impl& s = *impl_;
+  if (!s.trapezoidal || s.accelerationStale) return {};
+  return s.body.gather(s.body.acceleration.get());
+}
+
+void PetscSimulation::setInternalState(const Eigen::VectorXd& state) {
+  Impl& s = *impl_;
+  collectively(s.body.comm, [&] {
+    if (state.size() != 0 && (!s.trapezoidal || state.size() != s.body.numDofs)) {
+      throw ValidationError("PETSc backend: the internal state has " + std::to_string(state.size()) +
+                            " values; expected " +
+                            (s.trapezoidal ? std::to_string(s.body.numDofs) + " or none" : "none") + " for " +
+                            toString(s.settings.integrator));
+    }
+    if (!state.allFinite()) throw ValidationError("PETSc backend: the internal state is not finite");
+  });
+  if (state.size() == 0) return;
+  s.body.scatterOwned(state, s.body.acceleration.get());
+  s.accelerationStale = false;
 }
 
 Eigen::VectorXd PetscSimulation::gatherDisplacement() const {

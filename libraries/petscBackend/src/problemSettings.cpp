@@ -15,25 +15,55 @@ PetscIntegratorKind integratorKind(const std::string& name) {
                         "\" is not available on the PETSc backend (it runs backward-euler and trapezoidal)");
 }
 
-PetscForceModelKind forceModelKind(const ProblemSettings& settings) {
-  if (settings.forceModel == ForceModelType::linear) return PetscForceModelKind::linear;
-  if (settings.forceModel == ForceModelType::corotational && settings.tangent == TangentKind::simple) {
-    return PetscForceModelKind::corotational;
+PetscForceModelKind forceModelKind(ForceModelType type) {
+  switch (type) {
+    case ForceModelType::linear:
+      return PetscForceModelKind::linear;
+    case ForceModelType::corotational:
+      return PetscForceModelKind::corotational;
+    case ForceModelType::stvk:
+      return PetscForceModelKind::stvk;
+    case ForceModelType::neoHookean:
+      return PetscForceModelKind::neoHookean;
+    case ForceModelType::mooneyRivlin:
+      return PetscForceModelKind::mooneyRivlin;
   }
-  throw ValidationError("forceModel: only linear and corotational (simple tangent) are available on the PETSc backend");
+  throw ValidationError("forceModel \"" + toString(type) + "\" is not available on the PETSc backend");
 }
 
 }  // namespace
 
+PetscNewtonSettings petscNewtonSettings(const IntegratorOptions& options) {
+  if (options.rayleighStiffnessAtIterate) {
+    throw ValidationError(
+        "integrator.options.rayleighStiffnessAtIterate: not supported on the PETSc backend (Rayleigh damping keeps "
+        "K(u_k) of the step start)");
+  }
+  PetscNewtonSettings newton;
+  newton.maxIterations = options.maxIterations;
+  newton.tolerance = options.tolerance;
+  newton.lineSearch = options.lineSearch;
+  return newton;
+}
+
 PetscSimulationSettings petscSettingsForProblem(const Problem& problem, const std::string& integratorName,
-                                                double timestep) {
+                                                double timestep, const IntegratorOptions& options) {
   if (problem.hasContact()) {
     throw ValidationError("contact: not supported on the PETSc backend (its forces depend on the state)");
   }
   const ProblemSettings& physics = problem.settings();
   PetscSimulationSettings settings;
   settings.integrator = integratorKind(integratorName);
-  settings.forceModel = forceModelKind(physics);
+  settings.forceModel = forceModelKind(physics.forceModel);
+  settings.tangent = physics.tangent;
+  settings.hyperelastic = physics.hyperelastic;
+  settings.newton = petscNewtonSettings(options);
+  if (settings.newton.maxIterations > 1 && settings.integrator == PetscIntegratorKind::trapezoidal &&
+      settings.forceModel != PetscForceModelKind::linear) {
+    throw ValidationError(
+        "integrator.options.maxIterations: Newton iterations run with backward-euler only on the PETSc backend "
+        "(the trapezoidal rule takes the linearized step, maxIterations 1)");
+  }
   settings.massType = physics.mass;
   settings.timestep = timestep;
   settings.rayleighMass = physics.rayleighAlpha;

@@ -297,13 +297,20 @@ SimulationCheckpoint captureCheckpoint(const Integrator& integrator, std::int64_
 std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, const SimulationFileHeader& stored,
                                         const Integrator& integrator, const SimulationFileHeader& header,
                                         bool fingerprintDiffers) {
+  return runDifferences(checkpoint, stored, integrator.name(), integrator.displacement().size(), header,
+                        fingerprintDiffers);
+}
+
+std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, const SimulationFileHeader& stored,
+                                        const std::string& integratorName, std::int64_t numDofs,
+                                        const SimulationFileHeader& header, bool fingerprintDiffers) {
   std::vector<std::string> differences;
   const auto differ = [](double a, double b) {
     return std::bit_cast<std::uint64_t>(a) != std::bit_cast<std::uint64_t>(b);
   };
   const auto number = [](double value) { return formatNumber(value, 12); };
-  if (checkpoint.integrator != integrator.name()) {
-    differences.push_back("integrator (" + checkpoint.integrator + " there, " + integrator.name() + " here)");
+  if (checkpoint.integrator != integratorName) {
+    differences.push_back("integrator (" + checkpoint.integrator + " there, " + integratorName + " here)");
   }
   if (differ(stored.timestep, header.timestep)) {
     differences.push_back("timestep (" + number(stored.timestep) + " there, " + number(header.timestep) + " here)");
@@ -312,7 +319,7 @@ std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, 
     differences.push_back("frame interval 1 / frames.rate (" + number(stored.frameInterval) + " there, " +
                           number(header.frameInterval) + " here)");
   }
-  if (stored.numVertices != header.numVertices || checkpoint.displacement.size() != integrator.displacement().size()) {
+  if (stored.numVertices != header.numVertices || checkpoint.displacement.size() != numDofs) {
     differences.push_back("mesh vertex count (" + std::to_string(stored.numVertices) + " there, " +
                           std::to_string(header.numVertices) + " here)");
   }
@@ -328,9 +335,9 @@ std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, 
   return differences;
 }
 
-std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const SimulationFileHeader& header,
-                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator,
-                                  RunMonitor* monitor) {
+SimulationCheckpoint checkpointToResume(const std::filesystem::path& output, const SimulationFileHeader& header,
+                                        std::uint32_t fingerprint, std::int64_t requestedFrames,
+                                        const std::string& integratorName, std::int64_t numDofs) {
   namespace fs = std::filesystem;
   const fs::path checkpointFile = checkpointPathFor(output);
   const std::string restart = "; run without --resume to start over";
@@ -350,7 +357,7 @@ std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const Sim
   SimulationReader reader(output);
   const SimulationFileHeader& stored = reader.header();
   const std::vector<std::string> differences =
-      runDifferences(checkpoint, stored, integrator, header, checkpoint.fingerprint != fingerprint);
+      runDifferences(checkpoint, stored, integratorName, numDofs, header, checkpoint.fingerprint != fingerprint);
   if (!differences.empty()) {
     std::string list;
     for (const std::string& difference : differences) list += (list.empty() ? "" : "; ") + difference;
@@ -376,6 +383,14 @@ std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const Sim
                   " differs from the state in " + checkpointFile.string() + restart);
     }
   }
+  return checkpoint;
+}
+
+std::int64_t resumeFromCheckpoint(const std::filesystem::path& output, const SimulationFileHeader& header,
+                                  std::uint32_t fingerprint, std::int64_t requestedFrames, Integrator& integrator,
+                                  RunMonitor* monitor) {
+  const SimulationCheckpoint checkpoint = checkpointToResume(output, header, fingerprint, requestedFrames,
+                                                             integrator.name(), integrator.displacement().size());
   integrator.setState(checkpoint.displacement, checkpoint.velocity, checkpoint.time);
   integrator.setInternalState(checkpoint.internalState);
   if (monitor != nullptr) monitor->setState(checkpoint.monitorState);

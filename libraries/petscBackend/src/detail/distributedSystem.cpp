@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/corotationalLinearFEM/polarDecomposition.hpp>
 #include <asyncfem/petscBackend/partition.hpp>
 #include <climits>
 #include <cmath>
@@ -20,7 +19,7 @@ using RowMajorElementMatrix = Eigen::Matrix<double, 12, 12, Eigen::RowMajor>;
 
 /// Rest data of element e; ValidationError for a degenerate element, with the same
 /// criterion as the single-process assembly (|V| <= 1e-14 L^3, L the longest edge).
-ElementData elementData(const TetMesh& mesh, int e, bool cacheStiffness) {
+ElementData elementData(const TetMesh& mesh, int e) {
   ElementData data;
   data.rest = mesh.elementRestPositions(e);
   data.gradients = shapeFunctionGradients(data.rest, &data.volume);
@@ -37,28 +36,8 @@ ElementData elementData(const TetMesh& mesh, int e, bool cacheStiffness) {
             << longest << ")";
     throw ValidationError(message.str());
   }
-  const Material& material = mesh.elementMaterial(e);
-  data.density = material.density;
-  if (cacheStiffness) data.stiffness = linearElementStiffness(data.rest, material.youngsModulus, material.poissonRatio);
+  data.density = mesh.elementMaterial(e).density;
   return data;
-}
-
-/// Corotated element (Mueller & Gross 2004, as CorotationalLinearFEM): F = x G^T, R its
-/// polar rotation, force R K_e (R^T x - X) and simple tangent R K_e R^T.
-void corotatedElement(const ElementData& data, const ElementPositions& current, ElementVector& force,
-                      ElementMatrix& tangent) {
-  const Eigen::Matrix3d deformationGradient = current * data.gradients.transpose();
-  const Eigen::Matrix3d rotation = polarDecomposition(deformationGradient).rotation;
-  const ElementPositions corotated = (rotation.transpose() * current) - data.rest;
-  const ElementVector restoring = data.stiffness * Eigen::Map<const ElementVector>(corotated.data());
-  Eigen::Map<ElementPositions>(force.data()).noalias() =
-      rotation * Eigen::Map<const ElementPositions>(restoring.data());
-  for (int b = 0; b < 4; ++b) {
-    for (int a = 0; a < 4; ++a) {
-      tangent.block<3, 3>(3 * a, 3 * b).noalias() =
-          rotation * data.stiffness.block<3, 3>(3 * a, 3 * b) * rotation.transpose();
-    }
-  }
 }
 
 ElementMatrix elementMass(const ElementData& data, MassType massType) {
@@ -70,12 +49,11 @@ ElementMatrix elementMass(const ElementData& data, MassType massType) {
 
 DistributedSystem::DistributedSystem(MPI_Comm communicator, const TetMesh& mesh,
                                      const PetscSimulationSettings& settings)
-    : comm(communicator),
-      numDofs(mesh.numDofs()),
-      corotational(settings.forceModel == PetscForceModelKind::corotational) {
+    : comm(communicator), numDofs(mesh.numDofs()), nonlinear(settings.forceModel != PetscForceModelKind::linear) {
   partition(mesh, settings.fixedVertices);
-  assembleMassAndStiffness(mesh, settings.massType);
+  if (nonlinear) collectively(comm, [&] { forceModel = std::make_unique<LocalForceModel>(mesh, layout, settings); });
   createVectors();
+  assembleMassAndStiffness(mesh, settings);
   assembleStaticForce(settings);
   attachNearNullSpace(mesh);
   checkPetsc(VecScatterCreateToZero(displacement.get(), toRoot.out(), rootVector.out()), "VecScatterCreateToZero");
@@ -97,7 +75,7 @@ void DistributedSystem::partition(const TetMesh& mesh, const std::vector<int>& f
     layout = buildDistributedLayout(mesh, fixedVertices, parts, rank, numRanks);
     if (layout.numBlocks == 0) throw ValidationError("PETSc backend: every vertex is fixed, nothing to simulate");
     elements.reserve(layout.localElements.size());
-    for (int e : layout.localElements) elements.push_back(elementData(mesh, e, corotational));
+    for (int e : layout.localElements) elements.push_back(elementData(mesh, e));
   });
 }
 
@@ -140,34 +118,45 @@ void DistributedSystem::assembleMatrix(Mat matrix, const ElementFunction& elemen
   checkPetsc(MatAssemblyEnd(matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
 }
 
-// M and K share the pattern; the system matrix is a value-wise combination of them.
-void DistributedSystem::assembleMassAndStiffness(const TetMesh& mesh, MassType massType) {
+// M and K share the pattern; the system matrix is a value-wise combination of them. A
+// nonlinear model's K is its tangent at rest (u = 0).
+void DistributedSystem::assembleMassAndStiffness(const TetMesh& mesh, const PetscSimulationSettings& settings) {
   createMatrix(mass);
   createMatrix(stiffness);
-  assembleMatrix(mass.get(), [&](std::size_t k, ElementMatrix& out) { out = elementMass(elements[k], massType); });
-  assembleMatrix(stiffness.get(), [&](std::size_t k, ElementMatrix& out) {
-    if (corotational) {
-      out = elements[k].stiffness;  // the tangent at rest (R = I)
-    } else {
+  assembleMatrix(mass.get(),
+                 [&](std::size_t k, ElementMatrix& out) { out = elementMass(elements[k], settings.massType); });
+  if (nonlinear) {
+    checkPetsc(MatZeroEntries(stiffness.get()), "MatZeroEntries");
+    assembleNonlinear(displacement.get(), stiffness.get());
+  } else {
+    assembleMatrix(stiffness.get(), [&](std::size_t k, ElementMatrix& out) {
       const Material& material = mesh.elementMaterial(layout.localElements[k]);
       out = linearElementStiffness(elements[k].rest, material.youngsModulus, material.poissonRatio);
-    }
-  });
+    });
+  }
   checkPetsc(MatDuplicate(mass.get(), MAT_COPY_VALUES, system.out()), "MatDuplicate");
   checkPetsc(MatSetOption(system.get(), MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+  if (nonlinear && settings.newton.maxIterations > 1) {
+    checkPetsc(MatDuplicate(stiffness.get(), MAT_COPY_VALUES, iterateStiffness.out()), "MatDuplicate");
+    checkPetsc(MatSetOption(iterateStiffness.get(), MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+  }
 }
 
-// The displacement carries ghosts for the corotated element loop.
+// The displacement (and a Newton iterate's) carries ghosts for the nonlinear element loop.
 void DistributedSystem::createVectors() {
   checkPetsc(VecCreateGhost(comm, ownedDofs(), globalDofs(), static_cast<PetscInt>(layout.ghostDofs.size()),
                             layout.ghostDofs.data(), displacement.out()),
              "VecCreateGhost");
-  for (VecHandle* vector :
-       {&velocity, &acceleration, &staticForce, &externalForce, &internalForce, &rhs, &increment, &work, &product}) {
+  for (VecHandle* vector : {&velocity, &acceleration, &staticForce, &externalForce, &internalForce, &rhs, &increment,
+                            &work, &product, &residual, &correction, &candidate}) {
     createVector(*vector);
   }
   checkPetsc(VecSet(displacement.get(), 0.0), "VecSet");
-  for (Vec vector : {velocity.get(), acceleration.get(), staticForce.get(), increment.get()}) {
+  if (nonlinear) {
+    checkPetsc(VecDuplicate(displacement.get(), trial.out()), "VecDuplicate");
+    checkPetsc(VecSet(trial.get(), 0.0), "VecSet");
+  }
+  for (Vec vector : {velocity.get(), acceleration.get(), staticForce.get(), increment.get(), correction.get()}) {
     checkPetsc(VecSet(vector, 0.0), "VecSet");
   }
 }
@@ -214,53 +203,53 @@ void DistributedSystem::attachNearNullSpace(const TetMesh& mesh) {
   checkPetsc(MatSetNearNullSpace(mass.get(), nearNullSpace.get()), "MatSetNearNullSpace");
 }
 
-void DistributedSystem::combineSystem(double massWeight, double stiffnessWeight) {
+void DistributedSystem::combineSystem(double massWeight, double stiffnessWeight, Mat extra, double extraWeight) {
   checkPetsc(MatCopy(mass.get(), system.get(), SAME_NONZERO_PATTERN), "MatCopy");
   checkPetsc(MatScale(system.get(), massWeight), "MatScale");
   checkPetsc(MatAXPY(system.get(), stiffnessWeight, stiffness.get(), SAME_NONZERO_PATTERN), "MatAXPY");
-}
-
-/// The current positions x = X + u of local element k (u read from the ghosted form).
-ElementPositions DistributedSystem::currentPositions(std::size_t k, const PetscScalar* localDisplacement) const {
-  ElementPositions x = elements[k].rest;
-  for (int i = 0; i < 12; ++i) {
-    const PetscInt local = layout.elementLocalDofs[k][static_cast<std::size_t>(i)];
-    if (local >= 0) x(i % 3, i / 3) += localDisplacement[local];
+  if (extra != nullptr && extraWeight != 0.0) {
+    checkPetsc(MatAXPY(system.get(), extraWeight, extra, SAME_NONZERO_PATTERN), "MatAXPY");
   }
-  return x;
 }
 
-void DistributedSystem::assembleCorotated(double time) {
-  checkPetsc(VecGhostUpdateBegin(displacement.get(), INSERT_VALUES, SCATTER_FORWARD), "VecGhostUpdateBegin");
-  checkPetsc(VecGhostUpdateEnd(displacement.get(), INSERT_VALUES, SCATTER_FORWARD), "VecGhostUpdateEnd");
+namespace {
+
+/// Runs use(values) on the local form (owned entries, then ghosts) of a ghosted vector,
+/// after refreshing its ghosts.
+template <class Use>
+void withLocalForm(Vec ghosted, const Use& use) {
+  checkPetsc(VecGhostUpdateBegin(ghosted, INSERT_VALUES, SCATTER_FORWARD), "VecGhostUpdateBegin");
+  checkPetsc(VecGhostUpdateEnd(ghosted, INSERT_VALUES, SCATTER_FORWARD), "VecGhostUpdateEnd");
   Vec localForm = nullptr;
-  checkPetsc(VecGhostGetLocalForm(displacement.get(), &localForm), "VecGhostGetLocalForm");
+  checkPetsc(VecGhostGetLocalForm(ghosted, &localForm), "VecGhostGetLocalForm");
   const PetscScalar* values = nullptr;
   checkPetsc(VecGetArrayRead(localForm, &values), "VecGetArrayRead");
-  checkPetsc(MatZeroEntries(stiffness.get()), "MatZeroEntries");
-  checkPetsc(VecSet(internalForce.get(), 0.0), "VecSet");
-  collectively(comm, [&] {
-    ElementVector force;
-    ElementMatrix tangent;
-    RowMajorElementMatrix rowMajor;
-    for (std::size_t k = 0; k < elements.size(); ++k) {
-      corotatedElement(elements[k], currentPositions(k, values), force, tangent);
-      if (!force.allFinite()) {
-        throw NumericalError("PETSc backend: non-finite corotated force in element " +
-                             std::to_string(layout.localElements[k]) + " at t = " + std::to_string(time));
-      }
-      rowMajor = tangent;
-      const PetscInt* dofs = layout.elementDofs[k].data();
-      checkPetsc(MatSetValues(stiffness.get(), 12, dofs, 12, dofs, rowMajor.data(), ADD_VALUES), "MatSetValues");
-      checkPetsc(VecSetValues(internalForce.get(), 12, dofs, force.data(), ADD_VALUES), "VecSetValues");
-    }
-  });
+  use(values);
   checkPetsc(VecRestoreArrayRead(localForm, &values), "VecRestoreArrayRead");
-  checkPetsc(VecGhostRestoreLocalForm(displacement.get(), &localForm), "VecGhostRestoreLocalForm");
-  checkPetsc(MatAssemblyBegin(stiffness.get(), MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  checkPetsc(VecGhostRestoreLocalForm(ghosted, &localForm), "VecGhostRestoreLocalForm");
+}
+
+}  // namespace
+
+void DistributedSystem::assembleNonlinear(Vec ghostedDisplacement, Mat tangent) {
+  if (tangent != nullptr) checkPetsc(MatZeroEntries(tangent), "MatZeroEntries");
+  checkPetsc(VecSet(internalForce.get(), 0.0), "VecSet");
+  withLocalForm(ghostedDisplacement, [&](const PetscScalar* values) {
+    collectively(comm, [&] { forceModel->addForcesAndTangent(values, internalForce.get(), tangent); });
+  });
+  if (tangent != nullptr) checkPetsc(MatAssemblyBegin(tangent, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
   checkPetsc(VecAssemblyBegin(internalForce.get()), "VecAssemblyBegin");
-  checkPetsc(MatAssemblyEnd(stiffness.get(), MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  if (tangent != nullptr) checkPetsc(MatAssemblyEnd(tangent, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
   checkPetsc(VecAssemblyEnd(internalForce.get()), "VecAssemblyEnd");
+}
+
+double DistributedSystem::elasticEnergy(Vec ghostedDisplacement) {
+  double local = 0.0;
+  withLocalForm(ghostedDisplacement,
+                [&](const PetscScalar* values) { collectively(comm, [&] { local = forceModel->energy(values); }); });
+  double total = 0.0;
+  MPI_Allreduce(&local, &total, 1, MPI_DOUBLE, MPI_SUM, comm);
+  return total;
 }
 
 void DistributedSystem::scatterOwned(const Eigen::VectorXd& full, Vec vector) const {

@@ -10,26 +10,27 @@
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "detail/distributedLayout.hpp"
+#include "detail/localForceModel.hpp"
 #include "detail/petscHandle.hpp"
 
 namespace asyncfem::detail {
 
-/// What a local element needs at every step (rest shape, material, cached K_e for the
-/// corotational model).
+/// What a local element's mass and linear stiffness need (rest shape, material).
 struct ElementData {
   ElementPositions rest;
   Eigen::Matrix<double, 3, 4> gradients;  ///< shape-function gradients, rest configuration
   double volume = 0.0;                    ///< signed
   double density = 0.0;
-  ElementMatrix stiffness;  ///< K_e, corotational model only
 };
 
 /// The distributed body of a simulation, everything but the time stepping and the
 /// linear solvers: the layout (who owns which elements and DOFs, DistributedLayout), the
-/// local elements' rest data, the matrices M and K (K(u) for the corotational model) and
+/// local elements' rest data, the matrices M and K (K(u) for nonlinear models, from the
+/// rank's LocalForceModel) and
 /// the system matrix that combines them on their shared pattern, the state and work
 /// vectors (displacement ghosted), the static external force M g + constant force, and
 /// the scatter of full vectors to rank 0. Collective: every rank constructs it from the
@@ -43,11 +44,15 @@ struct DistributedSystem {
   PetscInt ownedDofs() const { return 3 * layout.ownedBlocks; }
   PetscInt globalDofs() const { return 3 * layout.numBlocks; }
 
-  /// system = massWeight M + stiffnessWeight K (values only; the pattern is M's).
-  void combineSystem(double massWeight, double stiffnessWeight);
-  /// Corotated f_int(u) into internalForce and simple tangent K(u) into stiffness, one
-  /// polar decomposition per element; time names the state in errors.
-  void assembleCorotated(double time);
+  /// system = massWeight M + stiffnessWeight K (values only; the pattern is M's), plus
+  /// extraWeight extra when extra is not null (a matrix of the same pattern).
+  void combineSystem(double massWeight, double stiffnessWeight, Mat extra = nullptr, double extraWeight = 0.0);
+  /// Nonlinear models: f_int(u) into internalForce and, unless tangent is null, K(u) into
+  /// tangent (stiffness or iterateStiffness), u the ghosted vector given (displacement or
+  /// trial); ghosts refreshed first.
+  void assembleNonlinear(Vec ghostedDisplacement, Mat tangent);
+  /// Nonlinear models: the elastic energy of the whole body at u (ghosted; summed over ranks).
+  double elasticEnergy(Vec ghostedDisplacement);
   /// externalForce = static force + timeDependentForce(t) (if any), checked on every rank.
   void evaluateExternalForce(double t, const std::function<void(double, Eigen::VectorXd&)>& timeDependentForce);
   /// The full (3n, fixed DOFs 0) form of a distributed vector on rank 0; empty elsewhere.
@@ -59,14 +64,18 @@ struct DistributedSystem {
 
   MPI_Comm comm;
   int numDofs = 0;  ///< 3n
-  bool corotational = false;
+  bool nonlinear = false;
   DistributedLayout layout;
-  std::vector<ElementData> elements;  ///< per local element
+  std::vector<ElementData> elements;            ///< per local element
+  std::unique_ptr<LocalForceModel> forceModel;  ///< nonlinear models only
 
-  MatHandle mass, stiffness, system;
+  /// iterateStiffness: K at a Newton iterate (nonlinear models with Newton iterations).
+  MatHandle mass, stiffness, iterateStiffness, system;
   NullSpaceHandle nearNullSpace;
   VecHandle displacement;  ///< ghosted
+  VecHandle trial;         ///< ghosted: a Newton iterate's u (nonlinear models)
   VecHandle velocity, acceleration, staticForce, externalForce, internalForce, rhs, increment, work, product;
+  VecHandle residual, correction, candidate;  ///< Newton iterations and line search
   ScatterHandle toRoot;
   VecHandle rootVector;
 
@@ -76,11 +85,10 @@ struct DistributedSystem {
   void createMatrix(MatHandle& matrix) const;
   template <class ElementFunction>
   void assembleMatrix(Mat matrix, const ElementFunction& elementMatrix);
-  void assembleMassAndStiffness(const TetMesh& mesh, MassType massType);
+  void assembleMassAndStiffness(const TetMesh& mesh, const PetscSimulationSettings& settings);
   void createVectors();
   void assembleStaticForce(const PetscSimulationSettings& settings);
   void attachNearNullSpace(const TetMesh& mesh);
-  ElementPositions currentPositions(std::size_t k, const PetscScalar* localDisplacement) const;
 };
 
 }  // namespace asyncfem::detail

@@ -27,6 +27,9 @@ class PetscRuntime {
   /// This process's rank in MPI_COMM_WORLD and the number of ranks.
   int rank() const { return rank_; }
   int size() const { return size_; }
+  /// The largest of value over the ranks, on every rank (collective: every rank calls it),
+  /// e.g. so that a stop request one rank received stops all of them at the same point.
+  int maxOverRanks(int value) const;
 
  private:
   bool ownsInitialization_ = false;

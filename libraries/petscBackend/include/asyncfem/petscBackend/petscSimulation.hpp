@@ -2,6 +2,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
+#include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
 #include <asyncfem/petscBackend/solverSettings.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
@@ -14,20 +16,36 @@ namespace asyncfem {
 
 /// Time integrators of the PETSc backend; the equations are those of the single-process
 /// BackwardEuler and Trapezoidal classes of the integrator library (see
-/// docs/petsc-backend.md), with one linearized (Newton) iteration per step for the
-/// corotational model, the single-process default.
+/// docs/petsc-backend.md): one linearized (Newton) iteration per step for the nonlinear
+/// models, the single-process default, or (backward Euler) Newton iterations with the
+/// line search on the incremental potential (PetscNewtonSettings).
 enum class PetscIntegratorKind { backwardEuler, trapezoidal };
 /// Internal forces: linear FEM (K constant, the system matrix is assembled and its
-/// preconditioner or factor built once) or corotated linear FEM with the simple tangent
-/// R K_e R^T (rotations per element, tangent re-assembled every step).
-enum class PetscForceModelKind { linear, corotational };
+/// preconditioner or factor built once), or a nonlinear model of the single-process
+/// libraries evaluated on each rank's elements (tangent re-assembled every iteration):
+/// corotated linear FEM (CorotationalLinearFEM, tangent PetscSimulationSettings::tangent)
+/// and the hyperelastic materials (makeHyperelasticForceModel, options
+/// PetscSimulationSettings::hyperelastic).
+enum class PetscForceModelKind { linear, corotational, stvk, neoHookean, mooneyRivlin };
 
-/// "backward-euler" / "trapezoidal" and "linear" / "corotational"; parse functions
-/// throw ValidationError listing the accepted names.
+/// "backward-euler" / "trapezoidal" and "linear" / "corotational" / "stvk" /
+/// "neo-hookean" / "mooney-rivlin"; parse functions throw ValidationError listing the
+/// accepted names.
 std::string toString(PetscIntegratorKind kind);
 std::string toString(PetscForceModelKind kind);
 PetscIntegratorKind parsePetscIntegratorKind(const std::string& name);
 PetscForceModelKind parsePetscForceModelKind(const std::string& name);
+
+/// Newton iterations of the backward Euler step for nonlinear models, with the meaning
+/// of IntegratorOptions' fields of the same names (the single-process BackwardEuler):
+/// maxIterations 1 is the linearized step; more iterate on the step equations until
+/// |R|_2 <= tolerance |b_0|_2, each update (the linearized one included) shortened by
+/// backtracking on the incremental potential when lineSearch is set.
+struct PetscNewtonSettings {
+  int maxIterations = 1;
+  double tolerance = 1e-8;
+  bool lineSearch = true;
+};
 
 /// Everything a distributed run needs besides the mesh. Every rank passes the same
 /// values (the mesh and these settings are replicated; the matrices, vectors and solves
@@ -35,6 +53,9 @@ PetscForceModelKind parsePetscForceModelKind(const std::string& name);
 struct PetscSimulationSettings {
   PetscIntegratorKind integrator = PetscIntegratorKind::backwardEuler;
   PetscForceModelKind forceModel = PetscForceModelKind::linear;
+  TangentKind tangent = TangentKind::simple;  ///< corotational model only
+  HyperelasticOptions hyperelastic;           ///< stvk, neo-Hookean and Mooney-Rivlin only
+  PetscNewtonSettings newton;                 ///< nonlinear models; > 1 iteration: backward Euler only
   MassType massType = MassType::consistent;
   double timestep = 0.01;          ///< h (time units), > 0
   double rayleighMass = 0.0;       ///< alpha (1/s), D = alpha M + beta K
@@ -71,6 +92,8 @@ struct PetscRunStats {
   long long solves = 0;
   long long solverIterations = 0;  ///< summed over solves (1 per direct solve)
   int lastIterations = 0;          ///< of the last step's solve
+  long long newtonIterations = 0;  ///< linear systems solved for steps (1 per linearized step)
+  int lineSearchHalvings = 0;      ///< of the last step
 };
 
 /// A body advanced in time on PETSc over MPI (every member is collective: all ranks
@@ -109,6 +132,16 @@ class PetscSimulation {
   /// Sets u and v (full 3n vectors, the same on every rank; fixed entries are ignored)
   /// and the time. Throws ValidationError on a size mismatch or non-finite values.
   void setState(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, double time = 0.0);
+  /// What the next step needs beyond u, v and t, as the single-process integrators'
+  /// internalState(): the trapezoidal rule's acceleration a_k (3n, on rank 0; empty
+  /// elsewhere, and empty on every rank before the first step or after setState(), when
+  /// a_k is still to be computed); empty for backward Euler. Collective.
+  Eigen::VectorXd gatherInternalState() const;
+  /// Restores it after setState() (checkpoints): the same full vector on every rank, or
+  /// empty (a_k is then computed from the equation of motion, as after setState()).
+  /// ValidationError on a size mismatch, non-finite values or a non-empty state for
+  /// backward Euler. Collective.
+  void setInternalState(const Eigen::VectorXd& state);
   /// The full displacement / velocity (3n, fixed DOFs 0) on rank 0; empty elsewhere.
   Eigen::VectorXd gatherDisplacement() const;
   Eigen::VectorXd gatherVelocity() const;

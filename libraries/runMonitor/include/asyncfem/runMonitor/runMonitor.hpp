@@ -130,6 +130,20 @@ std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, 
                                         const Integrator& integrator, const SimulationFileHeader& header,
                                         bool fingerprintDiffers);
 
+/// The same for a run whose state is not an Integrator's (the PETSc backend's): the
+/// integrator named integratorName with a state of numDofs values.
+std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, const SimulationFileHeader& stored,
+                                        const std::string& integratorName, std::int64_t numDofs,
+                                        const SimulationFileHeader& header, bool fingerprintDiffers);
+
+/// The checks of resumeFromCheckpoint() (below) for a run whose state is not an
+/// Integrator's: integratorName and numDofs stand for the integrator's name() and state
+/// size. Returns the checkpoint to continue from; restores nothing. Throws as
+/// resumeFromCheckpoint() does.
+SimulationCheckpoint checkpointToResume(const std::filesystem::path& output, const SimulationFileHeader& header,
+                                        std::uint32_t fingerprint, std::int64_t requestedFrames,
+                                        const std::string& integratorName, std::int64_t numDofs);
+
 /// Continues an interrupted run: reads the checkpoint next to output (checkpointPathFor),
 /// checks that output and checkpoint were written by this run (runDifferences against
 /// header and fingerprint), that requestedFrames is not below the frames already finished,
