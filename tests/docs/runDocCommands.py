@@ -57,7 +57,7 @@ import time
 
 # Folders a documented command may read (copied, so commands that regenerate files in
 # them write to the copy).
-DATA_FOLDERS = ["models", "tests/benchmarks/scenes", "tests/data"]
+DATA_FOLDERS = ["models", "tests/benchmarks/scenes", "tests/benchmarks/configs", "tests/data"]
 SHELL_LANGUAGES = {"sh", "bash", "shell", "console"}
 RUN_LANGUAGES = SHELL_LANGUAGES | {"python", "json"}
 MARKER = re.compile(r"^\s*<!--\s*docs-test:\s*(\w+)\b\s?(.*?)\s*-->\s*$")

@@ -85,3 +85,37 @@ def test_the_writer_refuses_a_nan_frame(tmp_path):
             writer.append_frame(0.1, u)
     reader = af.SimulationReader(path)
     assert len(reader) == 1 and np.isfinite(reader.read_frame(0).displacement).all()
+
+
+def test_run_monitor_names_the_frame():
+    """The library's frame loop from Python (af.RunMonitor, as offlineSimulator runs it): the
+    same NaN, stepped frame by frame, names the frame, step and vertex, in the message and as
+    fields of the exception; the state stays at the start of the failing step."""
+    mesh = small_box(cells=4)
+    problem = af.Problem(mesh, mesh.set_vertices("xmin"))
+    system = problem.dynamic_system()
+    pull = np.zeros(mesh.num_dofs)
+    pull.reshape(-1, 3)[mesh.set_vertices("xmax")] = [0.0, -5.0, 0.0]
+    system.external_force = lambda t, u, v: pull
+    system.force_model = NaNAfterSomeCalls(problem.stiffness_matrix())
+    h = 0.01
+    options = af.IntegratorOptions()
+    options.max_iterations = 3
+    stepper = af.BackwardEuler(system, h, options)
+    # The pull is set on the system, not given to the problem as a load, so the monitor's
+    # energy check (which knows the problem's loads only) is off.
+    monitor = af.RunMonitor(problem, energy_check=False)
+    finished = -1
+    with pytest.raises(af.NumericalError) as error:
+        for frame in range(20):
+            monitor.advance_frame(stepper, frame, STEPS_PER_FRAME)
+            finished = frame
+    fault = error.value
+    assert fault.frame == finished + 1 >= 1  # the frame after the last finished one
+    assert fault.step == int(round(stepper.time / h)) + 1  # 1-based: the step after the state kept
+    assert fault.vertex == BAD_VERTEX and fault.dof == 3 * BAD_VERTEX + 1
+    assert fault.time == pytest.approx(stepper.time + h, abs=1e-12)
+    assert str(fault).startswith(f"frame {fault.frame} (step {fault.step}, t = ")
+    assert np.isfinite(stepper.displacement).all()
+    with pytest.raises(ValueError, match="steps_per_frame"):
+        monitor.advance_frame(stepper, 0, 0)

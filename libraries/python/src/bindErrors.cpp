@@ -41,8 +41,11 @@ void bindErrors(py::module_& module) {
                            "Malformed input file: e.file is the file, e.line the 1-based line (0: the whole file).");
   validationErrorType = newType(module, "ValidationError", errorType,
                                 "Input that parses but is not valid (degenerate element, unknown set, bad value).");
-  numericalErrorType = newType(module, "NumericalError", errorType,
-                               "A computation failed numerically (non-finite state, failed factorization).");
+  numericalErrorType =
+      newType(module, "NumericalError", errorType,
+              "A computation failed numerically (non-finite state, failed factorization). Where it happened, "
+              "when known: e.frame (0-based), e.step (1-based), e.time, e.dof, e.vertex (0-based; -1 or nan when "
+              "unknown) and e.region, e.region_name (multirate integrators; -1: the large-step region L).");
   py::register_exception_translator([](std::exception_ptr pointer) {
     try {
       if (pointer) std::rethrow_exception(pointer);
@@ -54,7 +57,16 @@ void bindErrors(py::module_& module) {
     } catch (const ValidationError& error) {
       raise(validationErrorType, error.what());
     } catch (const NumericalError& error) {
-      raise(numericalErrorType, error.what());
+      const NumericalErrorLocation& where = error.location();
+      py::dict fields;
+      fields["frame"] = where.frame;
+      fields["step"] = where.step;
+      fields["time"] = where.time;
+      fields["dof"] = where.dof;
+      fields["vertex"] = where.vertex;
+      fields["region"] = where.region;
+      fields["region_name"] = where.regionName;
+      raise(numericalErrorType, error.what(), fields);
     } catch (const Error& error) {
       raise(errorType, error.what());
     }

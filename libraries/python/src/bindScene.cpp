@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <asyncfem/problem/problem.hpp>
+#include <asyncfem/runMonitor/runMonitor.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
@@ -136,6 +137,33 @@ void bindScene(py::module_& module) {
         return buildSceneMesh(loadScene(path));
       },
       py::arg("path"), "the mesh a scene file runs on (file or generator, material overrides applied)");
+  py::class_<RunMonitor>(module, "RunMonitor",
+                         "Watches a run for numerical failure, as offlineSimulator does: after every step a finite "
+                         "state and max |u| <= blow_up_factor x the rest bounding-box diagonal, no inverted element "
+                         "under a hyperelastic model without inversion handling, and after every frame of the free "
+                         "phase no energy growth. A failure raises NumericalError naming the frame, step, time and "
+                         "vertex (e.frame, e.step, e.time, e.vertex) with the state left at the failing step's start.")
+      .def(py::init([](const Problem& problem, double blowUpFactor, bool energyCheck) {
+             if (!(blowUpFactor > 0.0)) {
+               throw py::value_error("blow_up_factor: expected a number > 0, got " + std::to_string(blowUpFactor));
+             }
+             return RunMonitor(problem, RunMonitor::Settings{blowUpFactor, energyCheck});
+           }),
+           py::arg("problem"), py::arg("blow_up_factor") = 1000.0, py::arg("energy_check") = true,
+           py::keep_alive<1, 2>())
+      .def(
+          "advance_frame",
+          [](RunMonitor& monitor, Integrator& integrator, long long frame, int stepsPerFrame) {
+            if (stepsPerFrame < 1) {
+              throw py::value_error("steps_per_frame: expected a count >= 1, got " + std::to_string(stepsPerFrame));
+            }
+            py::gil_scoped_release release;
+            monitor.advanceFrame(integrator, frame, stepsPerFrame);
+          },
+          py::arg("integrator"), py::arg("frame"), py::arg("steps_per_frame"),
+          "runs steps_per_frame steps of integrator with the checks; frame (0-based) is the one messages name")
+      .def_property_readonly("energy_evaluations", &RunMonitor::energyEvaluations,
+                             "energy checks made so far (one per frame in the free phase)");
   module.def(
       "run_scene",
       [](const std::filesystem::path& path, const std::optional<std::filesystem::path>& output,
