@@ -115,11 +115,8 @@ Eigen::MatrixXd stepMap(Integrator& integrator) {
   return phi;
 }
 
-// The dense step map of small models: its worst one-step energy ratio, the largest
-// generalized eigenvalue of (Phi^T H Phi, H) with H = diag(K, M) on the free DOFs, and its
-// spectral radius are at most 1. Eigen-solver round-off on these 96 x 96 maps is ~1e-12.
-TEST(NestedRegions, DenseStepMapNeverGainsEnergy) {
-  test::TestBody body = smallBar();
+/// H = diag(K, M) on the free DOFs: E = x^T H x / 2 for the state x = [u; v].
+Eigen::MatrixXd stateEnergyMatrix(const test::TestBody& body) {
   const std::vector<int>& free = body.system.freeDofs.freeToFull();
   const auto nf = static_cast<Eigen::Index>(free.size());
   Eigen::SparseMatrix<double> k = body.system.forceModel->createStiffnessMatrix();
@@ -131,6 +128,26 @@ TEST(NestedRegions, DenseStepMapNeverGainsEnergy) {
       energy(a, b) = fullK(free[static_cast<std::size_t>(a)], free[static_cast<std::size_t>(b)]);
       energy(nf + a, nf + b) = fullM(free[static_cast<std::size_t>(a)], free[static_cast<std::size_t>(b)]);
     }
+  return energy;
+}
+
+/// Worst one-step energy ratio: the largest eigenvalue of (Phi^T H Phi, H).
+double worstEnergyRatio(const Eigen::MatrixXd& phi, const Eigen::MatrixXd& energy) {
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ratio(phi.transpose() * energy * phi, energy,
+                                                                  Eigen::EigenvaluesOnly);
+  return ratio.eigenvalues().maxCoeff();
+}
+
+double spectralRadius(const Eigen::MatrixXd& phi) {
+  return Eigen::EigenSolver<Eigen::MatrixXd>(phi, false).eigenvalues().cwiseAbs().maxCoeff();
+}
+
+// The dense step map of small models: its worst one-step energy ratio, the largest
+// generalized eigenvalue of (Phi^T H Phi, H) with H = diag(K, M) on the free DOFs, and its
+// spectral radius are at most 1. Eigen-solver round-off on these 96 x 96 maps is ~1e-12.
+TEST(NestedRegions, DenseStepMapNeverGainsEnergy) {
+  test::TestBody body = smallBar();
+  const Eigen::MatrixXd energy = stateEnergyMatrix(body);
   std::mt19937 random(7);
   const int ratios[][2] = {{4, 4}, {2, 16}, {16, 16}, {8, 1}};
   for (const auto& pair : ratios)
@@ -138,12 +155,26 @@ TEST(NestedRegions, DenseStepMapNeverGainsEnergy) {
       const Hierarchy h = randomHierarchy(body.mesh, random, pair[0], pair[1]);
       NestedAsyncBackwardEuler integrator(body.system, hL, withFreeDofs(body, h.regions));
       const Eigen::MatrixXd phi = stepMap(integrator);
-      Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ratio(phi.transpose() * energy * phi, energy,
-                                                                      Eigen::EigenvaluesOnly);
-      EXPECT_LE(ratio.eigenvalues().maxCoeff(), 1.0 + 1e-10) << h.describe() << " hL " << hL;
-      const double radius = Eigen::EigenSolver<Eigen::MatrixXd>(phi, false).eigenvalues().cwiseAbs().maxCoeff();
+      EXPECT_LE(worstEnergyRatio(phi, energy), 1.0 + 1e-10) << h.describe() << " hL " << hL;
+      const double radius = spectralRadius(phi);
       EXPECT_LE(radius, 1.0 + 1e-10) << h.describe() << " hL " << hL;
       EXPECT_GT(radius, 0.5) << "a map this contractive would mean the test measures nothing";
+    }
+}
+
+// The two-level stable coupling (AsyncBackwardEuler, Eqs. A8-A14) by the same dense check:
+// one region at ratios 1..64 on the free end of the cantilever, two step sizes.
+TEST(NestedRegions, TwoLevelStepMapNeverGainsEnergy) {
+  test::TestBody body = smallBar();
+  const Eigen::MatrixXd energy = stateEnergyMatrix(body);
+  AsyncOptions exact;
+  exact.laggedSchur = false;
+  for (int ratio : {1, 4, 64})
+    for (double hL : {1e-3, 2e-2}) {
+      AsyncBackwardEuler integrator(body.system, hL, {{"end", test::verticesBeyond(body.mesh, 0.5), ratio}}, exact);
+      const Eigen::MatrixXd phi = stepMap(integrator);
+      EXPECT_LE(worstEnergyRatio(phi, energy), 1.0 + 1e-10) << "m " << ratio << " hL " << hL;
+      EXPECT_LE(spectralRadius(phi), 1.0 + 1e-10) << "m " << ratio << " hL " << hL;
     }
 }
 
