@@ -58,6 +58,22 @@ grep -q "newton      " petsc.txt || { echo "no Newton line in the summary:"; cat
 "$mpiexec" -n 2 "$bin/offlineSimulator" scene.json --backend petsc --petsc-solver mumps -q --frames 4 -o resumed.afsim
 "$mpiexec" -n 3 "$bin/offlineSimulator" scene.json --backend petsc --petsc-solver mumps -q --resume -o resumed.afsim
 agree petsc.afsim resumed.afsim resumed-on-3-ranks 1e-6
+# .vtu series and velocities on PETSc: rank 0 writes them; 8 .vtu files listed in frames.pvd,
+# velocities in the records, and the frames equal the local run's (the linearized bound).
+python3 - <<'PY'
+import json
+scene = json.load(open("scene.json"))
+scene["forceModel"], scene["integrator"]["options"] = {"type": "linear"}, {}
+scene["output"] = {"velocities": True}
+json.dump(scene, open("outputs.json", "w"))
+PY
+"$bin/offlineSimulator" outputs.json -q -o local-outputs.afsim --vtu local-vtu
+"$mpiexec" -n 2 "$bin/offlineSimulator" outputs.json --backend petsc --petsc-solver mumps -q -o petsc-outputs.afsim \
+  --vtu petsc-vtu
+[ "$(ls petsc-vtu/frame_*.vtu | wc -l)" = 8 ] || { ls petsc-vtu; exit 1; }
+[ "$(grep -c '<DataSet' petsc-vtu/frames.pvd)" = 8 ] || { cat petsc-vtu/frames.pvd; exit 1; }
+"$bin/afsimTool" info petsc-outputs.afsim | grep -q "velocities  yes" || { "$bin/afsimTool" info petsc-outputs.afsim; exit 1; }
+agree local-outputs.afsim petsc-outputs.afsim vtu-and-velocities 1e-9
 # A local run does not take a PETSc checkpoint (nor the reverse): the integrator differs by name.
 if "$bin/offlineSimulator" scene.json -q --resume -o resumed.afsim 2> err.txt; then exit 1; fi
 grep -q 'integrator (backward-euler (PETSc) there, backward-euler here)' err.txt || { cat err.txt; exit 1; }

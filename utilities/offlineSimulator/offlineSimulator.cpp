@@ -359,14 +359,6 @@ void printSummary(const asyncfem::Scene& scene, const asyncfem::Simulation& simu
 #if ASYNCFEM_OFFLINE_WITH_PETSC
 const std::string petscPrefix = "--backend petsc: ";
 
-// What the PETSc backend does not write: .vtu files, velocities.
-void refusePetscOutputs(const asyncfem::Scene& scene) {
-  if (!scene.output.vtuFolder.empty() || scene.output.velocities) {
-    throw asyncfem::Error(petscPrefix +
-                          ".vtu output and output.velocities are not supported; the .afsim file is written");
-  }
-}
-
 // The backend's settings for the scene's problem (asyncfem::petscSettingsForProblem) and
 // its integrator's options (Newton iterations), with the solver chosen on the command line.
 asyncfem::PetscSimulationSettings petscSettings(const CommandLine& options, const asyncfem::Scene& scene,
@@ -410,11 +402,15 @@ void printPetscSummary(const asyncfem::Scene& scene, const asyncfem::PetscRunSta
   std::cout << out.str() << std::flush;
 }
 
-// The output of a PETSc run: rank 0 writes the frames and the checkpoint (writer is null on
-// the other ranks); every rank gathers the state for a checkpoint. The checkpoint names the
+// The output of a PETSc run: rank 0 writes the frames, the .vtu series and the checkpoint
+// (writer and vtuSeries are empty on the other ranks); every rank gathers the state for a
+// checkpoint and, with output.velocities, for each frame. The checkpoint names the
 // integrator with " (PETSc)", so that a local run does not resume it, nor this one a local one.
 struct PetscOutput {
   std::unique_ptr<asyncfem::SimulationWriter> writer;
+  std::optional<asyncfem::VtuSeriesWriter> vtuSeries;
+  const asyncfem::TetMesh* mesh = nullptr;
+  int vtuEvery = 1;
   asyncfem::SimulationFileHeader header;
   fs::path checkpointFile;
   std::uint32_t fingerprint = 0;
@@ -458,6 +454,7 @@ int openPetscOutput(const CommandLine& options, const asyncfem::Scene& scene, co
   output.header.numVertices = problem.mesh().numVertices();
   output.header.frameInterval = timing.frameInterval;
   output.header.timestep = simulation.timestep();
+  output.header.hasVelocities = scene.output.velocities;
   output.header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
   output.header.sceneFingerprint = asyncfem::problemFingerprint(problem);
   output.checkpointFile = asyncfem::checkpointPathFor(scene.output.file);
@@ -468,10 +465,16 @@ int openPetscOutput(const CommandLine& options, const asyncfem::Scene& scene, co
   output.sync = scene.output.sync;
   const bool root = runtime.rank() == 0;
   const asyncfem::SimulationWriter::Options writerOptions{scene.output.sync};
+  output.mesh = &problem.mesh();
+  output.vtuEvery = scene.output.vtuEvery;
+  if (root && !scene.output.vtuFolder.empty()) {
+    output.vtuSeries.emplace(scene.output.vtuFolder, scene.output.vtuEncoding);
+  }
   if (!options.resume) {
     if (root) {
       createOutputFolder(scene.output.file);
       output.writer = std::make_unique<asyncfem::SimulationWriter>(scene.output.file, output.header, writerOptions);
+      if (output.vtuSeries) output.vtuSeries->writeCollection();
     }
     output.checkpoint(simulation, 0);  // the rest state: a run stopped before its first frame resumes too
     return 0;
@@ -492,6 +495,10 @@ int openPetscOutput(const CommandLine& options, const asyncfem::Scene& scene, co
   const auto frames = static_cast<int>(checkpoint.frames);
   if (root) {
     output.writer = asyncfem::SimulationWriter::continueFile(scene.output.file, output.header, frames, writerOptions);
+    if (output.vtuSeries) {
+      if (frames > 0) listEarlierVtuFrames(scene, frames, *output.vtuSeries);
+      output.vtuSeries->writeCollection();
+    }
   }
   output.checkpointFrames = frames;
   return frames;
@@ -514,7 +521,15 @@ int runPetscFrames(const CommandLine& options, const asyncfem::Scene& scene, con
     for (; frame < timing.frameCount && runtime.maxOverRanks(static_cast<int>(stopSignal)) == 0; ++frame) {
       for (int s = 0; s < timing.stepsPerFrame; ++s) simulation.step();  // non-finite states throw on every rank
       const Eigen::VectorXd u = simulation.gatherDisplacement();
-      if (root) output.writer->appendFrame(simulation.time(), u);
+      if (output.header.hasVelocities) {
+        const Eigen::VectorXd v = simulation.gatherVelocity();  // collective, like the gather above
+        if (root) output.writer->appendFrame(simulation.time(), u, v);
+      } else if (root) {
+        output.writer->appendFrame(simulation.time(), u);
+      }
+      if (root && output.vtuSeries && frame % output.vtuEvery == 0) {
+        output.vtuSeries->writeFrame(frame, simulation.time(), *output.mesh, u);
+      }
       if (output.due(runtime, frame + 1, timing.frameCount)) output.checkpoint(simulation, frame + 1);
       progress.update(frame + 1);
     }
@@ -532,7 +547,6 @@ int runPetscFrames(const CommandLine& options, const asyncfem::Scene& scene, con
 // rank 0 writes the frames). Supports what that backend integrates: linear and
 // corotational backward Euler and trapezoidal, loads that depend on time only.
 int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::Scene& scene) {
-  refusePetscOutputs(scene);
   asyncfem::Stopwatch setupWatch;
   setupWatch.start();
   asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
