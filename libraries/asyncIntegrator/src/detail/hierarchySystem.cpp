@@ -11,7 +11,6 @@
 #include <string>
 #include <tuple>
 
-#include "detail/multirateSupport.hpp"
 #include "detail/sparseBlocks.hpp"
 
 namespace asyncfem::detail {
@@ -271,17 +270,12 @@ void HierarchySystem::chooseOrder() {
   order_.resize(static_cast<Eigen::Index>(keys.size()));
   for (std::size_t position = 0; position < keys.size(); ++position)
     order_.indices()[keys[position].unknown] = static_cast<int>(position);
-  // Position rows (Eq. N5) are in metres; scaled by M_dd / h_d they weigh like the velocity
-  // rows (momentum), so the LU's diagonal pivots stay the natural ones.
-  rowScale_ = Eigen::VectorXd::Ones(unknowns());
-  for (int d = 0; d < nf; ++d) {
-    const int dof = free_[static_cast<std::size_t>(d)];
-    const double mass = system_.mass.coeff(dof, dof);
-    for (long long j = 1; j <= dofCount_[static_cast<std::size_t>(d)]; ++j) rowScale_[displacementRow(d, j)] = mass;
-  }
 }
 
 void HierarchySystem::factorize(IntegratorStats& stats) {
+  // Position rows (Eq. N5) are in metres; scaled by M_dd / h_d they weigh like the velocity
+  // rows (momentum), so the LU's diagonal pivots stay the natural ones.
+  rowScale_ = Eigen::VectorXd::Ones(unknowns());
   for (int d = 0; d < static_cast<int>(free_.size()); ++d) {
     const double h = largeStep_ / dofCount_[static_cast<std::size_t>(d)];
     const int dof = free_[static_cast<std::size_t>(d)];
