@@ -149,22 +149,21 @@ void NestedAsyncBackwardEuler::step() {
   }
   Stopwatch forces;
   forces.start();
-  Eigen::VectorXd internalForce(displacement_.size());
-  system_.forceModel->internalForces(displacement_, internalForce);
-  // f_ext where some DOF's step ends (Eq. N3): t_0 + k hL / units, the last one at t_1.
-  std::map<long long, Eigen::VectorXd> external;
+  internalForce_.resize(displacement_.size());
+  system_.forceModel->internalForces(displacement_, internalForce_);
+  // f_ext where some DOF's step ends (Eq. N3): t_0 + k hL / units, the last one at t_1. The
+  // vectors are kept from step to step (same units every step), so nothing is allocated.
   if (system_.externalForce) {
     const double t0 = time(), t1 = stepEndTime();
     const auto units = static_cast<double>(counts_.units());
     for (long long unit : hierarchy_->stepEndUnits()) {
-      Eigen::VectorXd& f = external[unit];
+      Eigen::VectorXd& f = external_[unit];
       evaluateExternalForce(unit == counts_.units() ? t1 : t0 + static_cast<double>(unit) * (timestep() / units), f);
     }
   }
   stats_.forceSeconds += forces.stop();
-  Eigen::VectorXd u1, v1;
-  hierarchy_->step(displacement_, velocity_, internalForce, external, u1, v1, stats_);
-  commitStep(u1, v1);
+  hierarchy_->step(displacement_, velocity_, internalForce_, external_, newDisplacement_, newVelocity_, stats_);
+  commitStep(newDisplacement_, newVelocity_);
 }
 
 RunReport NestedAsyncBackwardEuler::report() const {

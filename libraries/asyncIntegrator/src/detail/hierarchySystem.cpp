@@ -68,6 +68,10 @@ HierarchySystem::HierarchySystem(const TetMesh& mesh, const DynamicSystem& syste
     offset_[d + 1] = static_cast<int>(total);
   }
   velocityUnknowns_ = static_cast<int>(total);
+  std::set<long long> ends;
+  for (int count : std::set<int>(dofCount_.begin(), dofCount_.end()))
+    for (long long j = 1; j <= count; ++j) ends.insert(j * (units_ / count));
+  stepEndUnits_.assign(ends.begin(), ends.end());
   ElementBlock probe;
   perElementTangent_ =
       mesh.numElements() > 0 && system.forceModel->elementTangent(Eigen::VectorXd::Zero(mesh.numDofs()), 0, probe);
@@ -298,13 +302,6 @@ void HierarchySystem::factorize(IntegratorStats& stats) {
   }
   factorNonZeros_ = lu_.nnzL() + lu_.nnzU();
   ++stats.factorizations;
-}
-
-std::vector<long long> HierarchySystem::stepEndUnits() const {
-  std::set<long long> units;
-  for (int count : std::set<int>(dofCount_.begin(), dofCount_.end()))
-    for (long long j = 1; j <= count; ++j) units.insert(j * (units_ / count));
-  return {units.begin(), units.end()};
 }
 
 // Eq. N3's right-hand side: h_d (f_ext,d(t_{d,j}) - f_int,d(u_0)), plus (M v_0)_d in d's

@@ -37,8 +37,8 @@ class HierarchySystem {
   void step(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0, const Eigen::VectorXd& internalForce,
             const std::map<long long, Eigen::VectorXd>& external, Eigen::VectorXd& u1, Eigen::VectorXd& v1,
             IntegratorStats& stats);
-  /// Time units at which some free DOF's step ends (where f_ext is needed).
-  std::vector<long long> stepEndUnits() const;
+  /// Time units at which some free DOF's step ends (where f_ext is needed), ascending.
+  const std::vector<long long>& stepEndUnits() const { return stepEndUnits_; }
 
   long long unknowns() const { return 2LL * velocityUnknowns_; }
   long long factorNonZeros() const { return factorNonZeros_; }
@@ -72,6 +72,7 @@ class HierarchySystem {
   const DynamicSystem& system_;
   const StepCounts& counts_;
   std::vector<int> free_, freeIndex_, dofCount_, offset_;
+  std::vector<long long> stepEndUnits_;
   int velocityUnknowns_ = 0;
   long long units_ = 1;
   double largeStep_ = 0.0;

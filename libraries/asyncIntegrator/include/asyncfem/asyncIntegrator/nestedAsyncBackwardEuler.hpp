@@ -5,6 +5,7 @@
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/integrator/multirateIntegrator.hpp>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -103,6 +104,9 @@ class NestedAsyncBackwardEuler final : public Integrator, public MultirateIntegr
   StepCounts counts_;
   std::unique_ptr<detail::HierarchySystem> hierarchy_;
   std::vector<RegionSummary> summaries_;
+  // Per-step buffers: f_int(u_0), f_ext at each step-end time unit, the new state.
+  Eigen::VectorXd internalForce_, newDisplacement_, newVelocity_;
+  std::map<long long, Eigen::VectorXd> external_;
   bool linear_ = true;
   bool built_ = false;
   double setUpSeconds_ = 0.0;
