@@ -10,7 +10,9 @@
 // Rows with a flop model (see kernelCost()) also report flops_per_element,
 // bytes_per_element, the achieved GFLOPs and GBps (per wall second; *_cpu per CPU second of
 // each thread) and their fractions of the BLAS dgemm rate and the STREAM-triad bandwidth
-// measured in the same process (machineRates.hpp; machine_* counters).
+// measured in the same process (machineRates.hpp; machine_* counters). The
+// *ScalarKernel rows run the corotational model with ElementKernel::scalar, the baseline
+// of the batched (SIMD) pass 1 in the same run.
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
@@ -78,6 +80,8 @@ double corotationalSeconds(int cells) {
 enum class Variant {
   corotational,
   corotationalExact,
+  corotationalScalar,
+  corotationalExactScalar,
   stvkGreen,
   stvk,
   neoHookean,
@@ -95,6 +99,13 @@ std::unique_ptr<ForceModel> makeModel(Variant variant, const TetMesh& mesh, bool
       return std::make_unique<CorotationalLinearFEM>(mesh);
     case Variant::corotationalExact:
       return std::make_unique<CorotationalLinearFEM>(mesh, TangentKind::exact);
+    case Variant::corotationalScalar:
+    case Variant::corotationalExactScalar: {
+      auto model = std::make_unique<CorotationalLinearFEM>(
+          mesh, variant == Variant::corotationalScalar ? TangentKind::simple : TangentKind::exact);
+      model->setElementKernel(ElementKernel::scalar);
+      return model;
+    }
     case Variant::stvkGreen:
       return makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::stvk);
     case Variant::stvk:
@@ -158,8 +169,10 @@ KernelCost kernelCost(Variant variant, bool invariantPath) {
   const double secondInvariantFlops = 153.0;  // B = F F^T and the 27 W_2 terms
   switch (variant) {
     case Variant::corotational:
+    case Variant::corotationalScalar:
       return {619.0 + 780.0 + 12.0, 248.0, 224.0 + 272.0 + 544.0 + 112.0 + 2304.0};
     case Variant::corotationalExact:
+    case Variant::corotationalExactScalar:
       return {619.0 + 95.0 + 4224.0 + 12.0, 248.0, 568.0 + 1600.0 + 64.0 + 2304.0 + 112.0};
     case Variant::stvkGreen:
       // F 75; E = (F^T F - I) / 2 63; S 16; V F S g 114; h = F g 60, g^T S g 140, g^T g 80,
@@ -245,6 +258,12 @@ void forcesAndTangent(benchmark::State& state, Variant variant, bool invariantPa
 
 BENCHMARK_CAPTURE(forcesAndTangent, corotational, Variant::corotational, true)->Arg(12)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, corotationalExact, Variant::corotationalExact, true)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, corotationalScalarKernel, Variant::corotationalScalar, true)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, corotationalExactScalarKernel, Variant::corotationalExactScalar, true)
     ->Arg(12)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, stvkGreenStrain, Variant::stvkGreen, true)->Arg(12)->Unit(benchmark::kMillisecond);
