@@ -256,6 +256,31 @@ void forcesAndTangent(benchmark::State& state, Variant variant, bool invariantPa
               cpuTotal / (calls * elements));
 }
 
+// Pass 1 of the corotational model alone (elasticEnergy() at a new displacement: F, R,
+// stress, element forces and rotated gradients, no assembly), per ElementKernel.
+void corotationalPass1(benchmark::State& state, ElementKernel kernel) {
+  const Setup& s = setup(static_cast<int>(state.range(0)));
+  CorotationalLinearFEM model(s.mesh);
+  model.setElementKernel(kernel);
+  Eigen::VectorXd displacement = s.displacement;
+  double total = 0.0;
+  const double cpuStart = processCpuSeconds();
+  for (auto _ : state) {
+    displacement[0] = -displacement[0];
+    Stopwatch watch;
+    watch.start();
+    benchmark::DoNotOptimize(model.elasticEnergy(displacement));
+    total += watch.stop();
+  }
+  const double calls = static_cast<double>(state.iterations());
+  const double elements = s.mesh.numElements();
+  state.counters["threads"] = omp_get_max_threads();
+  state.counters["us_per_element"] = 1e6 * total / (calls * elements);
+  state.counters["cpu_us_per_element"] = 1e6 * (processCpuSeconds() - cpuStart) / (calls * elements);
+}
+
+BENCHMARK_CAPTURE(corotationalPass1, batched, ElementKernel::batched)->Arg(12)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(corotationalPass1, scalar, ElementKernel::scalar)->Arg(12)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, corotational, Variant::corotational, true)->Arg(12)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, corotationalExact, Variant::corotationalExact, true)
     ->Arg(12)
