@@ -11,6 +11,8 @@
 #include <string>
 #include <utility>
 
+#include "elementBatches.hpp"
+
 namespace asyncfem {
 
 namespace {
@@ -204,6 +206,8 @@ CorotationalLinearFEM::CorotationalLinearFEM(const TetMesh& mesh, std::shared_pt
     checkElementVolume(e, signedVolumes[toIndex(e)], longestEdges[toIndex(e)], "CorotationalLinearFEM");
   elementScatterOffsets(*assembler_, numElements, blockSlots_, columnLengths_);
   vertexIncidences(elements_, mesh.numVertices(), incidenceOffsets_, incidences_);
+  batches_ = std::make_shared<const detail::ElementBatches>(
+      detail::makeElementBatches(elements_, shapeGradients_, lameVolume_));
   const Eigen::SparseMatrix<double> pattern = assembler_->createMatrix();
   patternOuter_.assign(pattern.outerIndexPtr(), pattern.outerIndexPtr() + pattern.outerSize() + 1);
 }
@@ -229,6 +233,48 @@ bool CorotationalLinearFEM::cacheHolds(const Eigen::VectorXd& displacement) cons
                      sizeof(double) * static_cast<std::size_t>(displacement.size())) == 0;
 }
 
+void CorotationalLinearFEM::evaluateElement(int e, const Eigen::VectorXd& displacement, bool warmStart,
+                                            bool needDifferentialOperator, long long& newtonSteps,
+                                            long long& fallbacks) {
+  const Index i = toIndex(e);
+  const Eigen::Matrix<double, 3, 4>& g = shapeGradients_[i];
+  const Eigen::Matrix3d deformationGradient = elementDeformationGradient(displacement, elements_, e, g);
+  const PolarRotation polar =
+      polarRotation(deformationGradient, warmStart ? &rotations_[i] : nullptr, needDifferentialOperator);
+  newtonSteps += polar.newtonSteps;
+  fallbacks += polar.usedDecomposition ? 1 : 0;
+  const Eigen::Matrix3d& rotation = polar.rotation;
+  rotations_[i] = rotation;
+  if (needDifferentialOperator) differentialOperators_[i] = polar.differentialOperator;
+  const Eigen::Matrix3d stressVolume =
+      corotatedStressVolume(rotation, deformationGradient, lameVolume_[i], elementEnergies_[i]);
+  const Eigen::Matrix3d rotatedStress = rotation * stressVolume;
+  elementForces_[i].noalias() = rotatedStress * g;
+  rotatedGradients_[i].noalias() = rotation * g;
+}
+
+void CorotationalLinearFEM::evaluateBatches(const Eigen::VectorXd& displacement, bool needDifferentialOperator,
+                                            long long& newtonSteps, long long& fallbacks) {
+  detail::BatchOutputs outputs;
+  outputs.rotations = rotations_.data();
+  outputs.differentialOperators = needDifferentialOperator ? differentialOperators_.data() : nullptr;
+  outputs.energies = elementEnergies_.data();
+  outputs.rotatedGradients = rotatedGradients_.data();
+  outputs.forces = elementForces_.data();
+  const int numBatches = batches_->numBatches;
+  long long steps = 0;
+  long long decompositions = 0;
+#pragma omp parallel for schedule(static) reduction(+ : steps, decompositions)
+  for (int batch = 0; batch < numBatches; ++batch) {
+    detail::BatchCounters counters;
+    detail::evaluateBatch(*batches_, batch, displacement, outputs, counters);
+    steps += counters.newtonSteps;
+    decompositions += counters.fallbacks;
+  }
+  newtonSteps += steps;
+  fallbacks += decompositions;
+}
+
 void CorotationalLinearFEM::evaluateElements(const Eigen::VectorXd& displacement, bool needDifferentialOperator) {
   if ((cacheHolds(displacement)) && (!needDifferentialOperator || cacheHasDifferentialOperators_)) {
     ++rotationStats_.reusedEvaluations;
@@ -240,24 +286,15 @@ void CorotationalLinearFEM::evaluateElements(const Eigen::VectorXd& displacement
   const bool warmStart = rotationStart_ == RotationStart::previousEvaluation && cacheValid_;
   long long newtonSteps = 0;
   long long fallbacks = 0;
-#pragma omp parallel for schedule(static) reduction(+ : newtonSteps, fallbacks)
-  for (int e = 0; e < numElements; ++e) {
-    const Index i = toIndex(e);
-    const Eigen::Matrix<double, 3, 4>& g = shapeGradients_[i];
-    const Eigen::Matrix3d deformationGradient = elementDeformationGradient(displacement, elements_, e, g);
-    const PolarRotation polar =
-        polarRotation(deformationGradient, warmStart ? &rotations_[i] : nullptr, needDifferentialOperator);
-    newtonSteps += polar.newtonSteps;
-    fallbacks += polar.usedDecomposition ? 1 : 0;
-    const Eigen::Matrix3d& rotation = polar.rotation;
-    rotations_[i] = rotation;
-    if (needDifferentialOperator) differentialOperators_[i] = polar.differentialOperator;
-    const Eigen::Matrix3d stressVolume =
-        corotatedStressVolume(rotation, deformationGradient, lameVolume_[i], elementEnergies_[i]);
-    const Eigen::Matrix3d rotatedStress = rotation * stressVolume;
-    elementForces_[i].noalias() = rotatedStress * g;
-    rotatedGradients_[i].noalias() = rotation * g;
+  // Elements before firstScalar went through the batched kernel.
+  int firstScalar = 0;
+  if (elementKernel_ == ElementKernel::batched && rotationStart_ == RotationStart::fromDeformation) {
+    evaluateBatches(displacement, needDifferentialOperator, newtonSteps, fallbacks);
+    firstScalar = batches_->numBatches * detail::kElementLanes;
   }
+#pragma omp parallel for schedule(static) reduction(+ : newtonSteps, fallbacks)
+  for (int e = firstScalar; e < numElements; ++e)
+    evaluateElement(e, displacement, warmStart, needDifferentialOperator, newtonSteps, fallbacks);
   rotationStats_.extractions += numElements;
   rotationStats_.newtonSteps += newtonSteps;
   rotationStats_.decompositionFallbacks += fallbacks;

@@ -12,6 +12,10 @@
 
 namespace asyncfem {
 
+namespace detail {
+struct ElementBatches;
+}
+
 /// Which tangent stiffness CorotationalLinearFEM returns.
 enum class TangentKind {
   /// K_e^R = R K_e R^T (R acting block-wise on the four vertices): the rotated linear
@@ -34,6 +38,19 @@ enum class RotationStart {
   /// 2016): fewer Newton steps under smooth motion, but the results then depend on the
   /// history of evaluations at the level of rounding.
   previousEvaluation,
+};
+
+/// How pass 1 (see CorotationalLinearFEM) evaluates the elements.
+enum class ElementKernel {
+  /// Four elements at a time, each scalar of the element computation an array over the
+  /// four (packed SIMD arithmetic), the geometry stored per batch of four at construction;
+  /// the last numElements % 4 elements, and every element under
+  /// RotationStart::previousEvaluation, take the scalar path. Equal to the scalar path to
+  /// rounding (the same Newton iteration, start and stopping rule per element; an element
+  /// that needs the SVD fallback takes the scalar polarRotation()). The default.
+  batched,
+  /// One element at a time.
+  scalar,
 };
 
 /// Counters of the rotation extractions since construction.
@@ -75,7 +92,8 @@ struct RotationStats {
 ///
 /// Evaluation runs in two parallel (OpenMP) passes and needs no allocation after the
 /// first call:
-///   1. per element: F = I + sum_a u_a g_a^T, R by polarRotation() (Newton on SO(3),
+///   1. per element (four at a time with the default ElementKernel::batched): F = I + sum_a u_a g_a^T, R by
+///   polarRotation() (Newton on SO(3),
 ///      SVD fallback), the corotated strain eps = sym(R^T F) - I, the stress times volume
 ///      V sigma = V (lambda tr(eps) I + 2 mu eps), the force f_a = R (V sigma) g_a (equal to
 ///      R K_e (R^T x - X) since K_e v = V sigma g_a), the energy
@@ -113,6 +131,12 @@ class CorotationalLinearFEM final : public ForceModel {
 
   TangentKind tangentKind() const { return tangentKind_; }
   void setTangentKind(TangentKind kind) { tangentKind_ = kind; }
+  ElementKernel elementKernel() const { return elementKernel_; }
+  /// Selects the pass-1 kernel (see ElementKernel); invalidates the cache.
+  void setElementKernel(ElementKernel kernel) {
+    elementKernel_ = kernel;
+    cacheValid_ = false;
+  }
   RotationStart rotationStart() const { return rotationStart_; }
   /// Changes where the rotation iterations start (see RotationStart); invalidates the cache.
   void setRotationStart(RotationStart start) {
@@ -169,6 +193,12 @@ class CorotationalLinearFEM final : public ForceModel {
   // Pass 1 (see the class comment) unless the cache already holds displacement; stores
   // R, h, element forces and energies (and, for the exact tangent, (tr S I - S)^{-1}).
   void evaluateElements(const Eigen::VectorXd& displacement, bool needDifferentialOperator);
+  // Pass 1 for element e with the scalar kernel.
+  void evaluateElement(int e, const Eigen::VectorXd& displacement, bool warmStart, bool needDifferentialOperator,
+                       long long& newtonSteps, long long& fallbacks);
+  // Pass 1 for the first numElements - numElements % 4 elements with the batched kernel.
+  void evaluateBatches(const Eigen::VectorXd& displacement, bool needDifferentialOperator, long long& newtonSteps,
+                       long long& fallbacks);
   bool cacheHolds(const Eigen::VectorXd& displacement) const;
   void assembleForces(Eigen::VectorXd& forces) const;
   void assembleTangent(const Eigen::VectorXd& displacement, Eigen::SparseMatrix<double>& stiffness) const;
@@ -192,7 +222,9 @@ class CorotationalLinearFEM final : public ForceModel {
   // valuePtr() index of entry (3 a, 3 b) of element e at 16 e + 4 b + a, and the column
   // length (stride between the three columns of vertex b) at 4 e + b.
   std::vector<int> blockSlots_, columnLengths_;
-  std::vector<int> patternOuter_;  // outer index array of the assembler's pattern
+  std::vector<int> patternOuter_;                          // outer index array of the assembler's pattern
+  std::shared_ptr<const detail::ElementBatches> batches_;  // geometry of the batched kernel
+  ElementKernel elementKernel_ = ElementKernel::batched;
   RotationStart rotationStart_ = RotationStart::fromDeformation;
   RotationStats rotationStats_;
   Eigen::VectorXd cachedDisplacement_;
