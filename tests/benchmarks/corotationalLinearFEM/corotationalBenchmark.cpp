@@ -12,9 +12,15 @@
 //
 // Usage: corotationalBenchmark [STEPS] [--mesh NAME] [--rayleigh-mass A] [--rayleigh-stiffness B]
 //                              [--toolkit-only exact|reuse] [--write-meshes DIR]
+//                              [--model MODEL] [--newton-iterations N] [--newton-tolerance EPS]
 // (default 30 timed steps per configuration). --write-meshes writes each timed problem
 // for an external program (see writeProblem) and exits; --toolkit-only times one toolkit
-// configuration alone (for whole-process timing against another program).
+// configuration alone (for whole-process timing against another program). --model picks
+// the force model of those two modes (corotational with the simple or the exact tangent,
+// StVK, neo-Hookean, Mooney-Rivlin, the hyperelastic ones with the settings of the Vega
+// agreement scenes, tests/data/vega/README.md); the comparison with the built-in reference
+// is corotational only. --newton-iterations N > 1 runs Newton as Vega does (relative
+// residual EPS, full steps, Rayleigh K at each iterate).
 #include <omp.h>
 
 #include <CLI/CLI.hpp>
@@ -24,6 +30,7 @@
 #include <asyncfem/core/threading.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/corotationalLinearFEM/polarDecomposition.hpp>
+#include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
@@ -51,6 +58,22 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 constexpr double kTimestep = 0.01;
 constexpr int kWarmupSteps = 5;
 const Eigen::Vector3d kGravity(0.0, 0.0, -9.81);
+// The hyperelastic settings of the Vega agreement scenes (tests/data/vega/README.md):
+// Vega's inversion threshold (clamped stretches) and compression resistance, and the
+// Mooney-Rivlin constants of their body material (Pa; density as the other models).
+constexpr double kInversionThreshold = 0.2;
+constexpr double kCompressionResistance = 500.0;
+const MooneyRivlinParameters kMooneyRivlin{3e4, 1.4e5, 2e6};
+const std::vector<std::string> kModels{"corotational", "corotational-exact", "stvk", "neo-hookean", "mooney-rivlin"};
+
+// The problem besides the mesh: force model and Newton settings (--model, --newton-*).
+struct ProblemSettings {
+  std::string model = "corotational";
+  int maxIterations = 1;      // 1: one linearized step, as Vega with maxIterations 1
+  double tolerance = 1e-6;    // Vega's epsilon: relative residual of the free DOFs
+  double rayleighMass = 0.0;  // D = alpha M + beta K(u at the step start)
+  double rayleighStiffness = 0.0;
+};
 
 struct Scene {
   std::string name;
@@ -61,16 +84,30 @@ struct Scene {
   Eigen::VectorXd gravityForce;  // M g, full
   double rayleighMass = 0.0;     // D = alpha M + beta K(u at the step start)
   double rayleighStiffness = 0.0;
+  std::string model = "corotational";
+  int maxIterations = 1;
+  double tolerance = 1e-6;
 };
 
 // A beam clamped at x = 0 that sags under gravity (rubber-like, so rotations are large).
-Scene makeScene(const std::string& name, const Eigen::Vector3d& size, const Eigen::Vector3i& cells, double alpha,
-                double beta) {
+Scene makeScene(const std::string& name, const Eigen::Vector3d& size, const Eigen::Vector3i& cells,
+                const ProblemSettings& settings) {
   BoxMeshSpec spec;
   spec.size = size;
   spec.cells = cells;
   spec.material = Material{"rubber", 1000.0, 5e5, 0.45};
-  Scene scene{name, makeBoxMesh(spec), nullptr, {}, {}, {}, alpha, beta};
+  if (settings.model == "mooney-rivlin") spec.material.mooneyRivlin = kMooneyRivlin;
+  Scene scene{name,
+              makeBoxMesh(spec),
+              nullptr,
+              {},
+              {},
+              {},
+              settings.rayleighMass,
+              settings.rayleighStiffness,
+              settings.model,
+              settings.maxIterations,
+              settings.tolerance};
   scene.assembler = std::make_shared<const MatrixAssembler>(scene.mesh);
   scene.mass = massMatrix(scene.mesh, *scene.assembler, MassType::consistent);
   std::vector<int> clamped;
@@ -208,16 +245,51 @@ class VegaStyleReference {
 struct Timing {
   double elementMs = 0, factorMs = 0, solveMs = 0, stepMs = 0;
   double elementMicrosPerElement = 0;
-  long long factorizations = 0, pcgIterations = 0;
+  long long factorizations = 0, pcgIterations = 0, newtonIterations = 0;
   double factorCostInIterations = 0.0;
   Eigen::VectorXd finalDisplacement;
 };
 
+// The scene's force model: corotational (Vega's warp 1 = simple tangent, warp 2 = exact),
+// or hyperelastic; neo-Hookean and Mooney-Rivlin with Vega's clamped inversion threshold
+// and compression resistance, StVK in the Green-strain form of Vega's StVKForceModel.
+std::shared_ptr<ForceModel> makeModel(const Scene& scene, RotationStart start) {
+  if (scene.model == "corotational" || scene.model == "corotational-exact") {
+    auto model = std::make_shared<CorotationalLinearFEM>(
+        scene.mesh, scene.assembler, scene.model == "corotational" ? TangentKind::simple : TangentKind::exact);
+    model->setRotationStart(start);
+    return model;
+  }
+  HyperelasticOptions options;
+  HyperelasticMaterialKind kind = HyperelasticMaterialKind::stvk;
+  if (scene.model != "stvk") {
+    kind = scene.model == "neo-hookean" ? HyperelasticMaterialKind::neoHookean : HyperelasticMaterialKind::mooneyRivlin;
+    options.inversionThreshold = kInversionThreshold;
+    options.inversionHandling = InversionHandling::vegaClamp;
+    options.enableCompressionResistance = true;
+    options.compressionResistance = kCompressionResistance;
+  }
+  return makeHyperelasticForceModel(scene.mesh, kind, options, scene.assembler);
+}
+
+// Exact solves or the kept factor, with the scene's Newton settings (Vega's loop: full
+// steps, D with K at each iterate, the relative residual of the free DOFs).
+IntegratorOptions integratorOptions(const Scene& scene, bool reuse, double pcgTolerance = 1e-8) {
+  IntegratorOptions options;
+  options.reuseFactor = reuse;
+  options.pcgTolerance = pcgTolerance;
+  options.maxIterations = scene.maxIterations;
+  if (scene.maxIterations > 1) {
+    options.tolerance = scene.tolerance;
+    options.lineSearch = false;
+    options.rayleighStiffnessAtIterate = true;
+  }
+  return options;
+}
+
 DynamicSystem toolkitSystem(const Scene& scene, RotationStart start = RotationStart::fromDeformation) {
   DynamicSystem system;
-  auto model = std::make_shared<CorotationalLinearFEM>(scene.mesh, scene.assembler);
-  model->setRotationStart(start);
-  system.forceModel = model;
+  system.forceModel = makeModel(scene, start);
   system.mass = scene.mass;
   system.freeDofs = scene.freeDofs;
   system.rayleighMass = scene.rayleighMass;
@@ -231,16 +303,17 @@ DynamicSystem toolkitSystem(const Scene& scene, RotationStart start = RotationSt
 
 Timing runToolkit(const Scene& scene, int warmup, int steps, bool reuse, double pcgTolerance = 1e-8,
                   RotationStart start = RotationStart::fromDeformation) {
-  IntegratorOptions options;
-  options.reuseFactor = reuse;
-  options.pcgTolerance = pcgTolerance;
-  BackwardEuler integrator(toolkitSystem(scene, start), kTimestep, options);
+  BackwardEuler integrator(toolkitSystem(scene, start), kTimestep, integratorOptions(scene, reuse, pcgTolerance));
   for (int k = 0; k < warmup; ++k) integrator.step();
   const IntegratorStats before = integrator.stats();
   const long long pcgBefore = reuse ? integrator.factorReuseStats()->pcgIterations : 0;
+  long long newtonIterations = 0;
   Stopwatch watch;
   watch.start();
-  for (int k = 0; k < steps; ++k) integrator.step();
+  for (int k = 0; k < steps; ++k) {
+    integrator.step();
+    newtonIterations += integrator.lastIterations();
+  }
   const double total = watch.stop();
   const IntegratorStats& after = integrator.stats();
   Timing t;
@@ -250,6 +323,7 @@ Timing runToolkit(const Scene& scene, int warmup, int steps, bool reuse, double 
   t.factorMs = 1e3 * (after.factorizationSeconds - before.factorizationSeconds) / steps;
   t.solveMs = 1e3 * (after.solveSeconds - before.solveSeconds) / steps;
   t.factorizations = after.factorizations - before.factorizations;
+  t.newtonIterations = newtonIterations;
   t.pcgIterations = reuse ? integrator.factorReuseStats()->pcgIterations - pcgBefore : 0;
   t.factorCostInIterations = reuse ? integrator.factorReuseStats()->factorCostInIterations : 0.0;
   t.finalDisplacement = integrator.displacement();
@@ -308,10 +382,28 @@ double scaledDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return (a - b).lpNorm<Eigen::Infinity>() / std::max(a.lpNorm<Eigen::Infinity>(), 1e-300);
 }
 
+// The .params lines that say which force model and Newton loop run (Vega's names: warp 1
+// or 2, the inversion threshold and compression resistance, maxIterations, epsilon).
+void writeModelParams(std::ostream& params, const Scene& scene) {
+  params << "model " << (scene.model == "corotational-exact" ? std::string("corotational") : scene.model) << '\n';
+  if (scene.model == "corotational" || scene.model == "corotational-exact") {
+    params << "warp " << (scene.model == "corotational" ? 1 : 2) << '\n';
+  } else if (scene.model != "stvk") {
+    params << "inversionThreshold " << kInversionThreshold << "\ncompressionResistance " << kCompressionResistance
+           << '\n';
+  }
+  if (scene.model == "mooney-rivlin") {
+    params << "# Mooney-Rivlin mu01 " << kMooneyRivlin.mu01 << " mu10 " << kMooneyRivlin.mu10 << " v1 "
+           << kMooneyRivlin.v1 << " Pa (in the .veg; youngsModulus and poissonRatio are unused)\n";
+  }
+  params << "maxIterations " << scene.maxIterations << "\nepsilon " << scene.tolerance << '\n';
+}
+
 // Writes the problem a run of this benchmark times, for an external program to run the
 // identical one: DIR/NAME.veg (the mesh and its material, writeVeg), DIR/NAME.fixed (the
 // fixed DOFs, 0-based global ids x 3 + coordinate, ascending, one a line), DIR/NAME.params
-// (material, time step, Rayleigh damping, gravity, step counts: `key value...` lines) and
+// (force model, material, time step, Rayleigh damping, gravity, Newton settings, step
+// counts: `key value...` lines; see writeModelParams) and
 // DIR/NAME.u and DIR/NAME.reuse.u (the toolkit's displacement after warmup + steps steps
 // from rest, exact solves and the default kept factor, PCG 1e-10; 17 significant digits, one
 // DOF a line).
@@ -334,9 +426,10 @@ void writeProblem(const Scene& scene, const std::filesystem::path& dir, int warm
   {
     const Material& m = scene.mesh.elementMaterial(0);
     std::ofstream params = open(".params");
-    params << "# corotational linear FEM (simple tangent R K R^T), consistent mass, external force M g,\n"
-           << "# from rest (u = v = 0), one linearized backward Euler step (one Newton iteration) per step\n"
-           << "youngsModulus " << m.youngsModulus << "\npoissonRatio " << m.poissonRatio << "\ndensity " << m.density
+    params << "# " << scene.model << ", consistent mass, external force M g, from rest (u = v = 0),\n"
+           << "# backward Euler with at most maxIterations Newton iterations per step\n";
+    writeModelParams(params, scene);
+    params << "youngsModulus " << m.youngsModulus << "\npoissonRatio " << m.poissonRatio << "\ndensity " << m.density
            << "\ntimestep " << kTimestep << "\ndampingMass " << scene.rayleighMass << "\ndampingStiffness "
            << scene.rayleighStiffness << "\ngravity " << kGravity.x() << ' ' << kGravity.y() << ' ' << kGravity.z()
            << "\nwarmupSteps " << warmup << "\ntimedSteps " << steps << "\nfixedDofs " << scene.freeDofs.numFixed()
@@ -344,9 +437,8 @@ void writeProblem(const Scene& scene, const std::filesystem::path& dir, int warm
   }
   Eigen::VectorXd exact;
   for (const bool reuse : {false, true}) {
-    IntegratorOptions options;
-    options.reuseFactor = reuse;
-    BackwardEuler integrator(toolkitSystem(scene), kTimestep, options);
+    BackwardEuler integrator(toolkitSystem(scene), kTimestep,
+                             integratorOptions(scene, reuse, IntegratorOptions{}.pcgTolerance));
     for (int k = 0; k < warmup + steps; ++k) integrator.step();
     const Eigen::VectorXd& u = integrator.displacement();
     if (!u.allFinite())
@@ -363,127 +455,159 @@ void writeProblem(const Scene& scene, const std::filesystem::path& dir, int warm
       scene.freeDofs.numFixed(), warmup + steps, exact.lpNorm<Eigen::Infinity>());
 }
 
-}  // namespace
+// The full comparison on one corotational scene: the built-in reference, the toolkit's
+// configurations, the element kernels alone and the agreement of the final states.
+void compareWithReference(const Scene& scene, int warmup, int steps, int threads) {
+  std::printf("\n%s: %d vertices, %d tets, %d free DOFs\n", scene.name.c_str(), scene.mesh.numVertices(),
+              scene.mesh.numElements(), scene.freeDofs.numFree());
+  omp_set_num_threads(threads);
+  const Timing reference = runReference(scene, warmup, steps);
+  const Timing exact = runToolkit(scene, warmup, steps, false);
+  const Timing reuse = runToolkit(scene, warmup, steps, true);
+  const Timing byDefault = runToolkit(scene, warmup, steps, true, IntegratorOptions{}.pcgTolerance);
+  // reuseFactor already makes results depend on the history (which factor is kept), so
+  // warm-started rotations lose nothing more there.
+  const Timing warm = runToolkit(scene, warmup, steps, true, 1e-8, RotationStart::previousEvaluation);
+  const int repeats = 10;
+  const double kernel1 = kernelMicros(scene, exact.finalDisplacement, 1, repeats);
+  const double kernelN = kernelMicros(scene, exact.finalDisplacement, threads, repeats);
+  const double kernelWarm = kernelMicros(scene, exact.finalDisplacement, 1, repeats, RotationStart::previousEvaluation);
+  const double kernelReference = referenceKernelMicros(scene, exact.finalDisplacement, 3);
+  omp_set_num_threads(threads);
+  std::printf(
+      "  element kernel (forces + tangent, us/element): reference %.3f, toolkit 1 thread %.3f (%.1fx), "
+      "%d threads %.3f (%.1fx)\n",
+      kernelReference, kernel1, kernelReference / kernel1, threads, kernelN, kernelReference / kernelN);
+  std::printf("  element kernel with warm-started rotations, 1 thread: %.3f us/element (%.1fx)\n", kernelWarm,
+              kernelReference / kernelWarm);
+  std::printf("  %-28s %10s %10s %10s %10s %8s %8s %9s\n", "per step (ms)", "elements", "factor", "solve", "step",
+              "factors", "PCG its", "vs ref");
+  const auto row = [&](const char* label, const Timing& t) {
+    std::printf("  %-28s %10.2f %10.2f %10.2f %10.2f %8lld %8lld %8.2fx\n", label, t.elementMs, t.factorMs, t.solveMs,
+                t.stepMs, t.factorizations, t.pcgIterations, reference.stepMs / t.stepMs);
+  };
+  row("Vega-style reference (1 thr)", reference);
+  row("toolkit, exact solves", exact);
+  row("toolkit, reuseFactor 1e-8", reuse);
+  row("toolkit, default (kept, 1e-10)", byDefault);
+  row("toolkit, reuse 1e-8 + warm R", warm);
+  std::printf(
+      "  final displacement, max |difference| / max |u|: toolkit exact vs reference %.2e, reuseFactor 1e-8 vs "
+      "exact %.2e, default (1e-10) vs exact %.2e (tip sag %.3f m)\n",
+      scaledDifference(exact.finalDisplacement, reference.finalDisplacement),
+      scaledDifference(reuse.finalDisplacement, exact.finalDisplacement),
+      scaledDifference(byDefault.finalDisplacement, exact.finalDisplacement),
+      exact.finalDisplacement.lpNorm<Eigen::Infinity>());
+  std::printf("  reuseFactor: one factorization counted as %.1f PCG iterations (flop ratio / 6)\n",
+              reuse.factorCostInIterations);
+}
 
-int main(int argc, char** argv) {
-  asyncfem::preferPassiveThreadWaiting(argv);
-  CLI::App app{"Corotational backward Euler step of this toolkit against a Vega-style reference."};
+// The exact and the factor-reusing path side by side over 100 steps of a scene.
+void compareOver100Steps(const Scene& scene) {
+  BackwardEuler exact(toolkitSystem(scene), kTimestep, integratorOptions(scene, false));
+  BackwardEuler reuse(toolkitSystem(scene), kTimestep,
+                      integratorOptions(scene, true, IntegratorOptions{}.pcgTolerance));
+  double largest = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    exact.step();
+    reuse.step();
+    largest = std::max(largest, scaledDifference(reuse.displacement(), exact.displacement()));
+  }
+  std::printf(
+      "\n%s, 100 steps from rest: max over steps of max |u_reuse - u_exact| / max |u_exact| = %.2e; "
+      "reuseFactor: %lld factorizations, %lld PCG iterations; exact: %lld factorizations\n",
+      scene.name.c_str(), largest, reuse.factorReuseStats()->refactorizations, reuse.factorReuseStats()->pcgIterations,
+      exact.stats().factorizations);
+}
+
+// One toolkit configuration alone, one line per scene (for timing against another program).
+void timeToolkitOnly(const std::vector<Scene>& scenes, int warmup, int steps, const std::string& configuration) {
+  for (const Scene& scene : scenes) {
+    const Timing t = runToolkit(scene, warmup, steps, configuration == "reuse", IntegratorOptions{}.pcgTolerance);
+    std::printf(
+        "%s, %s, toolkit %s, per step (ms): elements %.2f, factor %.2f, solve %.2f, step %.2f; %lld factorizations, "
+        "%lld PCG iterations, %lld Newton iterations; max |u| %.9f\n",
+        scene.name.c_str(), scene.model.c_str(), configuration.c_str(), t.elementMs, t.factorMs, t.solveMs, t.stepMs,
+        t.factorizations, t.pcgIterations, t.newtonIterations, t.finalDisplacement.lpNorm<Eigen::Infinity>());
+  }
+}
+
+struct CommandLine {
   int steps = 30;
   std::string meshName = "all";
   std::string writeDir;
   std::string toolkitOnly;
-  double alpha = 0.0;
-  double beta = 0.0;
-  app.add_option("steps", steps, "Timed steps per configuration (after 5 warm-up steps)")->check(CLI::PositiveNumber);
-  app.add_option("--mesh", meshName, "Which mesh")->check(CLI::IsMember({"all", "bridge-sized", "dragon-sized"}));
-  app.add_option("--rayleigh-mass", alpha, "Rayleigh damping alpha (D = alpha M + beta K)")
+  ProblemSettings settings;
+};
+
+void addOptions(CLI::App& app, CommandLine& c) {
+  app.add_option("steps", c.steps, "Timed steps per configuration (after 5 warm-up steps)")->check(CLI::PositiveNumber);
+  app.add_option("--mesh", c.meshName, "Which mesh")->check(CLI::IsMember({"all", "bridge-sized", "dragon-sized"}));
+  app.add_option("--rayleigh-mass", c.settings.rayleighMass, "Rayleigh damping alpha (D = alpha M + beta K)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--rayleigh-stiffness", beta, "Rayleigh damping beta")->check(CLI::NonNegativeNumber);
-  app.add_option("--write-meshes", writeDir,
+  app.add_option("--rayleigh-stiffness", c.settings.rayleighStiffness, "Rayleigh damping beta")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--write-meshes", c.writeDir,
                  "Write each problem (.veg, fixed DOFs, parameters, final displacement) to this folder and exit");
-  app.add_option("--toolkit-only", toolkitOnly,
+  app.add_option("--toolkit-only", c.toolkitOnly,
                  "Time only this toolkit configuration (exact solves, or reuse: the default kept factor, PCG to 1e-10)")
       ->check(CLI::IsMember({"exact", "reuse"}));
+  app.add_option("--model", c.settings.model,
+                 "Force model (with --toolkit-only or --write-meshes; corotational = Vega's warp 1, "
+                 "corotational-exact = warp 2)")
+      ->check(CLI::IsMember(kModels));
+  app.add_option("--newton-iterations", c.settings.maxIterations,
+                 "Newton iterations per step at most (Vega's maxIterations)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--newton-tolerance", c.settings.tolerance, "Newton's relative residual (Vega's epsilon)")
+      ->check(CLI::PositiveNumber);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  asyncfem::preferPassiveThreadWaiting(argv);
+  CLI::App app{"Nonlinear backward Euler steps of this toolkit against a Vega-style reference."};
+  CommandLine c;
+  addOptions(app, c);
   CLI11_PARSE(app, argc, argv);
+  const bool reference = c.toolkitOnly.empty() && c.writeDir.empty();
+  if (reference && (c.settings.model != "corotational" || c.settings.maxIterations != 1)) {
+    std::fprintf(stderr,
+                 "corotationalBenchmark: --model %s --newton-iterations %d needs --toolkit-only or --write-meshes (the "
+                 "built-in reference is corotational with one iteration)\n",
+                 c.settings.model.c_str(), c.settings.maxIterations);
+    return 1;
+  }
   const int warmup = kWarmupSteps;
   const int threads = omp_get_max_threads();
   std::printf(
-      "corotational backward Euler step, h = %g, %d warm-up + %d timed steps; Rayleigh alpha %g beta %g; %d OpenMP "
-      "threads; %s; load %s\n",
-      kTimestep, warmup, steps, alpha, beta, threads, cpuModel().c_str(), loadAverage().c_str());
+      "%s backward Euler step, h = %g, %d warm-up + %d timed steps, Newton at most %d iterations (tolerance %g); "
+      "Rayleigh alpha %g beta %g; %d OpenMP threads; %s; load %s\n",
+      c.settings.model.c_str(), kTimestep, warmup, c.steps, c.settings.maxIterations, c.settings.tolerance,
+      c.settings.rayleighMass, c.settings.rayleighStiffness, threads, cpuModel().c_str(), loadAverage().c_str());
   std::vector<Scene> scenes;
-  if (meshName != "dragon-sized") {
-    scenes.push_back(makeScene("bridge-sized", Eigen::Vector3d(4.8, 0.6, 0.7), Eigen::Vector3i(48, 6, 7), alpha, beta));
+  if (c.meshName != "dragon-sized") {
+    scenes.push_back(makeScene("bridge-sized", Eigen::Vector3d(4.8, 0.6, 0.7), Eigen::Vector3i(48, 6, 7), c.settings));
   }
-  if (meshName != "bridge-sized") {
+  if (c.meshName != "bridge-sized") {
     scenes.push_back(
-        makeScene("dragon-sized", Eigen::Vector3d(3.2, 1.6, 1.4), Eigen::Vector3i(32, 16, 14), alpha, beta));
+        makeScene("dragon-sized", Eigen::Vector3d(3.2, 1.6, 1.4), Eigen::Vector3i(32, 16, 14), c.settings));
   }
-  if (!writeDir.empty()) {
+  if (!c.writeDir.empty()) {
     try {
-      for (const Scene& scene : scenes) writeProblem(scene, writeDir, warmup, steps);
+      for (const Scene& scene : scenes) writeProblem(scene, c.writeDir, warmup, c.steps);
     } catch (const std::exception& error) {
-      std::fprintf(stderr, "corotationalBenchmark --write-meshes %s: %s\n", writeDir.c_str(), error.what());
+      std::fprintf(stderr, "corotationalBenchmark --write-meshes %s: %s\n", c.writeDir.c_str(), error.what());
       return 1;
     }
     return 0;
   }
-  if (!toolkitOnly.empty()) {
-    for (const Scene& scene : scenes) {
-      const Timing t = runToolkit(scene, warmup, steps, toolkitOnly == "reuse", IntegratorOptions{}.pcgTolerance);
-      std::printf(
-          "%s, toolkit %s, per step (ms): elements %.2f, factor %.2f, solve %.2f, step %.2f; %lld factorizations, %lld "
-          "PCG iterations; max |u| %.6f\n",
-          scene.name.c_str(), toolkitOnly.c_str(), t.elementMs, t.factorMs, t.solveMs, t.stepMs, t.factorizations,
-          t.pcgIterations, t.finalDisplacement.lpNorm<Eigen::Infinity>());
-    }
+  if (!c.toolkitOnly.empty()) {
+    timeToolkitOnly(scenes, warmup, c.steps, c.toolkitOnly);
     return 0;
   }
-  for (const Scene& scene : scenes) {
-    std::printf("\n%s: %d vertices, %d tets, %d free DOFs\n", scene.name.c_str(), scene.mesh.numVertices(),
-                scene.mesh.numElements(), scene.freeDofs.numFree());
-    omp_set_num_threads(threads);
-    const Timing reference = runReference(scene, warmup, steps);
-    const Timing exact = runToolkit(scene, warmup, steps, false);
-    const Timing reuse = runToolkit(scene, warmup, steps, true);
-    const Timing byDefault = runToolkit(scene, warmup, steps, true, IntegratorOptions{}.pcgTolerance);
-    // reuseFactor already makes results depend on the history (which factor is kept), so
-    // warm-started rotations lose nothing more there.
-    const Timing warm = runToolkit(scene, warmup, steps, true, 1e-8, RotationStart::previousEvaluation);
-    const int repeats = 10;
-    const double kernel1 = kernelMicros(scene, exact.finalDisplacement, 1, repeats);
-    const double kernelN = kernelMicros(scene, exact.finalDisplacement, threads, repeats);
-    const double kernelWarm =
-        kernelMicros(scene, exact.finalDisplacement, 1, repeats, RotationStart::previousEvaluation);
-    const double kernelReference = referenceKernelMicros(scene, exact.finalDisplacement, 3);
-    omp_set_num_threads(threads);
-    std::printf(
-        "  element kernel (forces + tangent, us/element): reference %.3f, toolkit 1 thread %.3f (%.1fx), "
-        "%d threads %.3f (%.1fx)\n",
-        kernelReference, kernel1, kernelReference / kernel1, threads, kernelN, kernelReference / kernelN);
-    std::printf("  element kernel with warm-started rotations, 1 thread: %.3f us/element (%.1fx)\n", kernelWarm,
-                kernelReference / kernelWarm);
-    std::printf("  %-28s %10s %10s %10s %10s %8s %8s %9s\n", "per step (ms)", "elements", "factor", "solve", "step",
-                "factors", "PCG its", "vs ref");
-    const auto row = [&](const char* label, const Timing& t) {
-      std::printf("  %-28s %10.2f %10.2f %10.2f %10.2f %8lld %8lld %8.2fx\n", label, t.elementMs, t.factorMs, t.solveMs,
-                  t.stepMs, t.factorizations, t.pcgIterations, reference.stepMs / t.stepMs);
-    };
-    row("Vega-style reference (1 thr)", reference);
-    row("toolkit, exact solves", exact);
-    row("toolkit, reuseFactor 1e-8", reuse);
-    row("toolkit, default (kept, 1e-10)", byDefault);
-    row("toolkit, reuse 1e-8 + warm R", warm);
-    std::printf(
-        "  final displacement, max |difference| / max |u|: toolkit exact vs reference %.2e, reuseFactor 1e-8 vs "
-        "exact %.2e, default (1e-10) vs exact %.2e (tip sag %.3f m)\n",
-        scaledDifference(exact.finalDisplacement, reference.finalDisplacement),
-        scaledDifference(reuse.finalDisplacement, exact.finalDisplacement),
-        scaledDifference(byDefault.finalDisplacement, exact.finalDisplacement),
-        exact.finalDisplacement.lpNorm<Eigen::Infinity>());
-    std::printf("  reuseFactor: one factorization counted as %.1f PCG iterations (flop ratio / 6)\n",
-                reuse.factorCostInIterations);
-  }
-  // The exact and the factor-reusing path side by side over 100 steps of the bridge.
-  if (scenes.front().name == "bridge-sized") {
-    const Scene& scene = scenes.front();
-    IntegratorOptions reuseOptions;
-    reuseOptions.reuseFactor = true;
-    IntegratorOptions exactOptions;
-    exactOptions.reuseFactor = false;
-    BackwardEuler exact(toolkitSystem(scene), kTimestep, exactOptions);
-    BackwardEuler reuse(toolkitSystem(scene), kTimestep, reuseOptions);
-    double largest = 0.0;
-    for (int k = 0; k < 100; ++k) {
-      exact.step();
-      reuse.step();
-      largest = std::max(largest, scaledDifference(reuse.displacement(), exact.displacement()));
-    }
-    std::printf(
-        "\n%s, 100 steps from rest: max over steps of max |u_reuse - u_exact| / max |u_exact| = %.2e; "
-        "reuseFactor: %lld factorizations, %lld PCG iterations; exact: %lld factorizations\n",
-        scene.name.c_str(), largest, reuse.factorReuseStats()->refactorizations,
-        reuse.factorReuseStats()->pcgIterations, exact.stats().factorizations);
-  }
+  for (const Scene& scene : scenes) compareWithReference(scene, warmup, c.steps, threads);
+  if (scenes.front().name == "bridge-sized") compareOver100Steps(scenes.front());
   return 0;
 }
