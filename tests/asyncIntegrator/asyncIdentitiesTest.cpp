@@ -101,8 +101,8 @@ TEST(AsyncIdentities, AllFastEqualsSmallSteps) {
 }
 
 // Identity 4: the structured solve equals the naive full-system solve, for several m,
-// |S|, damping values, one and three regions, every Schur mode that is exact and both
-// recovery modes.
+// |S|, damping values, one and three regions, every Schur mode that is exact, both
+// recovery modes, and A^S factored sparse (every region) or dense (every region).
 TEST(AsyncIdentities, StructuredEqualsNaive) {
   for (const AsyncCoupling coupling : kCouplings)
     for (const Damping& damping : kDampings) {
@@ -128,11 +128,17 @@ TEST(AsyncIdentities, StructuredEqualsNaive) {
           AsyncOptions lowRankDense = defaults;  // capacitance form of H^{LL*}, dense Z recovery
           lowRankDense.schur = SchurMode::lowRank;
           lowRankDense.recovery = RecoveryMode::denseZ;
+          AsyncOptions sparseRegions = defaults;  // CHOLMOD for every A^S, small regions too
+          sparseRegions.denseRegionDofs = 0;
+          AsyncOptions denseRegions = defaults;  // dense A^S and G for every region
+          denseRegions.regionSolver = SolverKind::dense;
           auto naive = makeAsync(ts, 2e-3, regions, naiveOptions);
           std::vector<std::unique_ptr<AsyncBackwardEuler>> structured;
           structured.push_back(makeAsync(ts, 2e-3, regions, defaults));
           structured.push_back(makeAsync(ts, 2e-3, regions, luSubstitution));
           structured.push_back(makeAsync(ts, 2e-3, regions, lowRankDense));
+          structured.push_back(makeAsync(ts, 2e-3, regions, sparseRegions));
+          structured.push_back(makeAsync(ts, 2e-3, regions, denseRegions));
           for (int k = 0; k < 3; ++k) {
             naive->step();
             for (auto& s : structured) s->step();

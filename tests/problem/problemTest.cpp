@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/factory.hpp>
 #include <asyncfem/problem/problem.hpp>
@@ -55,6 +56,55 @@ TEST(Problem, DynamicSystemRunsAnIntegratorUnderTheLoads) {
   // The pull lifts the tip; the root stays where it is.
   EXPECT_GT(integrator->displacement()[3 * pull.vertices.front() + 1], 0.0);
   EXPECT_EQ(integrator->displacement()[3 * mesh->vertexSets().at("root").front() + 1], 0.0);
+}
+
+// The hook that lets a multirate integrator evaluate the loads once per large step: true
+// exactly for intervals that hold a window bound (gravity and windows that never close
+// change nothing).
+TEST(Problem, ExternalForceChangesWhereAWindowOpensOrCloses) {
+  const auto mesh = beam();
+  VertexLoad pull;
+  pull.vertices = mesh->vertexSets().at("tip");
+  pull.perVertex = Eigen::Vector3d(0, 10.0, 0);
+  pull.start = 0.05;
+  pull.end = 0.1;
+  ProblemSettings settings;
+  settings.gravity = Eigen::Vector3d(0, -9.81, 0);
+  const DynamicSystem system = Problem(mesh, mesh->vertexSets().at("root"), settings, {pull}).dynamicSystem();
+  ASSERT_TRUE(static_cast<bool>(system.externalForceChanges));
+  EXPECT_FALSE(system.externalForceChanges(0.0, 0.04));
+  EXPECT_TRUE(system.externalForceChanges(0.04, 0.05));  // opens at the interval's end
+  EXPECT_TRUE(system.externalForceChanges(0.05, 0.06));  // opened at its start (left bound counts)
+  EXPECT_FALSE(system.externalForceChanges(0.06, 0.09));
+  EXPECT_TRUE(system.externalForceChanges(0.09, 0.12));
+  EXPECT_FALSE(system.externalForceChanges(0.12, 10.0));
+}
+
+// Evaluating the loads once per large step where they are constant changes nothing: the
+// asynchronous trajectory is bit for bit the one with an evaluation at every substep time,
+// through a window that opens and closes inside large steps.
+TEST(Problem, AsyncStepEvaluatesConstantLoadsOncePerLargeStep) {
+  const auto mesh = beam();
+  VertexLoad pull;
+  pull.vertices = mesh->vertexSets().at("tip");
+  pull.perVertex = Eigen::Vector3d(0, 40.0, 5.0);
+  pull.start = 0.013;  // inside the second large step of 0.01
+  pull.end = 0.047;    // inside the fifth
+  ProblemSettings settings;
+  settings.gravity = Eigen::Vector3d(0, -9.81, 0);
+  const DynamicSystem system = Problem(mesh, mesh->vertexSets().at("root"), settings, {pull}).dynamicSystem();
+  DynamicSystem everySubstep = system;
+  everySubstep.externalForceChanges = nullptr;
+  const std::vector<AsyncRegion> regions{{"tip", mesh->vertexSets().at("tip"), 8}};
+  AsyncBackwardEuler once(system, 0.01, regions);
+  AsyncBackwardEuler each(everySubstep, 0.01, regions);
+  for (int k = 0; k < 8; ++k) {
+    once.step();
+    each.step();
+    ASSERT_EQ(once.displacement(), each.displacement()) << "large step " << k;
+    ASSERT_EQ(once.velocity(), each.velocity()) << "large step " << k;
+  }
+  EXPECT_GT(once.displacement().cwiseAbs().maxCoeff(), 0.0);
 }
 
 TEST(Problem, RefusesBadBoundaries) {

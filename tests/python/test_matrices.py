@@ -65,7 +65,7 @@ def test_free_dofs_and_extraction(matrices):
     assert by_dofs.num_fixed == 2 and by_dofs.full_to_free[0] == -1
 
 
-@pytest.mark.parametrize("kind", ["cholmod", "umfpack", "eigen-ldlt", "eigen-lu"])
+@pytest.mark.parametrize("kind", ["cholmod", "umfpack", "eigen-ldlt", "eigen-lu", "dense"])
 def test_solvers(matrices, kind):
     mesh, _, stiffness, mass = matrices
     free = af.FreeDofs.from_fixed_vertices(mesh.num_vertices, mesh.vertex_set("xmin"))

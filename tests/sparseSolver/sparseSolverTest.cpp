@@ -78,9 +78,12 @@ long long lowerTriangleNonZeros(const SparseMatrix& a) {
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-const SolverKind kAllKinds[] = {SolverKind::cholmod, SolverKind::umfpack, SolverKind::eigenLDLT, SolverKind::eigenLU};
+const SolverKind kAllKinds[] = {SolverKind::cholmod, SolverKind::umfpack, SolverKind::eigenLDLT, SolverKind::eigenLU,
+                                SolverKind::dense};
 const SolverKind kUnsymmetricKinds[] = {SolverKind::umfpack, SolverKind::eigenLU};
-bool isCholesky(SolverKind kind) { return kind == SolverKind::cholmod || kind == SolverKind::eigenLDLT; }
+bool isCholesky(SolverKind kind) {
+  return kind == SolverKind::cholmod || kind == SolverKind::eigenLDLT || kind == SolverKind::dense;
+}
 
 TEST(SparseSolver, SolvesSpdSystems) {
   const SparseMatrix a = gridLaplacian(14, 0.5);  // 2744 unknowns
@@ -119,7 +122,7 @@ TEST(SparseSolver, CholeskyReadsOnlyTheUpperTriangle) {
   const SparseMatrix full = gridLaplacian(8, 0.3);
   const SparseMatrix upper = full.triangularView<Eigen::Upper>();
   const Eigen::MatrixXd b = randomRhs(full.rows(), 1, 12);
-  for (SolverKind kind : {SolverKind::cholmod, SolverKind::eigenLDLT}) {
+  for (SolverKind kind : {SolverKind::cholmod, SolverKind::eigenLDLT, SolverKind::dense}) {
     auto solver = makeSparseSolver(kind);
     solver->compute(upper);
     EXPECT_LT(relativeResidual(full, solver->solve(Eigen::VectorXd(b.col(0))), b), kResidualTolerance)
@@ -237,6 +240,23 @@ TEST(SparseSolver, OtherBackendsReportTheirOrdering) {
   auto lu = makeSparseSolver(SolverKind::eigenLU);
   lu->analyzePattern(a);
   EXPECT_EQ(lu->ordering(), "colamd");
+  auto dense = makeSparseSolver(SolverKind::dense);
+  dense->analyzePattern(a);
+  EXPECT_EQ(dense->ordering(), "natural");
+}
+
+TEST(SparseSolver, DenseRefusesLargeSystems) {
+  // 20^3 * 3 = 24000 unknowns would be 4.6 GB dense: refused before anything is allocated.
+  SparseMatrix large(24000, 24000);
+  large.setIdentity();
+  large.makeCompressed();
+  auto dense = makeSparseSolver(SolverKind::dense);
+  try {
+    dense->analyzePattern(large);
+    ADD_FAILURE() << "a 24000-unknown dense factor was accepted";
+  } catch (const Error& e) {
+    EXPECT_TRUE(contains(e.what(), "24000 unknowns")) << e.what();
+  }
 }
 
 TEST(SparseSolver, NotPositiveDefiniteIsANumericalErrorNamingTheColumn) {
@@ -244,7 +264,7 @@ TEST(SparseSolver, NotPositiveDefiniteIsANumericalErrorNamingTheColumn) {
   // excludes it is too: elimination fails exactly at column 10, whatever the ordering.
   SparseMatrix a = gridLaplacian(6, 0.0);
   a.coeffRef(10, 10) = -50.0;
-  for (SolverKind kind : {SolverKind::cholmod, SolverKind::eigenLDLT}) {
+  for (SolverKind kind : {SolverKind::cholmod, SolverKind::eigenLDLT, SolverKind::dense}) {
     auto solver = makeSparseSolver(kind);
     solver->analyzePattern(a);
     try {
@@ -363,6 +383,7 @@ TEST(SparseSolver, KindNamesRoundTrip) {
   for (SolverKind kind : kAllKinds) EXPECT_EQ(parseSolverKind(toString(kind)), kind);
   EXPECT_EQ(toString(SolverKind::eigenLDLT), "eigen-ldlt");
   EXPECT_EQ(toString(SolverKind::eigenLU), "eigen-lu");
+  EXPECT_EQ(toString(SolverKind::dense), "dense");
   try {
     parseSolverKind("superlu");
     ADD_FAILURE() << "unknown name accepted";

@@ -301,7 +301,7 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   runStats_.largeDofs = static_cast<int>(large.size());
   for (int i = 0; i < partition_.numRegions(); ++i) {
     const detail::RegionLayout layout{&partition_.regionDofs(i), &partition_.interfaceDofs(i), partition_.ratio(i)};
-    d.regions.emplace_back(mass, d.stiffness, layout, options_.regionSolver);
+    d.regions.emplace_back(mass, d.stiffness, layout, options_.regionSolver, options_.denseRegionDofs);
     runStats_.fastDofs += static_cast<int>(partition_.regionDofs(i).size());
     runStats_.interfaceDofs += static_cast<int>(partition_.interfaceDofs(i).size());
   }
@@ -501,13 +501,17 @@ void AsyncBackwardEuler::evaluateStartOfStep() {
   }
 }
 
-// f_ext on every region at its substeps (rb.external, |S| x m) and on L at t1.
+// f_ext on every region at its substeps (rb.external, |S| x m) and on L at t1. At the start
+// state, a force that the system says is constant in (t0, t1] (no load window opens or
+// closes there) is evaluated once, at t1, for every substep.
 void AsyncBackwardEuler::gatherExternalForces(double t0, double t1) {
   Impl& d = *impl_;
   const Eigen::VectorXd& u0 = displacement_;
   const Eigen::VectorXd& v0 = velocity_;
   d.forcesUsed = 0;
   const bool hasExternal = static_cast<bool>(system_.externalForce);
+  const bool constantInStep = hasExternal && !options_.substepStatePrediction && system_.externalForceChanges &&
+                              !system_.externalForceChanges(t0, t1);
   for (int i = 0; i < partition_.numRegions(); ++i) {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& s = partition_.regionDofs(i);
@@ -518,7 +522,7 @@ void AsyncBackwardEuler::gatherExternalForces(double t0, double t1) {
       continue;
     }
     for (int r = 1; r <= rb.ratio; ++r) {
-      const double time = substepTime(t0, t1, r, rb.ratio, rb.smallStep);
+      const double time = constantInStep ? t1 : substepTime(t0, t1, r, rb.ratio, rb.smallStep);
       const Eigen::VectorXd* f = nullptr;
       if (options_.substepStatePrediction) {
         d.predicted = u0 + (r * rb.smallStep) * v0;

@@ -117,8 +117,9 @@ AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
   solver.method = readChoice(reader, "method", kSolveMethods);
   solver.recovery = readChoice(reader, "recovery", kRecoveryModes);
   const std::string regionSolver =
-      reader.choice("regionSolver", "cholmod", {"cholmod", "umfpack", "eigen-ldlt", "eigen-lu"});
+      reader.choice("regionSolver", "cholmod", {"cholmod", "umfpack", "eigen-ldlt", "eigen-lu", "dense"});
   solver.regionSolver = parseSolverKind(regionSolver);
+  solver.denseRegionDofs = reader.integer("denseRegionDofs", solver.denseRegionDofs, 0, 4096);
   solver.substepStatePrediction = reader.boolean("substepContact", false);
   solver.laggedSchur = reader.boolean("laggedSchur", solver.laggedSchur);
   solver.quickSetUp = reader.boolean("quickSetUp", solver.quickSetUp);
@@ -257,9 +258,9 @@ AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const
 }
 
 const std::vector<std::string>& asyncOptionKeys() {
-  static const std::vector<std::string> keys{"coupling",     "schur",          "method",      "recovery",
-                                             "regionSolver", "substepContact", "laggedSchur", "quickSetUp",
-                                             "threads",      "regions",        "auto"};
+  static const std::vector<std::string> keys{"coupling",     "schur",           "method",         "recovery",
+                                             "regionSolver", "denseRegionDofs", "substepContact", "laggedSchur",
+                                             "quickSetUp",   "threads",         "regions",        "auto"};
   return keys;
 }
 
@@ -348,6 +349,7 @@ nlohmann::json asyncSettingsJson(const AsyncSettings& settings) {
   writeChoice("method", kSolveMethods, solver.method, defaults.method);
   writeChoice("recovery", kRecoveryModes, solver.recovery, defaults.recovery);
   if (solver.regionSolver != defaults.regionSolver) out["regionSolver"] = toString(solver.regionSolver);
+  if (solver.denseRegionDofs != defaults.denseRegionDofs) out["denseRegionDofs"] = solver.denseRegionDofs;
   if (solver.substepStatePrediction != defaults.substepStatePrediction) {
     out["substepContact"] = solver.substepStatePrediction;
   }

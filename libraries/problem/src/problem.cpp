@@ -6,6 +6,7 @@
 #include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <asyncfem/problem/problem.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
+#include <cmath>
 #include <iterator>
 
 namespace asyncfem {
@@ -149,6 +150,14 @@ DynamicSystem Problem::dynamicSystem() const {
     system.externalForce = [external](double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                                       Eigen::VectorXd& forces) {
       external->addTo(time, displacement, velocity, forces);
+    };
+    // Gravity is constant and contact depends on the state only; the windows open and
+    // close at their bounds. A bound within a millionth of the interval of it counts as
+    // inside, so that the snapping of bounds to step times never makes the answer wrong.
+    system.externalForceChanges = [breakpoints = external->breakpoints()](double from, double to) {
+      const double slack = 1e-6 * std::abs(to - from);
+      const auto first = std::lower_bound(breakpoints.begin(), breakpoints.end(), from - slack);
+      return first != breakpoints.end() && *first <= to + slack;
     };
   }
   if (contact_) {

@@ -131,6 +131,7 @@ void bindAsyncOptions(py::module_& module) {
       .def_readwrite("method", &AsyncOptions::method)
       .def_readwrite("recovery", &AsyncOptions::recovery)
       .def_readwrite("region_solver", &AsyncOptions::regionSolver)
+      .def_readwrite("dense_region_dofs", &AsyncOptions::denseRegionDofs)
       .def_readwrite("substep_state_prediction", &AsyncOptions::substepStatePrediction);
 
   py::class_<ScheduledRegion>(module, "ScheduledRegion",

@@ -38,13 +38,15 @@ auto matrixStep(void (SparseSolver::*step)(const Sparse&)) {
 
 void bindSolvers(py::module_& module) {
   py::enum_<SolverKind>(module, "SolverKind",
-                        "Sparse solver: cholmod (supernodal Cholesky), umfpack (LU), eigen_ldlt, eigen_lu")
+                        "Sparse solver: cholmod (supernodal Cholesky), umfpack (LU), eigen_ldlt, eigen_lu, dense "
+                        "(dense Cholesky, small SPD systems)")
       .value("cholmod", SolverKind::cholmod)
       .value("umfpack", SolverKind::umfpack)
       .value("eigen_ldlt", SolverKind::eigenLDLT)
-      .value("eigen_lu", SolverKind::eigenLU);
+      .value("eigen_lu", SolverKind::eigenLU)
+      .value("dense", SolverKind::dense);
   module.def("parse_solver_kind", &parseSolverKind, py::arg("name"),
-             "'cholmod', 'umfpack', 'eigen-ldlt', 'eigen-lu' -> SolverKind");
+             "'cholmod', 'umfpack', 'eigen-ldlt', 'eigen-lu', 'dense' -> SolverKind");
   module.def(
       "solver_kind_name", [](SolverKind kind) { return toString(kind); }, py::arg("kind"),
       "SolverKind -> its name ('cholmod', ...)");

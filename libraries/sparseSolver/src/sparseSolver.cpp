@@ -14,7 +14,8 @@ namespace {
 constexpr EnumName<SolverKind> kSolverNames[] = {{SolverKind::cholmod, "cholmod"},
                                                  {SolverKind::umfpack, "umfpack"},
                                                  {SolverKind::eigenLDLT, "eigen-ldlt"},
-                                                 {SolverKind::eigenLU, "eigen-lu"}};
+                                                 {SolverKind::eigenLU, "eigen-lu"},
+                                                 {SolverKind::dense, "dense"}};
 
 }  // namespace
 
@@ -38,6 +39,8 @@ std::unique_ptr<SparseSolver> makeSparseSolver(SolverKind kind) {
       return detail::makeEigenLDLTSolver();
     case SolverKind::eigenLU:
       return detail::makeEigenLUSolver();
+    case SolverKind::dense:
+      return detail::makeDenseSolver();
   }
   throw Error("makeSparseSolver: invalid SolverKind value " + std::to_string(static_cast<int>(kind)));
 }

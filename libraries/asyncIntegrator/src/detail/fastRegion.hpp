@@ -39,9 +39,10 @@ class FastRegion {
   using SparseMatrix = Eigen::SparseMatrix<double>;
 
   /// Cuts the mass blocks (constant) and prepares the stiffness blocks on the pattern of
-  /// stiffnessPattern (3n x 3n, the force model's); solverKind factors A^S.
+  /// stiffnessPattern (3n x 3n, the force model's); solverKind factors A^S, or the dense
+  /// Cholesky when the region has at most denseDofs free DOFs (AsyncOptions::denseRegionDofs).
   FastRegion(const SparseMatrix& mass, const SparseMatrix& stiffnessPattern, const RegionLayout& layout,
-             SolverKind solverKind);
+             SolverKind solverKind, int denseDofs = 0);
 
   /// K^{SS}, K^{SI}, K^{IS} of the current tangent K (3n x 3n): cut the first time, values
   /// only after.
@@ -51,7 +52,8 @@ class FastRegion {
   /// coefficients for large step hL (seconds).
   void updateBlocks(const SparseMatrix& stiffness, double largeStep, double alpha, double beta, bool damped,
                     AsyncCoupling coupling);
-  /// Numeric factorization of A^S (symbolic analysis the first time only).
+  /// Numeric factorization of A^S (symbolic analysis, and the choice of a dense factor, the
+  /// first time only).
   void factorize(IntegratorStats& stats);
 
   /// Forward substitution with H^{SS} (Eq. A13): A^S x_r = b_r + M^{SS} x_{r-1} - G sum_{i<r} x_i
@@ -81,7 +83,9 @@ class FastRegion {
   // Stable coupling: the interface elements and K_I^{II}, their stiffness on I x I (dense).
   std::vector<InterfaceElement> interfaceElements;
   Eigen::MatrixXd interfaceStiffness;
-  SparseMatrix GT;  // G^T, for products with many columns held row-wise
+  SparseMatrix GT;         // G^T, for products with many columns held row-wise
+  bool denseG = false;     // the region is small: A^S factored dense, G multiplied dense
+  Eigen::MatrixXd Gdense;  // G (denseG only)
   // The previous substep's solve gives M^{SS} x_{r-1} for free: A^S = (1 + hS alpha) M^{SS}
   // + (1 + beta / hS) G, so M^{SS} x_{r-1} = (rhs_{r-1} - (1 + beta / hS) G x_{r-1}) / (1 +
   // hS alpha), and substep r's right-hand side b_r + M^{SS} x_{r-1} - G sum_{i<r} x_i needs
@@ -108,10 +112,15 @@ class FastRegion {
   bool substituted = false;  // x holds every substep (observer, substitution recovery)
 
  private:
+  /// Replaces the sparse solver by the dense one where that is cheaper (see factorize).
+  void chooseDenseFactor();
   /// out -= G t for one column t (|S| entries), scattered column by column.
   void subtractStiffnessProduct(const double* t, double* out) const;
   /// outT = (G t)^T for tT = t^T (k x |S|), vectorized across the k columns.
   void rowWiseStiffnessProduct(const Eigen::MatrixXd& tT, Eigen::MatrixXd& outT) const;
+
+  int denseDofs_ = 0;
+  bool denseDecided_ = false;
 };
 
 /// What one computation of Z over every region did.

@@ -92,5 +92,6 @@ std::unique_ptr<SparseSolver> makeCholmodSolver();
 std::unique_ptr<SparseSolver> makeUmfpackSolver();
 std::unique_ptr<SparseSolver> makeEigenLDLTSolver();
 std::unique_ptr<SparseSolver> makeEigenLUSolver();
+std::unique_ptr<SparseSolver> makeDenseSolver();
 
 }  // namespace asyncfem::detail

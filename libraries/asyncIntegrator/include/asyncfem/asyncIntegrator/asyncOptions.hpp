@@ -98,6 +98,11 @@ struct AsyncOptions {
   /// false: a partition never leaves the quick path while its solves converge (studies of
   /// the deflation; the rent-or-buy rule is off).
   bool quickSetUpRebuild = true;
+  /// Regions of at most this many free DOFs factor A^{S_i} dense (SolverKind::dense) and
+  /// multiply by hS^2 K^{SS} dense, whatever regionSolver says: there the m substitutions
+  /// per large step cost less dense than sparse (docs/asynchronous-integrator.md,
+  /// "Performance notes"). 0: every region uses regionSolver.
+  int denseRegionDofs = 128;
 };
 
 /// Where an asynchronous run's time went, set-up apart from the steady-state steps (the

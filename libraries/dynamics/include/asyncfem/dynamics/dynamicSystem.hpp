@@ -18,6 +18,12 @@ namespace asyncfem {
 using ExternalForceFunction = std::function<void(double time, const Eigen::VectorXd& displacement,
                                                  const Eigen::VectorXd& velocity, Eigen::VectorXd& forces)>;
 
+/// Whether the external force at a fixed state may differ, at some time in (from, to], from
+/// its value at `to`. false lets a multirate integrator evaluate it once for all its
+/// substeps in that interval instead of once per substep time; true is always a correct
+/// answer (it only costs those evaluations).
+using ExternalForceChanges = std::function<bool(double from, double to)>;
+
 /// The vertices (ascending) closer than margin (a length) to an obstacle of the external
 /// force at displacement u, into vertices: what lets an integrator follow contact.
 using ObstacleProximity =
@@ -34,6 +40,9 @@ struct DynamicSystem {
   double rayleighMass = 0.0;            ///< alpha (1/s)
   double rayleighStiffness = 0.0;       ///< beta (s)
   ExternalForceFunction externalForce;  ///< may be empty: no external force
+  /// When externalForce changes in time (Problem sets it from its loads' windows). Empty:
+  /// it may change at any time (a user's force function).
+  ExternalForceChanges externalForceChanges;
   /// Where the external force's obstacles are (penalty contact); empty without obstacles.
   ObstacleProximity obstacleProximity;
   /// The mesh the matrices were built from (n vertices). Integrators that partition the

@@ -14,8 +14,9 @@ enum class SolverKind {
   umfpack,    ///< UMFPACK LU (any square non-singular matrix)
   eigenLDLT,  ///< Eigen SimplicialLDLT (SPD fallback, no SuiteSparse needed at run time)
   eigenLU,    ///< Eigen SparseLU (unsymmetric fallback)
+  dense,  ///< Eigen's blocked dense Cholesky (LLT) of the upper triangle: SPD systems of a few hundred unknowns at most
 };
-/// "cholmod", "umfpack", "eigen-ldlt", "eigen-lu".
+/// "cholmod", "umfpack", "eigen-ldlt", "eigen-lu", "dense".
 std::string toString(SolverKind kind);
 /// Inverse of toString; throws asyncfem::Error listing the valid names.
 SolverKind parseSolverKind(const std::string& name);
