@@ -109,6 +109,9 @@ void bindIntegrators(py::module_& module) {
           "external_force", [](const PythonDynamicSystem& s) { return s.externalForce; },
           [](PythonDynamicSystem& s, const py::object& callable) {
             s.system.externalForce = externalForceFromPython(callable);
+            // A Python function may change at any time: no multirate integrator may take it
+            // as constant over a large step (what a Problem's loads allowed).
+            s.system.externalForceChanges = nullptr;
             s.externalForce = callable;
           },
           "callable f(time, u, v) -> (3n,) array or None, added to the external force; one Python call per "

@@ -41,7 +41,8 @@ struct DynamicSystem {
   double rayleighStiffness = 0.0;       ///< beta (s)
   ExternalForceFunction externalForce;  ///< may be empty: no external force
   /// When externalForce changes in time (Problem sets it from its loads' windows). Empty:
-  /// it may change at any time (a user's force function).
+  /// it may change at any time (a user's force function). Whoever replaces externalForce
+  /// must reset or replace this too.
   ExternalForceChanges externalForceChanges;
   /// Where the external force's obstacles are (penalty contact); empty without obstacles.
   ObstacleProximity obstacleProximity;
