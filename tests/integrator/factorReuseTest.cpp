@@ -92,6 +92,35 @@ TEST(FactorReuseBackwardEuler, NewtonIterationsConvergeWithReusedFactors) {
   EXPECT_LE(scaledDifference(exact.displacement(), reused.displacement()), 1e-4);
 }
 
+// pcgSinglePrecision (the default) and the double factor as preconditioner: the summary's
+// counters say which ran, and both trajectories stay within the exact path's bound of
+// each other (each solve to a relative residual of 1e-10; see the first test).
+TEST(FactorReuseBackwardEuler, SinglePrecisionPreconditionerFollowsTheDoubleFactor) {
+  const BarBody bar = makeBar(MassType::consistent, 0.0, 0.0, Eigen::Vector3i(10, 2, 2));
+  const Eigen::VectorXd u0 = largeBend(bar.mesh);
+  IntegratorOptions singleOptions;
+  IntegratorOptions doubleOptions;
+  doubleOptions.pcgSinglePrecision = false;
+  ASSERT_TRUE(singleOptions.pcgSinglePrecision);
+  BackwardEuler single(swingingBar(bar), 2e-3, singleOptions);
+  BackwardEuler dual(swingingBar(bar), 2e-3, doubleOptions);
+  single.setState(u0, Eigen::VectorXd::Zero(u0.size()));
+  dual.setState(u0, Eigen::VectorXd::Zero(u0.size()));
+  double largestDifference = 0.0;
+  for (int k = 0; k < 50; ++k) {
+    single.step();
+    dual.step();
+    largestDifference = std::max(largestDifference, scaledDifference(single.displacement(), dual.displacement()));
+  }
+  EXPECT_LE(largestDifference, 1e-6);
+  EXPECT_TRUE(single.factorReuseStats()->singlePrecisionPreconditioner);
+  EXPECT_FALSE(dual.factorReuseStats()->singlePrecisionPreconditioner);
+  EXPECT_GT(single.factorReuseStats()->pcgIterations, 0);
+  EXPECT_NE(single.report().lines.front().find("applied in single precision"), std::string::npos)
+      << single.report().lines.front();
+  EXPECT_EQ(dual.report().lines.front().find("single precision"), std::string::npos);
+}
+
 TEST(FactorReuseBackwardEuler, BadOptionsAreRejected) {
   const BarBody bar = makeBar();
   IntegratorOptions options;

@@ -645,6 +645,8 @@ TEST(BuildSimulation, HyperelasticForceModelsRunFromTheScene) {
   json["forceModel"] = {{"type", "neo-hookean"}};
   json["integrator"]["options"] = {{"pcgTolerance", 2.0}};
   EXPECT_NE(sceneError(json).find("integrator.options.pcgTolerance"), std::string::npos) << sceneError(json);
+  json["integrator"]["options"] = {{"pcgSinglePrecision", 1}};
+  EXPECT_NE(sceneError(json).find("integrator.options.pcgSinglePrecision"), std::string::npos) << sceneError(json);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sparseSolver/factorReusingSolver.hpp>
 #include <random>
@@ -164,6 +165,93 @@ TEST(FactorReusingSolver, AnAbandonedSolveFallsBackToAnExactOne) {
   EXPECT_EQ(solver.stats().abandonedSolves, 1);
   EXPECT_EQ(solver.stats().refactorizations, 2);
   EXPECT_LE((second * x - b).norm(), 1e-13 * b.norm());  // exact solve: rounding only
+}
+
+// PCG to 1e-10 with the first factor kept throughout, preconditioned in single or double precision.
+FactorReuseOptions keepFirstFactor(bool singlePrecision) {
+  FactorReuseOptions options;
+  options.relativeTolerance = 1e-10;
+  options.amortize = false;
+  options.singlePrecisionPreconditioner = singlePrecision;
+  return options;
+}
+
+// The single-precision copy of CHOLMOD's supernodal factor is A^-1 to about 1e-7: with the
+// factor's own matrix (set again, so the next solve runs PCG) one PCG iteration brings the
+// residual to about 1e-7 |b| and a second below 1e-10, where the double factor needs one.
+// A copy with a wrong permutation, supernode layout or triangle would need many more.
+TEST(FactorReusingSolver, SinglePrecisionCopyIsTheFactorToSinglePrecision) {
+  const SparseMatrix a = driftingMatrix(8, 0.0);
+  const Eigen::VectorXd b = randomVector(a.rows(), 5);
+  std::vector<int> iterations;
+  for (const bool single : {true, false}) {
+    const FactorReuseOptions options = keepFirstFactor(single);
+    FactorReusingSolver solver(SolverKind::cholmod, options);
+    Eigen::VectorXd x;
+    solver.setMatrix(a);
+    solver.solve(b, x);  // exact, the double factor
+    solver.setMatrix(a);
+    solver.solve(b, x);
+    EXPECT_EQ(solver.stats().singlePrecisionPreconditioner, single);
+    EXPECT_EQ(solver.stats().refactorizations, 1);
+    EXPECT_LE((a * x - b).norm(), options.relativeTolerance * b.norm());
+    iterations.push_back(solver.stats().lastIterations);
+  }
+  EXPECT_EQ(iterations[0], 2);  // single precision
+  EXPECT_EQ(iterations[1], 1);  // double
+}
+
+// On a drifting sequence both preconditioners reach the tolerance in about as many
+// iterations, and the solutions agree to the tolerance times cond(A) (< 10 here).
+TEST(FactorReusingSolver, SinglePrecisionPreconditionerConvergesLikeTheDoubleFactor) {
+  const Eigen::VectorXd b = randomVector(512, 6);
+  std::vector<Eigen::VectorXd> solutions[2];
+  long long totalIterations[2] = {0, 0};
+  for (const bool single : {true, false}) {
+    const FactorReuseOptions options = keepFirstFactor(single);
+    FactorReusingSolver solver(SolverKind::cholmod, options);
+    Eigen::VectorXd x;
+    for (int step = 0; step < 6; ++step) {
+      const SparseMatrix a = driftingMatrix(8, 0.01 * step);
+      solver.setMatrix(a);
+      solver.solve(b, x);
+      EXPECT_LE((a * x - b).norm(), options.relativeTolerance * b.norm()) << "step " << step;
+      solutions[single ? 0 : 1].push_back(x);
+    }
+    EXPECT_EQ(solver.stats().abandonedSolves, 0);
+    totalIterations[single ? 0 : 1] = solver.stats().pcgIterations;
+  }
+  // Five PCG solves: at most one extra iteration each.
+  EXPECT_LE(totalIterations[0], totalIterations[1] + 5);
+  for (std::size_t step = 0; step < solutions[0].size(); ++step) {
+    EXPECT_LE((solutions[0][step] - solutions[1][step]).norm(), 1e-8 * solutions[1][step].norm()) << "step " << step;
+  }
+}
+
+// The default price of a factorization: max(30, factorFlops / (6 solveFlopsPerRhs)) in PCG
+// iterations with the single-precision copy, max(20, ...) with the double factor or a
+// solver without a supernodal factor (Eigen's LDLT).
+TEST(FactorReusingSolver, DefaultFactorCostHasAFloorPerPreconditioner) {
+  const SparseMatrix a = driftingMatrix(8, 0.0);
+  struct Case {
+    SolverKind kind;
+    bool single;
+    bool expectSingle;
+    double floor;
+  };
+  for (const Case& c : {Case{SolverKind::cholmod, true, true, 30.0}, Case{SolverKind::cholmod, false, false, 20.0},
+                        Case{SolverKind::eigenLDLT, true, false, 20.0}}) {
+    FactorReuseOptions options;
+    options.singlePrecisionPreconditioner = c.single;
+    FactorReusingSolver solver(c.kind, options);
+    solver.setMatrix(a);
+    const SolverStats& direct = solver.directStats();
+    ASSERT_GT(direct.solveFlopsPerRhs, 0.0);
+    EXPECT_EQ(solver.stats().singlePrecisionPreconditioner, c.expectSingle) << toString(c.kind);
+    EXPECT_EQ(solver.stats().factorCostInIterations,
+              std::max(c.floor, direct.factorFlops / (6.0 * direct.solveFlopsPerRhs)))
+        << toString(c.kind);
+  }
 }
 
 TEST(FactorReusingSolver, MisuseIsReportedClearly) {

@@ -39,6 +39,8 @@ BackwardEuler::BackwardEuler(DynamicSystem system, double timestep, const Integr
     reuseOptions.relativeTolerance = options_.pcgTolerance;
     reuseOptions.refactorAfterIterations = options_.pcgRefactorIterations;
     reuseOptions.maxIterations = std::max(25, 3 * options_.pcgRefactorIterations);
+    reuseOptions.factorCostInIterations = options_.pcgFactorCost;
+    reuseOptions.singlePrecisionPreconditioner = options_.pcgSinglePrecision;
     reuse_ = std::make_unique<FactorReusingSolver>(options_.solver, reuseOptions);
   }
   {
@@ -95,6 +97,7 @@ RunReport BackwardEuler::report() const {
     const FactorReuseStats& reuse = reuse_->stats();
     const long long steps = std::max<long long>(stats_.steps, 1);
     text << "linear solves: kept factor as PCG preconditioner (reuseFactor, relative residual " << options_.pcgTolerance
+         << (reuse.singlePrecisionPreconditioner ? ", applied in single precision" : "")
          << "): " << reuse.refactorizations << " factorizations in " << stats_.steps << " steps, "
          << std::setprecision(3) << static_cast<double>(reuse.pcgIterations) / static_cast<double>(steps)
          << " PCG iterations per step; refactored at every frame start, so a resumed run continues bit for bit";
@@ -329,6 +332,10 @@ double BackwardEuler::backtrack(const Eigen::VectorXd& dv, const Eigen::VectorXd
   // potential never rises by more than rounding.
   constexpr int kMaxHalvings = 12;
   const double roundingAllowance = 1e-12 * std::abs(potential);
+  // A predicted decrease below the potential's own rounding cannot be checked (a neo-Hookean
+  // energy at small strain is only accurate to about 1e-10 of itself): the iterate is
+  // converged to rounding, and the update is taken in full.
+  if (std::abs(slope) <= roundingAllowance) return 1.0;
   double t = 1.0;
   double bestT = 1.0;
   double bestPotential = std::numeric_limits<double>::infinity();

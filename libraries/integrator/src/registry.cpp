@@ -72,8 +72,8 @@ std::vector<std::string> IntegratorRegistry::dropForeignOptions(const std::strin
 
 const std::vector<std::string>& singleRateOptionKeys() {
   static const std::vector<std::string> keys{
-      "solver",      "maxIterations", "tolerance",    "lineSearch", "rayleighStiffnessAtIterate",
-      "reuseFactor", "pcgTolerance",  "maxFrequency", "force"};
+      "solver",      "maxIterations", "tolerance",          "lineSearch",   "rayleighStiffnessAtIterate",
+      "reuseFactor", "pcgTolerance",  "pcgSinglePrecision", "maxFrequency", "force"};
   return keys;
 }
 
@@ -97,6 +97,7 @@ IntegratorOptions parseIntegratorOptions(const nlohmann::json& options, const st
   result.pcgTolerance = reader.number("pcgTolerance", result.pcgTolerance);
   if (!(result.pcgTolerance > 0.0 && result.pcgTolerance < 1.0))
     reader.fail("pcgTolerance", "expected a number in (0, 1)");
+  result.pcgSinglePrecision = reader.boolean("pcgSinglePrecision", result.pcgSinglePrecision);
   result.maxFrequency = reader.number("maxFrequency", result.maxFrequency);
   if (result.maxFrequency < 0.0) reader.fail("maxFrequency", "expected a number >= 0 (0: estimate it)");
   result.force = reader.boolean("force", result.force);

@@ -402,10 +402,12 @@ double PetscSimulation::Impl::incrementalPotential(Vec dv) {
 
 // Armijo backtracking as BackwardEuler::backtrack: the step length t in (0, 1] from dv
 // along step, halving t up to 12 times until Phi(dv + t step) <= Phi(dv) + 1e-4 t slope
-// (differences below 1e-12 |Phi| count as no increase), else the t of the lowest Phi.
+// (differences below 1e-12 |Phi| count as no increase), else the t of the lowest Phi; a
+// slope below that allowance is taken in full, unchecked (converged to rounding).
 double PetscSimulation::Impl::backtrack(Vec dv, Vec step, double potential, double slope) {
   constexpr int kMaxHalvings = 12;
   const double roundingAllowance = 1e-12 * std::abs(potential);
+  if (std::abs(slope) <= roundingAllowance) return 1.0;
   Vec candidate = body.candidate.get();
   double t = 1.0;
   double bestT = 1.0;

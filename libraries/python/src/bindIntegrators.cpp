@@ -125,7 +125,8 @@ void bindIntegrators(py::module_& module) {
       module, "IntegratorOptions",
       "Options of the single-rate integrators: solver, Newton iterations and tolerance, line search, factor reuse")
       .def(py::init([](SolverKind solver, int maxIterations, double tolerance, double maxFrequency, bool force,
-                       bool lineSearch, bool rayleighStiffnessAtIterate, bool reuseFactor, double pcgTolerance) {
+                       bool lineSearch, bool rayleighStiffnessAtIterate, bool reuseFactor, double pcgTolerance,
+                       bool pcgSinglePrecision) {
              IntegratorOptions options;  // by name: the struct gains fields over time
              options.solver = solver;
              options.maxIterations = maxIterations;
@@ -136,12 +137,13 @@ void bindIntegrators(py::module_& module) {
              options.rayleighStiffnessAtIterate = rayleighStiffnessAtIterate;
              options.reuseFactor = reuseFactor;
              options.pcgTolerance = pcgTolerance;
+             options.pcgSinglePrecision = pcgSinglePrecision;
              return options;
            }),
            py::arg("solver") = SolverKind::cholmod, py::arg("max_iterations") = 1, py::arg("tolerance") = 1e-8,
            py::arg("max_frequency") = 0.0, py::arg("force") = false, py::arg("line_search") = true,
            py::arg("rayleigh_stiffness_at_iterate") = false, py::arg("reuse_factor") = true,
-           py::arg("pcg_tolerance") = 1e-10)
+           py::arg("pcg_tolerance") = 1e-10, py::arg("pcg_single_precision") = true)
       .def_readwrite("solver", &IntegratorOptions::solver)
       .def_readwrite("max_iterations", &IntegratorOptions::maxIterations)
       .def_readwrite("tolerance", &IntegratorOptions::tolerance)
@@ -150,6 +152,7 @@ void bindIntegrators(py::module_& module) {
       .def_readwrite("rayleigh_stiffness_at_iterate", &IntegratorOptions::rayleighStiffnessAtIterate)
       .def_readwrite("reuse_factor", &IntegratorOptions::reuseFactor)
       .def_readwrite("pcg_tolerance", &IntegratorOptions::pcgTolerance)
+      .def_readwrite("pcg_single_precision", &IntegratorOptions::pcgSinglePrecision)
       .def_readwrite("force", &IntegratorOptions::force);
 
   py::class_<IntegratorStats>(module, "IntegratorStats",

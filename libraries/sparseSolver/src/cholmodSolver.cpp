@@ -6,6 +6,7 @@
 #include <asyncfem/core/stopwatch.hpp>
 #include <string>
 
+#include "detail/singlePrecisionFactor.hpp"
 #include "detail/solverBase.hpp"
 
 namespace asyncfem::detail {
@@ -53,7 +54,7 @@ class CholmodCommon {
   cholmod_common common_{};
 };
 
-class CholmodSolver final : public SolverBase {
+class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
  public:
   CholmodSolver() {
     common_->supernodal = CHOLMOD_SUPERNODAL;
@@ -148,6 +149,24 @@ class CholmodSolver final : public SolverBase {
     }
     solution = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x_->x), rhs.rows(), rhs.cols());
     endSolve(rhs.cols(), watch);
+  }
+
+  bool copyFactor(SinglePrecisionFactor& out) const override {
+    if (factor_ == nullptr || !factor_->is_super || !factor_->is_ll || factor_->itype != CHOLMOD_INT ||
+        factor_->xtype != CHOLMOD_REAL || factor_->minor < factor_->n) {
+      return false;
+    }
+    SupernodalFactorView view;
+    view.size = static_cast<int>(factor_->n);
+    view.supernodes = static_cast<int>(factor_->nsuper);
+    view.super = static_cast<const int*>(factor_->super);
+    view.pi = static_cast<const int*>(factor_->pi);
+    view.px = static_cast<const int*>(factor_->px);
+    view.rows = static_cast<const int*>(factor_->s);
+    view.perm = static_cast<const int*>(factor_->Perm);
+    view.values = static_cast<const double*>(factor_->x);
+    out.assign(view);
+    return true;
   }
 
  private:

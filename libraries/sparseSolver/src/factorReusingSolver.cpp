@@ -5,6 +5,8 @@
 #include <cmath>
 #include <string>
 
+#include "detail/singlePrecisionFactor.hpp"
+
 namespace asyncfem {
 
 namespace {
@@ -45,13 +47,16 @@ void startFromGuessOrZero(const Eigen::SparseMatrix<double>& a, const Eigen::Vec
 
 // Preconditioned conjugate gradients (Saad, Iterative Methods, Alg. 9.1) from solution
 // with its residual, until |residual| <= target, maxIterations, or a direction along
-// which A is not positive. Returns the iterations; residualNorm is |residual| at the end.
-// z, direction and product are scratch.
+// which A is not positive. The direction update takes the Polak-Ribiere form
+// beta = r_new . (z_new - z_old) / r_old . z_old (flexible CG, Notay 2000), equal to
+// Alg. 9.1's in exact arithmetic with a symmetric preconditioner and robust when the
+// preconditioner is applied in single precision. Returns the iterations; residualNorm is
+// |residual| at the end. z, previousZ, direction and product are scratch.
 template <class Preconditioner>
 int preconditionedConjugateGradients(const Eigen::SparseMatrix<double>& a, double target, int maxIterations,
                                      const Preconditioner& precondition, Eigen::VectorXd& solution,
-                                     Eigen::VectorXd& residual, Eigen::VectorXd& z, Eigen::VectorXd& direction,
-                                     Eigen::VectorXd& product, double& residualNorm) {
+                                     Eigen::VectorXd& residual, Eigen::VectorXd& z, Eigen::VectorXd& previousZ,
+                                     Eigen::VectorXd& direction, Eigen::VectorXd& product, double& residualNorm) {
   precondition(residual, z);
   direction = z;
   double residualDotZ = residual.dot(z);
@@ -67,12 +72,29 @@ int preconditionedConjugateGradients(const Eigen::SparseMatrix<double>& a, doubl
     ++iterations;
     residualNorm = residual.norm();
     if (residualNorm <= target) break;
+    previousZ.swap(z);
     precondition(residual, z);
     const double nextDot = residual.dot(z);
-    direction = z + (nextDot / residualDotZ) * direction;
+    const double beta = (nextDot - residual.dot(previousZ)) / residualDotZ;
+    direction = z + beta * direction;
     residualDotZ = nextDot;
   }
   return iterations;
+}
+
+// The price of a numeric factorization in PCG iterations (FactorReuseOptions). Two regimes,
+// measured with CHOLMOD on the 2-core machine of docs/benchmarks.md ("The kept factor in
+// single precision"): while supernodes are small, the factorization's flop rate grows in
+// proportion to its flops per factor entry q = factorFlops / solveFlopsPerRhs (4.3
+// GFLOP/s at q = 66, 14 at q = 208) while the substitutions stay near 2 GFLOP/s, so a
+// factorization costs about as many iterations at any such size: 23-27 with the double
+// factor as preconditioner, 30-36 with the single-precision copy (the floor below). Once
+// the dense kernels saturate, it costs q / 6 (the ratio of CHOLMOD's supernodal rate to the
+// memory-bound substitutions on large meshes).
+double estimatedFactorCost(const SolverStats& direct, bool singlePrecision) {
+  const double floor = singlePrecision ? 30.0 : 20.0;
+  if (!(direct.solveFlopsPerRhs > 0.0)) return floor;
+  return std::max(floor, direct.factorFlops / (6.0 * direct.solveFlopsPerRhs));
 }
 
 // Whether the next setMatrix() should refactor after a converged PCG solve of iterations:
@@ -101,7 +123,7 @@ FactorReusingSolver::FactorReusingSolver(SolverKind direct, const FactorReuseOpt
   }
 }
 
-FactorReusingSolver::~FactorReusingSolver() = default;
+FactorReusingSolver::~FactorReusingSolver() = default;  // where SinglePrecisionFactor is complete
 
 void FactorReusingSolver::setMatrix(const Eigen::SparseMatrix<double>& matrix) {
   // A new size or entry count needs a new analysis; a pattern changed in place with the
@@ -121,14 +143,18 @@ void FactorReusingSolver::setMatrix(const Eigen::SparseMatrix<double>& matrix) {
 void FactorReusingSolver::refactor() {
   direct_->factorize(*matrix_);
   ++stats_.refactorizations;
+  singlePrecision_.reset();
+  const auto* source = dynamic_cast<const detail::SupernodalFactorSource*>(direct_.get());
+  if (options_.singlePrecisionPreconditioner && source != nullptr) {
+    auto copy = std::make_unique<detail::SinglePrecisionFactor>();
+    if (source->copyFactor(*copy)) singlePrecision_ = std::move(copy);
+  }
+  stats_.singlePrecisionPreconditioner = singlePrecision_ != nullptr;
   factorIsCurrent_ = true;
   refactorPending_ = false;
   firstStaleIterations_ = 0;
   double factorCost = options_.factorCostInIterations;
-  if (!(factorCost > 0.0)) {
-    const SolverStats& direct = direct_->stats();
-    factorCost = direct.solveFlopsPerRhs > 0.0 ? direct.factorFlops / (6.0 * direct.solveFlopsPerRhs) : 10.0;
-  }
+  if (!(factorCost > 0.0)) factorCost = estimatedFactorCost(direct_->stats(), singlePrecision_ != nullptr);
   stats_.factorCostInIterations = factorCost;
   // The factorization and the exact solve that follows it (one substitution).
   cycleCost_ = factorCost + 1.0;
@@ -136,6 +162,14 @@ void FactorReusingSolver::refactor() {
 }
 
 void FactorReusingSolver::applyPreconditioner(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
+  if (singlePrecision_) {
+    singlePrecision_->solve(rhs, out);
+  } else {
+    solveExactly(rhs, out);
+  }
+}
+
+void FactorReusingSolver::solveExactly(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
   direct_->solve(rhs, preconditioned_);
   out = preconditioned_.col(0);
 }
@@ -149,7 +183,7 @@ void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, const Eigen::VectorX
   checkSolveInput(matrix_, rhs);
   ++stats_.solves;
   if (factorIsCurrent_) {
-    applyPreconditioner(rhs, solution);
+    solveExactly(rhs, solution);
     ++cycleSolves_;
     ++stats_.exactSolves;
     recordNoIterations(stats_);
@@ -165,15 +199,16 @@ void FactorReusingSolver::solve(const Eigen::VectorXd& rhs, const Eigen::VectorX
   startFromGuessOrZero(*matrix_, rhs, rhsNorm, initialGuess, solution, residual_, product_);
   const auto precondition = [this](const Eigen::VectorXd& in, Eigen::VectorXd& out) { applyPreconditioner(in, out); };
   double residualNorm = 0.0;
-  const int iterations = preconditionedConjugateGradients(*matrix_, target, options_.maxIterations, precondition,
-                                                          solution, residual_, z_, direction_, product_, residualNorm);
+  const int iterations =
+      preconditionedConjugateGradients(*matrix_, target, options_.maxIterations, precondition, solution, residual_, z_,
+                                       previousZ_, direction_, product_, residualNorm);
   stats_.pcgIterations += iterations;
   stats_.lastIterations = iterations;
   if (!(residualNorm <= target)) {
     // The kept factor is no longer a useful preconditioner: factor A and solve exactly.
     ++stats_.abandonedSolves;
     refactor();
-    applyPreconditioner(rhs, solution);
+    solveExactly(rhs, solution);
     ++cycleSolves_;
     stats_.lastRelativeResidual = 0.0;
     return;

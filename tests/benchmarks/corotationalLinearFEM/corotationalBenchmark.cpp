@@ -73,6 +73,9 @@ struct ProblemSettings {
   double tolerance = 1e-6;    // Vega's epsilon: relative residual of the free DOFs
   double rayleighMass = 0.0;  // D = alpha M + beta K(u at the step start)
   double rayleighStiffness = 0.0;
+  double factorCost = 0.0;  // the kept factor's price in PCG iterations (<= 0: the flop model)
+  int refactorIterations = IntegratorOptions{}.pcgRefactorIterations;
+  bool singlePrecision = IntegratorOptions{}.pcgSinglePrecision;
 };
 
 struct Scene {
@@ -87,6 +90,9 @@ struct Scene {
   std::string model = "corotational";
   int maxIterations = 1;
   double tolerance = 1e-6;
+  double factorCost = 0.0;
+  int refactorIterations = IntegratorOptions{}.pcgRefactorIterations;
+  bool singlePrecision = IntegratorOptions{}.pcgSinglePrecision;
 };
 
 // A beam clamped at x = 0 that sags under gravity (rubber-like, so rotations are large).
@@ -107,7 +113,10 @@ Scene makeScene(const std::string& name, const Eigen::Vector3d& size, const Eige
               settings.rayleighStiffness,
               settings.model,
               settings.maxIterations,
-              settings.tolerance};
+              settings.tolerance,
+              settings.factorCost,
+              settings.refactorIterations,
+              settings.singlePrecision};
   scene.assembler = std::make_shared<const MatrixAssembler>(scene.mesh);
   scene.mass = massMatrix(scene.mesh, *scene.assembler, MassType::consistent);
   std::vector<int> clamped;
@@ -278,6 +287,9 @@ IntegratorOptions integratorOptions(const Scene& scene, bool reuse, double pcgTo
   IntegratorOptions options;
   options.reuseFactor = reuse;
   options.pcgTolerance = pcgTolerance;
+  options.pcgFactorCost = scene.factorCost;
+  options.pcgRefactorIterations = scene.refactorIterations;
+  options.pcgSinglePrecision = scene.singlePrecision;
   options.maxIterations = scene.maxIterations;
   if (scene.maxIterations > 1) {
     options.tolerance = scene.tolerance;
@@ -526,9 +538,10 @@ void timeToolkitOnly(const std::vector<Scene>& scenes, int warmup, int steps, co
     const Timing t = runToolkit(scene, warmup, steps, configuration == "reuse", IntegratorOptions{}.pcgTolerance);
     std::printf(
         "%s, %s, toolkit %s, per step (ms): elements %.2f, factor %.2f, solve %.2f, step %.2f; %lld factorizations, "
-        "%lld PCG iterations, %lld Newton iterations; max |u| %.9f\n",
+        "%lld PCG iterations, %lld Newton iterations; factorization priced at %.1f PCG iterations; max |u| %.9f\n",
         scene.name.c_str(), scene.model.c_str(), configuration.c_str(), t.elementMs, t.factorMs, t.solveMs, t.stepMs,
-        t.factorizations, t.pcgIterations, t.newtonIterations, t.finalDisplacement.lpNorm<Eigen::Infinity>());
+        t.factorizations, t.pcgIterations, t.newtonIterations, t.factorCostInIterations,
+        t.finalDisplacement.lpNorm<Eigen::Infinity>());
   }
 }
 
@@ -561,6 +574,15 @@ void addOptions(CLI::App& app, CommandLine& c) {
       ->check(CLI::PositiveNumber);
   app.add_option("--newton-tolerance", c.settings.tolerance, "Newton's relative residual (Vega's epsilon)")
       ->check(CLI::PositiveNumber);
+  app.add_option("--factor-cost", c.settings.factorCost,
+                 "The kept factor's refactorization priced in PCG iterations (IntegratorOptions::pcgFactorCost; "
+                 "0: the flop model)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--refactor-iterations", c.settings.refactorIterations,
+                 "Refactor after a PCG solve of more iterations (IntegratorOptions::pcgRefactorIterations)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("!--double-preconditioner", c.settings.singlePrecision,
+               "Precondition PCG with the double factor (IntegratorOptions::pcgSinglePrecision = false)");
 }
 
 }  // namespace

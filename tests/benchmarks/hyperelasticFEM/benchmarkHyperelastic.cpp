@@ -25,7 +25,7 @@
 #include <memory>
 #include <random>
 
-#include "machineRates.hpp"
+#include "../machineRates.hpp"
 
 namespace asyncfem::bench {
 namespace {

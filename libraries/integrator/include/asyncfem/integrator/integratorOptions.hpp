@@ -46,6 +46,13 @@ struct IntegratorOptions {
   double pcgTolerance = 1e-10;
   /// Iterations of a PCG solve above which the next step refactors (reuseFactor only).
   int pcgRefactorIterations = 8;
+  /// The price of one numeric factorization in PCG iterations, for the rule that
+  /// refactors once that pays (reuseFactor only; FactorReuseOptions::factorCostInIterations).
+  /// <= 0 (the default): estimated from the factorization's own flop counts.
+  double pcgFactorCost = 0.0;
+  /// Precondition PCG with a single-precision copy of the kept factor (CHOLMOD only;
+  /// FactorReuseOptions::singlePrecisionPreconditioner). false: the double factor.
+  bool pcgSinglePrecision = true;
 
   /// Explicit methods: an upper bound of the highest angular frequency omega_max
   /// (rad / time unit) of the free system, e.g. from estimateMaxFrequency(mesh, massType).

@@ -8,6 +8,10 @@
 
 namespace asyncfem {
 
+namespace detail {
+class SinglePrecisionFactor;
+}
+
 /// When FactorReusingSolver refactors and how accurately it solves.
 struct FactorReuseOptions {
   /// PCG stops once |b - A x|_2 <= relativeTolerance |b|_2.
@@ -25,26 +29,35 @@ struct FactorReuseOptions {
   /// counted as this many PCG iterations, the next setMatrix() refactors once the last
   /// solve's iterations exceed the average cost per solve since the last factorization
   /// (factorization and its exact solve included), the point where a longer cycle only
-  /// raises the average. <= 0 (default): estimated as factorFlops / (6 solveFlopsPerRhs)
-  /// from the direct solver's own counts, 6 being the speed of a supernodal factorization
-  /// over the memory-bound substitutions measured on CHOLMOD (README benchmark table:
-  /// 0.55 GFlop in 0.14 s against 5.7 MFlop in 8.7 ms). Deterministic: iteration counts
-  /// and flop counts only, never wall time.
+  /// raises the average. <= 0 (default): estimated from the direct solver's own counts as
+  /// max(30, factorFlops / (6 solveFlopsPerRhs)) with the single-precision preconditioner
+  /// below (20 instead of 30 with the double factor): about 30 iterations while the
+  /// factorization's rate still grows with its supernodes, then 6 as the speed of a
+  /// saturated supernodal factorization over the memory-bound substitutions (measured on
+  /// CHOLMOD, docs/benchmarks.md "The kept factor in single precision"). Deterministic:
+  /// iteration counts and flop counts only, never wall time.
   double factorCostInIterations = 0.0;
   /// Turns the amortisation rule off (only the two thresholds above apply).
   bool amortize = true;
+  /// PCG preconditions with a single-precision copy of the kept factor when the direct
+  /// solver is supernodal (CHOLMOD): each iteration then reads half the bytes, while the
+  /// iteration still converges to relativeTolerance in double precision (the rounding
+  /// only enters the preconditioner, as about 6e-8 of its output). The exact solve right
+  /// after a factorization keeps the double factor. false: the double factor throughout.
+  bool singlePrecisionPreconditioner = true;
 };
 
 /// Counters of a FactorReusingSolver since construction (or resetStats()).
 struct FactorReuseStats {
   long long solves = 0;
-  long long exactSolves = 0;            ///< solves with a factor of the current values (no iteration)
-  long long pcgIterations = 0;          ///< sum over the PCG solves (one product with A each)
-  long long refactorizations = 0;       ///< numeric factorizations, the first one included
-  long long abandonedSolves = 0;        ///< PCG runs that hit maxIterations (then solved exactly)
-  int lastIterations = 0;               ///< PCG iterations of the last solve (0: exact)
-  double factorCostInIterations = 0.0;  ///< the cost model in use (see FactorReuseOptions)
-  double lastRelativeResidual = 0.0;    ///< |b - A x| / |b| of the last PCG solve (0 when exact)
+  long long exactSolves = 0;                   ///< solves with a factor of the current values (no iteration)
+  long long pcgIterations = 0;                 ///< sum over the PCG solves (one product with A each)
+  long long refactorizations = 0;              ///< numeric factorizations, the first one included
+  long long abandonedSolves = 0;               ///< PCG runs that hit maxIterations (then solved exactly)
+  int lastIterations = 0;                      ///< PCG iterations of the last solve (0: exact)
+  double factorCostInIterations = 0.0;         ///< the cost model in use (see FactorReuseOptions)
+  double lastRelativeResidual = 0.0;           ///< |b - A x| / |b| of the last PCG solve (0 when exact)
+  bool singlePrecisionPreconditioner = false;  ///< whether PCG runs on the single-precision copy
 };
 
 /// Solves a sequence of systems A_k x = b_k whose matrices (one sparsity pattern, SPD,
@@ -94,10 +107,12 @@ class FactorReusingSolver {
  private:
   void refactor();
   void applyPreconditioner(const Eigen::VectorXd& rhs, Eigen::VectorXd& out);
+  void solveExactly(const Eigen::VectorXd& rhs, Eigen::VectorXd& out);
 
   FactorReuseOptions options_;
   FactorReuseStats stats_;
   std::unique_ptr<SparseSolver> direct_;
+  std::unique_ptr<detail::SinglePrecisionFactor> singlePrecision_;  // null: precondition in double
   const Eigen::SparseMatrix<double>* matrix_ = nullptr;
   bool analysed_ = false;
   bool factorIsCurrent_ = false;  // the factor is that of matrix_'s current values
@@ -106,7 +121,7 @@ class FactorReusingSolver {
   double cycleCost_ = 0.0;        // factorization + iterations since it, in PCG iterations
   long long cycleSolves_ = 0;     // solves since the last factorization
   Eigen::MatrixXd preconditioned_;
-  Eigen::VectorXd residual_, direction_, product_, z_;
+  Eigen::VectorXd residual_, direction_, product_, z_, previousZ_;
 };
 
 }  // namespace asyncfem
