@@ -228,6 +228,30 @@ TEST(FactorReusingSolver, SinglePrecisionPreconditionerConvergesLikeTheDoubleFac
   }
 }
 
+// A system whose factor's entries are far beyond float's range (A scaled by 1e80: L's
+// entries near 1e40, above float's 3.4e38) cannot be copied to single precision: the copy's
+// solve is not finite, so it is dropped and PCG runs with the double factor. (The check
+// compares the copy's solve of a fixed vector with the double factor's: a tridiagonal
+// chain with cond(A) = 6e6 still agreed to 2.4e-7, so conditioning alone rarely drops it.)
+TEST(FactorReusingSolver, SinglePrecisionCopyIsDroppedWhereFloatCannotHoldTheFactor) {
+  const SparseMatrix a = 1e80 * driftingMatrix(6, 0.0);
+  FactorReusingSolver solver(SolverKind::cholmod, keepFirstFactor(true));
+  solver.setMatrix(a);
+  EXPECT_FALSE(solver.stats().singlePrecisionPreconditioner);
+  const Eigen::VectorXd b = 1e80 * randomVector(a.rows(), 7);
+  Eigen::VectorXd x;
+  solver.solve(b, x);
+  solver.setMatrix(a);
+  solver.solve(b, x);
+  EXPECT_EQ(solver.stats().lastIterations, 1);  // the double factor of A itself
+  EXPECT_EQ(solver.stats().abandonedSolves, 0);
+  EXPECT_LE((a * x - b).norm(), 1e-10 * b.norm());
+  // The same system at its natural scale keeps the copy.
+  FactorReusingSolver natural(SolverKind::cholmod, keepFirstFactor(true));
+  natural.setMatrix(driftingMatrix(6, 0.0));
+  EXPECT_TRUE(natural.stats().singlePrecisionPreconditioner);
+}
+
 // The default price of a factorization: max(30, factorFlops / (6 solveFlopsPerRhs)) in PCG
 // iterations with the single-precision copy, max(20, ...) with the double factor or a
 // solver without a supernodal factor (Eigen's LDLT).

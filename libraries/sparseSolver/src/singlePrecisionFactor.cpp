@@ -3,6 +3,8 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace asyncfem::detail {
 
@@ -11,6 +13,16 @@ namespace {
 using FloatBlock = Eigen::Map<const Eigen::MatrixXf>;
 
 std::vector<int> copyInts(const int* data, int count) { return std::vector<int>(data, data + count); }
+
+// A double rounded to float; beyond float's range, the infinity of its sign (a plain
+// conversion of such a value is undefined behaviour).
+float toFloat(double value) {
+  if (std::abs(value) > static_cast<double>(std::numeric_limits<float>::max())) {
+    const float infinity = std::numeric_limits<float>::infinity();
+    return value > 0.0 ? infinity : -infinity;
+  }
+  return static_cast<float>(value);
+}
 
 }  // namespace
 
@@ -23,8 +35,7 @@ void SinglePrecisionFactor::assign(const SupernodalFactorView& factor) {
   rows_ = copyInts(factor.rows, pi_.back());
   perm_ = copyInts(factor.perm, size_);
   values_.resize(static_cast<std::size_t>(px_.back()));
-  std::transform(factor.values, factor.values + px_.back(), values_.begin(),
-                 [](double value) { return static_cast<float>(value); });
+  std::transform(factor.values, factor.values + px_.back(), values_.begin(), toFloat);
   int widest = 0;
   for (int k = 0; k < supernodes_; ++k) widest = std::max(widest, (pi_[k + 1] - pi_[k]) - (super_[k + 1] - super_[k]));
   work_.resize(size_);
@@ -53,7 +64,11 @@ void SinglePrecisionFactor::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& s
     return Supernode{first, columns, rowCount - columns, rows_.data() + pi_[k] + columns,
                      FloatBlock(values_.data() + px_[k], rowCount, columns)};
   };
-  for (int i = 0; i < size_; ++i) work_[i] = static_cast<float>(rhs[perm_[i]]);
+  // The solve is linear: rhs is scaled to a largest entry of 1 (a power of two, exact) so
+  // that it fits float's range whatever its units, and the solution scaled back.
+  const double largest = rhs.size() > 0 ? rhs.cwiseAbs().maxCoeff() : 0.0;
+  const double scale = largest > 0.0 && std::isfinite(largest) ? std::exp2(std::ceil(std::log2(largest))) : 1.0;
+  for (int i = 0; i < size_; ++i) work_[i] = toFloat(rhs[perm_[i]] / scale);
   // Forward: L y = P b, supernode by supernode: the diagonal block's triangle, then the
   // update of the rows below it.
   for (int k = 0; k < supernodes_; ++k) {
@@ -77,7 +92,7 @@ void SinglePrecisionFactor::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& s
     node.block.topRows(node.columns).transpose().triangularView<Eigen::Upper>().solveInPlace(x);
   }
   solution.resize(size_);
-  for (int i = 0; i < size_; ++i) solution[perm_[i]] = static_cast<double>(work_[i]);
+  for (int i = 0; i < size_; ++i) solution[perm_[i]] = scale * static_cast<double>(work_[i]);
 }
 
 }  // namespace asyncfem::detail

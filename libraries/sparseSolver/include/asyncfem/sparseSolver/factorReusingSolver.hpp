@@ -43,7 +43,11 @@ struct FactorReuseOptions {
   /// solver is supernodal (CHOLMOD): each iteration then reads half the bytes, while the
   /// iteration still converges to relativeTolerance in double precision (the rounding
   /// only enters the preconditioner, as about 6e-8 of its output). The exact solve right
-  /// after a factorization keeps the double factor. false: the double factor throughout.
+  /// after a factorization keeps the double factor. After each factorization the copy is
+  /// checked against the double factor on a fixed vector and dropped (the double factor
+  /// preconditions) when they differ by more than 1e-2 relatively (entries beyond
+  /// float's range, or conditioning that amplifies the rounding). false: the double
+  /// factor throughout.
   bool singlePrecisionPreconditioner = true;
 };
 
@@ -57,7 +61,7 @@ struct FactorReuseStats {
   int lastIterations = 0;                      ///< PCG iterations of the last solve (0: exact)
   double factorCostInIterations = 0.0;         ///< the cost model in use (see FactorReuseOptions)
   double lastRelativeResidual = 0.0;           ///< |b - A x| / |b| of the last PCG solve (0 when exact)
-  bool singlePrecisionPreconditioner = false;  ///< whether PCG runs on the single-precision copy
+  bool singlePrecisionPreconditioner = false;  ///< whether PCG runs on the single-precision copy (of the last factor)
 };
 
 /// Solves a sequence of systems A_k x = b_k whose matrices (one sparsity pattern, SPD,
@@ -108,6 +112,7 @@ class FactorReusingSolver {
   void refactor();
   void applyPreconditioner(const Eigen::VectorXd& rhs, Eigen::VectorXd& out);
   void solveExactly(const Eigen::VectorXd& rhs, Eigen::VectorXd& out);
+  void copySinglePrecisionFactor();
 
   FactorReuseOptions options_;
   FactorReuseStats stats_;
