@@ -32,6 +32,12 @@ namespace asyncfem {
 namespace {
 
 TEST(HyperelasticAllocation, RepeatedEvaluationsAllocateNothing) {
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer's allocator serves the allocations behind this file's operator new
+  // (its check that a new matrix is counted fails there), so the count means nothing.
+  GTEST_SKIP() << "SKIP: under AddressSanitizer the replaced operator new does not see the allocations (the normal "
+                  "build runs this test)";
+#endif
   const TetMesh mesh = test::smallBox(3);
   std::mt19937 random(2);
   const Eigen::VectorXd u = test::deformedDisplacement(mesh, test::randomRotation(random), 0.05, random);
