@@ -210,7 +210,8 @@ def mark_not_built(commands, not_built, module_built):
         missing = [name for name in not_built if re.search(r"(^|[\s/;&|])" + re.escape(name) + r"\b", text)]
         if command.block.scene:
             missing += [name for name in not_built if name == "offlineSimulator"]
-        if command.block.language == "python" and not module_built and re.search(r"\bimport asyncfem\b", text):
+        # A Python block or a shell command (python3 -c "import asyncfem ...") that needs the module.
+        if not module_built and re.search(r"\bimport asyncfem\b", text):
             missing.append("the asyncfem Python module")
         if missing:
             command.skip_reason = "not in this build: " + ", ".join(missing)

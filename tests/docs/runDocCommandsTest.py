@@ -27,6 +27,8 @@ CASES = [
      "'--frames 9' occurs in no command"),
     ("python", "<!-- docs-test: expect ^6$ -->\n```python\nprint(2 * 3)\n```\n", 0, "python block of 1 lines"),
     ("python-fails", "```python\nraise SystemExit(3)\n```\n", 1, "exit status 3"),
+    ("module-not-built", "```sh\npython3 -c \"import asyncfem\"\n```\n", 77,
+     "not in this build: the asyncfem Python module"),
     ("json-fragment", '```json\n"forces": [{"type": "pull"}]\n```\n', 0, "json block of 1 lines"),
     ("json-broken", '```json\n"forces": [{"type": }]\n```\n', 1, "does not parse as JSON"),
     ("unknown-marker", "<!-- docs-test: sometimes -->\n```sh\ntrue\n```\n", 1, "unknown or malformed"),
