@@ -84,13 +84,13 @@ int preconditionedConjugateGradients(const Eigen::SparseMatrix<double>& a, doubl
 
 // The price of a numeric factorization in PCG iterations (FactorReuseOptions). Two regimes,
 // measured with CHOLMOD on the 2-core machine of docs/benchmarks.md ("The kept factor in
-// single precision"): while supernodes are small, the factorization's flop rate grows in
-// proportion to its flops per factor entry q = factorFlops / solveFlopsPerRhs (4.3
-// GFLOP/s at q = 66, 14 at q = 208) while the substitutions stay near 2 GFLOP/s, so a
-// factorization costs about as many iterations at any such size: 23-27 with the double
-// factor as preconditioner, 30-36 with the single-precision copy (the floor below). Once
-// the dense kernels saturate, it costs q / 6 (the ratio of CHOLMOD's supernodal rate to the
-// memory-bound substitutions on large meshes).
+// single precision"): while supernodes are small, the factorization's flop rate grows with
+// its flops per factor entry q = factorFlops / solveFlopsPerRhs (4.3 GFLOP/s at q = 66, 14
+// at q = 208) while the substitutions stay near 2 GFLOP/s, so the price hardly depends on
+// the size there: 20-35 iterations on the bridge-sized mesh, 26-122 on box meshes up to
+// 35k tets, the single-precision copy at the upper end (the floors below are the
+// conservative side: amortisation is flat near its optimum). Once the dense kernels
+// saturate, it costs q / 6 (measured 63 single, 47 double at 105k tets, where q / 6 = 64).
 double estimatedFactorCost(const SolverStats& direct, bool singlePrecision) {
   const double floor = singlePrecision ? 30.0 : 20.0;
   if (!(direct.solveFlopsPerRhs > 0.0)) return floor;
