@@ -262,20 +262,51 @@ TEST(AsyncScene, TouchingRegionsRunTheNestedIntegrator) {
 }
 
 // "method": "nested" runs the nested integrator on regions that do not touch: the same
-// trajectory as the structured two-level solve, to round-off (1e-10 relative).
+// trajectory as the structured two-level solve, to round-off (1e-10 relative), through the
+// nested integrator's structured solve (the default) and through its LU ("nestedSolve").
 TEST(AsyncScene, NestedMethodMatchesTheStructuredSolve) {
   nlohmann::json scene = barScene();
   Simulation structured = build(scene);
   scene["integrator"]["options"]["method"] = "nested";
   Simulation nested = build(scene);
-  ASSERT_NE(dynamic_cast<asyncfem::NestedAsyncBackwardEuler*>(nested.integrator.get()), nullptr);
+  scene["integrator"]["options"]["nestedSolve"] = "lu";
+  Simulation nestedLU = build(scene);
+  auto* levels = dynamic_cast<asyncfem::NestedAsyncBackwardEuler*>(nested.integrator.get());
+  auto* lu = dynamic_cast<asyncfem::NestedAsyncBackwardEuler*>(nestedLU.integrator.get());
+  ASSERT_NE(levels, nullptr);
+  ASSERT_NE(lu, nullptr);
   for (int frame = 0; frame < structured.numFrames; ++frame) {
     asyncfem::advanceFrame(structured, frame);
     asyncfem::advanceFrame(nested, frame);
+    asyncfem::advanceFrame(nestedLU, frame);
   }
+  EXPECT_TRUE(levels->structuredSolve());
+  EXPECT_FALSE(lu->structuredSolve());
   const Eigen::VectorXd& a = structured.integrator->displacement();
-  const Eigen::VectorXd& b = nested.integrator->displacement();
-  EXPECT_LT((a - b).lpNorm<Eigen::Infinity>(), 1e-10 * a.lpNorm<Eigen::Infinity>());
+  for (const Simulation* other : {&nested, &nestedLU}) {
+    const Eigen::VectorXd& b = other->integrator->displacement();
+    EXPECT_LT((a - b).lpNorm<Eigen::Infinity>(), 1e-10 * a.lpNorm<Eigen::Infinity>());
+  }
+}
+
+// "nestedSolve" is read only where the nested integrator runs, and "structured" is refused
+// by name where the ratios do not form a chain.
+TEST(AsyncScene, NestedSolveKey) {
+  nlohmann::json scene = barScene();
+  scene["integrator"]["options"]["nestedSolve"] = "lu";
+  EXPECT_NE(errorOf(scene).find("integrator.options.nestedSolve: only meaningful for regions that touch or nest"),
+            std::string::npos)
+      << errorOf(scene);
+  scene["integrator"]["options"]["nestedSolve"] = "fast";
+  EXPECT_NE(errorOf(scene).find("integrator.options.nestedSolve"), std::string::npos) << errorOf(scene);
+  scene["integrator"]["options"]["method"] = "nested";
+  scene["integrator"]["options"]["nestedSolve"] = "structured";
+  scene["integrator"]["options"]["regions"][0]["ratio"] = 3;
+  scene["integrator"]["options"]["regions"].push_back(nlohmann::json::parse(
+      R"({"name": "middle", "ratio": 4, "boxes": [{"min": [0.9, -1, -1], "max": [1.1, 2, 2]}]})"));
+  EXPECT_NE(errorOf(scene).find("integrator.options.nestedSolve: nested async regions: the structured solve needs"),
+            std::string::npos)
+      << errorOf(scene);
 }
 
 }  // namespace

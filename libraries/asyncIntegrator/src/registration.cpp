@@ -258,9 +258,9 @@ AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const
 }
 
 const std::vector<std::string>& asyncOptionKeys() {
-  static const std::vector<std::string> keys{"coupling",     "schur",           "method",         "recovery",
-                                             "regionSolver", "denseRegionDofs", "substepContact", "laggedSchur",
-                                             "quickSetUp",   "threads",         "regions",        "auto"};
+  static const std::vector<std::string> keys{
+      "coupling",    "schur",      "method",  "recovery", "regionSolver", "denseRegionDofs", "substepContact",
+      "laggedSchur", "quickSetUp", "threads", "regions",  "auto",         "nestedSolve"};
   return keys;
 }
 
@@ -271,6 +271,8 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
   JsonObjectReader reader(options, context.optionsPath, sourceName);
   AsyncSettings out;
   out.solver = parseSolverOptions(reader, context.hasContact);
+  out.nestedSolve = parseNestedSolve(reader.choice("nestedSolve", "automatic", {"automatic", "structured", "lu"}));
+  const std::string nestedSolvePath = reader.keyPath("nestedSolve");
   const std::string regionsPath = reader.keyPath("regions");
   parseRegions(reader, context, options, out);
   reader.finish();
@@ -305,6 +307,10 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
     if (!counts->touching()) JsonObjectReader::failAt(sourceName, regionsPath, e.what());
     out.nested = true;
   }
+  if (out.nestedSolve != NestedSolve::automatic && !out.nested) {
+    JsonObjectReader::failAt(sourceName, nestedSolvePath,
+                             "only meaningful for regions that touch or nest, or with \"method\": \"nested\"");
+  }
   return out;
 }
 
@@ -322,7 +328,13 @@ std::unique_ptr<Integrator> makeNested(IntegratorContext& context, const AsyncSe
   if (parsed.solver.quickSetUp) refuse("quickSetUp", "the quick set-up");
   if (parsed.solver.substepStatePrediction) refuse("substepContact", "contact at the substeps' predicted states");
   if (parsed.solver.method == AsyncSolveMethod::naive) refuse("method", "the naive solve method");
-  return std::make_unique<NestedAsyncBackwardEuler>(std::move(context.system), context.timestep, parsed.regions);
+  try {
+    return std::make_unique<NestedAsyncBackwardEuler>(std::move(context.system), context.timestep, parsed.regions,
+                                                      parsed.nestedSolve);
+  } catch (const ValidationError& e) {
+    if (parsed.nestedSolve != NestedSolve::structured) throw;
+    JsonObjectReader::failAt(context.sourceName, context.optionsPath + ".nestedSolve", e.what());
+  }
 }
 
 }  // namespace
@@ -356,6 +368,7 @@ nlohmann::json asyncSettingsJson(const AsyncSettings& settings) {
   if (solver.laggedSchur != defaults.laggedSchur) out["laggedSchur"] = solver.laggedSchur;
   if (solver.quickSetUp != defaults.quickSetUp) out["quickSetUp"] = solver.quickSetUp;
   if (solver.threads != defaults.threads) out["threads"] = solver.threads;
+  if (settings.nestedSolve != NestedSolve::automatic) out["nestedSolve"] = toString(settings.nestedSolve);
   out["regions"] =
       settings.adaptive ? nlohmann::json{{"adaptive", settings.adaptiveSource}} : asyncRegionsJson(settings.regions);
   return out;

@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "detail/sparseBlocks.hpp"
+#include "detail/structuredHierarchySolve.hpp"
 
 namespace asyncfem::detail {
 
@@ -51,8 +52,9 @@ constexpr long long kMaxUnknowns = 1LL << 28;
 
 }  // namespace
 
-HierarchySystem::HierarchySystem(const TetMesh& mesh, const DynamicSystem& system, const StepCounts& counts)
-    : mesh_(mesh), system_(system), counts_(counts), units_(counts.units()) {
+HierarchySystem::HierarchySystem(const TetMesh& mesh, const DynamicSystem& system, const StepCounts& counts,
+                                 NestedSolve solve)
+    : mesh_(mesh), system_(system), counts_(counts), units_(counts.units()), requested_(solve) {
   free_ = system.freeDofs.freeToFull();
   freeIndex_ = system.freeDofs.fullToFree();
   dofCount_.resize(free_.size());
@@ -83,7 +85,15 @@ HierarchySystem::HierarchySystem(const TetMesh& mesh, const DynamicSystem& syste
   if (!perElementTangent_) checkLinearStiffness();
   chooseElementMass();
   chooseOrder();
+  if (solve == NestedSolve::structured ||
+      (solve == NestedSolve::automatic && StructuredHierarchySolve::applies(dofCount_))) {
+    structured_ = std::make_unique<StructuredHierarchySolve>(dofCount_, offset_, velocityUnknowns_);
+  } else if (solve == NestedSolve::automatic) {
+    fallbackReason_ = "the step counts do not divide one another in a chain";
+  }
 }
+
+HierarchySystem::~HierarchySystem() = default;
 
 void HierarchySystem::checkLinearStiffness() {
   Triplets triplets;
@@ -276,7 +286,33 @@ void HierarchySystem::chooseOrder() {
     order_.indices()[keys[position].unknown] = static_cast<int>(position);
 }
 
+// The structured solve (Eqs. N9-N12) when it applies. Its first factor is checked on a
+// known solution: an error above 1e-6 means the system lacks the structure it assumes,
+// which NestedSolve::automatic answers with the LU (and the report says why).
 void HierarchySystem::factorize(IntegratorStats& stats) {
+  if (structured_) {
+    try {
+      structured_->factor(matrix_, stats);
+      if (!structureChecked_) {
+        const double error = structured_->checkEndState(matrix_);
+        structureChecked_ = true;
+        if (!(error <= 1e-6)) {
+          throw NumericalError("the structured solve missed a known solution by " + std::to_string(error) +
+                               " (relative)");
+        }
+      }
+      factorNonZeros_ = structured_->storedEntries();
+      return;
+    } catch (const Error& e) {
+      if (requested_ == NestedSolve::structured) throw;
+      fallbackReason_ = e.what();
+      structured_.reset();
+    }
+  }
+  factorizeLU(stats);
+}
+
+void HierarchySystem::factorizeLU(IntegratorStats& stats) {
   // Position rows (Eq. N5) are in metres; scaled by M_dd / h_d they weigh like the velocity
   // rows (momentum), so the LU's diagonal pivots stay the natural ones.
   rowScale_ = Eigen::VectorXd::Ones(unknowns());
@@ -323,8 +359,14 @@ void HierarchySystem::step(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0,
     }
     rhs_[velocityRow(d, 1)] += momentum[dof];
   }
-  const Eigen::VectorXd ordered = order_ * rowScale_.cwiseProduct(rhs_);
-  solution_ = order_.transpose() * lu_.solve(ordered);
+  if (structured_) {
+    structured_->solve(rhs_, solution_, false);
+    solutionComplete_ = false;
+  } else {
+    const Eigen::VectorXd ordered = order_ * rowScale_.cwiseProduct(rhs_);
+    solution_ = order_.transpose() * lu_.solve(ordered);
+    solutionComplete_ = true;
+  }
   u1 = u0;
   v1 = v0;
   for (int d = 0; d < static_cast<int>(free_.size()); ++d) {
@@ -334,16 +376,32 @@ void HierarchySystem::step(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0,
     v1[dof] = solution_[velocityRow(d, last)];
   }
   ++stats.solvedRightHandSides;
-  stats.solveFlops += 2.0 * static_cast<double>(factorNonZeros_);  // one multiply-add per factor entry
+  // As the other integrators count: the substitutions with factors (LU: one multiply-add
+  // per factor entry), not the sparse products around them.
+  stats.solveFlops += structured_ ? structured_->substitutionFlops() : 2.0 * static_cast<double>(factorNonZeros_);
   stats.solveSeconds += solve.stop();
 }
 
+void HierarchySystem::completeSolution() const {
+  if (solutionComplete_ || !structured_ || solution_.size() == 0) return;
+  structured_->solve(rhs_, solution_, true);
+  solutionComplete_ = true;
+}
+
+std::string HierarchySystem::solveDescription() const {
+  if (structured_) return "structured solve (" + structured_->describe() + ")";
+  return "LU factor " + std::to_string(factorNonZeros_) + " non-zeros" +
+         (fallbackReason_.empty() ? "" : " (structured solve not used: " + fallbackReason_ + ")");
+}
+
 Eigen::VectorXd HierarchySystem::velocities(int freeDof) const {
+  completeSolution();
   if (solution_.size() == 0) return {};
   return solution_.segment(velocityRow(freeDof, 1), dofCount_[static_cast<std::size_t>(freeDof)]);
 }
 
 Eigen::VectorXd HierarchySystem::displacements(int freeDof) const {
+  completeSolution();
   if (solution_.size() == 0) return {};
   return solution_.segment(displacementRow(freeDof, 1), dofCount_[static_cast<std::size_t>(freeDof)]);
 }

@@ -12,9 +12,12 @@
 #include <asyncfem/integrator/integrator.hpp>
 #include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace asyncfem::detail {
+
+class StructuredHierarchySolve;
 
 /// Free DOF d (index into freeToFull) takes N_d steps of h_d = hL / N_d per large step; its
 /// unknowns are v_{d,j} (rows and columns offset_[d] + j - 1) and w_{d,j} = u_{d,j} - u_{d,0}
@@ -25,7 +28,8 @@ class HierarchySystem {
 
   /// Checks the element tangents and masses the system needs (see
   /// NestedAsyncBackwardEuler) and lays out the unknowns.
-  HierarchySystem(const TetMesh& mesh, const DynamicSystem& system, const StepCounts& counts);
+  HierarchySystem(const TetMesh& mesh, const DynamicSystem& system, const StepCounts& counts, NestedSolve solve);
+  ~HierarchySystem();
 
   /// Element tangents at u (the linear ones when the model has none), summed per element
   /// count, the matrix of Eqs. N4-N5 for large step hL, and its factor (symbolic analysis
@@ -42,6 +46,9 @@ class HierarchySystem {
 
   long long unknowns() const { return 2LL * velocityUnknowns_; }
   long long factorNonZeros() const { return factorNonZeros_; }
+  bool structured() const { return structured_ != nullptr; }
+  /// How the system is solved, for the run report.
+  std::string solveDescription() const;
   /// v_{d,1..N_d} and w_{d,1..N_d} of free DOF d from the last step.
   Eigen::VectorXd velocities(int freeDof) const;
   Eigen::VectorXd displacements(int freeDof) const;
@@ -63,6 +70,9 @@ class HierarchySystem {
   /// order of the free DOFs' graph, v before w; and the row scaling of the position rows.
   void chooseOrder();
   void factorize(IntegratorStats& stats);
+  void factorizeLU(IntegratorStats& stats);
+  /// Completes solution_ (every step's unknowns) after a structured solve.
+  void completeSolution() const;
 
   int velocityRow(int d, long long j) const { return offset_[static_cast<std::size_t>(d)] + static_cast<int>(j) - 1; }
   int displacementRow(int d, long long j) const { return velocityUnknowns_ + velocityRow(d, j); }
@@ -88,7 +98,14 @@ class HierarchySystem {
   Eigen::SparseLU<SparseMatrix, Eigen::NaturalOrdering<int>> lu_;
   bool analyzed_ = false;
   long long factorNonZeros_ = 0;
-  Eigen::VectorXd rhs_, solution_;
+  Eigen::VectorXd rhs_;
+  mutable Eigen::VectorXd solution_;
+  mutable bool solutionComplete_ = false;
+  // Eqs. N9-N12 when the counts form a chain (NestedSolve); null: the LU above.
+  NestedSolve requested_ = NestedSolve::automatic;
+  std::unique_ptr<StructuredHierarchySolve> structured_;
+  bool structureChecked_ = false;
+  std::string fallbackReason_;
 };
 
 }  // namespace asyncfem::detail

@@ -51,6 +51,23 @@ class StepCounts {
   bool touching_ = false;
 };
 
+/// How NestedAsyncBackwardEuler solves its step system (docs/asynchronous-integrator.md,
+/// "The solve").
+enum class NestedSolve {
+  /// structured when the step counts form a chain (each divides the next, e.g. 1, 8, 32),
+  /// the LU otherwise
+  automatic,
+  /// level by level, one factor per level (Eqs. N9-N12); asyncfem::ValidationError when the
+  /// counts do not form a chain
+  structured,
+  /// one sparse LU of the whole step system (Eq. N8), for any counts N6 allows
+  lu,
+};
+/// "automatic", "structured", "lu".
+std::string toString(NestedSolve solve);
+/// Inverse of toString; throws asyncfem::ValidationError naming the valid values.
+NestedSolve parseNestedSolve(const std::string& name);
+
 namespace detail {
 class HierarchySystem;
 }
@@ -64,8 +81,10 @@ class HierarchySystem;
 ///
 /// Solve: the per-step equations are written with the velocity and the displacement of
 /// every DOF at the end of each of its steps as unknowns (Eq. N5), which keeps every
-/// coupling local in time; the resulting sparse system is factored by sparse LU
-/// (UMFPACK, symbolic analysis once per partition). Linear force models factor it once
+/// coupling local in time. When the step counts divide one another in a chain (1, 8, 32)
+/// it is solved level by level (Eqs. N9-N12: one Schur complement and factor per level, the
+/// cost of AsyncBackwardEuler's structured solve per level); otherwise, or on request
+/// (NestedSolve::lu), by one sparse LU of the whole system. Linear force models factor once
 /// per hL; nonlinear ones linearize at the start of each large step (f_int(u_0), element
 /// tangents K_e(u_0)) and refactor numerically, as AsyncBackwardEuler does. With two
 /// levels its steps equal AsyncBackwardEuler's stable coupling to round-off.
@@ -78,7 +97,8 @@ class NestedAsyncBackwardEuler final : public Integrator, public MultirateIntegr
  public:
   /// system.mesh must be set. Throws asyncfem::ValidationError for what StepCounts
   /// rejects, a system without a mesh, or the checks above.
-  NestedAsyncBackwardEuler(DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions);
+  NestedAsyncBackwardEuler(DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions,
+                           NestedSolve solve = NestedSolve::automatic);
   ~NestedAsyncBackwardEuler() override;
 
   std::string name() const override { return "async"; }
@@ -92,7 +112,12 @@ class NestedAsyncBackwardEuler final : public Integrator, public MultirateIntegr
   const StepCounts& counts() const { return counts_; }
   /// Unknowns of the step system (2 sum over free DOFs of their counts).
   long long unknowns() const;
+  /// Entries the solve keeps: the LU's factor, or the structured solve's per-level factors
+  /// and dense recovery blocks.
   long long factorNonZeros() const;
+  /// Whether the structured solve is in use (after the first step: it falls back to the LU
+  /// under NestedSolve::automatic when its check fails, see report()).
+  bool structuredSolve() const;
   /// The last step's velocities v_{d,j} and displacement changes u_{d,j} - u_{d,0} of free
   /// DOF d (index into system().freeDofs.freeToFull()) at the end of its steps j = 1..N_d,
   /// in order (empty before the first step). For checks against the step's definition.

@@ -4,6 +4,7 @@
 #include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/nestedAsyncBackwardEuler.hpp>
 #include <asyncfem/integrator/registry.hpp>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -29,6 +30,8 @@ struct AsyncSettings {
   /// The regions touch or nest (an element joins two fast regions), which only
   /// NestedAsyncBackwardEuler runs; their ratios passed StepCounts' checks.
   bool nested = false;
+  /// How the nested integrator solves ("nestedSolve"; only with nested regions).
+  NestedSolve nestedSolve = NestedSolve::automatic;
 };
 
 /// The option keys "async" reads.
