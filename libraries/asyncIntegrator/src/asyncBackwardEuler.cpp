@@ -46,6 +46,9 @@ struct AsyncBackwardEuler::Impl {
   detail::NaiveSolver naive;
   // This step refactored A^S but keeps Z and H^{LL*} from an earlier tangent (laggedSchur).
   bool schurLagging = false;
+  // The lagged factor's rent-or-buy prices (flops, set at each full rebuild): one
+  // refinement iteration, one rebuild, and the iterations paid since the last rebuild.
+  double laggedIterationFlops = 0.0, laggedRebuildFlops = 0.0, laggedRent = 0.0;
   // Quick set-up (AsyncOptions::quickSetUp): L's system is solved on the whole system's
   // factor until the iterations' extra flops reach the priced cost of the rebuild (Eq. Q4).
   bool quick = false;
@@ -420,6 +423,27 @@ void AsyncBackwardEuler::fullSchurRebuild() {
   stats_.factorizationSeconds += schurSeconds;
   if (setUpBuild) runStats_.setupSchurSeconds += schurSeconds;
   d.schurLagging = false;
+  priceLaggedFactor();
+}
+
+// The flop prices of the lagged factor's rent-or-buy rule, with the same weights as the
+// quick set-up's (Eq. Q4): an iteration is one forward substitution per region, one solve
+// with the kept factor and one product with A^L; a rebuild is Z (|I_i| substitutions per
+// region, in blocks) and the factorization of H^{LL*}.
+void AsyncBackwardEuler::priceLaggedFactor() {
+  Impl& d = *impl_;
+  const SparseSolver* schur = d.schur.solver();
+  d.laggedRent = 0.0;
+  d.laggedIterationFlops = kSolveCallFlops + 2.0 * static_cast<double>(d.largeSystem.nonZeros()) +
+                           (schur != nullptr ? schur->stats().solveFlopsPerRhs : 0.0);
+  d.laggedRebuildFlops = schur != nullptr ? kBlockedFlopWeight * schur->stats().factorFlops : 0.0;
+  for (std::size_t i = 0; i < d.regions.size(); ++i) {
+    const FastRegion& rb = d.regions[i];
+    const double substitution = rb.ratio * (rb.solver->stats().solveFlopsPerRhs + 2.0 * double(rb.G.nonZeros()));
+    d.laggedIterationFlops += substitution + rb.ratio * kSolveCallFlops;
+    d.laggedRebuildFlops +=
+        kBlockedFlopWeight * substitution * static_cast<double>(partition_.interfaceDofs(static_cast<int>(i)).size());
+  }
 }
 
 // Stable coupling: A^L becomes Â^L = A^L - sum_i (1 - theta_i) hL^2 K_{I_i}^{II} (Eq. A11),
@@ -487,7 +511,7 @@ void AsyncBackwardEuler::evaluateStartOfStep() {
   Stopwatch rebuild;
   const bool first = runStats_.rebuilds == 0 && runStats_.steps == 0;
   d.schurLagging = options_.laggedSchur && !d.linear && d.schur.factored() && !d.schur.refreshRequested() &&
-                   options_.method == AsyncSolveMethod::structured;
+                   d.laggedRent < d.laggedRebuildFlops && options_.method == AsyncSolveMethod::structured;
   d.settingUp = first;
   refactor();
   d.settingUp = false;
@@ -651,10 +675,13 @@ void AsyncBackwardEuler::solveStructured() {
   } else if (!d.schurLagging) {
     d.schur.solve(d.rhsSchur, d.Y);
   } else {
-    const detail::SchurSolver::Refinement result =
-        d.schur.refine(d.rhsSchur, d.Y, apply, options_.coupling == AsyncCoupling::stable,
-                       options_.laggedSchurIterations, options_.laggedSchurTolerance);
+    // At least laggedSchurIterations, and as many as one rebuild costs (rent or buy).
+    const double affordable = d.laggedRebuildFlops / std::max(d.laggedIterationFlops, 1.0);
+    const int budget = std::max(options_.laggedSchurIterations, static_cast<int>(std::min(affordable, 1000.0)));
+    const detail::SchurSolver::Refinement result = d.schur.refine(
+        d.rhsSchur, d.Y, apply, options_.coupling == AsyncCoupling::stable, budget, options_.laggedSchurTolerance);
     runStats_.schurIterations += result.iterations;
+    d.laggedRent += result.iterations * d.laggedIterationFlops;
     if (result.converged && !result.zeroRightHandSide) {
       ++runStats_.laggedSteps;
       runStats_.largestSchurResidual = std::max(runStats_.largestSchurResidual, result.residual);

@@ -103,7 +103,7 @@ void bindAsyncOptions(py::module_& module) {
       .value("symmetric", SchurMode::symmetric);
   py::enum_<AsyncSolveMethod>(module, "AsyncSolveMethod",
                               "structured (block elimination, the default), naive (one big solve, for reference) or "
-                              "nested (the nested integrator's sparse LU, what touching or nested regions run)")
+                              "nested (the nested integrator, what touching or nested regions run)")
       .value("structured", AsyncSolveMethod::structured)
       .value("nested", AsyncSolveMethod::nested)
       .value("naive", AsyncSolveMethod::naive);

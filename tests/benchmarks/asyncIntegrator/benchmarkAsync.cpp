@@ -540,7 +540,7 @@ struct SteadyRow {
 /// (for callgrind). Corotational: the async large step (rebuild included) against m
 /// corotational single-rate steps at hS.
 void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotational, const std::string& only,
-                 bool collectFirst, bool rebuildSchur) {
+                 bool collectFirst, bool rebuildSchur, int laggedIterations) {
   std::vector<SteadyRow> rows;
   for (const std::string& spec : scenes) {
     const Scene scene = steadyScene(spec, corotational);
@@ -548,10 +548,12 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
     auto* async = dynamic_cast<AsyncBackwardEuler*>(simulation.integrator.get());
     if (async == nullptr) throw ValidationError(spec + ": the scene's integrator is not async");
     std::unique_ptr<AsyncBackwardEuler> rebuilt;
-    if (rebuildSchur) {
-      // The same scene with AsyncOptions::laggedSchur off: Z and H^{LL*} every large step.
+    if (rebuildSchur || laggedIterations > 0) {
+      // The same scene with AsyncOptions::laggedSchur off (Z and H^{LL*} every large step),
+      // or with another iteration limit for the lagged factor.
       AsyncOptions options = async->options();
-      options.laggedSchur = false;
+      options.laggedSchur = !rebuildSchur;
+      if (laggedIterations > 0) options.laggedSchurIterations = laggedIterations;
       std::vector<AsyncRegion> regions;
       for (int i = 0; i < async->partition().numRegions(); ++i) regions.push_back(async->partition().region(i));
       rebuilt =
@@ -606,6 +608,11 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
       row.setup = async->runStats().setupSeconds;
       row.setupZ = async->runStats().setupZSeconds;
       row.setupSchur = async->runStats().setupSchurSeconds;
+      if (corotational) {
+        const AsyncRunStats& stats = async->runStats();
+        std::fprintf(stderr, "%s: %lld steps, %lld lagged, %lld rebuilds, %lld Schur iterations\n",
+                     scene.sourceName.c_str(), stats.steps, stats.laggedSteps, stats.rebuilds, stats.schurIterations);
+      }
     }
     if (only.empty() || only == "single") {
       // Single-rate factors in its constructor: its set-up is construction + first step.
@@ -802,6 +809,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> scenes;
   std::string only;
   bool corotational = false, collectFirst = false, rebuildSchur = false;
+  int laggedIterations = 0;
   app.add_option("--study", study, "growth | ratio | schur | corotational | contact | steady | setup | all")
       ->check(CLI::IsMember({"growth", "ratio", "schur", "corotational", "contact", "steady", "setup", "all"}));
   app.add_option("--scenes", scenes, "steady and setup studies: scene files, or dragon:SPACING:SET:M:HL");
@@ -811,6 +819,9 @@ int main(int argc, char** argv) {
   app.add_flag(
       "--rebuild-schur", rebuildSchur,
       "steady study: AsyncOptions::laggedSchur off, Z and H^{LL*} rebuilt every large step (nonlinear forces)");
+  app.add_option("--lagged-iterations", laggedIterations,
+                 "steady study: AsyncOptions::laggedSchurIterations (0: the default)")
+      ->check(CLI::Range(0, 100000));
   app.add_flag("--first", collectFirst, "with --only: collect the first step (set-up included) instead");
   app.add_option("--cells", cells, "cells along the bar for the growth and schur studies")->check(CLI::Range(2, 400));
   app.add_option("--ratio-cells", ratioCells, "cells along the bar for the ratio study")->check(CLI::Range(2, 400));
@@ -829,7 +840,7 @@ int main(int argc, char** argv) {
     if (study == "schur" || study == "all") schurStudy(cells, ratio, hL, steps);
     if (study == "corotational" || study == "all") corotationalStudy(ratioCells, ratio, 1.0 / 120.0);
     if (study == "contact" || study == "all") contactStudy(ratioCells, ratio, 1.0 / 120.0);
-    if (study == "steady") steadyStudy(scenes, steps, corotational, only, collectFirst, rebuildSchur);
+    if (study == "steady") steadyStudy(scenes, steps, corotational, only, collectFirst, rebuildSchur, laggedIterations);
     if (study == "setup") setUpStudy(scenes, steps);
   } catch (const asyncfem::Error& e) {
     std::fprintf(stderr, "benchmarkAsync: %s\n", e.what());

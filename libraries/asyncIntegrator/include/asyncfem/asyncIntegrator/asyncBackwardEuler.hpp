@@ -109,6 +109,7 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   void assembleBlocks();
   void subtractInterfaceStiffness();
   void fullSchurRebuild();
+  void priceLaggedFactor();
   void borrowWholeFactor();
   void solveOnWholeFactor();
   void applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out);

@@ -77,10 +77,12 @@ struct AsyncOptions {
   /// rebuild is kept as a preconditioner and the Schur system of the current tangent is
   /// solved by preconditioned iterative refinement (each iteration: one forward substitution
   /// per region and one solve with the old factor) to a relative residual of
-  /// laggedSchurTolerance; when that takes more than laggedSchurIterations iterations the
-  /// step does the full rebuild instead, and so does the next one after a slow
-  /// convergence. A^S is refactored every step either way. The step then solves the
-  /// coupled system to the tolerance instead of to round-off.
+  /// laggedSchurTolerance. Rent or buy, priced in flops: a step may take as many
+  /// iterations as one rebuild costs (at least laggedSchurIterations); beyond that it does
+  /// the full rebuild instead, and so does the next step after a slow convergence (more than
+  /// half of them) or once the iterations since the last rebuild have cost a rebuild.
+  /// A^S is refactored every step either way. The step then solves the coupled system to
+  /// the tolerance instead of to round-off.
   bool laggedSchur = true;
   int laggedSchurIterations = 8;
   double laggedSchurTolerance = 1e-10;
