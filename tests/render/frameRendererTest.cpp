@@ -277,6 +277,29 @@ TEST_F(FrameRendererTest, GroundFollowsTheScenesContactGround) {
   EXPECT_EQ(readText(folder_ / "none" / "frame_00000.png"), readText(folder_ / "mesh" / "frame_00000.png"));
 }
 
+// The scene's contact spheres are drawn beside the mesh (an obstacle under the bar covers
+// background pixels), and not with --no-obstacles, which draws what a scene without
+// spheres draws, byte for byte.
+TEST_F(FrameRendererTest, DrawsTheScenesContactSpheres) {
+  const auto writeScene = [&](const std::string& name, const std::string& contact) {
+    std::ofstream(folder_ / name) << R"({"mesh": {"file": "bar.veg"}, "fixed": {"sets": ["xmin"]},)" << contact
+                                  << R"("integrator": {"name": "backward-euler", "timestep": 0.01},
+      "frames": {"rate": 10, "count": 6}})";
+  };
+  writeScene("sphere.json", R"("contact": {"spheres": [{"center": [1.0, -0.5, 0.2], "radius": 0.35}]},)");
+  writeScene("plain.json", "");
+  const std::string common = "run.afsim --frames 0 --width 96 --height 64 -q -j 1 -o ";
+  ASSERT_EQ(run(common + "sphere --scene sphere.json").exitCode, 0);
+  ASSERT_EQ(run(common + "hidden --scene sphere.json --no-obstacles").exitCode, 0);
+  ASSERT_EQ(run(common + "plain --scene plain.json").exitCode, 0);
+  const auto background = [](const std::uint8_t* p) { return p[0] == 255 && p[1] == 255 && p[2] == 255; };
+  const Image withSphere = readPng(folder_ / "sphere" / "frame_00000.png");
+  const Image hidden = readPng(folder_ / "hidden" / "frame_00000.png");
+  // The sphere's disc under the bar is about 10 x 10 pixels at this size: at least 40 of them.
+  EXPECT_LT(countPixels(withSphere, background) + 40, countPixels(hidden, background));
+  EXPECT_EQ(readText(folder_ / "hidden" / "frame_00000.png"), readText(folder_ / "plain" / "frame_00000.png"));
+}
+
 // offlineSimulator records the scene (absolute path and the fingerprint of the mesh and
 // fixed vertices it built) in the .afsim header: frameRenderer then needs neither --scene
 // nor --mesh, builds only the problem (no matrix, no factorization: the summary says so),

@@ -2,10 +2,14 @@
 // SurfaceEmbedding: the tet boundary, embedded render meshes read through assimp.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/render/surfaceEmbedding.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
+#include <cmath>
 #include <fstream>
+#include <map>
+#include <utility>
 
 #include "renderTestHelpers.hpp"
 
@@ -133,6 +137,42 @@ TEST(SurfaceEmbedding, BadSurfaceIsAnError) {
   } catch (const ValidationError& e) {
     EXPECT_NE(std::string(e.what()).find("vertex 7"), std::string::npos) << e.what();
   }
+}
+
+// sphereSurface (a scene's contact spheres as frameRenderer draws them): a closed,
+// outward-oriented triangle surface on the sphere. Vertices on the sphere to 1e-12 of the
+// radius (round-off of one normalisation); the enclosed volume below the ball's and within
+// 1% of it at 4 refinements (an inscribed polyhedron with 5,120 faces loses about 0.3%).
+TEST(SphereSurface, ClosedOutwardAndOnTheSphere) {
+  const Eigen::Vector3d center(0.3, -1.2, 2.0);
+  const double radius = 0.7;
+  for (const int refinements : {0, 2, 4}) {
+    const SurfaceMesh s = sphereSurface(center, radius, refinements);
+    const int faces = 20 << (2 * refinements);
+    ASSERT_EQ(static_cast<int>(s.triangles.size()), faces);
+    EXPECT_EQ(s.vertices.cols(), (faces / 2) + 2);  // Euler: V - E + F = 2 with E = 3F/2
+    for (Eigen::Index v = 0; v < s.vertices.cols(); ++v) {
+      EXPECT_NEAR((s.vertices.col(v) - center).norm(), radius, 1e-12 * radius);
+    }
+    std::map<std::pair<int, int>, int> directedEdges;  // closed and consistently oriented: each once
+    double volume = 0.0;
+    for (const auto& t : s.triangles) {
+      for (int e = 0; e < 3; ++e) ++directedEdges[{t[e], t[(e + 1) % 3]}];
+      const Eigen::Vector3d a = s.vertices.col(t[0]) - center;
+      volume += a.dot((s.vertices.col(t[1]) - center).cross(s.vertices.col(t[2]) - center)) / 6.0;
+    }
+    for (const auto& [edge, count] : directedEdges) {
+      EXPECT_EQ(count, 1);
+      EXPECT_EQ(directedEdges.count({edge.second, edge.first}), 1U);
+    }
+    const double ball = 4.0 / 3.0 * M_PI * radius * radius * radius;
+    EXPECT_GT(volume, 0.0);  // counter-clockwise from outside
+    EXPECT_LT(volume, ball);
+    if (refinements == 4) EXPECT_GT(volume, 0.99 * ball);
+  }
+  EXPECT_THROW(sphereSurface(center, 0.0), Error);
+  EXPECT_THROW(sphereSurface(center, std::nan("")), Error);
+  EXPECT_THROW(sphereSurface(center, 1.0, 7), Error);
 }
 
 }  // namespace

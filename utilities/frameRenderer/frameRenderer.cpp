@@ -21,6 +21,7 @@
 #include <asyncfem/image/text.hpp>
 #include <asyncfem/render/renderer.hpp>
 #include <asyncfem/render/surfaceEmbedding.hpp>
+#include <asyncfem/render/surfaceMesh.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/simulationIO/frameSelection.hpp>
@@ -66,6 +67,7 @@ struct CommandLine {
   std::vector<std::string> fixedSets;
   std::optional<std::string> renderMesh;
   bool ground = false;
+  bool noObstacles = false;
   std::optional<std::string> compare;
   std::optional<std::string> labels;
   std::vector<double> cameraPosition;
@@ -107,6 +109,8 @@ struct Shared {
   std::vector<Run> runs;                              // one, or two with --compare
   int assemblies = 0;                                 // matrices the problem assembled (none: only the mesh is needed)
   std::optional<ContactPlane> sceneGround;            // the scene's contact.ground, where --ground draws the floor
+  std::vector<SurfaceMesh> obstacles;                 // the scene's contact spheres, drawn unless --no-obstacles
+  std::vector<Eigen::Matrix3Xf> obstacleColors;       // one colour per obstacle vertex
 };
 
 /// A worker's own state: readers of every run and warping objects (neither is
@@ -206,6 +210,8 @@ void addInputOptions(CLI::App& app, CommandLine& options) {
   app.add_option("--render-mesh", options.renderMesh,
                  "Surface mesh (any format assimp reads) embedded in the tet mesh");
   app.add_flag("--ground", options.ground, "Draw a checkered ground plane with a shadow under the object");
+  app.add_flag("--no-obstacles", options.noObstacles,
+               "Do not draw the scene's contact spheres (drawn by default when the scene has them)");
   app.add_option("--compare", options.compare, "Second .afsim of the same mesh, drawn on the right");
   app.add_option("--labels", options.labels, "Labels of the two runs with --compare, \"left,right\"");
 }
@@ -320,6 +326,17 @@ RunsExtent checkRuns(const std::vector<Run>& runs, bool quiet) {
   return extent;
 }
 
+/// Obstacle colour: a warm grey, apart from the default surface colour and the tints.
+const Eigen::Vector3f kObstacleColor(0.56F, 0.52F, 0.47F);
+
+/// The scene's contact spheres as surfaces to draw beside the mesh.
+void addObstacles(const std::vector<ContactSphere>& spheres, Shared& shared) {
+  for (const ContactSphere& sphere : spheres) {
+    shared.obstacles.push_back(sphereSurface(sphere.center, sphere.radius));
+    shared.obstacleColors.push_back(kObstacleColor.replicate(1, shared.obstacles.back().vertices.cols()));
+  }
+}
+
 /// The mesh, and the vertices held fixed in the simulation: from --scene, from the scene
 /// the file records, or from --mesh. Only the problem is built: no matrix, no factorization.
 void loadMesh(const CommandLine& options, std::int64_t numVertices, Shared& shared) {
@@ -331,6 +348,7 @@ void loadMesh(const CommandLine& options, std::int64_t numVertices, Shared& shar
                       : recordedSceneProblem(header, shared.runs.front().file.string(), &warnings);
     const Scene scene = loadScene(options.scene ? *options.scene : header.scenePath);
     shared.sceneGround = scene.contact.ground;
+    if (!options.noObstacles) addObstacles(scene.contact.spheres, shared);
     if (options.tintRegions && !header.hasRegionRatios) shared.fixedRegionRatios = fixedRegionRatios(scene, *problem);
     shared.mesh = problem->sharedMesh();
     shared.fixedVertices = problem->fixedVertices();
@@ -515,7 +533,11 @@ Image drawFrame(Worker& worker, std::vector<std::unique_ptr<OffscreenRenderer>>&
           shared.surface.interpolate(tintByRatio(*shared.regionBase, shared.regionTint, worker.frame.regionRatios));
     }
     const Eigen::Matrix3Xf* colors = frameColors ? &*frameColors : shared.colors ? &*shared.colors : nullptr;
-    panels.push_back(own[r]->render({{x, shared.surface.triangles(), colors}}, setup.camera, setup.style));
+    std::vector<DrawSurface> surfaces{{x, shared.surface.triangles(), colors}};
+    for (std::size_t o = 0; o < shared.obstacles.size(); ++o) {
+      surfaces.push_back({shared.obstacles[o].vertices, shared.obstacles[o].triangles, &shared.obstacleColors[o]});
+    }
+    panels.push_back(own[r]->render(surfaces, setup.camera, setup.style));
   }
   if (panels.size() == 1) {
     return std::move(panels.front());

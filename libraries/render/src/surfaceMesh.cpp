@@ -2,15 +2,18 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <algorithm>
 #include <array>
 #include <assimp/Importer.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/render/surfaceMesh.hpp>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace asyncfem {
@@ -108,6 +111,53 @@ void writeObj(const std::filesystem::path& path, const SurfaceMesh& surface) {
   if (!out) {
     throw Error(path.string() + ": write failed");
   }
+}
+
+SurfaceMesh sphereSurface(const Eigen::Vector3d& center, double radius, int refinements) {
+  if (!(radius > 0.0) || !std::isfinite(radius)) {
+    throw Error("sphereSurface: the radius must be positive and finite, got " + std::to_string(radius));
+  }
+  if (refinements < 0 || refinements > 6) {
+    throw Error("sphereSurface: refinements must be in [0, 6], got " + std::to_string(refinements));
+  }
+  // The icosahedron's 12 vertices are the cyclic permutations of (0, +-1, +-t), t the
+  // golden ratio; its 20 faces, counter-clockwise from outside.
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Eigen::Vector3d> points = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  for (Eigen::Vector3d& p : points) p.normalize();
+  std::vector<std::array<int, 3>> faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                           {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                           {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                           {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (int level = 0; level < refinements; ++level) {
+    std::map<std::pair<int, int>, int> midpoints;  // each edge split once, shared by its two faces
+    const auto midpoint = [&](int a, int b) {
+      const std::pair<int, int> key(std::min(a, b), std::max(a, b));
+      const auto [it, inserted] = midpoints.emplace(key, static_cast<int>(points.size()));
+      if (inserted) points.push_back((points[a] + points[b]).normalized());
+      return it->second;
+    };
+    std::vector<std::array<int, 3>> finer;
+    finer.reserve(faces.size() * 4);
+    for (const auto& [a, b, c] : faces) {
+      const int ab = midpoint(a, b);
+      const int bc = midpoint(b, c);
+      const int ca = midpoint(c, a);
+      finer.push_back({a, ab, ca});
+      finer.push_back({b, bc, ab});
+      finer.push_back({c, ca, bc});
+      finer.push_back({ab, bc, ca});
+    }
+    faces = std::move(finer);
+  }
+  SurfaceMesh sphere;
+  sphere.vertices.resize(3, static_cast<Eigen::Index>(points.size()));
+  for (std::size_t v = 0; v < points.size(); ++v) {
+    sphere.vertices.col(static_cast<Eigen::Index>(v)) = center + (radius * points[v]);
+  }
+  sphere.triangles = std::move(faces);
+  return sphere;
 }
 
 }  // namespace asyncfem

@@ -28,4 +28,11 @@ SurfaceMesh loadSurfaceMesh(const std::filesystem::path& path);
 /// a deformed surface. Throws asyncfem::Error naming the file on failure.
 void writeObj(const std::filesystem::path& path, const SurfaceMesh& surface);
 
+/// A sphere of the given centre and radius (> 0) as a subdivided icosahedron: refinements
+/// (0 to 6) times each triangle is split in four and the new vertices are pushed onto the
+/// sphere, so it has 20 * 4^refinements triangles (4: 5,120), counter-clockwise seen from
+/// outside. Used to draw a scene's contact spheres. Throws asyncfem::Error for a
+/// non-positive or non-finite radius or refinements out of range.
+SurfaceMesh sphereSurface(const Eigen::Vector3d& center, double radius, int refinements = 4);
+
 }  // namespace asyncfem
