@@ -162,6 +162,41 @@ TEST(AdaptiveRegions, ContactRegionGrowsAtOnceAndShrinksAfterTheDwell) {
   EXPECT_EQ(reason, "contact region grows");
 }
 
+// A cached set-up stands in for the policy's proposal when it covers what is needed, also
+// beside a schedule, as long as it gives the windows' vertices exactly the ratio they have
+// now: the window's region while it is open, nothing extra once it has closed.
+TEST(AdaptiveRegions, CachedSetUpsStandInBesideASchedule) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
+  const std::vector<int> root = [&] {
+    std::vector<int> out;
+    for (int v = 0; v < ts.mesh.numVertices(); ++v)
+      if (ts.mesh.restPosition(v).x() > 0.2 && ts.mesh.restPosition(v).x() < 0.3) out.push_back(v);
+    return out;
+  }();
+  AdaptiveRegionOptions options = scheduleOf({{"window", 0.0, 1.0, root, 4}});
+  options.contact = true;
+  options.contactRatio = 6;
+  options.contactRings = 0;
+  options.contactLookahead = 0.0;
+  const ObstacleProximity proximity = [&](const Eigen::VectorXd&, double, std::vector<int>& out) {
+    out = test::verticesBeyond(ts.mesh, 0.9);
+  };
+  AdaptiveRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(ts.system.numDofs());
+  const std::vector<AsyncRegion> proposal{{"window", root, 4}, {"contact", test::verticesBeyond(ts.mesh, 0.9), 6}};
+  const std::vector<AsyncRegion> larger{{"window", root, 4}, {"contact", test::verticesBeyond(ts.mesh, 0.7), 6}};
+  const std::vector<AsyncRegion> withoutWindow{{"contact", test::verticesBeyond(ts.mesh, 0.7), 6}};
+  EXPECT_TRUE(policy.canServe(larger, proposal, 0.5, kLargeStep, zero, zero, proximity));
+  EXPECT_FALSE(policy.canServe(withoutWindow, proposal, 0.5, kLargeStep, zero, zero, proximity));  // window open
+  EXPECT_FALSE(policy.canServe(larger, proposal, 2.0, kLargeStep, zero, zero, proximity));         // window closed
+  // Closed: a contact region a layer larger serves (within the shrink factor of 2).
+  const std::vector<AsyncRegion> contactOnly{{"contact", test::verticesBeyond(ts.mesh, 0.8), 6}};
+  EXPECT_TRUE(policy.canServe(contactOnly, {proposal[1]}, 2.0, kLargeStep, zero, zero, proximity));
+  // A region on a window's vertex at a higher ratio than the window's is not a stand-in either.
+  const std::vector<AsyncRegion> faster{{"window", root, 8}, {"contact", test::verticesBeyond(ts.mesh, 0.7), 6}};
+  EXPECT_FALSE(policy.canServe(faster, proposal, 0.5, kLargeStep, zero, zero, proximity));
+}
+
 // Regions that touch (an element with vertices in both) are merged at the larger ratio,
 // and vertices without a free DOF are left out (the clamped face x = 0 here).
 TEST(AdaptiveRegions, TouchingWindowsMergeAndFixedVerticesAreLeftOut) {

@@ -292,9 +292,18 @@ bool AdaptiveRegionPolicy::canServe(const std::vector<AsyncRegion>& regions, con
                                     double time, double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                                     const ObstacleProximity& proximity) const {
   if (static_cast<double>(countFast(regions)) > options_.shrinkFactor * countFast(proposal)) return false;
-  if (!options_.schedule.empty()) return false;  // windows open and close exactly: no stand-ins
-  return covers(mesh_->numVertices(), regions,
-                assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings), indicatorRatios(0)));
+  const int n = mesh_->numVertices();
+  const std::vector<AsyncRegion> needed =
+      assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings), indicatorRatios(0));
+  if (!covers(n, regions, needed)) return false;
+  // Windows open and close exactly: on a window's vertices (open or closed now) a stand-in
+  // must give the ratio the policy gives them now, neither fewer substeps nor more.
+  const std::vector<int> have = vertexRatios(n, regions);
+  const std::vector<int> want = vertexRatios(n, needed);
+  for (const ScheduledRegion& window : options_.schedule)
+    for (const int vertex : window.vertices)
+      if (have[static_cast<std::size_t>(vertex)] != want[static_cast<std::size_t>(vertex)]) return false;
+  return true;
 }
 
 std::optional<std::vector<AsyncRegion>> AdaptiveRegionPolicy::decide(double time, double largeStep,

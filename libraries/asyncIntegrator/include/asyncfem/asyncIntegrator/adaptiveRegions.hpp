@@ -97,8 +97,9 @@ class AdaptiveRegionPolicy {
 
   /// Whether `regions` give every vertex the policy needs now at least the ratio it
   /// wants, and hold at most shrinkFactor times the vertices it would choose: a set-up
-  /// that can serve the next steps in place of `proposal`. Never with a schedule (its
-  /// windows open and close exactly).
+  /// that can serve the next steps in place of `proposal`. On the vertices of the
+  /// schedule's windows, open or closed, the ratio must be exactly the one the policy
+  /// gives them now (windows open and close exactly).
   bool canServe(const std::vector<AsyncRegion>& regions, const std::vector<AsyncRegion>& proposal, double time,
                 double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                 const ObstacleProximity& proximity) const;
