@@ -143,9 +143,19 @@ TEST(AdaptiveRegions, ContactRegionGrowsAtOnceAndShrinksAfterTheDwell) {
   EXPECT_EQ(reason, "contact region grows");
   ASSERT_EQ(next->size(), 1U);
   EXPECT_EQ((*next)[0].ratio, 6);
-  // The face grown by one ring (needed) and one more (hysteresis): x >= 0.75 on this mesh
-  // of 1/8 cubes.
+  // The face grown by one ring (needed) and one more (slack): x >= 0.75 on this mesh of
+  // 1/8 cubes; with a slack of 2, one ring more again.
   EXPECT_EQ((*next)[0].vertices, test::verticesBeyond(ts.mesh, 0.75));
+  {
+    AdaptiveRegionOptions wider = options;
+    wider.contactSlack = 2;
+    AdaptiveRegionPolicy widerPolicy(ts.mesh, ts.system.freeDofs, wider);
+    std::string widerReason;
+    const auto widerNext = widerPolicy.decide(0.0, kLargeStep, zero, zero, proximity, {}, 1, widerReason);
+    ASSERT_TRUE(widerNext);
+    ASSERT_EQ(widerNext->size(), 1U);
+    EXPECT_EQ((*widerNext)[0].vertices, test::verticesBeyond(ts.mesh, 0.625));
+  }
   current = *next;
   threshold = 0.85;  // still inside the region: kept
   EXPECT_FALSE(policy.decide(0.0, kLargeStep, zero, zero, proximity, current, 1, reason));
@@ -366,6 +376,14 @@ TEST(AdaptiveRegions, SceneKeys) {
   EXPECT_NE(
       parseError(barContext(true), nlohmann::json::parse(R"({"regions": {"adaptive": {"contact": {"ratio": 1}}}})"))
           .find("contact.ratio"),
+      std::string::npos);
+  const AsyncSettings slack = parseAsyncSettings(
+      barContext(true), nlohmann::json::parse(R"({"regions": {"adaptive": {"contact": {"slack": 3}}}})"));
+  ASSERT_TRUE(slack.adaptive);
+  EXPECT_EQ(slack.adaptive->contactSlack, 3);
+  EXPECT_NE(
+      parseError(barContext(true), nlohmann::json::parse(R"({"regions": {"adaptive": {"contact": {"slack": -1}}}})"))
+          .find("contact.slack"),
       std::string::npos);
   const AsyncSettings indicator = parseAsyncSettings(
       bar,

@@ -136,8 +136,8 @@ AdaptiveRegionPolicy::AdaptiveRegionPolicy(const TetMesh& mesh, const FreeDofs& 
     : mesh_(&mesh), options_(std::move(options)) {
   const AdaptiveRegionOptions& o = options_;
   if (o.contactRatio < 1) throw ValidationError("adaptive regions: contact ratio must be >= 1");
-  if (!(o.contactMargin >= 0.0) || !(o.contactLookahead >= 0.0) || o.contactRings < 0) {
-    throw ValidationError("adaptive regions: contact margin, lookahead and rings must be >= 0");
+  if (!(o.contactMargin >= 0.0) || !(o.contactLookahead >= 0.0) || o.contactRings < 0 || o.contactSlack < 0) {
+    throw ValidationError("adaptive regions: contact margin, lookahead, rings and slack must be >= 0");
   }
   if (o.indicator && (!(o.indicatorTolerance > 0.0) || o.indicatorRatio < 2 || o.indicatorRings < 0)) {
     throw ValidationError("adaptive regions: indicator tolerance must be > 0, ratio >= 2 and rings >= 0");
@@ -316,7 +316,8 @@ std::optional<std::vector<AsyncRegion>> AdaptiveRegionPolicy::decide(double time
   const std::vector<char> needed = contactVertices(largeStep, u, v, proximity, options_.contactRings);
   const std::vector<int> indicated = indicatorRatios(0);
   std::vector<char> generous = needed;
-  if (std::find(generous.begin(), generous.end(), 1) != generous.end()) growByRings(*mesh_, generous, 1);
+  if (std::find(generous.begin(), generous.end(), 1) != generous.end())
+    growByRings(*mesh_, generous, options_.contactSlack);
   std::vector<AsyncRegion> proposal = assemble(time, generous, indicatorRatios(1));
   const std::vector<int> windows = activeWindows(time);
   const std::vector<int> currentRatio = vertexRatios(n, current);

@@ -146,6 +146,7 @@ AdaptiveRegionOptions parseAdaptive(const IntegratorContext& context, const nloh
     out.contactLookahead = c.number("lookahead", out.contactLookahead);
     if (!(out.contactLookahead >= 0.0)) c.fail("lookahead", "must be >= 0 (large steps)");
     out.contactRings = c.integer("rings", out.contactRings, 0, 100);
+    out.contactSlack = c.integer("slack", out.contactSlack, 0, 100);
     c.finish();
   }
   if (const nlohmann::json* indicator = reader.find("indicator")) {

@@ -154,6 +154,7 @@ void bindAsyncOptions(py::module_& module) {
       .def_readwrite("contact_margin", &AdaptiveRegionOptions::contactMargin, "length")
       .def_readwrite("contact_lookahead", &AdaptiveRegionOptions::contactLookahead, "large steps")
       .def_readwrite("contact_rings", &AdaptiveRegionOptions::contactRings)
+      .def_readwrite("contact_slack", &AdaptiveRegionOptions::contactSlack, "extra rings of a new contact region")
       .def_readwrite("indicator", &AdaptiveRegionOptions::indicator,
                      "mark where the large step errs: |v_k - 2 v_(k-1) + v_(k-2)| / 2 against the tolerance")
       .def_readwrite("indicator_tolerance", &AdaptiveRegionOptions::indicatorTolerance,

@@ -32,11 +32,14 @@ struct AdaptiveRegionOptions {
   /// Contact policy: the vertices in contact or within contactMargin (a length) of an
   /// obstacle, at the step's start state or at the state predicted contactLookahead large
   /// steps ahead (u + k hL v), grown by contactRings element rings, at ratio contactRatio.
+  /// A new contact region is grown by contactSlack rings more than that, so that a
+  /// spreading patch stays inside it for a while instead of forcing a set-up per step.
   bool contact = false;
   int contactRatio = 8;
   double contactMargin = 0.0;
   double contactLookahead = 1.0;
   int contactRings = 1;
+  int contactSlack = 1;
   /// Indicator policy: the local error of the large step, estimated per vertex from the
   /// last three large-step velocities as e_v = |v_k - 2 v_{k-1} + v_{k-2}| / 2 (the
   /// velocity error of one backward Euler step, (hL^2 / 2) dv/dt^2 in differences; Eq. R1),
@@ -52,7 +55,7 @@ struct AdaptiveRegionOptions {
   /// Schedule policy.
   std::vector<ScheduledRegion> schedule;
   /// Hysteresis. A contact region that no longer covers what the policy needs is replaced
-  /// at once, grown by one ring more than needed (so small moves stay inside it); one that
+  /// at once, grown by contactSlack rings more than needed (so small moves stay inside it); one that
   /// covers it is kept for at least minDwell large steps, then replaced by a smaller one
   /// when it holds more than shrinkFactor times the vertices needed (or none is needed).
   int minDwell = 8;
