@@ -422,7 +422,7 @@ TEST(AutoRegions, OneMaterialBridgeProposesOnlyWhatPays) {
     // The kept regions are a valid partition.
     EXPECT_NO_THROW(RegionPartition(bridge.mesh, bridge.freeDofs, proposal.asyncRegions()));
   }
-  // Every region of the raw proposal at once (14 on the bridge) costs more than
+  // Every region of the raw proposal at once (14 on the held-out bridge) costs more than
   // single-rate at the smallest step they need: the model says so too.
   const AutoRegionCost all = estimateAsyncCost(bridge.mesh, bridge.freeDofs, raw.asyncRegions());
   EXPECT_EQ(

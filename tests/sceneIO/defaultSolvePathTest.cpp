@@ -61,7 +61,7 @@ Scene nonlinearScene(const ShippedCase& c, const nlohmann::json& options) {
 TEST(DefaultSolvePath, NonlinearBackwardEulerStaysWithin1e8OfExactSolvesOnEveryShippedScene) {
   // The kept factor's PCG stops at a relative residual of 1e-8 per solve; over 24 steps the
   // displacement then differs from exact solves by about cond(A) times that relative to
-  // the step (1e-11 to 1e-9 of max |u| measured, docs/benchmarks.md): the bound of
+  // the step (1e-11 to 1e-9 of max |u| measured, docs/benchmarks.md): the required bound of
   // 1e-8 of max |u| is what is asserted. The default must also really reuse (fewer
   // factorizations than steps), or the comparison would be vacuous.
   for (const ShippedCase& c : shippedCases()) {

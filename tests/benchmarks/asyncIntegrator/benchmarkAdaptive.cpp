@@ -5,7 +5,7 @@
 // fine step everywhere). Every ratio compares runs of the same process.
 //
 //   benchmarkAdaptive [--scene models/ball/ball.json] [--frames 90] [--repeats 1]
-//                     [--reference-steps 64] [--ladder 1,2,4,8,16]
+//                     [--reference-steps 64] [--ladder 1,2,4,8,16] [--csv com.csv]
 //
 // The frames are sampled at the scene's large step (one step per frame), so penetration
 // and rebound are seen at every large step. Figures per run:
@@ -25,6 +25,7 @@
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -89,6 +90,29 @@ struct Row {
   double reboundError = 0.0, penetrationError = 0.0, comError = 0.0;
 };
 
+/// The COM height of every run per frame as CSV (series,role,time,value), for
+/// scripts/plot-adaptive.py. Roles: reference, single-rate (the first rung, at hL),
+/// equal-cost (the single-rate run of the equal-cost verdict), adaptive, fixed, other.
+void writeSeries(const std::string& path, const std::vector<Row>& rows, double hL, const Row* equalCost) {
+  std::ofstream out(path);
+  if (!out) throw Error("benchmarkAdaptive: cannot write " + path);
+  out << "series,role,time,value\n";
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Row& row = rows[i];
+    const char* role = i == 0                 ? "reference"
+                       : i == 1               ? "single-rate"
+                       : &row == equalCost    ? "equal-cost"
+                       : i + 2 == rows.size() ? "adaptive"
+                       : i + 1 == rows.size() ? "fixed"
+                                              : "other";
+    for (std::size_t k = 0; k < row.measures.comHeight.size(); ++k) {
+      out << '"' << row.run.configuration.label << "\"," << role << ',' << (static_cast<double>(k + 1) * hL) << ','
+          << row.measures.comHeight[k] << '\n';
+    }
+  }
+  if (!out) throw Error("benchmarkAdaptive: writing " + path + " failed");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -102,6 +126,8 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "Timed repeats per configuration")->check(CLI::PositiveNumber);
   app.add_option("--reference-steps", referenceSteps, "Reference: single-rate steps per large step");
   app.add_option("--ladder", ladder, "Single-rate steps per large step to compare")->delimiter(',');
+  std::string csvPath;
+  app.add_option("--csv", csvPath, "Also write every run's COM height per frame here (for scripts/plot-adaptive.py)");
   CLI11_PARSE(app, argc, argv);
   try {
     Scene scene = loadScene(scenePath);
@@ -217,6 +243,7 @@ int main(int argc, char** argv) {
       const bool motion = hasRebound ? r.reboundError <= adaptive.reboundError : r.comError <= adaptive.comError;
       if (!equalError && r.run.completed && motion && r.penetrationError <= adaptive.penetrationError) equalError = &r;
     }
+    if (!csvPath.empty()) writeSeries(csvPath, rows, hL, equalCost);
     std::printf("\n");
     const char* motionName = hasRebound ? "rebound" : "COM height";
     const auto motionError = [&](const Row& r) { return hasRebound ? r.reboundError : r.comError; };
