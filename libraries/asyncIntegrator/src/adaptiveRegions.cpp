@@ -278,13 +278,15 @@ std::vector<AsyncRegion> AdaptiveRegionPolicy::wanted(double time, double largeS
 }
 
 namespace {
-/// Whether every vertex gets at least the ratio `needed` gives it under `regions`.
-bool covers(int numVertices, const std::vector<AsyncRegion>& regions, const std::vector<AsyncRegion>& needed) {
-  const std::vector<int> have = vertexRatios(numVertices, regions);
-  const std::vector<int> want = vertexRatios(numVertices, needed);
+/// Whether every vertex gets at least the ratio it wants (per-vertex ratios, 0: none).
+bool covers(const std::vector<int>& have, const std::vector<int>& want) {
   for (std::size_t vertex = 0; vertex < have.size(); ++vertex)
     if (have[vertex] < want[vertex]) return false;
   return true;
+}
+/// Whether every vertex gets at least the ratio `needed` gives it under `regions`.
+bool covers(int numVertices, const std::vector<AsyncRegion>& regions, const std::vector<AsyncRegion>& needed) {
+  return covers(vertexRatios(numVertices, regions), vertexRatios(numVertices, needed));
 }
 }  // namespace
 
@@ -293,13 +295,12 @@ bool AdaptiveRegionPolicy::canServe(const std::vector<AsyncRegion>& regions, con
                                     const ObstacleProximity& proximity) const {
   if (static_cast<double>(countFast(regions)) > options_.shrinkFactor * countFast(proposal)) return false;
   const int n = mesh_->numVertices();
-  const std::vector<AsyncRegion> needed =
-      assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings), indicatorRatios(0));
-  if (!covers(n, regions, needed)) return false;
+  const std::vector<int> have = vertexRatios(n, regions);
+  const std::vector<int> want = vertexRatios(
+      n, assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings), indicatorRatios(0)));
+  if (!covers(have, want)) return false;
   // Windows open and close exactly: on a window's vertices (open or closed now) a stand-in
   // must give the ratio the policy gives them now, neither fewer substeps nor more.
-  const std::vector<int> have = vertexRatios(n, regions);
-  const std::vector<int> want = vertexRatios(n, needed);
   for (const ScheduledRegion& window : options_.schedule)
     for (const int vertex : window.vertices)
       if (have[static_cast<std::size_t>(vertex)] != want[static_cast<std::size_t>(vertex)]) return false;
