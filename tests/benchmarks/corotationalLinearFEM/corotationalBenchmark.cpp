@@ -10,7 +10,7 @@
 // numeric factorization (the same CHOLMOD as the toolkit, so the comparison isolates
 // everything but the factorization library) and one solve per step.
 //
-// Usage: corotationalBenchmark [STEPS] [--mesh NAME] [--rayleigh-mass A] [--rayleigh-stiffness B]
+// Usage: corotationalBenchmark [STEPS] [--warmup N] [--mesh NAME|box:N] [--rayleigh-mass A] [--rayleigh-stiffness B]
 //                              [--toolkit-only exact|reuse] [--write-meshes DIR]
 //                              [--model MODEL] [--newton-iterations N] [--newton-tolerance EPS]
 // (default 30 timed steps per configuration). --write-meshes writes each timed problem
@@ -416,10 +416,10 @@ void writeModelParams(std::ostream& params, const Scene& scene) {
 // fixed DOFs, 0-based global ids x 3 + coordinate, ascending, one a line), DIR/NAME.params
 // (force model, material, time step, Rayleigh damping, gravity, Newton settings, step
 // counts: `key value...` lines; see writeModelParams) and
-// DIR/NAME.u and DIR/NAME.reuse.u (the toolkit's displacement after warmup + steps steps
+// unless states is false, DIR/NAME.u and DIR/NAME.reuse.u (the toolkit's displacement after warmup + steps steps
 // from rest, exact solves and the default kept factor, PCG 1e-10; 17 significant digits, one
 // DOF a line).
-void writeProblem(const Scene& scene, const std::filesystem::path& dir, int warmup, int steps) {
+void writeProblem(const Scene& scene, const std::filesystem::path& dir, int warmup, int steps, bool states) {
   std::filesystem::create_directories(dir);
   writeVeg(dir / (scene.name + ".veg"), scene.mesh);
   const auto open = [&](const std::string& extension) {
@@ -446,6 +446,12 @@ void writeProblem(const Scene& scene, const std::filesystem::path& dir, int warm
            << scene.rayleighStiffness << "\ngravity " << kGravity.x() << ' ' << kGravity.y() << ' ' << kGravity.z()
            << "\nwarmupSteps " << warmup << "\ntimedSteps " << steps << "\nfixedDofs " << scene.freeDofs.numFixed()
            << '\n';
+  }
+  if (!states) {
+    std::printf("%s: wrote %s/%s.{veg,fixed,params} (%d vertices, %d tets, %d fixed DOFs)\n", scene.name.c_str(),
+                dir.string().c_str(), scene.name.c_str(), scene.mesh.numVertices(), scene.mesh.numElements(),
+                scene.freeDofs.numFixed());
+    return;
   }
   Eigen::VectorXd exact;
   for (const bool reuse : {false, true}) {
@@ -547,21 +553,38 @@ void timeToolkitOnly(const std::vector<Scene>& scenes, int warmup, int steps, co
 
 struct CommandLine {
   int steps = 30;
+  int warmup = kWarmupSteps;
   std::string meshName = "all";
   std::string writeDir;
+  bool writeStates = true;
   std::string toolkitOnly;
   ProblemSettings settings;
 };
 
 void addOptions(CLI::App& app, CommandLine& c) {
-  app.add_option("steps", c.steps, "Timed steps per configuration (after 5 warm-up steps)")->check(CLI::PositiveNumber);
-  app.add_option("--mesh", c.meshName, "Which mesh")->check(CLI::IsMember({"all", "bridge-sized", "dragon-sized"}));
+  app.add_option("steps", c.steps, "Timed steps per configuration (after the warm-up steps)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--warmup", c.warmup, "Untimed steps before the timed ones (default 5)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--mesh", c.meshName,
+                 "Which mesh: all, bridge-sized, dragon-sized, or box:N (the 4 x 1 x 1 box of scripts/scale-study.py, "
+                 "4N x N x N cubes of 6 tets: 24 N^3 tets)")
+      ->check([](const std::string& name) -> std::string {
+        if (name == "all" || name == "bridge-sized" || name == "dragon-sized") return {};
+        if (name.rfind("box:", 0) == 0 && name.size() > 4 &&
+            name.find_first_not_of("0123456789", 4) == std::string::npos && std::stoi(name.substr(4)) >= 1) {
+          return {};
+        }
+        return "expected all, bridge-sized, dragon-sized or box:N with N >= 1, got " + name;
+      });
   app.add_option("--rayleigh-mass", c.settings.rayleighMass, "Rayleigh damping alpha (D = alpha M + beta K)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--rayleigh-stiffness", c.settings.rayleighStiffness, "Rayleigh damping beta")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--write-meshes", c.writeDir,
                  "Write each problem (.veg, fixed DOFs, parameters, final displacement) to this folder and exit");
+  app.add_flag("!--no-states", c.writeStates,
+               "With --write-meshes: skip the toolkit's final states (.u, .reuse.u), which cost two runs");
   app.add_option("--toolkit-only", c.toolkitOnly,
                  "Time only this toolkit configuration (exact solves, or reuse: the default kept factor, PCG to 1e-10)")
       ->check(CLI::IsMember({"exact", "reuse"}));
@@ -601,7 +624,7 @@ int main(int argc, char** argv) {
                  c.settings.model.c_str(), c.settings.maxIterations);
     return 1;
   }
-  const int warmup = kWarmupSteps;
+  const int warmup = c.warmup;
   const int threads = omp_get_max_threads();
   std::printf(
       "%s backward Euler step, h = %g, %d warm-up + %d timed steps, Newton at most %d iterations (tolerance %g); "
@@ -609,16 +632,22 @@ int main(int argc, char** argv) {
       c.settings.model.c_str(), kTimestep, warmup, c.steps, c.settings.maxIterations, c.settings.tolerance,
       c.settings.rayleighMass, c.settings.rayleighStiffness, threads, cpuModel().c_str(), loadAverage().c_str());
   std::vector<Scene> scenes;
-  if (c.meshName != "dragon-sized") {
+  if (c.meshName.rfind("box:", 0) == 0) {
+    // The scale study's box (scripts/scale-study.py): same material, clamp and gravity as the
+    // bridge-sized mesh, so a Vega run of the written problem times the same step at scale.
+    const int n = std::stoi(c.meshName.substr(4));
+    scenes.push_back(makeScene("box-" + std::to_string(n), Eigen::Vector3d(4.0, 1.0, 1.0), Eigen::Vector3i(4 * n, n, n),
+                               c.settings));
+  } else if (c.meshName != "dragon-sized") {
     scenes.push_back(makeScene("bridge-sized", Eigen::Vector3d(4.8, 0.6, 0.7), Eigen::Vector3i(48, 6, 7), c.settings));
   }
-  if (c.meshName != "bridge-sized") {
+  if (c.meshName == "all" || c.meshName == "dragon-sized") {
     scenes.push_back(
         makeScene("dragon-sized", Eigen::Vector3d(3.2, 1.6, 1.4), Eigen::Vector3i(32, 16, 14), c.settings));
   }
   if (!c.writeDir.empty()) {
     try {
-      for (const Scene& scene : scenes) writeProblem(scene, c.writeDir, warmup, c.steps);
+      for (const Scene& scene : scenes) writeProblem(scene, c.writeDir, warmup, c.steps, c.writeStates);
     } catch (const std::exception& error) {
       std::fprintf(stderr, "corotationalBenchmark --write-meshes %s: %s\n", c.writeDir.c_str(), error.what());
       return 1;
