@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <atomic>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <cmath>
@@ -233,6 +234,69 @@ TEST(Assembler, AssemblyIsBitIdenticalAcrossThreadCountsAndRepeats) {
   }
   // The std::function path computes the same element matrices as linearStiffnessMatrix.
   EXPECT_TRUE(bitIdentical(first, serial));
+}
+
+TEST(Assembler, BatchedAssemblyEqualsElementByElementBitForBit) {
+  // assembleBatches visits the elements in assemble()'s order, so the same element
+  // matrices give the same bits for any thread count; each batch is up to four consecutive
+  // elements of one chunk.
+  const ThreadCountGuard guard;
+  const TetMesh mesh = test::perturbedBox(16, 13);  // 24576 elements: threaded assembly
+  const MatrixAssembler assembler(mesh);
+  const auto elementStiffness = [&](int e, ElementMatrix& out) {
+    const Material& m = mesh.elementMaterial(e);
+    out = linearElementStiffness(mesh.elementRestPositions(e), m.youngsModulus, m.poissonRatio);
+  };
+  omp_set_num_threads(1);
+  SparseMatrix reference = assembler.createMatrix();
+  assembler.assemble(elementStiffness, reference);
+  std::vector<int> visits(static_cast<std::size_t>(mesh.numElements()), 0);
+  std::atomic<bool> batchesValid{true};
+  int longest = 0;
+  for (int threads : {1, 2, 3}) {
+    omp_set_num_threads(threads);
+    std::fill(visits.begin(), visits.end(), 0);
+    SparseMatrix batched = assembler.createMatrix();
+    assembler.assembleBatches(
+        [&](int first, int count, ElementMatrix* out) {
+          const int chunk = assembler.elementsPerChunk();
+          // count in [1, 4], all in the chunk of first.
+          if (count < 1 || count > MatrixAssembler::kElementBatch || first / chunk != (first + count - 1) / chunk) {
+            batchesValid = false;
+          }
+#pragma omp critical(assembler_test_longest)
+          longest = std::max(longest, count);
+          for (int i = 0; i < count; ++i) {
+            ++visits[static_cast<std::size_t>(first + i)];
+            elementStiffness(first + i, out[i]);
+          }
+        },
+        batched);
+    EXPECT_TRUE(bitIdentical(reference, batched)) << threads << " threads";
+    EXPECT_TRUE(std::all_of(visits.begin(), visits.end(), [](int v) { return v == 1; })) << threads << " threads";
+  }
+  EXPECT_TRUE(batchesValid);
+  EXPECT_EQ(longest, MatrixAssembler::kElementBatch);
+  // A batch that throws: the lowest failing batch's exception arrives, after every batch ran.
+  omp_set_num_threads(2);
+  SparseMatrix k = assembler.createMatrix();
+  std::fill(visits.begin(), visits.end(), 0);
+  try {
+    assembler.assembleBatches(
+        [&](int first, int count, ElementMatrix* out) {
+          for (int i = 0; i < count; ++i) {
+            ++visits[static_cast<std::size_t>(first + i)];
+            out[i].setZero();
+          }
+          if (first <= 1000 && 1000 < first + count) throw Error("batch of element 1000");
+          if (first <= 20000 && 20000 < first + count) throw Error("batch of element 20000");
+        },
+        k);
+    ADD_FAILURE() << "no exception";
+  } catch (const Error& error) {
+    EXPECT_STREQ(error.what(), "batch of element 1000");
+  }
+  EXPECT_TRUE(std::all_of(visits.begin(), visits.end(), [](int v) { return v == 1; }));
 }
 
 TEST(Assembler, ShuffledNumberingStaysCorrectAndDeterministic) {

@@ -2,6 +2,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <climits>
@@ -371,28 +372,30 @@ void MatrixAssembler::checkPattern(const Eigen::SparseMatrix<double>& matrix, co
   }
 }
 
+// Adds the element's 4x4 vertex blocks at their slots; a column of a block is
+// columnLength values before the next.
+void MatrixAssembler::scatterElement(int e, const ElementMatrix& local, double* values) const {
+  const int* slots = blockSlots_.data() + (toIndex(e) * 16);
+  for (int b = 0; b < 4; ++b) {
+    const Index columnVertex = toIndex(elements_(b, e));
+    const int columnLength = 3 * (blockOuter_[columnVertex + 1] - blockOuter_[columnVertex]);
+    for (int a = 0; a < 4; ++a) {
+      double* block = values + slots[(b * 4) + a];
+      for (int cj = 0; cj < 3; ++cj) {
+        double* column = block + (cj * columnLength);
+        for (int ci = 0; ci < 3; ++ci) column[ci] += local((3 * a) + ci, (3 * b) + cj);
+      }
+    }
+  }
+}
+
 template <class ElementFunction>
 void MatrixAssembler::assembleWith(const ElementFunction& elementMatrix, Eigen::SparseMatrix<double>& matrix) const {
   checkPattern(matrix, "assemble");
   double* values = matrix.valuePtr();
   const Eigen::Index nnz = matrix.nonZeros();
   const ColoredChunkSchedule schedule{colorOffsets_, coloredChunks_, chunkSize_, numElements_};
-  // Adds the element's 4x4 vertex blocks at their slots; a column of a block is
-  // columnLength values before the next.
-  const auto scatter = [&](int e, const ElementMatrix& local) {
-    const int* slots = blockSlots_.data() + (toIndex(e) * 16);
-    for (int b = 0; b < 4; ++b) {
-      const Index columnVertex = toIndex(elements_(b, e));
-      const int columnLength = 3 * (blockOuter_[columnVertex + 1] - blockOuter_[columnVertex]);
-      for (int a = 0; a < 4; ++a) {
-        double* block = values + slots[(b * 4) + a];
-        for (int cj = 0; cj < 3; ++cj) {
-          double* column = block + (cj * columnLength);
-          for (int ci = 0; ci < 3; ++ci) column[ci] += local((3 * a) + ci, (3 * b) + cj);
-        }
-      }
-    }
-  };
+  const auto scatter = [&](int e, const ElementMatrix& local) { scatterElement(e, local, values); };
   FirstElementError errors;
 #pragma omp parallel if (numElements_ >= kMinElementsForThreads)
   {
@@ -405,6 +408,41 @@ void MatrixAssembler::assembleWith(const ElementFunction& elementMatrix, Eigen::
 
 void MatrixAssembler::assemble(const ElementMatrixFunction& elementMatrix, Eigen::SparseMatrix<double>& matrix) const {
   assembleWith(elementMatrix, matrix);
+}
+
+void MatrixAssembler::assembleBatches(const ElementBatchFunction& elementBatch,
+                                      Eigen::SparseMatrix<double>& matrix) const {
+  checkPattern(matrix, "assembleBatches");
+  double* values = matrix.valuePtr();
+  const Eigen::Index nnz = matrix.nonZeros();
+  const ColoredChunkSchedule schedule{colorOffsets_, coloredChunks_, chunkSize_, numElements_};
+  FirstElementError errors;
+#pragma omp parallel if (numElements_ >= kMinElementsForThreads)
+  {
+#pragma omp for schedule(static)
+    for (Eigen::Index k = 0; k < nnz; ++k) values[k] = 0.0;
+    const int numColors = static_cast<int>(schedule.colorOffsets.size()) - 1;
+    for (int color = 0; color < numColors; ++color) {
+#pragma omp for schedule(dynamic, 1)
+      for (int k = schedule.colorOffsets[toIndex(color)]; k < schedule.colorOffsets[toIndex(color) + 1]; ++k) {
+        const int chunk = schedule.coloredChunks[toIndex(k)];
+        const int chunkEnd = std::min(schedule.numElements, (chunk + 1) * schedule.chunkSize);
+        std::array<ElementMatrix, kElementBatch> local;
+        // Elements in the order assemble() visits them, so every entry sums alike.
+        for (int first = chunk * schedule.chunkSize; first < chunkEnd; first += kElementBatch) {
+          const int count = std::min(kElementBatch, chunkEnd - first);
+          try {
+            elementBatch(first, count, local.data());
+          } catch (...) {
+            errors.record(first);
+            continue;
+          }
+          for (int i = 0; i < count; ++i) scatterElement(first + i, local[toIndex(i)], values);
+        }
+      }
+    }
+  }
+  errors.rethrowIfAny();
 }
 
 void MatrixAssembler::assemble(const std::vector<ElementMatrix>& elementMatrices,

@@ -73,6 +73,19 @@ class MatrixAssembler {
   /// unspecified). The std::function call per element costs no measurable time next to
   /// the element computation (see the benchmark), so there is no template overload.
   void assemble(const ElementMatrixFunction& elementMatrix, Eigen::SparseMatrix<double>& matrix) const;
+  /// Most elements one ElementBatchFunction call computes (kElementBatch consecutive ids).
+  static constexpr int kElementBatch = 4;
+  /// Computes the 12x12 matrices of elements first, ..., first + count - 1 (count in
+  /// [1, kElementBatch], consecutive ids) into out[0 .. count); called concurrently for
+  /// different batches. Lets a caller evaluate several elements at once (SIMD lanes over
+  /// elements) while the scatter stays the deterministic one of assemble().
+  using ElementBatchFunction = std::function<void(int first, int count, ElementMatrix* out)>;
+  /// Same as assemble(), with the element matrices computed in batches of up to
+  /// kElementBatch consecutive elements of one chunk (a batch is shorter only at a chunk's
+  /// end). The sum is bit-identical to assemble() with the same element matrices. If a
+  /// batch throws, none of its elements is scattered and the exception of the lowest
+  /// failing batch (by its first element) is rethrown after every batch was visited.
+  void assembleBatches(const ElementBatchFunction& elementBatch, Eigen::SparseMatrix<double>& matrix) const;
   /// Same, with element matrices already computed (numElements of them; asyncfem::Error
   /// otherwise).
   void assemble(const std::vector<ElementMatrix>& elementMatrices, Eigen::SparseMatrix<double>& matrix) const;
@@ -91,6 +104,8 @@ class MatrixAssembler {
   // defined (and instantiated) in assembler.cpp only, so callers need no OpenMP flags.
   template <class ElementFunction>
   void assembleWith(const ElementFunction& elementMatrix, Eigen::SparseMatrix<double>& matrix) const;
+  // The scatter of one element matrix into matrix's values (slot map of element e).
+  void scatterElement(int e, const ElementMatrix& local, double* values) const;
   void checkPattern(const Eigen::SparseMatrix<double>& matrix, const char* caller) const;
 
   int numDofs_ = 0;
