@@ -61,4 +61,16 @@ inline Eigen::MatrixXd finiteDifferenceTangent(ForceModel& model, const Eigen::V
   return result;
 }
 
+/// max |a - b| / max |b| over the entries (two evaluations of the same quantity).
+inline double relativeEntryDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
+}
+
+/// The same over the stored values of two matrices of one pattern.
+inline double relativeEntryDifference(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix<double>& b) {
+  const Eigen::Map<const Eigen::VectorXd> va(a.valuePtr(), a.nonZeros());
+  const Eigen::Map<const Eigen::VectorXd> vb(b.valuePtr(), b.nonZeros());
+  return relativeEntryDifference(va, vb);
+}
+
 }  // namespace asyncfem::test

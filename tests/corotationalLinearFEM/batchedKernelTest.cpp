@@ -36,17 +36,6 @@ Evaluation evaluate(const TetMesh& mesh, TangentKind kind, ElementKernel kernel,
   return result;
 }
 
-/// max |a - b| / max |b| over the entries.
-double relativeDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
-}
-
-double relativeDifference(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix<double>& b) {
-  const Eigen::Map<const Eigen::VectorXd> va(a.valuePtr(), a.nonZeros());
-  const Eigen::Map<const Eigen::VectorXd> vb(b.valuePtr(), b.nonZeros());
-  return relativeDifference(va, vb);
-}
-
 int invertedElements(const TetMesh& mesh, const Eigen::VectorXd& u) {
   int inverted = 0;
   for (int e = 0; e < mesh.numElements(); ++e) {
@@ -68,8 +57,8 @@ void expectKernelsAgree(const TetMesh& mesh, const Eigen::VectorXd& u, const std
   for (const TangentKind kind : {TangentKind::simple, TangentKind::exact}) {
     const Evaluation batched = evaluate(mesh, kind, ElementKernel::batched, u);
     const Evaluation scalar = evaluate(mesh, kind, ElementKernel::scalar, u);
-    const double forceDifference = relativeDifference(batched.forces, scalar.forces);
-    const double tangentDifference = relativeDifference(batched.tangent, scalar.tangent);
+    const double forceDifference = test::relativeEntryDifference(batched.forces, scalar.forces);
+    const double tangentDifference = test::relativeEntryDifference(batched.tangent, scalar.tangent);
     double rotationDifference = 0.0;
     for (std::size_t e = 0; e < scalar.rotations.size(); ++e)
       rotationDifference =

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <Eigen/LU>
+#include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/hyperelasticFEM/elementForceModel.hpp>
 #include <cmath>
@@ -69,13 +70,18 @@ void ElementForceModel::evaluate(const Eigen::VectorXd& displacement, Eigen::Vec
       const Eigen::VectorXd* displacement;
       bool wantForces;
     } context{this, &displacement, forces != nullptr};
-    assembler_->assemble(
-        [&context](int e, ElementMatrix& out) {
+    assembler_->assembleBatches(
+        [&context](int first, int count, ElementMatrix* out) {
           ElementForceModel& model = *context.model;
-          const Eigen::Matrix3d f = model.geometry_.deformationGradient(e, *context.displacement);
-          ElementVector* force = context.wantForces ? &model.elementForces_[static_cast<std::size_t>(e)] : nullptr;
-          model.computeElement(e, f, nullptr, force, &out);
-          if (!out.allFinite()) model.reportNonFinite(e, *context.displacement, "tangent");
+          std::array<Eigen::Matrix3d, MatrixAssembler::kElementBatch> f;
+          for (int i = 0; i < count; ++i) {
+            f[static_cast<std::size_t>(i)] = model.geometry_.deformationGradient(first + i, *context.displacement);
+          }
+          ElementVector* force = context.wantForces ? &model.elementForces_[static_cast<std::size_t>(first)] : nullptr;
+          model.computeBatch(first, count, f.data(), force, out);
+          for (int i = 0; i < count; ++i) {
+            if (!out[i].allFinite()) model.reportNonFinite(first + i, *context.displacement, "tangent");
+          }
         },
         *stiffness);
   } else if (forces != nullptr) {
@@ -95,6 +101,13 @@ void ElementForceModel::evaluate(const Eigen::VectorXd& displacement, Eigen::Vec
     for (int a = 0; a < 4; ++a) {
       forces->segment<3>(3 * static_cast<Eigen::Index>(geometry_.elements(a, e))) += local.segment<3>(3 * a);
     }
+  }
+}
+
+void ElementForceModel::computeBatch(int first, int count, const Eigen::Matrix3d* deformationGradients,
+                                     ElementVector* forces, ElementMatrix* tangents) const {
+  for (int i = 0; i < count; ++i) {
+    computeElement(first + i, deformationGradients[i], nullptr, forces != nullptr ? forces + i : nullptr, tangents + i);
   }
 }
 

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "detail/batchedInvariantKernel.hpp"
 #include "detail/invariantKernel.hpp"
 #include "detail/isotropicMaterials.hpp"
 
@@ -379,6 +380,24 @@ void IsotropicHyperelasticFEM::computeElementFromInvariants(int element, const E
   if (tangent == nullptr) return;
   detail::elementTangentFromStressDerivative(dStressdF, geometry().shapeGradients[e], volume, *tangent);
   symmetrizeElementMatrix(*tangent);
+}
+
+void IsotropicHyperelasticFEM::computeBatch(int first, int count, const Eigen::Matrix3d* deformationGradients,
+                                            ElementVector* forces, ElementMatrix* tangents) const {
+  bool batched = options_.batchedKernel && options_.invariantPath && !options_.enforceSPD && count == detail::kLanes;
+  const auto e0 = static_cast<std::size_t>(first);
+  for (int i = 0; batched && i < count; ++i) {
+    batched = elementMaterials_[e0 + static_cast<std::size_t>(i)] == elementMaterials_[e0] &&
+              detail::invariantPathApplies(deformationGradients[i], options_);
+  }
+  if (!batched) {
+    ElementForceModel::computeBatch(first, count, deformationGradients, forces, tangents);
+    return;
+  }
+  const detail::ElementBatchInput input{deformationGradients, &geometry().volumes[e0], &geometry().shapeGradients[e0]};
+  batchedElements_.fetch_add(count, std::memory_order_relaxed);
+  detail::batchedInvariantTerms(kind_, constants_[static_cast<std::size_t>(elementMaterials_[e0])], input, forces,
+                                tangents);
 }
 
 }  // namespace asyncfem

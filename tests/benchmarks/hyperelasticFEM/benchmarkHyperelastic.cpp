@@ -90,10 +90,11 @@ enum class Variant {
   neoHookeanHandled
 };
 
-std::unique_ptr<ForceModel> makeModel(Variant variant, const TetMesh& mesh, bool invariantPath) {
+std::unique_ptr<ForceModel> makeModel(Variant variant, const TetMesh& mesh, bool invariantPath, bool batched) {
   HyperelasticOptions options;
   options.stvkFormulation = StVKFormulation::principalStretches;
   options.invariantPath = invariantPath;
+  options.batchedKernel = batched;
   switch (variant) {
     case Variant::corotational:
       return std::make_unique<CorotationalLinearFEM>(mesh);
@@ -214,11 +215,12 @@ void reportRates(benchmark::State& state, const KernelCost& cost, double newtonS
   state.counters["bandwidth_fraction_cpu"] = gbpsCpu / machine.triadGBpsCpu;
 }
 
-void forcesAndTangent(benchmark::State& state, Variant variant, bool invariantPath) {
+// batched: HyperelasticOptions::batchedKernel (the default; false: one element at a time).
+void forcesAndTangent(benchmark::State& state, Variant variant, bool invariantPath, bool batched = true) {
   const int cells = static_cast<int>(state.range(0));
   const Setup& s = setup(cells);
   const double baseline = corotationalSeconds(cells);
-  auto model = makeModel(variant, s.mesh, invariantPath);
+  auto model = makeModel(variant, s.mesh, invariantPath, batched);
   Eigen::VectorXd forces;
   Eigen::SparseMatrix<double> stiffness = model->createStiffnessMatrix();
   Eigen::VectorXd displacement = s.displacement;
@@ -295,16 +297,28 @@ BENCHMARK_CAPTURE(forcesAndTangent, stvkGreenStrain, Variant::stvkGreen, true)->
 BENCHMARK_CAPTURE(forcesAndTangent, stvkPrincipalStretches, Variant::stvk, true)
     ->Arg(12)
     ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, stvkPrincipalStretchesOneAtATime, Variant::stvk, true, false)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, stvkThroughSvd, Variant::stvk, false)->Arg(12)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, neoHookean, Variant::neoHookean, true)->Arg(12)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, neoHookeanOneAtATime, Variant::neoHookean, true, false)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, neoHookeanThroughSvd, Variant::neoHookean, false)
     ->Arg(12)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, mooneyRivlin, Variant::mooneyRivlin, true)->Arg(12)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, mooneyRivlinOneAtATime, Variant::mooneyRivlin, true, false)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, mooneyRivlinThroughSvd, Variant::mooneyRivlin, false)
     ->Arg(12)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, neoHookeanThresholdCompression, Variant::neoHookeanThreshold, true)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(forcesAndTangent, neoHookeanThresholdCompressionOneAtATime, Variant::neoHookeanThreshold, true, false)
     ->Arg(12)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(forcesAndTangent, neoHookeanThresholdCompressionThroughSvd, Variant::neoHookeanThreshold, false)

@@ -72,6 +72,15 @@ class ElementForceModel : public ForceModel {
   virtual void computeElement(int element, const Eigen::Matrix3d& deformationGradient, double* energy,
                               ElementVector* force, ElementMatrix* tangent) const = 0;
 
+  /// Forces (when forces is not null) and tangents of the count <= MatrixAssembler::
+  /// kElementBatch consecutive elements first, ... with deformation gradients
+  /// deformationGradients[0 .. count), into forces[i] and tangents[i]: what count calls of
+  /// computeElement() give (the default makes them). A model overrides it to evaluate the
+  /// elements together (SIMD lanes over elements); the tangent path of the element loop
+  /// calls it. Called concurrently for different batches; must not throw.
+  virtual void computeBatch(int first, int count, const Eigen::Matrix3d* deformationGradients, ElementVector* forces,
+                            ElementMatrix* tangents) const;
+
   const std::string& modelName() const { return name_; }
 
  private:

@@ -85,6 +85,12 @@ struct HyperelasticOptions {
   /// 2-3x faster (docs/benchmarks.md, "Hyperelastic element kernels"). false: every element
   /// through principal stretches (for comparisons).
   bool invariantPath = true;
+  /// The element loop of the tangent evaluates four consecutive elements at once (SIMD
+  /// lanes over elements, the invariant path only) where all four take the invariant path
+  /// and share a material; other batches go one element at a time. Equal to the
+  /// one-element kernel to rounding (docs/benchmarks.md, "Hyperelastic element kernels").
+  /// false: one element at a time everywhere (for comparisons).
+  bool batchedKernel = true;
 
   /// True when a finite threshold is set.
   bool inversionHandlingEnabled() const { return inversionThreshold > -std::numeric_limits<double>::max(); }

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <asyncfem/hyperelasticFEM/elementForceModel.hpp>
 #include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
+#include <atomic>
 #include <memory>
 #include <vector>
 
@@ -58,10 +59,17 @@ class IsotropicHyperelasticFEM final : public ElementForceModel {
   /// Energy density W (per rest volume) of element e at principal stretches s, with the
   /// inversion handling of the options; for tests and tools.
   double energyDensity(int element, const Eigen::Vector3d& stretches) const;
+  /// Elements whose tangent went through the batched kernel since construction (all
+  /// evaluations together; options().batchedKernel), for tests and tools.
+  long long batchedElements() const { return batchedElements_.load(std::memory_order_relaxed); }
 
  protected:
   void computeElement(int element, const Eigen::Matrix3d& deformationGradient, double* energy, ElementVector* force,
                       ElementMatrix* tangent) const override;
+  /// Four elements of one material that all take the invariant path go through the
+  /// batched kernel (options().batchedKernel); any other batch one element at a time.
+  void computeBatch(int first, int count, const Eigen::Matrix3d* deformationGradients, ElementVector* forces,
+                    ElementMatrix* tangents) const override;
 
  private:
   /// computeElement for an element where options_.invariantPath applies (invariantKernel.hpp).
@@ -72,6 +80,7 @@ class IsotropicHyperelasticFEM final : public ElementForceModel {
   HyperelasticOptions options_;
   std::vector<detail::IsotropicMaterialConstants> constants_;  // per material of the mesh
   std::vector<int> elementMaterials_;
+  mutable std::atomic<long long> batchedElements_{0};
 };
 
 }  // namespace asyncfem
