@@ -5,9 +5,9 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 #include <algorithm>
-#include <atomic>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <random>
