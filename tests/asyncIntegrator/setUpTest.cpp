@@ -83,5 +83,39 @@ TEST(AsyncSetUp, ASystemWithoutAMeshIsAnError) {
   }
 }
 
+// AsyncOptions::largeSystemSolver: the factory is called at each set-up with L's DOFs, its
+// solver is given the assembled H^{LL*}, and the run equals the default (CHOLMOD) one to
+// the rounding of two direct factorizations (Eigen's LDLT here; kappa eps over a few steps,
+// 1e-10 of the largest displacement), before and after a new partition.
+TEST(AsyncSetUp, AnExternalLargeSystemSolverSolvesLsSystem) {
+  const test::TestSystem ts = test::makeTestSystem(0.3, 2e-3);
+  const double hL = 5e-3;
+  const std::vector<AsyncRegion> tip{{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}};
+  const std::vector<AsyncRegion> half{{"half", test::verticesBeyond(ts.mesh, 0.5), 8}};
+  std::vector<std::size_t> largeSizes;
+  AsyncOptions options;
+  options.largeSystemSolver = [&largeSizes](const std::vector<int>& largeDofs) {
+    largeSizes.push_back(largeDofs.size());
+    return makeSparseSolver(SolverKind::eigenLDLT);
+  };
+  AsyncBackwardEuler external(ts.mesh, ts.system, hL, tip, options);
+  AsyncBackwardEuler reference(ts.mesh, ts.system, hL, tip);
+  for (AsyncBackwardEuler* integrator : {&external, &reference}) {
+    integrator->setState(ts.u0, ts.v0);
+    for (int k = 0; k < 3; ++k) integrator->step();
+    integrator->setUp(RegionPartition(ts.mesh, ts.system.freeDofs, half));
+    for (int k = 0; k < 3; ++k) integrator->step();
+  }
+  ASSERT_EQ(largeSizes.size(), 2u);
+  EXPECT_GT(largeSizes[0], largeSizes[1]);  // the half region leaves L fewer DOFs than the tip
+  EXPECT_EQ(largeSizes[1], external.partition().largeDofs().size());
+  const double scale = reference.displacement().cwiseAbs().maxCoeff();
+  EXPECT_GT(scale, 0.0);
+  EXPECT_LE((external.displacement() - reference.displacement()).cwiseAbs().maxCoeff(), 1e-10 * scale);
+  // The paper's coupling gives an unsymmetric H^{LL*}: refused with an external solver.
+  options.coupling = AsyncCoupling::paper;
+  EXPECT_THROW(AsyncBackwardEuler(ts.mesh, ts.system, hL, tip, options), ValidationError);
+}
+
 }  // namespace
 }  // namespace asyncfem

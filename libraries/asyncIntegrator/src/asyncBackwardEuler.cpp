@@ -168,6 +168,12 @@ AsyncBackwardEuler::AsyncBackwardEuler(DynamicSystem system, double largeTimeste
   if (options_.method == AsyncSolveMethod::nested) {
     throw ValidationError("async integrator: the method \"nested\" is NestedAsyncBackwardEuler's; build that instead");
   }
+  if (options_.largeSystemSolver &&
+      (options_.coupling != AsyncCoupling::stable || options_.method != AsyncSolveMethod::structured)) {
+    throw ValidationError(
+        "async integrator: an external solver of L's system (largeSystemSolver) needs the stable coupling and the "
+        "structured method (it is given the symmetric H^{LL*})");
+  }
   const Impl& d = *impl_;
   if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
   if (d.linear)
@@ -312,6 +318,7 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
     d.perElementTangent = detail::findInterfaceElements(*system_.mesh, partition_, system_, d.regions);
   }
   d.schur.reset();
+  if (options_.largeSystemSolver) d.schur.useExternalSolver(options_.largeSystemSolver, large);
   d.naive.reset();
   d.schurLagging = false;
   d.quick = options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
@@ -714,10 +721,8 @@ void AsyncBackwardEuler::solveOnWholeFactor() {
   // deflate it whole.
   const double perDirection = 2.0 * static_cast<double>(d.rhsSchur.size());
   const int keep = static_cast<int>(std::min(runStats_.interfaceDofs + 16.0, kMaxDeflationEntries / perDirection));
-  Stopwatch watch;
   const detail::SchurSolver::Refinement result =
       d.schur.solveDeflated(d.rhsSchur, d.Y, apply, options_.quickSetUpIterations, options_.laggedSchurTolerance, keep);
-  const double seconds = watch.stop();
   runStats_.quickIterations += result.iterations;
   if (result.converged) {
     ++runStats_.quickSteps;

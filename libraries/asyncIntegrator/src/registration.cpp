@@ -381,11 +381,12 @@ int largestRatio(const std::vector<AsyncRegion>& regions) {
   return largest;
 }
 
-void registerMultirateIntegrators(IntegratorRegistry& registry) {
+void registerMultirateIntegrators(IntegratorRegistry& registry, AsyncSettingsHook asyncHook) {
   registry.add(
       "async",
-      [](IntegratorContext context, const nlohmann::json& options) -> std::unique_ptr<Integrator> {
-        const AsyncSettings parsed = parseAsyncSettings(context, options);
+      [asyncHook](IntegratorContext context, const nlohmann::json& options) -> std::unique_ptr<Integrator> {
+        AsyncSettings parsed = parseAsyncSettings(context, options);
+        if (asyncHook) asyncHook(parsed, context);
         if (parsed.nested) return makeNested(context, parsed);
         auto integrator = std::make_unique<AsyncBackwardEuler>(*context.mesh, std::move(context.system),
                                                                context.timestep, parsed.regions, parsed.solver);

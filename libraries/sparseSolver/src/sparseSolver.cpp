@@ -20,6 +20,7 @@ constexpr EnumName<SolverKind> kSolverNames[] = {{SolverKind::cholmod, "cholmod"
 }  // namespace
 
 std::string toString(SolverKind kind) {
+  if (kind == SolverKind::external) return "external";
   if (const std::optional<std::string_view> name = findEnumName(kSolverNames, kind)) return std::string(*name);
   throw Error("toString: invalid SolverKind value " + std::to_string(static_cast<int>(kind)));
 }
@@ -41,6 +42,8 @@ std::unique_ptr<SparseSolver> makeSparseSolver(SolverKind kind) {
       return detail::makeEigenLUSolver();
     case SolverKind::dense:
       return detail::makeDenseSolver();
+    case SolverKind::external:
+      throw Error("makeSparseSolver: an external solver is built by the library that provides it");
   }
   throw Error("makeSparseSolver: invalid SolverKind value " + std::to_string(static_cast<int>(kind)));
 }

@@ -3,6 +3,7 @@
 #include "detail/schurSolver.hpp"
 
 #include <algorithm>
+#include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <cmath>
 
@@ -28,11 +29,27 @@ std::vector<int> interfaceUnionOf(const RegionPartition& partition) {
 }
 }  // namespace
 
-void SchurSolver::reset() { *this = SchurSolver(); }
+void SchurSolver::reset() {
+  AsyncOptions::LargeSystemSolverFactory external = std::move(external_);
+  *this = SchurSolver();
+  external_ = std::move(external);
+}
+
+void SchurSolver::useExternalSolver(AsyncOptions::LargeSystemSolverFactory factory, std::vector<int> largeDofs) {
+  external_ = std::move(factory);
+  externalLarge_ = std::move(largeDofs);
+  solver_.reset();
+  analyzed_ = false;
+}
 
 void SchurSolver::chooseSolver(SchurMode mode) {
   if (mode != modeUsed_ || !solver_) {
-    solver_ = makeSparseSolver(mode == SchurMode::lu ? SolverKind::umfpack : SolverKind::cholmod);
+    if (external_) {
+      solver_ = external_(externalLarge_);
+      if (!solver_) throw Error("async integrator: the large-system solver factory returned no solver");
+    } else {
+      solver_ = makeSparseSolver(mode == SchurMode::lu ? SolverKind::umfpack : SolverKind::cholmod);
+    }
     analyzed_ = false;
   }
   modeUsed_ = mode;
@@ -61,6 +78,9 @@ void SchurSolver::factor(const SparseMatrix& largeSystem, const RegionPartition&
   if (mode == SchurMode::lowRank && numLarge * static_cast<double>(all.size()) > kMaxLowRankEntries) {
     mode = SchurMode::lu;  // A^{-1} U would not fit: factor H^{LL*} itself
   }
+  // An external solver is given H^{LL*} itself, symmetrized (the stable coupling's
+  // corrections are symmetric to round-off; the constructor refuses the paper's).
+  if (external_) mode = SchurMode::symmetric;
   chooseSolver(mode);
   if (mode == SchurMode::lowRank) {
     factorLowRank(largeSystem, partition, regions, all, stats);
@@ -149,6 +169,8 @@ void SchurSolver::factorAssembled(const SparseMatrix& largeSystem, const RegionP
       }
   }
   stats.assemblySeconds += assembly.stop();
+  // An iterative solver preconditions on Â^L, H^{LL*} without the regions' dense blocks.
+  if (solver_->usesPreconditionerMatrix()) solver_->setPreconditionerMatrix(largeSystem);
   factorizeCounted(*solver_, schur_, analyzed_, stats);
 }
 

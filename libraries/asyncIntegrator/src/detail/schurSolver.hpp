@@ -69,8 +69,12 @@ class SchurSolver {
   void forgetDirections() { kept_ = 0; }
   int keptDirections() const { return kept_; }
 
-  /// Forgets the pattern, the analysis and the factor (a new partition).
+  /// Forgets the pattern, the analysis and the factor (a new partition). Keeps the
+  /// external solver's factory.
   void reset();
+  /// From the next factor() on, H^{LL*} is assembled (symmetric mode) and factored by the
+  /// solver factory(largeDofs) returns (AsyncOptions::largeSystemSolver); empty: CHOLMOD.
+  void useExternalSolver(AsyncOptions::LargeSystemSolverFactory factory, std::vector<int> largeDofs);
   SchurMode modeUsed() const { return modeUsed_; }
   bool factored() const { return factored_; }
   /// Whether the last refine() converged slowly; cleared by the next factor().
@@ -91,6 +95,8 @@ class SchurSolver {
                        const std::vector<FastRegion>& regions, IntegratorStats& stats);
 
   SchurMode modeUsed_ = SchurMode::lowRank;
+  AsyncOptions::LargeSystemSolverFactory external_;
+  std::vector<int> externalLarge_;
   WholeSystemFactor* borrowed_ = nullptr;
   std::vector<int> borrowedLarge_;  // global ids of L (a copy: the set-up may be cached)
   // Deflation space of solveDeflated: columns [0, kept_) of directions_ (W, H^{LL*}-

@@ -4,6 +4,8 @@
 #include <Eigen/Core>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <functional>
+#include <memory>
+#include <vector>
 
 // The choices and the run statistics of the asynchronous integrator (AsyncBackwardEuler).
 namespace asyncfem {
@@ -105,6 +107,16 @@ struct AsyncOptions {
   /// per large step cost less dense than sparse (docs/asynchronous-integrator.md,
   /// "Performance notes"). 0: every region uses regionSolver.
   int denseRegionDofs = 128;
+  /// The solver of L's system H^{LL*} (structured method, stable coupling), or empty for
+  /// CHOLMOD. Called with the global DOF ids of L (ascending; the rows of H^{LL*}) at each
+  /// set-up; the solver it returns is given the assembled H^{LL*} (every entry of each
+  /// dense interface block on a fixed pattern, both triangles, symmetric) and must solve it
+  /// to the accuracy the run needs; an iterative one that asks for a preconditioning matrix
+  /// (SparseSolver::usesPreconditionerMatrix) gets Â^L, the same without the dense blocks. The petscBackend library's
+  /// makePetscLargeSystemSolver() solves it distributed over MPI ranks (docs/petsc-backend.md, "The asynchronous
+  /// integrator over MPI"). The paper's coupling (unsymmetric H^{LL*}) is refused with it.
+  using LargeSystemSolverFactory = std::function<std::unique_ptr<SparseSolver>(const std::vector<int>& largeDofs)>;
+  LargeSystemSolverFactory largeSystemSolver{};
 };
 
 /// Where an asynchronous run's time went, set-up apart from the steady-state steps (the

@@ -6,6 +6,7 @@
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/asyncIntegrator/nestedAsyncBackwardEuler.hpp>
 #include <asyncfem/integrator/registry.hpp>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -67,8 +68,14 @@ nlohmann::json asyncRegionsJson(const std::vector<AsyncRegion>& regions);
 /// step any of them takes; 1 when there are none (everything runs at hL).
 int largestRatio(const std::vector<AsyncRegion>& regions);
 
+/// Adjusts or refuses (by throwing ValidationError) the settings of each "async" integrator
+/// a registry builds, after they are read from the scene: e.g. the PETSc backend sets
+/// AsyncOptions::largeSystemSolver and refuses nested regions.
+/// The context is the integrator's (its mesh, system, timestep).
+using AsyncSettingsHook = std::function<void(AsyncSettings&, const IntegratorContext&)>;
+
 /// Adds "async" (AsyncBackwardEuler), "multirate-uncoupled" (UncoupledMultirate) and
-/// "schroeder2011" (Schroeder2011).
-void registerMultirateIntegrators(IntegratorRegistry& registry);
+/// "schroeder2011" (Schroeder2011); "async" runs asyncHook (when given) on its settings.
+void registerMultirateIntegrators(IntegratorRegistry& registry, AsyncSettingsHook asyncHook = {});
 
 }  // namespace asyncfem

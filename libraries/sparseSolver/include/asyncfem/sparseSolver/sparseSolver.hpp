@@ -15,10 +15,15 @@ enum class SolverKind {
   eigenLDLT,  ///< Eigen SimplicialLDLT (SPD fallback, no SuiteSparse needed at run time)
   eigenLU,    ///< Eigen SparseLU (unsymmetric fallback)
   dense,  ///< Eigen's blocked dense Cholesky (LLT) of the upper triangle: SPD systems of a few hundred unknowns at most
+  /// A SparseSolver implemented outside this library (e.g. the petscBackend library's
+  /// distributed solver); makeSparseSolver() cannot create it and parseSolverKind() does
+  /// not accept its name.
+  external,
 };
-/// "cholmod", "umfpack", "eigen-ldlt", "eigen-lu", "dense".
+/// "cholmod", "umfpack", "eigen-ldlt", "eigen-lu", "dense" (and "external").
 std::string toString(SolverKind kind);
-/// Inverse of toString; throws asyncfem::Error listing the valid names.
+/// Inverse of toString for the kinds makeSparseSolver() creates; throws asyncfem::Error
+/// listing the valid names.
 SolverKind parseSolverKind(const std::string& name);
 
 /// Counters a solver keeps; the machine-independent cost figures come from the
@@ -67,6 +72,14 @@ class SparseSolver {
     return x.col(0);
   }
 
+  /// Iterative solvers: whether a preconditioning matrix besides A serves them better
+  /// (e.g. A without the dense blocks that slow an algebraic multigrid down). Direct
+  /// solvers: false, the default.
+  virtual bool usesPreconditionerMatrix() const { return false; }
+  /// That matrix (A's size, SPD, its pattern fixed from call to call), given before each
+  /// factorize() of A; ignored by solvers that do not use one.
+  virtual void setPreconditionerMatrix(const Eigen::SparseMatrix<double>& matrix) { (void)matrix; }
+
   virtual SolverKind kind() const = 0;
   /// Fill-reducing ordering in effect after analyzePattern(): "metis", "amd", "colamd",
   /// "natural", ... as the backend reports it ("default" when the backend does not say,
@@ -79,7 +92,7 @@ class SparseSolver {
   SolverStats stats_;
 };
 
-/// Creates a solver of the given kind.
+/// Creates a solver of the given kind (asyncfem::Error for SolverKind::external).
 std::unique_ptr<SparseSolver> makeSparseSolver(SolverKind kind);
 
 }  // namespace asyncfem
