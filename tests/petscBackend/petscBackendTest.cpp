@@ -30,6 +30,8 @@
 #include <utility>
 #include <vector>
 
+#include "cantilever.hpp"
+
 namespace asyncfem::test {
 namespace {
 
@@ -49,16 +51,8 @@ constexpr double kTimestep = 0.02;
 constexpr int kSteps = 15;
 constexpr double kSolverTolerance = 1e-10;  // relative residual of the iterative solves
 
-/// A 1 x 0.2 x 0.2 cantilever (12 x 3 x 3 cubes, 648 tets, 208 vertices) of soft rubber,
-/// x = 0 face fixed, sagging under gravity: tip deflection of ~0.1 in 0.5 s, rotations
-/// large enough that corotational and linear FEM differ visibly.
-TetMesh beamMesh() {
-  BoxMeshSpec spec;
-  spec.size = Eigen::Vector3d(1.0, 0.2, 0.2);
-  spec.cells = Eigen::Vector3i(12, 3, 3);
-  spec.material = Material{"rubber", 1000.0, 1e6, 0.45};
-  return makeBoxMesh(spec);
-}
+/// The cantilever of cantilever.hpp, x = 0 face fixed, sagging under gravity.
+TetMesh beamMesh() { return rubberCantilever(); }
 
 const Eigen::Vector3d kGravity(0.0, -9.81, 0.0);
 

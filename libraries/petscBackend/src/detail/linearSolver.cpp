@@ -88,6 +88,14 @@ void LinearSolver::setOperator(Mat matrix) {
   checkPetsc(KSPSetOperators(ksp_.get(), matrix, matrix), "KSPSetOperators");
 }
 
+void LinearSolver::setOperators(Mat matrix, Mat preconditioning) {
+  checkPetsc(MatSetOption(matrix, MAT_SPD, PETSC_TRUE), "MatSetOption(MAT_SPD)");
+  checkPetsc(MatSetOption(preconditioning, MAT_SPD, PETSC_TRUE), "MatSetOption(MAT_SPD)");
+  checkPetsc(KSPSetOperators(ksp_.get(), matrix, preconditioning), "KSPSetOperators");
+}
+
+void LinearSolver::setUp() { checkPetsc(KSPSetUp(ksp_.get()), "KSPSetUp"); }
+
 SolveOutcome LinearSolver::solve(Vec b, Vec x) {
   checkPetsc(KSPSolve(ksp_.get(), b, x), "KSPSolve");
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;

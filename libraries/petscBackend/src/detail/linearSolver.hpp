@@ -38,6 +38,11 @@ class LinearSolver {
 
   /// Solves with matrix from now on (its preconditioner or factor is rebuilt on the next solve).
   void setOperator(Mat matrix);
+  /// Solves with matrix, preconditioned by one built from preconditioning (both SPD).
+  void setOperators(Mat matrix, Mat preconditioning);
+  /// Builds the preconditioner or factor of the current operator now (KSPSetUp) instead of
+  /// at the next solve.
+  void setUp();
   /// Solves A x = b; x holds the initial guess of iterative solvers on entry.
   SolveOutcome solve(Vec b, Vec x);
   /// The KSP and PC types PETSc resolved after the options database.
