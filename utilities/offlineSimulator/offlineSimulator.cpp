@@ -48,7 +48,9 @@
 #include <vector>
 
 #if ASYNCFEM_OFFLINE_WITH_PETSC
+#include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/integrator/registry.hpp>
+#include <asyncfem/petscBackend/largeSystemSolver.hpp>
 #include <asyncfem/petscBackend/petscRuntime.hpp>
 #include <asyncfem/petscBackend/petscSimulation.hpp>
 #include <asyncfem/petscBackend/problemSettings.hpp>
@@ -790,6 +792,140 @@ int runLocal(int argc, char** argv, const CommandLine& options, const asyncfem::
   return 0;
 }
 
+#if ASYNCFEM_OFFLINE_WITH_PETSC
+// --backend petsc with the "async" integrator: every rank builds the scene's simulation and
+// steps the asynchronous integrator on the replicated state; L's system H^{LL*} is solved
+// distributed (makePetscLargeSystemSolver). Rank 0 writes the frames, checkpoints and the
+// summary. The ranks agree once per frame on a stop signal and on rank 0's output failing,
+// so none is left waiting in a collective call.
+asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options,
+                                                std::shared_ptr<asyncfem::PetscSolveCounts> totals) {
+  asyncfem::PetscSolverSettings solver;
+  solver.kind = asyncfem::parsePetscSolverKind(options.petscSolver);
+  // The L solve is one part of a step whose other parts are exact to round-off.
+  solver.relativeTolerance = 1e-10;
+  asyncfem::IntegratorRegistry registry = asyncfem::defaultIntegratorRegistry();
+  asyncfem::registerMultirateIntegrators(
+      registry, [solver, totals](asyncfem::AsyncSettings& settings, const asyncfem::IntegratorContext& context) {
+        if (settings.nested) {
+          throw asyncfem::ValidationError(
+              "--backend petsc: touching or nested regions (NestedAsyncBackwardEuler) are not available on the PETSc "
+              "backend; run them locally");
+        }
+        if (settings.solver.coupling != asyncfem::AsyncCoupling::stable ||
+            settings.solver.method != asyncfem::AsyncSolveMethod::structured) {
+          throw asyncfem::ValidationError(
+              "--backend petsc: the asynchronous integrator runs there with the stable coupling and the structured "
+              "method only");
+        }
+        settings.solver.largeSystemSolver = asyncfem::makePetscLargeSystemSolver(*context.mesh, solver, totals);
+      });
+  return registry;
+}
+
+int runPetscAsync(int argc, char** argv, const CommandLine& options, const asyncfem::Scene& scene) {
+  asyncfem::Stopwatch setupWatch;
+  setupWatch.start();
+  asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
+  const bool root = runtime.rank() == 0;
+  auto totals = std::make_shared<asyncfem::PetscSolveCounts>();
+  asyncfem::Simulation simulation = asyncfem::buildSimulation(scene, petscAsyncRegistry(options, totals));
+  if (root) {
+    for (const std::string& warning : simulation.warnings)
+      std::cerr << "offlineSimulator: warning: " << warning << "\n";
+  }
+  RunRecord record;
+  record.before = simulation.integrator->stats();
+  record.schedule = asyncfem::CheckpointSchedule{options.checkpointEvery, options.checkpointSeconds};
+  std::optional<RunOutput> output;
+  std::string failure;
+  if (root) {
+    try {
+      output = openOutput(options, scene, simulation, record);
+    } catch (const asyncfem::Error& error) {
+      failure = error.what();
+    }
+  } else if (options.resume) {
+    // Every rank restores the checkpoint's state (reading only); rank 0 also continues the file.
+    try {
+      RunOutput probe;
+      probe.header = outputHeader(options, scene, simulation);
+      probe.fingerprint =
+          asyncfem::runFingerprint(fingerprintText(options.scene), scene.integrator.name, probe.header.timestep,
+                                   probe.header.frameInterval, *simulation.problem);
+      record.firstFrame = static_cast<int>(asyncfem::resumeFromCheckpoint(
+          scene.output.file, probe.header, probe.fingerprint, simulation.timing.frameCount, *simulation.integrator,
+          simulation.monitor ? &*simulation.monitor : nullptr));
+    } catch (const asyncfem::Error& error) {
+      failure = error.what();
+    }
+  }
+  if (runtime.maxOverRanks(failure.empty() ? 0 : 1) != 0) {
+    throw asyncfem::Error(failure.empty() ? "another rank could not open the output or resume" : failure);
+  }
+  record.setupSeconds = setupWatch.stop();
+  installStopHandlers();  // after PETSc's start, whose own handlers it replaces for these signals
+  asyncfem::cli::ProgressReporter progress(
+      "offlineSimulator",
+      root ? asyncfem::cli::chooseProgressStyle(options.quiet, options.progress) : asyncfem::cli::ProgressStyle::none,
+      simulation.timing.frameCount, record.firstFrame);
+  asyncfem::Stopwatch loopWatch;
+  loopWatch.start();
+  int frame = record.firstFrame;
+  int signal = 0;
+  bool outputFailed = false;
+  const auto agree = [&] {  // collective
+    signal = runtime.maxOverRanks(static_cast<int>(stopSignal));
+    outputFailed = runtime.maxOverRanks(failure.empty() ? 0 : 1) != 0;
+    return signal == 0 && !outputFailed;
+  };
+  for (; frame < simulation.timing.frameCount && agree(); ++frame) {
+    try {
+      asyncfem::advanceFrame(simulation, frame);  // numerical failures throw alike on every rank
+    } catch (const asyncfem::Error& error) {
+      progress.finish();
+      const int kept = output ? static_cast<int>(output->writer->numFrames()) : frame;
+      throw asyncfem::Error(std::string(error.what()) + "; the " + std::to_string(kept) +
+                            " frames before it are kept in " + scene.output.file.string());
+    }
+    if (!output) continue;
+    try {
+      writeFrame(*output, scene, simulation, frame, record);
+    } catch (const asyncfem::Error& error) {
+      failure = error.what();
+    }
+    progress.update(frame + 1);
+  }
+  if (frame == simulation.timing.frameCount) agree();
+  record.loopSeconds = loopWatch.stop();
+  progress.finish();
+  if (outputFailed) throw asyncfem::Error(root ? failure : "rank 0 could not write the output");
+  if (output) {
+    if (signal != 0 && output->checkpointFrames != output->writer->numFrames()) {
+      output->checkpoint(simulation, output->writer->numFrames(), scene.output.sync, record);
+    }
+    output->writer->close();
+  }
+  if (signal != 0 && frame < simulation.timing.frameCount) {
+    if (root) {
+      std::cerr << "offlineSimulator: interrupted by " << signalName(signal) << ": " << frame << " of "
+                << simulation.timing.frameCount << " frames are complete in " << scene.output.file.string()
+                << " (checkpoint after frame " << output->checkpointFrames << " in " << output->checkpointFile.string()
+                << "); continue the run with:\n  mpiexec -n " << runtime.size() << " " << resumeCommand(argc, argv)
+                << "\n";
+    }
+    return 128 + signal;
+  }
+  if (root && !options.quiet) {
+    record.outputBytes = static_cast<std::int64_t>(fs::file_size(scene.output.file));
+    printSummary(scene, simulation, record);
+    std::printf("  PETSc       %d ranks solve L's system (KSP %s): %lld solves, %lld iterations; rank 0 owns %d rows\n",
+                runtime.size(), options.petscSolver.c_str(), totals->solves, totals->iterations, totals->ownedRows);
+  }
+  return 0;
+}
+#endif
+
 int run(int argc, char** argv) {
   CLI::App app{
       "Runs a scene file (docs/scene-format.md) and writes its frames to an .afsim file "
@@ -806,6 +942,7 @@ int run(int argc, char** argv) {
   refuseOutputsOverInputs(options, scene);
   if (options.backend == "petsc") {
 #if ASYNCFEM_OFFLINE_WITH_PETSC
+    if (scene.integrator.name == "async") return runPetscAsync(argc, argv, options, scene);
     return runPetsc(argc, argv, options, scene);
 #else
     throw asyncfem::Error(
