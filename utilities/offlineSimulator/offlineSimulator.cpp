@@ -823,30 +823,19 @@ asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options,
   return registry;
 }
 
-int runPetscAsync(int argc, char** argv, const CommandLine& options, const asyncfem::Scene& scene) {
-  asyncfem::Stopwatch setupWatch;
-  setupWatch.start();
-  asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
-  const bool root = runtime.rank() == 0;
-  auto totals = std::make_shared<asyncfem::PetscSolveCounts>();
-  asyncfem::Simulation simulation = asyncfem::buildSimulation(scene, petscAsyncRegistry(options, totals));
-  if (root) {
-    for (const std::string& warning : simulation.warnings)
-      std::cerr << "offlineSimulator: warning: " << warning << "\n";
-  }
-  RunRecord record;
-  record.before = simulation.integrator->stats();
-  record.schedule = asyncfem::CheckpointSchedule{options.checkpointEvery, options.checkpointSeconds};
+// Rank 0 opens (or continues) the output; on --resume the other ranks restore the
+// checkpoint's state, reading only. Collective: every rank learns whether any failed.
+std::optional<RunOutput> openOnEveryRank(asyncfem::PetscRuntime& runtime, const CommandLine& options,
+                                         const asyncfem::Scene& scene, asyncfem::Simulation& simulation,
+                                         RunRecord& record, std::string& failure) {
   std::optional<RunOutput> output;
-  std::string failure;
-  if (root) {
+  if (runtime.rank() == 0) {
     try {
       output = openOutput(options, scene, simulation, record);
     } catch (const asyncfem::Error& error) {
       failure = error.what();
     }
   } else if (options.resume) {
-    // Every rank restores the checkpoint's state (reading only); rank 0 also continues the file.
     try {
       RunOutput probe;
       probe.header = outputHeader(options, scene, simulation);
@@ -863,6 +852,25 @@ int runPetscAsync(int argc, char** argv, const CommandLine& options, const async
   if (runtime.maxOverRanks(failure.empty() ? 0 : 1) != 0) {
     throw asyncfem::Error(failure.empty() ? "another rank could not open the output or resume" : failure);
   }
+  return output;
+}
+
+int runPetscAsync(int argc, char** argv, const CommandLine& options, const asyncfem::Scene& scene) {
+  asyncfem::Stopwatch setupWatch;
+  setupWatch.start();
+  asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
+  const bool root = runtime.rank() == 0;
+  auto totals = std::make_shared<asyncfem::PetscSolveCounts>();
+  asyncfem::Simulation simulation = asyncfem::buildSimulation(scene, petscAsyncRegistry(options, totals));
+  if (root) {
+    for (const std::string& warning : simulation.warnings)
+      std::cerr << "offlineSimulator: warning: " << warning << "\n";
+  }
+  RunRecord record;
+  record.before = simulation.integrator->stats();
+  record.schedule = asyncfem::CheckpointSchedule{options.checkpointEvery, options.checkpointSeconds};
+  std::string failure;
+  std::optional<RunOutput> output = openOnEveryRank(runtime, options, scene, simulation, record, failure);
   record.setupSeconds = setupWatch.stop();
   installStopHandlers();  // after PETSc's start, whose own handlers it replaces for these signals
   asyncfem::cli::ProgressReporter progress(
