@@ -94,8 +94,11 @@ TEST(AsyncSetUp, AnExternalLargeSystemSolverSolvesLsSystem) {
   const std::vector<AsyncRegion> half{{"half", test::verticesBeyond(ts.mesh, 0.5), 8}};
   std::vector<std::size_t> largeSizes;
   AsyncOptions options;
-  options.largeSystemSolver = [&largeSizes](const std::vector<int>& largeDofs) {
+  std::vector<std::vector<std::vector<int>>> interfaces;
+  options.largeSystemSolver = [&largeSizes, &interfaces](const std::vector<int>& largeDofs,
+                                                         const std::vector<std::vector<int>>& interfaceDofs) {
     largeSizes.push_back(largeDofs.size());
+    interfaces.push_back(interfaceDofs);
     return makeSparseSolver(SolverKind::eigenLDLT);
   };
   AsyncBackwardEuler external(ts.mesh, ts.system, hL, tip, options);
@@ -109,6 +112,12 @@ TEST(AsyncSetUp, AnExternalLargeSystemSolverSolvesLsSystem) {
   ASSERT_EQ(largeSizes.size(), 2u);
   EXPECT_GT(largeSizes[0], largeSizes[1]);  // the half region leaves L fewer DOFs than the tip
   EXPECT_EQ(largeSizes[1], external.partition().largeDofs().size());
+  // Each call names every region's interface DOFs, which are DOFs of L.
+  ASSERT_EQ(interfaces.size(), 2u);
+  ASSERT_EQ(interfaces[1].size(), 1u);
+  EXPECT_EQ(interfaces[1][0], external.partition().interfaceDofs(0));
+  EXPECT_FALSE(interfaces[0][0].empty());
+  EXPECT_NE(interfaces[0][0], interfaces[1][0]);
   const double scale = reference.displacement().cwiseAbs().maxCoeff();
   EXPECT_GT(scale, 0.0);
   EXPECT_LE((external.displacement() - reference.displacement()).cwiseAbs().maxCoeff(), 1e-10 * scale);

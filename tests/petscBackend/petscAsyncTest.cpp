@@ -7,6 +7,7 @@
 #include <mpi.h>
 
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
@@ -217,6 +218,10 @@ TEST_P(PetscAsync, TrajectoryMatchesTheLocalAsyncRun) {
   EXPECT_GT(local.back().lpNorm<Eigen::Infinity>(), 1e-3);  // the beam moves
   EXPECT_GE(totals->solves, kAsyncSteps);                   // L was solved on PETSc
   EXPECT_TRUE(sameOnEveryRank(distributed.back()));
+  // The tip region's interface (one layer of vertices) is far below a rank's share of L's:
+  // one rank owns all of its rows.
+  EXPECT_EQ(totals->regionsOnOneRank, 1);
+  EXPECT_EQ(totals->regionsSplit, 0);
 }
 
 std::string asyncCaseName(const ::testing::TestParamInfo<AsyncCase>& info) {
@@ -231,6 +236,80 @@ INSTANTIATE_TEST_SUITE_P(Models, PetscAsync,
                                            AsyncCase{Model::corotational, PetscSolverKind::cgGamg},
                                            AsyncCase{Model::neoHookean, PetscSolverKind::mumps}),
                          asyncCaseName);
+
+// assignVertexOwners: every vertex outside the groups keeps the lowest part among its
+// elements'; each group (merged with those it shares a vertex with) moves whole to the rank
+// that owned most of it; a group over the size limit is left as it was. Exact integers, so
+// compared exactly; the expected owners are computed here from the definitions.
+TEST(AssignVertexOwners, KeepsEachInterfaceOnTheRankThatHeldMostOfIt) {
+  const TetMesh mesh = cantilever();
+  const int ranks = 3;
+  std::vector<int> parts(static_cast<std::size_t>(mesh.numElements()));
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    double x = 0.0;
+    for (const int v : mesh.element(e)) x += mesh.restPosition(v).x() / 4.0;
+    parts[static_cast<std::size_t>(e)] = std::min(2, static_cast<int>(x * 3.0));
+  }
+  std::vector<int> lowest(static_cast<std::size_t>(mesh.numVertices()), ranks);
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    for (const int v : mesh.element(e)) {
+      lowest[static_cast<std::size_t>(v)] =
+          std::min(lowest[static_cast<std::size_t>(v)], parts[static_cast<std::size_t>(e)]);
+    }
+  }
+  // Group 0 straddles the cut at x = 1/3 (more of it on part 0); groups 1 and 2 share a
+  // vertex near x = 2/3 and are merged (more of them on part 2); group 3 is too large.
+  std::vector<std::vector<int>> groups(4);
+  int sharedVertex = -1;
+  for (int v = 0; v < mesh.numVertices(); ++v) {
+    const double x = mesh.restPosition(v).x();
+    if (x > 0.2 && x < 0.45) groups[0].push_back(v);
+    if (x > 0.6 && x < 0.68) groups[1].push_back(v);
+    if (x > 0.66 && x < 0.9) groups[2].push_back(v);
+    if (x > 0.6 && x < 0.68 && x > 0.66) sharedVertex = v;
+    if (x > 0.9) groups[3].push_back(v);
+  }
+  ASSERT_GE(sharedVertex, 0);
+  const int limit = static_cast<int>(groups[3].size()) - 1;
+  const VertexOwners owners = assignVertexOwners(mesh, parts, ranks, groups, 1000);
+  const VertexOwners limited = assignVertexOwners(mesh, parts, ranks, {groups[3]}, limit);
+  EXPECT_EQ(owners.groupsKept, 3);  // 0, {1, 2} and 3 under the limit of 1000
+  EXPECT_EQ(owners.groupsSplit, 0);
+  EXPECT_EQ(limited.groupsKept, 0);
+  EXPECT_EQ(limited.groupsSplit, 1);
+  EXPECT_EQ(limited.owner, lowest);  // the split group keeps the lowest-part owners
+  const auto majority = [&lowest, ranks](const std::vector<int>& vertices) {
+    std::vector<int> votes(static_cast<std::size_t>(ranks), 0);
+    for (const int v : vertices) ++votes[static_cast<std::size_t>(lowest[static_cast<std::size_t>(v)])];
+    return static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+  };
+  std::vector<int> merged = groups[1];
+  merged.insert(merged.end(), groups[2].begin(), groups[2].end());
+  std::sort(merged.begin(), merged.end());
+  merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
+  std::vector<int> expected = lowest;
+  for (const std::vector<int>* group : {&groups[0], &merged, &groups[3]}) {
+    const int keeper = majority(*group);
+    for (const int v : *group) expected[static_cast<std::size_t>(v)] = keeper;
+  }
+  EXPECT_EQ(owners.owner, expected);
+  // The straddling group had vertices on two parts before and has one now.
+  std::vector<int> before, after;
+  for (const int v : groups[0]) {
+    before.push_back(lowest[static_cast<std::size_t>(v)]);
+    after.push_back(owners.owner[static_cast<std::size_t>(v)]);
+  }
+  EXPECT_NE(*std::min_element(before.begin(), before.end()), *std::max_element(before.begin(), before.end()));
+  EXPECT_EQ(*std::min_element(after.begin(), after.end()), *std::max_element(after.begin(), after.end()));
+  // A vertex id outside the mesh is named.
+  try {
+    assignVertexOwners(mesh, parts, ranks, {{0, mesh.numVertices()}}, 1000);
+    ADD_FAILURE() << "an out-of-range vertex was accepted";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("vertex " + std::to_string(mesh.numVertices())), std::string::npos)
+        << error.what();
+  }
+}
 
 // The paper's coupling (an unsymmetric H^{LL*}) and the naive method are refused by name.
 TEST(PetscAsync, OnlyTheStableStructuredSolveTakesAnExternalSolver) {

@@ -533,7 +533,9 @@ TEST_F(OfflineSimulatorTest, ResumeWithTheKeptFactorIsBitIdentical) {
     ASSERT_EQ(first.exitCode, 0) << first.err;
     EXPECT_NE(first.out.find(reuse ? "kept factor as PCG preconditioner" : "linear solves: exact"), std::string::npos)
         << first.out;
-    if (reuse) EXPECT_EQ(first.out.find(" 0 PCG iterations per step"), std::string::npos) << first.out;
+    if (reuse) {
+      EXPECT_EQ(first.out.find(" 0 PCG iterations per step"), std::string::npos) << first.out;
+    }
     const RunResult resumed = run(quoted(scene) + " --frames 10 --resume --output " + quoted(output));
     ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
     EXPECT_EQ(resumed.out.find("resume:"), std::string::npos) << resumed.out;

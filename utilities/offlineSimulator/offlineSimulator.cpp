@@ -927,8 +927,11 @@ int runPetscAsync(int argc, char** argv, const CommandLine& options, const async
   if (root && !options.quiet) {
     record.outputBytes = static_cast<std::int64_t>(fs::file_size(scene.output.file));
     printSummary(scene, simulation, record);
-    std::printf("  PETSc       %d ranks solve L's system (KSP %s): %lld solves, %lld iterations; rank 0 owns %d rows\n",
-                runtime.size(), options.petscSolver.c_str(), totals->solves, totals->iterations, totals->ownedRows);
+    std::printf(
+        "  PETSc       %d ranks solve L's system (KSP %s): %lld solves, %lld iterations; rank 0 owns %d rows "
+        "(%lld entries in other ranks' columns); region interfaces on one rank: %d, split: %d\n",
+        runtime.size(), options.petscSolver.c_str(), totals->solves, totals->iterations, totals->ownedRows,
+        totals->offRankEntries, totals->regionsOnOneRank, totals->regionsSplit);
   }
   return 0;
 }

@@ -318,7 +318,11 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
     d.perElementTangent = detail::findInterfaceElements(*system_.mesh, partition_, system_, d.regions);
   }
   d.schur.reset();
-  if (options_.largeSystemSolver) d.schur.useExternalSolver(options_.largeSystemSolver, large);
+  if (options_.largeSystemSolver) {
+    std::vector<std::vector<int>> interfaces;
+    for (int i = 0; i < partition_.numRegions(); ++i) interfaces.push_back(partition_.interfaceDofs(i));
+    d.schur.useExternalSolver(options_.largeSystemSolver, large, std::move(interfaces));
+  }
   d.naive.reset();
   d.schurLagging = false;
   d.quick = options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&

@@ -41,6 +41,7 @@ struct DistributedCopy {
   std::vector<std::vector<PetscInt>> rowColumns;  // PETSc columns of each owned row
   std::vector<std::vector<int>> rowEntries;       // and where their values sit in the CSC arrays
   std::vector<int> outer, inner;
+  long long offRankEntries = 0;
 
   bool matches(const SparseMatrix& m) const {
     return !outer.empty() && static_cast<std::size_t>(m.nonZeros()) == inner.size() &&
@@ -66,6 +67,8 @@ struct DistributedCopy {
         (n.owner[static_cast<std::size_t>(c)] == n.rank ? diagonal : offDiagonal)[static_cast<std::size_t>(local)]++;
       }
     }
+    offRankEntries = 0;
+    for (const PetscInt count : offDiagonal) offRankEntries += count;
     const auto owned = static_cast<PetscInt>(n.ownedRowIndex.size());
     checkPetsc(MatCreate(PETSC_COMM_WORLD, matrix.out()), "MatCreate");
     checkPetsc(MatSetSizes(matrix.get(), owned, owned, n.rows, n.rows), "MatSetSizes");
@@ -122,6 +125,8 @@ class PetscSparseSolver final : public SparseSolver {
     system_ = DistributedCopy{};
     preconditioner_ = DistributedCopy{};
     system_.build(matrix, numbering_);
+    counts_.offRankEntries = system_.offRankEntries;
+    if (totals_) totals_->offRankEntries = counts_.offRankEntries;
     checkPetsc(MatCreateVecs(system_.matrix.get(), x_.out(), b_.out()), "MatCreateVecs");
     checkPetsc(VecScatterCreateToAll(x_.get(), toAll_.out(), all_.out()), "VecScatterCreateToAll");
     makeRigidBodyModes();
@@ -324,8 +329,83 @@ const PetscSolveCounts* petscSolveCounts(const SparseSolver& solver) {
   return petsc != nullptr ? &petsc->counts() : nullptr;
 }
 
-std::function<std::unique_ptr<SparseSolver>(const std::vector<int>& largeDofs)> makePetscLargeSystemSolver(
-    const TetMesh& mesh, const PetscSolverSettings& settings, std::shared_ptr<PetscSolveCounts> totals) {
+namespace {
+
+/// Union-find over the groups of keepTogether: groups that share a vertex get one root.
+std::vector<int> mergeGroups(const std::vector<std::vector<int>>& groups, int numVertices) {
+  std::vector<int> root(groups.size());
+  for (std::size_t g = 0; g < groups.size(); ++g) root[g] = static_cast<int>(g);
+  const auto find = [&root](int g) {
+    while (root[static_cast<std::size_t>(g)] != g)
+      g = root[static_cast<std::size_t>(g)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(g)])];
+    return g;
+  };
+  std::vector<int> firstGroup(static_cast<std::size_t>(numVertices), -1);
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    for (const int v : groups[g]) {
+      if (v < 0 || v >= numVertices) {
+        throw Error("assignVertexOwners: vertex " + std::to_string(v) + " of group " + std::to_string(g) +
+                    " is not a vertex of the mesh (" + std::to_string(numVertices) + " vertices)");
+      }
+      int& first = firstGroup[static_cast<std::size_t>(v)];
+      if (first < 0) {
+        first = static_cast<int>(g);
+      } else {
+        root[static_cast<std::size_t>(find(static_cast<int>(g)))] = find(first);
+      }
+    }
+  }
+  for (std::size_t g = 0; g < groups.size(); ++g) root[g] = find(static_cast<int>(g));
+  return root;
+}
+
+}  // namespace
+
+VertexOwners assignVertexOwners(const TetMesh& mesh, const std::vector<int>& elementParts, int ranks,
+                                const std::vector<std::vector<int>>& keepTogether, int maxGroupVertices) {
+  if (elementParts.size() != static_cast<std::size_t>(mesh.numElements())) {
+    throw Error("assignVertexOwners: " + std::to_string(elementParts.size()) + " element parts for " +
+                std::to_string(mesh.numElements()) + " elements");
+  }
+  VertexOwners result;
+  const int numVertices = mesh.numVertices();
+  result.owner.assign(static_cast<std::size_t>(numVertices), ranks);
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    for (const int v : mesh.element(e)) {
+      int& o = result.owner[static_cast<std::size_t>(v)];
+      o = std::min(o, elementParts[static_cast<std::size_t>(e)]);
+    }
+  }
+  for (int& o : result.owner) o = std::min(o, ranks - 1);  // vertices of no element (no rows reach them)
+  // Each merged group's distinct vertices, then its majority rank.
+  const std::vector<int> root = mergeGroups(keepTogether, numVertices);
+  std::vector<std::vector<int>> merged(keepTogether.size());
+  for (std::size_t g = 0; g < keepTogether.size(); ++g) {
+    std::vector<int>& into = merged[static_cast<std::size_t>(root[g])];
+    into.insert(into.end(), keepTogether[g].begin(), keepTogether[g].end());
+  }
+  std::vector<int> votes(static_cast<std::size_t>(ranks));
+  for (std::vector<int>& group : merged) {
+    std::sort(group.begin(), group.end());
+    group.erase(std::unique(group.begin(), group.end()), group.end());
+    if (group.empty()) continue;
+    if (static_cast<int>(group.size()) > maxGroupVertices) {
+      ++result.groupsSplit;
+      continue;
+    }
+    std::fill(votes.begin(), votes.end(), 0);
+    for (const int v : group) ++votes[static_cast<std::size_t>(result.owner[static_cast<std::size_t>(v)])];
+    const int keeper = static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+    for (const int v : group) result.owner[static_cast<std::size_t>(v)] = keeper;
+    ++result.groupsKept;
+  }
+  return result;
+}
+
+std::function<std::unique_ptr<SparseSolver>(const std::vector<int>& largeDofs,
+                                            const std::vector<std::vector<int>>& interfaceDofs)>
+makePetscLargeSystemSolver(const TetMesh& mesh, const PetscSolverSettings& settings,
+                           std::shared_ptr<PetscSolveCounts> totals) {
   int rank = 0;
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
   int ranks = 1;
@@ -335,20 +415,26 @@ std::function<std::unique_ptr<SparseSolver>(const std::vector<int>& largeDofs)> 
     if (rank == 0 && ranks > 1) parts = partitionElements(mesh, ranks);
   });
   if (!parts.empty()) MPI_Bcast(parts.data(), static_cast<int>(parts.size()), MPI_INT, 0, PETSC_COMM_WORLD);
-  auto owner = std::make_shared<std::vector<int>>(static_cast<std::size_t>(mesh.numVertices()), ranks);
-  for (int e = 0; e < mesh.numElements(); ++e) {
-    const Eigen::Vector4i vertices = mesh.element(e);
-    for (int v : vertices) {
-      int& o = (*owner)[static_cast<std::size_t>(v)];
-      o = std::min(o, parts[static_cast<std::size_t>(e)]);
-    }
-  }
-  for (int& o : *owner) o = std::min(o, ranks - 1);  // vertices of no element (no rows reach them)
   auto coordinates = std::make_shared<Eigen::Matrix3Xd>(mesh.restPositions());
-  return [settings, owner, coordinates, totals](const std::vector<int>& largeDofs) -> std::unique_ptr<SparseSolver> {
+  auto meshShared = std::make_shared<TetMesh>(mesh);
+  return [settings, parts = std::move(parts), meshShared, coordinates, totals, ranks](
+             const std::vector<int>& largeDofs,
+             const std::vector<std::vector<int>>& interfaceDofs) -> std::unique_ptr<SparseSolver> {
     std::vector<int> rowVertex(largeDofs.size());
     for (std::size_t k = 0; k < largeDofs.size(); ++k) rowVertex[k] = largeDofs[k] / 3;
-    return makePetscSparseSolver(settings, std::move(rowVertex), owner, coordinates, totals);
+    std::vector<std::vector<int>> groups(interfaceDofs.size());
+    for (std::size_t i = 0; i < interfaceDofs.size(); ++i) {
+      for (const int dof : interfaceDofs[i]) groups[i].push_back(dof / 3);
+    }
+    // A group may take at most one rank's share of L's vertices.
+    const int share = static_cast<int>(largeDofs.size() / 3 / static_cast<std::size_t>(ranks));
+    VertexOwners owners = assignVertexOwners(*meshShared, parts, ranks, groups, std::max(share, 1));
+    if (totals) {
+      totals->regionsOnOneRank = owners.groupsKept;
+      totals->regionsSplit = owners.groupsSplit;
+    }
+    auto owner = std::make_shared<const std::vector<int>>(std::move(owners.owner));
+    return makePetscSparseSolver(settings, std::move(rowVertex), std::move(owner), coordinates, totals);
   };
 }
 

@@ -35,9 +35,11 @@ void SchurSolver::reset() {
   external_ = std::move(external);
 }
 
-void SchurSolver::useExternalSolver(AsyncOptions::LargeSystemSolverFactory factory, std::vector<int> largeDofs) {
+void SchurSolver::useExternalSolver(AsyncOptions::LargeSystemSolverFactory factory, std::vector<int> largeDofs,
+                                    std::vector<std::vector<int>> interfaceDofs) {
   external_ = std::move(factory);
   externalLarge_ = std::move(largeDofs);
+  externalInterfaces_ = std::move(interfaceDofs);
   solver_.reset();
   analyzed_ = false;
 }
@@ -45,7 +47,7 @@ void SchurSolver::useExternalSolver(AsyncOptions::LargeSystemSolverFactory facto
 void SchurSolver::chooseSolver(SchurMode mode) {
   if (mode != modeUsed_ || !solver_) {
     if (external_) {
-      solver_ = external_(externalLarge_);
+      solver_ = external_(externalLarge_, externalInterfaces_);
       if (!solver_) throw Error("async integrator: the large-system solver factory returned no solver");
     } else {
       solver_ = makeSparseSolver(mode == SchurMode::lu ? SolverKind::umfpack : SolverKind::cholmod);

@@ -73,8 +73,10 @@ class SchurSolver {
   /// external solver's factory.
   void reset();
   /// From the next factor() on, H^{LL*} is assembled (symmetric mode) and factored by the
-  /// solver factory(largeDofs) returns (AsyncOptions::largeSystemSolver); empty: CHOLMOD.
-  void useExternalSolver(AsyncOptions::LargeSystemSolverFactory factory, std::vector<int> largeDofs);
+  /// solver factory(largeDofs, interfaceDofs) returns (AsyncOptions::largeSystemSolver);
+  /// empty: CHOLMOD.
+  void useExternalSolver(AsyncOptions::LargeSystemSolverFactory factory, std::vector<int> largeDofs,
+                         std::vector<std::vector<int>> interfaceDofs);
   SchurMode modeUsed() const { return modeUsed_; }
   bool factored() const { return factored_; }
   /// Whether the last refine() converged slowly; cleared by the next factor().
@@ -97,6 +99,7 @@ class SchurSolver {
   SchurMode modeUsed_ = SchurMode::lowRank;
   AsyncOptions::LargeSystemSolverFactory external_;
   std::vector<int> externalLarge_;
+  std::vector<std::vector<int>> externalInterfaces_;
   WholeSystemFactor* borrowed_ = nullptr;
   std::vector<int> borrowedLarge_;  // global ids of L (a copy: the set-up may be cached)
   // Deflation space of solveDeflated: columns [0, kept_) of directions_ (W, H^{LL*}-

@@ -108,14 +108,17 @@ struct AsyncOptions {
   /// "Performance notes"). 0: every region uses regionSolver.
   int denseRegionDofs = 128;
   /// The solver of L's system H^{LL*} (structured method, stable coupling), or empty for
-  /// CHOLMOD. Called with the global DOF ids of L (ascending; the rows of H^{LL*}) at each
-  /// set-up; the solver it returns is given the assembled H^{LL*} (every entry of each
+  /// CHOLMOD. Called at each set-up with the global DOF ids of L (ascending; the rows of
+  /// H^{LL*}) and, for each fast region i, the global DOF ids of its interface I_i (the rows
+  /// and columns its dense block C_i couples; a distributed solver keeps each on one rank
+  /// where it can); the solver it returns is given the assembled H^{LL*} (every entry of each
   /// dense interface block on a fixed pattern, both triangles, symmetric) and must solve it
   /// to the accuracy the run needs; an iterative one that asks for a preconditioning matrix
   /// (SparseSolver::usesPreconditionerMatrix) gets Â^L, the same without the dense blocks. The petscBackend library's
   /// makePetscLargeSystemSolver() solves it distributed over MPI ranks (docs/petsc-backend.md, "The asynchronous
   /// integrator over MPI"). The paper's coupling (unsymmetric H^{LL*}) is refused with it.
-  using LargeSystemSolverFactory = std::function<std::unique_ptr<SparseSolver>(const std::vector<int>& largeDofs)>;
+  using LargeSystemSolverFactory = std::function<std::unique_ptr<SparseSolver>(
+      const std::vector<int>& largeDofs, const std::vector<std::vector<int>>& interfaceDofs)>;
   LargeSystemSolverFactory largeSystemSolver{};
 };
 

@@ -16,7 +16,27 @@ struct PetscSolveCounts {
   long long iterations = 0;  ///< KSP iterations summed over the solves (1 per direct solve)
   int lastIterations = 0;
   int ownedRows = 0;  ///< rows of the distributed matrix this rank owns
+  /// Entries of this rank's rows in columns another rank owns (the last matrix analysed):
+  /// what a product with the matrix communicates.
+  long long offRankEntries = 0;
+  /// makePetscLargeSystemSolver, the last set-up: region interfaces (merged where they
+  /// share a vertex) whose rows one rank owns, and those left split (more vertices than one
+  /// rank's share of L's).
+  int regionsOnOneRank = 0, regionsSplit = 0;
 };
+
+/// Owners of a mesh's vertices for ranks ranks, from an element partition (one part per
+/// element): each vertex goes to the lowest part among its elements' (a vertex of no
+/// element to the last rank). Then each group in keepTogether (vertex ids; groups that
+/// share a vertex are merged) with at most maxGroupVertices vertices moves whole to the
+/// rank that already owns most of it (ties: the lowest); larger groups stay split.
+struct VertexOwners {
+  std::vector<int> owner;
+  int groupsKept = 0;   ///< merged groups now on one rank
+  int groupsSplit = 0;  ///< merged groups over maxGroupVertices, on several ranks
+};
+VertexOwners assignVertexOwners(const TetMesh& mesh, const std::vector<int>& elementParts, int ranks,
+                                const std::vector<std::vector<int>>& keepTogether, int maxGroupVertices);
 
 /// A SparseSolver whose matrix and right-hand sides are the same on every rank of
 /// MPI_COMM_WORLD (replicated), and whose solve is distributed: each rank inserts the rows
@@ -52,10 +72,15 @@ const PetscSolveCounts* petscSolveCounts(const SparseSolver& solver);
 /// the integrator on the replicated state, and H^{LL*} is solved distributed. Rows (global
 /// DOF ids 3 v + c) are owned by their vertex's rank in METIS's element partition of mesh
 /// (partitionElements(), computed on rank 0 and broadcast; a vertex belongs to the lowest
-/// rank among its elements'), so each rank's rows are a compact piece of the mesh; GAMG
-/// gets the rigid-body modes. Collective; needs a live PetscRuntime, which must outlive
+/// rank among its elements'), so each rank's rows are a compact piece of the mesh; at each
+/// set-up every region's interface vertices are then kept on one rank
+/// (assignVertexOwners(), groups up to one rank's share of L's vertices), so the dense
+/// block C_i of each region lies in one rank's diagonal block. GAMG gets the rigid-body
+/// modes. Collective; needs a live PetscRuntime, which must outlive
 /// every solver made.
-std::function<std::unique_ptr<SparseSolver>(const std::vector<int>& largeDofs)> makePetscLargeSystemSolver(
-    const TetMesh& mesh, const PetscSolverSettings& settings, std::shared_ptr<PetscSolveCounts> totals = {});
+std::function<std::unique_ptr<SparseSolver>(const std::vector<int>& largeDofs,
+                                            const std::vector<std::vector<int>>& interfaceDofs)>
+makePetscLargeSystemSolver(const TetMesh& mesh, const PetscSolverSettings& settings,
+                           std::shared_ptr<PetscSolveCounts> totals = {});
 
 }  // namespace asyncfem
