@@ -2,8 +2,10 @@
 # The asynchronous integrator over MPI (docs/petsc-backend.md, "The asynchronous integrator
 # over MPI"): a box cantilever 4 x 1 x 1 (CELLS cubes across, 4 CELLS along; 6 tets each),
 # corotational with the exact tangent, sagging under gravity and pulled sideways, its last
-# 5% along x a fast region at ratio 8; offlineSimulator locally (CHOLMOD) and with
-# --backend petsc on 1 and 2 ranks (CG + GAMG, MUMPS). One Markdown row per run on stdout:
+# FRACTION (default 0.05) of its length a fast region at ratio 8 (REGIONS=2: also as much
+# at its fixed end, from x = 0.05); offlineSimulator locally (CHOLMOD) and with --backend
+# petsc on RANKS (default 1 and 2) ranks (CG + GAMG, MUMPS), the regions owned by one rank
+# each and, beyond one rank, replicated on every rank. One Markdown row per run on stdout:
 # set-up and wall time per frame from the simulator's summary, and the largest difference
 # from the local run's frames relative to the largest displacement (on every vertex up to
 # 3,000 vertices, on an evenly spaced sample of about 3,000 beyond).
@@ -12,6 +14,12 @@ set -euo pipefail
 bin=$(cd "${1:-build/bin}" && pwd)
 cells_list=${CELLS:-"12 18"}
 ranks=${RANKS:-"1 2"}
+# Each rank count with the regions owned by one rank each; beyond one rank also replicated.
+runs=""
+for n in $ranks; do
+  runs="$runs $n:owned"
+  [ "$n" -gt 1 ] && runs="$runs $n:replicated"
+done
 frames=${FRAMES:-3}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 export OMP_NUM_THREADS=1 OMPI_MCA_mpi_yield_when_idle=1
@@ -20,6 +28,13 @@ trap 'rm -rf "$work"' EXIT
 cd "$work"
 echo "| tets | vertices | run | set-up (s) | per frame (ms) | frame ratio to local | L solves / iterations | difference from local |"
 echo "|---|---|---|---|---|---|---|---|"
+fraction=${FRACTION:-0.05}
+tip_start=$(python3 -c "print(4 - 4 * $fraction)")
+second=""
+if [ "${REGIONS:-1}" = 2 ]; then
+  root_end=$(python3 -c "print(0.05 + 4 * $fraction)")
+  second=', {"name": "root", "ratio": 8, "boxes": [{"min": [0.05, -1, -1], "max": ['$root_end', 2, 2]}]}'
+fi
 for cells in $cells_list; do
   cat > scene.json <<JSON
 {
@@ -30,7 +45,7 @@ for cells in $cells_list; do
   "forces": [{"type": "pull", "set": "xmax", "force": [0, 0, 20], "window": [0, 0.1]}],
   "forceModel": {"type": "corotational", "tangent": "exact"},
   "integrator": {"name": "async", "timestep": 0.01,
-                 "options": {"regions": [{"name": "tip", "ratio": 8, "boxes": [{"min": [3.8, -1, -1], "max": [5, 2, 2]}]}]}},
+                 "options": {"regions": [{"name": "tip", "ratio": 8, "boxes": [{"min": [$tip_start, -1, -1], "max": [5, 2, 2]}]}$second]}},
   "frames": {"rate": 25, "count": $frames}
 }
 JSON
@@ -41,8 +56,11 @@ JSON
   local_setup=$(grep -m1 "^  setup" local.txt | awk '{print $2}')
   echo "| $tets | $vertices | local (CHOLMOD) | $local_setup | $local_frame | 1.00 | | |"
   for solver in cg-gamg mumps; do
-    for n in $ranks; do
-      mpiexec -n "$n" "$bin/offlineSimulator" scene.json --backend petsc --petsc-solver "$solver" -o petsc.afsim > petsc.txt 2> /dev/null
+    for run in $runs; do
+      n=${run%:*}
+      regions=${run#*:}
+      mpiexec -n "$n" "$bin/offlineSimulator" scene.json --backend petsc --petsc-solver "$solver" \
+        --petsc-regions "$regions" -o petsc.afsim > petsc.txt 2> /dev/null
       frame=$(grep -m1 "^  per frame" petsc.txt | awk '{print $3}')
       setup=$(grep -m1 "^  setup" petsc.txt | awk '{print $2}')
       solves=$(grep -m1 "PETSc  " petsc.txt | sed 's/.*: \([0-9]*\) solves, \([0-9]*\) iterations.*/\1 \/ \2/')
@@ -59,7 +77,7 @@ print(f"{max(abs(x - y) for r, s in zip(a, b) for x, y in zip(r, s)) / scale:.1e
 PY
 )
       ratio=$(python3 -c "print(f'{$frame / $local_frame:.2f}')")
-      echo "| $tets | $vertices | PETSc $solver, $n rank(s) | $setup | $frame | $ratio | $solves | $difference |"
+      echo "| $tets | $vertices | PETSc $solver, $n rank(s), regions $regions | $setup | $frame | $ratio | $solves | $difference |"
     done
   done
 done

@@ -17,6 +17,7 @@
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -79,14 +80,27 @@ std::vector<AsyncRegion> tipRegion(const TetMesh& mesh) {
   return {region};
 }
 
-std::vector<Eigen::VectorXd> asyncTrajectory(Model model, const AsyncOptions& options) {
+/// The tip region and, apart from it, the vertices of the plane x = 0.25 at ratio 4.
+std::vector<AsyncRegion> twoRegions(const TetMesh& mesh) {
+  std::vector<AsyncRegion> regions = tipRegion(mesh);
+  AsyncRegion plane{"plane", {}, 4};
+  for (int v = 0; v < mesh.numVertices(); ++v)
+    if (std::abs(mesh.restPosition(v).x() - 0.25) < 1e-9) plane.vertices.push_back(v);
+  regions.push_back(plane);
+  return regions;
+}
+
+std::vector<Eigen::VectorXd> asyncTrajectory(Model model, const AsyncOptions& options, bool bothRegions = false,
+                                             long long* factorizations = nullptr) {
   auto mesh = std::make_shared<const TetMesh>(cantilever());
-  AsyncBackwardEuler integrator(*mesh, cantileverSystem(mesh, model), kStep, tipRegion(*mesh), options);
+  AsyncBackwardEuler integrator(*mesh, cantileverSystem(mesh, model), kStep,
+                                bothRegions ? twoRegions(*mesh) : tipRegion(*mesh), options);
   std::vector<Eigen::VectorXd> states;
   for (int k = 0; k < kAsyncSteps; ++k) {
     integrator.step();
     states.push_back(integrator.displacement());
   }
+  if (factorizations != nullptr) *factorizations = integrator.stats().factorizations;
   return states;
 }
 
@@ -236,6 +250,77 @@ INSTANTIATE_TEST_SUITE_P(Models, PetscAsync,
                                            AsyncCase{Model::corotational, PetscSolverKind::cgGamg},
                                            AsyncCase{Model::neoHookean, PetscSolverKind::mumps}),
                          asyncCaseName);
+
+// AsyncOptions::regionDistribution from makePetscRegionDistribution: each of two regions is
+// computed by one rank only (its A^S, Z, C_i, substitutions and recovery), the rest summed
+// with MPI_Allreduce. The trajectory follows the local run to the same tolerances as the
+// replicated regions (the sums add the owner's values to zeros, so they are exact; the rest
+// is the L solve's tolerance), every rank holds the same state, and a rank that owns fewer
+// than both regions factors less than the local run.
+TEST(PetscAsync, RegionsOwnedByOneRankFollowTheLocalRun) {
+  int ranks = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  for (const AsyncCase c :
+       {AsyncCase{Model::linear, PetscSolverKind::mumps}, AsyncCase{Model::corotational, PetscSolverKind::cgGamg}}) {
+    SCOPED_TRACE(c.model == Model::linear ? "linear, MUMPS" : "corotational, GAMG");
+    long long localFactorizations = 0, factorizations = 0;
+    const std::vector<Eigen::VectorXd> local = asyncTrajectory(c.model, AsyncOptions{}, true, &localFactorizations);
+    auto mesh = std::make_shared<const TetMesh>(cantilever());
+    PetscSolverSettings settings;
+    settings.kind = c.solver;
+    settings.relativeTolerance = kRelativeTolerance;
+    AsyncOptions options;
+    options.largeSystemSolver = makePetscLargeSystemSolver(*mesh, settings);
+    const PetscRegionDistribution distribution = makePetscRegionDistribution(*mesh);
+    options.regionDistribution.ownedRegions = distribution.ownedRegions;
+    options.regionDistribution.sum = distribution.sum;
+    const std::vector<Eigen::VectorXd> distributed = asyncTrajectory(c.model, options, true, &factorizations);
+    EXPECT_LE(largestDifference(distributed, local), c.solver == PetscSolverKind::mumps ? 1e-10 : 5e-6);
+    EXPECT_TRUE(sameOnEveryRank(distributed.back()));
+    // How many regions this rank computes, from the distribution itself.
+    const RegionPartition partition(*mesh, cantileverSystem(mesh, c.model).freeDofs, twoRegions(*mesh));
+    std::vector<std::vector<int>> regionDofs, interfaceDofs;
+    for (int i = 0; i < partition.numRegions(); ++i) {
+      regionDofs.push_back(partition.regionDofs(i));
+      interfaceDofs.push_back(partition.interfaceDofs(i));
+    }
+    const std::vector<char> owned = distribution.ownedRegions(regionDofs, interfaceDofs);
+    int mine = static_cast<int>(std::count(owned.begin(), owned.end(), 1)), total = 0;
+    MPI_Allreduce(&mine, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+    EXPECT_EQ(total, 2);
+    if (mine < 2) EXPECT_LT(factorizations, localFactorizations);
+    if (ranks == 1) EXPECT_EQ(mine, 2);
+  }
+}
+
+// regionOwners: a region whose interface lies on one rank goes to that rank; one without
+// an interface (or with a split one) to the rank owning most of its vertices.
+TEST(AssignVertexOwners, RegionOwnersFollowTheirInterface) {
+  const TetMesh mesh = cantilever();
+  std::vector<int> parts(static_cast<std::size_t>(mesh.numElements()));
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    double x = 0.0;
+    for (const int v : mesh.element(e)) x += mesh.restPosition(v).x() / 4.0;
+    parts[static_cast<std::size_t>(e)] = x < 0.5 ? 0 : 1;
+  }
+  // Region 0: the plane x = 7/12 (lowest-part owner 1) with the interface planes 5/12, 1/2
+  // (owner 0) and 2/3 (owner 1): the interface goes whole to rank 0, and the region with
+  // it. Region 1: the plane x = 5/6, interface planes 3/4 and 11/12 (all on rank 1). Region
+  // 2: no interface, the planes 5/12, 1/2 and 7/12 (2 of 3 on rank 0).
+  const auto planes = [&mesh](std::initializer_list<double> xs) {
+    std::vector<int> out;
+    for (int v = 0; v < mesh.numVertices(); ++v)
+      for (const double x : xs)
+        if (std::abs(mesh.restPosition(v).x() - x) < 1e-9) out.push_back(v);
+    return out;
+  };
+  const std::vector<std::vector<int>> regions{planes({7.0 / 12}), planes({5.0 / 6}), planes({5.0 / 12, 0.5, 7.0 / 12})};
+  const std::vector<std::vector<int>> interfaces{planes({5.0 / 12, 0.5, 2.0 / 3}), planes({0.75, 11.0 / 12}), {}};
+  EXPECT_EQ(regionOwners(mesh, parts, 2, regions, interfaces, 1000), (std::vector<int>{0, 1, 0}));
+  // With a limit below the interfaces' sizes they stay split (region 1's lies on one rank
+  // anyway), and region 0 goes by its own vertices: rank 1.
+  EXPECT_EQ(regionOwners(mesh, parts, 2, regions, interfaces, 4), (std::vector<int>{1, 1, 0}));
+}
 
 // assignVertexOwners: every vertex outside the groups keeps the lowest part among its
 // elements'; each group (merged with those it shares a vertex with) moves whole to the rank

@@ -80,6 +80,7 @@ struct CommandLine {
   std::string backend = "local";
   std::string petscSolver = "cg-gamg";
   std::string petscOptions;
+  std::string petscRegions = "owned";
 };
 
 // The signal that asked the run to stop (0: none). A signal handler can only set a flag
@@ -631,6 +632,11 @@ void addRunOptions(CLI::App& app, CommandLine& options) {
       ->capture_default_str();
   app.add_option("--petsc-options", options.petscOptions,
                  "With --backend petsc: PETSc options database entries, e.g. \"-ksp_rtol 1e-10 -ksp_monitor\"");
+  app.add_option("--petsc-regions", options.petscRegions,
+                 "With --backend petsc and the async integrator: owned (each fast region computed by one rank, "
+                 "the default) or replicated (every rank computes every region)")
+      ->check(CLI::IsMember({"owned", "replicated"}))
+      ->capture_default_str();
 }
 
 /// Where the frame loop writes: the .afsim file, the .vtu series, the checkpoint and its
@@ -795,9 +801,10 @@ int runLocal(int argc, char** argv, const CommandLine& options, const asyncfem::
 #if ASYNCFEM_OFFLINE_WITH_PETSC
 // --backend petsc with the "async" integrator: every rank builds the scene's simulation and
 // steps the asynchronous integrator on the replicated state; L's system H^{LL*} is solved
-// distributed (makePetscLargeSystemSolver). Rank 0 writes the frames, checkpoints and the
-// summary. The ranks agree once per frame on a stop signal and on rank 0's output failing,
-// so none is left waiting in a collective call.
+// distributed (makePetscLargeSystemSolver), and each fast region is computed by one rank
+// (makePetscRegionDistribution; --petsc-regions replicated: by every rank). Rank 0 writes the frames, checkpoints and
+// the summary. The ranks agree once per frame on a stop signal and on rank 0's output failing, so none is left waiting
+// in a collective call.
 asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options,
                                                 std::shared_ptr<asyncfem::PetscSolveCounts> totals) {
   asyncfem::PetscSolverSettings solver;
@@ -805,8 +812,9 @@ asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options,
   // The L solve is one part of a step whose other parts are exact to round-off.
   solver.relativeTolerance = 1e-10;
   asyncfem::IntegratorRegistry registry = asyncfem::defaultIntegratorRegistry();
+  const bool owned = options.petscRegions == "owned";
   asyncfem::registerMultirateIntegrators(
-      registry, [solver, totals](asyncfem::AsyncSettings& settings, const asyncfem::IntegratorContext& context) {
+      registry, [solver, totals, owned](asyncfem::AsyncSettings& settings, const asyncfem::IntegratorContext& context) {
         if (settings.nested) {
           throw asyncfem::ValidationError(
               "--backend petsc: touching or nested regions (NestedAsyncBackwardEuler) are not available on the PETSc "
@@ -819,8 +827,28 @@ asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options,
               "method only");
         }
         settings.solver.largeSystemSolver = asyncfem::makePetscLargeSystemSolver(*context.mesh, solver, totals);
+        if (owned) {
+          asyncfem::PetscRegionDistribution distribution = asyncfem::makePetscRegionDistribution(*context.mesh, totals);
+          settings.solver.regionDistribution.ownedRegions = std::move(distribution.ownedRegions);
+          settings.solver.regionDistribution.sum = std::move(distribution.sum);
+        }
       });
   return registry;
+}
+
+// Rank 0's summary lines of the distributed work: L's solves and rows, the regions.
+void printPetscAsyncSummary(int ranks, const CommandLine& options, const asyncfem::PetscSolveCounts& totals) {
+  std::printf(
+      "  PETSc       %d ranks solve L's system (KSP %s): %lld solves, %lld iterations; rank 0 owns %d rows "
+      "(%lld entries in other ranks' columns); region interfaces on one rank: %d, split: %d\n",
+      ranks, options.petscSolver.c_str(), totals.solves, totals.iterations, totals.ownedRows, totals.offRankEntries,
+      totals.regionsOnOneRank, totals.regionsSplit);
+  if (options.petscRegions == "owned") {
+    std::printf("  PETSc       fast regions owned by one rank each: rank 0 computes %d of %d\n", totals.regionsComputed,
+                totals.regions);
+  } else {
+    std::printf("  PETSc       fast regions replicated: every rank computes every region\n");
+  }
 }
 
 // Rank 0 opens (or continues) the output; on --resume the other ranks restore the
@@ -927,11 +955,7 @@ int runPetscAsync(int argc, char** argv, const CommandLine& options, const async
   if (root && !options.quiet) {
     record.outputBytes = static_cast<std::int64_t>(fs::file_size(scene.output.file));
     printSummary(scene, simulation, record);
-    std::printf(
-        "  PETSc       %d ranks solve L's system (KSP %s): %lld solves, %lld iterations; rank 0 owns %d rows "
-        "(%lld entries in other ranks' columns); region interfaces on one rank: %d, split: %d\n",
-        runtime.size(), options.petscSolver.c_str(), totals->solves, totals->iterations, totals->ownedRows,
-        totals->offRankEntries, totals->regionsOnOneRank, totals->regionsSplit);
+    printPetscAsyncSummary(runtime.size(), options, *totals);
   }
   return 0;
 }

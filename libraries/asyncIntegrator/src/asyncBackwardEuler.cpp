@@ -61,6 +61,7 @@ struct AsyncBackwardEuler::Impl {
   // Per-step buffers (full 3n, or |L|).
   Eigen::VectorXd stiffVelocity, massVelocity, stateForce, predicted, newU, newV, work;
   Eigen::VectorXd rhsL, rhsSchur, Y;
+  std::vector<double> interfaceSum;  // regionDistribution: the owners' interface rows, summed
   const Eigen::VectorXd* externalL = nullptr;
   // External forces at the distinct times of one large step (shared by regions whose
   // substeps fall on the same times), valid for one step.
@@ -129,7 +130,7 @@ QuickCosts quickCosts(const std::vector<FastRegion>& regions, const SparseMatrix
     const FastRegion& rb = regions[i];
     // A forward substitution: m_i solves with A^S and m_i products with G; Z is |I_i| of
     // them, in blocks of columns.
-    const double substitution = rb.ratio * (rb.solver->stats().solveFlopsPerRhs + 2.0 * double(rb.G.nonZeros()));
+    const double substitution = rb.substitutionFlops;
     costs.iteration += substitution + rb.ratio * kSolveCallFlops;
     costs.rebuild +=
         kBlockedFlopWeight * substitution * static_cast<double>(partition.interfaceDofs(static_cast<int>(i)).size());
@@ -173,6 +174,16 @@ AsyncBackwardEuler::AsyncBackwardEuler(DynamicSystem system, double largeTimeste
     throw ValidationError(
         "async integrator: an external solver of L's system (largeSystemSolver) needs the stable coupling and the "
         "structured method (it is given the symmetric H^{LL*})");
+  }
+  const AsyncOptions::RegionDistribution& distribution = options_.regionDistribution;
+  if (static_cast<bool>(distribution.ownedRegions) != static_cast<bool>(distribution.sum)) {
+    throw ValidationError("async integrator: regionDistribution needs both ownedRegions and sum");
+  }
+  if (distributed() &&
+      (options_.coupling != AsyncCoupling::stable || options_.method != AsyncSolveMethod::structured)) {
+    throw ValidationError(
+        "async integrator: regions owned by one process (regionDistribution) need the stable coupling and the "
+        "structured method");
   }
   const Impl& d = *impl_;
   if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
@@ -314,6 +325,7 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
     runStats_.fastDofs += static_cast<int>(partition_.regionDofs(i).size());
     runStats_.interfaceDofs += static_cast<int>(partition_.interfaceDofs(i).size());
   }
+  if (distributed()) assignRegionOwners();
   if (options_.coupling == AsyncCoupling::stable) {
     d.perElementTangent = detail::findInterfaceElements(*system_.mesh, partition_, system_, d.regions);
   }
@@ -357,8 +369,9 @@ void AsyncBackwardEuler::refactor() {
   // Structured: factor every A^S; Z = (H^{SS})^{-1} H^{SI}, the corrections C_i = H^{IS} Z
   // and H^{LL*} unless the lagged factor is kept this step.
   Stopwatch factor;
-  for (FastRegion& rb : d.regions) rb.factorize(stats_);
+  runOwnedTasks(1, [&](int i) { d.regions[static_cast<std::size_t>(i)].factorize(stats_); });
   stats_.factorizationSeconds += factor.stop();
+  priceSubstitutions();
   if (d.schurLagging) return;
   if (d.quick) {
     borrowWholeFactor();
@@ -412,7 +425,13 @@ void AsyncBackwardEuler::fullSchurRebuild() {
   Impl& d = *impl_;
   const bool setUpBuild = d.settingUp;
   Stopwatch factor;
-  const detail::CorrectionRun run = detail::computeCorrections(d.regions, options_, system_.damped());
+  detail::CorrectionRun run;
+  try {
+    run = detail::computeCorrections(d.regions, options_, system_.damped());
+  } catch (...) {
+    if (!distributed()) throw;
+    holdFailure(-1);
+  }
   stats_.factorizations += run.helperFactorizations;
   runStats_.zThreads = run.threads;
   runStats_.zColumns = run.columns;
@@ -420,6 +439,7 @@ void AsyncBackwardEuler::fullSchurRebuild() {
   zColumnSeconds_ += zSeconds;
   stats_.factorizationSeconds += zSeconds;
   (setUpBuild ? runStats_.setupZSeconds : runStats_.rebuildZSeconds) += zSeconds;
+  if (distributed()) shareCorrections();
   schurAsymmetry_ = 0.0;
   for (const FastRegion& rb : d.regions) {
     const double norm = rb.correction.norm();
@@ -450,7 +470,7 @@ void AsyncBackwardEuler::priceLaggedFactor() {
   d.laggedRebuildFlops = schur != nullptr ? kBlockedFlopWeight * schur->stats().factorFlops : 0.0;
   for (std::size_t i = 0; i < d.regions.size(); ++i) {
     const FastRegion& rb = d.regions[i];
-    const double substitution = rb.ratio * (rb.solver->stats().solveFlopsPerRhs + 2.0 * double(rb.G.nonZeros()));
+    const double substitution = rb.substitutionFlops;
     d.laggedIterationFlops += substitution + rb.ratio * kSolveCallFlops;
     d.laggedRebuildFlops +=
         kBlockedFlopWeight * substitution * static_cast<double>(partition_.interfaceDofs(static_cast<int>(i)).size());
@@ -667,17 +687,13 @@ void AsyncBackwardEuler::solveStructured() {
   const bool damped = system_.damped();
   const int numRegions = partition_.numRegions();
   const int threads = detail::threadBudget(options_.threads);
-  detail::parallelTasks(numRegions, threads, [&](int i) {
+  runOwnedTasks(threads, [&](int i) {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     rb.forwardSubstitute(rb.rhs, rb.y);
     if (rb.Mis.rows() > 0) rb.interfaceRowOf(rb.y, damped);
   });
   d.rhsSchur = d.rhsL;
-  for (int i = 0; i < numRegions; ++i) {
-    const FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
-    const std::vector<int>& pos = partition_.interfacePositions(i);
-    for (std::size_t k = 0; k < pos.size(); ++k) d.rhsSchur[pos[k]] -= rb.interfaceRow[static_cast<Eigen::Index>(k)];
-  }
+  subtractOwnedInterfaceRows(d.rhsSchur);
   const auto apply = [this](const Eigen::VectorXd& y, Eigen::VectorXd& out) { applySchur(y, out); };
   if (partition_.largeDofs().empty()) {
     d.Y.resize(0);
@@ -705,7 +721,8 @@ void AsyncBackwardEuler::solveStructured() {
       d.schur.solve(d.rhsSchur, d.Y);
     }
   }
-  detail::parallelTasks(numRegions, threads, [&](int i) { recoverRegion(i); });
+  runOwnedTasks(threads, [&](int i) { recoverRegion(i); });
+  if (distributed()) shareRecoveries();
 }
 
 // Quick set-up (Eqs. Q1-Q3): deflated conjugate gradients on H^{LL*}, preconditioned by the
@@ -795,7 +812,7 @@ void AsyncBackwardEuler::assembleNewState(double t0, double t1) {
       d.newV[s[k]] = v0[s[k]] + rb.xLast[row];
       d.newU[s[k]] = u0[s[k]] + rb.smallStep * (m * v0[s[k]] + rb.xSum[row]);
     }
-    if (!observer_) continue;
+    if (!observer_ || !rb.owned) continue;
     // Substep states, only for an installed observer (x then holds every substep).
     const Eigen::VectorXd vS0 = detail::gather(v0, s), uS0 = detail::gather(u0, s);
     Eigen::VectorXd running = Eigen::VectorXd::Zero(rb.x.rows());
@@ -835,7 +852,7 @@ void AsyncBackwardEuler::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& o
   out.resize(y.size());
   out.noalias() = d.largeSystem * y;
   const int numRegions = partition_.numRegions();
-  detail::parallelTasks(numRegions, detail::threadBudget(options_.threads), [&](int i) {
+  runOwnedTasks(detail::threadBudget(options_.threads), [&](int i) {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& pos = partition_.interfacePositions(i);
     if (pos.empty()) return;
@@ -850,10 +867,174 @@ void AsyncBackwardEuler::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& o
     rb.forwardSubstitute(rb.probe, rb.probeSolution);
     rb.interfaceRowOf(rb.probeSolution, damped);
   });
+  subtractOwnedInterfaceRows(out);
+}
+
+// Regions owned by one process (AsyncOptions::regionDistribution). Every process steps the
+// same state and cuts every region's blocks (Â^L and the right-hand sides need them); only
+// a region's owner factors A^S, computes Z and C_i, substitutes and recovers. The sums
+// over processes below hand the others what they need, at the same points on every
+// process, so all of them hold the same H^{LL*}, Y and new state and take the same
+// decisions (lagged factor, rent or buy). A failure in a process's region work is held
+// until the next sum, which carries it to every process, so all stop at the same point.
+
+// task(i) for every region this process owns (all of them when not distributed).
+void AsyncBackwardEuler::runOwnedTasks(int threads, const std::function<void(int)>& task) {
+  Impl& d = *impl_;
+  if (!distributed()) {
+    detail::parallelTasks(partition_.numRegions(), threads, task);
+    return;
+  }
+  std::vector<std::exception_ptr> failures(d.regions.size());
+  detail::parallelTasks(partition_.numRegions(), threads, [&](int i) {
+    if (!d.regions[static_cast<std::size_t>(i)].owned) return;
+    try {
+      task(i);
+    } catch (...) {
+      failures[static_cast<std::size_t>(i)] = std::current_exception();
+    }
+  });
+  for (std::size_t i = 0; i < failures.size(); ++i) {
+    if (failures[i] && !heldFailure_) {
+      heldFailure_ = failures[i];
+      heldFailureRegion_ = static_cast<int>(i);
+    }
+  }
+}
+
+// Inside a catch block: holds the exception in flight (region: -1 when not known).
+void AsyncBackwardEuler::holdFailure(int region) {
+  if (heldFailure_) return;
+  heldFailure_ = std::current_exception();
+  heldFailureRegion_ = region;
+}
+
+// values summed over the processes, with two more entries that count the processes
+// holding a failure and add up their failing regions (+1): every process then throws,
+// the failing one its own exception, the others an Error naming the region.
+void AsyncBackwardEuler::sumOverProcesses(std::vector<double>& values) {
+  values.push_back(heldFailure_ ? 1.0 : 0.0);
+  values.push_back(heldFailure_ ? heldFailureRegion_ + 1.0 : 0.0);
+  options_.regionDistribution.sum(values.data(), values.size());
+  const double failed = values[values.size() - 2], region = values.back() - 1.0;
+  values.resize(values.size() - 2);
+  if (failed == 0.0) return;
+  if (heldFailure_) {
+    const std::exception_ptr failure = heldFailure_;
+    heldFailure_ = nullptr;
+    std::rethrow_exception(failure);
+  }
+  std::string which = "a fast region";
+  if (failed == 1.0 && region >= 0.0 && region < partition_.numRegions()) {
+    const int i = static_cast<int>(region);
+    which = "fast region " + std::to_string(i) + " (" + partition_.region(i).name + ")";
+  }
+  throw Error("async integrator: " + which +
+              ", computed by another process, failed in this step (that process reports why); every process stops "
+              "here");
+}
+
+void AsyncBackwardEuler::assignRegionOwners() {
+  Impl& d = *impl_;
+  const int numRegions = partition_.numRegions();
+  std::vector<std::vector<int>> regionDofs, interfaceDofs;
   for (int i = 0; i < numRegions; ++i) {
-    const std::vector<int>& pos = partition_.interfacePositions(i);
+    regionDofs.push_back(partition_.regionDofs(i));
+    interfaceDofs.push_back(partition_.interfaceDofs(i));
+  }
+  const std::vector<char> owned = options_.regionDistribution.ownedRegions(regionDofs, interfaceDofs);
+  if (owned.size() != static_cast<std::size_t>(numRegions)) {
+    throw ValidationError("async integrator: regionDistribution.ownedRegions answered for " +
+                          std::to_string(owned.size()) + " regions, the partition has " + std::to_string(numRegions));
+  }
+  std::vector<double> owners(owned.begin(), owned.end());
+  sumOverProcesses(owners);
+  for (int i = 0; i < numRegions; ++i) {
+    const double count = owners[static_cast<std::size_t>(i)];
+    if (count != 1.0) {
+      throw ValidationError("async integrator: region " + std::to_string(i) + " (" + partition_.region(i).name +
+                            ") has " + std::to_string(static_cast<int>(count)) +
+                            " owners over the processes (regionDistribution.ownedRegions must give it exactly one)");
+    }
+    d.regions[static_cast<std::size_t>(i)].owned = owned[static_cast<std::size_t>(i)] != 0;
+  }
+}
+
+// Each region's substitution flops, from its owner's factor (the rent-or-buy prices).
+void AsyncBackwardEuler::priceSubstitutions() {
+  Impl& d = *impl_;
+  std::vector<double> flops(d.regions.size(), 0.0);
+  for (std::size_t i = 0; i < d.regions.size(); ++i) {
+    const FastRegion& rb = d.regions[i];
+    if (rb.owned) flops[i] = rb.ratio * (rb.solver->stats().solveFlopsPerRhs + 2.0 * double(rb.G.nonZeros()));
+  }
+  if (distributed()) sumOverProcesses(flops);
+  for (std::size_t i = 0; i < d.regions.size(); ++i) d.regions[i].substitutionFlops = flops[i];
+}
+
+// Every C_i from its owner (the others hold zeros).
+void AsyncBackwardEuler::shareCorrections() {
+  Impl& d = *impl_;
+  std::vector<double> all;
+  for (const FastRegion& rb : d.regions)
+    all.insert(all.end(), rb.correction.data(), rb.correction.data() + rb.correction.size());
+  sumOverProcesses(all);
+  std::size_t at = 0;
+  for (FastRegion& rb : d.regions) {
+    std::copy_n(all.data() + at, rb.correction.size(), rb.correction.data());
+    at += static_cast<std::size_t>(rb.correction.size());
+  }
+}
+
+// target -= the interface rows of every region's last substitution (interfaceRow) at its
+// interface positions; distributed, from the owners' rows summed over the processes.
+void AsyncBackwardEuler::subtractOwnedInterfaceRows(Eigen::VectorXd& target) {
+  Impl& d = *impl_;
+  const int numRegions = partition_.numRegions();
+  if (!distributed()) {
+    for (int i = 0; i < numRegions; ++i) {
+      const FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
+      const std::vector<int>& pos = partition_.interfacePositions(i);
+      for (std::size_t k = 0; k < pos.size(); ++k) target[pos[k]] -= rb.interfaceRow[static_cast<Eigen::Index>(k)];
+    }
+    return;
+  }
+  d.interfaceSum.assign(static_cast<std::size_t>(target.size()), 0.0);
+  for (int i = 0; i < numRegions; ++i) {
     const FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
-    for (std::size_t k = 0; k < pos.size(); ++k) out[pos[k]] -= rb.interfaceRow[static_cast<Eigen::Index>(k)];
+    if (!rb.owned) continue;
+    const std::vector<int>& pos = partition_.interfacePositions(i);
+    for (std::size_t k = 0; k < pos.size(); ++k)
+      d.interfaceSum[static_cast<std::size_t>(pos[k])] += rb.interfaceRow[static_cast<Eigen::Index>(k)];
+  }
+  sumOverProcesses(d.interfaceSum);
+  target -= Eigen::Map<const Eigen::VectorXd>(d.interfaceSum.data(), target.size());
+}
+
+// X_m and sum_r X_r of every region from its owner, for the new state.
+void AsyncBackwardEuler::shareRecoveries() {
+  Impl& d = *impl_;
+  std::vector<double> all;
+  for (FastRegion& rb : d.regions) {
+    const auto sizeS = static_cast<Eigen::Index>(rb.systemMatrix.rows());
+    if (!rb.owned) {
+      rb.xLast.setZero(sizeS);
+      rb.xSum.setZero(sizeS);
+    } else if (rb.substituted) {
+      rb.xLast = rb.x.col(rb.ratio - 1);
+      rb.xSum = rb.x.rowwise().sum();
+    }
+    all.insert(all.end(), rb.xLast.data(), rb.xLast.data() + sizeS);
+    all.insert(all.end(), rb.xSum.data(), rb.xSum.data() + sizeS);
+  }
+  sumOverProcesses(all);
+  std::size_t at = 0;
+  for (FastRegion& rb : d.regions) {
+    const auto sizeS = static_cast<std::size_t>(rb.systemMatrix.rows());
+    std::copy_n(all.data() + at, sizeS, rb.xLast.data());
+    std::copy_n(all.data() + at + sizeS, sizeS, rb.xSum.data());
+    at += 2 * sizeS;
+    if (!rb.owned) rb.substituted = false;
   }
 }
 
@@ -868,6 +1049,7 @@ double AsyncBackwardEuler::solveFloorSeconds(int repeats) {
       d.naive.solveRandom();
     } else {
       for (FastRegion& rb : d.regions) {
+        if (!rb.owned) continue;
         const bool dense = rb.useDenseZ || rb.Msi.cols() == 0;
         const int solves = dense ? rb.ratio : 2 * rb.ratio;
         const Eigen::VectorXd rhs = Eigen::VectorXd::Random(rb.systemMatrix.rows());

@@ -402,6 +402,95 @@ VertexOwners assignVertexOwners(const TetMesh& mesh, const std::vector<int>& ele
   return result;
 }
 
+std::vector<int> regionOwners(const TetMesh& mesh, const std::vector<int>& elementParts, int ranks,
+                              const std::vector<std::vector<int>>& regionVertices,
+                              const std::vector<std::vector<int>>& interfaceVertices, int maxGroupVertices) {
+  const std::vector<int> byPart = assignVertexOwners(mesh, elementParts, ranks, {}, 0).owner;
+  const std::vector<int> kept =
+      assignVertexOwners(mesh, elementParts, ranks, interfaceVertices, maxGroupVertices).owner;
+  std::vector<int> owners(regionVertices.size(), 0);
+  std::vector<int> votes(static_cast<std::size_t>(ranks));
+  for (std::size_t i = 0; i < regionVertices.size(); ++i) {
+    const std::vector<int> none;
+    const std::vector<int>& ring = i < interfaceVertices.size() ? interfaceVertices[i] : none;
+    const bool oneRank = !ring.empty() && std::all_of(ring.begin(), ring.end(), [&](int v) {
+      return kept[static_cast<std::size_t>(v)] == kept[static_cast<std::size_t>(ring.front())];
+    });
+    if (oneRank) {
+      owners[i] = kept[static_cast<std::size_t>(ring.front())];
+      continue;
+    }
+    std::fill(votes.begin(), votes.end(), 0);
+    for (const int v : regionVertices[i]) {
+      if (v < 0 || v >= mesh.numVertices()) {
+        throw Error("regionOwners: vertex " + std::to_string(v) + " of region " + std::to_string(i) +
+                    " is not a vertex of the mesh");
+      }
+      ++votes[static_cast<std::size_t>(byPart[static_cast<std::size_t>(v)])];
+    }
+    owners[i] = static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+  }
+  return owners;
+}
+
+namespace {
+
+/// METIS's element partition of mesh into the ranks of PETSC_COMM_WORLD, computed on rank
+/// 0 and broadcast (all zeros on one rank). Collective.
+std::vector<int> elementPartsOnEveryRank(const TetMesh& mesh, int rank, int ranks) {
+  std::vector<int> parts(static_cast<std::size_t>(mesh.numElements()), 0);
+  detail::collectively(PETSC_COMM_WORLD, [&] {
+    if (rank == 0 && ranks > 1) parts = partitionElements(mesh, ranks);
+  });
+  if (!parts.empty()) MPI_Bcast(parts.data(), static_cast<int>(parts.size()), MPI_INT, 0, PETSC_COMM_WORLD);
+  return parts;
+}
+
+/// Vertex ids of DOF lists (3 v + c), each list's vertices once, ascending.
+std::vector<std::vector<int>> verticesOf(const std::vector<std::vector<int>>& dofLists) {
+  std::vector<std::vector<int>> vertices(dofLists.size());
+  for (std::size_t i = 0; i < dofLists.size(); ++i) {
+    for (const int dof : dofLists[i]) vertices[i].push_back(dof / 3);
+    std::sort(vertices[i].begin(), vertices[i].end());
+    vertices[i].erase(std::unique(vertices[i].begin(), vertices[i].end()), vertices[i].end());
+  }
+  return vertices;
+}
+
+/// A group of vertices kept on one rank may hold at most one rank's share of the mesh's.
+int groupLimit(const TetMesh& mesh, int ranks) { return std::max(1, mesh.numVertices() / std::max(ranks, 1)); }
+
+}  // namespace
+
+PetscRegionDistribution makePetscRegionDistribution(const TetMesh& mesh, std::shared_ptr<PetscSolveCounts> totals) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
+  auto parts = std::make_shared<const std::vector<int>>(elementPartsOnEveryRank(mesh, rank, ranks));
+  auto meshShared = std::make_shared<const TetMesh>(mesh);
+  PetscRegionDistribution distribution;
+  distribution.ownedRegions = [parts, meshShared, rank, ranks, totals](
+                                  const std::vector<std::vector<int>>& regionDofs,
+                                  const std::vector<std::vector<int>>& interfaceDofs) {
+    const std::vector<int> owners = regionOwners(*meshShared, *parts, ranks, verticesOf(regionDofs),
+                                                 verticesOf(interfaceDofs), groupLimit(*meshShared, ranks));
+    std::vector<char> owned(owners.size());
+    for (std::size_t i = 0; i < owners.size(); ++i) owned[i] = owners[i] == rank ? 1 : 0;
+    if (totals) {
+      totals->regionsComputed = static_cast<int>(std::count(owned.begin(), owned.end(), 1));
+      totals->regions = static_cast<int>(owned.size());
+    }
+    return owned;
+  };
+  distribution.sum = [](double* values, std::size_t count) {
+    if (count == 0) return;
+    const int status =
+        MPI_Allreduce(MPI_IN_PLACE, values, static_cast<int>(count), MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+    if (status != MPI_SUCCESS) throw Error("async integrator over MPI: MPI_Allreduce failed");
+  };
+  return distribution;
+}
+
 std::function<std::unique_ptr<SparseSolver>(const std::vector<int>& largeDofs,
                                             const std::vector<std::vector<int>>& interfaceDofs)>
 makePetscLargeSystemSolver(const TetMesh& mesh, const PetscSolverSettings& settings,
@@ -410,11 +499,7 @@ makePetscLargeSystemSolver(const TetMesh& mesh, const PetscSolverSettings& setti
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
   int ranks = 1;
   MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
-  std::vector<int> parts(static_cast<std::size_t>(mesh.numElements()), 0);
-  detail::collectively(PETSC_COMM_WORLD, [&] {
-    if (rank == 0 && ranks > 1) parts = partitionElements(mesh, ranks);
-  });
-  if (!parts.empty()) MPI_Bcast(parts.data(), static_cast<int>(parts.size()), MPI_INT, 0, PETSC_COMM_WORLD);
+  std::vector<int> parts = elementPartsOnEveryRank(mesh, rank, ranks);
   auto coordinates = std::make_shared<Eigen::Matrix3Xd>(mesh.restPositions());
   auto meshShared = std::make_shared<TetMesh>(mesh);
   return [settings, parts = std::move(parts), meshShared, coordinates, totals, ranks](
@@ -422,13 +507,8 @@ makePetscLargeSystemSolver(const TetMesh& mesh, const PetscSolverSettings& setti
              const std::vector<std::vector<int>>& interfaceDofs) -> std::unique_ptr<SparseSolver> {
     std::vector<int> rowVertex(largeDofs.size());
     for (std::size_t k = 0; k < largeDofs.size(); ++k) rowVertex[k] = largeDofs[k] / 3;
-    std::vector<std::vector<int>> groups(interfaceDofs.size());
-    for (std::size_t i = 0; i < interfaceDofs.size(); ++i) {
-      for (const int dof : interfaceDofs[i]) groups[i].push_back(dof / 3);
-    }
-    // A group may take at most one rank's share of L's vertices.
-    const int share = static_cast<int>(largeDofs.size() / 3 / static_cast<std::size_t>(ranks));
-    VertexOwners owners = assignVertexOwners(*meshShared, parts, ranks, groups, std::max(share, 1));
+    VertexOwners owners =
+        assignVertexOwners(*meshShared, parts, ranks, verticesOf(interfaceDofs), groupLimit(*meshShared, ranks));
     if (totals) {
       totals->regionsOnOneRank = owners.groupsKept;
       totals->regionsSplit = owners.groupsSplit;

@@ -244,11 +244,12 @@ CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOp
     FastRegion& rb = regions[i];
     const Eigen::Index q = rb.Msi.cols();
     const Eigen::Index sizeS = rb.systemMatrix.rows();
-    rb.useDenseZ = chooseDenseZ(rb, options.recovery);
+    rb.useDenseZ = rb.owned && chooseDenseZ(rb, options.recovery);
     rb.correction.resize(q, q);
     rb.zLast.resize(rb.useDenseZ ? sizeS : 0, rb.useDenseZ ? q : 0);
     rb.zSum.resize(rb.useDenseZ ? sizeS : 0, rb.useDenseZ ? q : 0);
-    if (q == 0) continue;
+    if (!rb.owned) rb.correction.setZero();  // the owner's C_i arrives by the sum over processes
+    if (q == 0 || !rb.owned) continue;
     run.columns += static_cast<long long>(rb.ratio) * q;
     const int blocks =
         static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(threads, q / kMinZColumnsPerThread)));

@@ -74,6 +74,12 @@ class FastRegion {
 
   int ratio = 1;
   double smallStep = 0.0;  // hS
+  // AsyncOptions::regionDistribution: whether this process computes the region (its
+  // factor, Z, C_i, substitutions, recovery); the blocks are cut on every process.
+  bool owned = true;
+  // Flops of one forward substitution (m solves with A^S and m products with G), from the
+  // owner's factor: what the rent-or-buy rules price.
+  double substitutionFlops = 0.0;
   SubmatrixExtractor massSS, massSI, massIS, stiffSS, stiffSI, stiffIS;
   SparseMatrix Mss, Kss, Dss, Msi, Ksi, Dsi, Mis, Kis, Dis;
   bool cut = false;           // K blocks extracted once; later only their values are updated
@@ -133,6 +139,7 @@ struct CorrectionRun {
 /// Z and the Schur corrections of every region (recovery mode chosen per region). The
 /// columns of Z are independent: each region's are split into blocks, one per thread, each
 /// solved with its own copy of the A^S factor, since one solver object is not thread-safe.
+/// Regions this process does not own get C_i = 0 (their owner's is summed in later).
 CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOptions& options, bool damped);
 
 }  // namespace asyncfem::detail

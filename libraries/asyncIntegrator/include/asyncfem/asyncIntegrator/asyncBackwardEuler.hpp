@@ -9,6 +9,7 @@
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -123,7 +124,21 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   void recoverRegion(int region);
   void assembleNewState(double t0, double t1);
   void countSolves();
+  // AsyncOptions::regionDistribution (asyncBackwardEuler.cpp, "Regions owned by one process").
+  bool distributed() const { return static_cast<bool>(options_.regionDistribution.sum); }
+  void assignRegionOwners();
+  void priceSubstitutions();
+  void shareCorrections();
+  void subtractOwnedInterfaceRows(Eigen::VectorXd& target);
+  void shareRecoveries();
+  void runOwnedTasks(int threads, const std::function<void(int)>& task);
+  void holdFailure(int region);
+  void sumOverProcesses(std::vector<double>& values);
   AsyncOptions options_;
+  // Distributed: the first failure of this process's region work, held until the next sum
+  // over the processes, where every process learns of it and all stop (none waits).
+  std::exception_ptr heldFailure_;
+  int heldFailureRegion_ = -1;
   SubstepObserver observer_;
   double schurAsymmetry_ = 0.0;
   double zColumnSeconds_ = 0.0;

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -120,6 +121,27 @@ struct AsyncOptions {
   using LargeSystemSolverFactory = std::function<std::unique_ptr<SparseSolver>(
       const std::vector<int>& largeDofs, const std::vector<std::vector<int>>& interfaceDofs)>;
   LargeSystemSolverFactory largeSystemSolver{};
+
+  /// A run on several processes that step the same integrator on the same state (MPI
+  /// ranks): each fast region is computed by one process only, its owner (the factor of
+  /// A^S, Z and C_i, the forward substitutions and the recovery of its substeps), and
+  /// what the others need of it is summed over the processes: the corrections C_i (for
+  /// H^{LL*}), each substitution's interface rows, the region's end-of-step velocities and
+  /// the priced cost of its solves. Stable coupling and structured method only; a substep
+  /// observer sees only this process's regions. Both members empty (the default): this
+  /// process computes every region.
+  struct RegionDistribution {
+    /// At each set-up, with every region's free DOFs and interface DOFs (global ids): 1
+    /// for each region this process computes. Every region needs exactly one owner (checked
+    /// with sum; otherwise a ValidationError naming the region, on every process).
+    std::function<std::vector<char>(const std::vector<std::vector<int>>& regionDofs,
+                                    const std::vector<std::vector<int>>& interfaceDofs)>
+        ownedRegions;
+    /// values[0, count) replaced by their sum over the processes. Collective: every process
+    /// calls it at the same point with the same count, and all receive the same sums.
+    std::function<void(double* values, std::size_t count)> sum;
+  };
+  RegionDistribution regionDistribution{};
 };
 
 /// Where an asynchronous run's time went, set-up apart from the steady-state steps (the

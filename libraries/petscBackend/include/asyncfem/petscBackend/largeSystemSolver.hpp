@@ -4,6 +4,7 @@
 #include <asyncfem/petscBackend/solverSettings.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -21,8 +22,10 @@ struct PetscSolveCounts {
   long long offRankEntries = 0;
   /// makePetscLargeSystemSolver, the last set-up: region interfaces (merged where they
   /// share a vertex) whose rows one rank owns, and those left split (more vertices than one
-  /// rank's share of L's).
+  /// rank's share of the mesh's).
   int regionsOnOneRank = 0, regionsSplit = 0;
+  /// makePetscRegionDistribution, the last set-up: the regions this rank computes, of all.
+  int regionsComputed = 0, regions = 0;
 };
 
 /// Owners of a mesh's vertices for ranks ranks, from an element partition (one part per
@@ -37,6 +40,29 @@ struct VertexOwners {
 };
 VertexOwners assignVertexOwners(const TetMesh& mesh, const std::vector<int>& elementParts, int ranks,
                                 const std::vector<std::vector<int>>& keepTogether, int maxGroupVertices);
+
+/// The rank that computes each fast region (vertex ids of its free vertices and of its
+/// interface, one list each per region): the rank assignVertexOwners() gives its interface
+/// when that lies on one rank, so a region and its rows of L's system share a rank;
+/// otherwise (a split interface, or none) the rank owning most of its own vertices by the
+/// lowest-part rule (ties: the lowest).
+std::vector<int> regionOwners(const TetMesh& mesh, const std::vector<int>& elementParts, int ranks,
+                              const std::vector<std::vector<int>>& regionVertices,
+                              const std::vector<std::vector<int>>& interfaceVertices, int maxGroupVertices);
+
+/// The members of AsyncOptions::RegionDistribution for a run on MPI_COMM_WORLD (assign them
+/// to options.regionDistribution.ownedRegions and .sum): each region is computed by the
+/// rank regionOwners() names, from the same METIS partition and size limit that
+/// makePetscLargeSystemSolver() uses, so it owns the region's interface rows too; the sum
+/// is MPI_Allreduce. Collective (rank 0 partitions); needs a live PetscRuntime. totals, when
+/// given, gets regionsComputed and regions at each set-up.
+struct PetscRegionDistribution {
+  std::function<std::vector<char>(const std::vector<std::vector<int>>& regionDofs,
+                                  const std::vector<std::vector<int>>& interfaceDofs)>
+      ownedRegions;
+  std::function<void(double* values, std::size_t count)> sum;
+};
+PetscRegionDistribution makePetscRegionDistribution(const TetMesh& mesh, std::shared_ptr<PetscSolveCounts> totals = {});
 
 /// A SparseSolver whose matrix and right-hand sides are the same on every rank of
 /// MPI_COMM_WORLD (replicated), and whose solve is distributed: each rank inserts the rows
@@ -74,7 +100,7 @@ const PetscSolveCounts* petscSolveCounts(const SparseSolver& solver);
 /// (partitionElements(), computed on rank 0 and broadcast; a vertex belongs to the lowest
 /// rank among its elements'), so each rank's rows are a compact piece of the mesh; at each
 /// set-up every region's interface vertices are then kept on one rank
-/// (assignVertexOwners(), groups up to one rank's share of L's vertices), so the dense
+/// (assignVertexOwners(), groups up to one rank's share of the mesh's vertices), so the dense
 /// block C_i of each region lies in one rank's diagonal block. GAMG gets the rigid-body
 /// modes. Collective; needs a live PetscRuntime, which must outlive
 /// every solver made.
