@@ -7,6 +7,7 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <asyncfem/hyperelasticFEM/isotropicHyperelasticFEM.hpp>
+#include <asyncfem/hyperelasticFEM/stvkFEM.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <cstdio>
 #include <random>
@@ -147,20 +148,25 @@ TEST(HyperelasticBatchedKernel, BatchesWithAnElementBelowTheThresholdGoOneAtATim
   }
 }
 
-TEST(HyperelasticBatchedKernel, BatchesMixingMaterialsGoOneAtATime) {
-  // Two materials alternating every seven elements: some batches hold both, most one.
-  const TetMesh box = test::smallBox(10);
+/// box's elements alternating every seven between its material and a ten times stiffer
+/// copy ("stiff", Poisson ratio 0.3): some batches of four hold both, most one.
+TetMesh alternatingMaterials(const TetMesh& box) {
   std::vector<Material> materials = box.materials();
   Material stiff = materials.front();
   stiff.name = "stiff";
   stiff.youngsModulus *= 10.0;
+  stiff.poissonRatio = 0.3;
   stiff.mooneyRivlin->mu01 *= 10.0;
   stiff.mooneyRivlin->mu10 *= 10.0;
   stiff.mooneyRivlin->v1 *= 10.0;
   materials.push_back(stiff);
   std::vector<int> elementMaterials(static_cast<std::size_t>(box.numElements()));
   for (int e = 0; e < box.numElements(); ++e) elementMaterials[static_cast<std::size_t>(e)] = (e / 7) % 2;
-  const TetMesh mesh(box.restPositions(), box.elements(), materials, elementMaterials);
+  return TetMesh(box.restPositions(), box.elements(), materials, elementMaterials);
+}
+
+TEST(HyperelasticBatchedKernel, BatchesMixingMaterialsGoOneAtATime) {
+  const TetMesh mesh = alternatingMaterials(test::smallBox(10));
   std::mt19937 random(47);
   const Eigen::VectorXd u = test::deformedDisplacement(mesh, test::randomRotation(random), 0.02, random);
   for (const ModelCase& c : invariantCases()) {
@@ -172,6 +178,43 @@ TEST(HyperelasticBatchedKernel, BatchesMixingMaterialsGoOneAtATime) {
     for (int start = 0; start < mesh.numElements(); start += chunk)
       fullBatches += (std::min(mesh.numElements(), start + chunk) - start) / 4;
     EXPECT_LT(batched, 4 * fullBatches) << c.label;
+  }
+}
+
+// StVK in the Green-strain form (StVKFEM) batches every full batch of four of a chunk,
+// whatever the materials (its Lame parameters are per element): on random deformations of
+// about 10% and 30% strain, and with two materials alternating every seven elements, the
+// batched forces and tangent equal one element at a time to kRoundingTolerance (the same
+// formulas, products summed in another order), and the count of batched elements equals
+// the full batches of the assembler's chunks.
+TEST(StVKBatchedKernel, EqualsOneElementAtATime) {
+  const TetMesh box = test::smallBox(10);
+  const TetMesh mixed = alternatingMaterials(box);
+  std::mt19937 random(53);
+  for (const TetMesh* mesh : {&box, &mixed}) {
+    const int chunk = MatrixAssembler(*mesh).elementsPerChunk();
+    long long fullBatches = 0;
+    for (int start = 0; start < mesh->numElements(); start += chunk)
+      fullBatches += (std::min(mesh->numElements(), start + chunk) - start) / 4;
+    ASSERT_GT(fullBatches, 0);
+    for (const double amplitude : {0.01, 0.03}) {
+      const Eigen::VectorXd u = test::deformedDisplacement(*mesh, test::randomRotation(random), amplitude, random);
+      StVKFEM batched(*mesh, nullptr, true), single(*mesh, nullptr, false);
+      Eigen::VectorXd forcesBatched, forcesSingle;
+      Eigen::SparseMatrix<double> tangentBatched = batched.createStiffnessMatrix();
+      Eigen::SparseMatrix<double> tangentSingle = single.createStiffnessMatrix();
+      batched.forcesAndTangent(u, forcesBatched, tangentBatched);
+      single.forcesAndTangent(u, forcesSingle, tangentSingle);
+      const double forceDifference = test::relativeEntryDifference(forcesBatched, forcesSingle);
+      const double tangentDifference = test::relativeEntryDifference(tangentBatched, tangentSingle);
+      std::printf(
+          "[ measured ] StVK Green strain, %s, amplitude %.2f: forces %.2e, tangent %.2e of the largest entry\n",
+          mesh == &box ? "one material" : "two materials", amplitude, forceDifference, tangentDifference);
+      EXPECT_LE(forceDifference, kRoundingTolerance);
+      EXPECT_LE(tangentDifference, kRoundingTolerance);
+      EXPECT_EQ(batched.batchedElements(), 4 * fullBatches);
+      EXPECT_EQ(single.batchedElements(), 0);
+    }
   }
 }
 

@@ -15,7 +15,7 @@ std::unique_ptr<ForceModel> makeHyperelasticForceModel(const TetMesh& mesh, Hype
           "stvk in the Green-strain form has no inversion threshold, compression resistance or enforceSPD: choose "
           "the principal-stretch formulation for them");
     }
-    return std::make_unique<StVKFEM>(mesh, std::move(assembler));
+    return std::make_unique<StVKFEM>(mesh, std::move(assembler), options.batchedKernel);
   }
   return std::make_unique<IsotropicHyperelasticFEM>(mesh, kind, options, std::move(assembler));
 }

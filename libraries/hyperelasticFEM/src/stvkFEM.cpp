@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <asyncfem/hyperelasticFEM/stvkFEM.hpp>
 
+#include "detail/batchedStvkKernel.hpp"
+
 namespace asyncfem {
 
-StVKFEM::StVKFEM(const TetMesh& mesh, std::shared_ptr<const MatrixAssembler> assembler)
-    : ElementForceModel(mesh, std::move(assembler), "StVKFEM") {
+StVKFEM::StVKFEM(const TetMesh& mesh, std::shared_ptr<const MatrixAssembler> assembler, bool batchedKernel)
+    : ElementForceModel(mesh, std::move(assembler), "StVKFEM"), batchedKernel_(batchedKernel) {
   const int count = mesh.numElements();
   lame_.resize(static_cast<std::size_t>(count));
   for (int e = 0; e < count; ++e) {
@@ -45,6 +47,18 @@ void StVKFEM::computeElement(int element, const Eigen::Matrix3d& deformationGrad
       }
     }
   }
+}
+
+void StVKFEM::computeBatch(int first, int count, const Eigen::Matrix3d* deformationGradients, ElementVector* forces,
+                           ElementMatrix* tangents) const {
+  if (!batchedKernel_ || count != detail::kStvkLanes) {
+    ElementForceModel::computeBatch(first, count, deformationGradients, forces, tangents);
+    return;
+  }
+  const auto e0 = static_cast<std::size_t>(first);
+  batchedElements_.fetch_add(count, std::memory_order_relaxed);
+  detail::batchedStvkTerms(deformationGradients, &geometry().volumes[e0], &geometry().shapeGradients[e0], &lame_[e0],
+                           forces, tangents);
 }
 
 }  // namespace asyncfem

@@ -87,9 +87,10 @@ struct HyperelasticOptions {
   bool invariantPath = true;
   /// The element loop of the tangent evaluates four consecutive elements at once (SIMD
   /// lanes over elements, the invariant path only) where all four take the invariant path
-  /// and share a material; other batches go one element at a time. Equal to the
-  /// one-element kernel to rounding (docs/benchmarks.md, "Hyperelastic element kernels").
-  /// false: one element at a time everywhere (for comparisons).
+  /// and share a material; other batches go one element at a time. StVK in the
+  /// Green-strain form (StVKFEM) batches every full batch of four (no inversion path).
+  /// Equal to the one-element kernel to rounding (docs/benchmarks.md, "Hyperelastic element
+  /// kernels"). false: one element at a time everywhere (for comparisons).
   bool batchedKernel = true;
 
   /// True when a finite threshold is set.

@@ -3,6 +3,7 @@
 
 #include <asyncfem/hyperelasticFEM/elementForceModel.hpp>
 #include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
+#include <atomic>
 #include <memory>
 #include <vector>
 
@@ -23,18 +24,28 @@ namespace asyncfem {
 class StVKFEM final : public ElementForceModel {
  public:
   /// Throws ValidationError naming the lowest degenerate element; assembler as in
-  /// ElementForceModel (null: built here).
-  explicit StVKFEM(const TetMesh& mesh, std::shared_ptr<const MatrixAssembler> assembler = nullptr);
+  /// ElementForceModel (null: built here). batchedKernel: the tangent pass evaluates four
+  /// elements at a time (SIMD lanes over elements; HyperelasticOptions::batchedKernel),
+  /// equal to one element at a time to rounding.
+  explicit StVKFEM(const TetMesh& mesh, std::shared_ptr<const MatrixAssembler> assembler = nullptr,
+                   bool batchedKernel = true);
 
   /// Lame parameters of element e.
   const LameParameters& elementLame(int e) const { return lame_[static_cast<std::size_t>(e)]; }
+  /// Elements evaluated by the batched kernel since construction (all evaluations
+  /// together), for tests and tools.
+  long long batchedElements() const { return batchedElements_.load(std::memory_order_relaxed); }
 
  protected:
   void computeElement(int element, const Eigen::Matrix3d& deformationGradient, double* energy, ElementVector* force,
                       ElementMatrix* tangent) const override;
+  void computeBatch(int first, int count, const Eigen::Matrix3d* deformationGradients, ElementVector* forces,
+                    ElementMatrix* tangents) const override;
 
  private:
   std::vector<LameParameters> lame_;
+  bool batchedKernel_ = true;
+  mutable std::atomic<long long> batchedElements_{0};
 };
 
 }  // namespace asyncfem
