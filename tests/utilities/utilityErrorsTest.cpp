@@ -150,7 +150,7 @@ TEST_F(UtilityErrorsTest, SuggestRegionsHonoursTheScenesAutoSettings) {
 // The ball falls for about 50 large steps before its contact patch needs a region.
 TEST_F(UtilityErrorsTest, SuggestRegionsExplainsRunTimeRegions) {
   const RunResult result =
-      run("suggestRegions", "'" + std::string(ASYNCFEM_MODELS_DIR) + "/ball/ball.json' --adaptive-steps 70");
+      run("suggestRegions", std::string("'") + ASYNCFEM_MODELS_DIR + "/ball/ball.json' --adaptive-steps 70");
   ASSERT_EQ(result.exitCode, 0) << result.err;
   EXPECT_NE(result.out.find("the scene chooses its regions at run time"), std::string::npos) << result.out;
   EXPECT_NE(result.out.find("\"contact\""), std::string::npos) << result.out;
@@ -162,7 +162,7 @@ TEST_F(UtilityErrorsTest, SuggestRegionsExplainsRunTimeRegions) {
 }
 
 TEST_F(UtilityErrorsTest, SuggestRegionsFixesABareMeshByBoxOrBouFile) {
-  const std::string beam = "'" + std::string(ASYNCFEM_MODELS_DIR) + "/beam/beam.veg' --dt 0.0083333 --json";
+  const std::string beam = std::string("'") + ASYNCFEM_MODELS_DIR + "/beam/beam.veg' --dt 0.0083333 --json";
   const RunResult bySet = run("suggestRegions", beam + " --fixed-set xmin");
   ASSERT_EQ(bySet.exitCode, 0) << bySet.err;
   const RunResult byBox = run("suggestRegions", beam + " --fixed-box -1 -1 -1 1e-9 1 1");
