@@ -140,6 +140,52 @@ Eigen::SparseMatrix<double> freeSystem(const TetMesh& mesh, std::vector<int>& ro
 // residual of 1e-10, so a relative error of at most kappa 1e-10 (kappa of M + h^2 K here is
 // about 4.5e3: 1e-6 bounds it); MUMPS to rounding (1e-10). Every rank gets the same
 // solution, bit for bit; a second factorization with new values solves the new system.
+// solveApproximately: MUMPS solves exactly (rounding, 1e-10 of the solution); one GAMG cycle
+// is a fixed linear map (approximate(b1 + 2 b2) = approximate(b1) + 2 approximate(b2) to
+// rounding, 1e-10 relative) that at least halves the error's energy norm squared from a
+// zero start, as the outer conjugate gradients of the lagged Schur refinement need; ranks
+// agree bit for bit.
+TEST(PetscSparseSolver, SolvesApproximatelyWithOneCycle) {
+  const TetMesh mesh = cantilever();
+  std::vector<int> rowVertex;
+  const Eigen::SparseMatrix<double> system = freeSystem(mesh, rowVertex);
+  Eigen::MatrixXd rhs(system.rows(), 3);
+  for (Eigen::Index i = 0; i < rhs.rows(); ++i) {
+    rhs(i, 0) = std::sin(0.37 * double(i));
+    rhs(i, 1) = 1.0 + std::cos(0.11 * double(i));
+  }
+  rhs.col(2) = rhs.col(0) + 2.0 * rhs.col(1);
+  int ranks = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  auto owner = std::make_shared<std::vector<int>>(static_cast<std::size_t>(mesh.numVertices()));
+  for (int v = 0; v < mesh.numVertices(); ++v) (*owner)[static_cast<std::size_t>(v)] = v % ranks;
+  auto coordinates = std::make_shared<const Eigen::Matrix3Xd>(mesh.restPositions());
+  for (PetscSolverKind kind : {PetscSolverKind::cgGamg, PetscSolverKind::mumps}) {
+    SCOPED_TRACE(kind == PetscSolverKind::mumps ? "MUMPS" : "CG + GAMG");
+    PetscSolverSettings settings;
+    settings.kind = kind;
+    settings.relativeTolerance = kRelativeTolerance;
+    std::unique_ptr<SparseSolver> solver = makePetscSparseSolver(settings, rowVertex, owner, coordinates);
+    solver->compute(system);
+    Eigen::MatrixXd approximate, exact;
+    solver->solveApproximately(rhs, approximate);
+    solver->solve(rhs, exact);
+    const Eigen::VectorXd combined = approximate.col(0) + 2.0 * approximate.col(1);
+    EXPECT_LE((approximate.col(2) - combined).norm(), 1e-10 * combined.norm());
+    for (int j = 0; j < 2; ++j) {
+      // The error shrinks in the energy norm (the norm conjugate gradients minimize in).
+      const Eigen::VectorXd error = exact.col(j) - approximate.col(j);
+      EXPECT_LT(error.dot(system * error), 0.5 * exact.col(j).dot(system * exact.col(j)));
+      if (kind == PetscSolverKind::mumps) {
+        EXPECT_LE((approximate.col(j) - exact.col(j)).norm(), 1e-10 * exact.col(j).norm());
+      } else {
+        EXPECT_GT((approximate.col(j) - exact.col(j)).norm(), 1e-6 * exact.col(j).norm());  // one cycle, not a solve
+      }
+      EXPECT_TRUE(sameOnEveryRank(approximate.col(j)));
+    }
+  }
+}
+
 TEST(PetscSparseSolver, SolvesLikeADirectSolverOnEveryRank) {
   const TetMesh mesh = cantilever();
   std::vector<int> rowVertex;

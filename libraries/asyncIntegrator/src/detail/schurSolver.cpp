@@ -194,12 +194,21 @@ void SchurSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
   solution.noalias() += lowRankBasis_ * (unionCorrection_ * z);
 }
 
+void SchurSolver::precondition(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  if (borrowed_ != nullptr || !external_ || modeUsed_ != SchurMode::symmetric) {
+    solve(rhs, solution);
+    return;
+  }
+  solver_->solveApproximately(rhs, solution_);
+  solution = solution_.col(0);
+}
+
 SchurSolver::Refinement SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution,
                                             const Operator& apply, bool symmetric, int maxIterations,
                                             double tolerance) {
   Refinement result;
   const double scale = rhs.norm();
-  solve(rhs, solution);
+  precondition(rhs, solution);
   if (scale == 0.0) {
     result.converged = result.zeroRightHandSide = true;
     return result;
@@ -217,7 +226,7 @@ SchurSolver::Refinement SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::V
       return result;
     }
     ++result.iterations;
-    solve(residual_, correction_);  // z = P^{-1} r
+    precondition(residual_, correction_);  // z = P^{-1} r
     if (!symmetric) {
       solution += correction_;
       apply(solution, product_);

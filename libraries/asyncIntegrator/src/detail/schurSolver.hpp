@@ -44,6 +44,9 @@ class SchurSolver {
               SchurMode requested, AsyncCoupling coupling, double asymmetry, IntegratorStats& stats);
   /// solution = (H^{LL*})^{-1} rhs with the last factor.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
+  /// The preconditioner of refine(): solve(), or an external solver's solveApproximately()
+  /// (one multigrid cycle instead of iterating to its tolerance).
+  void precondition(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
   /// H^{LL*} solution = rhs for the operator of the current blocks, with the last factor as
   /// preconditioner (laggedSchur): conjugate gradients when symmetric (the stable coupling),
   /// iterative refinement otherwise, to a relative residual of tolerance in at most

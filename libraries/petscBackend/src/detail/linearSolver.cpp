@@ -113,6 +113,13 @@ SolveOutcome LinearSolver::solve(Vec b, Vec x) {
   return outcome;
 }
 
+void LinearSolver::applyPreconditioner(Vec b, Vec x) {
+  checkPetsc(KSPSetUp(ksp_.get()), "KSPSetUp");
+  PC pc = nullptr;
+  checkPetsc(KSPGetPC(ksp_.get(), &pc), "KSPGetPC");
+  checkPetsc(PCApply(pc, b, x), "PCApply");
+}
+
 std::string LinearSolver::kspType() const {
   KSPType type = nullptr;
   checkPetsc(KSPGetType(ksp_.get(), &type), "KSPGetType");

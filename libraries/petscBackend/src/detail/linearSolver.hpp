@@ -45,6 +45,8 @@ class LinearSolver {
   void setUp();
   /// Solves A x = b; x holds the initial guess of iterative solvers on entry.
   SolveOutcome solve(Vec b, Vec x);
+  /// x = M^{-1} b, one application of the preconditioner of the current operator.
+  void applyPreconditioner(Vec b, Vec x);
   /// The KSP and PC types PETSc resolved after the options database.
   std::string kspType() const;
   std::string pcType() const;

@@ -79,6 +79,14 @@ class SparseSolver {
   /// That matrix (A's size, SPD, its pattern fixed from call to call), given before each
   /// factorize() of A; ignored by solvers that do not use one.
   virtual void setPreconditionerMatrix(const Eigen::SparseMatrix<double>& matrix) { (void)matrix; }
+  /// A fixed, symmetric positive definite approximation of A^{-1} applied to every column
+  /// of rhs, for callers that iterate on the exact operator themselves (preconditioned
+  /// conjugate gradients): an iterative solver applies its preconditioner once (one
+  /// multigrid cycle) instead of iterating to its tolerance. Default, and direct solvers:
+  /// solve().
+  virtual void solveApproximately(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) {
+    solve(rhs, solution);
+  }
 
   virtual SolverKind kind() const = 0;
   /// Fill-reducing ordering in effect after analyzePattern(): "metis", "amd", "colamd",
