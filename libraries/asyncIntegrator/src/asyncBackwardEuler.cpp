@@ -61,7 +61,7 @@ struct AsyncBackwardEuler::Impl {
   // Per-step buffers (full 3n, or |L|).
   Eigen::VectorXd stiffVelocity, massVelocity, stateForce, predicted, newU, newV, work;
   Eigen::VectorXd rhsL, rhsSchur, Y;
-  std::vector<double> interfaceSum;  // regionDistribution: the owners' interface rows, summed
+  std::vector<double> interfaceSum;  // regionDistribution: every region's interface rows, summed
   const Eigen::VectorXd* externalL = nullptr;
   // External forces at the distinct times of one large step (shared by regions whose
   // substeps fall on the same times), valid for one step.
@@ -987,7 +987,8 @@ void AsyncBackwardEuler::shareCorrections() {
 }
 
 // target -= the interface rows of every region's last substitution (interfaceRow) at its
-// interface positions; distributed, from the owners' rows summed over the processes.
+// interface positions; distributed, from the owners' rows summed over the processes (only
+// the sum of |I_i| values travels, not vectors of L's size).
 void AsyncBackwardEuler::subtractOwnedInterfaceRows(Eigen::VectorXd& target) {
   Impl& d = *impl_;
   const int numRegions = partition_.numRegions();
@@ -999,16 +1000,26 @@ void AsyncBackwardEuler::subtractOwnedInterfaceRows(Eigen::VectorXd& target) {
     }
     return;
   }
-  d.interfaceSum.assign(static_cast<std::size_t>(target.size()), 0.0);
+  // Every region's rows, concatenated in region order (sizes |I_i| known to every process):
+  // the owner fills its segment, the sum hands it to all, and the subtraction below runs in
+  // the order of the one-process path.
+  d.interfaceSum.clear();
   for (int i = 0; i < numRegions; ++i) {
     const FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
-    if (!rb.owned) continue;
-    const std::vector<int>& pos = partition_.interfacePositions(i);
-    for (std::size_t k = 0; k < pos.size(); ++k)
-      d.interfaceSum[static_cast<std::size_t>(pos[k])] += rb.interfaceRow[static_cast<Eigen::Index>(k)];
+    const std::size_t size = partition_.interfacePositions(i).size();
+    if (rb.owned) {
+      d.interfaceSum.insert(d.interfaceSum.end(), rb.interfaceRow.data(), rb.interfaceRow.data() + size);
+    } else {
+      d.interfaceSum.insert(d.interfaceSum.end(), size, 0.0);
+    }
   }
   sumOverProcesses(d.interfaceSum);
-  target -= Eigen::Map<const Eigen::VectorXd>(d.interfaceSum.data(), target.size());
+  std::size_t at = 0;
+  for (int i = 0; i < numRegions; ++i) {
+    const std::vector<int>& pos = partition_.interfacePositions(i);
+    for (std::size_t k = 0; k < pos.size(); ++k) target[pos[k]] -= d.interfaceSum[at + k];
+    at += pos.size();
+  }
 }
 
 // X_m and sum_r X_r of every region from its owner, for the new state.
