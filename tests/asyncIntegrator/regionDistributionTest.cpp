@@ -36,7 +36,8 @@ class ThreadGroup {
       : size_(size), slots_(static_cast<std::size_t>(size)), turns_(static_cast<std::size_t>(size)) {}
 
   void sum(int me, double* values, std::size_t count) {
-    turns_[static_cast<std::size_t>(me)]->unlock();
+    std::unique_lock<std::mutex>* turn = turns_[static_cast<std::size_t>(me)];  // null outside run()
+    if (turn != nullptr) turn->unlock();
     std::vector<double> total(count, 0.0);
     {
       std::unique_lock<std::mutex> lock(mutex_);
@@ -48,7 +49,7 @@ class ThreadGroup {
       }
       arrive(lock);  // every participant has read the deposits before the next sum
     }
-    turns_[static_cast<std::size_t>(me)]->lock();
+    if (turn != nullptr) turn->lock();
     std::copy(total.begin(), total.end(), values);
   }
 
@@ -211,8 +212,9 @@ TEST(AsyncRegionDistribution, AFailingRegionStopsEveryProcess) {
 }
 
 // A region claimed by both processes (or by none) is an error on every process, naming the
-// region; so is an answer for the wrong number of regions, and a distribution with one of
-// its two members, or with the paper's coupling.
+// region; so is an answer for the wrong number of regions (on every process, even when one
+// process alone answers wrongly), and a distribution with one of its two members, or with
+// the paper's coupling.
 TEST(AsyncRegionDistribution, EveryRegionNeedsExactlyOneOwner) {
   const test::TestSystem ts = test::makeTestSystem(0.3, 2e-3);
   const std::vector<AsyncRegion> tip{{"tip", test::verticesBeyond(ts.mesh, 0.875), 4}};
@@ -229,6 +231,26 @@ TEST(AsyncRegionDistribution, EveryRegionNeedsExactlyOneOwner) {
   for (const std::string& message : messages) {
     EXPECT_NE(message.find("region 0 (tip) has 2 owners"), std::string::npos) << message;
   }
+  // Only process 1 answers for the wrong number of regions: it reports that, process 0 stops
+  // at the same sum instead of waiting for it.
+  ThreadGroup pair(2);
+  std::vector<std::string> stops(2);
+  pair.run([&](int me) {
+    AsyncOptions options = claimingAll(pair, me, 2, me == 0);
+    if (me == 1) {
+      options.regionDistribution.ownedRegions = [](const std::vector<std::vector<int>>&,
+                                                   const std::vector<std::vector<int>>&) {
+        return std::vector<char>(3, 0);
+      };
+    }
+    try {
+      AsyncBackwardEuler integrator(ts.mesh, ts.system, 5e-3, tip, options);
+    } catch (const Error& error) {
+      stops[static_cast<std::size_t>(me)] = error.what();
+    }
+  });
+  EXPECT_NE(stops[0].find("computed by another process, failed"), std::string::npos) << stops[0];
+  EXPECT_NE(stops[1].find("answered for 3 regions, the partition has 1"), std::string::npos) << stops[1];
   ThreadGroup alone(1);
   AsyncOptions options = distributedOptions(alone, 0, 1);
   options.regionDistribution.ownedRegions = [](const std::vector<std::vector<int>>&,

@@ -942,12 +942,19 @@ void AsyncBackwardEuler::assignRegionOwners() {
     regionDofs.push_back(partition_.regionDofs(i));
     interfaceDofs.push_back(partition_.interfaceDofs(i));
   }
-  const std::vector<char> owned = options_.regionDistribution.ownedRegions(regionDofs, interfaceDofs);
-  if (owned.size() != static_cast<std::size_t>(numRegions)) {
-    throw ValidationError("async integrator: regionDistribution.ownedRegions answered for " +
-                          std::to_string(owned.size()) + " regions, the partition has " + std::to_string(numRegions));
+  // A bad answer on one process must still reach the sum, or the others would wait there.
+  std::vector<char> owned;
+  std::vector<double> owners(static_cast<std::size_t>(numRegions), 0.0);
+  try {
+    owned = options_.regionDistribution.ownedRegions(regionDofs, interfaceDofs);
+    if (owned.size() != static_cast<std::size_t>(numRegions)) {
+      throw ValidationError("async integrator: regionDistribution.ownedRegions answered for " +
+                            std::to_string(owned.size()) + " regions, the partition has " + std::to_string(numRegions));
+    }
+    std::copy(owned.begin(), owned.end(), owners.begin());
+  } catch (...) {
+    holdFailure(-1);
   }
-  std::vector<double> owners(owned.begin(), owned.end());
   sumOverProcesses(owners);
   for (int i = 0; i < numRegions; ++i) {
     const double count = owners[static_cast<std::size_t>(i)];
