@@ -374,6 +374,14 @@ std::vector<int> mergeGroups(const std::vector<std::vector<int>>& groups, int nu
   return root;
 }
 
+/// The rank owning most of vertices by owner (ties: the lowest); votes is scratch of the
+/// rank count.
+int majorityRank(const std::vector<int>& vertices, const std::vector<int>& owner, std::vector<int>& votes) {
+  std::fill(votes.begin(), votes.end(), 0);
+  for (const int v : vertices) ++votes[static_cast<std::size_t>(owner[static_cast<std::size_t>(v)])];
+  return static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+}
+
 }  // namespace
 
 VertexOwners assignVertexOwners(const TetMesh& mesh, const std::vector<int>& elementParts, int ranks,
@@ -408,9 +416,7 @@ VertexOwners assignVertexOwners(const TetMesh& mesh, const std::vector<int>& ele
       ++result.groupsSplit;
       continue;
     }
-    std::fill(votes.begin(), votes.end(), 0);
-    for (const int v : group) ++votes[static_cast<std::size_t>(result.owner[static_cast<std::size_t>(v)])];
-    const int keeper = static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+    const int keeper = majorityRank(group, result.owner, votes);
     for (const int v : group) result.owner[static_cast<std::size_t>(v)] = keeper;
     ++result.groupsKept;
   }
@@ -435,15 +441,13 @@ std::vector<int> regionOwners(const TetMesh& mesh, const std::vector<int>& eleme
       owners[i] = kept[static_cast<std::size_t>(ring.front())];
       continue;
     }
-    std::fill(votes.begin(), votes.end(), 0);
     for (const int v : regionVertices[i]) {
       if (v < 0 || v >= mesh.numVertices()) {
         throw Error("regionOwners: vertex " + std::to_string(v) + " of region " + std::to_string(i) +
                     " is not a vertex of the mesh");
       }
-      ++votes[static_cast<std::size_t>(byPart[static_cast<std::size_t>(v)])];
     }
-    owners[i] = static_cast<int>(std::max_element(votes.begin(), votes.end()) - votes.begin());
+    owners[i] = majorityRank(regionVertices[i], byPart, votes);
   }
   return owners;
 }
