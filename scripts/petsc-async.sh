@@ -5,7 +5,7 @@
 # FRACTION (default 0.05) of its length a fast region at ratio 8 (REGIONS=2: also as much
 # at its fixed end, from x = 0.05); offlineSimulator locally (CHOLMOD) and with --backend
 # petsc on RANKS (default 1 and 2) ranks (CG + GAMG, MUMPS), the regions owned by one rank
-# each and, beyond one rank, replicated on every rank. One Markdown row per run on stdout:
+# each and the element loops distributed and, beyond one rank, each replicated on every rank. One Markdown row per run on stdout:
 # set-up and wall time per frame from the simulator's summary, and the largest difference
 # from the local run's frames relative to the largest displacement (on every vertex up to
 # 3,000 vertices, on an evenly spaced sample of about 3,000 beyond).
@@ -14,11 +14,13 @@ set -euo pipefail
 bin=$(cd "${1:-build/bin}" && pwd)
 cells_list=${CELLS:-"12 18"}
 ranks=${RANKS:-"1 2"}
-# Each rank count with the regions owned by one rank each; beyond one rank also replicated.
+# Each rank count with the regions owned by one rank each and the element loops
+# distributed; beyond one rank also with the element loops replicated, and with both
+# replicated (only L's solve distributed).
 runs=""
 for n in $ranks; do
-  runs="$runs $n:owned"
-  [ "$n" -gt 1 ] && runs="$runs $n:replicated"
+  runs="$runs $n:owned:distributed"
+  [ "$n" -gt 1 ] && runs="$runs $n:owned:replicated $n:replicated:replicated"
 done
 frames=${FRAMES:-3}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
@@ -57,10 +59,9 @@ JSON
   echo "| $tets | $vertices | local (CHOLMOD) | $local_setup | $local_frame | 1.00 | | |"
   for solver in cg-gamg mumps; do
     for run in $runs; do
-      n=${run%:*}
-      regions=${run#*:}
+      IFS=: read -r n regions elements <<< "$run"
       mpiexec -n "$n" "$bin/offlineSimulator" scene.json --backend petsc --petsc-solver "$solver" \
-        --petsc-regions "$regions" -o petsc.afsim > petsc.txt 2> /dev/null
+        --petsc-regions "$regions" --petsc-elements "$elements" -o petsc.afsim > petsc.txt 2> /dev/null
       frame=$(grep -m1 "^  per frame" petsc.txt | awk '{print $3}')
       setup=$(grep -m1 "^  setup" petsc.txt | awk '{print $2}')
       solves=$(grep -m1 "PETSc  " petsc.txt | sed 's/.*: \([0-9]*\) solves, \([0-9]*\) iterations.*/\1 \/ \2/')
@@ -77,7 +78,7 @@ print(f"{max(abs(x - y) for r, s in zip(a, b) for x, y in zip(r, s)) / scale:.1e
 PY
 )
       ratio=$(python3 -c "print(f'{$frame / $local_frame:.2f}')")
-      echo "| $tets | $vertices | PETSc $solver, $n rank(s), regions $regions | $setup | $frame | $ratio | $solves | $difference |"
+      echo "| $tets | $vertices | PETSc $solver, $n rank(s), regions $regions, elements $elements | $setup | $frame | $ratio | $solves | $difference |"
     done
   done
 done

@@ -99,7 +99,8 @@ grep -q "interrupted by SIGINT: [0-9]* of 100000 frames are complete in long.afs
   { cat interrupted.txt; exit 1; }
 "$bin/afsimTool" info long.afsim | grep -q "checksums   ok" || { "$bin/afsimTool" info long.afsim; exit 1; }
 # The asynchronous integrator over MPI: every rank steps the replicated state, each fast
-# region is computed by one rank, L's system H^{LL*} is solved distributed. The antenna (rod and ring at ratio 30), corotational with
+# region is computed by one rank, each rank evaluates its own elements' forces and tangent
+# (summed over the ranks), L's system H^{LL*} is solved distributed. The antenna (rod and ring at ratio 30), corotational with
 # the exact tangent, 8 frames on 2 ranks (CG + GAMG to a relative residual of 1e-10, the
 # simulator's setting for L) equal the local run: kappa 1e-10 per step as in the Newton
 # bound above, 1e-6 (observed 2e-14). Resumed from 4 frames on 3 ranks with MUMPS: the same
@@ -117,11 +118,14 @@ PY
 "$mpiexec" -n 2 "$bin/offlineSimulator" antenna.json --backend petsc -o antenna-petsc.afsim > antenna.txt 2> /dev/null
 grep -q "PETSc       2 ranks solve L's system" antenna.txt || { cat antenna.txt; exit 1; }
 grep -q "fast regions owned by one rank each: rank 0 computes [01] of 1" antenna.txt || { cat antenna.txt; exit 1; }
+grep -q "element loops: each rank evaluates its elements' forces and tangent" antenna.txt || { cat antenna.txt; exit 1; }
 agree antenna-local.afsim antenna-petsc.afsim async-on-2-ranks 1e-6 637 8
-# The same with every rank computing the region (--petsc-regions replicated): the same bound.
+# The same with every rank computing the region and every element (--petsc-regions
+# replicated --petsc-elements replicated): the same bound.
 "$mpiexec" -n 2 "$bin/offlineSimulator" antenna.json --backend petsc --petsc-regions replicated \
-  -o antenna-replicated.afsim > replicated.txt 2> /dev/null
+  --petsc-elements replicated -o antenna-replicated.afsim > replicated.txt 2> /dev/null
 grep -q "fast regions replicated: every rank computes every region" replicated.txt || { cat replicated.txt; exit 1; }
+grep -q "element loops: every rank evaluates every element" replicated.txt || { cat replicated.txt; exit 1; }
 agree antenna-local.afsim antenna-replicated.afsim async-replicated-on-2-ranks 1e-6 637 8
 "$mpiexec" -n 2 "$bin/offlineSimulator" antenna.json --backend petsc --petsc-solver mumps -q --frames 4 \
   -o antenna-resumed.afsim

@@ -54,6 +54,7 @@
 #include <asyncfem/petscBackend/petscRuntime.hpp>
 #include <asyncfem/petscBackend/petscSimulation.hpp>
 #include <asyncfem/petscBackend/problemSettings.hpp>
+#include <asyncfem/petscBackend/rankSummedForceModel.hpp>
 #endif
 
 #include "commandLine.hpp"
@@ -81,6 +82,7 @@ struct CommandLine {
   std::string petscSolver = "cg-gamg";
   std::string petscOptions;
   std::string petscRegions = "owned";
+  std::string petscElements = "distributed";
 };
 
 // The signal that asked the run to stop (0: none). A signal handler can only set a flag
@@ -637,6 +639,12 @@ void addRunOptions(CLI::App& app, CommandLine& options) {
                  "the default) or replicated (every rank computes every region)")
       ->check(CLI::IsMember({"owned", "replicated"}))
       ->capture_default_str();
+  app.add_option("--petsc-elements", options.petscElements,
+                 "With --backend petsc and the async integrator: distributed (each rank evaluates the nonlinear "
+                 "forces and tangent of its elements, summed over the ranks; the default) or replicated (every "
+                 "rank evaluates every element)")
+      ->check(CLI::IsMember({"distributed", "replicated"}))
+      ->capture_default_str();
 }
 
 /// Where the frame loop writes: the .afsim file, the .vtu series, the checkpoint and its
@@ -805,7 +813,7 @@ int runLocal(int argc, char** argv, const CommandLine& options, const asyncfem::
 // (makePetscRegionDistribution; --petsc-regions replicated: by every rank). Rank 0 writes the frames, checkpoints and
 // the summary. The ranks agree once per frame on a stop signal and on rank 0's output failing, so none is left waiting
 // in a collective call.
-asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options,
+asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options, const asyncfem::Scene& scene,
                                                 std::shared_ptr<asyncfem::PetscSolveCounts> totals) {
   asyncfem::PetscSolverSettings solver;
   solver.kind = asyncfem::parsePetscSolverKind(options.petscSolver);
@@ -833,11 +841,27 @@ asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options,
           settings.solver.regionDistribution.sum = std::move(distribution.sum);
         }
       });
+  if (options.petscElements != "distributed" || scene.forceModel == asyncfem::ForceModelType::linear) return registry;
+  // Each rank evaluates the nonlinear forces and tangent of its own elements; the sums reach every rank.
+  asyncfem::ProblemSettings physics;
+  physics.forceModel = scene.forceModel;
+  physics.tangent = scene.tangent;
+  physics.hyperelastic = scene.hyperelastic;
+  const asyncfem::IntegratorFactory async = *registry.find("async");
+  registry.add(
+      "async",
+      [async, physics](asyncfem::IntegratorContext context, const nlohmann::json& integratorOptions) {
+        context.system.forceModel =
+            asyncfem::makeRankSummedForceModel(*context.mesh, physics, std::move(context.system.forceModel));
+        return async(std::move(context), integratorOptions);
+      },
+      registry.optionKeys("async"));
   return registry;
 }
 
 // Rank 0's summary lines of the distributed work: L's solves and rows, the regions.
-void printPetscAsyncSummary(int ranks, const CommandLine& options, const asyncfem::PetscSolveCounts& totals) {
+void printPetscAsyncSummary(int ranks, const CommandLine& options, const asyncfem::PetscSolveCounts& totals,
+                            bool linear) {
   std::printf(
       "  PETSc       %d ranks solve L's system (KSP %s): %lld solves, %lld iterations; rank 0 owns %d rows "
       "(%lld entries in other ranks' columns); region interfaces on one rank: %d, split: %d\n",
@@ -849,6 +873,10 @@ void printPetscAsyncSummary(int ranks, const CommandLine& options, const asyncfe
   } else {
     std::printf("  PETSc       fast regions replicated: every rank computes every region\n");
   }
+  std::printf("  PETSc       element loops: %s\n",
+              options.petscElements == "distributed" && !linear
+                  ? "each rank evaluates its elements' forces and tangent, summed over the ranks"
+                  : (linear ? "K u, linear model (no element loop)" : "every rank evaluates every element"));
 }
 
 // Rank 0 opens (or continues) the output; on --resume the other ranks restore the
@@ -889,7 +917,7 @@ int runPetscAsync(int argc, char** argv, const CommandLine& options, const async
   asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
   const bool root = runtime.rank() == 0;
   auto totals = std::make_shared<asyncfem::PetscSolveCounts>();
-  asyncfem::Simulation simulation = asyncfem::buildSimulation(scene, petscAsyncRegistry(options, totals));
+  asyncfem::Simulation simulation = asyncfem::buildSimulation(scene, petscAsyncRegistry(options, scene, totals));
   if (root) {
     for (const std::string& warning : simulation.warnings)
       std::cerr << "offlineSimulator: warning: " << warning << "\n";
@@ -955,7 +983,7 @@ int runPetscAsync(int argc, char** argv, const CommandLine& options, const async
   if (root && !options.quiet) {
     record.outputBytes = static_cast<std::int64_t>(fs::file_size(scene.output.file));
     printSummary(scene, simulation, record);
-    printPetscAsyncSummary(runtime.size(), options, *totals);
+    printPetscAsyncSummary(runtime.size(), options, *totals, scene.forceModel == asyncfem::ForceModelType::linear);
   }
   return 0;
 }

@@ -11,6 +11,7 @@
 #include <asyncfem/petscBackend/partition.hpp>
 #include <string>
 
+#include "detail/distributedLayout.hpp"
 #include "detail/linearSolver.hpp"
 #include "detail/petscCall.hpp"
 #include "detail/petscHandle.hpp"
@@ -454,17 +455,6 @@ std::vector<int> regionOwners(const TetMesh& mesh, const std::vector<int>& eleme
 
 namespace {
 
-/// METIS's element partition of mesh into the ranks of PETSC_COMM_WORLD, computed on rank
-/// 0 and broadcast (all zeros on one rank). Collective.
-std::vector<int> elementPartsOnEveryRank(const TetMesh& mesh, int rank, int ranks) {
-  std::vector<int> parts(static_cast<std::size_t>(mesh.numElements()), 0);
-  detail::collectively(PETSC_COMM_WORLD, [&] {
-    if (rank == 0 && ranks > 1) parts = partitionElements(mesh, ranks);
-  });
-  if (!parts.empty()) MPI_Bcast(parts.data(), static_cast<int>(parts.size()), MPI_INT, 0, PETSC_COMM_WORLD);
-  return parts;
-}
-
 /// Vertex ids of DOF lists (3 v + c), each list's vertices once, ascending.
 std::vector<std::vector<int>> verticesOf(const std::vector<std::vector<int>>& dofLists) {
   std::vector<std::vector<int>> vertices(dofLists.size());
@@ -485,7 +475,7 @@ PetscRegionDistribution makePetscRegionDistribution(const TetMesh& mesh, std::sh
   int rank = 0, ranks = 1;
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
   MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
-  auto parts = std::make_shared<const std::vector<int>>(elementPartsOnEveryRank(mesh, rank, ranks));
+  auto parts = std::make_shared<const std::vector<int>>(detail::elementPartsOnEveryRank(mesh, PETSC_COMM_WORLD));
   auto meshShared = std::make_shared<const TetMesh>(mesh);
   PetscRegionDistribution distribution;
   distribution.ownedRegions = [parts, meshShared, rank, ranks, totals](
@@ -514,11 +504,9 @@ std::function<std::unique_ptr<SparseSolver>(const std::vector<int>& largeDofs,
                                             const std::vector<std::vector<int>>& interfaceDofs)>
 makePetscLargeSystemSolver(const TetMesh& mesh, const PetscSolverSettings& settings,
                            std::shared_ptr<PetscSolveCounts> totals) {
-  int rank = 0;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
   int ranks = 1;
   MPI_Comm_size(PETSC_COMM_WORLD, &ranks);
-  std::vector<int> parts = elementPartsOnEveryRank(mesh, rank, ranks);
+  std::vector<int> parts = detail::elementPartsOnEveryRank(mesh, PETSC_COMM_WORLD);
   auto coordinates = std::make_shared<Eigen::Matrix3Xd>(mesh.restPositions());
   auto meshShared = std::make_shared<TetMesh>(mesh);
   return [settings, parts = std::move(parts), meshShared, coordinates, totals, ranks](

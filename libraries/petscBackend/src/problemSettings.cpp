@@ -15,7 +15,9 @@ PetscIntegratorKind integratorKind(const std::string& name) {
                         "\" is not available on the PETSc backend (it runs backward-euler and trapezoidal)");
 }
 
-PetscForceModelKind forceModelKind(ForceModelType type) {
+}  // namespace
+
+PetscForceModelKind petscForceModelKind(ForceModelType type) {
   switch (type) {
     case ForceModelType::linear:
       return PetscForceModelKind::linear;
@@ -30,8 +32,6 @@ PetscForceModelKind forceModelKind(ForceModelType type) {
   }
   throw ValidationError("forceModel \"" + toString(type) + "\" is not available on the PETSc backend");
 }
-
-}  // namespace
 
 PetscNewtonSettings petscNewtonSettings(const IntegratorOptions& options) {
   if (options.rayleighStiffnessAtIterate) {
@@ -54,7 +54,7 @@ PetscSimulationSettings petscSettingsForProblem(const Problem& problem, const st
   const ProblemSettings& physics = problem.settings();
   PetscSimulationSettings settings;
   settings.integrator = integratorKind(integratorName);
-  settings.forceModel = forceModelKind(physics.forceModel);
+  settings.forceModel = petscForceModelKind(physics.forceModel);
   settings.tangent = physics.tangent;
   settings.hyperelastic = physics.hyperelastic;
   settings.newton = petscNewtonSettings(options);

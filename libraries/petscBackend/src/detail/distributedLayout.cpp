@@ -3,8 +3,11 @@
 
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/petscBackend/partition.hpp>
 #include <climits>
 #include <string>
+
+#include "detail/petscCall.hpp"
 
 namespace asyncfem::detail {
 
@@ -173,6 +176,19 @@ DistributedLayout buildDistributedLayout(const TetMesh& mesh, const std::vector<
   numberElementDofs(mesh, layout);
   countMatrixBlocks(mesh, adjacency, layout);
   return layout;
+}
+
+std::vector<int> elementPartsOnEveryRank(const TetMesh& mesh, MPI_Comm comm) {
+  int rank = 0;
+  int ranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &ranks);
+  std::vector<int> parts(static_cast<std::size_t>(mesh.numElements()), 0);
+  collectively(comm, [&] {
+    if (rank == 0 && ranks > 1) parts = partitionElements(mesh, ranks);
+  });
+  if (!parts.empty() && ranks > 1) MPI_Bcast(parts.data(), static_cast<int>(parts.size()), MPI_INT, 0, comm);
+  return parts;
 }
 
 }  // namespace asyncfem::detail

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <mpi.h>
 #include <petscsys.h>
 
 #include <array>
@@ -45,5 +46,10 @@ struct DistributedLayout {
 /// out of range or a free vertex that no element uses (its rows would be zero).
 DistributedLayout buildDistributedLayout(const TetMesh& mesh, const std::vector<int>& fixedVertices,
                                          const std::vector<int>& elementPart, int rank, int numRanks);
+
+/// METIS's element partition of mesh into the ranks of comm (partitionElements()),
+/// computed on rank 0 and broadcast, so every rank holds the same parts whatever METIS
+/// does (all zeros on one rank). Collective; a METIS failure throws on every rank.
+std::vector<int> elementPartsOnEveryRank(const TetMesh& mesh, MPI_Comm comm);
 
 }  // namespace asyncfem::detail

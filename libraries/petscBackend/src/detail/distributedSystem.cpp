@@ -66,11 +66,7 @@ void DistributedSystem::partition(const TetMesh& mesh, const std::vector<int>& f
   int numRanks = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &numRanks);
-  std::vector<int> parts(static_cast<std::size_t>(mesh.numElements()), 0);
-  collectively(comm, [&] {
-    if (rank == 0) parts = partitionElements(mesh, numRanks);
-  });
-  if (!parts.empty()) MPI_Bcast(parts.data(), static_cast<int>(parts.size()), MPI_INT, 0, comm);
+  const std::vector<int> parts = elementPartsOnEveryRank(mesh, comm);
   collectively(comm, [&] {
     layout = buildDistributedLayout(mesh, fixedVertices, parts, rank, numRanks);
     if (layout.numBlocks == 0) throw ValidationError("PETSc backend: every vertex is fixed, nothing to simulate");

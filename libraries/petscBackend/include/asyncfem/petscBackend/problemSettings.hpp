@@ -20,6 +20,10 @@ namespace asyncfem {
 PetscSimulationSettings petscSettingsForProblem(const Problem& problem, const std::string& integratorName,
                                                 double timestep, const IntegratorOptions& options = {});
 
+/// The backend's name of a problem's force model type (the same models). Never throws for
+/// the types there are today (it throws ValidationError for an unknown value).
+PetscForceModelKind petscForceModelKind(ForceModelType type);
+
 /// The Newton settings of the single-process backward Euler's options: maxIterations,
 /// tolerance and lineSearch. The options that choose the single-process linear solve
 /// (solver, reuseFactor, pcgTolerance, pcgRefactorIterations) have no meaning here (the

@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "detail/subMeshModel.hpp"
+
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
+#include <asyncfem/hyperelasticFEM/factory.hpp>
+#include <regex>
+#include <string>
+
+namespace asyncfem::detail {
+
+TetMesh subMesh(const TetMesh& mesh, const std::vector<int>& elements, std::vector<int>& meshVertex) {
+  meshVertex.clear();
+  for (int e : elements) {
+    for (int a = 0; a < 4; ++a) meshVertex.push_back(mesh.elements()(a, e));
+  }
+  std::sort(meshVertex.begin(), meshVertex.end());
+  meshVertex.erase(std::unique(meshVertex.begin(), meshVertex.end()), meshVertex.end());
+  std::vector<int> subVertex(static_cast<std::size_t>(mesh.numVertices()), -1);
+  Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(meshVertex.size()));
+  for (std::size_t i = 0; i < meshVertex.size(); ++i) {
+    subVertex[static_cast<std::size_t>(meshVertex[i])] = static_cast<int>(i);
+    positions.col(static_cast<Eigen::Index>(i)) = mesh.restPositions().col(meshVertex[i]);
+  }
+  Eigen::Matrix4Xi connectivity(4, static_cast<Eigen::Index>(elements.size()));
+  std::vector<int> materials;
+  materials.reserve(elements.size());
+  for (std::size_t k = 0; k < elements.size(); ++k) {
+    for (int a = 0; a < 4; ++a) {
+      connectivity(a, static_cast<Eigen::Index>(k)) =
+          subVertex[static_cast<std::size_t>(mesh.elements()(a, elements[k]))];
+    }
+    materials.push_back(mesh.elementMaterialIndex(elements[k]));
+  }
+  return TetMesh(std::move(positions), std::move(connectivity), mesh.materials(), std::move(materials));
+}
+
+std::unique_ptr<ForceModel> makeSubMeshModel(const TetMesh& mesh, PetscForceModelKind kind, TangentKind tangent,
+                                             const HyperelasticOptions& hyperelastic) {
+  switch (kind) {
+    case PetscForceModelKind::corotational:
+      return std::make_unique<CorotationalLinearFEM>(mesh, tangent);
+    case PetscForceModelKind::stvk:
+      return makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::stvk, hyperelastic);
+    case PetscForceModelKind::neoHookean:
+      return makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::neoHookean, hyperelastic);
+    case PetscForceModelKind::mooneyRivlin:
+      return makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::mooneyRivlin, hyperelastic);
+    case PetscForceModelKind::linear:
+      break;
+  }
+  throw Error("PETSc backend: the linear model has no local force model");
+}
+
+void inMeshNumbering(const std::vector<int>& meshElement, const std::function<void()>& work) {
+  const auto translate = [&](const std::string& message) {
+    static const std::regex elementNumber("element (\\d+)");
+    std::string result;
+    auto last = message.cbegin();
+    for (std::sregex_iterator it(message.begin(), message.end(), elementNumber), end; it != end; ++it) {
+      const std::size_t sub = std::stoul((*it)[1].str());
+      result.append(last, message.cbegin() + it->position());
+      result += "element " + (sub < meshElement.size() ? std::to_string(meshElement[sub]) : (*it)[1].str());
+      last = message.cbegin() + it->position() + it->length();
+    }
+    result.append(last, message.cend());
+    return result;
+  };
+  try {
+    work();
+  } catch (const NumericalError& error) {
+    throw NumericalError(translate(error.what()));
+  } catch (const ValidationError& error) {
+    throw ValidationError(translate(error.what()));
+  } catch (const Error& error) {
+    throw Error(translate(error.what()));
+  }
+}
+
+}  // namespace asyncfem::detail
