@@ -685,7 +685,6 @@ void AsyncBackwardEuler::regionRightHandSides() {
 void AsyncBackwardEuler::solveStructured() {
   Impl& d = *impl_;
   const bool damped = system_.damped();
-  const int numRegions = partition_.numRegions();
   const int threads = detail::threadBudget(options_.threads);
   runOwnedTasks(threads, [&](int i) {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
@@ -851,7 +850,6 @@ void AsyncBackwardEuler::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& o
   const bool damped = system_.damped();
   out.resize(y.size());
   out.noalias() = d.largeSystem * y;
-  const int numRegions = partition_.numRegions();
   runOwnedTasks(detail::threadBudget(options_.threads), [&](int i) {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& pos = partition_.interfacePositions(i);

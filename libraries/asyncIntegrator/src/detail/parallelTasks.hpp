@@ -5,6 +5,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <asyncfem/core/threading.hpp>
 #include <exception>
 #include <vector>
 
@@ -27,6 +28,9 @@ void parallelTasks(int count, int threads, const Body& body) {
     return;
   }
   std::vector<std::exception_ptr> failures(static_cast<std::size_t>(std::max(count, 0)));
+  // The tasks' solver calls run side by side: the BLAS starting teams of its own inside
+  // each would put more threads than cores.
+  const ScopedBlasThreads oneBlasThread(1);
 #pragma omp parallel for schedule(dynamic) num_threads(std::max(1, std::min(threads, count))) if (count > 1)
   for (int t = 0; t < count; ++t) {
     try {

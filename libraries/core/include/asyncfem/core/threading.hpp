@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <dlfcn.h>
 #include <unistd.h>
 
 #include <cstdlib>
+#include <cstring>
 
 namespace asyncfem {
 
@@ -22,5 +24,51 @@ inline void preferPassiveThreadWaiting(char** argv) {
   ::execv("/proc/self/exe", argv);
   // execv only returns on failure (no /proc): carry on with the default policy.
 }
+
+/// While alive, the BLAS runs each of its calls on at most `threads` threads of its own, then
+/// its previous count returns. For code that calls the BLAS (CHOLMOD's supernodal solves
+/// and factorizations) from several OpenMP threads at once: each call would otherwise start
+/// a team of the BLAS's threads on the same cores, which then compete with the OpenMP
+/// threads (on 2 cores the corotational dinosaur's asynchronous large step took 44 to 48 ms
+/// on average, 29 ms with the BLAS held to one thread; docs/benchmarks.md). It acts on OpenBLAS,
+/// found in the process at run time (openblas_set_num_threads); with another BLAS it does
+/// nothing. The count is process-wide: create it in the thread that starts the parallel
+/// region, not inside it.
+class ScopedBlasThreads {
+ public:
+  explicit ScopedBlasThreads(int threads) {
+    int (*get)() = nullptr;
+    symbol("openblas_get_num_threads", get);
+    symbol("openblas_set_num_threads", set_);
+    if (get == nullptr || set_ == nullptr) {
+      set_ = nullptr;
+      return;
+    }
+    previous_ = get();
+    if (previous_ <= threads) {
+      set_ = nullptr;  // already at most that many: nothing to restore
+      return;
+    }
+    set_(threads);
+  }
+  ~ScopedBlasThreads() {
+    if (set_ != nullptr) set_(previous_);
+  }
+  ScopedBlasThreads(const ScopedBlasThreads&) = delete;
+  ScopedBlasThreads& operator=(const ScopedBlasThreads&) = delete;
+
+ private:
+  // A function of the process's libraries by name, or null (copied from dlsym's object
+  // pointer, which ISO C++ does not convert to a function pointer directly).
+  template <class Function>
+  static void symbol(const char* name, Function& function) {
+    void* address = ::dlsym(RTLD_DEFAULT, name);
+    function = nullptr;
+    if (address != nullptr) std::memcpy(&function, &address, sizeof(function));
+  }
+
+  void (*set_)(int) = nullptr;
+  int previous_ = 0;
+};
 
 }  // namespace asyncfem
