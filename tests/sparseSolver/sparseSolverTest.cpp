@@ -229,6 +229,22 @@ TEST(SparseSolver, CholmodUsesMetisOrdering) {
   EXPECT_GT(solver->stats().factorFlops, 0.0);
 }
 
+// FillOrdering::automatic: AMD up to kAmdMaxRows rows, METIS above; the solves are as
+// exact either way (relative residual 1e-12 for these SPD Laplacians, cond <= 121).
+TEST(SparseSolver, AutomaticOrderingTakesAmdForSmallMatrices) {
+  for (const int k : {12, 24}) {  // 1,728 and 13,824 rows
+    const SparseMatrix a = gridLaplacian(k, 0.1);
+    auto solver = makeSparseSolver(SolverKind::cholmod, FillOrdering::automatic);
+    solver->compute(a);
+    EXPECT_EQ(solver->ordering(), a.rows() <= kAmdMaxRows ? "amd" : "metis") << a.rows() << " rows";
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(a.rows(), -1.0, 2.0);
+    const Eigen::VectorXd x = solver->solve(b);
+    EXPECT_LE((a * x - b).norm(), 1e-12 * b.norm());
+  }
+  ASSERT_LT(12 * 12 * 12, kAmdMaxRows);
+  ASSERT_GT(24 * 24 * 24, kAmdMaxRows);
+}
+
 TEST(SparseSolver, OtherBackendsReportTheirOrdering) {
   const SparseMatrix a = gridLaplacian(6, 0.5);
   auto umfpack = makeSparseSolver(SolverKind::umfpack);

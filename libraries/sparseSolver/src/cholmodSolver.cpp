@@ -57,9 +57,9 @@ class CholmodCommon {
 
 class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
  public:
-  CholmodSolver() {
+  explicit CholmodSolver(FillOrdering ordering) : fillOrdering_(ordering) {
     common_->supernodal = CHOLMOD_SUPERNODAL;
-    useMetis();
+    chooseOrdering(0);
   }
   ~CholmodSolver() override {
     // Free in reverse order of dependence on the common, which CholmodCommon finishes last.
@@ -77,7 +77,7 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     beginAnalyze(a, "cholmod");
     if (factor_) cholmod_free_factor(&factor_, common_.get());
     cholmod_sparse view = upperTriangleView(a);
-    useMetis();
+    chooseOrdering(a.rows());
     factor_ = cholmod_analyze(&view, common_.get());
     if (!factor_ && common_->status == CHOLMOD_NOT_INSTALLED) {
       // A CHOLMOD built without METIS: fall back to its default strategy (AMD, possibly
@@ -180,10 +180,12 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
   }
 
  private:
-  /// Asks for METIS only (no comparison with AMD), the ordering the design calls for.
-  void useMetis() {
+  /// Asks for one ordering, no comparison: METIS, the ordering the design calls for, or
+  /// with FillOrdering::automatic AMD for a matrix of up to kAmdMaxRows rows.
+  void chooseOrdering(Eigen::Index rows) {
     common_->nmethods = 1;
-    common_->method[0].ordering = CHOLMOD_METIS;
+    const bool amd = fillOrdering_ == FillOrdering::automatic && rows <= kAmdMaxRows;
+    common_->method[0].ordering = amd ? CHOLMOD_AMD : CHOLMOD_METIS;
     common_->postorder = 1;
   }
 
@@ -223,6 +225,7 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
   // Declared first so it is destroyed last: every CHOLMOD object below belongs to it.
   CholmodCommon common_;
   cholmod_factor* factor_ = nullptr;
+  FillOrdering fillOrdering_ = FillOrdering::metis;
   cholmod_dense* x_ = nullptr;  ///< solution buffer reused by cholmod_solve2
   cholmod_dense* y_ = nullptr;  ///< cholmod_solve2 workspace
   cholmod_dense* e_ = nullptr;  ///< cholmod_solve2 workspace
@@ -230,6 +233,8 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
 
 }  // namespace
 
-std::unique_ptr<SparseSolver> makeCholmodSolver() { return std::make_unique<CholmodSolver>(); }
+std::unique_ptr<SparseSolver> makeCholmodSolver(FillOrdering ordering) {
+  return std::make_unique<CholmodSolver>(ordering);
+}
 
 }  // namespace asyncfem::detail

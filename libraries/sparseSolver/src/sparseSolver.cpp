@@ -30,10 +30,10 @@ SolverKind parseSolverKind(const std::string& name) {
   throw Error("unknown sparse solver '" + name + "' (valid: " + joinEnumNames(kSolverNames, ", ", ", ") + ")");
 }
 
-std::unique_ptr<SparseSolver> makeSparseSolver(SolverKind kind) {
+std::unique_ptr<SparseSolver> makeSparseSolver(SolverKind kind, FillOrdering ordering) {
   switch (kind) {
     case SolverKind::cholmod:
-      return detail::makeCholmodSolver();
+      return detail::makeCholmodSolver(ordering);
     case SolverKind::umfpack:
       return detail::makeUmfpackSolver();
     case SolverKind::eigenLDLT:

@@ -88,7 +88,7 @@ class SolverBase : public SparseSolver {
 };
 
 /// Backend factories, one per source file.
-std::unique_ptr<SparseSolver> makeCholmodSolver();
+std::unique_ptr<SparseSolver> makeCholmodSolver(FillOrdering ordering);
 std::unique_ptr<SparseSolver> makeUmfpackSolver();
 std::unique_ptr<SparseSolver> makeEigenLDLTSolver();
 std::unique_ptr<SparseSolver> makeEigenLUSolver();
