@@ -139,6 +139,28 @@ TEST(SubmatrixExtractor, ExtractsFreeSystemOfAssembledStiffness) {
   EXPECT_EQ(Eigen::MatrixXd(free), 2.0 * denseBlock(Eigen::MatrixXd(k), dofs.freeToFull(), dofs.freeToFull()));
 }
 
+// updateCombination: a A + b B on the block in one pass equals the sum of the two
+// extractions (each entry a A_ij + b B_ij, the same two products and one sum: exact), for M
+// and K of one mesh (one assembler, one pattern); a matrix of another pattern is refused.
+TEST(SubmatrixExtractor, CombinesTwoMatricesOfOnePattern) {
+  const TetMesh mesh = test::mixedMaterialBox(3);
+  const MatrixAssembler assembler(mesh);
+  const SparseMatrix k = linearStiffnessMatrix(mesh, assembler);
+  const SparseMatrix m = massMatrix(mesh, assembler, MassType::consistent);
+  const FreeDofs dofs = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("xmin"));
+  const SubmatrixExtractor extractor(m, dofs.freeToFull(), dofs.freeToFull());
+  SparseMatrix combined = extractor.extract(m);
+  const double a = 1.0, b = 0.01 * 0.01;
+  extractor.updateCombination(a, m, b, k, combined);
+  const Eigen::MatrixXd expected = a * denseBlock(Eigen::MatrixXd(m), dofs.freeToFull(), dofs.freeToFull()) +
+                                   b * denseBlock(Eigen::MatrixXd(k), dofs.freeToFull(), dofs.freeToFull());
+  EXPECT_EQ(Eigen::MatrixXd(combined), expected);
+  EXPECT_GT(expected.norm(), 0.0);
+  std::mt19937 random(3);
+  const SparseMatrix other = randomSparse(m.rows(), m.cols(), 0.01, random);
+  EXPECT_THROW(extractor.updateCombination(a, m, b, other, combined), Error);
+}
+
 TEST(SubmatrixExtractor, RejectsBadIndexListsAndForeignMatrices) {
   std::mt19937 random(1);
   const SparseMatrix full = randomSparse(10, 8, 0.3, random);

@@ -148,24 +148,45 @@ Eigen::SparseMatrix<double> SubmatrixExtractor::extract(const Eigen::SparseMatri
   return sub;
 }
 
-void SubmatrixExtractor::update(const Eigen::SparseMatrix<double>& full, Eigen::SparseMatrix<double>& sub) const {
+void SubmatrixExtractor::checkShapes(const Eigen::SparseMatrix<double>& full, const Eigen::SparseMatrix<double>& sub,
+                                     const char* caller) const {
   if (full.rows() != sourceRows_ || full.cols() != sourceCols_ || full.nonZeros() != sourceNonZeros_) {
-    throw Error("SubmatrixExtractor::update: the " + std::to_string(full.rows()) + " x " + std::to_string(full.cols()) +
-                " matrix with " + std::to_string(full.nonZeros()) +
+    throw Error(std::string("SubmatrixExtractor::") + caller + ": the " + std::to_string(full.rows()) + " x " +
+                std::to_string(full.cols()) + " matrix with " + std::to_string(full.nonZeros()) +
                 " entries does not have the pattern the extractor was built for (" + std::to_string(sourceRows_) +
                 " x " + std::to_string(sourceCols_) + ", " + std::to_string(sourceNonZeros_) + " entries)");
   }
   if (sub.rows() != pattern_.rows() || sub.cols() != pattern_.cols() || sub.nonZeros() != pattern_.nonZeros() ||
       !sub.isCompressed()) {
-    throw Error("SubmatrixExtractor::update: sub is not a matrix from extract() (" + std::to_string(sub.rows()) +
-                " x " + std::to_string(sub.cols()) + ", expected " + std::to_string(pattern_.rows()) + " x " +
-                std::to_string(pattern_.cols()) + ")");
+    throw Error(std::string("SubmatrixExtractor::") + caller + ": sub is not a matrix from extract() (" +
+                std::to_string(sub.rows()) + " x " + std::to_string(sub.cols()) + ", expected " +
+                std::to_string(pattern_.rows()) + " x " + std::to_string(pattern_.cols()) + ")");
   }
+}
+
+void SubmatrixExtractor::update(const Eigen::SparseMatrix<double>& full, Eigen::SparseMatrix<double>& sub) const {
+  checkShapes(full, sub, "update");
   const double* source = full.valuePtr();
   double* target = sub.valuePtr();
   const Eigen::Index count = pattern_.nonZeros();
 #pragma omp parallel for schedule(static)
   for (Eigen::Index k = 0; k < count; ++k) target[k] = source[sourceSlots_[static_cast<std::size_t>(k)]];
+}
+
+void SubmatrixExtractor::updateCombination(double a, const Eigen::SparseMatrix<double>& A, double b,
+                                           const Eigen::SparseMatrix<double>& B,
+                                           Eigen::SparseMatrix<double>& sub) const {
+  checkShapes(A, sub, "updateCombination");
+  checkShapes(B, sub, "updateCombination");
+  const double* first = A.valuePtr();
+  const double* second = B.valuePtr();
+  double* target = sub.valuePtr();
+  const Eigen::Index count = pattern_.nonZeros();
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index k = 0; k < count; ++k) {
+    const std::size_t slot = static_cast<std::size_t>(sourceSlots_[static_cast<std::size_t>(k)]);
+    target[k] = (a * first[slot]) + (b * second[slot]);
+  }
 }
 
 }  // namespace asyncfem

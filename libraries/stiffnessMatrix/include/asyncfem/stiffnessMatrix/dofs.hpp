@@ -61,8 +61,18 @@ class SubmatrixExtractor {
   /// the pattern the extractor was built from (size and entry count are checked:
   /// asyncfem::Error otherwise). Parallel, one copy per stored entry.
   void update(const Eigen::SparseMatrix<double>& full, Eigen::SparseMatrix<double>& sub) const;
+  /// Overwrites sub's values (sub from extract()) with those of a A + b B, where A and B
+  /// both have the pattern the extractor was built from (checked as in update()): one pass
+  /// instead of two extractions and a sum, e.g. M + h^2 K on a block of one mesh.
+  void updateCombination(double a, const Eigen::SparseMatrix<double>& A, double b, const Eigen::SparseMatrix<double>& B,
+                         Eigen::SparseMatrix<double>& sub) const;
 
  private:
+  // Throws asyncfem::Error (naming caller) unless full has the source pattern's shape and
+  // entry count and sub is one of extract()'s matrices.
+  void checkShapes(const Eigen::SparseMatrix<double>& full, const Eigen::SparseMatrix<double>& sub,
+                   const char* caller) const;
+
   Eigen::SparseMatrix<double> pattern_;
   std::vector<int> sourceSlots_;  // for every stored entry of pattern_, its index in full.valuePtr()
   // Shape and entry count of the matrix the map was built from (cheap pattern check).
