@@ -39,8 +39,13 @@ struct AsyncBackwardEuler::Impl {
   Eigen::VectorXd internalForce;
   std::vector<FastRegion> regions;
   SubmatrixExtractor massLL, stiffLL;
-  SparseMatrix Mll, Kll;     // M^{LL} (constant), K^{LL}
-  bool cutLL = false;        // K^{LL} extracted once per partition; later only its values are updated
+  // M and K share one pattern (element matrices on the same mesh): K^{LL} is cut with
+  // massLL's map and stiffLL stays empty. Checked once (-1: not yet).
+  int sharedPattern = -1;
+  // Linear forces: K is in stiffness (constant), so a new partition need not evaluate it again.
+  bool linearStiffnessKnown = false;
+  SparseMatrix Mll, Kll;     // M^{LL} (constant), K^{LL}; only when M and K have different patterns
+  bool cutLL = false;        // L's blocks extracted once per partition; later only their values are updated
   SparseMatrix largeSystem;  // Â^L
   detail::SchurSolver schur;
   detail::NaiveSolver naive;
@@ -312,8 +317,9 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   partition_ = std::move(partition);
   const SparseMatrix& mass = system_.mass;
   const std::vector<int>& large = partition_.largeDofs();
+  if (d.sharedPattern < 0) d.sharedPattern = detail::samePattern(mass, d.stiffness) ? 1 : 0;
   d.massLL = SubmatrixExtractor(mass, large, large);
-  d.stiffLL = SubmatrixExtractor(d.stiffness, large, large);
+  d.stiffLL = d.sharedPattern == 1 ? SubmatrixExtractor() : SubmatrixExtractor(d.stiffness, large, large);
   d.cutLL = false;
   d.regions.clear();
   d.regions.reserve(static_cast<std::size_t>(partition_.numRegions()));
@@ -326,8 +332,14 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
     runStats_.interfaceDofs += static_cast<int>(partition_.interfaceDofs(i).size());
   }
   if (distributed()) assignRegionOwners();
+  if (d.linear) {
+    // K is constant: evaluated once for the first partition, kept for the next ones.
+    detail::evaluateForces(system_, true, d.linearStiffnessKnown, displacement_, d.internalForce, d.stiffness, stats_);
+    d.linearStiffnessKnown = true;
+  }
   if (options_.coupling == AsyncCoupling::stable) {
-    d.perElementTangent = detail::findInterfaceElements(*system_.mesh, partition_, system_, d.regions);
+    d.perElementTangent =
+        detail::findInterfaceElements(*system_.mesh, partition_, system_, d.regions, d.linear ? &d.stiffness : nullptr);
   }
   d.schur.reset();
   if (options_.largeSystemSolver) {
@@ -344,7 +356,6 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   if (d.linear) {
     // K is constant: build and factor everything now, so the first step costs a steady one.
     d.settingUp = true;
-    detail::evaluateForces(system_, true, false, displacement_, d.internalForce, d.stiffness, stats_);
     refactor();
     d.settingUp = false;
     d.factorsCurrent = true;
@@ -404,12 +415,18 @@ void AsyncBackwardEuler::assembleBlocks() {
   const double hL = timestep();
   const double alpha = system_.rayleighMass, beta = system_.rayleighStiffness;
   Stopwatch assembly;
-  if (!d.cutLL) d.Mll = d.massLL.extract(system_.mass);
-  detail::updateBlock(d.stiffLL, d.stiffness, d.Kll, d.cutLL);
-  d.cutLL = true;
   // A^L = M^{LL} + hL D^{LL} + hL^2 K^{LL} (Eq. A1 at hL).
   const stepFormula::MatrixWeights weights = stepFormula::backwardEuler::systemMatrix(hL, alpha, beta);
-  detail::combineInto(weights.mass, d.Mll, weights.stiffness, d.Kll, d.largeSystem);
+  if (d.sharedPattern == 1) {
+    // One pass over L's entries of M and K (no M^{LL}, K^{LL} of their own).
+    if (!d.cutLL) d.largeSystem = d.massLL.extract(system_.mass);
+    d.massLL.updateCombination(weights.mass, system_.mass, weights.stiffness, d.stiffness, d.largeSystem);
+  } else {
+    if (!d.cutLL) d.Mll = d.massLL.extract(system_.mass);
+    detail::updateBlock(d.stiffLL, d.stiffness, d.Kll, d.cutLL);
+    detail::combineInto(weights.mass, d.Mll, weights.stiffness, d.Kll, d.largeSystem);
+  }
+  d.cutLL = true;
   for (FastRegion& rb : d.regions) rb.updateBlocks(d.stiffness, hL, alpha, beta, system_.damped(), options_.coupling);
   if (options_.coupling == AsyncCoupling::stable) subtractInterfaceStiffness();
   if (d.linear && !d.symmetryChecked) {

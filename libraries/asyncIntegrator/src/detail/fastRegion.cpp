@@ -25,7 +25,8 @@ FastRegion::FastRegion(const SparseMatrix& mass, const SparseMatrix& stiffnessPa
   Mss = massSS.extract(mass);
   Msi = massSI.extract(mass);
   Mis = massIS.extract(mass);
-  solver = makeSparseSolver(solverKind);
+  // Fast regions are analysed at every (re-)partition: AMD where it is the cheaper analysis.
+  solver = makeSparseSolver(solverKind, FillOrdering::automatic);
 }
 
 void FastRegion::updateStiffnessBlocks(const SparseMatrix& stiffness) {
@@ -255,7 +256,7 @@ CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOp
         static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(threads, q / kMinZColumnsPerThread)));
     run.threads = std::max(run.threads, blocks);
     while (static_cast<int>(rb.helperSolvers.size()) < blocks - 1) {
-      rb.helperSolvers.push_back(makeSparseSolver(rb.solver->kind()));
+      rb.helperSolvers.push_back(makeSparseSolver(rb.solver->kind(), FillOrdering::automatic));
       rb.helperAnalyzed.push_back(0);
     }
     for (int j = 1; j < blocks; ++j) helpers.emplace_back(static_cast<int>(i), j - 1);

@@ -14,10 +14,14 @@ namespace {
 
 /// The matrix model's K against the mesh's linear FEM stiffness on the columns of the
 /// interface DOFs (see findInterfaceElements).
-void checkLinearModelMatchesMesh(const TetMesh& mesh, const RegionPartition& partition, const DynamicSystem& system) {
-  const Eigen::VectorXd probe = Eigen::VectorXd::Zero(mesh.numDofs());
-  Eigen::SparseMatrix<double> stiffness = system.forceModel->createStiffnessMatrix();
-  system.forceModel->tangentStiffness(probe, stiffness);
+void checkLinearModelMatchesMesh(const TetMesh& mesh, const RegionPartition& partition, const DynamicSystem& system,
+                                 const Eigen::SparseMatrix<double>* knownStiffness) {
+  Eigen::SparseMatrix<double> evaluated;
+  if (knownStiffness == nullptr) {
+    evaluated = system.forceModel->createStiffnessMatrix();
+    system.forceModel->tangentStiffness(Eigen::VectorXd::Zero(mesh.numDofs()), evaluated);
+  }
+  const Eigen::SparseMatrix<double>& stiffness = knownStiffness != nullptr ? *knownStiffness : evaluated;
   std::vector<int> columnOf(static_cast<std::size_t>(mesh.numDofs()), -1);
   std::vector<int> columns;
   for (int i = 0; i < partition.numRegions(); ++i)
@@ -67,7 +71,7 @@ void checkLinearModelMatchesMesh(const TetMesh& mesh, const RegionPartition& par
 }  // namespace
 
 bool findInterfaceElements(const TetMesh& mesh, const RegionPartition& partition, const DynamicSystem& system,
-                           std::vector<FastRegion>& regions) {
+                           std::vector<FastRegion>& regions, const Eigen::SparseMatrix<double>* knownStiffness) {
   const std::vector<int>& vertexRegion = partition.vertexRegion();
   std::vector<std::vector<int>> interfaceIndex(regions.size());
   for (int i = 0; i < partition.numRegions(); ++i) {
@@ -108,7 +112,7 @@ bool findInterfaceElements(const TetMesh& mesh, const RegionPartition& partition
     regions[static_cast<std::size_t>(fast)].interfaceElements.push_back(element);
   }
   if (perElement) return true;
-  checkLinearModelMatchesMesh(mesh, partition, system);
+  checkLinearModelMatchesMesh(mesh, partition, system, knownStiffness);
   return false;
 }
 

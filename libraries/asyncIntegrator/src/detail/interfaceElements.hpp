@@ -18,8 +18,11 @@ namespace asyncfem::detail {
 /// same element matrices summed in another order differ by round-off, ~1e-15; a different
 /// material or a scaled K differs by far more; asyncfem::ValidationError otherwise, and
 /// for a nonlinear model without element tangents). Returns whether the force model gives
-/// per-element tangents (then they are recomputed at every rebuild).
+/// per-element tangents (then they are recomputed at every rebuild). knownStiffness, when
+/// given, is the linear model's K already evaluated (the check then reads it instead of
+/// asking the model for a new copy).
 bool findInterfaceElements(const TetMesh& mesh, const RegionPartition& partition, const DynamicSystem& system,
-                           std::vector<FastRegion>& regions);
+                           std::vector<FastRegion>& regions,
+                           const Eigen::SparseMatrix<double>* knownStiffness = nullptr);
 
 }  // namespace asyncfem::detail

@@ -35,15 +35,12 @@ double columnDot(const SparseMatrix& matrix, int column, const Eigen::VectorXd& 
   return sum;
 }
 
-namespace {
-/// Whether x and y are compressed with identical patterns.
 bool samePattern(const SparseMatrix& x, const SparseMatrix& y) {
   return x.rows() == y.rows() && x.cols() == y.cols() && x.isCompressed() && y.isCompressed() &&
          x.nonZeros() == y.nonZeros() &&
          std::equal(x.outerIndexPtr(), x.outerIndexPtr() + x.outerSize() + 1, y.outerIndexPtr()) &&
          std::equal(x.innerIndexPtr(), x.innerIndexPtr() + x.nonZeros(), y.innerIndexPtr());
 }
-}  // namespace
 
 void combineInto(double a, const SparseMatrix& A, double b, const SparseMatrix& B, SparseMatrix& out) {
   if (!samePattern(A, B)) {

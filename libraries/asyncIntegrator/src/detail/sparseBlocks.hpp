@@ -23,6 +23,9 @@ double* findEntry(SparseMatrix& matrix, int row, int column);
 /// Column c of a compressed matrix dotted with x (row c of K x when K is symmetric).
 double columnDot(const SparseMatrix& matrix, int column, const Eigen::VectorXd& x);
 
+/// Whether x and y are compressed with identical patterns (sizes, column starts and rows).
+bool samePattern(const SparseMatrix& x, const SparseMatrix& y);
+
 /// out = a A + b B. When A and B share one pattern (blocks cut from M and K, which the
 /// assembler builds on one pattern) only values are written, into out's storage if it
 /// already has that pattern; otherwise Eigen's general sum.
