@@ -332,9 +332,10 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
     runStats_.interfaceDofs += static_cast<int>(partition_.interfaceDofs(i).size());
   }
   if (distributed()) assignRegionOwners();
-  if (d.linear) {
-    // K is constant: evaluated once for the first partition, kept for the next ones.
-    detail::evaluateForces(system_, true, d.linearStiffnessKnown, displacement_, d.internalForce, d.stiffness, stats_);
+  if (d.linear && !d.linearStiffnessKnown) {
+    // K is constant: evaluated for the first partition, kept for the next ones (whose steps
+    // evaluate f_int themselves).
+    detail::evaluateForces(system_, true, false, displacement_, d.internalForce, d.stiffness, stats_);
     d.linearStiffnessKnown = true;
   }
   if (options_.coupling == AsyncCoupling::stable) {
