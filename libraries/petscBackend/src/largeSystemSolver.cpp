@@ -491,12 +491,7 @@ PetscRegionDistribution makePetscRegionDistribution(const TetMesh& mesh, std::sh
     }
     return owned;
   };
-  distribution.sum = [](double* values, std::size_t count) {
-    if (count == 0) return;
-    const int status =
-        MPI_Allreduce(MPI_IN_PLACE, values, static_cast<int>(count), MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
-    if (status != MPI_SUCCESS) throw Error("async integrator over MPI: MPI_Allreduce failed");
-  };
+  distribution.sum = [](double* values, std::size_t count) { detail::sumOverRanks(PETSC_COMM_WORLD, values, count); };
   return distribution;
 }
 

@@ -18,14 +18,6 @@ namespace asyncfem {
 
 namespace {
 
-/// Sums values over the ranks of comm in place.
-void sumOverRanks(MPI_Comm comm, double* values, Eigen::Index count) {
-  if (count == 0) return;
-  if (MPI_Allreduce(MPI_IN_PLACE, values, static_cast<int>(count), MPI_DOUBLE, MPI_SUM, comm) != MPI_SUCCESS) {
-    throw Error("rank-summed force model: MPI_Allreduce failed");
-  }
-}
-
 class RankSummedForceModel final : public ForceModel {
  public:
   RankSummedForceModel(const TetMesh& mesh, const ProblemSettings& physics, std::shared_ptr<ForceModel> wholeMesh)
@@ -36,7 +28,8 @@ class RankSummedForceModel final : public ForceModel {
     for (int e = 0; e < mesh.numElements(); ++e) {
       if (parts[static_cast<std::size_t>(e)] == rank) meshElement_.push_back(e);
     }
-    pattern_ = whole_->createStiffnessMatrix();
+    const Eigen::SparseMatrix<double> pattern = whole_->createStiffnessMatrix();
+    entries_ = pattern.nonZeros();
     detail::collectively(PETSC_COMM_WORLD, [&] {
       if (meshElement_.empty()) return;  // a rank without elements adds zeros
       const TetMesh part = detail::subMesh(mesh, meshElement_, meshVertex_);
@@ -45,7 +38,7 @@ class RankSummedForceModel final : public ForceModel {
                                           physics.hyperelastic);
       });
       subTangent_ = model_->createStiffnessMatrix();
-      mapEntries();
+      mapEntries(pattern);
       subDisplacement_.setZero(part.numDofs());
     });
   }
@@ -74,9 +67,9 @@ class RankSummedForceModel final : public ForceModel {
         throw Error("rank-summed force model: displacement has size " + std::to_string(displacement.size()) +
                     ", expected " + std::to_string(numDofs()));
       }
-      if (stiffness.rows() != pattern_.rows() || stiffness.cols() != pattern_.cols() || !stiffness.isCompressed() ||
-          stiffness.nonZeros() != pattern_.nonZeros()) {
-        stiffness = pattern_;  // not the pattern of createStiffnessMatrix(): given it, as the models do
+      if (stiffness.rows() != numDofs() || stiffness.cols() != numDofs() || !stiffness.isCompressed() ||
+          stiffness.nonZeros() != entries_) {
+        stiffness = createStiffnessMatrix();  // not the pattern of createStiffnessMatrix(): given it, as the models do
       }
       forces.setZero(numDofs());
       std::fill(stiffness.valuePtr(), stiffness.valuePtr() + stiffness.nonZeros(), 0.0);
@@ -93,19 +86,19 @@ class RankSummedForceModel final : public ForceModel {
       const double* subValues = subTangent_.valuePtr();
       for (std::size_t p = 0; p < entry_.size(); ++p) values[entry_[p]] += subValues[p];
     });
-    sumOverRanks(PETSC_COMM_WORLD, forces.data(), forces.size());
-    sumOverRanks(PETSC_COMM_WORLD, stiffness.valuePtr(), stiffness.nonZeros());
+    detail::sumOverRanks(PETSC_COMM_WORLD, forces.data(), static_cast<std::size_t>(forces.size()));
+    detail::sumOverRanks(PETSC_COMM_WORLD, stiffness.valuePtr(), static_cast<std::size_t>(stiffness.nonZeros()));
   }
 
  private:
   // entry_[p]: the stored entry of the whole mesh's pattern that the sub-tangent's stored
   // entry p adds to (same DOF pair in mesh numbering).
-  void mapEntries() {
+  void mapEntries(const Eigen::SparseMatrix<double>& pattern) {
     entry_.resize(static_cast<std::size_t>(subTangent_.nonZeros()));
     for (Eigen::Index j = 0; j < subTangent_.outerSize(); ++j) {
       const Eigen::Index column = (3 * meshVertex_[static_cast<std::size_t>(j / 3)]) + (j % 3);
-      const int* rowsBegin = pattern_.innerIndexPtr() + pattern_.outerIndexPtr()[column];
-      const int* rowsEnd = pattern_.innerIndexPtr() + pattern_.outerIndexPtr()[column + 1];
+      const int* rowsBegin = pattern.innerIndexPtr() + pattern.outerIndexPtr()[column];
+      const int* rowsEnd = pattern.innerIndexPtr() + pattern.outerIndexPtr()[column + 1];
       for (Eigen::Index p = subTangent_.outerIndexPtr()[j]; p < subTangent_.outerIndexPtr()[j + 1]; ++p) {
         const int subRow = subTangent_.innerIndexPtr()[p];
         const int row = (3 * meshVertex_[static_cast<std::size_t>(subRow / 3)]) + (subRow % 3);
@@ -114,16 +107,16 @@ class RankSummedForceModel final : public ForceModel {
           throw Error("rank-summed force model: the whole mesh's stiffness pattern lacks entry (" +
                       std::to_string(row) + ", " + std::to_string(column) + ")");
         }
-        entry_[static_cast<std::size_t>(p)] = found - pattern_.innerIndexPtr();
+        entry_[static_cast<std::size_t>(p)] = found - pattern.innerIndexPtr();
       }
     }
   }
 
   std::shared_ptr<ForceModel> whole_;
-  Eigen::SparseMatrix<double> pattern_;  // whole_'s pattern, for the entry map and checks
-  std::vector<int> meshElement_;         // this rank's elements (sub-mesh element -> mesh element)
-  std::vector<int> meshVertex_;          // sub-mesh vertex -> mesh vertex
-  std::unique_ptr<ForceModel> model_;    // null on a rank without elements
+  Eigen::Index entries_ = 0;           // stored entries of whole_'s pattern (the size check)
+  std::vector<int> meshElement_;       // this rank's elements (sub-mesh element -> mesh element)
+  std::vector<int> meshVertex_;        // sub-mesh vertex -> mesh vertex
+  std::unique_ptr<ForceModel> model_;  // null on a rank without elements
   std::vector<Eigen::Index> entry_;
   Eigen::VectorXd subDisplacement_, subForces_;
   Eigen::SparseMatrix<double> subTangent_;

@@ -83,4 +83,11 @@ void collectively(MPI_Comm comm, const std::function<void()>& work) {
   }
 }
 
+void sumOverRanks(MPI_Comm comm, double* values, std::size_t count) {
+  if (count == 0) return;
+  if (MPI_Allreduce(MPI_IN_PLACE, values, static_cast<int>(count), MPI_DOUBLE, MPI_SUM, comm) != MPI_SUCCESS) {
+    throw Error("MPI_Allreduce (a sum over the ranks) failed");
+  }
+}
+
 }  // namespace asyncfem::detail

@@ -4,6 +4,7 @@
 #include <mpi.h>
 #include <petscsys.h>
 
+#include <cstddef>
 #include <functional>
 
 namespace asyncfem::detail {
@@ -24,5 +25,9 @@ void checkPetsc(PetscErrorCode code, const char* call);
 /// waiting in a later collective call. Collective over comm; work must not call
 /// collective operations itself.
 void collectively(MPI_Comm comm, const std::function<void()>& work);
+
+/// Sums count doubles over the ranks of comm in place (MPI_Allreduce); collective. Throws
+/// asyncfem::Error if MPI reports a failure.
+void sumOverRanks(MPI_Comm comm, double* values, std::size_t count);
 
 }  // namespace asyncfem::detail
