@@ -843,10 +843,7 @@ asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options, cons
       });
   if (options.petscElements != "distributed" || scene.forceModel == asyncfem::ForceModelType::linear) return registry;
   // Each rank evaluates the nonlinear forces and tangent of its own elements; the sums reach every rank.
-  asyncfem::ProblemSettings physics;
-  physics.forceModel = scene.forceModel;
-  physics.tangent = scene.tangent;
-  physics.hyperelastic = scene.hyperelastic;
+  const asyncfem::ProblemSettings physics = asyncfem::problemSettings(scene);
   const asyncfem::IntegratorFactory async = *registry.find("async");
   registry.add(
       "async",

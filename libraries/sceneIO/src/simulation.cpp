@@ -278,10 +278,7 @@ TetMesh buildSceneMesh(const Scene& scene, std::vector<std::string>* warnings) {
   return applyMaterialOverrides(scene, loadMesh(scene, warnings));
 }
 
-std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std::string>* warnings) {
-  auto mesh = std::make_shared<const TetMesh>(buildSceneMesh(scene, warnings));
-  std::vector<int> fixed = collectFixedVertices(scene, *mesh);
-  std::vector<VertexLoad> loads = collectLoads(scene, *mesh, frameTimingOf(scene).timestep);
+ProblemSettings problemSettings(const Scene& scene) {
   ProblemSettings settings;
   settings.mass = scene.mass;
   settings.forceModel = scene.forceModel;
@@ -290,6 +287,14 @@ std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std:
   settings.rayleighAlpha = scene.rayleighAlpha;
   settings.rayleighBeta = scene.rayleighBeta;
   settings.gravity = scene.gravity;
+  return settings;
+}
+
+std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std::string>* warnings) {
+  auto mesh = std::make_shared<const TetMesh>(buildSceneMesh(scene, warnings));
+  std::vector<int> fixed = collectFixedVertices(scene, *mesh);
+  std::vector<VertexLoad> loads = collectLoads(scene, *mesh, frameTimingOf(scene).timestep);
+  const ProblemSettings settings = problemSettings(scene);
   std::shared_ptr<const PenaltyContact> contact;
   if (scene.contact.enabled()) {
     contact = std::make_shared<PenaltyContact>(mesh->restPositions(), scene.contact.planes, scene.contact.spheres,

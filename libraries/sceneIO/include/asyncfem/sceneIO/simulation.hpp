@@ -42,6 +42,10 @@ TetMesh buildSceneMesh(const Scene& scene, std::vector<std::string>* warnings = 
 /// fixed). warnings: as for buildSceneMesh.
 std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std::string>* warnings = nullptr);
 
+/// The physics settings a scene gives its Problem (mass, force model with its tangent and
+/// hyperelastic options, Rayleigh damping, gravity): what buildProblem() passes on.
+ProblemSettings problemSettings(const Scene& scene);
+
 /// The problem of the scene an .afsim file recorded (header.scenePath, version 2), for
 /// readers of the frames that were given no --scene or --mesh. Throws asyncfem::Error
 /// naming fileName when the file records no scene, the scene cannot be loaded, or it now
