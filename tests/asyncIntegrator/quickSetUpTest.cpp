@@ -124,6 +124,30 @@ TEST(QuickSetUp, ANewPartitionFactorsOnlyItsRegions) {
   EXPECT_LT(stateDifference(exact, fast), 1e-8);
 }
 
+// Partitions that shrink L and grow it again: the deflation directions' storage is kept
+// across partitions (only their count is reset), so the directions of an earlier partition
+// must not leak into a later one's solves. Five steps each, rent-or-buy off so that every
+// step stays on the quick path; 1e-8 relative to the exact set-up over the 15 steps.
+TEST(QuickSetUp, DeflationStorageKeptAcrossPartitionsOfEverySize) {
+  const test::TestSystem ts = test::makeTestSystem(0.0, 1e-3);
+  const std::vector<AsyncRegion> small{{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}};
+  const std::vector<AsyncRegion> large{{"half", test::verticesBeyond(ts.mesh, 0.5), 8}};
+  AsyncOptions options = quick(true);
+  options.quickSetUpRebuild = false;
+  SideBySide runs(ts, small, quick(false), options);
+  for (const std::vector<AsyncRegion>* regions : {&large, &small}) {
+    for (int k = 0; k < 5; ++k) runs.step();
+    runs.fast.setUp(RegionPartition(ts.mesh, ts.system.freeDofs, *regions));
+    runs.exact.setUp(runs.fast.partition());
+  }
+  long long last = 0;
+  for (int k = 0; k < 5; ++k) last = runs.step();
+  EXPECT_EQ(runs.fast.runStats().quickSteps, 15);
+  EXPECT_EQ(runs.fast.runStats().quickEnds, 0);
+  EXPECT_LT(last, runs.fast.runStats().quickIterations / 15);  // still learning from its own solves
+  EXPECT_LT(runs.difference(), 1e-8);
+}
+
 // Corotational forces: the tangent changes every step, so the kept directions are dropped
 // at every refactorization and the borrowed factor (first tangent) preconditions the
 // later ones; 1e-8 relative over 15 steps, as for linear forces.

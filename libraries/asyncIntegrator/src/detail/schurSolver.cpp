@@ -29,10 +29,34 @@ std::vector<int> interfaceUnionOf(const RegionPartition& partition) {
 }
 }  // namespace
 
+void ColumnStore::shape(Eigen::Index rows, Eigen::Index columns, Eigen::Index kept) {
+  const auto needed = static_cast<std::size_t>(rows) * static_cast<std::size_t>(columns);
+  if (needed > capacity_) {
+    // A quarter more than asked: the next partition's interface is often a little larger.
+    // Pages untouched until written cost nothing.
+    const std::size_t capacity = needed + needed / 4;
+    std::unique_ptr<double[]> grown(new double[capacity]);
+    if (rows == rows_ && kept > 0) std::copy_n(data_.get(), static_cast<std::size_t>(rows * kept), grown.get());
+    data_ = std::move(grown);
+    capacity_ = capacity;
+  }
+  rows_ = rows;
+  columns_ = columns;
+}
+
+void ColumnStore::release() {
+  data_.reset();
+  capacity_ = 0;
+  rows_ = columns_ = 0;
+}
+
 void SchurSolver::reset() {
   AsyncOptions::LargeSystemSolverFactory external = std::move(external_);
+  ColumnStore directions = std::move(directions_), products = std::move(productsOfDirections_);
   *this = SchurSolver();
   external_ = std::move(external);
+  directions_ = std::move(directions);
+  productsOfDirections_ = std::move(products);
 }
 
 void SchurSolver::useExternalSolver(AsyncOptions::LargeSystemSolverFactory factory, std::vector<int> largeDofs,
@@ -65,8 +89,8 @@ void SchurSolver::factor(const SparseMatrix& largeSystem, const RegionPartition&
   borrowed_ = nullptr;
   borrowedLarge_.clear();
   kept_ = 0;
-  directions_.resize(0, 0);
-  productsOfDirections_.resize(0, 0);
+  directions_.release();
+  productsOfDirections_.release();
   const auto numLarge = static_cast<double>(largeSystem.rows());
   if (largeSystem.rows() == 0) return;
   const std::vector<int> all = interfaceUnionOf(partition);
@@ -276,10 +300,11 @@ SchurSolver::Refinement SchurSolver::solveDeflated(const Eigen::VectorXd& rhs, E
     result.converged = result.zeroRightHandSide = true;
     return result;
   }
-  if (directions_.rows() != n || directions_.cols() < keep) {
-    directions_.conservativeResize(n, keep);
-    productsOfDirections_.conservativeResize(n, keep);
+  if (directions_.rows() != n) kept_ = 0;  // another operator's size: nothing to keep
+  if (directions_.rows() != n || directions_.columns() < keep) {
     kept_ = std::min(kept_, keep);
+    directions_.shape(n, keep, kept_);
+    productsOfDirections_.shape(n, keep, kept_);
   }
   residual_ = rhs;
   if (kept_ > 0) {

@@ -19,6 +19,28 @@
 
 namespace asyncfem::detail {
 
+/// Columns of one length in storage that outlives them: shaping it for other columns
+/// (a new partition's |L|) reuses the memory already there, so a re-partition on the quick
+/// set-up neither frees the last partition's deflation space nor faults a new one in
+/// (2 |L| x kept doubles, up to 128 MiB). Not initialized.
+class ColumnStore {
+ public:
+  /// Room for `columns` columns of `rows` doubles. The first `kept` columns keep their
+  /// values when rows is unchanged; the others are undefined.
+  void shape(Eigen::Index rows, Eigen::Index columns, Eigen::Index kept);
+  /// Frees the storage.
+  void release();
+  Eigen::Index rows() const { return rows_; }
+  Eigen::Index columns() const { return columns_; }
+  Eigen::Map<Eigen::MatrixXd> leftCols(Eigen::Index count) { return {data_.get(), rows_, count}; }
+  Eigen::Map<Eigen::VectorXd> col(Eigen::Index k) { return {data_.get() + k * rows_, rows_}; }
+
+ private:
+  std::unique_ptr<double[]> data_;
+  std::size_t capacity_ = 0;
+  Eigen::Index rows_ = 0, columns_ = 0;
+};
+
 /// Factors H^{LL*} in one of three strategies (SchurMode) and solves with it; with a
 /// factor kept from an earlier tangent, solves the current Schur system by preconditioned
 /// refinement (AsyncOptions::laggedSchur); or, before any factor of its own, borrows the
@@ -72,8 +94,8 @@ class SchurSolver {
   void forgetDirections() { kept_ = 0; }
   int keptDirections() const { return kept_; }
 
-  /// Forgets the pattern, the analysis and the factor (a new partition). Keeps the
-  /// external solver's factory.
+  /// Forgets the pattern, the analysis, the factor and the deflation directions (a new
+  /// partition). Keeps the external solver's factory and the directions' storage.
   void reset();
   /// From the next factor() on, H^{LL*} is assembled (symmetric mode) and factored by the
   /// solver factory(largeDofs, interfaceDofs) returns (AsyncOptions::largeSystemSolver);
@@ -107,7 +129,8 @@ class SchurSolver {
   std::vector<int> borrowedLarge_;  // global ids of L (a copy: the set-up may be cached)
   // Deflation space of solveDeflated: columns [0, kept_) of directions_ (W, H^{LL*}-
   // orthonormal) and of their products (H^{LL*} W).
-  Eigen::MatrixXd directions_, productsOfDirections_;
+  // Kept by reset().
+  ColumnStore directions_, productsOfDirections_;
   int kept_ = 0;
   Eigen::VectorXd coefficients_;
   std::unique_ptr<SparseSolver> solver_;  // of H^{LL*} (lu, symmetric) or of A^L (lowRank)
