@@ -156,9 +156,17 @@ TEST(SubmatrixExtractor, CombinesTwoMatricesOfOnePattern) {
                                    b * denseBlock(Eigen::MatrixXd(k), dofs.freeToFull(), dofs.freeToFull());
   EXPECT_EQ(Eigen::MatrixXd(combined), expected);
   EXPECT_GT(expected.norm(), 0.0);
+  // extractCombination: the same matrix, pattern included, from nothing; and it can be updated.
+  SparseMatrix fresh = extractor.extractCombination(a, m, b, k);
+  EXPECT_EQ(fresh.nonZeros(), combined.nonZeros());
+  EXPECT_EQ(Eigen::MatrixXd(fresh), expected);
+  extractor.updateCombination(2.0 * a, m, b, k, fresh);
+  EXPECT_EQ(Eigen::MatrixXd(fresh), 2.0 * a * denseBlock(Eigen::MatrixXd(m), dofs.freeToFull(), dofs.freeToFull()) +
+                                        b * denseBlock(Eigen::MatrixXd(k), dofs.freeToFull(), dofs.freeToFull()));
   std::mt19937 random(3);
   const SparseMatrix other = randomSparse(m.rows(), m.cols(), 0.01, random);
   EXPECT_THROW(extractor.updateCombination(a, m, b, other, combined), Error);
+  EXPECT_THROW((void)extractor.extractCombination(a, m, b, other), Error);
 }
 
 TEST(SubmatrixExtractor, RejectsBadIndexListsAndForeignMatrices) {

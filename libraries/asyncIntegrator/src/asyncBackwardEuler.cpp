@@ -420,8 +420,11 @@ void AsyncBackwardEuler::assembleBlocks() {
   const stepFormula::MatrixWeights weights = stepFormula::backwardEuler::systemMatrix(hL, alpha, beta);
   if (d.sharedPattern == 1) {
     // One pass over L's entries of M and K (no M^{LL}, K^{LL} of their own).
-    if (!d.cutLL) d.largeSystem = d.massLL.extract(system_.mass);
-    d.massLL.updateCombination(weights.mass, system_.mass, weights.stiffness, d.stiffness, d.largeSystem);
+    if (!d.cutLL) {
+      d.largeSystem = d.massLL.extractCombination(weights.mass, system_.mass, weights.stiffness, d.stiffness);
+    } else {
+      d.massLL.updateCombination(weights.mass, system_.mass, weights.stiffness, d.stiffness, d.largeSystem);
+    }
   } else {
     if (!d.cutLL) d.Mll = d.massLL.extract(system_.mass);
     detail::updateBlock(d.stiffLL, d.stiffness, d.Kll, d.cutLL);

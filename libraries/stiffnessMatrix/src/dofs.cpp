@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <string>
@@ -39,17 +40,6 @@ std::vector<int> subRowMap(const std::vector<int>& rows, Eigen::Index fullRows) 
   std::vector<int> fullToSubRow(toIndex(static_cast<int>(fullRows)), -1);
   for (std::size_t k = 0; k < rows.size(); ++k) fullToSubRow[toIndex(rows[k])] = static_cast<int>(k);
   return fullToSubRow;
-}
-
-// Number of stored entries of full in columns cols whose row is kept by fullToSubRow.
-long long countKeptEntries(const Eigen::SparseMatrix<double>& full, const std::vector<int>& cols,
-                           const std::vector<int>& fullToSubRow) {
-  const int* inner = full.innerIndexPtr();
-  long long kept = 0;
-  for (int c : cols)
-    for (int p = full.outerIndexPtr()[c]; p < columnEnd(full, c); ++p)
-      kept += fullToSubRow[toIndex(inner[p])] >= 0 ? 1 : 0;
-  return kept;
 }
 
 }  // namespace
@@ -115,27 +105,30 @@ SubmatrixExtractor::SubmatrixExtractor(const Eigen::SparseMatrix<double>& full, 
   const int* outer = full.outerIndexPtr();
   const int* inner = full.innerIndexPtr();
 
-  // Two passes: count the kept entries of every column, then fill rows and sources. Rows
+  // One pass into room for every entry of the kept columns (a bound, trimmed after). Rows
   // of full are sorted and the row map is increasing, so sub's rows come out sorted.
-  const long long kept = countKeptEntries(full, cols, fullToSubRow);
+  long long bound = 0;
+  for (int c : cols) bound += columnEnd(full, c) - outer[c];
   pattern_.resize(static_cast<Eigen::Index>(rows.size()), numSubCols);
-  pattern_.resizeNonZeros(static_cast<Eigen::Index>(kept));
-  sourceSlots_.resize(static_cast<std::size_t>(kept));
+  pattern_.resizeNonZeros(static_cast<Eigen::Index>(bound));
+  sourceSlots_.resize(static_cast<std::size_t>(bound));
   int* subOuter = pattern_.outerIndexPtr();
   int* subInner = pattern_.innerIndexPtr();
+  int* slots = sourceSlots_.data();
   int written = 0;
   for (int j = 0; j < numSubCols; ++j) {
     subOuter[j] = written;
     const int c = cols[toIndex(j)];
     for (int p = outer[c]; p < columnEnd(full, c); ++p) {
       const int subRow = fullToSubRow[toIndex(inner[p])];
-      if (subRow < 0) continue;
       subInner[written] = subRow;
-      sourceSlots_[toIndex(written)] = p;
-      ++written;
+      slots[written] = p;
+      written += subRow >= 0 ? 1 : 0;
     }
   }
   subOuter[numSubCols] = written;
+  pattern_.resizeNonZeros(written);
+  sourceSlots_.resize(static_cast<std::size_t>(written));
   std::fill_n(pattern_.valuePtr(), written, 0.0);
   sourceRows_ = full.rows();
   sourceCols_ = full.cols();
@@ -145,6 +138,18 @@ SubmatrixExtractor::SubmatrixExtractor(const Eigen::SparseMatrix<double>& full, 
 Eigen::SparseMatrix<double> SubmatrixExtractor::extract(const Eigen::SparseMatrix<double>& full) const {
   Eigen::SparseMatrix<double> sub = pattern_;
   update(full, sub);
+  return sub;
+}
+
+Eigen::SparseMatrix<double> SubmatrixExtractor::extractCombination(double a, const Eigen::SparseMatrix<double>& A,
+                                                                   double b,
+                                                                   const Eigen::SparseMatrix<double>& B) const {
+  // The pattern without its zero values: updateCombination writes every value.
+  Eigen::SparseMatrix<double> sub(pattern_.rows(), pattern_.cols());
+  sub.resizeNonZeros(pattern_.nonZeros());
+  std::copy_n(pattern_.outerIndexPtr(), pattern_.outerSize() + 1, sub.outerIndexPtr());
+  std::copy_n(pattern_.innerIndexPtr(), pattern_.nonZeros(), sub.innerIndexPtr());
+  updateCombination(a, A, b, B, sub);
   return sub;
 }
 

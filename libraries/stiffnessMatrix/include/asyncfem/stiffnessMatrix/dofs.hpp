@@ -66,6 +66,10 @@ class SubmatrixExtractor {
   /// instead of two extractions and a sum, e.g. M + h^2 K on a block of one mesh.
   void updateCombination(double a, const Eigen::SparseMatrix<double>& A, double b, const Eigen::SparseMatrix<double>& B,
                          Eigen::SparseMatrix<double>& sub) const;
+  /// A new submatrix with values a A + b B: extract() and updateCombination() in one pass
+  /// over the values (a large block cut once per partition).
+  Eigen::SparseMatrix<double> extractCombination(double a, const Eigen::SparseMatrix<double>& A, double b,
+                                                 const Eigen::SparseMatrix<double>& B) const;
 
  private:
   // Throws asyncfem::Error (naming caller) unless full has the source pattern's shape and
