@@ -51,12 +51,15 @@ void ColumnStore::release() {
 }
 
 void SchurSolver::reset() {
-  AsyncOptions::LargeSystemSolverFactory external = std::move(external_);
-  ColumnStore directions = std::move(directions_), products = std::move(productsOfDirections_);
+  auto old = std::make_unique<SchurSolver>(std::move(*this));
   *this = SchurSolver();
-  external_ = std::move(external);
-  directions_ = std::move(directions);
-  productsOfDirections_ = std::move(products);
+  external_ = std::move(old->external_);
+  directions_ = std::move(old->directions_);
+  productsOfDirections_ = std::move(old->productsOfDirections_);
+  // The old factor, pattern and maps (tens of MiB at |L| of 30k) are freed by the next
+  // factor(), not here: a quick-set-up partition starts without that cost, and a
+  // partition that builds its own factor frees them just before.
+  retired_ = old->retired_ ? std::move(old->retired_) : std::move(old);
 }
 
 void SchurSolver::useExternalSolver(AsyncOptions::LargeSystemSolverFactory factory, std::vector<int> largeDofs,
@@ -84,6 +87,7 @@ void SchurSolver::chooseSolver(SchurMode mode) {
 void SchurSolver::factor(const SparseMatrix& largeSystem, const RegionPartition& partition,
                          const std::vector<FastRegion>& regions, SchurMode requested, AsyncCoupling coupling,
                          double asymmetry, IntegratorStats& stats) {
+  retired_.reset();
   factored_ = true;
   refreshNext_ = false;
   borrowed_ = nullptr;

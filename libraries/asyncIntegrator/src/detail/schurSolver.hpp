@@ -95,7 +95,8 @@ class SchurSolver {
   int keptDirections() const { return kept_; }
 
   /// Forgets the pattern, the analysis, the factor and the deflation directions (a new
-  /// partition). Keeps the external solver's factory and the directions' storage.
+  /// partition). Keeps the external solver's factory and the directions' storage; the old
+  /// factor's memory is released by the next factor().
   void reset();
   /// From the next factor() on, H^{LL*} is assembled (symmetric mode) and factored by the
   /// solver factory(largeDofs, interfaceDofs) returns (AsyncOptions::largeSystemSolver);
@@ -150,6 +151,8 @@ class SchurSolver {
   Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;  // I - U^T W C
   Eigen::MatrixXd solution_;
   Eigen::VectorXd product_, residual_, correction_, direction_;
+  // The previous partition's solver, kept by reset() until the next factor() frees it.
+  std::unique_ptr<SchurSolver> retired_;
 };
 
 }  // namespace asyncfem::detail
