@@ -23,6 +23,7 @@ void expectSameSolverOptions(const AsyncOptions& a, const AsyncOptions& b) {
   EXPECT_EQ(a.regionSolver, b.regionSolver);
   EXPECT_EQ(a.substepStatePrediction, b.substepStatePrediction);
   EXPECT_EQ(a.laggedSchur, b.laggedSchur);
+  EXPECT_EQ(a.laggedSchurRotation, b.laggedSchurRotation);
   EXPECT_EQ(a.threads, b.threads);
 }
 
@@ -47,7 +48,7 @@ TEST(AsyncSettingsCodec, ExplicitSettingsRoundTrip) {
   const std::vector<nlohmann::json> solverKeys{
       {{"coupling", "paper"}, {"schur", "lu"}, {"method", "naive"}, {"recovery", "substitution"}},
       {{"schur", "symmetric"}, {"recovery", "dense-z"}, {"regionSolver", "eigen-ldlt"}, {"laggedSchur", false}},
-      {{"regionSolver", "umfpack"}, {"threads", 3}},
+      {{"regionSolver", "umfpack"}, {"threads", 3}, {"laggedSchurRotation", false}},
       nlohmann::json::object()};
   for (nlohmann::json options : solverKeys) {
     options["regions"] = {{{"name", "stiff"}, {"ratio", 6}, {"elementSets", {"stiff"}}},

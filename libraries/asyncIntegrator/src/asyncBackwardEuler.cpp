@@ -23,6 +23,7 @@
 #include "detail/parallelTasks.hpp"
 #include "detail/schurSolver.hpp"
 #include "detail/sparseBlocks.hpp"
+#include "detail/vertexRotations.hpp"
 #include "detail/wholeSystemFactor.hpp"
 
 namespace asyncfem {
@@ -48,6 +49,7 @@ struct AsyncBackwardEuler::Impl {
   bool cutLL = false;        // L's blocks extracted once per partition; later only their values are updated
   SparseMatrix largeSystem;  // Â^L
   detail::SchurSolver schur;
+  detail::VertexRotations rotations;  // since the last rebuild (laggedSchurRotation)
   detail::NaiveSolver naive;
   // This step refactored A^S but keeps Z and H^{LL*} from an earlier tangent (laggedSchur).
   bool schurLagging = false;
@@ -476,6 +478,19 @@ void AsyncBackwardEuler::fullSchurRebuild() {
   if (setUpBuild) runStats_.setupSchurSeconds += schurSeconds;
   d.schurLagging = false;
   priceLaggedFactor();
+  if (turnsLaggedFactor()) {
+    // The rotations are measured from this state, where the factor's tangent was taken.
+    d.rotations.setReference(*system_.mesh, displacement_);
+    const std::vector<int>& large = partition_.largeDofs();
+    d.schur.setPreconditionerTransform(
+        [&d, &large](Eigen::VectorXd& x, bool transpose) { d.rotations.rotate(large, x, transpose); });
+  }
+}
+
+bool AsyncBackwardEuler::turnsLaggedFactor() const {
+  const Impl& d = *impl_;
+  return options_.laggedSchur && options_.laggedSchurRotation && !d.linear && system_.mesh &&
+         !options_.largeSystemSolver && options_.method == AsyncSolveMethod::structured;
 }
 
 // The flop prices of the lagged factor's rent-or-buy rule, with the same weights as the
@@ -723,6 +738,7 @@ void AsyncBackwardEuler::solveStructured() {
     d.schur.solve(d.rhsSchur, d.Y);
   } else {
     // At least laggedSchurIterations, and as many as one rebuild costs (rent or buy).
+    if (turnsLaggedFactor()) d.rotations.update(*system_.mesh, displacement_);
     const double affordable = d.laggedRebuildFlops / std::max(d.laggedIterationFlops, 1.0);
     const int budget = std::max(options_.laggedSchurIterations, static_cast<int>(std::min(affordable, 1000.0)));
     const detail::SchurSolver::Refinement result = d.schur.refine(

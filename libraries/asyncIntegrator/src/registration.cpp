@@ -122,6 +122,7 @@ AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
   solver.denseRegionDofs = reader.integer("denseRegionDofs", solver.denseRegionDofs, 0, 4096);
   solver.substepStatePrediction = reader.boolean("substepContact", false);
   solver.laggedSchur = reader.boolean("laggedSchur", solver.laggedSchur);
+  solver.laggedSchurRotation = reader.boolean("laggedSchurRotation", solver.laggedSchurRotation);
   solver.quickSetUp = reader.boolean("quickSetUp", solver.quickSetUp);
   solver.threads = reader.integer("threads", solver.threads, 0, 1024);
   if (solver.substepStatePrediction && !hasContact) {
@@ -259,9 +260,11 @@ AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const
 }
 
 const std::vector<std::string>& asyncOptionKeys() {
-  static const std::vector<std::string> keys{
-      "coupling",    "schur",      "method",  "recovery", "regionSolver", "denseRegionDofs", "substepContact",
-      "laggedSchur", "quickSetUp", "threads", "regions",  "auto",         "nestedSolve"};
+  static const std::vector<std::string> keys{"coupling",       "schur",        "method",
+                                             "recovery",       "regionSolver", "denseRegionDofs",
+                                             "substepContact", "laggedSchur",  "laggedSchurRotation",
+                                             "quickSetUp",     "threads",      "regions",
+                                             "auto",           "nestedSolve"};
   return keys;
 }
 
@@ -367,6 +370,9 @@ nlohmann::json asyncSettingsJson(const AsyncSettings& settings) {
     out["substepContact"] = solver.substepStatePrediction;
   }
   if (solver.laggedSchur != defaults.laggedSchur) out["laggedSchur"] = solver.laggedSchur;
+  if (solver.laggedSchurRotation != defaults.laggedSchurRotation) {
+    out["laggedSchurRotation"] = solver.laggedSchurRotation;
+  }
   if (solver.quickSetUp != defaults.quickSetUp) out["quickSetUp"] = solver.quickSetUp;
   if (solver.threads != defaults.threads) out["threads"] = solver.threads;
   if (settings.nestedSolve != NestedSolve::automatic) out["nestedSolve"] = toString(settings.nestedSolve);

@@ -545,7 +545,7 @@ struct SteadyRow {
 /// steps at hS, both as the mean wall time of all timed steps (the lagged factor's rebuilds
 /// and single-rate's refactorizations included), the medians beside them.
 void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotational, const std::string& only,
-                 bool collectFirst, bool rebuildSchur, int laggedIterations) {
+                 bool collectFirst, bool rebuildSchur, int laggedIterations, bool unturned) {
   std::vector<SteadyRow> rows;
   for (const std::string& spec : scenes) {
     const Scene scene = steadyScene(spec, corotational);
@@ -553,11 +553,13 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
     auto* async = dynamic_cast<AsyncBackwardEuler*>(simulation.integrator.get());
     if (async == nullptr) throw ValidationError(spec + ": the scene's integrator is not async");
     std::unique_ptr<AsyncBackwardEuler> rebuilt;
-    if (rebuildSchur || laggedIterations > 0) {
+    if (rebuildSchur || laggedIterations > 0 || unturned) {
       // The same scene with AsyncOptions::laggedSchur off (Z and H^{LL*} every large step),
-      // or with another iteration limit for the lagged factor.
+      // with another iteration limit for the lagged factor, or with the lagged factor not
+      // turned with the body.
       AsyncOptions options = async->options();
       options.laggedSchur = !rebuildSchur;
+      options.laggedSchurRotation = !unturned;
       if (laggedIterations > 0) options.laggedSchurIterations = laggedIterations;
       std::vector<AsyncRegion> regions;
       for (int i = 0; i < async->partition().numRegions(); ++i) regions.push_back(async->partition().region(i));
@@ -819,7 +821,7 @@ int main(int argc, char** argv) {
   double hL = 5e-3;
   std::vector<std::string> scenes;
   std::string only;
-  bool corotational = false, collectFirst = false, rebuildSchur = false;
+  bool corotational = false, collectFirst = false, rebuildSchur = false, unturned = false;
   int laggedIterations = 0;
   app.add_option("--study", study, "growth | ratio | schur | corotational | contact | steady | setup | all")
       ->check(CLI::IsMember({"growth", "ratio", "schur", "corotational", "contact", "steady", "setup", "all"}));
@@ -833,6 +835,8 @@ int main(int argc, char** argv) {
   app.add_option("--lagged-iterations", laggedIterations,
                  "steady study: AsyncOptions::laggedSchurIterations (0: the default)")
       ->check(CLI::Range(0, 100000));
+  app.add_flag("--unturned-lagged-factor", unturned,
+               "steady study: AsyncOptions::laggedSchurRotation off (the lagged factor not turned with the body)");
   app.add_flag("--first", collectFirst, "with --only: collect the first step (set-up included) instead");
   app.add_option("--cells", cells, "cells along the bar for the growth and schur studies")->check(CLI::Range(2, 400));
   app.add_option("--ratio-cells", ratioCells, "cells along the bar for the ratio study")->check(CLI::Range(2, 400));
@@ -851,7 +855,8 @@ int main(int argc, char** argv) {
     if (study == "schur" || study == "all") schurStudy(cells, ratio, hL, steps);
     if (study == "corotational" || study == "all") corotationalStudy(ratioCells, ratio, 1.0 / 120.0);
     if (study == "contact" || study == "all") contactStudy(ratioCells, ratio, 1.0 / 120.0);
-    if (study == "steady") steadyStudy(scenes, steps, corotational, only, collectFirst, rebuildSchur, laggedIterations);
+    if (study == "steady")
+      steadyStudy(scenes, steps, corotational, only, collectFirst, rebuildSchur, laggedIterations, unturned);
     if (study == "setup") setUpStudy(scenes, steps);
   } catch (const asyncfem::Error& e) {
     std::fprintf(stderr, "benchmarkAsync: %s\n", e.what());

@@ -88,6 +88,7 @@ void SchurSolver::factor(const SparseMatrix& largeSystem, const RegionPartition&
                          const std::vector<FastRegion>& regions, SchurMode requested, AsyncCoupling coupling,
                          double asymmetry, IntegratorStats& stats) {
   retired_.reset();
+  transform_ = nullptr;
   factored_ = true;
   refreshNext_ = false;
   borrowed_ = nullptr;
@@ -223,6 +224,17 @@ void SchurSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
 }
 
 void SchurSolver::precondition(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  if (!transform_) {
+    applyPreconditioner(rhs, solution);
+    return;
+  }
+  turned_ = rhs;
+  transform_(turned_, true);
+  applyPreconditioner(turned_, solution);
+  transform_(solution, false);
+}
+
+void SchurSolver::applyPreconditioner(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
   if (borrowed_ != nullptr || !external_ || modeUsed_ != SchurMode::symmetric) {
     solve(rhs, solution);
     return;

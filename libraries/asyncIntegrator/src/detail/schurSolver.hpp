@@ -69,6 +69,12 @@ class SchurSolver {
   /// The preconditioner of refine(): solve(), or an external solver's solveApproximately()
   /// (one multigrid cycle instead of iterating to its tolerance).
   void precondition(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
+  /// x <- T x (transpose: T^T x) on vectors of |L| entries, orthogonal.
+  using Transform = std::function<void(Eigen::VectorXd& x, bool transpose)>;
+  /// From now until the next factor(), precondition() applies T P T^T with P the last
+  /// factor's inverse (T orthogonal, so still symmetric positive definite): the lagged
+  /// factor turned with the body (VertexRotations). Empty: P alone.
+  void setPreconditionerTransform(Transform transform) { transform_ = std::move(transform); }
   /// H^{LL*} solution = rhs for the operator of the current blocks, with the last factor as
   /// preconditioner (laggedSchur): conjugate gradients when symmetric (the stable coupling),
   /// iterative refinement otherwise, to a relative residual of tolerance in at most
@@ -111,6 +117,8 @@ class SchurSolver {
 
  private:
   void chooseSolver(SchurMode mode);
+  /// precondition() without the transform.
+  void applyPreconditioner(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
   /// One conjugate-gradient update from z = correction_ and r = residual_ (rz carries
   /// r.z between calls); deflated: the direction is made H-orthogonal to the kept ones.
   /// Returns the direction's curvature p.Hp (not positive: nothing was updated).
@@ -151,6 +159,8 @@ class SchurSolver {
   Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;  // I - U^T W C
   Eigen::MatrixXd solution_;
   Eigen::VectorXd product_, residual_, correction_, direction_;
+  Transform transform_;  // of the preconditioner, until the next factor()
+  Eigen::VectorXd turned_;
   // The previous partition's solver, kept by reset() until the next factor() frees it.
   std::unique_ptr<SchurSolver> retired_;
 };

@@ -87,6 +87,15 @@ struct AsyncOptions {
   /// A^S is refactored every step either way. The step then solves the coupled system to
   /// the tolerance instead of to round-off.
   bool laggedSchur = true;
+  /// With laggedSchur: the kept factor preconditions turned with the body, T P T^T with
+  /// T the block diagonal of every vertex's rotation since the factor was built (the polar
+  /// rotation of its elements' mean deformation gradient from that state; docs/
+  /// asynchronous-integrator.md, "The lagged factor turned with the body"). A corotational
+  /// or hyperelastic tangent that has turned with the body since the rebuild satisfies
+  /// K ~ T K_ref T^T, so fewer iterations and rebuilds are needed where parts of the body
+  /// swing. The solution is the same to laggedSchurTolerance either way. Not with
+  /// largeSystemSolver (an external solver's preconditioner is its own).
+  bool laggedSchurRotation = true;
   int laggedSchurIterations = 8;
   double laggedSchurTolerance = 1e-10;
   /// Stable coupling, structured method only (docs/asynchronous-integrator.md, "Quick

@@ -1,0 +1,82 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "detail/vertexRotations.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <asyncfem/corotationalLinearFEM/polarDecomposition.hpp>
+#include <cmath>
+
+namespace asyncfem::detail {
+
+namespace {
+/// Below this fraction of its rest value, an element's |det D| counts as flat.
+constexpr double kFlatElement = 1e-8;
+
+Eigen::Matrix3d edgeMatrix(const TetMesh& mesh, const Eigen::VectorXd& displacement, int element) {
+  const auto corner = [&](int c) -> Eigen::Vector3d {
+    const int v = mesh.elements()(c, element);
+    return mesh.restPosition(v) + displacement.segment<3>(3 * static_cast<Eigen::Index>(v));
+  };
+  const Eigen::Vector3d x0 = corner(0);
+  Eigen::Matrix3d d;
+  for (int c = 1; c < 4; ++c) d.col(c - 1) = corner(c) - x0;
+  return d;
+}
+}  // namespace
+
+void VertexRotations::setReference(const TetMesh& mesh, const Eigen::VectorXd& displacement) {
+  const int elements = mesh.numElements();
+  referenceInverse_.resize(static_cast<std::size_t>(elements));
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(displacement.size());
+  for (int e = 0; e < elements; ++e) {
+    const Eigen::Matrix3d d = edgeMatrix(mesh, displacement, e);
+    const double restDeterminant = std::abs(edgeMatrix(mesh, rest, e).determinant());
+    const double determinant = d.determinant();
+    referenceInverse_[static_cast<std::size_t>(e)] =
+        std::abs(determinant) > kFlatElement * restDeterminant && std::isfinite(determinant)
+            ? Eigen::Matrix3d(d.inverse())
+            : Eigen::Matrix3d::Zero();
+  }
+  rotations_.assign(static_cast<std::size_t>(mesh.numVertices()), Eigen::Matrix3d::Identity());
+  largestAngle_ = 0.0;
+}
+
+void VertexRotations::update(const TetMesh& mesh, const Eigen::VectorXd& displacement) {
+  meanGradient_.assign(rotations_.size(), Eigen::Matrix3d::Zero());
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const Eigen::Matrix3d& inverse = referenceInverse_[static_cast<std::size_t>(e)];
+    if (inverse.isZero(0.0)) continue;
+    const Eigen::Matrix3d gradient = edgeMatrix(mesh, displacement, e) * inverse;
+    for (int c = 0; c < 4; ++c) meanGradient_[static_cast<std::size_t>(mesh.elements()(c, e))] += gradient;
+  }
+  largestAngle_ = 0.0;
+  for (std::size_t v = 0; v < rotations_.size(); ++v) {
+    const Eigen::Matrix3d& gradient = meanGradient_[v];
+    if (gradient.isZero(0.0) || !gradient.allFinite()) {
+      rotations_[v].setIdentity();
+      continue;
+    }
+    const Eigen::Matrix3d last = rotations_[v];
+    rotations_[v] = polarRotation(gradient, &last).rotation;
+    const double cosine = std::clamp(0.5 * (rotations_[v].trace() - 1.0), -1.0, 1.0);
+    largestAngle_ = std::max(largestAngle_, std::acos(cosine));
+  }
+}
+
+void VertexRotations::rotate(const std::vector<int>& dofs, Eigen::VectorXd& x, bool transpose) const {
+  std::size_t k = 0;
+  while (k + 2 < dofs.size()) {
+    const int dof = dofs[k];
+    if (dof % 3 != 0 || dofs[k + 1] != dof + 1 || dofs[k + 2] != dof + 2) {
+      ++k;
+      continue;
+    }
+    const Eigen::Matrix3d& rotation = rotations_[static_cast<std::size_t>(dof / 3)];
+    const auto at = static_cast<Eigen::Index>(k);
+    const Eigen::Vector3d y = x.segment<3>(at);
+    x.segment<3>(at) = transpose ? Eigen::Vector3d(rotation.transpose() * y) : Eigen::Vector3d(rotation * y);
+    k += 3;
+  }
+}
+
+}  // namespace asyncfem::detail
