@@ -147,47 +147,52 @@ void FastRegion::couplingProducts(bool damped) {
   if (damped) dampY.noalias() = Dsi * yInterface;
 }
 
-void FastRegion::correctionColumns(SparseSolver& columnSolver, bool damped, Eigen::Index first, Eigen::Index width) {
+void FastRegion::correctionColumns(SparseSolver& columnSolver, bool damped, Eigen::Index first, Eigen::Index width,
+                                   int block) {
   const Eigen::Index size = systemMatrix.rows();
   const CouplingCoefficients& k = coupling;
-  Eigen::MatrixXd rhsColumns = Eigen::MatrixXd::Zero(size, width), z, combinedT(width, size), productT(width, size);
-  Eigen::MatrixXd runningT = Eigen::MatrixXd::Zero(width, size);  // (sum_{i<r} Z_i)^T
-  Eigen::MatrixXd sumM = Eigen::MatrixXd::Zero(size, width), sumK = sumM, sumD, sum;
-  if (damped) sumD = sumM;
-  if (useDenseZ) sum = sumM;
+  ColumnScratch& w = columnScratch[static_cast<std::size_t>(block)];
+  w.rhsColumns.setZero(size, width);
+  w.combinedT.resize(width, size);
+  w.productT.resize(width, size);
+  w.runningT.setZero(width, size);  // (sum_{i<r} Z_i)^T
+  w.sumM.setZero(size, width);
+  w.sumK.setZero(size, width);
+  if (damped) w.sumD.setZero(size, width);
+  if (useDenseZ) w.sum.setZero(size, width);
   // rhsColumns += scale * block(:, first .. first + width), for a sparse block of H^{SI}.
-  const auto addColumns = [&](const SparseMatrix& block, double scale) {
+  const auto addColumns = [&](const SparseMatrix& matrix, double scale) {
     if (scale == 0.0) return;
     for (Eigen::Index c = 0; c < width; ++c)
-      for (SparseMatrix::InnerIterator it(block, first + c); it; ++it) rhsColumns(it.row(), c) += scale * it.value();
+      for (SparseMatrix::InnerIterator it(matrix, first + c); it; ++it) w.rhsColumns(it.row(), c) += scale * it.value();
   };
   for (int r = 1; r <= ratio; ++r) {
     // Row r of H^{SS} Z = H^{SI}: A^S Z_r = B_r + M^{SS} Z_{r-1} - G sum_{i<r} Z_i.
     if (r >= 2) {
-      runningT += z.transpose();
-      combinedT = runningT;
-      combinedT += stepWeight * z.transpose();
-      rowWiseStiffnessProduct(combinedT, productT);
-      rhsColumns *= rhsWeight;
-      rhsColumns -= productT.transpose();
+      w.runningT += w.z.transpose();
+      w.combinedT = w.runningT;
+      w.combinedT += stepWeight * w.z.transpose();
+      rowWiseStiffnessProduct(w.combinedT, w.productT);
+      w.rhsColumns *= rhsWeight;
+      w.rhsColumns -= w.productT.transpose();
     }
     addColumns(Msi, k.bM[r - 1]);
     addColumns(Ksi, k.bK[r - 1]);
     if (damped) addColumns(Dsi, k.bD[r - 1]);
-    columnSolver.solve(rhsColumns, z);
-    if (k.eM[r - 1] != 0.0) sumM += k.eM[r - 1] * z;
-    sumK += k.eK[r - 1] * z;
-    if (damped) sumD += k.eD[r - 1] * z;
-    if (useDenseZ) sum += z;
+    columnSolver.solve(w.rhsColumns, w.z);
+    if (k.eM[r - 1] != 0.0) w.sumM += k.eM[r - 1] * w.z;
+    w.sumK += k.eK[r - 1] * w.z;
+    if (damped) w.sumD += k.eD[r - 1] * w.z;
+    if (useDenseZ) w.sum += w.z;
   }
   if (useDenseZ) {
-    zLast.middleCols(first, width) = z;
-    zSum.middleCols(first, width) = sum;
+    zLast.middleCols(first, width) = w.z;
+    zSum.middleCols(first, width) = w.sum;
   }
-  Eigen::MatrixXd columns = Mis * sumM;
-  columns += Kis * sumK;
-  if (damped) columns += Dis * sumD;
-  correction.middleCols(first, width) = columns;
+  w.columns.noalias() = Mis * w.sumM;
+  w.columns.noalias() += Kis * w.sumK;
+  if (damped) w.columns.noalias() += Dis * w.sumD;
+  correction.middleCols(first, width) = w.columns;
 }
 
 void FastRegion::assembleInterfaceStiffness(const ForceModel& forceModel, const Eigen::VectorXd& u, bool perElement) {
@@ -259,6 +264,7 @@ CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOp
       rb.helperSolvers.push_back(makeSparseSolver(rb.solver->kind(), FillOrdering::automatic));
       rb.helperAnalyzed.push_back(0);
     }
+    if (static_cast<int>(rb.columnScratch.size()) < blocks) rb.columnScratch.resize(static_cast<std::size_t>(blocks));
     for (int j = 1; j < blocks; ++j) helpers.emplace_back(static_cast<int>(i), j - 1);
     for (int j = 0; j < blocks; ++j) {
       const Eigen::Index first = q * j / blocks, last = q * (j + 1) / blocks;
@@ -279,7 +285,7 @@ CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOp
     const ColumnTask& task = tasks[static_cast<std::size_t>(t)];
     FastRegion& rb = regions[static_cast<std::size_t>(task.region)];
     SparseSolver& solver = task.block == 0 ? *rb.solver : *rb.helperSolvers[static_cast<std::size_t>(task.block - 1)];
-    rb.correctionColumns(solver, damped, task.first, task.width);
+    rb.correctionColumns(solver, damped, task.first, task.width, task.block);
   });
   return run;
 }

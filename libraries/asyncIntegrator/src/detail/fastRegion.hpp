@@ -67,7 +67,8 @@ class FastRegion {
   /// Columns [first, first + width) of Z = (H^{SS})^{-1} H^{SI} with `solver` (a factor of
   /// A^S), and the same columns of C_i = H^{IS} Z (Eq. A7), of Z_m and of sum_r Z_r
   /// (dense recovery).
-  void correctionColumns(SparseSolver& solver, bool damped, Eigen::Index first, Eigen::Index width);
+  /// block: which of the concurrent column blocks (its own scratch, kept between rebuilds).
+  void correctionColumns(SparseSolver& solver, bool damped, Eigen::Index first, Eigen::Index width, int block);
   /// K_I^{II}: the interface elements' tangent on I x I (dense), with each element's
   /// tangent from the force model at u when perElement (else the cached linear ones).
   void assembleInterfaceStiffness(const ForceModel& forceModel, const Eigen::VectorXd& u, bool perElement);
@@ -116,6 +117,13 @@ class FastRegion {
   Eigen::VectorXd yInterface, massY, stiffY, dampY;
   Eigen::VectorXd ySum, xLast, xSum;
   bool substituted = false;  // x holds every substep (observer, substitution recovery)
+  /// Work matrices of one column block of Z (|S| x width or width x |S|), kept between
+  /// rebuilds: a nonlinear run rebuilds every few steps, and fresh ones of several MiB each
+  /// time cost page faults (8% of the dinosaur's corotational steps).
+  struct ColumnScratch {
+    Eigen::MatrixXd rhsColumns, z, combinedT, productT, runningT, sumM, sumK, sumD, sum, columns;
+  };
+  std::vector<ColumnScratch> columnScratch;  // one per column block
 
  private:
   /// Replaces the sparse solver by the dense one where that is cheaper (see factorize).
