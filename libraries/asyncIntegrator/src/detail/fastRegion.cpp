@@ -83,13 +83,16 @@ void FastRegion::subtractStiffnessProduct(const double* t, double* out) const {
     Eigen::Map<Eigen::VectorXd>(out, size).noalias() -= Gdense * Eigen::Map<const Eigen::VectorXd>(t, size);
     return;
   }
-  const int* outer = G.outerIndexPtr();
-  const int* inner = G.innerIndexPtr();
-  const double* values = G.valuePtr();
-  const Eigen::Index size = G.outerSize();
-  for (Eigen::Index column = 0; column < size; ++column) {
-    const double tc = t[column];
-    for (int k = outer[column]; k < outer[column + 1]; ++k) out[inner[k]] -= values[k] * tc;
+  // Row by row through G^T's columns: one gathered dot product and one write per row,
+  // instead of a scattered update per entry.
+  const int* outer = GT.outerIndexPtr();
+  const int* inner = GT.innerIndexPtr();
+  const double* values = GT.valuePtr();
+  const Eigen::Index size = GT.outerSize();
+  for (Eigen::Index row = 0; row < size; ++row) {
+    double sum = 0.0;
+    for (int k = outer[row]; k < outer[row + 1]; ++k) sum += values[k] * t[inner[k]];
+    out[row] -= sum;
   }
 }
 

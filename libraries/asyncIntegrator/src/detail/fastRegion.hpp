@@ -128,7 +128,7 @@ class FastRegion {
  private:
   /// Replaces the sparse solver by the dense one where that is cheaper (see factorize).
   void chooseDenseFactor();
-  /// out -= G t for one column t (|S| entries), scattered column by column.
+  /// out -= G t for one column t (|S| entries), row by row through G^T.
   void subtractStiffnessProduct(const double* t, double* out) const;
   /// outT = (G t)^T for tT = t^T (k x |S|), vectorized across the k columns.
   void rowWiseStiffnessProduct(const Eigen::MatrixXd& tT, Eigen::MatrixXd& outT) const;
