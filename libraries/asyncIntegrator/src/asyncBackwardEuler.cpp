@@ -59,6 +59,8 @@ struct AsyncBackwardEuler::Impl {
   // Quick set-up (AsyncOptions::quickSetUp): L's system is solved on the whole system's
   // factor until the iterations' extra flops reach the priced cost of the rebuild (Eq. Q4).
   bool quick = false;
+  // The lagged solve converged with its tracker: recovery from the summed probes.
+  bool recoverFromProbes = false;
   double quickExtraFlops = 0.0;
   // Linear forces with a symmetric K (checked once): f_int(u_0) = K u_0 and K v_0 are taken
   // row by row (row i = column i) on the DOFs that need them, and L's rows need only
@@ -730,6 +732,7 @@ void AsyncBackwardEuler::solveStructured() {
   d.rhsSchur = d.rhsL;
   subtractOwnedInterfaceRows(d.rhsSchur);
   const auto apply = [this](const Eigen::VectorXd& y, Eigen::VectorXd& out) { applySchur(y, out); };
+  d.recoverFromProbes = false;
   if (partition_.largeDofs().empty()) {
     d.Y.resize(0);
   } else if (d.schur.borrowing()) {
@@ -741,8 +744,13 @@ void AsyncBackwardEuler::solveStructured() {
     if (turnsLaggedFactor()) d.rotations.update(*system_.mesh, displacement_);
     const double affordable = d.laggedRebuildFlops / std::max(d.laggedIterationFlops, 1.0);
     const int budget = std::max(options_.laggedSchurIterations, static_cast<int>(std::min(affordable, 1000.0)));
-    const detail::SchurSolver::Refinement result = d.schur.refine(
-        d.rhsSchur, d.Y, apply, options_.coupling == AsyncCoupling::stable, budget, options_.laggedSchurTolerance);
+    const detail::SchurSolver::Tracker track = [this, threads](double coefficient, bool reset) {
+      sumProbeSubstitutions(threads, coefficient, reset);
+    };
+    const detail::SchurSolver::Refinement result =
+        d.schur.refine(d.rhsSchur, d.Y, apply, options_.coupling == AsyncCoupling::stable, budget,
+                       options_.laggedSchurTolerance, track);
+    d.recoverFromProbes = result.converged;
     runStats_.schurIterations += result.iterations;
     d.laggedRent += result.iterations * d.laggedIterationFlops;
     if (result.converged && !result.zeroRightHandSide) {
@@ -809,6 +817,14 @@ void AsyncBackwardEuler::recoverRegion(int i) {
     return;
   }
   detail::gatherInto(d.Y, pos, rb.yInterface);
+  if (d.recoverFromProbes) {
+    // X = y - (H^{SS})^{-1} H^{SL} Y, the substitution of H^{SL} Y summed along the lagged
+    // solve's iterations (forward substitution is linear): no substitution of its own.
+    rb.x = rb.y;
+    rb.x -= rb.probeSum;
+    rb.substituted = true;
+    return;
+  }
   if (rb.useDenseZ && !observer_ && !d.schurLagging && !d.schur.borrowing()) {
     rb.xLast = rb.y.col(rb.ratio - 1);
     rb.xLast.noalias() -= rb.zLast * rb.yInterface;
@@ -882,6 +898,21 @@ void AsyncBackwardEuler::countSolves() {
 
 // out = H^{LL*} y for the current blocks: Â^L y minus, per region, the interface rows of
 // H^{LS} (H^{SS})^{-1} H^{SL} y (one forward substitution per region).
+// The lagged solve's tracker (SchurSolver::Tracker): every region's probeSum follows
+// (H^{SS})^{-1} H^{SL} Y as Y moves, from the substitutions applySchur made anyway.
+void AsyncBackwardEuler::sumProbeSubstitutions(int threads, double coefficient, bool reset) {
+  Impl& d = *impl_;
+  runOwnedTasks(threads, [&](int i) {
+    FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
+    if (partition_.interfacePositions(i).empty()) return;
+    if (reset) {
+      rb.probeSum = rb.probeSolution;
+    } else {
+      rb.probeSum += coefficient * rb.probeSolution;
+    }
+  });
+}
+
 void AsyncBackwardEuler::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out) {
   Impl& d = *impl_;
   const bool damped = system_.damped();

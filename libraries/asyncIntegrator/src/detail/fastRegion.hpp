@@ -111,6 +111,7 @@ class FastRegion {
   Eigen::MatrixXd external;              // |S| x m, f_ext on S at the substeps
   Eigen::MatrixXd y, x;                  // forward substitutions of b and of b - H^{SL} Y
   Eigen::MatrixXd probe, probeSolution;  // H^{SL} y and its forward substitution (applySchur)
+  Eigen::MatrixXd probeSum;              // the substitution of H^{SL} Y, summed along a lagged solve
   Eigen::VectorXd runningStiffness, substepRhs, combined;
   Eigen::MatrixXd substepSolution;
   Eigen::VectorXd weightedM, weightedD, weightedK, interfaceRow;  // Eq. (A7)

@@ -244,8 +244,8 @@ void SchurSolver::applyPreconditioner(const Eigen::VectorXd& rhs, Eigen::VectorX
 }
 
 SchurSolver::Refinement SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution,
-                                            const Operator& apply, bool symmetric, int maxIterations,
-                                            double tolerance) {
+                                            const Operator& apply, bool symmetric, int maxIterations, double tolerance,
+                                            const Tracker& track) {
   Refinement result;
   const double scale = rhs.norm();
   precondition(rhs, solution);
@@ -254,6 +254,12 @@ SchurSolver::Refinement SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::V
     return result;
   }
   apply(solution, product_);
+  if (track) track(1.0, true);
+  struct Untrack {
+    const Tracker*& slot;
+    ~Untrack() { slot = nullptr; }
+  } untrack{track_};
+  track_ = track ? &track : nullptr;
   residual_ = rhs - product_;  // r
   double rz = 0.0;
   for (int iteration = 1; iteration <= maxIterations; ++iteration) {
@@ -270,6 +276,7 @@ SchurSolver::Refinement SchurSolver::refine(const Eigen::VectorXd& rhs, Eigen::V
     if (!symmetric) {
       solution += correction_;
       apply(solution, product_);
+      if (track) track(1.0, true);
       residual_ = rhs - product_;
       continue;
     }
@@ -298,6 +305,7 @@ double SchurSolver::conjugateStep(Eigen::VectorXd& solution, const Operator& app
   if (!(curvature > 0.0)) return curvature;
   const double step = rz / curvature;
   solution += step * direction_;
+  if (track_ != nullptr) (*track_)(step, false);
   residual_ -= step * product_;
   return curvature;
 }

@@ -81,8 +81,15 @@ class SchurSolver {
   /// maxIterations iterations. Not converged: the caller then refactors. A slow convergence
   /// (more than half the iterations) asks for a refactor at the next step
   /// (refreshRequested()).
+  ///
+  /// track (may be empty) follows the solution through the operator's side products:
+  /// track(1, true) right after apply() was called with the whole current solution, and
+  /// track(step, false) after the solution moved by step times the direction apply() was
+  /// last called with. So a caller can keep any linear image of the solution that apply()
+  /// computes on the way (the regions' substitutions of H^{SL} Y) without computing it again.
+  using Tracker = std::function<void(double coefficient, bool reset)>;
   Refinement refine(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution, const Operator& apply, bool symmetric,
-                    int maxIterations, double tolerance);
+                    int maxIterations, double tolerance, const Tracker& track = {});
 
   /// Until the next factor() or reset(), solve() applies the inverse of the Schur
   /// complement of the whole single-rate system on L (largeDofs: global ids of L) instead
@@ -159,7 +166,8 @@ class SchurSolver {
   Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;  // I - U^T W C
   Eigen::MatrixXd solution_;
   Eigen::VectorXd product_, residual_, correction_, direction_;
-  Transform transform_;  // of the preconditioner, until the next factor()
+  Transform transform_;             // of the preconditioner, until the next factor()
+  const Tracker* track_ = nullptr;  // refine()'s, while it runs
   Eigen::VectorXd turned_;
   // The previous partition's solver, kept by reset() until the next factor() frees it.
   std::unique_ptr<SchurSolver> retired_;

@@ -116,6 +116,7 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   void borrowWholeFactor();
   void solveOnWholeFactor();
   void applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out);
+  void sumProbeSubstitutions(int threads, double coefficient, bool reset);
   void evaluateStartOfStep();
   void gatherExternalForces(double t0, double t1);
   void largeRightHandSide();
