@@ -59,6 +59,9 @@ struct AsyncBackwardEuler::Impl {
   // Quick set-up (AsyncOptions::quickSetUp): L's system is solved on the whole system's
   // factor until the iterations' extra flops reach the priced cost of the rebuild (Eq. Q4).
   bool quick = false;
+  // Whether the lagged factor was last built with Z (not refreshed): the next rebuild
+  // the rule asks for may then be a refresh.
+  bool lastRebuildFull = false;
   // The lagged solve converged with its tracker: recovery from the summed probes.
   bool recoverFromProbes = false;
   double quickExtraFlops = 0.0;
@@ -479,14 +482,37 @@ void AsyncBackwardEuler::fullSchurRebuild() {
   stats_.factorizationSeconds += schurSeconds;
   if (setUpBuild) runStats_.setupSchurSeconds += schurSeconds;
   d.schurLagging = false;
-  priceLaggedFactor();
-  if (turnsLaggedFactor()) {
-    // The rotations are measured from this state, where the factor's tangent was taken.
-    d.rotations.setReference(*system_.mesh, displacement_);
-    const std::vector<int>& large = partition_.largeDofs();
-    d.schur.setPreconditionerTransform(
-        [&d, &large](Eigen::VectorXd& x, bool transpose) { d.rotations.rotate(large, x, transpose); });
+  d.lastRebuildFull = true;
+  keepLaggedFactor();
+}
+
+// A refresh (laggedSchurRotation): the kept corrections C_i turned with the body since the
+// factor was built (Eq. T2) and H^{LL*} refactored from the current A^L, without Z. The
+// next rebuild the rule asks for is a full one.
+void AsyncBackwardEuler::refreshLaggedFactor() {
+  Impl& d = *impl_;
+  Stopwatch factor;
+  d.rotations.update(*system_.mesh, displacement_);
+  for (int i = 0; i < partition_.numRegions(); ++i) {
+    d.rotations.turnBlock(partition_.interfaceDofs(i), d.regions[static_cast<std::size_t>(i)].correction);
   }
+  d.schur.factor(d.largeSystem, partition_, d.regions, options_.schur, options_.coupling, schurAsymmetry_, stats_);
+  stats_.factorizationSeconds += factor.stop();
+  ++runStats_.laggedRefreshes;
+  d.lastRebuildFull = false;
+  keepLaggedFactor();
+}
+
+// After a factor of H^{LL*}: the rent-or-buy prices and, with laggedSchurRotation, the
+// rotations measured from this state (where the factor's tangent was taken).
+void AsyncBackwardEuler::keepLaggedFactor() {
+  Impl& d = *impl_;
+  priceLaggedFactor();
+  if (!turnsLaggedFactor()) return;
+  d.rotations.setReference(*system_.mesh, displacement_);
+  const std::vector<int>& large = partition_.largeDofs();
+  d.schur.setPreconditionerTransform(
+      [&d, &large](Eigen::VectorXd& x, bool transpose) { d.rotations.rotate(large, x, transpose); });
 }
 
 bool AsyncBackwardEuler::turnsLaggedFactor() const {
@@ -581,8 +607,13 @@ void AsyncBackwardEuler::evaluateStartOfStep() {
   const bool first = runStats_.rebuilds == 0 && runStats_.steps == 0;
   d.schurLagging = options_.laggedSchur && !d.linear && d.schur.factored() && !d.schur.refreshRequested() &&
                    d.laggedRent < d.laggedRebuildFlops && options_.method == AsyncSolveMethod::structured;
+  // With the turned factor, every other rebuild the rule asks for is a refresh.
+  const bool refresh = !first && !d.schurLagging && d.lastRebuildFull && !d.quick && d.schur.factored() &&
+                       !d.schur.borrowing() && turnsLaggedFactor();
+  if (refresh) d.schurLagging = true;  // refactor() then factors the regions' A^S only
   d.settingUp = first;
   refactor();
+  if (refresh) refreshLaggedFactor();
   d.settingUp = false;
   d.factorsCurrent = true;
   const double seconds = rebuild.stop();
@@ -1198,8 +1229,10 @@ RunReport AsyncBackwardEuler::report() const {
                 1000.0 * r.meanStepSeconds(), r.steps, r.rebuilds, r.rebuildSeconds);
   lines.emplace_back(line);
   if (r.laggedSteps > 0) {
-    std::snprintf(line, sizeof(line), "async lagged Schur: %lld steps, %lld iterations, largest relative residual %.2e",
-                  r.laggedSteps, r.schurIterations, r.largestSchurResidual);
+    std::snprintf(line, sizeof(line),
+                  "async lagged Schur: %lld steps, %lld iterations, largest relative residual %.2e; %lld rebuilds "
+                  "refreshed without Z",
+                  r.laggedSteps, r.schurIterations, r.largestSchurResidual, r.laggedRefreshes);
     lines.emplace_back(line);
   }
   if (r.quickSteps > 0 || r.quickEnds > 0) {

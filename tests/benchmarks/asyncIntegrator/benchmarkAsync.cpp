@@ -618,8 +618,9 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
       row.setupSchur = async->runStats().setupSchurSeconds;
       if (corotational) {
         const AsyncRunStats& stats = async->runStats();
-        std::fprintf(stderr, "%s: %lld steps, %lld lagged, %lld rebuilds, %lld Schur iterations\n",
-                     scene.sourceName.c_str(), stats.steps, stats.laggedSteps, stats.rebuilds, stats.schurIterations);
+        std::fprintf(stderr, "%s: %lld steps, %lld lagged, %lld rebuilds, %lld Schur iterations, %lld refreshes\n",
+                     scene.sourceName.c_str(), stats.steps, stats.laggedSteps, stats.rebuilds, stats.schurIterations,
+                     stats.laggedRefreshes);
       }
     }
     if (only.empty() || only == "single") {

@@ -63,7 +63,8 @@ void VertexRotations::update(const TetMesh& mesh, const Eigen::VectorXd& displac
   }
 }
 
-void VertexRotations::rotate(const std::vector<int>& dofs, Eigen::VectorXd& x, bool transpose) const {
+template <class Visit>
+void VertexRotations::forEachTurnedVertex(const std::vector<int>& dofs, Visit&& visit) const {
   std::size_t k = 0;
   while (k + 2 < dofs.size()) {
     const int dof = dofs[k];
@@ -71,12 +72,26 @@ void VertexRotations::rotate(const std::vector<int>& dofs, Eigen::VectorXd& x, b
       ++k;
       continue;
     }
-    const Eigen::Matrix3d& rotation = rotations_[static_cast<std::size_t>(dof / 3)];
-    const auto at = static_cast<Eigen::Index>(k);
-    const Eigen::Vector3d y = x.segment<3>(at);
-    x.segment<3>(at) = transpose ? Eigen::Vector3d(rotation.transpose() * y) : Eigen::Vector3d(rotation * y);
+    visit(static_cast<Eigen::Index>(k), rotations_[static_cast<std::size_t>(dof / 3)]);
     k += 3;
   }
+}
+
+void VertexRotations::rotate(const std::vector<int>& dofs, Eigen::VectorXd& x, bool transpose) const {
+  forEachTurnedVertex(dofs, [&](Eigen::Index at, const Eigen::Matrix3d& rotation) {
+    const Eigen::Vector3d y = x.segment<3>(at);
+    x.segment<3>(at) = transpose ? Eigen::Vector3d(rotation.transpose() * y) : Eigen::Vector3d(rotation * y);
+  });
+}
+
+void VertexRotations::turnBlock(const std::vector<int>& dofs, Eigen::MatrixXd& block) const {
+  // R block: every row triple of a turned vertex; then (R block) R^T: every column triple.
+  forEachTurnedVertex(dofs, [&](Eigen::Index at, const Eigen::Matrix3d& rotation) {
+    block.middleRows<3>(at) = (rotation * block.middleRows<3>(at)).eval();
+  });
+  forEachTurnedVertex(dofs, [&](Eigen::Index at, const Eigen::Matrix3d& rotation) {
+    block.middleCols<3>(at) = (block.middleCols<3>(at) * rotation.transpose()).eval();
+  });
 }
 
 }  // namespace asyncfem::detail

@@ -30,11 +30,17 @@ class VertexRotations {
   /// vertex whose three DOFs are consecutive entries of dofs is turned; the other entries
   /// are left as they are.
   void rotate(const std::vector<int>& dofs, Eigen::VectorXd& x, bool transpose) const;
+  /// block <- R block R^T for a square block on dofs (as rotate()).
+  void turnBlock(const std::vector<int>& dofs, Eigen::MatrixXd& block) const;
   /// Largest rotation angle (radians) over the vertices at the last update().
   double largestAngle() const { return largestAngle_; }
   bool empty() const { return rotations_.empty(); }
 
  private:
+  /// visit(position in dofs, R_v) for every vertex whose three DOFs are consecutive in dofs.
+  template <class Visit>
+  void forEachTurnedVertex(const std::vector<int>& dofs, Visit&& visit) const;
+
   std::vector<Eigen::Matrix3d> referenceInverse_;  // per element: D_ref^{-1}, zero when left out
   std::vector<Eigen::Matrix3d> rotations_;         // per vertex
   std::vector<Eigen::Matrix3d> meanGradient_;      // per vertex, scratch

@@ -111,6 +111,8 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   void subtractInterfaceStiffness();
   void fullSchurRebuild();
   void priceLaggedFactor();
+  void refreshLaggedFactor();
+  void keepLaggedFactor();
   /// Whether the lagged factor preconditions turned with the body (laggedSchurRotation).
   bool turnsLaggedFactor() const;
   void borrowWholeFactor();

@@ -94,7 +94,10 @@ struct AsyncOptions {
   /// or hyperelastic tangent that has turned with the body since the rebuild satisfies
   /// K ~ T K_ref T^T, so fewer iterations and rebuilds are needed where parts of the body
   /// swing. The solution is the same to laggedSchurTolerance either way. Not with
-  /// largeSystemSolver (an external solver's preconditioner is its own).
+  /// largeSystemSolver (an external solver's preconditioner is its own). Also, every other
+  /// rebuild that the rent-or-buy rule asks for is a refresh: the kept corrections C_i
+  /// turned with the body and H^{LL*} refactored from the current A^L, without Z (the
+  /// m |I| solves); the next one is a full rebuild.
   bool laggedSchurRotation = true;
   int laggedSchurIterations = 8;
   double laggedSchurTolerance = 1e-10;
@@ -176,6 +179,7 @@ struct AsyncRunStats {
   long long zColumns = 0;             ///< right-hand sides of one Z computation: sum_i m_i |I_i|
   long long laggedSteps = 0;          ///< steps solved with the lagged H^{LL*} (AsyncOptions::laggedSchur)
   long long schurIterations = 0;      ///< iterative refinement iterations over those steps
+  long long laggedRefreshes = 0;      ///< rebuilds that turned the kept C_i instead of computing Z
   double largestSchurResidual = 0.0;  ///< largest final relative residual of those steps
   long long quickSteps = 0;           ///< steps solved on the whole system's factor (quickSetUp)
   long long quickIterations = 0;      ///< conjugate gradient iterations over those steps
