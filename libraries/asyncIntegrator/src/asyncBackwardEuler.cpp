@@ -927,8 +927,6 @@ void AsyncBackwardEuler::countSolves() {
   }
 }
 
-// out = H^{LL*} y for the current blocks: Â^L y minus, per region, the interface rows of
-// H^{LS} (H^{SS})^{-1} H^{SL} y (one forward substitution per region).
 // The lagged solve's tracker (SchurSolver::Tracker): every region's probeSum follows
 // (H^{SS})^{-1} H^{SL} Y as Y moves, from the substitutions applySchur made anyway.
 void AsyncBackwardEuler::sumProbeSubstitutions(int threads, double coefficient, bool reset) {
@@ -944,6 +942,8 @@ void AsyncBackwardEuler::sumProbeSubstitutions(int threads, double coefficient, 
   });
 }
 
+// out = H^{LL*} y for the current blocks: Â^L y minus, per region, the interface rows of
+// H^{LS} (H^{SS})^{-1} H^{SL} y (one forward substitution per region).
 void AsyncBackwardEuler::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out) {
   Impl& d = *impl_;
   const bool damped = system_.damped();
