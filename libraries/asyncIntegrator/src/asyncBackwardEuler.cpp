@@ -7,6 +7,7 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/detail/vertexRotations.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/integrator/stepFormula.hpp>
@@ -23,7 +24,6 @@
 #include "detail/parallelTasks.hpp"
 #include "detail/schurSolver.hpp"
 #include "detail/sparseBlocks.hpp"
-#include "detail/vertexRotations.hpp"
 #include "detail/wholeSystemFactor.hpp"
 
 namespace asyncfem {

@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "detail/vertexRotations.hpp"
-
 #include <Eigen/LU>
 #include <algorithm>
+#include <asyncfem/asyncIntegrator/detail/vertexRotations.hpp>
 #include <asyncfem/corotationalLinearFEM/polarDecomposition.hpp>
 #include <cmath>
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Rotations of a body's vertices since a reference state, for the lagged Schur factor's
 // preconditioner (docs/asynchronous-integrator.md, "The lagged factor turned with the
-// body"). Private to the library.
+// body"). In the public include tree for its unit test only; not part of the API.
 #pragma once
 
 #include <Eigen/Core>
