@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "../common/gaussianMatrix.hpp"
 #include "../common/testProblems.hpp"
 
 namespace asyncfem {
@@ -41,14 +42,6 @@ struct TurnedBar {
   }
 };
 
-Eigen::MatrixXd randomMatrix(Eigen::Index rows, Eigen::Index cols, unsigned seed) {
-  std::mt19937 random(seed);
-  std::normal_distribution<double> draw;
-  Eigen::MatrixXd m(rows, cols);
-  for (Eigen::Index k = 0; k < m.size(); ++k) m.data()[k] = draw(random);
-  return m;
-}
-
 // From a deformed reference turned rigidly by R: R at every vertex, R^T undoes it, and a
 // block B on every DOF becomes blockdiag(R) B blockdiag(R)^T.
 TEST(VertexRotations, ARigidTurnOfADeformedReferenceIsEveryVertexsRotation) {
@@ -58,7 +51,7 @@ TEST(VertexRotations, ARigidTurnOfADeformedReferenceIsEveryVertexsRotation) {
   rotations.update(*bar.mesh, bar.turned);
   EXPECT_NEAR(rotations.largestAngle(), 0.7, kTolerance);
   const std::vector<int> dofs = bar.allDofs();
-  const Eigen::VectorXd x = randomMatrix(bar.mesh->numDofs(), 1, 1);
+  const Eigen::VectorXd x = test::gaussianMatrix(bar.mesh->numDofs(), 1, 1);
   Eigen::VectorXd y = x;
   rotations.rotate(dofs, y, false);
   Eigen::MatrixXd blockRotation = Eigen::MatrixXd::Zero(bar.mesh->numDofs(), bar.mesh->numDofs());
@@ -66,7 +59,7 @@ TEST(VertexRotations, ARigidTurnOfADeformedReferenceIsEveryVertexsRotation) {
   EXPECT_LE((y - blockRotation * x).norm(), kTolerance * x.norm());
   rotations.rotate(dofs, y, true);
   EXPECT_LE((y - x).norm(), kTolerance * x.norm());
-  const Eigen::MatrixXd block = randomMatrix(bar.mesh->numDofs(), bar.mesh->numDofs(), 2);
+  const Eigen::MatrixXd block = test::gaussianMatrix(bar.mesh->numDofs(), bar.mesh->numDofs(), 2);
   Eigen::MatrixXd turnedBlock = block;
   rotations.turnBlock(dofs, turnedBlock);
   const Eigen::MatrixXd expected = blockRotation * block * blockRotation.transpose();
@@ -82,7 +75,7 @@ TEST(VertexRotations, IdentityAtTheReferenceAndPartialVerticesLeftAlone) {
   rotations.update(*bar.mesh, bar.reference);
   EXPECT_LT(rotations.largestAngle(), 1e-6);  // acos near 1: sqrt of a few ulps
   std::vector<int> dofs = bar.allDofs();
-  const Eigen::VectorXd x = randomMatrix(bar.mesh->numDofs(), 1, 3);
+  const Eigen::VectorXd x = test::gaussianMatrix(bar.mesh->numDofs(), 1, 3);
   Eigen::VectorXd y = x;
   rotations.rotate(dofs, y, false);
   EXPECT_LE((y - x).norm(), kTolerance * x.norm());

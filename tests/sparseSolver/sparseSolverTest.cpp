@@ -8,6 +8,8 @@
 #include <thread>
 #include <vector>
 
+#include "../common/gaussianMatrix.hpp"
+
 namespace asyncfem {
 namespace {
 
@@ -61,14 +63,6 @@ double relativeResidual(const SparseMatrix& a, const Eigen::MatrixXd& x, const E
   return (a * x - b).norm() / b.norm();
 }
 
-Eigen::MatrixXd randomRhs(Eigen::Index n, Eigen::Index k, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> gaussian;
-  Eigen::MatrixXd b(n, k);
-  for (Eigen::Index i = 0; i < b.size(); ++i) b.data()[i] = gaussian(rng);
-  return b;
-}
-
 long long lowerTriangleNonZeros(const SparseMatrix& a) {
   long long count = 0;
   for (int c = 0; c < a.outerSize(); ++c)
@@ -87,7 +81,7 @@ bool isCholesky(SolverKind kind) {
 
 TEST(SparseSolver, SolvesSpdSystems) {
   const SparseMatrix a = gridLaplacian(14, 0.5);  // 2744 unknowns
-  const Eigen::MatrixXd b = randomRhs(a.rows(), 1, 1);
+  const Eigen::MatrixXd b = test::gaussianMatrix(a.rows(), 1, 1);
   for (SolverKind kind : kAllKinds) {
     auto solver = makeSparseSolver(kind);
     EXPECT_EQ(solver->kind(), kind);
@@ -103,7 +97,7 @@ TEST(SparseSolver, SolvesSpdSystems) {
 
 TEST(SparseSolver, SolvesUnsymmetricSystems) {
   const SparseMatrix a = unsymmetric(14, 3);
-  const Eigen::MatrixXd b = randomRhs(a.rows(), 1, 2);
+  const Eigen::MatrixXd b = test::gaussianMatrix(a.rows(), 1, 2);
   for (SolverKind kind : kUnsymmetricKinds) {
     auto solver = makeSparseSolver(kind);
     solver->compute(a);
@@ -121,7 +115,7 @@ TEST(SparseSolver, SolvesUnsymmetricSystems) {
 TEST(SparseSolver, CholeskyReadsOnlyTheUpperTriangle) {
   const SparseMatrix full = gridLaplacian(8, 0.3);
   const SparseMatrix upper = full.triangularView<Eigen::Upper>();
-  const Eigen::MatrixXd b = randomRhs(full.rows(), 1, 12);
+  const Eigen::MatrixXd b = test::gaussianMatrix(full.rows(), 1, 12);
   for (SolverKind kind : {SolverKind::cholmod, SolverKind::eigenLDLT, SolverKind::dense}) {
     auto solver = makeSparseSolver(kind);
     solver->compute(upper);
@@ -133,7 +127,7 @@ TEST(SparseSolver, CholeskyReadsOnlyTheUpperTriangle) {
 TEST(SparseSolver, MultipleRightHandSidesMatchColumnByColumn) {
   const SparseMatrix spd = gridLaplacian(10, 0.1);
   const SparseMatrix lu = unsymmetric(10, 7);
-  const Eigen::MatrixXd b = randomRhs(spd.rows(), 5, 4);
+  const Eigen::MatrixXd b = test::gaussianMatrix(spd.rows(), 5, 4);
   for (SolverKind kind : kAllKinds) {
     const SparseMatrix& a = isCholesky(kind) ? spd : lu;
     auto solver = makeSparseSolver(kind);
@@ -161,7 +155,7 @@ TEST(SparseSolver, MultipleRightHandSidesMatchColumnByColumn) {
 TEST(SparseSolver, RefactorizationReusesTheAnalysis) {
   const SparseMatrix spd = gridLaplacian(10, 0.1);
   const SparseMatrix lu = unsymmetric(10, 5);
-  const Eigen::MatrixXd b = randomRhs(spd.rows(), 1, 5);
+  const Eigen::MatrixXd b = test::gaussianMatrix(spd.rows(), 1, 5);
   for (SolverKind kind : kAllKinds) {
     const SparseMatrix& a = isCholesky(kind) ? spd : lu;
     auto solver = makeSparseSolver(kind);
@@ -188,7 +182,7 @@ TEST(SparseSolver, StatsAreConsistent) {
     const SparseMatrix& a = isCholesky(kind) ? spd : lu;
     auto solver = makeSparseSolver(kind);
     solver->compute(a);
-    solver->solve(randomRhs(a.rows(), 3, 9).col(0).eval());
+    solver->solve(test::gaussianMatrix(a.rows(), 3, 9).col(0).eval());
     const SolverStats& stats = solver->stats();
     // Fill only adds entries: L holds at least A's lower triangle (L + U at least A).
     EXPECT_GE(stats.factorNonZeros, isCholesky(kind) ? lowerTriangleNonZeros(a) : a.nonZeros()) << toString(kind);
@@ -296,7 +290,7 @@ TEST(SparseSolver, NotPositiveDefiniteIsANumericalErrorNamingTheColumn) {
     SparseMatrix fixed = a;
     fixed.coeffRef(10, 10) = 6.0;
     solver->factorize(fixed);
-    const Eigen::MatrixXd b = randomRhs(a.rows(), 1, 10);
+    const Eigen::MatrixXd b = test::gaussianMatrix(a.rows(), 1, 10);
     solver->solve(b, x);
     EXPECT_LT(relativeResidual(fixed, x, b), kResidualTolerance) << toString(kind);
     EXPECT_EQ(solver->stats().analyses, 1);
@@ -427,7 +421,7 @@ TEST(SparseSolver, IndependentSolversRunConcurrently) {
   for (Job& job : jobs) {
     threads.emplace_back([&job] {
       auto solver = makeSparseSolver(job.kind);
-      const Eigen::MatrixXd b = randomRhs(job.matrix->rows(), 3, 6);
+      const Eigen::MatrixXd b = test::gaussianMatrix(job.matrix->rows(), 3, 6);
       Eigen::MatrixXd x;
       job.residual = 0.0;
       for (int round = 0; round < 4; ++round) {
