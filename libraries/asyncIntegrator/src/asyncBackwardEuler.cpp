@@ -357,6 +357,7 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   }
   d.naive.reset();
   d.schurLagging = false;
+  d.lastRebuildFull = false;  // no factor of H^{LL*} for this partition yet
   d.quick = options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
             options_.method == AsyncSolveMethod::structured;
   d.quickExtraFlops = 0.0;
@@ -608,8 +609,8 @@ void AsyncBackwardEuler::evaluateStartOfStep() {
   d.schurLagging = options_.laggedSchur && !d.linear && d.schur.factored() && !d.schur.refreshRequested() &&
                    d.laggedRent < d.laggedRebuildFlops && options_.method == AsyncSolveMethod::structured;
   // With the turned factor, every other rebuild the rule asks for is a refresh.
-  const bool refresh = !first && !d.schurLagging && d.lastRebuildFull && !d.quick && d.schur.factored() &&
-                       !d.schur.borrowing() && turnsLaggedFactor();
+  // lastRebuildFull: this partition's H^{LL*} was factored with Z (so not borrowed, not quick).
+  const bool refresh = !first && !d.schurLagging && d.lastRebuildFull && turnsLaggedFactor();
   if (refresh) d.schurLagging = true;  // refactor() then factors the regions' A^S only
   d.settingUp = first;
   refactor();

@@ -22,7 +22,7 @@ namespace asyncfem::detail {
 /// Columns of one length in storage that outlives them: shaping it for other columns
 /// (a new partition's |L|) reuses the memory already there, so a re-partition on the quick
 /// set-up neither frees the last partition's deflation space nor faults a new one in
-/// (2 |L| x kept doubles, up to 128 MiB). Not initialized.
+/// (2 |L| x kept doubles, up to 64 MiB in all). Not initialized.
 class ColumnStore {
  public:
   /// Room for `columns` columns of `rows` doubles. The first `kept` columns keep their

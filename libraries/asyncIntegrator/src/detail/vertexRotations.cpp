@@ -11,10 +11,12 @@ namespace {
 /// Below this fraction of its rest value, an element's |det D| counts as flat.
 constexpr double kFlatElement = 1e-8;
 
-Eigen::Matrix3d edgeMatrix(const TetMesh& mesh, const Eigen::VectorXd& displacement, int element) {
+/// The element's edge matrix at displacement (null: at rest).
+Eigen::Matrix3d edgeMatrix(const TetMesh& mesh, const Eigen::VectorXd* displacement, int element) {
   const auto corner = [&](int c) -> Eigen::Vector3d {
     const int v = mesh.elements()(c, element);
-    return mesh.restPosition(v) + displacement.segment<3>(3 * static_cast<Eigen::Index>(v));
+    const Eigen::Vector3d rest = mesh.restPosition(v);
+    return displacement ? Eigen::Vector3d(rest + displacement->segment<3>(3 * static_cast<Eigen::Index>(v))) : rest;
   };
   const Eigen::Vector3d x0 = corner(0);
   Eigen::Matrix3d d;
@@ -26,10 +28,9 @@ Eigen::Matrix3d edgeMatrix(const TetMesh& mesh, const Eigen::VectorXd& displacem
 void VertexRotations::setReference(const TetMesh& mesh, const Eigen::VectorXd& displacement) {
   const int elements = mesh.numElements();
   referenceInverse_.resize(static_cast<std::size_t>(elements));
-  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(displacement.size());
   for (int e = 0; e < elements; ++e) {
-    const Eigen::Matrix3d d = edgeMatrix(mesh, displacement, e);
-    const double restDeterminant = std::abs(edgeMatrix(mesh, rest, e).determinant());
+    const Eigen::Matrix3d d = edgeMatrix(mesh, &displacement, e);
+    const double restDeterminant = std::abs(edgeMatrix(mesh, nullptr, e).determinant());
     const double determinant = d.determinant();
     referenceInverse_[static_cast<std::size_t>(e)] =
         std::abs(determinant) > kFlatElement * restDeterminant && std::isfinite(determinant)
@@ -45,7 +46,7 @@ void VertexRotations::update(const TetMesh& mesh, const Eigen::VectorXd& displac
   for (int e = 0; e < mesh.numElements(); ++e) {
     const Eigen::Matrix3d& inverse = referenceInverse_[static_cast<std::size_t>(e)];
     if (inverse.isZero(0.0)) continue;
-    const Eigen::Matrix3d gradient = edgeMatrix(mesh, displacement, e) * inverse;
+    const Eigen::Matrix3d gradient = edgeMatrix(mesh, &displacement, e) * inverse;
     for (int c = 0; c < 4; ++c) meanGradient_[static_cast<std::size_t>(mesh.elements()(c, e))] += gradient;
   }
   largestAngle_ = 0.0;
