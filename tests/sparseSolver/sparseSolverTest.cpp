@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <random>
@@ -401,6 +402,84 @@ TEST(SparseSolver, KindNamesRoundTrip) {
     EXPECT_TRUE(contains(e.what(), "'superlu'")) << e.what();
     for (SolverKind kind : kAllKinds) EXPECT_TRUE(contains(e.what(), toString(kind))) << e.what();
   }
+}
+
+/// An SPD matrix of n unknowns whose Cholesky factor is one dense supernode (every
+/// unknown coupled to every other): B B^T / n + I with B Gaussian, eigenvalues in [1, ~5].
+SparseMatrix denseSpd(int n, unsigned seed) {
+  const Eigen::MatrixXd b = test::gaussianMatrix(n, n, seed);
+  const Eigen::MatrixXd dense = b * b.transpose() / n + Eigen::MatrixXd::Identity(n, n);
+  SparseMatrix a = dense.sparseView();
+  a.makeCompressed();
+  return a;
+}
+
+TEST(SparseSolver, CholmodFactorsSmallAndLargeSupernodesToTheDenseSolution) {
+  // A grid Laplacian's factor has small supernodes (the solver's own supernodal
+  // factorization), a dense matrix's one large supernode (CHOLMOD's). Each solution is
+  // compared with a dense Cholesky solve: both are backward stable and cond <= 121
+  // (Laplacian) or about 5 (dense), so they agree to about cond * eps = 3e-14; 1e-12.
+  const SparseMatrix matrices[] = {gridLaplacian(10, 0.1), denseSpd(400, 21)};
+  for (const SparseMatrix& a : matrices) {
+    const Eigen::MatrixXd b = test::gaussianMatrix(a.rows(), 2, 22);
+    const Eigen::MatrixXd expected = Eigen::MatrixXd(a).llt().solve(b);
+    auto solver = makeSparseSolver(SolverKind::cholmod);
+    solver->analyzePattern(a);
+    for (int round = 0; round < 2; ++round) {  // the first factorization and a refactorization
+      SparseMatrix scaled = a * (1.0 + round);
+      solver->factorize(scaled);
+      Eigen::MatrixXd x;
+      solver->solve(b, x);
+      EXPECT_LE((x * (1.0 + round) - expected).norm(), 1e-12 * expected.norm()) << a.rows() << " round " << round;
+      for (int c = 0; c < 2; ++c) {
+        const Eigen::VectorXd column = solver->solve(Eigen::VectorXd(b.col(c)));  // one-column substitution
+        EXPECT_LE((column * (1.0 + round) - expected.col(c)).norm(), 1e-12 * expected.col(c).norm());
+      }
+    }
+  }
+}
+
+TEST(SparseSolver, CholmodRefactorizationsAndFreshSolversAgreeBitForBit) {
+  // A run resumed from a checkpoint builds a fresh solver where the uninterrupted run
+  // refactors its own: both must compute the same factor, bit for bit.
+  const SparseMatrix matrices[] = {gridLaplacian(9, 0.3), denseSpd(300, 23)};
+  for (const SparseMatrix& a : matrices) {
+    const Eigen::VectorXd b = test::gaussianMatrix(a.rows(), 1, 24);
+    const SparseMatrix other = a * 3.0;
+    auto running = makeSparseSolver(SolverKind::cholmod);
+    running->compute(other);
+    running->factorize(a);
+    auto fresh = makeSparseSolver(SolverKind::cholmod);
+    fresh->compute(a);
+    const Eigen::VectorXd x = running->solve(b), y = fresh->solve(b);
+    EXPECT_EQ((x - y).cwiseAbs().maxCoeff(), 0.0) << a.rows();
+  }
+}
+
+TEST(SparseSolver, CholmodApproximateSolvesUseASinglePrecisionFactor) {
+  // One column: a single-precision copy of the factor. Rounding L to float (6e-8) moves
+  // the solution by about cond * 6e-8 <= 121 * 6e-8 = 7e-6; 1e-4. It must differ from the
+  // exact solve (else the copy is not in use); several columns solve exactly.
+  const SparseMatrix a = gridLaplacian(10, 0.1);
+  auto solver = makeSparseSolver(SolverKind::cholmod);
+  solver->compute(a);
+  const Eigen::MatrixXd b = test::gaussianMatrix(a.rows(), 2, 25);
+  Eigen::MatrixXd exact, approximate;
+  solver->solve(b.col(0), exact);
+  solver->solveApproximately(b.col(0), approximate);
+  const double difference = (approximate - exact).norm() / exact.norm();
+  EXPECT_LE(difference, 1e-4);
+  EXPECT_GT(difference, 1e-12);
+  solver->solve(b, exact);
+  solver->solveApproximately(b, approximate);
+  EXPECT_EQ((approximate - exact).cwiseAbs().maxCoeff(), 0.0);
+  // Entries beyond float's range (the matrix scaled by 1e80): the copy would overflow, so
+  // approximate solves are exact ones.
+  const SparseMatrix huge = a * 1e80;
+  solver->factorize(huge);
+  solver->solve(b.col(1), exact);
+  solver->solveApproximately(b.col(1), approximate);
+  EXPECT_EQ((approximate - exact).cwiseAbs().maxCoeff(), 0.0);
 }
 
 TEST(SparseSolver, IndependentSolversRunConcurrently) {

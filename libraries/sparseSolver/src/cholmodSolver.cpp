@@ -9,6 +9,7 @@
 
 #include "detail/singlePrecisionFactor.hpp"
 #include "detail/solverBase.hpp"
+#include "detail/supernodalCholesky.hpp"
 
 namespace asyncfem::detail {
 namespace {
@@ -76,6 +77,8 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     Stopwatch watch;  // runs from construction
     beginAnalyze(a, "cholmod");
     if (factor_) cholmod_free_factor(&factor_, common_.get());
+    small_.clear();
+    widest_ = -1;
     cholmod_sparse view = upperTriangleView(a);
     chooseOrdering(a.rows());
     factor_ = cholmod_analyze(&view, common_.get());
@@ -92,6 +95,7 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
                   " matrix failed (CHOLMOD status " + std::to_string(common_->status) + ")");
     }
     recordFactorCosts();
+    allocateSmallFactor();
     ++stats_.analyses;
     stats_.analyzeSeconds += watch.stop();
   }
@@ -99,6 +103,11 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
   void factorize(const SparseMatrix& a) override {
     Stopwatch watch;  // runs from construction
     beginFactorize(a, "cholmod");
+    singleState_ = SingleCopy::notMade;
+    if (factorSmall(a)) {
+      endFactorize(watch);
+      return;
+    }
     cholmod_sparse view = upperTriangleView(a);
     // CHOLMOD's supernodal factorization opens OpenMP regions of a fixed team size
     // (CHOLMOD_OMP_NUM_THREADS, 4 in Debian's build) whatever OMP_NUM_THREADS says; on a
@@ -136,6 +145,10 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     beginSolve(rhs, "cholmod");
     solution.resize(rhs.rows(), rhs.cols());
     if (rhs.cols() == 0) return;
+    if (rhs.cols() == 1 && solveOneColumn(rhs, solution)) {
+      endSolve(1, watch);
+      return;
+    }
     // CHOLMOD takes B through a non-const pointer but only reads it; a contiguous
     // right-hand side is used in place, a strided one is copied once.
     Eigen::MatrixXd contiguousCopy;
@@ -161,11 +174,77 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     endSolve(rhs.cols(), watch);
   }
 
-  bool copyFactor(SinglePrecisionFactor& out) const override {
-    if (factor_ == nullptr || !factor_->is_super || !factor_->is_ll || factor_->itype != CHOLMOD_INT ||
-        factor_->xtype != CHOLMOD_REAL || factor_->minor < factor_->n) {
-      return false;
+  /// One column: through a single-precision copy of the factor (made at the first call
+  /// after a factorization; half the bytes per substitution), unless the copy disagrees
+  /// with the factor (SinglePrecisionFactor::agreesWith); otherwise solve().
+  void solveApproximately(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) override {
+    if (rhs.cols() != 1 || !singleCopyUsable()) {
+      solve(rhs, solution);
+      return;
     }
+    Stopwatch watch;  // runs from construction
+    beginSolve(rhs, "cholmod");
+    single_.solve(rhs.col(0), singleSolution_);
+    solution = singleSolution_;
+    endSolve(1, watch);
+  }
+
+  bool copyFactor(SinglePrecisionFactor& out) const override {
+    SupernodalFactorView view;
+    if (!viewFactor(view)) return false;
+    out.assign(view);
+    return true;
+  }
+
+ private:
+  /// Whether single_ holds a usable copy of the current factor (made here if not yet).
+  bool singleCopyUsable() {
+    if (singleState_ == SingleCopy::notMade) {
+      const bool made = copyFactor(single_) && single_.agreesWith([this](const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+        Eigen::MatrixXd column;
+        solve(b, column);
+        x = column.col(0);
+      });
+      singleState_ = made ? SingleCopy::usable : SingleCopy::unusable;
+    }
+    return singleState_ == SingleCopy::usable;
+  }
+
+  /// The factorization of a factor with small supernodes by SupernodalCholesky, into
+  /// CHOLMOD's factor object (whose solves then apply it). False where CHOLMOD factors:
+  /// large supernodes, or a pivot that is not positive (CHOLMOD then locates it for the
+  /// error message).
+  bool factorSmall(const SparseMatrix& a) {
+    if (!smallSupernodes_ || !numericSupernodal()) return false;
+    const SupernodalFactorView view = supernodalArrays();
+    if (!small_.prepared()) small_.prepare(view, view.perm, a);
+    if (!small_.factor(a, static_cast<double*>(factor_->x), factor_->xsize)) return false;
+    factor_->minor = factor_->n;
+    return true;
+  }
+
+  /// After the analysis: whether SupernodalCholesky factors (small supernodes), and if so
+  /// the factor's numeric arrays, allocated as CHOLMOD's own factorization would, so that
+  /// every factorization of this pattern, the first included, runs the same arithmetic (a
+  /// run resumed from a checkpoint then equals the uninterrupted one bit for bit).
+  void allocateSmallFactor() {
+    smallSupernodes_ =
+        factor_->is_super && factor_->nsuper > 0 &&
+        stats_.factorFlops <= SupernodalCholesky::kSmallSupernodeFlops * static_cast<double>(factor_->nsuper);
+    if (smallSupernodes_ && !cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/1, /*to_packed=*/1,
+                                                   /*to_monotonic=*/1, factor_, common_.get())) {
+      smallSupernodes_ = false;  // CHOLMOD factors (and allocates) instead
+    }
+  }
+
+  /// Whether the factor holds the values of a supernodal L L^T with int indices (from a
+  /// numeric factorization, successful or not).
+  bool numericSupernodal() const {
+    return factor_ != nullptr && factor_->x != nullptr && factor_->is_super && factor_->is_ll &&
+           factor_->itype == CHOLMOD_INT && factor_->xtype == CHOLMOD_REAL;
+  }
+
+  SupernodalFactorView supernodalArrays() const {
     SupernodalFactorView view;
     view.size = static_cast<int>(factor_->n);
     view.supernodes = static_cast<int>(factor_->nsuper);
@@ -175,11 +254,35 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     view.rows = static_cast<const int*>(factor_->s);
     view.perm = static_cast<const int*>(factor_->Perm);
     view.values = static_cast<const double*>(factor_->x);
-    out.assign(view);
+    return view;
+  }
+
+  /// The numeric factor's arrays, when it is a complete supernodal L L^T with int indices.
+  bool viewFactor(SupernodalFactorView& view) const {
+    if (!numericSupernodal() || factor_->minor < factor_->n) return false;
+    view = supernodalArrays();
     return true;
   }
 
- private:
+  /// One right-hand side through the supernodes with Eigen's kernels (supernodalSubstitution.hpp)
+  /// instead of cholmod_solve2, whose two BLAS calls per supernode cost more than their
+  /// work on the small supernodes of fast regions and meshes of a few thousand unknowns
+  /// (docs/benchmarks.md, "Single-column solves"). False where the factor is not supernodal.
+  bool solveOneColumn(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) {
+    SupernodalFactorView view;
+    if (!viewFactor(view)) return false;
+    const int n = view.size;
+    work_.resize(n);
+    for (int i = 0; i < n; ++i) work_[i] = rhs(view.perm[i], 0);
+    if (widest_ < 0) {
+      widest_ = widestUpdate(view);
+      below_.resize(widest_);
+    }
+    substituteInPlace(view, work_, below_);
+    for (int i = 0; i < n; ++i) solution(view.perm[i], 0) = work_[i];
+    return true;
+  }
+
   /// Asks for one ordering, no comparison: METIS, the ordering the design calls for, or
   /// with FillOrdering::automatic AMD for a matrix of up to kAmdMaxRows rows.
   void chooseOrdering(Eigen::Index rows) {
@@ -226,9 +329,17 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
   CholmodCommon common_;
   cholmod_factor* factor_ = nullptr;
   FillOrdering fillOrdering_ = FillOrdering::metis;
-  cholmod_dense* x_ = nullptr;  ///< solution buffer reused by cholmod_solve2
-  cholmod_dense* y_ = nullptr;  ///< cholmod_solve2 workspace
-  cholmod_dense* e_ = nullptr;  ///< cholmod_solve2 workspace
+  cholmod_dense* x_ = nullptr;    ///< solution buffer reused by cholmod_solve2
+  cholmod_dense* y_ = nullptr;    ///< cholmod_solve2 workspace
+  cholmod_dense* e_ = nullptr;    ///< cholmod_solve2 workspace
+  Eigen::VectorXd work_, below_;  ///< solveOneColumn's permuted vector and update buffer
+  int widest_ = -1;               ///< widestUpdate of the analysed factor (-1: not yet known)
+  bool smallSupernodes_ = false;  ///< factorize() runs SupernodalCholesky (allocateSmallFactor)
+  SupernodalCholesky small_;
+  enum class SingleCopy { notMade, usable, unusable };
+  SingleCopy singleState_ = SingleCopy::notMade;  ///< of the current factor (solveApproximately)
+  SinglePrecisionFactor single_;
+  Eigen::VectorXd singleSolution_;
 };
 
 }  // namespace

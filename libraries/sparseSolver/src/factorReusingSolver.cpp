@@ -159,21 +159,9 @@ void FactorReusingSolver::copySinglePrecisionFactor() {
   singlePrecision_.reset();
   const auto* source = dynamic_cast<const detail::SupernodalFactorSource*>(direct_.get());
   auto copy = std::make_unique<detail::SinglePrecisionFactor>();
-  if (options_.singlePrecisionPreconditioner && source != nullptr && source->copyFactor(*copy)) {
-    // Rounded to float, L's entries carry a relative error of 6e-8 (a solve of the
-    // well-conditioned test systems and the shipped scenes' matrices is within 1e-6 of
-    // the double factor's), unless they leave float's range (1e-38 to 3e38) or A's
-    // conditioning amplifies the rounding: where the copy's solve of a fixed vector is off
-    // from the double factor's by more than kSinglePrecisionLimit (or not finite), it
-    // would slow PCG down, and the double factor is kept as the preconditioner instead.
-    constexpr double kSinglePrecisionLimit = 1e-2;
-    const Eigen::Index n = matrix_->rows();
-    const Eigen::VectorXd probe = Eigen::VectorXd::LinSpaced(n, 1.0, 2.0).array().sin();
-    Eigen::VectorXd single;
-    Eigen::VectorXd exact;
-    copy->solve(probe, single);
-    solveExactly(probe, exact);
-    if ((single - exact).norm() <= kSinglePrecisionLimit * exact.norm()) singlePrecision_ = std::move(copy);
+  if (options_.singlePrecisionPreconditioner && source != nullptr && source->copyFactor(*copy) &&
+      copy->agreesWith([this](const Eigen::VectorXd& rhs, Eigen::VectorXd& out) { solveExactly(rhs, out); })) {
+    singlePrecision_ = std::move(copy);
   }
   stats_.singlePrecisionPreconditioner = singlePrecision_ != nullptr;
 }

@@ -235,7 +235,7 @@ void SchurSolver::precondition(const Eigen::VectorXd& rhs, Eigen::VectorXd& solu
 }
 
 void SchurSolver::applyPreconditioner(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
-  if (borrowed_ != nullptr || !external_ || modeUsed_ != SchurMode::symmetric) {
+  if (borrowed_ != nullptr || modeUsed_ != SchurMode::symmetric) {
     solve(rhs, solution);
     return;
   }
@@ -293,8 +293,12 @@ double SchurSolver::conjugateStep(Eigen::VectorXd& solution, const Operator& app
   if (first) {
     direction_ = correction_;
   } else {
-    direction_ = correction_ + (rzNew / rz) * direction_;
+    // Flexible (Polak-Ribiere) beta = z^T (r - r_previous) / rz: equal to the classical
+    // rzNew / rz with a fixed symmetric preconditioner, and robust to one that is only
+    // nearly so (the single-precision factor of solveApproximately).
+    direction_ = correction_ + ((rzNew - previousResidual_.dot(correction_)) / rz) * direction_;
   }
+  previousResidual_ = residual_;
   rz = rzNew;
   if (deflated && kept_ > 0) {
     coefficients_.noalias() = productsOfDirections_.leftCols(kept_).transpose() * direction_;

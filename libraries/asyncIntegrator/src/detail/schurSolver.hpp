@@ -66,8 +66,9 @@ class SchurSolver {
               SchurMode requested, AsyncCoupling coupling, double asymmetry, IntegratorStats& stats);
   /// solution = (H^{LL*})^{-1} rhs with the last factor.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
-  /// The preconditioner of refine(): solve(), or an external solver's solveApproximately()
-  /// (one multigrid cycle instead of iterating to its tolerance).
+  /// The preconditioner of refine(): the factor's solveApproximately() in symmetric mode
+  /// (CHOLMOD: a single-precision copy of the factor; an external solver: one multigrid
+  /// cycle instead of iterating to its tolerance), solve() otherwise.
   void precondition(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
   /// x <- T x (transpose: T^T x) on vectors of |L| entries, orthogonal.
   using Transform = std::function<void(Eigen::VectorXd& x, bool transpose)>;
@@ -165,7 +166,7 @@ class SchurSolver {
   Eigen::MatrixXd lowRankBasis_;                      // W = (A^L)^{-1} U, |L| x q
   Eigen::PartialPivLU<Eigen::MatrixXd> capacitance_;  // I - U^T W C
   Eigen::MatrixXd solution_;
-  Eigen::VectorXd product_, residual_, correction_, direction_;
+  Eigen::VectorXd product_, residual_, correction_, direction_, previousResidual_;
   Transform transform_;             // of the preconditioner, until the next factor()
   const Tracker* track_ = nullptr;  // refine()'s, while it runs
   Eigen::VectorXd turned_;

@@ -2,24 +2,17 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
+
+#include "detail/supernodalSubstitution.hpp"
 
 namespace asyncfem::detail {
 
-/// The arrays of a supernodal Cholesky factor P A P^T = L L^T, as CHOLMOD keeps them
-/// (int indices): supernode k holds columns super[k] .. super[k+1]-1 of L as a dense
-/// column-major block of (pi[k+1] - pi[k]) rows, stored from x[px[k]]; its row indices
-/// are rows[pi[k]] .. (the first ones are its own columns, in order); perm is P (row i of
-/// P A P^T is row perm[i] of A).
-struct SupernodalFactorView {
-  int size = 0;
-  int supernodes = 0;
-  const int* super = nullptr;
-  const int* pi = nullptr;
-  const int* px = nullptr;
-  const int* rows = nullptr;
+/// A supernodal Cholesky factor P A P^T = L L^T in double (supernodalSubstitution.hpp)
+/// and its fill-reducing permutation: row i of P A P^T is row perm[i] of A.
+struct SupernodalFactorView : SupernodalArrays<double> {
   const int* perm = nullptr;
-  const double* values = nullptr;
 };
 
 /// A copy of a supernodal Cholesky factor in single precision, applied as a
@@ -35,7 +28,10 @@ class SinglePrecisionFactor {
   void assign(const SupernodalFactorView& factor);
   bool empty() const { return size_ == 0; }
   /// solution = the approximate A^-1 rhs (sizes: the factor's).
-  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
+  void solve(const Eigen::Ref<const Eigen::VectorXd>& rhs, Eigen::VectorXd& solution);
+  /// Whether this copy may stand in for the double factor as a preconditioner: its solve
+  /// of a fixed vector is finite and within 1e-2 relatively of exactSolve's.
+  bool agreesWith(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& exactSolve);
 
  private:
   int size_ = 0;

@@ -82,8 +82,12 @@ class SparseSolver {
   /// A fixed, symmetric positive definite approximation of A^{-1} applied to every column
   /// of rhs, for callers that iterate on the exact operator themselves (preconditioned
   /// conjugate gradients): an iterative solver applies its preconditioner once (one
-  /// multigrid cycle) instead of iterating to its tolerance. Default, and direct solvers:
-  /// solve().
+  /// multigrid cycle) instead of iterating to its tolerance; CHOLMOD solves one column with
+  /// a single-precision copy of its factor (relative error about 1e-7, half the bytes per
+  /// substitution; nearly symmetric only, so iterate with a flexible conjugate-gradient
+  /// update), made at the first such call after each factorization, or with the factor
+  /// where the copy would not do (entries beyond float's range). Default, and the other
+  /// direct solvers: solve().
   virtual void solveApproximately(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) {
     solve(rhs, solution);
   }

@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "detail/supernodalSubstitution.hpp"
+
+namespace asyncfem::detail {
+
+/// The numeric supernodal Cholesky factorization P A P^T = L L^T on a symbolic structure
+/// CHOLMOD analysed (SupernodalArrays' layout), right-looking with Eigen's dense kernels:
+/// per supernode the diagonal block's L L^T, the rows below it by a triangular solve, and
+/// their outer product subtracted from the ancestors' blocks through a row map.
+///
+/// What it is for: CHOLMOD's numeric factorization opens OpenMP regions per supernode and
+/// per descendant update whatever the sizes (each a system call to wake the team, a few
+/// microseconds on a virtual machine), which on the small factors of fast regions (a few
+/// thousand flops per supernode) costs several times the arithmetic. On large supernodes
+/// CHOLMOD's BLAS kernels (and threads) are faster: CholmodSolver uses this class only
+/// below kSmallSupernodeFlops flops per supernode (docs/benchmarks.md, "Small
+/// factorizations").
+class SupernodalCholesky {
+ public:
+  /// Flops per supernode below which this factorization is faster than CHOLMOD's, measured
+  /// on the fast regions of the shipped scenes and on box meshes (one and two threads).
+  static constexpr double kSmallSupernodeFlops = 4e5;
+
+  /// Prepares for matrices with a's pattern (square, compressed; the upper triangle is
+  /// read, as CHOLMOD reads a symmetric matrix with stype 1): where each of its entries
+  /// lands in L's values. perm: P (row i of P A P^T is row perm[i] of A). The factor's
+  /// arrays must stay valid while factor() is used.
+  void prepare(const SupernodalArrays<double>& factor, const int* perm, const Eigen::SparseMatrix<double>& a);
+  bool prepared() const { return prepared_; }
+  void clear() { prepared_ = false; }
+
+  /// Factors a (the prepared pattern) into values (the factor's value array, valueCount
+  /// entries). False, with values partly overwritten, when a pivot is not positive.
+  bool factor(const Eigen::SparseMatrix<double>& a, double* values, std::size_t valueCount);
+
+ private:
+  /// Subtracts the lower triangle of update_ (the outer product of the rows below supernode
+  /// s) from the blocks of s's ancestors.
+  void subtractUpdate(int s, double* values);
+
+  SupernodalArrays<double> structure_;
+  bool prepared_ = false;
+  std::vector<int> columnSupernode_;  // supernode of each column of L
+  std::vector<int> target_;           // entry k of a's values -> index into L's values (-1: lower triangle)
+  std::vector<int> rowPosition_;      // row -> its position in the current target supernode
+  Eigen::MatrixXd update_;
+};
+
+}  // namespace asyncfem::detail

@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "detail/supernodalCholesky.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+
+namespace asyncfem::detail {
+
+void SupernodalCholesky::prepare(const SupernodalArrays<double>& factor, const int* perm,
+                                 const Eigen::SparseMatrix<double>& a) {
+  structure_ = factor;
+  const int n = factor.size;
+  columnSupernode_.assign(static_cast<std::size_t>(n), 0);
+  for (int s = 0; s < factor.supernodes; ++s)
+    for (int c = factor.super[s]; c < factor.super[s + 1]; ++c) columnSupernode_[static_cast<std::size_t>(c)] = s;
+  std::vector<int> inverse(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) inverse[static_cast<std::size_t>(perm[i])] = i;
+  // Each upper-triangle entry (i, j) of a is entry (max, min) of P A P^T's lower triangle,
+  // in the supernode of its column: entries grouped by that supernode, then placed through
+  // the supernode's row positions.
+  struct Entry {
+    int index, row, column;
+  };
+  std::vector<std::vector<Entry>> bySupernode(static_cast<std::size_t>(factor.supernodes));
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  for (int j = 0; j < n; ++j) {
+    for (int k = outer[j]; k < outer[j + 1]; ++k) {
+      if (inner[k] > j) continue;
+      const int p = inverse[static_cast<std::size_t>(inner[k])], q = inverse[static_cast<std::size_t>(j)];
+      const int column = std::min(p, q);
+      bySupernode[static_cast<std::size_t>(columnSupernode_[static_cast<std::size_t>(column)])].push_back(
+          {k, std::max(p, q), column});
+    }
+  }
+  target_.assign(static_cast<std::size_t>(a.nonZeros()), -1);
+  rowPosition_.assign(static_cast<std::size_t>(n), -1);
+  int widest = 0;
+  for (int s = 0; s < factor.supernodes; ++s) {
+    const int rows = factor.pi[s + 1] - factor.pi[s];
+    widest = std::max(widest, rows - (factor.super[s + 1] - factor.super[s]));
+    for (int r = 0; r < rows; ++r) rowPosition_[static_cast<std::size_t>(factor.rows[factor.pi[s] + r])] = r;
+    for (const Entry& e : bySupernode[static_cast<std::size_t>(s)]) {
+      target_[static_cast<std::size_t>(e.index)] =
+          factor.px[s] + (e.column - factor.super[s]) * rows + rowPosition_[static_cast<std::size_t>(e.row)];
+    }
+  }
+  update_.resize(widest, widest);
+  prepared_ = true;
+}
+
+bool SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& a, double* values, std::size_t valueCount) {
+  std::fill(values, values + valueCount, 0.0);
+  const double* entries = a.valuePtr();
+  for (std::size_t k = 0; k < target_.size(); ++k) {
+    if (target_[k] >= 0) values[target_[k]] += entries[k];
+  }
+  const SupernodalArrays<double>& f = structure_;
+  for (int s = 0; s < f.supernodes; ++s) {
+    const int columns = f.super[s + 1] - f.super[s];
+    const int rows = f.pi[s + 1] - f.pi[s];
+    const int below = rows - columns;
+    Eigen::Map<Eigen::MatrixXd> block(values + f.px[s], rows, columns);
+    Eigen::Ref<Eigen::MatrixXd> diagonal = block.topRows(columns);
+    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(diagonal);  // in place, lower triangle
+    if (llt.info() != Eigen::Success) return false;
+    if (below == 0) continue;
+    auto lower = block.bottomRows(below);
+    // L21 = A21 L11^-T, then the ancestors lose L21 L21^T.
+    block.topRows(columns).triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(lower);
+    auto update = update_.topLeftCorner(below, below);
+    update.triangularView<Eigen::Lower>() = lower * lower.transpose();
+    subtractUpdate(s, values);
+  }
+  return true;
+}
+
+void SupernodalCholesky::subtractUpdate(int s, double* values) {
+  const SupernodalArrays<double>& f = structure_;
+  const int columns = f.super[s + 1] - f.super[s];
+  const int below = (f.pi[s + 1] - f.pi[s]) - columns;
+  const int* rowsBelow = f.rows + f.pi[s] + columns;
+  // The rows below s are ascending, so the columns they name in one ancestor t are
+  // consecutive: one row map per ancestor.
+  int j = 0;
+  while (j < below) {
+    const int t = columnSupernode_[static_cast<std::size_t>(rowsBelow[j])];
+    const int targetRows = f.pi[t + 1] - f.pi[t];
+    for (int r = 0; r < targetRows; ++r) rowPosition_[static_cast<std::size_t>(f.rows[f.pi[t] + r])] = r;
+    for (; j < below && rowsBelow[j] < f.super[t + 1]; ++j) {
+      double* column = values + f.px[t] + static_cast<std::ptrdiff_t>(rowsBelow[j] - f.super[t]) * targetRows;
+      for (int i = j; i < below; ++i) column[rowPosition_[static_cast<std::size_t>(rowsBelow[i])]] -= update_(i, j);
+    }
+  }
+}
+
+}  // namespace asyncfem::detail
