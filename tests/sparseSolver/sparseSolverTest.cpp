@@ -415,8 +415,8 @@ SparseMatrix denseSpd(int n, unsigned seed) {
 }
 
 TEST(SparseSolver, CholmodFactorsSmallAndLargeSupernodesToTheDenseSolution) {
-  // A grid Laplacian's factor has small supernodes (the solver's own supernodal
-  // factorization), a dense matrix's one large supernode (CHOLMOD's). Each solution is
+  // A grid Laplacian's factor has many small supernodes, a dense matrix's one large
+  // supernode (no update to scatter). Each solution is
   // compared with a dense Cholesky solve: both are backward stable and cond <= 121
   // (Laplacian) or about 5 (dense), so they agree to about cond * eps = 3e-14; 1e-12.
   const SparseMatrix matrices[] = {gridLaplacian(10, 0.1), denseSpd(400, 21)};

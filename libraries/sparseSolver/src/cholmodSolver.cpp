@@ -77,7 +77,7 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     Stopwatch watch;  // runs from construction
     beginAnalyze(a, "cholmod");
     if (factor_) cholmod_free_factor(&factor_, common_.get());
-    small_.clear();
+    own_.clear();
     widest_ = -1;
     cholmod_sparse view = upperTriangleView(a);
     chooseOrdering(a.rows());
@@ -95,7 +95,7 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
                   " matrix failed (CHOLMOD status " + std::to_string(common_->status) + ")");
     }
     recordFactorCosts();
-    allocateSmallFactor();
+    allocateOwnFactor();
     ++stats_.analyses;
     stats_.analyzeSeconds += watch.stop();
   }
@@ -104,7 +104,7 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     Stopwatch watch;  // runs from construction
     beginFactorize(a, "cholmod");
     singleState_ = SingleCopy::notMade;
-    if (factorSmall(a)) {
+    if (factorOwn(a)) {
       endFactorize(watch);
       return;
     }
@@ -210,30 +210,28 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     return singleState_ == SingleCopy::usable;
   }
 
-  /// The factorization of a factor with small supernodes by SupernodalCholesky, into
-  /// CHOLMOD's factor object (whose solves then apply it). False where CHOLMOD factors:
-  /// large supernodes, or a pivot that is not positive (CHOLMOD then locates it for the
-  /// error message).
-  bool factorSmall(const SparseMatrix& a) {
-    if (!smallSupernodes_ || !numericSupernodal()) return false;
+  /// The numeric factorization by SupernodalCholesky, into CHOLMOD's factor object (whose
+  /// solves then apply it). False where CHOLMOD factors: a buffer beyond
+  /// SupernodalCholesky::kMaxUpdateEntries, or a pivot that is not positive (CHOLMOD then
+  /// locates it for the error message).
+  bool factorOwn(const SparseMatrix& a) {
+    if (!ownFactorization_ || !numericSupernodal()) return false;
     const SupernodalFactorView view = supernodalArrays();
-    if (!small_.prepared()) small_.prepare(view, view.perm, a);
-    if (!small_.factor(a, static_cast<double*>(factor_->x), factor_->xsize)) return false;
+    if (!own_.prepared()) own_.prepare(view, view.perm, a);
+    if (!own_.factor(a, static_cast<double*>(factor_->x), factor_->xsize)) return false;
     factor_->minor = factor_->n;
     return true;
   }
 
-  /// After the analysis: whether SupernodalCholesky factors (small supernodes), and if so
+  /// After the analysis: whether SupernodalCholesky factors (its buffer fits), and if so
   /// the factor's numeric arrays, allocated as CHOLMOD's own factorization would, so that
   /// every factorization of this pattern, the first included, runs the same arithmetic (a
   /// run resumed from a checkpoint then equals the uninterrupted one bit for bit).
-  void allocateSmallFactor() {
-    smallSupernodes_ =
-        factor_->is_super && factor_->nsuper > 0 &&
-        stats_.factorFlops <= SupernodalCholesky::kSmallSupernodeFlops * static_cast<double>(factor_->nsuper);
-    if (smallSupernodes_ && !cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/1, /*to_packed=*/1,
-                                                   /*to_monotonic=*/1, factor_, common_.get())) {
-      smallSupernodes_ = false;  // CHOLMOD factors (and allocates) instead
+  void allocateOwnFactor() {
+    ownFactorization_ = factor_->is_super && factor_->nsuper > 0 && SupernodalCholesky::fits(supernodalArrays());
+    if (ownFactorization_ && !cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/1, /*to_packed=*/1,
+                                                    /*to_monotonic=*/1, factor_, common_.get())) {
+      ownFactorization_ = false;  // CHOLMOD factors (and allocates) instead
     }
   }
 
@@ -329,13 +327,13 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
   CholmodCommon common_;
   cholmod_factor* factor_ = nullptr;
   FillOrdering fillOrdering_ = FillOrdering::metis;
-  cholmod_dense* x_ = nullptr;    ///< solution buffer reused by cholmod_solve2
-  cholmod_dense* y_ = nullptr;    ///< cholmod_solve2 workspace
-  cholmod_dense* e_ = nullptr;    ///< cholmod_solve2 workspace
-  Eigen::VectorXd work_, below_;  ///< solveOneColumn's permuted vector and update buffer
-  int widest_ = -1;               ///< widestUpdate of the analysed factor (-1: not yet known)
-  bool smallSupernodes_ = false;  ///< factorize() runs SupernodalCholesky (allocateSmallFactor)
-  SupernodalCholesky small_;
+  cholmod_dense* x_ = nullptr;     ///< solution buffer reused by cholmod_solve2
+  cholmod_dense* y_ = nullptr;     ///< cholmod_solve2 workspace
+  cholmod_dense* e_ = nullptr;     ///< cholmod_solve2 workspace
+  Eigen::VectorXd work_, below_;   ///< solveOneColumn's permuted vector and update buffer
+  int widest_ = -1;                ///< widestUpdate of the analysed factor (-1: not yet known)
+  bool ownFactorization_ = false;  ///< factorize() runs SupernodalCholesky (allocateOwnFactor)
+  SupernodalCholesky own_;
   enum class SingleCopy { notMade, usable, unusable };
   SingleCopy singleState_ = SingleCopy::notMade;  ///< of the current factor (solveApproximately)
   SinglePrecisionFactor single_;

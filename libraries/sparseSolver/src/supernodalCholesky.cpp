@@ -1,8 +1,16 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "detail/supernodalCholesky.hpp"
 
-#include <Eigen/Dense>
 #include <algorithm>
+
+// LAPACK and BLAS (Fortran interface, column-major), the kernels CHOLMOD calls too.
+extern "C" {
+void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n,
+            const double* alpha, const double* a, const int* lda, double* b, const int* ldb);
+void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k, const double* alpha, const double* a,
+            const int* lda, const double* beta, double* c, const int* ldc);
+}
 
 namespace asyncfem::detail {
 
@@ -45,7 +53,7 @@ void SupernodalCholesky::prepare(const SupernodalArrays<double>& factor, const i
           factor.px[s] + (e.column - factor.super[s]) * rows + rowPosition_[static_cast<std::size_t>(e.row)];
     }
   }
-  update_.resize(widest, widest);
+  update_.resize(static_cast<std::size_t>(widest) * static_cast<std::size_t>(widest));
   prepared_ = true;
 }
 
@@ -56,20 +64,19 @@ bool SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& a, double* va
     if (target_[k] >= 0) values[target_[k]] += entries[k];
   }
   const SupernodalArrays<double>& f = structure_;
+  const double one = 1.0, zero = 0.0;
   for (int s = 0; s < f.supernodes; ++s) {
     const int columns = f.super[s + 1] - f.super[s];
     const int rows = f.pi[s + 1] - f.pi[s];
     const int below = rows - columns;
-    Eigen::Map<Eigen::MatrixXd> block(values + f.px[s], rows, columns);
-    Eigen::Ref<Eigen::MatrixXd> diagonal = block.topRows(columns);
-    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(diagonal);  // in place, lower triangle
-    if (llt.info() != Eigen::Success) return false;
+    double* block = values + f.px[s];
+    int info = 0;
+    dpotrf_("L", &columns, block, &rows, &info);  // L11 L11^T of the diagonal block, in place
+    if (info != 0) return false;
     if (below == 0) continue;
-    auto lower = block.bottomRows(below);
-    // L21 = A21 L11^-T, then the ancestors lose L21 L21^T.
-    block.topRows(columns).triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(lower);
-    auto update = update_.topLeftCorner(below, below);
-    update.triangularView<Eigen::Lower>() = lower * lower.transpose();
+    // L21 = A21 L11^-T, then the ancestors lose L21 L21^T (lower triangle into update_).
+    dtrsm_("R", "L", "T", "N", &below, &columns, &one, block, &rows, block + columns, &rows);
+    dsyrk_("L", "N", &below, &columns, &one, block + columns, &rows, &zero, update_.data(), &below);
     subtractUpdate(s, values);
   }
   return true;
@@ -89,7 +96,9 @@ void SupernodalCholesky::subtractUpdate(int s, double* values) {
     for (int r = 0; r < targetRows; ++r) rowPosition_[static_cast<std::size_t>(f.rows[f.pi[t] + r])] = r;
     for (; j < below && rowsBelow[j] < f.super[t + 1]; ++j) {
       double* column = values + f.px[t] + static_cast<std::ptrdiff_t>(rowsBelow[j] - f.super[t]) * targetRows;
-      for (int i = j; i < below; ++i) column[rowPosition_[static_cast<std::size_t>(rowsBelow[i])]] -= update_(i, j);
+      const double* update =
+          update_.data() + static_cast<std::ptrdiff_t>(j) * below;  // column j, leading dimension below
+      for (int i = j; i < below; ++i) column[rowPosition_[static_cast<std::size_t>(rowsBelow[i])]] -= update[i];
     }
   }
 }

@@ -10,22 +10,27 @@
 namespace asyncfem::detail {
 
 /// The numeric supernodal Cholesky factorization P A P^T = L L^T on a symbolic structure
-/// CHOLMOD analysed (SupernodalArrays' layout), right-looking with Eigen's dense kernels:
-/// per supernode the diagonal block's L L^T, the rows below it by a triangular solve, and
-/// their outer product subtracted from the ancestors' blocks through a row map.
+/// CHOLMOD analysed (SupernodalArrays' layout), right-looking with LAPACK's and BLAS's
+/// dense kernels (the ones CHOLMOD calls): per supernode the diagonal block's L L^T
+/// (dpotrf), the rows below it by a triangular solve (dtrsm), and their outer product
+/// (dsyrk) subtracted from the ancestors' blocks through a row map.
 ///
-/// What it is for: CHOLMOD's numeric factorization opens OpenMP regions per supernode and
-/// per descendant update whatever the sizes (each a system call to wake the team, a few
-/// microseconds on a virtual machine), which on the small factors of fast regions (a few
-/// thousand flops per supernode) costs several times the arithmetic. On large supernodes
-/// CHOLMOD's BLAS kernels (and threads) are faster: CholmodSolver uses this class only
-/// below kSmallSupernodeFlops flops per supernode (docs/benchmarks.md, "Small
-/// factorizations").
+/// What it is for: CHOLMOD's numeric factorization opens an OpenMP region per supernode
+/// and per descendant update whatever the sizes, each ending in a system call to wake the
+/// team (a few microseconds on a virtual machine), which on the small factors of fast
+/// regions costs several times the arithmetic and on meshes of 10^4 unknowns still about a
+/// third of the time (docs/benchmarks.md, "Factorizations without OpenMP regions").
+/// CholmodSolver factors with it whenever the outer-product buffer (the most rows below
+/// one supernode, squared) holds at most kMaxUpdateEntries doubles.
 class SupernodalCholesky {
  public:
-  /// Flops per supernode below which this factorization is faster than CHOLMOD's, measured
-  /// on the fast regions of the shipped scenes and on box meshes (one and two threads).
-  static constexpr double kSmallSupernodeFlops = 4e5;
+  /// Largest outer-product buffer (doubles, 32 MiB) this factorization allocates.
+  static constexpr double kMaxUpdateEntries = 4.0 * 1024 * 1024;
+  /// Whether factor's largest outer product fits kMaxUpdateEntries.
+  static bool fits(const SupernodalArrays<double>& factor) {
+    const double widest = widestUpdate(factor);
+    return widest * widest <= kMaxUpdateEntries;
+  }
 
   /// Prepares for matrices with a's pattern (square, compressed; the upper triangle is
   /// read, as CHOLMOD reads a symmetric matrix with stype 1): where each of its entries
@@ -41,7 +46,7 @@ class SupernodalCholesky {
 
  private:
   /// Subtracts the lower triangle of update_ (the outer product of the rows below supernode
-  /// s) from the blocks of s's ancestors.
+  /// s, column-major with leading dimension their count) from the blocks of s's ancestors.
   void subtractUpdate(int s, double* values);
 
   SupernodalArrays<double> structure_;
@@ -49,7 +54,7 @@ class SupernodalCholesky {
   std::vector<int> columnSupernode_;  // supernode of each column of L
   std::vector<int> target_;           // entry k of a's values -> index into L's values (-1: lower triangle)
   std::vector<int> rowPosition_;      // row -> its position in the current target supernode
-  Eigen::MatrixXd update_;
+  std::vector<double> update_;
 };
 
 }  // namespace asyncfem::detail
