@@ -117,10 +117,13 @@ namespace {
 constexpr double kMaxDeflationEntries = 8.0 * 1024 * 1024;
 /// What a flop of a supernodal factorization, or of a solve with many right-hand sides
 /// (Z's columns in blocks), costs against one of a single solve (BLAS 3 against memory-
-/// bound substitutions): CHOLMOD on this project's 2-core machine, one thread, factored at
-/// 7.0-8.6 GFlop/s and solved single right-hand sides at 3.2-4.8 GFlop/s (benchmarkAsync
-/// --study setup on dragon meshes of 2k and 10k vertices and the dinosaur).
-constexpr double kBlockedFlopWeight = 0.4;
+/// bound substitutions). Measured on this project's 2-core machine, one thread, corotational
+/// beam and dinosaur (benchmarkAsync --study steady --corotational): a lagged iteration (the
+/// forward substitutions with A^S, one-column kernel of sparseSolver, and the single-
+/// precision kept factor) runs at about 7 GFlop/s, a rebuild (Z and the factor of H^{LL*})
+/// at 9.6-10 GFlop/s: 0.7. (It was 0.4 while single solves went through CHOLMOD's BLAS
+/// calls at 3.2-4.8 GFlop/s; priced at 0.4 since, rebuilds cost 1.7-2x their price.)
+constexpr double kBlockedFlopWeight = 0.7;
 /// The fixed cost of one solve call (wrapping, scatter and gather, CHOLMOD's workspace) in
 /// flops of a solve, which dominates the small A^S solves of a forward substitution.
 constexpr double kSolveCallFlops = 1e5;

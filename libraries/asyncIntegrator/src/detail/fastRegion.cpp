@@ -50,7 +50,7 @@ void FastRegion::updateBlocks(const SparseMatrix& stiffness, double largeStep, d
   const stepFormula::MatrixWeights weights = stepFormula::backwardEuler::systemMatrix(hS, alpha, beta);
   combineInto(weights.mass, Mss, weights.stiffness, Kss, systemMatrix);
   combineInto(0.0, Mss, hS * hS, Kss, G);
-  GT = G.transpose();
+  transposeInto(G, GT, gtPattern_);
   if (denseG) Gdense = G;
   rhsWeight = 1.0 / (1.0 + hS * alpha);
   stepWeight = (1.0 + beta / hS) / (1.0 + hS * alpha);

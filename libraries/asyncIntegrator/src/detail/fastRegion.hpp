@@ -17,6 +17,8 @@
 #include <memory>
 #include <vector>
 
+#include "detail/sparseBlocks.hpp"
+
 namespace asyncfem::detail {
 
 /// One interface element of a fast region (vertices in S_i and in L): where its DOFs sit
@@ -136,6 +138,7 @@ class FastRegion {
 
   int denseDofs_ = 0;
   bool denseDecided_ = false;
+  TransposePattern gtPattern_;  // G's pattern and where GT's entries come from
 };
 
 /// What one computation of Z over every region did.

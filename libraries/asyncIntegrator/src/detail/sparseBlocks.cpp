@@ -55,6 +55,31 @@ void combineInto(double a, const SparseMatrix& A, double b, const SparseMatrix& 
   for (Eigen::Index k = 0; k < A.nonZeros(); ++k) ov[k] = a * av[k] + b * bv[k];
 }
 
+void transposeInto(const SparseMatrix& matrix, SparseMatrix& out, TransposePattern& pattern) {
+  const int* outer = matrix.outerIndexPtr();
+  const int* inner = matrix.innerIndexPtr();
+  const auto columns = static_cast<std::size_t>(matrix.outerSize());
+  const auto entries = static_cast<std::size_t>(matrix.nonZeros());
+  const bool known = pattern.outer.size() == columns + 1 && pattern.inner.size() == entries &&
+                     std::equal(outer, outer + columns + 1, pattern.outer.begin()) &&
+                     std::equal(inner, inner + entries, pattern.inner.begin());
+  if (!known) {
+    out = matrix.transpose();
+    out.makeCompressed();
+    pattern.outer.assign(outer, outer + columns + 1);
+    pattern.inner.assign(inner, inner + entries);
+    // Column c's entries, in order, land in out's columns (their rows) in order of c.
+    std::vector<int> next(out.outerIndexPtr(), out.outerIndexPtr() + out.outerSize());
+    pattern.source.assign(entries, 0);
+    for (std::size_t c = 0; c < columns; ++c)
+      for (int k = outer[c]; k < outer[c + 1]; ++k) pattern.source[static_cast<std::size_t>(next[inner[k]]++)] = k;
+    return;
+  }
+  const double* values = matrix.valuePtr();
+  double* target = out.valuePtr();
+  for (std::size_t k = 0; k < entries; ++k) target[k] = values[pattern.source[k]];
+}
+
 double largestMagnitude(const SparseMatrix& matrix) {
   double value = 0.0;
   for (Eigen::Index k = 0; k < matrix.nonZeros(); ++k) value = std::max(value, std::abs(matrix.valuePtr()[k]));

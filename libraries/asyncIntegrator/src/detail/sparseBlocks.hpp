@@ -31,6 +31,15 @@ bool samePattern(const SparseMatrix& x, const SparseMatrix& y);
 /// already has that pattern; otherwise Eigen's general sum.
 void combineInto(double a, const SparseMatrix& A, double b, const SparseMatrix& B, SparseMatrix& out);
 
+/// out = matrix^T for a compressed matrix. The pattern and the entry map are built the
+/// first time and whenever matrix's pattern changes (recorded in pattern); after that only
+/// values are copied, without an allocation.
+struct TransposePattern {
+  std::vector<int> outer, inner;  ///< matrix's pattern when the map was built
+  std::vector<int> source;        ///< entry k of out is entry source[k] of matrix
+};
+void transposeInto(const SparseMatrix& matrix, SparseMatrix& out, TransposePattern& pattern);
+
 /// Largest |entry| of a matrix (0 for an empty one).
 double largestMagnitude(const SparseMatrix& matrix);
 
