@@ -526,6 +526,10 @@ Scene steadyScene(const std::string& spec, bool corotational) {
   return scene;
 }
 
+/// Large steps per block when the corotational steady study times async and single-rate
+/// at hS in turn.
+constexpr int kInterleavedSteps = 10;
+
 struct SteadyRow {
   std::string name;
   int vertices = 0, fastVertices = 0, interfaceDofs = 0, ratio = 1;
@@ -543,7 +547,8 @@ struct SteadyRow {
 /// set-up against single-rate steps at hL. With `only`, one configuration and no table
 /// (for callgrind). Corotational: the async large step against m corotational single-rate
 /// steps at hS, both as the mean wall time of all timed steps (the lagged factor's rebuilds
-/// and single-rate's refactorizations included), the medians beside them.
+/// and single-rate's refactorizations included), the medians beside them, timed in turn in
+/// blocks of kInterleavedSteps large steps.
 void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotational, const std::string& only,
                  bool collectFirst, bool rebuildSchur, int laggedIterations, bool unturned) {
   std::vector<SteadyRow> rows;
@@ -585,24 +590,40 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
     const DynamicSystem system = async->system();
     // Collected for callgrind: the first step (set-up included) with --first, else the
     // timed steady steps.
-    const auto measure = [&](Integrator& integrator, double* setup, double* mean = nullptr) {
+    const auto warmUp = [&](Integrator& integrator, double* setup) {
       Stopwatch first;
       if (!only.empty() && collectFirst) ASYNCFEM_COLLECT_ON();
       integrator.step();
       if (!only.empty() && collectFirst) ASYNCFEM_COLLECT_OFF();
       if (setup) *setup = first.stop();
       integrator.step();
-      std::vector<double> samples;
+    };
+    const auto timeSteps = [&](Integrator& integrator, int count, std::vector<double>& samples) {
       if (!only.empty() && !collectFirst) ASYNCFEM_COLLECT_ON();
-      for (int k = 0; k < steps; ++k) {
+      for (int k = 0; k < count; ++k) {
         Stopwatch watch;
         integrator.step();
         samples.push_back(watch.stop());
       }
       if (!only.empty() && !collectFirst) ASYNCFEM_COLLECT_OFF();
-      if (mean) *mean = std::accumulate(samples.begin(), samples.end(), 0.0) / static_cast<double>(samples.size());
+    };
+    const auto mean = [](const std::vector<double>& samples) {
+      return std::accumulate(samples.begin(), samples.end(), 0.0) / static_cast<double>(samples.size());
+    };
+    const auto measure = [&](Integrator& integrator, double* setup, double* meanStep = nullptr) {
+      warmUp(integrator, setup);
+      std::vector<double> samples;
+      timeSteps(integrator, steps, samples);
+      if (meanStep) *meanStep = mean(samples);
       return median(samples);
     };
+    // Corotational, whole table: the async steps and single-rate's at hS in turn, blocks of
+    // kInterleavedSteps large steps each, so that a change of the shared machine's speed
+    // during the run weighs on both sides of the ratio alike.
+    const bool interleaved = only.empty() && corotational;
+    std::unique_ptr<Integrator> small;
+    std::vector<double> asyncSamples, smallSamples;
+    if (interleaved) small = makeIntegrator("backward-euler", system, row.hL / row.ratio);
     if (only.empty() || only == "async") {
       if (!only.empty() && collectFirst) {
         // The set-up runs in the constructor (setUp()); collect it once more, as it is.
@@ -610,7 +631,21 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
         async->setUp(async->partition());
         ASYNCFEM_COLLECT_OFF();
       }
-      row.asyncStep = measure(*async, &row.setup, &row.asyncMeanWall);
+      if (interleaved) {
+        warmUp(*async, &row.setup);
+        warmUp(*small, nullptr);
+        for (int done = 0; done < steps; done += kInterleavedSteps) {
+          const int block = std::min(kInterleavedSteps, steps - done);
+          timeSteps(*async, block, asyncSamples);
+          timeSteps(*small, block * row.ratio, smallSamples);
+        }
+        row.asyncStep = median(asyncSamples);
+        row.asyncMeanWall = mean(asyncSamples);
+        row.singleStepHS = median(smallSamples) * row.ratio;
+        row.singleMeanHS = mean(smallSamples) * row.ratio;
+      } else {
+        row.asyncStep = measure(*async, &row.setup, &row.asyncMeanWall);
+      }
       row.asyncMeanStep =
           corotational ? async->runStats().meanStepWithRebuildSeconds() : async->runStats().meanStepSeconds();
       row.setup = async->runStats().setupSeconds;
@@ -633,9 +668,9 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
       row.singleStep = measure(*single, &row.singleSetup);
       row.singleSetup += constructionSeconds;
     }
-    if ((only.empty() && corotational) || only == "single-hs") {
-      auto small = makeIntegrator("backward-euler", system, row.hL / row.ratio);
-      row.singleStepHS = measure(*small, nullptr, &row.singleMeanHS) * row.ratio;
+    if (only == "single-hs") {
+      auto hs = makeIntegrator("backward-euler", system, row.hL / row.ratio);
+      row.singleStepHS = measure(*hs, nullptr, &row.singleMeanHS) * row.ratio;
       row.singleMeanHS *= row.ratio;
     }
     if (!only.empty()) {
@@ -675,11 +710,12 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
     std::printf("%s", rebuildSchur ? "With AsyncOptions::laggedSchur off (Z and H^{LL*} rebuilt every large step).\n\n"
                                    : "With AsyncOptions::laggedSchur (the default).\n\n");
     std::printf(
-        "Mean wall time of the %d timed steps (rebuilds and refactorizations included); medians in parentheses.\n\n"
+        "Mean wall time of the %d timed steps (rebuilds and refactorizations included); medians in parentheses. "
+        "Async and single-rate at hS timed in turn, %d large steps at a time.\n\n"
         "| scene | vertices | S vertices (%%) | interface DOFs | m | async ms/large step | single-rate hL ms/step | "
         "single-rate hS ms per hL | async / single-rate hS (medians) | cost model ratio | async set-up ms "
         "|\n|---|---|---|---|---|---|---|---|---|---|---|\n",
-        steps);
+        steps, kInterleavedSteps);
     for (const SteadyRow& r : rows)
       std::printf(
           "| %s | %d | %d (%.1f%%) | %d | %d | %.3f (%.3f) | %.3f | %.3f (%.3f) | %.2f (%.2f) | %.2f | %.1f |\n",
