@@ -262,10 +262,10 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     return true;
   }
 
-  /// One right-hand side through the supernodes with Eigen's kernels (supernodalSubstitution.hpp)
-  /// instead of cholmod_solve2, whose two BLAS calls per supernode cost more than their
-  /// work on the small supernodes of fast regions and meshes of a few thousand unknowns
-  /// (docs/benchmarks.md, "Single-column solves"). False where the factor is not supernodal.
+  /// One right-hand side through the supernodes with Eigen's kernels (supernodalSubstitution.hpp,
+  /// shared with the single-precision copy) instead of cholmod_solve2 and its two BLAS
+  /// calls per supernode: 3-5% faster on the fast regions' A^S (docs/benchmarks.md,
+  /// "Factorizations without OpenMP regions"). False where the factor is not supernodal.
   bool solveOneColumn(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) {
     SupernodalFactorView view;
     if (!viewFactor(view)) return false;
