@@ -124,6 +124,10 @@ constexpr double kMaxDeflationEntries = 8.0 * 1024 * 1024;
 /// at 9.6-10 GFlop/s: 0.7. (It was 0.4 while single solves went through CHOLMOD's BLAS
 /// calls at 3.2-4.8 GFlop/s; priced at 0.4 since, rebuilds cost 1.7-2x their price.)
 constexpr double kBlockedFlopWeight = 0.7;
+/// The same weight for the quick set-up's rule (Eq. Q4), whose iterations solve with the
+/// whole system's factor (millions of entries: CHOLMOD's solves with OpenBLAS's kernels, at
+/// the 3.2-4.8 GFlop/s measured for it): 0.4.
+constexpr double kQuickBlockedFlopWeight = 0.4;
 /// The fixed cost of one solve call (wrapping, scatter and gather, CHOLMOD's workspace) in
 /// flops of a solve, which dominates the small A^S solves of a forward substitution.
 constexpr double kSolveCallFlops = 1e5;
@@ -140,7 +144,7 @@ QuickCosts quickCosts(const std::vector<FastRegion>& regions, const SparseMatrix
   QuickCosts costs;
   costs.exactSolve = whole.solveFlops() + kSolveCallFlops;
   costs.iteration = costs.exactSolve + 2.0 * static_cast<double>(largeSystem.nonZeros());
-  costs.rebuild = kBlockedFlopWeight * whole.factorFlops();
+  costs.rebuild = kQuickBlockedFlopWeight * whole.factorFlops();
   for (std::size_t i = 0; i < regions.size(); ++i) {
     const FastRegion& rb = regions[i];
     // A forward substitution: m_i solves with A^S and m_i products with G; Z is |I_i| of
@@ -148,7 +152,7 @@ QuickCosts quickCosts(const std::vector<FastRegion>& regions, const SparseMatrix
     const double substitution = rb.substitutionFlops;
     costs.iteration += substitution + rb.ratio * kSolveCallFlops;
     costs.rebuild +=
-        kBlockedFlopWeight * substitution * static_cast<double>(partition.interfaceDofs(static_cast<int>(i)).size());
+        kQuickBlockedFlopWeight * substitution * static_cast<double>(partition.interfaceDofs(static_cast<int>(i)).size());
   }
   return costs;
 }

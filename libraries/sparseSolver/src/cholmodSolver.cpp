@@ -264,11 +264,14 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
 
   /// One right-hand side through the supernodes with Eigen's kernels (supernodalSubstitution.hpp,
   /// shared with the single-precision copy) instead of cholmod_solve2 and its two BLAS
-  /// calls per supernode: 3-5% faster on the fast regions' A^S (docs/benchmarks.md,
-  /// "Factorizations without OpenMP regions"). False where the factor is not supernodal.
+  /// calls per supernode, on factors of at most kOneColumnMaxNonZeros entries: 3-5% faster
+  /// on the fast regions' A^S (40k-100k entries), even at 1.3M, and 1.3x slower at 7.6M,
+  /// where OpenBLAS's kernels on large supernodes win (one thread, box meshes; docs/benchmarks.md,
+  /// "Factorizations without OpenMP regions"). False where cholmod_solve2 solves.
   bool solveOneColumn(const Eigen::Ref<const Eigen::MatrixXd>& rhs, Eigen::MatrixXd& solution) {
+    constexpr long long kOneColumnMaxNonZeros = 1000000;
     SupernodalFactorView view;
-    if (!viewFactor(view)) return false;
+    if (stats_.factorNonZeros > kOneColumnMaxNonZeros || !viewFactor(view)) return false;
     const int n = view.size;
     work_.resize(n);
     for (int i = 0; i < n; ++i) work_[i] = rhs(view.perm[i], 0);

@@ -24,23 +24,28 @@ void SupernodalCholesky::prepare(const SupernodalArrays<double>& factor, const i
   std::vector<int> inverse(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) inverse[static_cast<std::size_t>(perm[i])] = i;
   // Each upper-triangle entry (i, j) of a is entry (max, min) of P A P^T's lower triangle,
-  // in the supernode of its column: entries grouped by that supernode, then placed through
-  // the supernode's row positions.
-  struct Entry {
-    int index, row, column;
-  };
-  std::vector<std::vector<Entry>> bySupernode(static_cast<std::size_t>(factor.supernodes));
+  // in the supernode of its column: the entries are counted per supernode, sorted into one
+  // array by a counting sort, then placed through each supernode's row positions.
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
-  for (int j = 0; j < n; ++j) {
-    for (int k = outer[j]; k < outer[j + 1]; ++k) {
-      if (inner[k] > j) continue;
-      const int p = inverse[static_cast<std::size_t>(inner[k])], q = inverse[static_cast<std::size_t>(j)];
-      const int column = std::min(p, q);
-      bySupernode[static_cast<std::size_t>(columnSupernode_[static_cast<std::size_t>(column)])].push_back(
-          {k, std::max(p, q), column});
-    }
-  }
+  const auto supernodeOf = [&](int k, int j) {
+    const int p = inverse[static_cast<std::size_t>(inner[k])], q = inverse[static_cast<std::size_t>(j)];
+    return columnSupernode_[static_cast<std::size_t>(std::min(p, q))];
+  };
+  std::vector<int> start(static_cast<std::size_t>(factor.supernodes) + 1, 0);
+  for (int j = 0; j < n; ++j)
+    for (int k = outer[j]; k < outer[j + 1]; ++k)
+      if (inner[k] <= j) ++start[static_cast<std::size_t>(supernodeOf(k, j)) + 1];
+  for (int s = 0; s < factor.supernodes; ++s) start[s + 1] += start[s];
+  std::vector<int> next(start.begin(), start.end() - 1), sorted(static_cast<std::size_t>(start.back())),
+      sortedColumn(sorted.size());
+  for (int j = 0; j < n; ++j)
+    for (int k = outer[j]; k < outer[j + 1]; ++k)
+      if (inner[k] <= j) {
+        const auto slot = static_cast<std::size_t>(next[static_cast<std::size_t>(supernodeOf(k, j))]++);
+        sorted[slot] = k;
+        sortedColumn[slot] = j;
+      }
   target_.assign(static_cast<std::size_t>(a.nonZeros()), -1);
   rowPosition_.assign(static_cast<std::size_t>(n), -1);
   int widest = 0;
@@ -48,12 +53,16 @@ void SupernodalCholesky::prepare(const SupernodalArrays<double>& factor, const i
     const int rows = factor.pi[s + 1] - factor.pi[s];
     widest = std::max(widest, rows - (factor.super[s + 1] - factor.super[s]));
     for (int r = 0; r < rows; ++r) rowPosition_[static_cast<std::size_t>(factor.rows[factor.pi[s] + r])] = r;
-    for (const Entry& e : bySupernode[static_cast<std::size_t>(s)]) {
-      target_[static_cast<std::size_t>(e.index)] =
-          factor.px[s] + (e.column - factor.super[s]) * rows + rowPosition_[static_cast<std::size_t>(e.row)];
+    for (int e = start[static_cast<std::size_t>(s)]; e < start[static_cast<std::size_t>(s) + 1]; ++e) {
+      const int k = sorted[static_cast<std::size_t>(e)];
+      const int p = inverse[static_cast<std::size_t>(inner[k])];
+      const int q = inverse[static_cast<std::size_t>(sortedColumn[static_cast<std::size_t>(e)])];
+      target_[static_cast<std::size_t>(k)] = factor.px[s] + (std::min(p, q) - factor.super[s]) * rows +
+                                             rowPosition_[static_cast<std::size_t>(std::max(p, q))];
     }
   }
-  update_.resize(static_cast<std::size_t>(widest) * static_cast<std::size_t>(widest));
+  // dsyrk writes the buffer before reading it (beta = 0): no need to clear it.
+  update_.reset(new double[static_cast<std::size_t>(widest) * static_cast<std::size_t>(widest)]);
   prepared_ = true;
 }
 
@@ -76,7 +85,7 @@ bool SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& a, double* va
     if (below == 0) continue;
     // L21 = A21 L11^-T, then the ancestors lose L21 L21^T (lower triangle into update_).
     dtrsm_("R", "L", "T", "N", &below, &columns, &one, block, &rows, block + columns, &rows);
-    dsyrk_("L", "N", &below, &columns, &one, block + columns, &rows, &zero, update_.data(), &below);
+    dsyrk_("L", "N", &below, &columns, &one, block + columns, &rows, &zero, update_.get(), &below);
     subtractUpdate(s, values);
   }
   return true;
@@ -97,7 +106,7 @@ void SupernodalCholesky::subtractUpdate(int s, double* values) {
     for (; j < below && rowsBelow[j] < f.super[t + 1]; ++j) {
       double* column = values + f.px[t] + static_cast<std::ptrdiff_t>(rowsBelow[j] - f.super[t]) * targetRows;
       const double* update =
-          update_.data() + static_cast<std::ptrdiff_t>(j) * below;  // column j, leading dimension below
+          update_.get() + static_cast<std::ptrdiff_t>(j) * below;  // column j, leading dimension below
       for (int i = j; i < below; ++i) column[rowPosition_[static_cast<std::size_t>(rowsBelow[i])]] -= update[i];
     }
   }

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
 #include <vector>
 
 #include "detail/supernodalSubstitution.hpp"
@@ -54,7 +55,7 @@ class SupernodalCholesky {
   std::vector<int> columnSupernode_;  // supernode of each column of L
   std::vector<int> target_;           // entry k of a's values -> index into L's values (-1: lower triangle)
   std::vector<int> rowPosition_;      // row -> its position in the current target supernode
-  std::vector<double> update_;
+  std::unique_ptr<double[]> update_;  // the outer product of one supernode's rows below it
 };
 
 }  // namespace asyncfem::detail
