@@ -151,8 +151,8 @@ QuickCosts quickCosts(const std::vector<FastRegion>& regions, const SparseMatrix
     // them, in blocks of columns.
     const double substitution = rb.substitutionFlops;
     costs.iteration += substitution + rb.ratio * kSolveCallFlops;
-    costs.rebuild +=
-        kQuickBlockedFlopWeight * substitution * static_cast<double>(partition.interfaceDofs(static_cast<int>(i)).size());
+    costs.rebuild += kQuickBlockedFlopWeight * substitution *
+                     static_cast<double>(partition.interfaceDofs(static_cast<int>(i)).size());
   }
   return costs;
 }
