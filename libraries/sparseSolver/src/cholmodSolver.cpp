@@ -217,7 +217,7 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
   bool factorOwn(const SparseMatrix& a) {
     if (!ownFactorization_ || !numericSupernodal()) return false;
     const SupernodalFactorView view = supernodalArrays();
-    if (!own_.prepared()) own_.prepare(view, view.perm, a);
+    if (!own_.preparedFor(view)) own_.prepare(view, view.perm, a);
     if (!own_.factor(a, static_cast<double*>(factor_->x), factor_->xsize)) return false;
     factor_->minor = factor_->n;
     return true;

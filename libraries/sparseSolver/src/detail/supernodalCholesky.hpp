@@ -38,7 +38,12 @@ class SupernodalCholesky {
   /// lands in L's values. perm: P (row i of P A P^T is row perm[i] of A). The factor's
   /// arrays must stay valid while factor() is used.
   void prepare(const SupernodalArrays<double>& factor, const int* perm, const Eigen::SparseMatrix<double>& a);
-  bool prepared() const { return prepared_; }
+  /// Whether prepare() ran for this structure (the same arrays: CHOLMOD keeps a factor's
+  /// symbolic arrays in place across factorizations, but a new analysis replaces them).
+  bool preparedFor(const SupernodalArrays<double>& factor) const {
+    return prepared_ && factor.supernodes == structure_.supernodes && factor.super == structure_.super &&
+           factor.pi == structure_.pi && factor.px == structure_.px && factor.rows == structure_.rows;
+  }
   void clear() { prepared_ = false; }
 
   /// Factors a (the prepared pattern) into values (the factor's value array, valueCount
