@@ -169,6 +169,41 @@ TEST(SubmatrixExtractor, CombinesTwoMatricesOfOnePattern) {
   EXPECT_THROW((void)extractor.extractCombination(a, m, b, other), Error);
 }
 
+// rebuild(): a re-partition's cut in the storage of the previous one. The rebuilt extractor
+// gives exactly what a fresh one for the new lists gives (same entries, same copies:
+// exact), and extractCombinationInto() fills a matrix that held a larger cut without
+// moving its entries (no allocation); a bad list leaves the old map usable.
+TEST(SubmatrixExtractor, RebuildsForNewIndexListsInItsOwnStorage) {
+  const TetMesh mesh = test::mixedMaterialBox(3);
+  const MatrixAssembler assembler(mesh);
+  const SparseMatrix k = linearStiffnessMatrix(mesh, assembler);
+  const SparseMatrix m = massMatrix(mesh, assembler, MassType::consistent);
+  const FreeDofs wide = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("xmin"));
+  std::vector<int> narrow;  // every other free DOF: fewer entries than the first cut
+  for (std::size_t i = 0; i < wide.freeToFull().size(); i += 2) narrow.push_back(wide.freeToFull()[i]);
+  SubmatrixExtractor extractor(m, wide.freeToFull(), wide.freeToFull());
+  const double a = 1.0, b = 0.01 * 0.01;
+  SparseMatrix sub = extractor.extractCombination(a, m, b, k);
+  const double* storage = sub.valuePtr();
+  extractor.rebuild(m, narrow, narrow);
+  extractor.extractCombinationInto(a, m, b, k, sub);
+  EXPECT_EQ(sub.valuePtr(), storage);
+  const SubmatrixExtractor fresh(m, narrow, narrow);
+  const SparseMatrix expected = fresh.extractCombination(a, m, b, k);
+  ASSERT_EQ(sub.rows(), static_cast<Eigen::Index>(narrow.size()));
+  EXPECT_EQ(sub.nonZeros(), expected.nonZeros());
+  EXPECT_EQ(Eigen::MatrixXd(sub), Eigen::MatrixXd(expected));
+  EXPECT_EQ(Eigen::MatrixXd(extractor.extract(k)), denseBlock(Eigen::MatrixXd(k), narrow, narrow));
+  // Back to the wide cut (more entries than it holds now: it grows).
+  extractor.rebuild(m, wide.freeToFull(), wide.freeToFull());
+  extractor.extractCombinationInto(a, m, b, k, sub);
+  EXPECT_EQ(Eigen::MatrixXd(sub), a * denseBlock(Eigen::MatrixXd(m), wide.freeToFull(), wide.freeToFull()) +
+                                      b * denseBlock(Eigen::MatrixXd(k), wide.freeToFull(), wide.freeToFull()));
+  EXPECT_THROW(extractor.rebuild(m, {2, 1}, {0}), ValidationError);
+  EXPECT_EQ(Eigen::MatrixXd(extractor.extract(m)),
+            denseBlock(Eigen::MatrixXd(m), wide.freeToFull(), wide.freeToFull()));
+}
+
 TEST(SubmatrixExtractor, RejectsBadIndexListsAndForeignMatrices) {
   std::mt19937 random(1);
   const SparseMatrix full = randomSparse(10, 8, 0.3, random);

@@ -332,8 +332,8 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   const SparseMatrix& mass = system_.mass;
   const std::vector<int>& large = partition_.largeDofs();
   if (d.sharedPattern < 0) d.sharedPattern = detail::samePattern(mass, d.stiffness) ? 1 : 0;
-  d.massLL = SubmatrixExtractor(mass, large, large);
-  d.stiffLL = d.sharedPattern == 1 ? SubmatrixExtractor() : SubmatrixExtractor(d.stiffness, large, large);
+  d.massLL.rebuild(mass, large, large);  // in the storage of the previous partition's cut
+  if (d.sharedPattern != 1) d.stiffLL.rebuild(d.stiffness, large, large);
   d.cutLL = false;
   d.regions.clear();
   d.regions.reserve(static_cast<std::size_t>(partition_.numRegions()));
@@ -436,7 +436,7 @@ void AsyncBackwardEuler::assembleBlocks() {
   if (d.sharedPattern == 1) {
     // One pass over L's entries of M and K (no M^{LL}, K^{LL} of their own).
     if (!d.cutLL) {
-      d.largeSystem = d.massLL.extractCombination(weights.mass, system_.mass, weights.stiffness, d.stiffness);
+      d.massLL.extractCombinationInto(weights.mass, system_.mass, weights.stiffness, d.stiffness, d.largeSystem);
     } else {
       d.massLL.updateCombination(weights.mass, system_.mass, weights.stiffness, d.stiffness, d.largeSystem);
     }

@@ -98,6 +98,11 @@ Eigen::VectorXd FreeDofs::expand(const Eigen::VectorXd& free) const {
 
 SubmatrixExtractor::SubmatrixExtractor(const Eigen::SparseMatrix<double>& full, const std::vector<int>& rows,
                                        const std::vector<int>& cols) {
+  rebuild(full, rows, cols);
+}
+
+void SubmatrixExtractor::rebuild(const Eigen::SparseMatrix<double>& full, const std::vector<int>& rows,
+                                 const std::vector<int>& cols) {
   checkIndexList(rows, full.rows(), "row");
   checkIndexList(cols, full.cols(), "column");
   const std::vector<int> fullToSubRow = subRowMap(rows, full.rows());
@@ -145,12 +150,21 @@ Eigen::SparseMatrix<double> SubmatrixExtractor::extractCombination(double a, con
                                                                    double b,
                                                                    const Eigen::SparseMatrix<double>& B) const {
   // The pattern without its zero values: updateCombination writes every value.
-  Eigen::SparseMatrix<double> sub(pattern_.rows(), pattern_.cols());
+  Eigen::SparseMatrix<double> sub;
+  extractCombinationInto(a, A, b, B, sub);
+  return sub;
+}
+
+void SubmatrixExtractor::extractCombinationInto(double a, const Eigen::SparseMatrix<double>& A, double b,
+                                                const Eigen::SparseMatrix<double>& B,
+                                                Eigen::SparseMatrix<double>& sub) const {
+  // The pattern without its zero values: updateCombination writes every value. Eigen's
+  // resize keeps the entry storage (and the column starts when their count is unchanged).
+  sub.resize(pattern_.rows(), pattern_.cols());
   sub.resizeNonZeros(pattern_.nonZeros());
   std::copy_n(pattern_.outerIndexPtr(), pattern_.outerSize() + 1, sub.outerIndexPtr());
   std::copy_n(pattern_.innerIndexPtr(), pattern_.nonZeros(), sub.innerIndexPtr());
   updateCombination(a, A, b, B, sub);
-  return sub;
 }
 
 void SubmatrixExtractor::checkShapes(const Eigen::SparseMatrix<double>& full, const Eigen::SparseMatrix<double>& sub,
