@@ -42,6 +42,19 @@ TEST(ScopedBlasThreads, HoldsOpenBlasToTheCountWhileAlive) {
     EXPECT_EQ(get(), 1);
   }
   EXPECT_EQ(get(), 2);
+  {
+    // hold(false) gives the earlier count back for the large calls, hold(true) takes it
+    // again; the destructor restores it whichever state the guard was left in.
+    asyncfem::ScopedBlasThreads toggled(1);
+    EXPECT_EQ(get(), 1);
+    toggled.hold(false);
+    EXPECT_EQ(get(), 2);
+    toggled.hold(false);
+    EXPECT_EQ(get(), 2);
+    toggled.hold(true);
+    EXPECT_EQ(get(), 1);
+  }
+  EXPECT_EQ(get(), 2);
   set(original);
 }
 

@@ -2,6 +2,7 @@
 #include "detail/supernodalCholesky.hpp"
 
 #include <algorithm>
+#include <asyncfem/core/threading.hpp>
 
 // LAPACK and BLAS (Fortran interface, column-major), the kernels CHOLMOD calls too.
 extern "C" {
@@ -66,7 +67,21 @@ void SupernodalCholesky::prepare(const SupernodalArrays<double>& factor, const i
   prepared_ = true;
 }
 
+namespace {
+/// Supernodes whose work (rows^2 x columns, about the flops of their dpotrf, dtrsm and dsyrk)
+/// is below this run their BLAS calls on one thread. Measured at OMP_NUM_THREADS=2 on the
+/// 2-core machine (corotationalBenchmark 30 --toolkit-only exact, factorization ms per step,
+/// two runs each): bridge-sized 23.8-25.8 with every call on the BLAS's threads, 18.4-23.5
+/// with this threshold; dragon-sized 225 either way, but 281-302 with every call on one
+/// thread (its largest supernodes gain from two).
+constexpr double kThreadedBlasWork = 1e7;
+}  // namespace
+
 bool SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& a, double* values, std::size_t valueCount) {
+  // Small supernodes on one BLAS thread: a call that wakes the BLAS's own threads pays a
+  // futex wake-up and leaves them spinning (sched_yield) for a while on cores the caller's
+  // OpenMP threads want (bridge-sized corotational step at two threads, kThreadedBlasWork).
+  ScopedBlasThreads blas(1);
   std::fill(values, values + valueCount, 0.0);
   const double* entries = a.valuePtr();
   for (std::size_t k = 0; k < target_.size(); ++k) {
@@ -79,6 +94,7 @@ bool SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& a, double* va
     const int rows = f.pi[s + 1] - f.pi[s];
     const int below = rows - columns;
     double* block = values + f.px[s];
+    blas.hold(static_cast<double>(rows) * rows * columns < kThreadedBlasWork);
     int info = 0;
     dpotrf_("L", &columns, block, &rows, &info);  // L11 L11^T of the diagonal block, in place
     if (info != 0) return false;

@@ -36,7 +36,7 @@ inline void preferPassiveThreadWaiting(char** argv) {
 /// region, not inside it.
 class ScopedBlasThreads {
  public:
-  explicit ScopedBlasThreads(int threads) {
+  explicit ScopedBlasThreads(int threads) : threads_(threads) {
     int (*get)() = nullptr;
     symbol("openblas_get_num_threads", get);
     symbol("openblas_set_num_threads", set_);
@@ -45,17 +45,20 @@ class ScopedBlasThreads {
       return;
     }
     previous_ = get();
-    if (previous_ <= threads) {
-      set_ = nullptr;  // already at most that many: nothing to restore
-      return;
-    }
-    set_(threads);
+    hold(true);
   }
-  ~ScopedBlasThreads() {
-    if (set_ != nullptr) set_(previous_);
-  }
+  ~ScopedBlasThreads() { hold(false); }
   ScopedBlasThreads(const ScopedBlasThreads&) = delete;
   ScopedBlasThreads& operator=(const ScopedBlasThreads&) = delete;
+
+  /// true: the BLAS runs on at most the constructor's count (as after construction);
+  /// false: on its previous count again, until the next hold(true). For a sequence of calls
+  /// of which only the largest gain from the BLAS's threads (a supernodal factorization).
+  void hold(bool held) {
+    if (set_ == nullptr || previous_ <= threads_ || held == held_) return;  // nothing to change
+    set_(held ? threads_ : previous_);
+    held_ = held;
+  }
 
  private:
   // A function of the process's libraries by name, or null (copied from dlsym's object
@@ -68,7 +71,9 @@ class ScopedBlasThreads {
   }
 
   void (*set_)(int) = nullptr;
+  int threads_ = 1;
   int previous_ = 0;
+  bool held_ = false;
 };
 
 }  // namespace asyncfem
