@@ -95,5 +95,79 @@ TEST(PenaltyContact, RejectsBadParameters) {
                ValidationError);
 }
 
+// jacobian(): each block against central differences of addForces in u and in v, for a
+// vertex in a plane and one in a sphere, with normal damping and friction in its viscous
+// and its sliding regime (states chosen away from the kinks, so the force is smooth there).
+// Tolerance 1e-6 of the block's norm: central differences with a step of 1e-7 of the
+// state's scale err by about step^2 times the third derivative (curvature 1/0.3 here) plus
+// round-off of 1e-16 / 1e-7 of the force.
+TEST(PenaltyContact, JacobianMatchesFiniteDifferencesOfTheForces) {
+  Eigen::Matrix3Xd rest(3, 3);
+  rest.col(0) = Eigen::Vector3d(0.1, -0.02, 0.05);  // in the ground
+  rest.col(1) = Eigen::Vector3d(2.0, 0.9, 0.1);     // in the sphere (centre (2, 1.2, 0), radius 0.35)
+  rest.col(2) = Eigen::Vector3d(0, 3, 0);           // free
+  const ContactSphere sphere{Eigen::Vector3d(2.0, 1.2, 0.0), 0.35};
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(9), v = Eigen::VectorXd::Zero(9);
+  u.segment<3>(0) = Eigen::Vector3d(0.01, 0.003, -0.02);
+  u.segment<3>(3) = Eigen::Vector3d(0.02, -0.01, 0.03);
+  v.segment<3>(0) = Eigen::Vector3d(0.3, -0.2, 0.1);
+  v.segment<3>(3) = Eigen::Vector3d(-0.4, 0.25, 0.2);
+  for (const double viscosity : {1.0, 1e4}) {  // viscous (eta |v_t| < mu f_n), then sliding
+    PenaltyContactParameters p;
+    p.stiffness = 2000;
+    p.damping = 15;
+    p.friction = 0.4;
+    p.frictionViscosity = viscosity;
+    const PenaltyContact contact(rest, {ContactPlane{}}, {sphere}, p);
+    const PenaltyContactJacobian jacobian = contact.jacobian(u, v);
+    ASSERT_EQ(jacobian.vertices, (std::vector<int>{0, 1}));
+    ASSERT_EQ(jacobian.stiffness.size(), 2u);
+    ASSERT_EQ(jacobian.damping.size(), 2u);
+    for (std::size_t k = 0; k < 2; ++k) {
+      const int vertex = jacobian.vertices[k];
+      Eigen::Matrix3d stiffness, damping;
+      for (int j = 0; j < 3; ++j) {
+        for (const bool inVelocity : {false, true}) {
+          const double step = 1e-7 * (inVelocity ? 1.0 : 0.1);
+          Eigen::VectorXd plusU = u, minusU = u, plusV = v, minusV = v;
+          Eigen::VectorXd& plus = inVelocity ? plusV : plusU;
+          Eigen::VectorXd& minus = inVelocity ? minusV : minusU;
+          plus[3 * vertex + j] += step;
+          minus[3 * vertex + j] -= step;
+          Eigen::VectorXd fPlus = Eigen::VectorXd::Zero(9), fMinus = Eigen::VectorXd::Zero(9);
+          contact.addForces(plusU, plusV, fPlus);
+          contact.addForces(minusU, minusV, fMinus);
+          const Eigen::Vector3d column = -(fPlus - fMinus).segment<3>(3 * vertex) / (2.0 * step);
+          (inVelocity ? damping : stiffness).col(j) = column;
+        }
+      }
+      EXPECT_LE((jacobian.stiffness[k] - stiffness).norm(), 1e-6 * stiffness.norm())
+          << "vertex " << vertex << ", eta " << viscosity << "\n"
+          << jacobian.stiffness[k] << "\n"
+          << stiffness;
+      EXPECT_LE((jacobian.damping[k] - damping).norm(), 1e-6 * damping.norm())
+          << "vertex " << vertex << ", eta " << viscosity << "\n"
+          << jacobian.damping[k] << "\n"
+          << damping;
+    }
+  }
+  // A vertex leaving so fast that damping would pull: no force, so no entry.
+  PenaltyContactParameters p;
+  p.stiffness = 2000;
+  p.damping = 15;
+  const PenaltyContact contact(rest, {ContactPlane{}}, {}, p);
+  Eigen::VectorXd leaving = Eigen::VectorXd::Zero(9);
+  leaving[1] = 10.0;
+  EXPECT_TRUE(contact.jacobian(u, leaving).vertices.empty());
+  // A plane without damping or friction: exactly k n n^T, and nothing in v.
+  p.damping = 0;
+  const PenaltyContactJacobian plain = PenaltyContact(rest, {ContactPlane{}}, {}, p).jacobian(u, v);
+  ASSERT_EQ(plain.vertices, (std::vector<int>{0}));
+  Eigen::Matrix3d expected = Eigen::Matrix3d::Zero();
+  expected(1, 1) = 2000;
+  EXPECT_EQ(plain.stiffness[0], expected);
+  EXPECT_EQ(plain.damping[0], Eigen::Matrix3d::Zero());
+}
+
 }  // namespace
 }  // namespace asyncfem

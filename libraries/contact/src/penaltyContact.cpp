@@ -43,7 +43,7 @@ void PenaltyContact::forEachContact(const Eigen::VectorXd& displacement, const s
     const Eigen::Vector3d x = restPositions_.col(v) + displacement.segment<3>(3 * v);
     for (const ContactPlane& plane : planes_) {
       const double depth = plane.offset - plane.normal.dot(x);
-      if (depth > -margin) visit(v, depth, plane.normal);
+      if (depth > -margin) visit(v, depth, plane.normal, 0.0);
     }
     for (const ContactSphere& sphere : spheres_) {
       const Eigen::Vector3d r = x - sphere.center;
@@ -51,7 +51,7 @@ void PenaltyContact::forEachContact(const Eigen::VectorXd& displacement, const s
       const double depth = sphere.radius - distance;
       if (depth > -margin) {
         const Eigen::Vector3d normal = distance > 0.0 ? Eigen::Vector3d(r / distance) : Eigen::Vector3d::UnitY();
-        visit(v, depth, normal);
+        visit(v, depth, normal, distance > 0.0 ? 1.0 / distance : 0.0);
       }
     }
   }
@@ -60,7 +60,7 @@ void PenaltyContact::forEachContact(const Eigen::VectorXd& displacement, const s
 void PenaltyContact::addForces(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                                Eigen::VectorXd& forces, const std::vector<int>* vertices) const {
   const PenaltyContactParameters& p = parameters_;
-  forEachContact(displacement, vertices, [&](int v, double depth, const Eigen::Vector3d& normal) {
+  forEachContact(displacement, vertices, [&](int v, double depth, const Eigen::Vector3d& normal, double) {
     const Eigen::Vector3d vel = velocity.segment<3>(3 * v);
     const double normalVelocity = vel.dot(normal);
     const double normalForce = std::max(0.0, p.stiffness * depth - p.damping * normalVelocity);
@@ -77,10 +77,54 @@ void PenaltyContact::addForces(const Eigen::VectorXd& displacement, const Eigen:
   });
 }
 
+PenaltyContactJacobian PenaltyContact::jacobian(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                                const std::vector<int>* vertices) const {
+  const PenaltyContactParameters& p = parameters_;
+  PenaltyContactJacobian out;
+  const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+  forEachContact(displacement, vertices, [&](int v, double depth, const Eigen::Vector3d& n, double curvature) {
+    const Eigen::Vector3d vel = velocity.segment<3>(3 * v);
+    const double normalVelocity = vel.dot(n);
+    const double normalForce = p.stiffness * depth - p.damping * normalVelocity;
+    if (!(normalForce > 0.0)) return;  // clamped: no force, no derivative
+    // dn/dx = curvature P (zero for a plane), P = I - n n^T; d depth/dx = -n^T.
+    const Eigen::Matrix3d P = identity - n * n.transpose();
+    const Eigen::Matrix3d turn = curvature * P;
+    // f_n = k depth - c v.n: its gradients in x and v (row vectors).
+    const Eigen::RowVector3d dNormalDx = -p.stiffness * n.transpose() - p.damping * vel.transpose() * turn;
+    const Eigen::RowVector3d dNormalDv = -p.damping * n.transpose();
+    // f = f_n n: df/dx = n df_n/dx + f_n dn/dx, df/dv = n df_n/dv.
+    Eigen::Matrix3d dfdx = n * dNormalDx + normalForce * turn;
+    Eigen::Matrix3d dfdv = n * dNormalDv;
+    if (p.friction > 0.0) {
+      // t = P v; dt/dv = P, dt/dx = -((v.n) I + n v^T) dn/dx.
+      const Eigen::Vector3d tangential = vel - normalVelocity * n;
+      const double speed = tangential.norm();
+      if (speed > 0.0) {
+        const Eigen::Matrix3d dtdx = -(normalVelocity * identity + n * vel.transpose()) * turn;
+        if (p.frictionViscosity * speed <= p.friction * normalForce) {
+          dfdx -= p.frictionViscosity * dtdx;  // f_t = -eta t
+          dfdv -= p.frictionViscosity * P;
+        } else {
+          // f_t = -mu f_n t / |t|; d(t/|t|) = (I - t^ t^^T) dt / |t|.
+          const Eigen::Vector3d direction = tangential / speed;
+          const Eigen::Matrix3d project = (identity - direction * direction.transpose()) / speed;
+          dfdx -= p.friction * (direction * dNormalDx + normalForce * project * dtdx);
+          dfdv -= p.friction * (direction * dNormalDv + normalForce * project * P);
+        }
+      }
+    }
+    out.vertices.push_back(v);
+    out.stiffness.push_back(-dfdx);
+    out.damping.push_back(-dfdv);
+  });
+  return out;
+}
+
 double PenaltyContact::maxPenetration(const Eigen::VectorXd& displacement) const {
   double worst = 0.0;
   forEachContact(displacement, nullptr,
-                 [&](int, double depth, const Eigen::Vector3d&) { worst = std::max(worst, depth); });
+                 [&](int, double depth, const Eigen::Vector3d&, double) { worst = std::max(worst, depth); });
   return worst;
 }
 
@@ -88,7 +132,7 @@ std::vector<int> PenaltyContact::verticesWithin(const Eigen::VectorXd& displacem
   std::vector<int> out;
   forEachContact(
       displacement, nullptr,
-      [&](int v, double, const Eigen::Vector3d&) {
+      [&](int v, double, const Eigen::Vector3d&, double) {
         if (out.empty() || out.back() != v) out.push_back(v);
       },
       std::max(0.0, margin));
@@ -98,7 +142,7 @@ std::vector<int> PenaltyContact::verticesWithin(const Eigen::VectorXd& displacem
 int PenaltyContact::activeContacts(const Eigen::VectorXd& displacement) const {
   int count = 0;
   int last = -1;
-  forEachContact(displacement, nullptr, [&](int v, double, const Eigen::Vector3d&) {
+  forEachContact(displacement, nullptr, [&](int v, double, const Eigen::Vector3d&, double) {
     if (v != last) ++count;
     last = v;
   });

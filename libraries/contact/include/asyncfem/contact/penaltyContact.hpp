@@ -42,6 +42,17 @@ struct PenaltyContactParameters {
   double frictionViscosity = 1e3;  ///< eta
 };
 
+/// The derivatives of PenaltyContact's forces at one state, per vertex in contact: with the
+/// signs of the equation of motion (M a + D v + K u = f), stiffness[k] = -df/du and
+/// damping[k] = -df/dv of vertex vertices[k] (3 x 3 blocks; a vertex touching two
+/// obstacles appears twice). What an implicit integrator adds to its system matrix to
+/// treat contact implicitly (linearized at that state).
+struct PenaltyContactJacobian {
+  std::vector<int> vertices;
+  std::vector<Eigen::Matrix3d> stiffness;
+  std::vector<Eigen::Matrix3d> damping;
+};
+
 class PenaltyContact {
  public:
   /// restPositions: 3 x n. Throws asyncfem::ValidationError for a non-positive stiffness,
@@ -53,6 +64,16 @@ class PenaltyContact {
   /// `vertices` are tested when it is non-null (e.g. a fast region's vertices).
   void addForces(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, Eigen::VectorXd& forces,
                  const std::vector<int>* vertices = nullptr) const;
+
+  /// The derivatives of addForces' forces at (u, v) (same vertex filter), exact where the
+  /// force is smooth: a plane's normal force gives k n n^T and c n n^T; a sphere's adds the
+  /// turning of its normal, (k d - c v.n) (I - n n^T) / |x - c| and the damping's term;
+  /// friction adds eta P (viscous regime, P = I - n n^T) or the derivatives of
+  /// mu f_n t / |t| (sliding). Where the normal force is clamped to zero the vertex has no
+  /// entry; at the kinks (f_n = 0, mu f_n = eta |t|, t = 0) the one-sided derivative of the
+  /// branch addForces takes.
+  PenaltyContactJacobian jacobian(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                  const std::vector<int>* vertices = nullptr) const;
 
   /// Largest penetration depth over all vertices and obstacles at u (0 if none).
   double maxPenetration(const Eigen::VectorXd& displacement) const;
@@ -66,8 +87,9 @@ class PenaltyContact {
 
  private:
   template <class Visitor>
-  /// visit(vertex, depth, normal) for every vertex and obstacle with depth > -margin
-  /// (margin 0: the vertices in contact), vertices in ascending order.
+  /// visit(vertex, depth, normal, curvature) for every vertex and obstacle with depth >
+  /// -margin (margin 0: the vertices in contact), vertices in ascending order; curvature is
+  /// 1 / |x - c| for a sphere (how fast its normal turns with x), 0 for a plane.
   void forEachContact(const Eigen::VectorXd& displacement, const std::vector<int>* vertices, Visitor&& visit,
                       double margin = 0.0) const;
 
