@@ -139,15 +139,24 @@ TEST(SubmatrixExtractor, ExtractsFreeSystemOfAssembledStiffness) {
   EXPECT_EQ(Eigen::MatrixXd(free), 2.0 * denseBlock(Eigen::MatrixXd(k), dofs.freeToFull(), dofs.freeToFull()));
 }
 
+// Stiffness and consistent mass of the mixed-material box (one assembler, one pattern),
+// with the free DOFs of its xmin face held.
+struct BoxMatrices {
+  TetMesh mesh = test::mixedMaterialBox(3);
+  MatrixAssembler assembler{mesh};
+  SparseMatrix k = linearStiffnessMatrix(mesh, assembler);
+  SparseMatrix m = massMatrix(mesh, assembler, MassType::consistent);
+  FreeDofs dofs = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("xmin"));
+};
+
 // updateCombination: a A + b B on the block in one pass equals the sum of the two
 // extractions (each entry a A_ij + b B_ij, the same two products and one sum: exact), for M
 // and K of one mesh (one assembler, one pattern); a matrix of another pattern is refused.
 TEST(SubmatrixExtractor, CombinesTwoMatricesOfOnePattern) {
-  const TetMesh mesh = test::mixedMaterialBox(3);
-  const MatrixAssembler assembler(mesh);
-  const SparseMatrix k = linearStiffnessMatrix(mesh, assembler);
-  const SparseMatrix m = massMatrix(mesh, assembler, MassType::consistent);
-  const FreeDofs dofs = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("xmin"));
+  const BoxMatrices box;
+  const SparseMatrix& k = box.k;
+  const SparseMatrix& m = box.m;
+  const FreeDofs& dofs = box.dofs;
   const SubmatrixExtractor extractor(m, dofs.freeToFull(), dofs.freeToFull());
   SparseMatrix combined = extractor.extract(m);
   const double a = 1.0, b = 0.01 * 0.01;
@@ -174,11 +183,10 @@ TEST(SubmatrixExtractor, CombinesTwoMatricesOfOnePattern) {
 // exact), and extractCombinationInto() fills a matrix that held a larger cut without
 // moving its entries (no allocation); a bad list leaves the old map usable.
 TEST(SubmatrixExtractor, RebuildsForNewIndexListsInItsOwnStorage) {
-  const TetMesh mesh = test::mixedMaterialBox(3);
-  const MatrixAssembler assembler(mesh);
-  const SparseMatrix k = linearStiffnessMatrix(mesh, assembler);
-  const SparseMatrix m = massMatrix(mesh, assembler, MassType::consistent);
-  const FreeDofs wide = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("xmin"));
+  const BoxMatrices box;
+  const SparseMatrix& k = box.k;
+  const SparseMatrix& m = box.m;
+  const FreeDofs& wide = box.dofs;
   std::vector<int> narrow;  // every other free DOF: fewer entries than the first cut
   for (std::size_t i = 0; i < wide.freeToFull().size(); i += 2) narrow.push_back(wide.freeToFull()[i]);
   SubmatrixExtractor extractor(m, wide.freeToFull(), wide.freeToFull());
