@@ -154,6 +154,7 @@ StepGrowthEstimate estimateStepGrowth(Integrator& integrator, const StepGrowthOp
 DynamicSystem homogeneousLinearSystem(const DynamicSystem& system) {
   DynamicSystem out = system;
   out.externalForce = nullptr;
+  out.externalForceJacobian = nullptr;
   if (!system.forceModel->isLinear()) {
     out.forceModel = std::make_shared<LinearForceModel>(restStiffness(*system.forceModel, system.numDofs()));
   }

@@ -21,6 +21,9 @@ void DynamicSystem::validate() const {
     throw ValidationError("the dynamic system's mesh has " + std::to_string(mesh->numDofs()) +
                           " DOFs but the force model has " + std::to_string(n));
   }
+  if (externalForceJacobian && !externalForce) {
+    throw ValidationError("the dynamic system has an external-force Jacobian but no external force");
+  }
   if (!(rayleighMass >= 0.0) || !(rayleighStiffness >= 0.0) || !std::isfinite(rayleighMass) ||
       !std::isfinite(rayleighStiffness)) {
     throw ValidationError("Rayleigh damping coefficients must be finite and >= 0 (alpha " +

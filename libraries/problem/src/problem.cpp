@@ -19,6 +19,12 @@ Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVert
       windows_(std::move(windows)),
       contact_(std::move(contact)) {
   if (!mesh_) throw ValidationError("problem: no mesh");
+  if (settings_.implicitContact && contact_ && contact_->parameters().friction > 0.0) {
+    throw ValidationError(
+        "problem: implicit contact with friction " + std::to_string(contact_->parameters().friction) +
+        ": friction is not treated implicitly (its force grows with the depth, a coupling Newton's symmetric step "
+        "matrix cannot hold); set the friction to 0 or treat contact explicitly");
+  }
   const int n = mesh_->numVertices();
   std::sort(fixedVertices_.begin(), fixedVertices_.end());
   fixedVertices_.erase(std::unique(fixedVertices_.begin(), fixedVertices_.end()), fixedVertices_.end());
@@ -165,6 +171,12 @@ DynamicSystem Problem::dynamicSystem() const {
                                                     std::vector<int>& vertices) {
       vertices = contact->verticesWithin(displacement, margin);
     };
+    if (settings_.implicitContact) {
+      system.externalForceJacobian = [contact = contact_](double, const Eigen::VectorXd& displacement,
+                                                          const Eigen::VectorXd& velocity, VertexJacobian& jacobian) {
+        jacobian = contact->jacobian(displacement, velocity);
+      };
+    }
   }
   return system;
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <asyncfem/core/vertexJacobian.hpp>
 #include <vector>
 
 namespace asyncfem {
@@ -33,8 +34,8 @@ struct ContactSphere {
 /// chatter). k: stiffness (force / length per vertex), c: normal damping (force /
 /// velocity per vertex). Frictionless when mu = 0 (default).
 ///
-/// The forces are explicit (evaluated at one state); integrators apply them once per
-/// (large) step.
+/// The forces are evaluated at one state; integrators apply them explicitly, or (single-rate
+/// backward Euler with DynamicSystem::externalForceJacobian) linearized with jacobian().
 struct PenaltyContactParameters {
   double stiffness = 1e4;
   double damping = 0.0;
@@ -42,16 +43,11 @@ struct PenaltyContactParameters {
   double frictionViscosity = 1e3;  ///< eta
 };
 
-/// The derivatives of PenaltyContact's forces at one state, per vertex in contact: with the
-/// signs of the equation of motion (M a + D v + K u = f), stiffness[k] = -df/du and
-/// damping[k] = -df/dv of vertex vertices[k] (3 x 3 blocks; a vertex touching two
-/// obstacles appears twice). What an implicit integrator adds to its system matrix to
-/// treat contact implicitly (linearized at that state).
-struct PenaltyContactJacobian {
-  std::vector<int> vertices;
-  std::vector<Eigen::Matrix3d> stiffness;
-  std::vector<Eigen::Matrix3d> damping;
-};
+/// The derivatives of PenaltyContact's forces at one state, per vertex in contact
+/// (stiffness = -df/du, damping = -df/dv; a vertex touching two obstacles appears twice):
+/// what an implicit integrator adds to its system matrix to treat contact implicitly
+/// (linearized at that state).
+using PenaltyContactJacobian = VertexJacobian;
 
 class PenaltyContact {
  public:

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <asyncfem/core/vertexJacobian.hpp>
 #include <asyncfem/forceModel/forceModel.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
@@ -24,6 +25,12 @@ using ExternalForceFunction = std::function<void(double time, const Eigen::Vecto
 /// answer (it only costs those evaluations).
 using ExternalForceChanges = std::function<bool(double from, double to)>;
 
+/// The derivatives of the external force's state-dependent part at time and state (u, v),
+/// per vertex (stiffness = -df/du, damping = -df/dv), into jacobian (cleared first): what an
+/// implicit integrator needs to treat that part implicitly (penalty contact).
+using ExternalForceJacobianFunction = std::function<void(double time, const Eigen::VectorXd& displacement,
+                                                         const Eigen::VectorXd& velocity, VertexJacobian& jacobian)>;
+
 /// The vertices (ascending) closer than margin (a length) to an obstacle of the external
 /// force at displacement u, into vertices: what lets an integrator follow contact.
 using ObstacleProximity =
@@ -44,6 +51,12 @@ struct DynamicSystem {
   /// it may change at any time (a user's force function). Whoever replaces externalForce
   /// must reset or replace this too.
   ExternalForceChanges externalForceChanges;
+  /// When set, the external force is to be treated implicitly: integrators that can
+  /// (Integrator::linearizesExternalForce(): single-rate BackwardEuler) use these
+  /// derivatives; the others apply the force explicitly as always, and
+  /// IntegratorRegistry::create refuses to build them for such a system.
+  /// Whoever replaces externalForce must reset or replace this too.
+  ExternalForceJacobianFunction externalForceJacobian;
   /// Where the external force's obstacles are (penalty contact); empty without obstacles.
   ObstacleProximity obstacleProximity;
   /// The mesh the matrices were built from (n vertices). Integrators that partition the

@@ -33,6 +33,10 @@ struct ProblemSettings {
   double rayleighAlpha = 0.0;                 ///< D = alpha M + beta K
   double rayleighBeta = 0.0;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< acceleration (length / time^2)
+  /// Penalty contact treated implicitly: dynamicSystem() then carries the contact's
+  /// derivatives (DynamicSystem::externalForceJacobian). No effect without contact;
+  /// frictionless contact only (the constructor refuses friction > 0).
+  bool implicitContact = false;
 };
 
 /// A problem to integrate in time, independent of any integrator: the resolved mesh
