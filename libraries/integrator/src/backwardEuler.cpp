@@ -25,6 +25,10 @@ BackwardEuler::BackwardEuler(DynamicSystem system, double timestep, const Integr
     throw ValidationError("backward Euler needs a Newton tolerance >= 0 (got " + std::to_string(options_.tolerance) +
                           ")");
   }
+  if (options_.contactIterations < 1) {
+    throw ValidationError("backward Euler needs contactIterations >= 1 (got " +
+                          std::to_string(options_.contactIterations) + ")");
+  }
   if (options_.reuseFactor && !(options_.pcgTolerance > 0.0 && options_.pcgTolerance < 1.0)) {
     throw ValidationError("backward Euler needs a PCG tolerance in (0, 1) (got " +
                           std::to_string(options_.pcgTolerance) + ")");
@@ -34,7 +38,9 @@ BackwardEuler::BackwardEuler(DynamicSystem system, double timestep, const Integr
                           std::to_string(options_.pcgRefactorIterations) + ")");
   }
   linear_ = system_.forceModel->isLinear();
-  if (options_.reuseFactor && !linear_) {
+  implicitExternal_ = static_cast<bool>(system_.externalForceJacobian);
+  // With implicit contact a linear model's matrix changes with the contact set too.
+  if (options_.reuseFactor && (!linear_ || implicitExternal_)) {
     FactorReuseOptions reuseOptions;
     reuseOptions.relativeTolerance = options_.pcgTolerance;
     reuseOptions.refactorAfterIterations = options_.pcgRefactorIterations;
@@ -48,11 +54,16 @@ BackwardEuler::BackwardEuler(DynamicSystem system, double timestep, const Integr
     free_ = std::make_unique<detail::FreeSystem>(system_, options_.solver);
   }
   if (!system_.damped()) stats_.skipped.emplace_back("damping matrix (alpha = beta = 0)");
+  if (implicitExternal_ && options_.lineSearch && options_.maxIterations > 1) {
+    stats_.skipped.emplace_back(
+        "line search (implicit contact: the step equations are no potential's gradient; Newton updates taken in full)");
+  }
   if (linear_) {
     // f_int(u) = K u with K constant: evaluate K once (at rest) and keep it.
     Eigen::VectorXd rest = Eigen::VectorXd::Zero(system_.numDofs());
     free_->evaluateForcesAndTangent(system_, rest, free_->stiffness, stats_);
-    stats_.skipped.emplace_back("refactorization (constant system matrix)");
+    stats_.skipped.emplace_back(implicitExternal_ ? "refactorization while no vertex is in contact"
+                                                  : "refactorization (constant system matrix)");
     if (options_.maxIterations > 1) {
       stats_.skipped.emplace_back("Newton iterations (linear force model: the linearized step is exact)");
     }
@@ -68,16 +79,25 @@ void BackwardEuler::setTimestep(double timestep) {
   if (timestep != previous) factorizationStale_ = true;
 }
 
-void BackwardEuler::assembleSystemMatrix() {
+void BackwardEuler::assembleSystemMatrix(bool withContact) {
   const stepFormula::MatrixWeights weights =
       stepFormula::backwardEuler::systemMatrix(timestep_, system_.rayleighMass, system_.rayleighStiffness);
   free_->assemble({weights.mass, weights.stiffness}, {&free_->mass, &free_->stiffness}, stats_);
+  if (withContact) addContactBlocks();
+}
+
+void BackwardEuler::addContactBlocks() {
+  // The contact force linearized at the predicted state (u_k + h v_k, v_k):
+  // f(u_{k+1}, v_{k+1}) ~ f_p - K_c h dv - C_c dv, so the step's matrix gains h^2 K_c + h C_c.
+  const double h = timestep_;
+  if (!contact_.empty()) free_->addVertexBlocks(system_.freeDofs, contact_, h * h, h, stats_);
 }
 
 void BackwardEuler::assembleAndFactor() {
-  assembleSystemMatrix();
+  assembleSystemMatrix(false);
   free_->factorize(stats_);
   factorizationStale_ = false;
+  factorHasContact_ = false;
 }
 
 const FactorReuseStats* BackwardEuler::factorReuseStats() const { return reuse_ ? &reuse_->stats() : nullptr; }
@@ -89,6 +109,17 @@ void BackwardEuler::restartPoint() {
 RunReport BackwardEuler::report() const {
   RunReport report;
   report.factorNonZeros = free_->solver().stats().factorNonZeros;
+  if (implicitExternal_) {
+    std::ostringstream text;
+    text << "implicit contact: " << contactSteps_ << " of " << stats_.steps
+         << " steps predicted contact; Newton on the step equations with the contact at each iterate, "
+         << unconvergedContactSteps_ << " steps stopped at "
+         << std::max(options_.maxIterations, options_.contactIterations) << " iterations unconverged";
+    if (unconvergedContactSteps_ > 0) {
+      text << " (largest relative residual " << std::setprecision(3) << largestUnconvergedResidual_ << ")";
+    }
+    report.lines.push_back(text.str());
+  }
   if (linear_) return report;
   std::ostringstream text;
   if (!reuse_) {
@@ -107,7 +138,7 @@ RunReport BackwardEuler::report() const {
 }
 
 void BackwardEuler::assembleForReuse() {
-  assembleSystemMatrix();
+  assembleSystemMatrix(true);
   updateReusedMatrix();
 }
 
@@ -152,12 +183,33 @@ void BackwardEuler::restrictStepStart(Eigen::VectorXd& force) {
   const FreeDofs& dofs = system_.freeDofs;
   detail::restrictTo(dofs, displacement_, u_);
   detail::restrictTo(dofs, velocity_, v_);
-  if (system_.externalForce) {
+  if (implicitExternal_) {
+    // Linearized at the predicted state (u_k + h v_k, v_k): a vertex about to reach an
+    // obstacle is already in the step's contact set, so the spring is never skipped for a
+    // step (the class comment has the equations).
+    fullPredicted_ = displacement_ + timestep_ * velocity_;
+    zeroFixed(fullPredicted_);
+    evaluateImplicitExternalForce(fullPredicted_, velocity_, force);
+    predictedImpulse_ = timestep_ * force.norm();
+    if (!contact_.empty()) ++contactSteps_;
+  } else if (system_.externalForce) {
     evaluateExternalForce(stepEndTime(), fullForce_);
     detail::restrictTo(dofs, fullForce_, force);
   } else {
     force.setZero(u_.size());
   }
+}
+
+void BackwardEuler::evaluateImplicitExternalForce(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                                  Eigen::VectorXd& force) {
+  {
+    TimeInto timer(stats_.forceSeconds);
+    fullForce_.setZero(system_.numDofs());
+    system_.externalForce(stepEndTime(), displacement, velocity, fullForce_);
+    contact_.clear();
+    system_.externalForceJacobian(stepEndTime(), displacement, velocity, contact_);
+  }
+  detail::restrictTo(system_.freeDofs, fullForce_, force);
 }
 
 void BackwardEuler::finishStep() {
@@ -172,8 +224,9 @@ void BackwardEuler::stepLinear() {
   const double h = timestep_;
   const double alpha = system_.rayleighMass;
   const double beta = system_.rayleighStiffness;
-  if (factorizationStale_) assembleAndFactor();
-  restrictStepStart(rhs_);
+  if (factorizationStale_ || factorHasContact_) assembleAndFactor();
+  restrictStepStart(force_);
+  rhs_ = force_;
   {
     // Fixed DOFs are zero, so the free rows of K u are K_ff u_f:
     // b = h ( f_ext - K (u + (beta + h) v) - alpha M v ) (Eq. A1, stepFormula).
@@ -186,10 +239,109 @@ void BackwardEuler::stepLinear() {
     if (alpha != 0.0) rhs_.noalias() -= alpha * (free_->mass * v_);
     rhs_ *= recipe.scale;
   }
-  free_->solve(rhs_, dv_, stats_);
+  const bool predictedContact = !contact_.empty();
+  solveLinearStep(rhs_, dv_);
   lastIterations_ = 1;
   lastRelativeResidual_ = -1.0;
+  if (implicitExternal_) lastIterations_ = linearContactIterations(rhs_.norm(), predictedContact);
   finishStep();
+}
+
+void BackwardEuler::solveLinearStep(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  if (contact_.empty()) {
+    if (factorHasContact_) assembleAndFactor();
+    free_->solve(rhs, solution, stats_);
+    return;
+  }
+  // K constant, the contact blocks not: M + h D + h^2 K is kept factored for the steps
+  // without contact, the solves with contact use their own matrix (kept-factor PCG with
+  // reuseFactor, else a factorization that the next contact-free solve replaces).
+  assembleSystemMatrix(true);
+  if (reuse_) {
+    updateReusedMatrix();
+    solveWithReuse(rhs, solution);
+  } else {
+    free_->factorize(stats_);
+    factorHasContact_ = true;
+    free_->solve(rhs, solution, stats_);
+  }
+}
+
+int BackwardEuler::linearContactIterations(double rhsNorm, bool solvedWithContact) {
+  // Newton on R(dv) = M dv - h ( f_ext(u_{k+1}, v_{k+1}) - K u_{k+1} - D v_{k+1} ), K constant:
+  // only the contact force and its blocks change between iterates.
+  const double h = timestep_;
+  const int allowed = std::max(options_.maxIterations, options_.contactIterations);
+  const double scale = contactResidualScale(rhsNorm);
+  Eigen::VectorXd newVelocity, newDisplacement, internal, residual, correction;
+  for (int iterations = 1;; ++iterations) {
+    newVelocity = v_ + dv_;
+    newDisplacement = u_ + h * newVelocity;
+    detail::expandTo(system_.freeDofs, newDisplacement, fullU_);
+    detail::expandTo(system_.freeDofs, newVelocity, fullV_);
+    evaluateImplicitExternalForce(fullU_, fullV_, force_);
+    // No contact in the solve nor at its result: the force did not depend on the state.
+    if (!solvedWithContact && contact_.empty()) return iterations;
+    {
+      TimeInto timer(stats_.forceSeconds);
+      internal.noalias() = free_->stiffness * newDisplacement;
+    }
+    iterateResidual(internal, free_->stiffness, newVelocity, residual);
+    if (retreatContactStep(residual.norm() / scale, iterations, allowed, correction)) continue;
+    if (stopContactIterations(residual.norm() / scale, iterations, allowed)) return iterations;
+    solveLinearStep(-residual, correction);
+    dv_ += correction;
+    solvedWithContact = !contact_.empty();
+  }
+}
+
+double BackwardEuler::contactResidualScale(double rhsNorm) const {
+  // |b_0| alone vanishes for a body resting on an obstacle (the forces balance), where the
+  // residual of an exact solve is rounding: relative to the impulse of the external force
+  // over the step too, the tolerance stays meaningful there.
+  const double scale = std::max(rhsNorm, predictedImpulse_);
+  return scale > 0.0 ? scale : 1.0;
+}
+
+bool BackwardEuler::retreatContactStep(double relativeResidual, int iterations, int allowed,
+                                       const Eigen::VectorXd& correction) {
+  // Where the contact set or the clamped normal damping switches, a full Newton update can
+  // land on a larger residual and the iteration cycle; halving it back (at most 8 times,
+  // each halving one iteration) until the residual norm decreases breaks the cycle.
+  constexpr int kMaxHalvings = 8;
+  if (iterations == 1) {
+    contactPreviousResidual_ = std::numeric_limits<double>::infinity();
+    contactHalvings_ = 0;
+  }
+  if (relativeResidual < contactPreviousResidual_ || contactHalvings_ >= kMaxHalvings || iterations >= allowed ||
+      !std::isfinite(relativeResidual) || relativeResidual <= options_.tolerance) {
+    contactPreviousResidual_ = relativeResidual;
+    contactHalvings_ = 0;
+    contactStepFraction_ = 1.0;
+    return false;
+  }
+  contactStepFraction_ *= 0.5;
+  dv_ -= contactStepFraction_ * correction;
+  ++contactHalvings_;
+  return true;
+}
+
+bool BackwardEuler::stopContactIterations(double relativeResidual, int iterations, int allowed) {
+  lastRelativeResidual_ = relativeResidual;
+  if (!std::isfinite(relativeResidual)) {
+    throw NumericalError(name() + ": the step to t = " + std::to_string(stepEndTime()) +
+                         " has a non-finite residual with implicit contact");
+  }
+  if (relativeResidual <= options_.tolerance) return true;
+  if (iterations < allowed) return false;
+  if (relativeResidual > 1.0) {
+    throw NumericalError(name() + ": Newton with implicit contact diverged in the step to t = " +
+                         std::to_string(stepEndTime()) + ": relative residual " + std::to_string(relativeResidual) +
+                         " after " + std::to_string(iterations) + " iterations (contactIterations)");
+  }
+  ++unconvergedContactSteps_;
+  largestUnconvergedResidual_ = std::max(largestUnconvergedResidual_, relativeResidual);
+  return true;
 }
 
 void BackwardEuler::stepNonlinear() {
@@ -198,6 +350,7 @@ void BackwardEuler::stepNonlinear() {
   const double beta = system_.rayleighStiffness;
   detail::FreeSystem& free = *free_;
   restrictStepStart(force_);
+  const bool predictedContact = !contact_.empty();
 
   // Linearized step: tangent and forces at u_k.
   free.evaluateForcesAndTangent(system_, displacement_, free.stiffness, stats_);
@@ -206,7 +359,8 @@ void BackwardEuler::stepNonlinear() {
   if (reuse_) {
     assembleForReuse();
   } else {
-    assembleAndFactor();
+    assembleSystemMatrix(true);
+    free.factorize(stats_);
   }
   {
     TimeInto timer(stats_.forceSeconds);
@@ -225,14 +379,15 @@ void BackwardEuler::stepNonlinear() {
   }
   lastRelativeResidual_ = -1.0;
   lastLineSearchHalvings_ = 0;
-  if (options_.lineSearch && options_.maxIterations > 1) {
+  if (options_.lineSearch && options_.maxIterations > 1 && !implicitExternal_) {
     // The linearized step starts from dv = 0 with the slope estimated by its own
     // right-hand side (the linearization of -R(0)).
     Eigen::VectorXd start = Eigen::VectorXd::Zero(dv_.size());
     const Eigen::VectorXd step = dv_;
     dv_ = start + backtrack(start, step, incrementalPotential(start), -rhs_.dot(step)) * step;
   }
-  lastIterations_ = options_.maxIterations > 1 ? newtonIterations(rhsNorm, internal) : 1;
+  lastIterations_ =
+      (options_.maxIterations > 1 || implicitExternal_) ? newtonIterations(rhsNorm, internal, predictedContact) : 1;
   finishStep();
 }
 
@@ -250,19 +405,29 @@ void BackwardEuler::iterateResidual(const Eigen::VectorXd& internal,
   if (beta != 0.0) residual.noalias() += (h * beta) * (dampingStiffness * newVelocity);
 }
 
-int BackwardEuler::newtonIterations(double rhsNorm, Eigen::VectorXd& internal) {
+int BackwardEuler::newtonIterations(double rhsNorm, Eigen::VectorXd& internal, bool solvedWithContact) {
   const double h = timestep_;
   const double beta = system_.rayleighStiffness;
   detail::FreeSystem& free = *free_;
-  const bool lineSearch = options_.lineSearch && options_.maxIterations > 1;
+  const bool lineSearch = options_.lineSearch && options_.maxIterations > 1 && !implicitExternal_;
   const bool dampingAtIterate = options_.rayleighStiffnessAtIterate && beta != 0.0;
-  const double scale = rhsNorm > 0.0 ? rhsNorm : 1.0;
+  const double scale = implicitExternal_ ? contactResidualScale(rhsNorm) : (rhsNorm > 0.0 ? rhsNorm : 1.0);
+  const int allowed =
+      implicitExternal_ ? std::max(options_.maxIterations, options_.contactIterations) : options_.maxIterations;
   Eigen::VectorXd newVelocity, newDisplacement, residual, correction;
   for (int iterations = 1;; ++iterations) {
     newVelocity = v_ + dv_;
     newDisplacement = u_ + h * newVelocity;
     detail::expandTo(system_.freeDofs, newDisplacement, fullU_);
-    const bool mayIterate = iterations < options_.maxIterations;
+    if (implicitExternal_) {
+      // The contact force and its derivatives at the iterate: Newton on the step equations
+      // with the contact set of the iterate.
+      detail::expandTo(system_.freeDofs, newVelocity, fullV_);
+      evaluateImplicitExternalForce(fullU_, fullV_, force_);
+      // The linearized step asked for (maxIterations = 1) and no contact involved: as without it.
+      if (options_.maxIterations == 1 && !solvedWithContact && contact_.empty()) return iterations;
+    }
+    const bool mayIterate = iterations < allowed;
     if (mayIterate || dampingAtIterate) {
       free.evaluateForcesAndTangent(system_, fullU_, free.iterateStiffness, stats_);
     } else {
@@ -272,6 +437,14 @@ int BackwardEuler::newtonIterations(double rhsNorm, Eigen::VectorXd& internal) {
     // D = alpha M + beta K(u_k), or beta K(u_{k+1}^{(i)}) with rayleighStiffnessAtIterate.
     const Eigen::SparseMatrix<double>& dampingStiffness = dampingAtIterate ? free.iterateStiffness : free.stiffness;
     iterateResidual(internal, dampingStiffness, newVelocity, residual);
+    if (implicitExternal_) {
+      if (retreatContactStep(residual.norm() / scale, iterations, allowed, correction)) continue;
+      if (stopContactIterations(residual.norm() / scale, iterations, allowed)) return iterations;
+      solveNewtonCorrection(dampingStiffness, residual, correction);
+      dv_ += correction;
+      solvedWithContact = !contact_.empty();
+      continue;
+    }
     lastRelativeResidual_ = residual.norm() / scale;
     if (lastRelativeResidual_ <= options_.tolerance) return iterations;
     if (!mayIterate) {
@@ -295,6 +468,7 @@ void BackwardEuler::solveNewtonCorrection(const Eigen::SparseMatrix<double>& dam
   detail::FreeSystem& free = *free_;
   free.assemble({1.0 + (h * system_.rayleighMass), h * system_.rayleighStiffness, h * h},
                 {&free.mass, &dampingStiffness, &free.iterateStiffness}, stats_);
+  addContactBlocks();
   if (reuse_) {
     updateReusedMatrix();
     solveWithReuse(-residual, correction);

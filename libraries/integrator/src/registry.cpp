@@ -39,8 +39,10 @@ std::unique_ptr<Integrator> IntegratorRegistry::create(const std::string& name, 
     throw ValidationError(prefix + "integrator.name: unknown integrator \"" + name + "\" (known: " + known + ")");
   }
   const auto located = [&](const std::string& message) { return message.rfind(prefix, 0) == 0; };
+  const bool implicitExternalForce = static_cast<bool>(context.system.externalForceJacobian);
+  std::unique_ptr<Integrator> integrator;
   try {
-    return (*factory)(std::move(context), options);
+    integrator = (*factory)(std::move(context), options);
   } catch (const TimestepError& error) {
     if (located(error.what())) throw;
     throw TimestepError(prefix + "integrator.timestep: " + error.what());
@@ -51,6 +53,12 @@ std::unique_ptr<Integrator> IntegratorRegistry::create(const std::string& name, 
     if (located(error.what())) throw;
     throw NumericalError(prefix + "integrator: " + error.what(), error.location());
   }
+  if (implicitExternalForce && !integrator->linearizesExternalForce()) {
+    throw ValidationError(prefix + "contact.implicit: integrator \"" + name +
+                          "\" applies contact forces explicitly; implicit contact is linearized by \"backward-euler\" "
+                          "only (use it, or leave contact.implicit out)");
+  }
+  return integrator;
 }
 
 std::vector<std::string> IntegratorRegistry::dropForeignOptions(const std::string& name,
@@ -72,7 +80,7 @@ std::vector<std::string> IntegratorRegistry::dropForeignOptions(const std::strin
 
 const std::vector<std::string>& singleRateOptionKeys() {
   static const std::vector<std::string> keys{
-      "solver",      "maxIterations", "tolerance",          "lineSearch",   "rayleighStiffnessAtIterate",
+      "solver",      "maxIterations", "contactIterations",  "tolerance",    "lineSearch", "rayleighStiffnessAtIterate",
       "reuseFactor", "pcgTolerance",  "pcgSinglePrecision", "maxFrequency", "force"};
   return keys;
 }
@@ -91,6 +99,7 @@ IntegratorOptions parseIntegratorOptions(const nlohmann::json& options, const st
   result.maxIterations = reader.integer("maxIterations", result.maxIterations, 1, 1000);
   result.tolerance = reader.number("tolerance", result.tolerance);
   if (!(result.tolerance > 0.0)) reader.fail("tolerance", "expected a number > 0");
+  result.contactIterations = reader.integer("contactIterations", result.contactIterations, 1, 1000);
   result.lineSearch = reader.boolean("lineSearch", result.lineSearch);
   result.rayleighStiffnessAtIterate = reader.boolean("rayleighStiffnessAtIterate", result.rayleighStiffnessAtIterate);
   result.reuseFactor = reader.boolean("reuseFactor", result.reuseFactor);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "detail/freeSystem.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <cmath>
@@ -128,6 +130,41 @@ void FreeSystem::assemble(const std::vector<double>& coefficients,
                           const std::vector<const Eigen::SparseMatrix<double>*>& matrices, IntegratorStats& stats) {
   TimeInto timer(stats.assemblySeconds);
   combine(coefficients, matrices, systemMatrix);
+}
+
+Eigen::Matrix3d symmetricPositivePart(const Eigen::Matrix3d& block) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(0.5 * (block + block.transpose()));
+  const Eigen::Vector3d clamped = eigen.eigenvalues().cwiseMax(0.0);
+  return eigen.eigenvectors() * clamped.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+void FreeSystem::addVertexBlocks(const FreeDofs& dofs, const VertexJacobian& jacobian, double stiffnessWeight,
+                                 double dampingWeight, IntegratorStats& stats) {
+  TimeInto timer(stats.assemblySeconds);
+  const std::vector<int>& fullToFree = dofs.fullToFree();
+  const int* outer = systemMatrix.outerIndexPtr();
+  const int* inner = systemMatrix.innerIndexPtr();
+  double* values = systemMatrix.valuePtr();
+  for (std::size_t k = 0; k < jacobian.vertices.size(); ++k) {
+    const Eigen::Matrix3d block =
+        symmetricPositivePart((stiffnessWeight * jacobian.stiffness[k]) + (dampingWeight * jacobian.damping[k]));
+    const int vertex = jacobian.vertices[k];
+    for (int c = 0; c < 3; ++c) {
+      const int column = fullToFree[static_cast<std::size_t>((3 * vertex) + c)];
+      if (column < 0) continue;
+      for (int r = 0; r < 3; ++r) {
+        const int row = fullToFree[static_cast<std::size_t>((3 * vertex) + r)];
+        if (row < 0) continue;
+        const int* begin = inner + outer[column];
+        const int* end = inner + outer[column + 1];
+        const int* slot = std::lower_bound(begin, end, row);
+        if (slot == end || *slot != row) {
+          throw Error("vertex " + std::to_string(vertex) + "'s own 3 x 3 block is not in the system matrix's pattern");
+        }
+        values[slot - inner] += block(r, c);
+      }
+    }
+  }
 }
 
 void FreeSystem::rethrowWithMeshDof(const NumericalError& error) const {

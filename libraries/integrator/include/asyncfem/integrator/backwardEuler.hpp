@@ -57,6 +57,22 @@ class FreeSystem;
 /// line search then acts on the linearized first update only (the later ones solve
 /// equations that are no potential's gradient and are taken in full, as in Vega).
 ///
+/// Implicit external force (DynamicSystem::externalForceJacobian set, e.g. penalty contact
+/// with contact.implicit): the force f(u, v) is evaluated at the predicted state
+/// (u_p, v_k) = (u_k + h v_k, v_k) and linearized there, f ~ f_p - K_c (u_{k+1} - u_p) -
+/// C_c (v_{k+1} - v_k) = f_p - (h K_c + C_c) dv, so the step becomes
+///
+///     (M + h D + h^2 K + h^2 K_c + h C_c) dv = h ( f_p - f_int(u_k) - D v_k - h K v_k )
+///
+/// (K_c, C_c the per-vertex blocks -df/du, -df/dv at the prediction). Exact for a plane
+/// without friction while the set of vertices in contact is that of the prediction; a stiff
+/// spring (omega h >> 2) stays stable where an explicit one adds energy at every impact.
+/// Linear models keep M + h D + h^2 K factored for the steps without contact and solve the
+/// steps with contact with their own matrix (kept-factor PCG under options.reuseFactor, else
+/// a factorization). With Newton iterations (maxIterations > 1) the force and its blocks
+/// are evaluated again at every iterate (the contact set follows the iterate); the line
+/// search is then off, since contact (its damping and friction) is no potential's gradient.
+///
 /// options.reuseFactor (nonlinear models, the default): the system matrix is still
 /// assembled at every step, but solved by a FactorReusingSolver: PCG to
 /// options.pcgTolerance preconditioned by the last numeric factor, refactoring when the
@@ -91,6 +107,8 @@ class BackwardEuler final : public Integrator {
   /// The factor non-zeros and, for nonlinear models, a summary line saying which linear
   /// solve path ran (exact factorizations, or the kept factor with its counts).
   RunReport report() const override;
+  /// True: DynamicSystem::externalForceJacobian is used (see the class comment).
+  bool linearizesExternalForce() const override { return true; }
 
  private:
   void stepLinear();
@@ -101,15 +119,37 @@ class BackwardEuler final : public Integrator {
   void finishStep();
   /// Newton iterations after the linearized step (options_.maxIterations > 1): returns
   /// how many were taken in all, counting the linearized one.
-  int newtonIterations(double rhsNorm, Eigen::VectorXd& internal);
+  /// With implicit contact also for maxIterations = 1 when the step involves contact
+  /// (solvedWithContact: the linearized step's matrix had contact blocks).
+  int newtonIterations(double rhsNorm, Eigen::VectorXd& internal, bool solvedWithContact);
+  /// Linear model: solution = A^{-1} rhs, A = M + h D + h^2 K plus contact_'s blocks.
+  void solveLinearStep(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
+  /// Linear model with implicit contact: Newton iterations after the first solve, returns
+  /// the solves made in all.
+  int linearContactIterations(double rhsNorm, bool solvedWithContact);
+  /// Records the relative residual; true when the contact iterations stop (converged, or
+  /// at the allowed count: counted as unconverged). Throws NumericalError when not finite.
+  bool stopContactIterations(double relativeResidual, int iterations, int allowed);
+  /// When the last contact Newton update (correction, of which contactStepFraction_ is
+  /// applied) raised the residual: moves dv_ back to half that fraction and returns true
+  /// (the caller evaluates again). false: accept, take a new update.
+  bool retreatContactStep(double relativeResidual, int iterations, int allowed, const Eigen::VectorXd& correction);
+  /// What contact iterations' residuals are relative to: max(|b_0|, h |f_ext(prediction)|).
+  double contactResidualScale(double rhsNorm) const;
   /// residual = R(dv) at the iterate (internal forces f_int(u_{k+1}), free).
   void iterateResidual(const Eigen::VectorXd& internal, const Eigen::SparseMatrix<double>& dampingStiffness,
                        const Eigen::VectorXd& newVelocity, Eigen::VectorXd& residual);
   /// J correction = -residual with J at the iterate (refactored, or the kept factor).
   void solveNewtonCorrection(const Eigen::SparseMatrix<double>& dampingStiffness, const Eigen::VectorXd& residual,
                              Eigen::VectorXd& correction);
-  /// free_->systemMatrix = the step formula's (A1) combination of M and K.
-  void assembleSystemMatrix();
+  /// free_->systemMatrix = the step formula's (A1) combination of M and K, plus the
+  /// implicit contact blocks of contact_ when withContact.
+  void assembleSystemMatrix(bool withContact);
+  /// free_->systemMatrix += h^2 K_c + h C_c (contact_'s blocks).
+  void addContactBlocks();
+  /// force (free) = f_ext(t_{k+1}) at the full state (u, v), and contact_ = its Jacobian there.
+  void evaluateImplicitExternalForce(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                     Eigen::VectorXd& force);
   void assembleAndFactor();
   // Incremental potential Phi(dv) of the current step (see the class comment).
   double incrementalPotential(const Eigen::VectorXd& dv);
@@ -126,12 +166,22 @@ class BackwardEuler final : public Integrator {
   std::unique_ptr<FactorReusingSolver> reuse_;  // options_.reuseFactor, nonlinear models only
   bool linear_ = false;
   bool factorizationStale_ = true;
+  bool implicitExternal_ = false;  // system_.externalForceJacobian is set
+  bool factorHasContact_ = false;  // linear model: free_'s factor holds contact blocks
+  VertexJacobian contact_;         // the external force's Jacobian at the last evaluation
+  long long contactSteps_ = 0;     // steps whose prediction had vertices in contact
+  long long unconvergedContactSteps_ = 0;
+  double largestUnconvergedResidual_ = 0.0;
+  double contactPreviousResidual_ = 0.0;  // backtracking of the contact Newton updates
+  double contactStepFraction_ = 1.0;
+  int contactHalvings_ = 0;
+  double predictedImpulse_ = 0.0;  // h |f_ext| at the prediction (implicit contact)
   int lastIterations_ = 0;
   double lastRelativeResidual_ = -1.0;
   int lastLineSearchHalvings_ = 0;
   // Scratch on the free DOFs, kept to avoid per-step allocation.
   Eigen::VectorXd u_, v_, force_, rhs_, dv_, work_;
-  Eigen::VectorXd fullForce_, fullU_, fullV_;
+  Eigen::VectorXd fullForce_, fullU_, fullV_, fullPredicted_;
 };
 
 }  // namespace asyncfem

@@ -110,6 +110,10 @@ class Integrator {
   /// This integrator as a multirate one (fast regions, their vertices), or nullptr for a
   /// single-rate integrator. Lets drivers describe any integrator without knowing its type.
   virtual const MultirateIntegrator* multirate() const { return nullptr; }
+  /// Whether the integrator uses DynamicSystem::externalForceJacobian (treats the external
+  /// force's state-dependent part implicitly). IntegratorRegistry::create refuses a system
+  /// that carries one for an integrator that does not.
+  virtual bool linearizesExternalForce() const { return false; }
 
   const DynamicSystem& system() const { return system_; }
   /// Kinetic energy v^T M v / 2 plus the force model's elastic energy.

@@ -20,6 +20,11 @@ struct IntegratorOptions {
   int maxIterations = 1;
   /// Relative Newton tolerance (see maxIterations).
   double tolerance = 1e-8;
+  /// Backward Euler with implicit contact (DynamicSystem::externalForceJacobian): Newton
+  /// iterations allowed for a step whose prediction or end state has vertices in contact,
+  /// with the contact force and its derivatives at each iterate, until the residual meets
+  /// tolerance (linear force models too). The larger of this and maxIterations applies.
+  int contactIterations = 10;
   /// Backward Euler with maxIterations > 1: backtrack every Newton update (the
   /// linearized first one included) until the incremental potential decreases, so that a
   /// large step cannot diverge (see BackwardEuler). No effect with maxIterations = 1,
