@@ -432,6 +432,10 @@ void parseContact(JsonObjectReader& top, Scene& scene) {
   if (p.friction < 0.0) reader.fail("friction", "expected a Coulomb coefficient >= 0");
   p.frictionViscosity = reader.number("frictionViscosity", p.frictionViscosity);
   requirePositive(reader, "frictionViscosity", p.frictionViscosity);
+  out.implicit = reader.boolean("implicit", false);
+  if (out.implicit && p.friction > 0.0) {
+    reader.fail("implicit", "implicit contact is frictionless: set contact.friction to 0, or leave implicit out");
+  }
   reader.finish();
   if (!out.enabled()) reader.fail("ground", "contact needs a ground, planes or spheres");
 }

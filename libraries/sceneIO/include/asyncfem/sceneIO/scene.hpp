@@ -106,6 +106,7 @@ struct Scene {
     std::optional<ContactPlane> ground;  ///< contact.ground when given (also in planes), for renderers
     std::vector<ContactSphere> spheres;
     PenaltyContactParameters parameters;
+    bool implicit = false;  ///< contact.implicit: linearized in the step (single-rate backward Euler)
     bool enabled() const { return !planes.empty() || !spheres.empty(); }
   } contact;
   Tangent tangent = Tangent::simple;  ///< corotational only
