@@ -6,6 +6,11 @@
 //
 //   benchmarkAdaptive [--scene models/ball/ball.json] [--frames 90] [--repeats 1]
 //                     [--reference-steps 64] [--ladder 1,2,4,8,16] [--csv com.csv]
+//                     [--contact-stiffness K] [--implicit-contact]
+//
+// --contact-stiffness replaces the scene's contact.stiffness; --implicit-contact runs the
+// single-rate rows (reference and ladder) with contact.implicit (backward Euler solves the
+// step with the contact at its end state), the async rows as the scene says (explicit).
 //
 // The frames are sampled at the scene's large step (one step per frame), so penetration
 // and rebound are seen at every large step. Figures per run:
@@ -119,14 +124,25 @@ int main(int argc, char** argv) {
   app.add_option("--ladder", ladder, "Single-rate steps per large step to compare")->delimiter(',');
   std::string csvPath;
   app.add_option("--csv", csvPath, "Also write every run's COM height per frame here (for scripts/plot-adaptive.py)");
+  double contactStiffness = 0.0;
+  app.add_option("--contact-stiffness", contactStiffness, "Replace the scene's contact.stiffness")
+      ->check(CLI::PositiveNumber);
+  bool implicitContact = false;
+  app.add_flag("--implicit-contact", implicitContact, "Single-rate rows with contact.implicit (frictionless scenes)");
   CLI11_PARSE(app, argc, argv);
   try {
     Scene scene = loadScene(scenePath);
+    if (contactStiffness > 0.0) scene.contact.parameters.stiffness = contactStiffness;
     const FrameTiming timing = frameTimingOf(scene);
     const double hL = timing.timestep;
     // One frame per large step.
     scene.frames.rate = 1.0 / hL;
     scene.frames.count = frames;
+    // The single-rate rows' scene (the same frames): contact.implicit when asked for.
+    Scene singleRateScene = scene;
+    singleRateScene.contact.implicit = implicitContact || scene.contact.implicit;
+    scene.contact.implicit = false;  // the async rows apply contact explicitly
+    const std::string singleRateLabel = singleRateScene.contact.implicit ? ", implicit contact" : "";
     const Simulation baseline = buildSimulation(scene);
     const TetMesh& mesh = *baseline.mesh;
     const Eigen::VectorXd lumped = baseline.problem->massMatrix() * Eigen::VectorXd::Ones(mesh.numDofs());
@@ -136,10 +152,11 @@ int main(int argc, char** argv) {
                                    scene.contact.parameters);
 
     std::vector<BenchmarkConfiguration> configurations;
-    configurations.push_back(
-        {"reference: backward Euler, hL/" + std::to_string(referenceSteps), "backward-euler", referenceSteps});
+    configurations.push_back({"reference: backward Euler, hL/" + std::to_string(referenceSteps) + singleRateLabel,
+                              "backward-euler", referenceSteps});
     for (int steps : ladder) {
-      configurations.push_back({"backward Euler, hL/" + std::to_string(steps), "backward-euler", steps});
+      configurations.push_back(
+          {"backward Euler, hL/" + std::to_string(steps) + singleRateLabel, "backward-euler", steps});
     }
     nlohmann::json adaptiveOptions = scene.integrator.options;
     const nlohmann::json contact = adaptiveOptions["regions"]["adaptive"]["contact"];
@@ -194,7 +211,8 @@ int main(int argc, char** argv) {
     std::vector<Row> rows;
     for (const BenchmarkConfiguration& configuration : configurations) {
       Row row;
-      row.run = runConfiguration(scene, configuration, frames, repeats);
+      row.run = runConfiguration(configuration.integrator == "backward-euler" ? singleRateScene : scene, configuration,
+                                 frames, repeats);
       row.measures = measure(row.run.frames, mesh, vertexMass, obstacles);
       rows.push_back(std::move(row));
       std::fprintf(stderr, "ran %s\n", configuration.label.c_str());
