@@ -10,6 +10,7 @@
 #include <string>
 
 #include "detail/freeSystem.hpp"
+#include "detail/lowRankContact.hpp"
 
 namespace asyncfem {
 
@@ -39,6 +40,7 @@ BackwardEuler::BackwardEuler(DynamicSystem system, double timestep, const Integr
   }
   linear_ = system_.forceModel->isLinear();
   implicitExternal_ = static_cast<bool>(system_.externalForceJacobian);
+  lowRank_ = std::make_unique<detail::LowRankContactSolver>();
   // With implicit contact a linear model's matrix changes with the contact set too.
   if (options_.reuseFactor && (!linear_ || implicitExternal_)) {
     FactorReuseOptions reuseOptions;
@@ -115,6 +117,10 @@ RunReport BackwardEuler::report() const {
          << " steps predicted contact; Newton on the step equations with the contact at each iterate, "
          << unconvergedContactSteps_ << " steps stopped at "
          << std::max(options_.maxIterations, options_.contactIterations) << " iterations unconverged";
+    if (linear_) {
+      text << "; " << lowRankSolves_ << " contact solves by a low-rank update of the kept factor ("
+           << lowRank_->cachedVertices() << " vertices' columns cached)";
+    }
     if (unconvergedContactSteps_ > 0) {
       text << " (largest relative residual " << std::setprecision(3) << largestUnconvergedResidual_ << ")";
     }
@@ -224,6 +230,7 @@ void BackwardEuler::stepLinear() {
   const double h = timestep_;
   const double alpha = system_.rayleighMass;
   const double beta = system_.rayleighStiffness;
+  if (factorizationStale_) lowRank_->clear();  // a new timestep: a new M + h D + h^2 K
   if (factorizationStale_ || factorHasContact_) assembleAndFactor();
   restrictStepStart(force_);
   rhs_ = force_;
@@ -253,9 +260,17 @@ void BackwardEuler::solveLinearStep(const Eigen::VectorXd& rhs, Eigen::VectorXd&
     free_->solve(rhs, solution, stats_);
     return;
   }
-  // K constant, the contact blocks not: M + h D + h^2 K is kept factored for the steps
-  // without contact, the solves with contact use their own matrix (kept-factor PCG with
-  // reuseFactor, else a factorization that the next contact-free solve replaces).
+  // K constant, the contact blocks not: M + h D + h^2 K is kept factored, and a solve with
+  // contact updates it by the blocks' low rank (Woodbury) where that is cheaper than a
+  // factorization; else it solves its own matrix (kept-factor PCG with reuseFactor, or a
+  // factorization that the next contact-free solve replaces).
+  if (options_.contactLowRank && lowRank_->pays(*free_, system_.freeDofs, contact_)) {
+    if (factorHasContact_) assembleAndFactor();
+    const double h = timestep_;
+    lowRank_->solve(*free_, system_.freeDofs, contact_, h * h, h, rhs, solution, stats_);
+    ++lowRankSolves_;
+    return;
+  }
   assembleSystemMatrix(true);
   if (reuse_) {
     updateReusedMatrix();

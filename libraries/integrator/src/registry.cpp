@@ -79,9 +79,18 @@ std::vector<std::string> IntegratorRegistry::dropForeignOptions(const std::strin
 }
 
 const std::vector<std::string>& singleRateOptionKeys() {
-  static const std::vector<std::string> keys{
-      "solver",      "maxIterations", "contactIterations",  "tolerance",    "lineSearch", "rayleighStiffnessAtIterate",
-      "reuseFactor", "pcgTolerance",  "pcgSinglePrecision", "maxFrequency", "force"};
+  static const std::vector<std::string> keys{"solver",
+                                             "maxIterations",
+                                             "contactIterations",
+                                             "contactLowRank",
+                                             "tolerance",
+                                             "lineSearch",
+                                             "rayleighStiffnessAtIterate",
+                                             "reuseFactor",
+                                             "pcgTolerance",
+                                             "pcgSinglePrecision",
+                                             "maxFrequency",
+                                             "force"};
   return keys;
 }
 
@@ -100,6 +109,7 @@ IntegratorOptions parseIntegratorOptions(const nlohmann::json& options, const st
   result.tolerance = reader.number("tolerance", result.tolerance);
   if (!(result.tolerance > 0.0)) reader.fail("tolerance", "expected a number > 0");
   result.contactIterations = reader.integer("contactIterations", result.contactIterations, 1, 1000);
+  result.contactLowRank = reader.boolean("contactLowRank", result.contactLowRank);
   result.lineSearch = reader.boolean("lineSearch", result.lineSearch);
   result.rayleighStiffnessAtIterate = reader.boolean("rayleighStiffnessAtIterate", result.rayleighStiffnessAtIterate);
   result.reuseFactor = reader.boolean("reuseFactor", result.reuseFactor);

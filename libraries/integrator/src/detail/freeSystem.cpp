@@ -202,6 +202,13 @@ void FreeSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, Integrato
   stats.solveFlops += solver_->stats().solveFlopsPerRhs;
 }
 
+void FreeSystem::solve(const Eigen::MatrixXd& rhs, Eigen::MatrixXd& x, IntegratorStats& stats) {
+  TimeInto timer(stats.solveSeconds);
+  solver_->solve(rhs, x);
+  stats.solvedRightHandSides += rhs.cols();
+  stats.solveFlops += static_cast<double>(rhs.cols()) * solver_->stats().solveFlopsPerRhs;
+}
+
 void FreeMassSolver::setup(const Eigen::SparseMatrix<double>& freeMass, SolverKind kind, IntegratorStats& stats) {
   TimeInto timer(stats.factorizationSeconds);
   diagonal_ = isDiagonal(freeMass);

@@ -82,9 +82,12 @@ class FreeSystem {
   [[noreturn]] void rethrowWithMeshDof(const NumericalError& error) const;
   /// x = systemMatrix^{-1} rhs with the last factorization.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, IntegratorStats& stats);
+  /// X = systemMatrix^{-1} B (several right-hand sides) with the last factorization.
+  void solve(const Eigen::MatrixXd& rhs, Eigen::MatrixXd& x, IntegratorStats& stats);
 
   const Eigen::VectorXd& fullForces() const { return fullForces_; }
   SparseSolver& solver() { return *solver_; }
+  const SparseSolver& solver() const { return *solver_; }
 
   Eigen::SparseMatrix<double> mass;              ///< M on the free DOFs
   Eigen::SparseMatrix<double> stiffness;         ///< K on the free DOFs (constant, or tangent at step start)

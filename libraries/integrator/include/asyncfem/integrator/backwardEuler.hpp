@@ -11,7 +11,8 @@ namespace asyncfem {
 
 namespace detail {
 class FreeSystem;
-}
+class LowRankContactSolver;
+}  // namespace detail
 
 /// Implicit backward Euler on the free DOFs (paper Eq. 5; shared design note, section
 /// "Single-rate implicit backward Euler"). One step of size h from (u_k, v_k):
@@ -58,20 +59,26 @@ class FreeSystem;
 /// equations that are no potential's gradient and are taken in full, as in Vega).
 ///
 /// Implicit external force (DynamicSystem::externalForceJacobian set, e.g. penalty contact
-/// with contact.implicit): the force f(u, v) is evaluated at the predicted state
-/// (u_p, v_k) = (u_k + h v_k, v_k) and linearized there, f ~ f_p - K_c (u_{k+1} - u_p) -
-/// C_c (v_{k+1} - v_k) = f_p - (h K_c + C_c) dv, so the step becomes
+/// with contact.implicit): the step solves the backward Euler equations with the force at
+/// the step's end state,
 ///
-///     (M + h D + h^2 K + h^2 K_c + h C_c) dv = h ( f_p - f_int(u_k) - D v_k - h K v_k )
+///     R(dv) = M dv - h ( f(u_{k+1}, v_{k+1}) - f_int(u_{k+1}) - D v_{k+1} ) = 0,
 ///
-/// (K_c, C_c the per-vertex blocks -df/du, -df/dv at the prediction). Exact for a plane
-/// without friction while the set of vertices in contact is that of the prediction; a stiff
-/// spring (omega h >> 2) stays stable where an explicit one adds energy at every impact.
-/// Linear models keep M + h D + h^2 K factored for the steps without contact and solve the
-/// steps with contact with their own matrix (kept-factor PCG under options.reuseFactor, else
-/// a factorization). With Newton iterations (maxIterations > 1) the force and its blocks
-/// are evaluated again at every iterate (the contact set follows the iterate); the line
-/// search is then off, since contact (its damping and friction) is no potential's gradient.
+/// by Newton from the predicted state (u_k + h v_k, v_k): the first solve is the linearized
+/// step with the force and its per-vertex blocks K_c = -df/du, C_c = -df/dv taken at the
+/// prediction, f ~ f_p - (h K_c + C_c) dv, i.e. h^2 K_c + h C_c added to the step matrix
+/// (their symmetric positive semi-definite part, so the matrix stays one for Cholesky).
+/// Whenever the prediction or a result has vertices in contact, Newton continues with the
+/// force and blocks at each iterate until |R| <= tolerance * max(|b_0|, h |f_p|), at most
+/// max(maxIterations, contactIterations) iterations; an update that raises |R| is halved
+/// back (up to 8 times); a step that stops unconverged is counted (report()), and one whose
+/// relative residual is then above 1 throws NumericalError. Exact for a frictionless plane
+/// once the contact set settles; a stiff spring (omega h >> 2) stays stable where an explicit
+/// one adds energy at impacts. Linear models keep M + h D + h^2 K factored and solve a step
+/// with contact by a low-rank (Woodbury) update of that factor where cheaper
+/// (options.contactLowRank), else with the step's own matrix (kept-factor PCG under
+/// options.reuseFactor, or a factorization). The line search is off with implicit contact
+/// (contact damping is no potential's gradient).
 ///
 /// options.reuseFactor (nonlinear models, the default): the system matrix is still
 /// assembled at every step, but solved by a FactorReusingSolver: PCG to
@@ -166,10 +173,12 @@ class BackwardEuler final : public Integrator {
   std::unique_ptr<FactorReusingSolver> reuse_;  // options_.reuseFactor, nonlinear models only
   bool linear_ = false;
   bool factorizationStale_ = true;
-  bool implicitExternal_ = false;  // system_.externalForceJacobian is set
-  bool factorHasContact_ = false;  // linear model: free_'s factor holds contact blocks
-  VertexJacobian contact_;         // the external force's Jacobian at the last evaluation
-  long long contactSteps_ = 0;     // steps whose prediction had vertices in contact
+  bool implicitExternal_ = false;                          // system_.externalForceJacobian is set
+  bool factorHasContact_ = false;                          // linear model: free_'s factor holds contact blocks
+  VertexJacobian contact_;                                 // the external force's Jacobian at the last evaluation
+  long long contactSteps_ = 0;                             // steps whose prediction had vertices in contact
+  std::unique_ptr<detail::LowRankContactSolver> lowRank_;  // linear models: Woodbury updates of the kept factor
+  long long lowRankSolves_ = 0;
   long long unconvergedContactSteps_ = 0;
   double largestUnconvergedResidual_ = 0.0;
   double contactPreviousResidual_ = 0.0;  // backtracking of the contact Newton updates

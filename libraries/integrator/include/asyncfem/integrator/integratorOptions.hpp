@@ -25,6 +25,11 @@ struct IntegratorOptions {
   /// with the contact force and its derivatives at each iterate, until the residual meets
   /// tolerance (linear force models too). The larger of this and maxIterations applies.
   int contactIterations = 10;
+  /// Backward Euler, linear models with implicit contact: solve a step with contact by a
+  /// low-rank (Woodbury) update of the kept contact-free factor where its flops are below a
+  /// factorization's; false: always the contact step's own matrix (factored, or kept-factor
+  /// PCG under reuseFactor).
+  bool contactLowRank = true;
   /// Backward Euler with maxIterations > 1: backtrack every Newton update (the
   /// linearized first one included) until the incremental potential decreases, so that a
   /// large step cannot diverge (see BackwardEuler). No effect with maxIterations = 1,

@@ -1,0 +1,120 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "detail/lowRankContact.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <asyncfem/core/error.hpp>
+#include <cmath>
+
+namespace asyncfem::detail {
+
+namespace {
+
+// The cache holds at most this many doubles (256 MiB): past it a contact solve factors.
+constexpr double kMaxCachedDoubles = 32.0 * 1024 * 1024;
+
+}  // namespace
+
+bool LowRankContactSolver::pays(const FreeSystem& free, const FreeDofs& dofs, const VertexJacobian& contact) const {
+  const double n = dofs.numFree();
+  const double rank = 3.0 * static_cast<double>(contact.vertices.size());  // at most
+  int uncached = 0;
+  for (const int v : contact.vertices) uncached += columns_.count(v) == 0 ? 1 : 0;
+  const double cached = static_cast<double>(columns_.size() + static_cast<std::size_t>(uncached));
+  if (cached * 3.0 * n > kMaxCachedDoubles) return false;
+  const SolverStats& solver = free.solver().stats();
+  // Forming Y (n x r from n x 3 per block), U^T Y, applying Y, the r x r Cholesky and the
+  // solve itself. A vertex's first contact adds three substitutions (its cached columns),
+  // paid once for all the solves it takes part in: not counted here.
+  const double dense = (6.0 * n * rank) + (2.0 * n * rank) + (rank * rank * rank / 3.0);
+  const double substitutions = solver.solveFlopsPerRhs;
+  return dense + substitutions < solver.factorFlops;
+}
+
+const Eigen::MatrixXd& LowRankContactSolver::columnsOf(int vertex, FreeSystem& free, const FreeDofs& dofs,
+                                                       IntegratorStats& stats) {
+  const auto found = columns_.find(vertex);
+  if (found != columns_.end()) return found->second;
+  const std::vector<int>& fullToFree = dofs.fullToFree();
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(dofs.numFree(), 3);
+  for (int c = 0; c < 3; ++c) {
+    const int dof = fullToFree[static_cast<std::size_t>((3 * vertex) + c)];
+    if (dof >= 0) unit(dof, c) = 1.0;
+  }
+  Eigen::MatrixXd solved;
+  free.solve(unit, solved, stats);
+  for (int c = 0; c < 3; ++c) {
+    if (fullToFree[static_cast<std::size_t>((3 * vertex) + c)] < 0) solved.col(c).setZero();
+  }
+  return columns_.emplace(vertex, std::move(solved)).first->second;
+}
+
+void LowRankContactSolver::solve(FreeSystem& free, const FreeDofs& dofs, const VertexJacobian& contact,
+                                 double stiffnessWeight, double dampingWeight, const Eigen::VectorXd& rhs,
+                                 Eigen::VectorXd& x, IntegratorStats& stats) {
+  const std::vector<int>& fullToFree = dofs.fullToFree();
+  // U: per block, sqrt(lambda) q for its positive eigenpairs, with the fixed DOFs' rows and
+  // columns of the block dropped first (as addVertexBlocks drops them).
+  u_.resize(3, static_cast<Eigen::Index>(3 * contact.vertices.size()));
+  vertexOf_.clear();
+  for (std::size_t k = 0; k < contact.vertices.size(); ++k) {
+    const int vertex = contact.vertices[k];
+    Eigen::Matrix3d block =
+        symmetricPositivePart((stiffnessWeight * contact.stiffness[k]) + (dampingWeight * contact.damping[k]));
+    for (int c = 0; c < 3; ++c) {
+      if (fullToFree[static_cast<std::size_t>((3 * vertex) + c)] < 0) {
+        block.row(c).setZero();
+        block.col(c).setZero();
+      }
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(block);
+    const double largest = eigen.eigenvalues().maxCoeff();
+    for (int i = 0; i < 3; ++i) {
+      const double lambda = eigen.eigenvalues()[i];
+      if (!(lambda > 1e-14 * largest)) continue;
+      u_.col(static_cast<Eigen::Index>(vertexOf_.size())) = std::sqrt(lambda) * eigen.eigenvectors().col(i);
+      vertexOf_.push_back(vertex);
+    }
+  }
+  const auto rank = static_cast<Eigen::Index>(vertexOf_.size());
+  free.solve(rhs, base_, stats);
+  if (rank == 0) {
+    x = base_;
+    return;
+  }
+  // The vertices' cached columns first (substitutions, timed as solves by free), then the
+  // dense work, timed here. Y = A_0^{-1} U, column j = C_v u_j.
+  std::vector<const Eigen::MatrixXd*> columns(static_cast<std::size_t>(rank));
+  for (Eigen::Index j = 0; j < rank; ++j) {
+    columns[static_cast<std::size_t>(j)] = &columnsOf(vertexOf_[static_cast<std::size_t>(j)], free, dofs, stats);
+  }
+  TimeInto timer(stats.solveSeconds);
+  y_.resize(base_.size(), rank);
+  for (Eigen::Index j = 0; j < rank; ++j) y_.col(j).noalias() = *columns[static_cast<std::size_t>(j)] * u_.col(j);
+  // U^T z for a free vector z: u_i . z at vertex(i)'s free DOFs (fixed ones are zero in u).
+  const auto projectOnto = [&](const auto& z, Eigen::Index i) {
+    const int vertex = vertexOf_[static_cast<std::size_t>(i)];
+    double sum = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      const int dof = fullToFree[static_cast<std::size_t>((3 * vertex) + c)];
+      if (dof >= 0) sum += u_(c, i) * z[dof];
+    }
+    return sum;
+  };
+  small_.setIdentity(rank, rank);
+  for (Eigen::Index j = 0; j < rank; ++j) {
+    const auto column = y_.col(j);
+    for (Eigen::Index i = 0; i < rank; ++i) small_(i, j) += projectOnto(column, i);
+  }
+  // Symmetric in exact arithmetic; its lower triangle is what the factorization reads.
+  const Eigen::LLT<Eigen::MatrixXd> factor(small_);
+  if (factor.info() != Eigen::Success) {
+    throw NumericalError("implicit contact: the low-rank update I + U^T A^{-1} U is not positive definite");
+  }
+  projected_.resize(rank);
+  for (Eigen::Index i = 0; i < rank; ++i) projected_[i] = projectOnto(base_, i);
+  x = base_;
+  x.noalias() -= y_ * factor.solve(projected_);
+}
+
+}  // namespace asyncfem::detail
