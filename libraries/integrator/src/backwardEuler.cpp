@@ -250,7 +250,7 @@ void BackwardEuler::stepLinear() {
   solveLinearStep(rhs_, dv_);
   lastIterations_ = 1;
   lastRelativeResidual_ = -1.0;
-  if (implicitExternal_) lastIterations_ = linearContactIterations(rhs_.norm(), predictedContact);
+  if (implicitExternal_) lastIterations_ = linearContactIterations(rhs_.norm(), predictedContact, nullptr);
   finishStep();
 }
 
@@ -282,9 +282,12 @@ void BackwardEuler::solveLinearStep(const Eigen::VectorXd& rhs, Eigen::VectorXd&
   }
 }
 
-int BackwardEuler::linearContactIterations(double rhsNorm, bool solvedWithContact) {
-  // Newton on R(dv) = M dv - h ( f_ext(u_{k+1}, v_{k+1}) - K u_{k+1} - D v_{k+1} ), K constant:
-  // only the contact force and its blocks change between iterates.
+int BackwardEuler::linearContactIterations(double rhsNorm, bool solvedWithContact,
+                                           const Eigen::VectorXd* startInternal) {
+  // Newton on R(dv) = M dv - h ( f_ext(u_{k+1}, v_{k+1}) - f_int - D v_{k+1} ) with the elastic
+  // force linear in the step: K u_{k+1} (linear model, K constant) or, for the linearized
+  // step of a nonlinear one, f_int(u_k) + K(u_k) (u_{k+1} - u_k) (startInternal). Only the
+  // contact force and its blocks change between iterates.
   const double h = timestep_;
   const int allowed = std::max(options_.maxIterations, options_.contactIterations);
   const double scale = contactResidualScale(rhsNorm);
@@ -299,12 +302,30 @@ int BackwardEuler::linearContactIterations(double rhsNorm, bool solvedWithContac
     if (!solvedWithContact && contact_.empty()) return iterations;
     {
       TimeInto timer(stats_.forceSeconds);
-      internal.noalias() = free_->stiffness * newDisplacement;
+      if (startInternal == nullptr) {
+        internal.noalias() = free_->stiffness * newDisplacement;
+      } else {
+        work_ = newDisplacement - u_;
+        internal = *startInternal;
+        internal.noalias() += free_->stiffness * work_;
+      }
     }
     iterateResidual(internal, free_->stiffness, newVelocity, residual);
     if (retreatContactStep(residual.norm() / scale, iterations, allowed, correction)) continue;
     if (stopContactIterations(residual.norm() / scale, iterations, allowed)) return iterations;
-    solveLinearStep(-residual, correction);
+    if (startInternal == nullptr) {
+      solveLinearStep(-residual, correction);
+    } else {
+      // The step-start tangent with the iterate's contact blocks.
+      assembleSystemMatrix(true);
+      if (reuse_) {
+        updateReusedMatrix();
+        solveWithReuse(-residual, correction);
+      } else {
+        free_->factorize(stats_);
+        free_->solve(-residual, correction, stats_);
+      }
+    }
     dv_ += correction;
     solvedWithContact = !contact_.empty();
   }
@@ -401,8 +422,14 @@ void BackwardEuler::stepNonlinear() {
     const Eigen::VectorXd step = dv_;
     dv_ = start + backtrack(start, step, incrementalPotential(start), -rhs_.dot(step)) * step;
   }
-  lastIterations_ =
-      (options_.maxIterations > 1 || implicitExternal_) ? newtonIterations(rhsNorm, internal, predictedContact) : 1;
+  if (options_.maxIterations > 1) {
+    lastIterations_ = newtonIterations(rhsNorm, internal, predictedContact);
+  } else if (implicitExternal_) {
+    // The linearized step asked for: elasticity stays linearized at u_k, contact iterates.
+    lastIterations_ = linearContactIterations(rhsNorm, predictedContact, &internal);
+  } else {
+    lastIterations_ = 1;
+  }
   finishStep();
 }
 

@@ -70,7 +70,9 @@ class LowRankContactSolver;
 /// (their symmetric positive semi-definite part, so the matrix stays one for Cholesky).
 /// Whenever the prediction or a result has vertices in contact, Newton continues with the
 /// force and blocks at each iterate until |R| <= tolerance * max(|b_0|, h |f_p|), at most
-/// max(maxIterations, contactIterations) iterations; an update that raises |R| is halved
+/// max(maxIterations, contactIterations) iterations (a nonlinear model with maxIterations = 1
+/// keeps its elastic force linearized at u_k, f_int(u_k) + K(u_k)(u_{k+1} - u_k), so only the
+/// contact iterates: the linearized step asked for, with implicit contact); an update that raises |R| is halved
 /// back (up to 8 times); a step that stops unconverged is counted (report()), and one whose
 /// relative residual is then above 1 throws NumericalError. Exact for a frictionless plane
 /// once the contact set settles; a stiff spring (omega h >> 2) stays stable where an explicit
@@ -126,14 +128,14 @@ class BackwardEuler final : public Integrator {
   void finishStep();
   /// Newton iterations after the linearized step (options_.maxIterations > 1): returns
   /// how many were taken in all, counting the linearized one.
-  /// With implicit contact also for maxIterations = 1 when the step involves contact
-  /// (solvedWithContact: the linearized step's matrix had contact blocks).
+  /// solvedWithContact: the linearized step's matrix had contact blocks (implicit contact).
   int newtonIterations(double rhsNorm, Eigen::VectorXd& internal, bool solvedWithContact);
   /// Linear model: solution = A^{-1} rhs, A = M + h D + h^2 K plus contact_'s blocks.
   void solveLinearStep(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
-  /// Linear model with implicit contact: Newton iterations after the first solve, returns
-  /// the solves made in all.
-  int linearContactIterations(double rhsNorm, bool solvedWithContact);
+  /// Implicit contact with the elastic force linear in the step (a linear model, or the
+  /// linearized step of a nonlinear one: startInternal = f_int(u_k) on the free DOFs, K(u_k)
+  /// in free_->stiffness): Newton iterations after the first solve, returns the solves made.
+  int linearContactIterations(double rhsNorm, bool solvedWithContact, const Eigen::VectorXd* startInternal);
   /// Records the relative residual; true when the contact iterations stop (converged, or
   /// at the allowed count: counted as unconverged). Throws NumericalError when not finite.
   bool stopContactIterations(double relativeResidual, int iterations, int allowed);
