@@ -89,8 +89,8 @@ void BackwardEuler::assembleSystemMatrix(bool withContact) {
 }
 
 void BackwardEuler::addContactBlocks() {
-  // The contact force linearized at the predicted state (u_k + h v_k, v_k):
-  // f(u_{k+1}, v_{k+1}) ~ f_p - K_c h dv - C_c dv, so the step's matrix gains h^2 K_c + h C_c.
+  // The contact force linearized at its last evaluation (the prediction or an iterate):
+  // f ~ f_i - (h K_c + C_c) (dv - dv_i), so the step's matrix gains h^2 K_c + h C_c.
   const double h = timestep_;
   if (!contact_.empty()) free_->addVertexBlocks(system_.freeDofs, contact_, h * h, h, stats_);
 }
@@ -271,6 +271,10 @@ void BackwardEuler::solveLinearStep(const Eigen::VectorXd& rhs, Eigen::VectorXd&
     ++lowRankSolves_;
     return;
   }
+  solveWithContactMatrix(rhs, solution);
+}
+
+void BackwardEuler::solveWithContactMatrix(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
   assembleSystemMatrix(true);
   if (reuse_) {
     updateReusedMatrix();
@@ -316,15 +320,7 @@ int BackwardEuler::linearContactIterations(double rhsNorm, bool solvedWithContac
     if (startInternal == nullptr) {
       solveLinearStep(-residual, correction);
     } else {
-      // The step-start tangent with the iterate's contact blocks.
-      assembleSystemMatrix(true);
-      if (reuse_) {
-        updateReusedMatrix();
-        solveWithReuse(-residual, correction);
-      } else {
-        free_->factorize(stats_);
-        free_->solve(-residual, correction, stats_);
-      }
+      solveWithContactMatrix(-residual, correction);  // the step-start tangent, the iterate's blocks
     }
     dv_ += correction;
     solvedWithContact = !contact_.empty();
@@ -423,7 +419,7 @@ void BackwardEuler::stepNonlinear() {
     dv_ = start + backtrack(start, step, incrementalPotential(start), -rhs_.dot(step)) * step;
   }
   if (options_.maxIterations > 1) {
-    lastIterations_ = newtonIterations(rhsNorm, internal, predictedContact);
+    lastIterations_ = newtonIterations(rhsNorm, internal);
   } else if (implicitExternal_) {
     // The linearized step asked for: elasticity stays linearized at u_k, contact iterates.
     lastIterations_ = linearContactIterations(rhsNorm, predictedContact, &internal);
@@ -447,7 +443,7 @@ void BackwardEuler::iterateResidual(const Eigen::VectorXd& internal,
   if (beta != 0.0) residual.noalias() += (h * beta) * (dampingStiffness * newVelocity);
 }
 
-int BackwardEuler::newtonIterations(double rhsNorm, Eigen::VectorXd& internal, bool solvedWithContact) {
+int BackwardEuler::newtonIterations(double rhsNorm, Eigen::VectorXd& internal) {
   const double h = timestep_;
   const double beta = system_.rayleighStiffness;
   detail::FreeSystem& free = *free_;
@@ -466,8 +462,6 @@ int BackwardEuler::newtonIterations(double rhsNorm, Eigen::VectorXd& internal, b
       // with the contact set of the iterate.
       detail::expandTo(system_.freeDofs, newVelocity, fullV_);
       evaluateImplicitExternalForce(fullU_, fullV_, force_);
-      // The linearized step asked for (maxIterations = 1) and no contact involved: as without it.
-      if (options_.maxIterations == 1 && !solvedWithContact && contact_.empty()) return iterations;
     }
     const bool mayIterate = iterations < allowed;
     if (mayIterate || dampingAtIterate) {
@@ -484,7 +478,6 @@ int BackwardEuler::newtonIterations(double rhsNorm, Eigen::VectorXd& internal, b
       if (stopContactIterations(residual.norm() / scale, iterations, allowed)) return iterations;
       solveNewtonCorrection(dampingStiffness, residual, correction);
       dv_ += correction;
-      solvedWithContact = !contact_.empty();
       continue;
     }
     lastRelativeResidual_ = residual.norm() / scale;

@@ -8,6 +8,7 @@
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <cmath>
 #include <iterator>
+#include <sstream>
 
 namespace asyncfem {
 
@@ -20,8 +21,10 @@ Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVert
       contact_(std::move(contact)) {
   if (!mesh_) throw ValidationError("problem: no mesh");
   if (settings_.implicitContact && contact_ && contact_->parameters().friction > 0.0) {
+    std::ostringstream friction;
+    friction << contact_->parameters().friction;
     throw ValidationError(
-        "problem: implicit contact with friction " + std::to_string(contact_->parameters().friction) +
+        "problem: implicit contact with friction " + friction.str() +
         ": friction is not treated implicitly (its force grows with the depth, a coupling Newton's symmetric step "
         "matrix cannot hold); set the friction to 0 or treat contact explicitly");
   }

@@ -128,10 +128,12 @@ class BackwardEuler final : public Integrator {
   void finishStep();
   /// Newton iterations after the linearized step (options_.maxIterations > 1): returns
   /// how many were taken in all, counting the linearized one.
-  /// solvedWithContact: the linearized step's matrix had contact blocks (implicit contact).
-  int newtonIterations(double rhsNorm, Eigen::VectorXd& internal, bool solvedWithContact);
+  int newtonIterations(double rhsNorm, Eigen::VectorXd& internal);
   /// Linear model: solution = A^{-1} rhs, A = M + h D + h^2 K plus contact_'s blocks.
   void solveLinearStep(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
+  /// solution = A^{-1} rhs with A assembled with contact_'s blocks and solved as it stands
+  /// (kept-factor PCG under reuseFactor, else factored).
+  void solveWithContactMatrix(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution);
   /// Implicit contact with the elastic force linear in the step (a linear model, or the
   /// linearized step of a nonlinear one: startInternal = f_int(u_k) on the free DOFs, K(u_k)
   /// in free_->stiffness): Newton iterations after the first solve, returns the solves made.
