@@ -44,11 +44,13 @@ class TimeInto {
   Stopwatch watch_;
 };
 
-/// The symmetric part of block with its negative eigenvalues set to zero: what of a
-/// contact force's derivatives a symmetric positive definite step matrix can take
-/// (friction couples the normal and tangential directions unsymmetrically; a sphere's
-/// turning normal gives a negative curvature term).
-Eigen::Matrix3d symmetricPositivePart(const Eigen::Matrix3d& block);
+/// What of contact block k (stiffnessWeight * stiffness + dampingWeight * damping) a step
+/// matrix on the free DOFs takes: its symmetric part with the negative eigenvalues set to
+/// zero (friction couples the normal and tangential directions unsymmetrically; a sphere's
+/// turning normal gives a negative curvature term), the rows and columns of the vertex's
+/// fixed DOFs zeroed.
+Eigen::Matrix3d freeContactBlock(const FreeDofs& dofs, const VertexJacobian& jacobian, std::size_t k,
+                                 double stiffnessWeight, double dampingWeight);
 
 /// Free-DOF matrices of a DynamicSystem and one factorization of a linear combination of
 /// them. Every free matrix shares the pattern of the force model's stiffness restricted
@@ -67,10 +69,9 @@ class FreeSystem {
   /// systemMatrix = sum_i coefficients[i] * matrices[i] (free matrices of this object).
   void assemble(const std::vector<double>& coefficients,
                 const std::vector<const Eigen::SparseMatrix<double>*>& matrices, IntegratorStats& stats);
-  /// systemMatrix += the symmetric positive semi-definite part (symmetricPositivePart) of
-  /// stiffnessWeight * jacobian.stiffness + dampingWeight * jacobian.damping, each 3 x 3
-  /// block on its vertex's free DOFs (fixed DOFs' rows and columns dropped), so that the
-  /// matrix stays one for Cholesky. The blocks lie in the pattern (a vertex's own block is in K's).
+  /// systemMatrix += every freeContactBlock of jacobian on its vertex's free DOFs (the
+  /// symmetric positive semi-definite part, so that the matrix stays one for Cholesky). The blocks lie in the pattern
+  /// (a vertex's own block is in K's).
   void addVertexBlocks(const FreeDofs& dofs, const VertexJacobian& jacobian, double stiffnessWeight,
                        double dampingWeight, IntegratorStats& stats);
   /// Numeric factorization of systemMatrix (symbolic analysis the first time only). A

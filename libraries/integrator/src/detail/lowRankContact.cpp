@@ -53,21 +53,14 @@ void LowRankContactSolver::solve(FreeSystem& free, const FreeDofs& dofs, const V
                                  double stiffnessWeight, double dampingWeight, const Eigen::VectorXd& rhs,
                                  Eigen::VectorXd& x, IntegratorStats& stats) {
   const std::vector<int>& fullToFree = dofs.fullToFree();
-  // U: per block, sqrt(lambda) q for its positive eigenpairs, with the fixed DOFs' rows and
-  // columns of the block dropped first (as addVertexBlocks drops them).
+  // U: per block, sqrt(lambda) q for the positive eigenpairs of the block the step matrix
+  // would take (freeContactBlock, as addVertexBlocks adds it).
   u_.resize(3, static_cast<Eigen::Index>(3 * contact.vertices.size()));
   vertexOf_.clear();
   for (std::size_t k = 0; k < contact.vertices.size(); ++k) {
     const int vertex = contact.vertices[k];
-    Eigen::Matrix3d block =
-        symmetricPositivePart((stiffnessWeight * contact.stiffness[k]) + (dampingWeight * contact.damping[k]));
-    for (int c = 0; c < 3; ++c) {
-      if (fullToFree[static_cast<std::size_t>((3 * vertex) + c)] < 0) {
-        block.row(c).setZero();
-        block.col(c).setZero();
-      }
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(block);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(
+        freeContactBlock(dofs, contact, k, stiffnessWeight, dampingWeight));
     const double largest = eigen.eigenvalues().maxCoeff();
     for (int i = 0; i < 3; ++i) {
       const double lambda = eigen.eigenvalues()[i];
