@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "detail/freeSystem.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/integrator/contactBlock.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <cmath>
 #include <string>
@@ -132,31 +132,6 @@ void FreeSystem::assemble(const std::vector<double>& coefficients,
   combine(coefficients, matrices, systemMatrix);
 }
 
-namespace {
-
-// The symmetric part of block with its negative eigenvalues set to zero.
-Eigen::Matrix3d symmetricPositivePart(const Eigen::Matrix3d& block) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(0.5 * (block + block.transpose()));
-  const Eigen::Vector3d clamped = eigen.eigenvalues().cwiseMax(0.0);
-  return eigen.eigenvectors() * clamped.asDiagonal() * eigen.eigenvectors().transpose();
-}
-
-}  // namespace
-
-Eigen::Matrix3d freeContactBlock(const FreeDofs& dofs, const VertexJacobian& jacobian, std::size_t k,
-                                 double stiffnessWeight, double dampingWeight) {
-  Eigen::Matrix3d block =
-      symmetricPositivePart((stiffnessWeight * jacobian.stiffness[k]) + (dampingWeight * jacobian.damping[k]));
-  const std::vector<int>& fullToFree = dofs.fullToFree();
-  for (int c = 0; c < 3; ++c) {
-    if (fullToFree[static_cast<std::size_t>((3 * jacobian.vertices[k]) + c)] < 0) {
-      block.row(c).setZero();
-      block.col(c).setZero();
-    }
-  }
-  return block;
-}
-
 void FreeSystem::addVertexBlocks(const FreeDofs& dofs, const VertexJacobian& jacobian, double stiffnessWeight,
                                  double dampingWeight, IntegratorStats& stats) {
   TimeInto timer(stats.assemblySeconds);
@@ -165,7 +140,7 @@ void FreeSystem::addVertexBlocks(const FreeDofs& dofs, const VertexJacobian& jac
   const int* inner = systemMatrix.innerIndexPtr();
   double* values = systemMatrix.valuePtr();
   for (std::size_t k = 0; k < jacobian.vertices.size(); ++k) {
-    const Eigen::Matrix3d block = freeContactBlock(dofs, jacobian, k, stiffnessWeight, dampingWeight);
+    const Eigen::Matrix3d block = contactStepBlock(dofs, jacobian, k, stiffnessWeight, dampingWeight);
     const int vertex = jacobian.vertices[k];
     for (int c = 0; c < 3; ++c) {
       const int column = fullToFree[static_cast<std::size_t>((3 * vertex) + c)];

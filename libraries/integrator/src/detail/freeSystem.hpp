@@ -44,14 +44,6 @@ class TimeInto {
   Stopwatch watch_;
 };
 
-/// What of contact block k (stiffnessWeight * stiffness + dampingWeight * damping) a step
-/// matrix on the free DOFs takes: its symmetric part with the negative eigenvalues set to
-/// zero (friction couples the normal and tangential directions unsymmetrically; a sphere's
-/// turning normal gives a negative curvature term), the rows and columns of the vertex's
-/// fixed DOFs zeroed.
-Eigen::Matrix3d freeContactBlock(const FreeDofs& dofs, const VertexJacobian& jacobian, std::size_t k,
-                                 double stiffnessWeight, double dampingWeight);
-
 /// Free-DOF matrices of a DynamicSystem and one factorization of a linear combination of
 /// them. Every free matrix shares the pattern of the force model's stiffness restricted
 /// to the free DOFs, so combinations are value-wise sums (combine()).
@@ -69,7 +61,7 @@ class FreeSystem {
   /// systemMatrix = sum_i coefficients[i] * matrices[i] (free matrices of this object).
   void assemble(const std::vector<double>& coefficients,
                 const std::vector<const Eigen::SparseMatrix<double>*>& matrices, IntegratorStats& stats);
-  /// systemMatrix += every freeContactBlock of jacobian on its vertex's free DOFs (the
+  /// systemMatrix += every contactStepBlock of jacobian on its vertex's free DOFs (the
   /// symmetric positive semi-definite part, so that the matrix stays one for Cholesky). The blocks lie in the pattern
   /// (a vertex's own block is in K's).
   void addVertexBlocks(const FreeDofs& dofs, const VertexJacobian& jacobian, double stiffnessWeight,

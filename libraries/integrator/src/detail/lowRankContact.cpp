@@ -4,6 +4,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/integrator/contactBlock.hpp>
 #include <cmath>
 
 namespace asyncfem::detail {
@@ -54,13 +55,13 @@ void LowRankContactSolver::solve(FreeSystem& free, const FreeDofs& dofs, const V
                                  Eigen::VectorXd& x, IntegratorStats& stats) {
   const std::vector<int>& fullToFree = dofs.fullToFree();
   // U: per block, sqrt(lambda) q for the positive eigenpairs of the block the step matrix
-  // would take (freeContactBlock, as addVertexBlocks adds it).
+  // would take (contactStepBlock, as addVertexBlocks adds it).
   u_.resize(3, static_cast<Eigen::Index>(3 * contact.vertices.size()));
   vertexOf_.clear();
   for (std::size_t k = 0; k < contact.vertices.size(); ++k) {
     const int vertex = contact.vertices[k];
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(
-        freeContactBlock(dofs, contact, k, stiffnessWeight, dampingWeight));
+        contactStepBlock(dofs, contact, k, stiffnessWeight, dampingWeight));
     const double largest = eigen.eigenvalues().maxCoeff();
     for (int i = 0; i < 3; ++i) {
       const double lambda = eigen.eigenvalues()[i];
