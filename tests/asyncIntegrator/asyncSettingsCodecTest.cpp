@@ -25,6 +25,8 @@ void expectSameSolverOptions(const AsyncOptions& a, const AsyncOptions& b) {
   EXPECT_EQ(a.laggedSchur, b.laggedSchur);
   EXPECT_EQ(a.laggedSchurRotation, b.laggedSchurRotation);
   EXPECT_EQ(a.threads, b.threads);
+  EXPECT_EQ(a.contactIterations, b.contactIterations);
+  EXPECT_EQ(a.contactTolerance, b.contactTolerance);
 }
 
 void expectSameRegions(const std::vector<AsyncRegion>& a, const std::vector<AsyncRegion>& b) {
@@ -49,6 +51,7 @@ TEST(AsyncSettingsCodec, ExplicitSettingsRoundTrip) {
       {{"coupling", "paper"}, {"schur", "lu"}, {"method", "naive"}, {"recovery", "substitution"}},
       {{"schur", "symmetric"}, {"recovery", "dense-z"}, {"regionSolver", "eigen-ldlt"}, {"laggedSchur", false}},
       {{"regionSolver", "umfpack"}, {"threads", 3}, {"laggedSchurRotation", false}},
+      {{"contactIterations", 12}, {"contactTolerance", 1e-6}},
       nlohmann::json::object()};
   for (nlohmann::json options : solverKeys) {
     options["regions"] = {{{"name", "stiff"}, {"ratio", 6}, {"elementSets", {"stiff"}}},

@@ -24,11 +24,13 @@
 #include "detail/parallelTasks.hpp"
 #include "detail/schurSolver.hpp"
 #include "detail/sparseBlocks.hpp"
+#include "detail/substepContact.hpp"
 #include "detail/wholeSystemFactor.hpp"
 
 namespace asyncfem {
 
 using detail::FastRegion;
+using detail::substepTime;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
 struct AsyncBackwardEuler::Impl {
@@ -80,6 +82,10 @@ struct AsyncBackwardEuler::Impl {
   std::vector<double> forceTimes;
   std::vector<Eigen::VectorXd> forceValues;
   std::size_t forcesUsed = 0;
+  // Implicit contact (DynamicSystem::externalForceJacobian): the contact iteration, and
+  // whether a region's A^S holds contact blocks that Z and H^{LL*} were not built with.
+  detail::SubstepContact contact;
+  bool correctionsStale = false;
 
   bool rowProducts() const { return linear && symmetricStiffness; }
   /// f_ext at time and state (u, v0), evaluated in this thread (the callback need not be
@@ -169,11 +175,6 @@ std::vector<std::pair<int, std::vector<int>>> partitionKey(const RegionPartition
   return key;
 }
 
-/// Time of substep r of a region with `ratio` substeps in the large step [t0, t1]; the last
-/// one is exactly t1.
-double substepTime(double t0, double t1, int r, int ratio, double smallStep) {
-  return r == ratio ? t1 : t0 + (r * smallStep);
-}
 }  // namespace
 
 AsyncBackwardEuler::AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system, double largeTimestep,
@@ -203,6 +204,11 @@ AsyncBackwardEuler::AsyncBackwardEuler(DynamicSystem system, double largeTimeste
     throw ValidationError(
         "async integrator: regions owned by one process (regionDistribution) need the stable coupling and the "
         "structured method");
+  }
+  if (!(options_.contactTolerance > 0.0 && options_.contactTolerance < 1.0) || options_.contactIterations < 1) {
+    throw ValidationError("async integrator: contactTolerance must be in (0, 1) and contactIterations >= 1 (got " +
+                          std::to_string(options_.contactTolerance) + ", " +
+                          std::to_string(options_.contactIterations) + ")");
   }
   const Impl& d = *impl_;
   if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
@@ -333,6 +339,7 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   const std::vector<int>& large = partition_.largeDofs();
   if (d.sharedPattern < 0) d.sharedPattern = detail::samePattern(mass, d.stiffness) ? 1 : 0;
   d.massLL.rebuild(mass, large, large);  // in the storage of the previous partition's cut
+  d.contact.setPartition(partition_, mass);
   if (d.sharedPattern != 1) d.stiffLL.rebuild(d.stiffness, large, large);
   d.cutLL = false;
   d.regions.clear();
@@ -377,6 +384,15 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
     d.factorsCurrent = true;
   }
   runStats_.setupSeconds += watch.stop();
+}
+
+bool AsyncBackwardEuler::implicitContact() const {
+  return static_cast<bool>(system_.externalForceJacobian) && linearizesExternalForce();
+}
+
+bool AsyncBackwardEuler::linearizesExternalForce() const {
+  return options_.coupling == AsyncCoupling::stable && options_.method == AsyncSolveMethod::structured &&
+         !options_.largeSystemSolver && !distributed();
 }
 
 void AsyncBackwardEuler::setTimestep(double timestep) {
@@ -486,11 +502,24 @@ void AsyncBackwardEuler::fullSchurRebuild() {
   factor.start();
   d.schur.factor(d.largeSystem, partition_, d.regions, options_.schur, options_.coupling, schurAsymmetry_, stats_);
   schurModeUsed_ = d.schur.modeUsed();
+  d.contact.noteFactored();
+  d.correctionsStale = false;
   const double schurSeconds = factor.stop();
   stats_.factorizationSeconds += schurSeconds;
   if (setUpBuild) runStats_.setupSchurSeconds += schurSeconds;
   d.schurLagging = false;
   d.lastRebuildFull = true;
+  keepLaggedFactor();
+}
+
+// H^{LL*} refactored from the current Â^L with the corrections C_i kept (they are
+// current): implicit contact's blocks of L changed, nothing else.
+void AsyncBackwardEuler::refactorLargeSystem() {
+  Impl& d = *impl_;
+  Stopwatch factor;
+  d.schur.factor(d.largeSystem, partition_, d.regions, options_.schur, options_.coupling, schurAsymmetry_, stats_);
+  d.contact.noteFactored();
+  stats_.factorizationSeconds += factor.stop();
   keepLaggedFactor();
 }
 
@@ -505,6 +534,7 @@ void AsyncBackwardEuler::refreshLaggedFactor() {
     d.rotations.turnBlock(partition_.interfaceDofs(i), d.regions[static_cast<std::size_t>(i)].correction);
   }
   d.schur.factor(d.largeSystem, partition_, d.regions, options_.schur, options_.coupling, schurAsymmetry_, stats_);
+  d.contact.noteFactored();
   stats_.factorizationSeconds += factor.stop();
   ++runStats_.laggedRefreshes;
   d.lastRebuildFull = false;
@@ -589,7 +619,9 @@ void AsyncBackwardEuler::step() {
   gatherExternalForces(t0, t1);  // right-hand sides (A4), (A12)
   largeRightHandSide();
   regionRightHandSides();
-  if (options_.method == AsyncSolveMethod::naive) {
+  if (implicitContact()) {
+    solveWithImplicitContact(t0, t1);
+  } else if (options_.method == AsyncSolveMethod::naive) {
     d.naive.solve(d.regions, d.rhsL, d.Y);
   } else {
     solveStructured();
@@ -601,6 +633,71 @@ void AsyncBackwardEuler::step() {
   ++runStats_.steps;
   ++stepsKept_;
   runStats_.stepSeconds += whole.stop() - (runStats_.setupSeconds + runStats_.rebuildSeconds - rebuildBefore);
+}
+
+// Implicit contact (Eqs. C1-C4): L's contact blocks in Â^L for this step, then solves
+// with the external force moved to the last solve's substep and end states until it no
+// longer changes.
+void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
+  Impl& d = *impl_;
+  const double hL = timestep();
+  if (d.externalL == nullptr) throw Error("async integrator: implicit contact without an external force function");
+  struct Restore {
+    Impl& d;
+    ~Restore() { d.contact.removeBlocks(d.largeSystem); }
+  } restore{d};
+  const detail::ContactStep step{&system_, &partition_, &displacement_, &velocity_, t0, t1, hL};
+  d.contact.start(step, d.rhsL, *d.externalL, d.regions, d.largeSystem);
+  refactorContactRegions();
+  // Rent or buy, as for the lagged factor: once the iterations that stale corrections cost
+  // have added up to a rebuild, rebuild (with this step's blocks).
+  if (d.correctionsStale && !d.schur.borrowing() && d.laggedRent >= d.laggedRebuildFlops) {
+    Stopwatch rebuild;
+    fullSchurRebuild();
+    runStats_.rebuildSeconds += rebuild.stop();
+    ++runStats_.rebuilds;
+  }
+  for (int iterations = 1;; ++iterations) {
+    solveStructured();
+    const double residual = d.contact.update(d.regions, d.Y, d.largeSystem, d.rhsL);
+    refactorContactRegions();
+    ++runStats_.contactIterations;
+    if (!std::isfinite(residual)) {
+      throw NumericalError("async integrator: the step to t = " + std::to_string(t1) +
+                           " has a non-finite state or external force with implicit contact (vertex " +
+                           std::to_string(d.contact.worstVertex()) + ")");
+    }
+    if (residual <= options_.contactTolerance) break;
+    if (iterations < options_.contactIterations) continue;
+    if (residual > 1.0) {
+      const int vertex = d.contact.worstVertex();
+      const int region = vertex >= 0 ? partition_.vertexRegion()[static_cast<std::size_t>(vertex)] : -1;
+      throw NumericalError(
+          "async integrator: implicit contact did not converge in the step to t = " + std::to_string(t1) +
+          ": relative residual " + std::to_string(residual) + " after " + std::to_string(iterations) +
+          " iterations, largest at vertex " + std::to_string(vertex) +
+          (region >= 0 ? " of fast region " + std::to_string(region) + " (" + partition_.region(region).name +
+                             "): its contact springs may be too stiff for hS = hL / " +
+                             std::to_string(partition_.ratio(region)) + " (raise the ratio, or use backward-euler)"
+                       : " of L"));
+    }
+    ++runStats_.unconvergedContactSteps;
+    runStats_.largestContactResidual = std::max(runStats_.largestContactResidual, residual);
+    break;
+  }
+  ++runStats_.contactSteps;
+}
+
+// The regions whose A^S the contact blocks just changed: refactored, their Z stale.
+void AsyncBackwardEuler::refactorContactRegions() {
+  Impl& d = *impl_;
+  const std::vector<int>& changed = d.contact.changedRegions();
+  if (changed.empty()) return;
+  Stopwatch factor;
+  for (int i : changed) d.regions[static_cast<std::size_t>(i)].factorize(stats_);
+  runStats_.contactRegionFactorizations += static_cast<long long>(changed.size());
+  stats_.factorizationSeconds += factor.stop();
+  d.correctionsStale = true;
 }
 
 // f_int(u_0) (and K(u_0) for nonlinear forces), then the refactorization a nonlinear step
@@ -642,8 +739,11 @@ void AsyncBackwardEuler::gatherExternalForces(double t0, double t1) {
   const Eigen::VectorXd& v0 = velocity_;
   d.forcesUsed = 0;
   const bool hasExternal = static_cast<bool>(system_.externalForce);
-  const bool constantInStep = hasExternal && !options_.substepStatePrediction && system_.externalForceChanges &&
-                              !system_.externalForceChanges(t0, t1);
+  // Implicit contact starts its iteration from the predicted states (Eq. C3 at X = 0).
+  const bool implicit = implicitContact();
+  const bool predict = options_.substepStatePrediction || implicit;
+  const bool constantInStep =
+      hasExternal && !predict && system_.externalForceChanges && !system_.externalForceChanges(t0, t1);
   for (int i = 0; i < partition_.numRegions(); ++i) {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& s = partition_.regionDofs(i);
@@ -656,7 +756,7 @@ void AsyncBackwardEuler::gatherExternalForces(double t0, double t1) {
     for (int r = 1; r <= rb.ratio; ++r) {
       const double time = constantInStep ? t1 : substepTime(t0, t1, r, rb.ratio, rb.smallStep);
       const Eigen::VectorXd* f = nullptr;
-      if (options_.substepStatePrediction) {
+      if (predict) {
         d.predicted = u0 + (r * rb.smallStep) * v0;
         f = &d.forceAt(system_, time, d.predicted, u0, v0);
       } else {
@@ -665,7 +765,12 @@ void AsyncBackwardEuler::gatherExternalForces(double t0, double t1) {
       for (Eigen::Index k = 0; k < sizeS; ++k) rb.external(k, r - 1) = (*f)[s[static_cast<std::size_t>(k)]];
     }
   }
-  d.externalL = hasExternal ? &d.forceAt(system_, t1, u0, u0, v0) : nullptr;
+  if (hasExternal && implicit) {
+    d.predicted = u0 + timestep() * v0;
+    d.externalL = &d.forceAt(system_, t1, d.predicted, u0, v0);
+  } else {
+    d.externalL = hasExternal ? &d.forceAt(system_, t1, u0, u0, v0) : nullptr;
+  }
 }
 
 // b^L = hL (f_ext - f_int(u_0) - D v_0) - hL^2 K v_0 (Eq. A1 at hL); for linear forces
@@ -776,7 +881,7 @@ void AsyncBackwardEuler::solveStructured() {
     d.Y.resize(0);
   } else if (d.schur.borrowing()) {
     solveOnWholeFactor();
-  } else if (!d.schurLagging) {
+  } else if (!d.schurLagging && d.contact.factorIsExact() && !d.correctionsStale) {
     d.schur.solve(d.rhsSchur, d.Y);
   } else {
     // At least laggedSchurIterations, and as many as one rebuild costs (rent or buy).
@@ -797,9 +902,14 @@ void AsyncBackwardEuler::solveStructured() {
       runStats_.largestSchurResidual = std::max(runStats_.largestSchurResidual, result.residual);
     }
     if (!result.converged) {
-      // The old factor no longer preconditions well enough: rebuild now (exact solve).
+      // The old factor no longer preconditions well enough: rebuild now (exact solve). For
+      // linear forces only L's contact blocks changed (Z and C_i hold): H^{LL*} alone.
       Stopwatch rebuild;
-      fullSchurRebuild();
+      if (!d.schurLagging && !d.correctionsStale) {
+        refactorLargeSystem();
+      } else {
+        fullSchurRebuild();
+      }
       runStats_.rebuildSeconds += rebuild.stop();
       d.schur.solve(d.rhsSchur, d.Y);
     }
@@ -815,7 +925,7 @@ void AsyncBackwardEuler::solveStructured() {
 // or-buy rule: about twice what knowing the partition's lifetime would have cost at most).
 void AsyncBackwardEuler::solveOnWholeFactor() {
   Impl& d = *impl_;
-  if (partition_.numRegions() == 0) {
+  if (partition_.numRegions() == 0 && !d.contact.blocksInMatrix()) {
     d.schur.solve(d.rhsSchur, d.Y);
     return;
   }
@@ -864,7 +974,8 @@ void AsyncBackwardEuler::recoverRegion(int i) {
     rb.substituted = true;
     return;
   }
-  if (rb.useDenseZ && !observer_ && !d.schurLagging && !d.schur.borrowing()) {
+  // Implicit contact evaluates the force at every substep: x must hold them all.
+  if (rb.useDenseZ && !observer_ && !d.schurLagging && !d.schur.borrowing() && !implicitContact()) {
     rb.xLast = rb.y.col(rb.ratio - 1);
     rb.xLast.noalias() -= rb.zLast * rb.yInterface;
     rb.xSum = rb.y.rowwise().sum();
@@ -1248,6 +1359,17 @@ RunReport AsyncBackwardEuler::report() const {
                   "async quick set-up: %lld steps on the whole system's factor, %lld iterations (largest relative "
                   "residual %.2e); %lld partition(s) then built Z and H^LL*",
                   r.quickSteps, r.quickIterations, r.largestQuickResidual, r.quickEnds);
+    lines.emplace_back(line);
+  }
+  if (r.contactSteps > 0) {
+    std::snprintf(line, sizeof(line),
+                  "async implicit contact: %lld solves over %lld steps (%.2f per step); %lld steps stopped at %d "
+                  "iterations unconverged (largest relative residual %.2e); A^S refactored %lld times for contact "
+                  "stiff at hS",
+                  r.contactIterations, r.contactSteps,
+                  static_cast<double>(r.contactIterations) / static_cast<double>(r.contactSteps),
+                  r.unconvergedContactSteps, options_.contactIterations, r.largestContactResidual,
+                  r.contactRegionFactorizations);
     lines.emplace_back(line);
   }
   if (policy_) appendRepartitionLines(repartitions_, lines);

@@ -125,6 +125,11 @@ AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
   solver.laggedSchurRotation = reader.boolean("laggedSchurRotation", solver.laggedSchurRotation);
   solver.quickSetUp = reader.boolean("quickSetUp", solver.quickSetUp);
   solver.threads = reader.integer("threads", solver.threads, 0, 1024);
+  solver.contactIterations = reader.integer("contactIterations", solver.contactIterations, 1, 1000);
+  solver.contactTolerance = reader.number("contactTolerance", solver.contactTolerance);
+  if (!(solver.contactTolerance > 0.0 && solver.contactTolerance < 1.0)) {
+    reader.fail("contactTolerance", "must be in (0, 1)");
+  }
   if (solver.substepStatePrediction && !hasContact) {
     reader.fail("substepContact", "only meaningful with a \"contact\" section");
   }
@@ -260,11 +265,22 @@ AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const
 }
 
 const std::vector<std::string>& asyncOptionKeys() {
-  static const std::vector<std::string> keys{"coupling",       "schur",        "method",
-                                             "recovery",       "regionSolver", "denseRegionDofs",
-                                             "substepContact", "laggedSchur",  "laggedSchurRotation",
-                                             "quickSetUp",     "threads",      "regions",
-                                             "auto",           "nestedSolve"};
+  static const std::vector<std::string> keys{"coupling",
+                                             "schur",
+                                             "method",
+                                             "recovery",
+                                             "regionSolver",
+                                             "denseRegionDofs",
+                                             "substepContact",
+                                             "laggedSchur",
+                                             "laggedSchurRotation",
+                                             "quickSetUp",
+                                             "threads",
+                                             "regions",
+                                             "auto",
+                                             "nestedSolve",
+                                             "contactIterations",
+                                             "contactTolerance"};
   return keys;
 }
 
@@ -375,6 +391,8 @@ nlohmann::json asyncSettingsJson(const AsyncSettings& settings) {
   }
   if (solver.quickSetUp != defaults.quickSetUp) out["quickSetUp"] = solver.quickSetUp;
   if (solver.threads != defaults.threads) out["threads"] = solver.threads;
+  if (solver.contactIterations != defaults.contactIterations) out["contactIterations"] = solver.contactIterations;
+  if (solver.contactTolerance != defaults.contactTolerance) out["contactTolerance"] = solver.contactTolerance;
   if (settings.nestedSolve != NestedSolve::automatic) out["nestedSolve"] = toString(settings.nestedSolve);
   out["regions"] =
       settings.adaptive ? nlohmann::json{{"adaptive", settings.adaptiveSource}} : asyncRegionsJson(settings.regions);

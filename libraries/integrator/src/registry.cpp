@@ -56,7 +56,8 @@ std::unique_ptr<Integrator> IntegratorRegistry::create(const std::string& name, 
   if (implicitExternalForce && !integrator->linearizesExternalForce()) {
     throw ValidationError(prefix + "contact.implicit: integrator \"" + name +
                           "\" applies contact forces explicitly; implicit contact is linearized by \"backward-euler\" "
-                          "only (use it, or leave contact.implicit out)");
+                          "and \"async\" (stable coupling, structured method) only (use one, or leave "
+                          "contact.implicit out)");
   }
   return integrator;
 }

@@ -132,7 +132,9 @@ void bindAsyncOptions(py::module_& module) {
       .def_readwrite("recovery", &AsyncOptions::recovery)
       .def_readwrite("region_solver", &AsyncOptions::regionSolver)
       .def_readwrite("dense_region_dofs", &AsyncOptions::denseRegionDofs)
-      .def_readwrite("substep_state_prediction", &AsyncOptions::substepStatePrediction);
+      .def_readwrite("substep_state_prediction", &AsyncOptions::substepStatePrediction)
+      .def_readwrite("contact_tolerance", &AsyncOptions::contactTolerance)
+      .def_readwrite("contact_iterations", &AsyncOptions::contactIterations);
 
   py::class_<ScheduledRegion>(module, "ScheduledRegion",
                               "A fast region of the schedule policy: vertices at ratio from start to end (s)")

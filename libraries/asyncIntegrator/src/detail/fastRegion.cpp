@@ -3,7 +3,9 @@
 #include "detail/fastRegion.hpp"
 
 #include <algorithm>
+#include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/stepFormula.hpp>
+#include <string>
 
 #include "detail/multirateSupport.hpp"
 #include "detail/parallelTasks.hpp"
@@ -40,6 +42,13 @@ void FastRegion::updateBlocks(const SparseMatrix& stiffness, double largeStep, d
                               AsyncCoupling couplingKind) {
   const double hS = largeStep / ratio;
   smallStep = hS;
+  beta_ = damped ? beta : 0.0;
+  // A^S and G are rebuilt from K below: contact blocks in them go with their old values.
+  contactSaved_.clear();
+  contactPositions.clear();
+  contactBlocks.clear();
+  contactStiffness.clear();
+  contactShortcut.clear();
   updateStiffnessBlocks(stiffness);
   if (damped) {
     combineInto(alpha, Mss, beta, Kss, Dss);
@@ -60,6 +69,79 @@ void FastRegion::updateBlocks(const SparseMatrix& stiffness, double largeStep, d
 void FastRegion::factorize(IntegratorStats& stats) {
   if (!analyzed && !denseDecided_) chooseDenseFactor();
   factorizeCounted(*solver, systemMatrix, analyzed, stats);
+}
+
+void FastRegion::removeContactBlocks() {
+  for (auto it = contactSaved_.rbegin(); it != contactSaved_.rend(); ++it) *it->first = it->second;
+  contactSaved_.clear();
+}
+
+bool FastRegion::setContactBlocks(const std::vector<std::array<int, 3>>& positions,
+                                  const std::vector<Eigen::Matrix3d>& blocks,
+                                  const std::vector<Eigen::Matrix3d>& stiffness) {
+  if (positions == contactPositions && blocks == contactBlocks && stiffness == contactStiffness) return false;
+  removeContactBlocks();
+  contactPositions = positions;
+  contactBlocks = blocks;
+  contactStiffness = stiffness;
+  contactShortcut.clear();
+  const auto add = [&](SparseMatrix& matrix, int row, int column, double value) {
+    double* entry = findEntry(matrix, row, column);
+    if (entry == nullptr) {
+      throw Error("async integrator: implicit contact: vertex block (" + std::to_string(row) + ", " +
+                  std::to_string(column) + ") of a fast region is not in its matrix's pattern");
+    }
+    contactSaved_.emplace_back(entry, *entry);
+    *entry += value;
+  };
+  for (std::size_t k = 0; k < positions.size(); ++k) {
+    contactShortcut.push_back(rhsWeight * (((beta_ / smallStep) * stiffness[k]) - (blocks[k] - stiffness[k])));
+    for (int c = 0; c < 3; ++c) {
+      for (int r = 0; r < 3; ++r) {
+        const int row = positions[k][static_cast<std::size_t>(r)], column = positions[k][static_cast<std::size_t>(c)];
+        if (row < 0 || column < 0) continue;
+        add(systemMatrix, row, column, blocks[k](r, c));
+        add(G, row, column, stiffness[k](r, c));
+      }
+    }
+  }
+  transposeInto(G, GT, gtPattern_);
+  if (denseG) Gdense = G;
+  return true;
+}
+
+void FastRegion::addShortcutCorrection(const double* t, double* out) const {
+  for (std::size_t k = 0; k < contactPositions.size(); ++k) {
+    const std::array<int, 3>& position = contactPositions[k];
+    for (int r = 0; r < 3; ++r) {
+      const int row = position[static_cast<std::size_t>(r)];
+      if (row < 0) continue;
+      for (int c = 0; c < 3; ++c) {
+        const int column = position[static_cast<std::size_t>(c)];
+        if (column >= 0) out[row] += contactShortcut[k](r, c) * t[column];
+      }
+    }
+  }
+}
+
+void FastRegion::addContactProduct(const Eigen::MatrixXd& z, Eigen::MatrixXd& y) const {
+  for (std::size_t k = 0; k < contactPositions.size(); ++k) {
+    const std::array<int, 3>& position = contactPositions[k];
+    const Eigen::Matrix3d damping = contactBlocks[k] - contactStiffness[k];  // hS C_c
+    for (int r = 0; r < 3; ++r) {
+      const int row = position[static_cast<std::size_t>(r)];
+      if (row < 0) continue;
+      for (int c = 0; c < 3; ++c) {
+        const int column = position[static_cast<std::size_t>(c)];
+        if (column < 0) continue;
+        double running = 0.0;
+        for (Eigen::Index j = 0; j < z.cols(); ++j) {
+          running += z(column, j);
+          y(row, j) += (contactStiffness[k](r, c) * running) + (damping(r, c) * z(column, j));
+        }
+      }
+    }
+  }
 }
 
 // A region of at most denseDofs_ free DOFs is factored dense, and G multiplied dense: there
@@ -126,6 +208,7 @@ void FastRegion::forwardSubstitute(const Eigen::MatrixXd& b, Eigen::MatrixXd& x)
       substepRhs *= rhsWeight;
       substepRhs += b.col(r - 1);
       subtractStiffnessProduct(combined.data(), substepRhs.data());
+      if (!contactPositions.empty()) addShortcutCorrection(x.col(r - 2).data(), substepRhs.data());
     }
     solver->solve(substepRhs, substepSolution);
     x.col(r - 1) = substepSolution.col(0);
@@ -178,6 +261,8 @@ void FastRegion::correctionColumns(SparseSolver& columnSolver, bool damped, Eige
       rowWiseStiffnessProduct(w.combinedT, w.productT);
       w.rhsColumns *= rhsWeight;
       w.rhsColumns -= w.productT.transpose();
+      for (Eigen::Index c = 0; c < width && !contactPositions.empty(); ++c)
+        addShortcutCorrection(w.z.col(c).data(), w.rhsColumns.col(c).data());
     }
     addColumns(Msi, k.bM[r - 1]);
     addColumns(Ksi, k.bK[r - 1]);

@@ -15,6 +15,7 @@
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "detail/sparseBlocks.hpp"
@@ -57,6 +58,18 @@ class FastRegion {
   /// Numeric factorization of A^S (symbolic analysis, and the choice of a dense factor, the
   /// first time only).
   void factorize(IntegratorStats& stats);
+  /// Implicit contact (docs/asynchronous-integrator.md, Eq. C2): per contacting vertex of S
+  /// (positions: its three rows of S, -1 for a fixed DOF) the block P = hS^2 K_c + hS C_c
+  /// in A^S and hS^2 K_c in G, in place of the blocks set before (values kept and restored
+  /// exactly). Returns whether A^S changed (then it needs factorize, and Z is stale).
+  /// updateBlocks drops them (it rebuilds A^S and G from K).
+  bool setContactBlocks(const std::vector<std::array<int, 3>>& positions, const std::vector<Eigen::Matrix3d>& blocks,
+                        const std::vector<Eigen::Matrix3d>& stiffness);
+  bool hasContactBlocks() const { return !contactPositions.empty(); }
+  /// y += J z for the contact blocks, J the linearized contact force's part of the step
+  /// operator on S (hS^2 K_c on every substep's running sum, hS C_c on its own): column r of
+  /// y gets hS^2 K_c sum_{j<=r} z_j + hS C_c z_r.
+  void addContactProduct(const Eigen::MatrixXd& z, Eigen::MatrixXd& y) const;
 
   /// Forward substitution with H^{SS} (Eq. A13): A^S x_r = b_r + M^{SS} x_{r-1} - G sum_{i<r} x_i
   /// for the columns b_r of b (|S| x m), into x (|S| x m).
@@ -95,6 +108,11 @@ class FastRegion {
   SparseMatrix GT;         // G^T, for products with many columns held row-wise
   bool denseG = false;     // the region is small: A^S factored dense, G multiplied dense
   Eigen::MatrixXd Gdense;  // G (denseG only)
+  // Implicit contact's blocks (setContactBlocks): positions in S, P = hS^2 K_c + hS C_c,
+  // Gc = hS^2 K_c, and what the substitution's M^{SS} x_{r-1} shortcut misses with them in
+  // A^S and G: Q = rhsWeight (beta / hS Gc - (P - Gc)), added as Q x_{r-1}.
+  std::vector<std::array<int, 3>> contactPositions;
+  std::vector<Eigen::Matrix3d> contactBlocks, contactStiffness, contactShortcut;
   // The previous substep's solve gives M^{SS} x_{r-1} for free: A^S = (1 + hS alpha) M^{SS}
   // + (1 + beta / hS) G, so M^{SS} x_{r-1} = (rhs_{r-1} - (1 + beta / hS) G x_{r-1}) / (1 +
   // hS alpha), and substep r's right-hand side b_r + M^{SS} x_{r-1} - G sum_{i<r} x_i needs
@@ -136,7 +154,14 @@ class FastRegion {
   /// outT = (G t)^T for tT = t^T (k x |S|), vectorized across the k columns.
   void rowWiseStiffnessProduct(const Eigen::MatrixXd& tT, Eigen::MatrixXd& outT) const;
 
+  /// out += Q t (the contact blocks' correction of the substitution shortcut) for one column.
+  void addShortcutCorrection(const double* t, double* out) const;
+  /// Restores the entries of A^S and G that the contact blocks changed.
+  void removeContactBlocks();
+
   int denseDofs_ = 0;
+  double beta_ = 0.0;
+  std::vector<std::pair<double*, double>> contactSaved_;  // A^S and G entries and their values before
   bool denseDecided_ = false;
   TransposePattern gtPattern_;  // G's pattern and where GT's entries come from
 };

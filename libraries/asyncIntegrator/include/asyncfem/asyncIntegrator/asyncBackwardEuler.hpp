@@ -70,6 +70,9 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   std::string name() const override { return "async"; }
   void step() override;
   void setTimestep(double timestep) override;
+  /// With the stable coupling and the structured method on one process: implicit contact
+  /// (docs/asynchronous-integrator.md, "Implicit contact").
+  bool linearizesExternalForce() const override;
 
   const AsyncOptions& options() const { return options_; }
   void setSubstepObserver(SubstepObserver observer) { observer_ = std::move(observer); }
@@ -112,6 +115,12 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   void fullSchurRebuild();
   void priceLaggedFactor();
   void refreshLaggedFactor();
+  void refactorLargeSystem();
+  /// The system asks for implicit contact and this integrator's options allow it (else the
+  /// contact is explicit, and IntegratorRegistry::create refuses the combination).
+  bool implicitContact() const;
+  void solveWithImplicitContact(double t0, double t1);
+  void refactorContactRegions();
   void keepLaggedFactor();
   /// Whether the lagged factor preconditions turned with the body (laggedSchurRotation).
   bool turnsLaggedFactor() const;

@@ -1,0 +1,130 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Implicit penalty contact in one asynchronous large step (docs/asynchronous-integrator.md,
+// "Implicit contact", Eqs. C1-C4). Private to the library.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <array>
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
+#include <asyncfem/core/vertexJacobian.hpp>
+#include <asyncfem/dynamics/dynamicSystem.hpp>
+#include <utility>
+#include <vector>
+
+#include "detail/fastRegion.hpp"
+
+namespace asyncfem::detail {
+
+/// Time of substep r of a region with `ratio` substeps in the large step [t0, t1]; the last
+/// one is exactly t1.
+inline double substepTime(double t0, double t1, int r, int ratio, double smallStep) {
+  return r == ratio ? t1 : t0 + (r * smallStep);
+}
+
+/// Contact blocks of L's vertices in the large system: hL^2 K_c + hL C_c per vertex
+/// (contactStepBlock), at the L positions of its three DOFs (-1: fixed).
+struct LargeContactBlocks {
+  std::vector<std::array<int, 3>> positions;
+  std::vector<Eigen::Matrix3d> values;
+
+  bool empty() const { return positions.empty(); }
+  bool operator==(const LargeContactBlocks& other) const;
+};
+
+/// The large step the contact iteration solves: its times, start state and partition
+/// (referenced, alive for the step).
+struct ContactStep {
+  const DynamicSystem* system = nullptr;
+  const RegionPartition* partition = nullptr;
+  const Eigen::VectorXd* u0 = nullptr;
+  const Eigen::VectorXd* v0 = nullptr;
+  double t0 = 0.0, t1 = 0.0, hL = 0.0;
+};
+
+/// The contact iteration of one large step: Newton's method on the step equations with the
+/// external force at each fast substep's state and at L's end state (Eq. C3). The step's
+/// linear system is the one of every other step plus the contact blocks of the vertices in
+/// contact in the last iterate (Eq. C2: in Â^L for L's, at its end state; in A^S and G for
+/// a region's whose spring is stiff at hS, at the last of its substeps where it touches; a
+/// region's soft spring converges without). Updates are backtracked on the residual's norm
+/// (Eq. C4).
+class SubstepContact {
+ public:
+  /// Where each full DOF sits in L or in its fast region, and the vertices' lumped masses
+  /// (call at each set-up).
+  void setPartition(const RegionPartition& partition, const Eigen::SparseMatrix<double>& mass);
+
+  /// Starts a step from the predicted states (the increments zero): keeps the first
+  /// solve's right-hand sides without their force terms g = h f_ext (externalL, full size,
+  /// at the predicted end state for L; each region's `external` columns at its predicted
+  /// substep states) and sets the contact blocks there (addBlocks). Throws NumericalError
+  /// naming the vertex where those forces are not finite.
+  void start(const ContactStep& step, const Eigen::VectorXd& rhsL, const Eigen::VectorXd& externalL,
+             std::vector<FastRegion>& regions, Eigen::SparseMatrix<double>& largeSystem);
+  /// One iteration after a solve (Y: L's velocity increments; each region's x: its
+  /// substeps' increments): the state moves from the last accepted one toward the solve's,
+  /// halved (up to kMaxHalvings times) while the residual's 2-norm would rise; Y and every
+  /// x become that state. The contact blocks are then taken there (addBlocks: see
+  /// changedRegions()) and the right-hand sides (rhsL and each region's rhs) set for the
+  /// next solve. Returns the state's largest residual, relative to the step's scale (the
+  /// largest entry of the first right-hand sides and force terms); NaN for a non-finite state.
+  double update(std::vector<FastRegion>& regions, Eigen::VectorXd& Y, Eigen::SparseMatrix<double>& largeSystem,
+                Eigen::VectorXd& rhsL);
+  /// Restores the entries of largeSystem that L's blocks changed (the contact-free Â^L
+  /// again, bit for bit). A region's blocks stay in its A^S (the next step's are often the
+  /// same, and its factor with them).
+  void removeBlocks(Eigen::SparseMatrix<double>& largeSystem);
+
+  /// The regions whose A^S the last addBlocks changed (to refactor; their Z is stale).
+  const std::vector<int>& changedRegions() const { return changedRegions_; }
+  /// A factor of H^{LL*} was built from the large system as it is now.
+  void noteFactored() { factored_ = inMatrix_; }
+  /// Whether the last factor of H^{LL*} solves the current large system exactly.
+  bool factorIsExact() const { return factored_ == inMatrix_; }
+  bool blocksInMatrix() const { return !inMatrix_.empty(); }
+  /// The vertex with the largest residual after the last update (for error messages), -1 if none.
+  int worstVertex() const { return worstVertex_; }
+
+  static constexpr int kMaxHalvings = 8;
+
+ private:
+  /// Calls visit(time, region, r) at every state of the increments trialY_ and trialX_
+  /// held in u_ and v_: first the end state (region -1, every region at its last substep),
+  /// then each region's substeps r < m (the others at their end). u_, v_ end at the end state.
+  template <class Visit>
+  void visitStates(const std::vector<FastRegion>& regions, Visit&& visit);
+  /// G(z), the force terms h f_ext at the states of trialY_ and trialX_, into trialForceL_
+  /// and trialForceS_.
+  void forcesAt(const std::vector<FastRegion>& regions);
+  /// The contact blocks at the states of trialY_ and trialX_, in place of the ones before.
+  void addBlocks(Eigen::SparseMatrix<double>& largeSystem, std::vector<FastRegion>& regions);
+  /// The largest residual of the trial state at theta along the update (worstVertex_:
+  /// where), its 2-norm into merit.
+  double trialResidual(const std::vector<FastRegion>& regions, double theta, double& merit);
+  /// y += B x, B L's blocks in the large system.
+  void addBlockProduct(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+
+  ContactStep step_;
+  std::vector<int> largePosition_, regionPosition_, vertexRegion_, changedRegions_;
+  Eigen::VectorXd vertexMass_;  // lumped (row sums of M), per DOF
+  LargeContactBlocks inMatrix_, factored_;
+  std::vector<std::pair<double*, double>> saved_;  // entries of Â^L addBlocks changed, and their values before
+  // The right-hand sides are base + g: g the force terms of the last solve (forceL_,
+  // forceS_). The accepted state z (acceptedY_, acceptedX_), A_0 z - base there (operatorL_,
+  // operatorS_; A_0 the step's operator without contact blocks) and its residual's norm
+  // |A_0 z - base - G(z)|_2, which backtracking lowers (the max norm, reported, is not smooth).
+  Eigen::VectorXd baseL_, forceL_, acceptedY_, operatorL_, solvedOperatorL_, blockProduct_;
+  std::vector<Eigen::MatrixXd> baseS_, forceS_, acceptedX_, operatorS_, solvedOperatorS_;
+  double meritNorm_ = 0.0, scale_ = 0.0;
+  int worstVertex_ = -1;
+  // A trial state and its force terms.
+  Eigen::VectorXd trialY_, trialForceL_;
+  std::vector<Eigen::MatrixXd> trialX_, trialForceS_;
+  Eigen::VectorXd u_, v_, f_;       // full-size state and force
+  Eigen::VectorXd running_, sums_;  // a region's sums of its substeps' increments
+  VertexJacobian jacobian_;
+  std::vector<char> blocked_;  // per vertex: has a block from an earlier state of this addBlocks
+};
+
+}  // namespace asyncfem::detail
