@@ -163,6 +163,13 @@ QuickCosts quickCosts(const std::vector<FastRegion>& regions, const SparseMatrix
   return costs;
 }
 
+/// A tolerance as a reader writes it (1e-10, not to_string's 0.000000).
+std::string shortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+
 std::vector<std::pair<int, std::vector<int>>> partitionKey(const RegionPartition& partition) {
   std::vector<std::pair<int, std::vector<int>>> key;
   for (int i = 0; i < partition.numRegions(); ++i) {
@@ -1318,7 +1325,7 @@ RunReport AsyncBackwardEuler::report() const {
     report.resumeCaveat =
         "laggedSchur: the H^{LL*} factor kept as preconditioner is not in the checkpoint, so the resumed run "
         "refactors at its first step; its frames match an uninterrupted run to about the Schur tolerance (" +
-        std::to_string(options_.laggedSchurTolerance) + "), not bit for bit";
+        shortNumber(options_.laggedSchurTolerance) + "), not bit for bit";
   }
   if (options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
       options_.method == AsyncSolveMethod::structured) {
@@ -1327,7 +1334,15 @@ RunReport AsyncBackwardEuler::report() const {
         "quickSetUp: whether the partition still solved on the whole system's factor is not in the checkpoint, "
         "so the resumed run starts on it again; its frames match an uninterrupted run to about the Schur "
         "tolerance (" +
-        std::to_string(options_.laggedSchurTolerance) + "), not bit for bit";
+        shortNumber(options_.laggedSchurTolerance) + "), not bit for bit";
+  }
+  if (implicitContact()) {
+    if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
+    report.resumeCaveat +=
+        "implicit contact: the contact blocks kept in the regions' A^S (and the factors built with them) are not in "
+        "the checkpoint, so the resumed run's contact iterations start from other matrices; its frames match an "
+        "uninterrupted run to about the contact tolerance (" +
+        shortNumber(options_.contactTolerance) + "), not bit for bit";
   }
   if (policy_) {
     if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
