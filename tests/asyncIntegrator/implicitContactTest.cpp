@@ -93,10 +93,10 @@ int inContact(const ContactBar& bar, const Eigen::VectorXd& u, const std::vector
 // The structured solve with implicit contact equals the per-substep definition with the
 // contact force at each fast substep's own state and at L's end state, solved by Newton
 // (DefinitionStep), over three steps in which fast and L vertices touch the ground
-// (omega hL = 4 for the tip: 0.5 at hS = hL / 8, 2 at hL / 2). Tolerance 1e-8: the contact iterations stop at
-// a relative change of 1e-13 and the definition's Newton at round-off; the two solve
-// systems of condition ~1e6. The explicit contact misses it by far more (so the check
-// can fail).
+// (omega hL = 4 for the tip: 0.5 at hS = hL / 8, 2 at hL / 2), with the set-up's factors
+// and with the quick set-up (conjugate gradients to 1e-10 for L's system). Tolerance 1e-8: the contact iterations stop
+// at a relative change of 1e-13 and the definition's Newton at round-off; the two solve systems of condition ~1e6. The
+// explicit contact misses it by far more (so the check can fail).
 TEST(AsyncImplicitContact, StepMatchesThePerSubstepDefinition) {
   for (const int ratio : {8, 2}) {
     for (const bool implicit : {true, false}) {
@@ -107,15 +107,24 @@ TEST(AsyncImplicitContact, StepMatchesThePerSubstepDefinition) {
       for (int v = 0; v < bar.ts.mesh.numVertices(); ++v)
         if (!std::binary_search(tip.begin(), tip.end(), v)) large.push_back(v);
       AsyncBackwardEuler async(bar.ts.system, kLargeStep, regions, tightContact());
+      // The quick set-up's path too (L's system by conjugate gradients on the whole
+      // system's factor, with the contact blocks in its operator).
+      AsyncOptions quickOptions = tightContact();
+      quickOptions.quickSetUp = true;
+      AsyncBackwardEuler quick(bar.ts.system, kLargeStep, regions, quickOptions);
       async.setState(bar.ts.u0, bar.ts.v0);
+      quick.setState(bar.ts.u0, bar.ts.v0);
       const test::DefinitionStep definition(bar.ts.mesh, bar.ts.system, regions);
       Eigen::VectorXd u = bar.ts.u0, v = bar.ts.v0;
-      double worst = 0.0;
+      double worst = 0.0, worstQuick = 0.0;
       int fastTouching = 0, largeTouching = 0;
       for (int k = 0; k < 3; ++k) {
         async.step();
+        quick.step();
         definition.step(kLargeStep, k * kLargeStep, u, v);
         worst = std::max({worst, relativeDifference(async.displacement(), u), relativeDifference(async.velocity(), v)});
+        worstQuick = std::max(
+            {worstQuick, relativeDifference(quick.displacement(), u), relativeDifference(quick.velocity(), v)});
         fastTouching = std::max(fastTouching, inContact(bar, u, tip));
         largeTouching = std::max(largeTouching, inContact(bar, u, large));
       }
@@ -123,12 +132,14 @@ TEST(AsyncImplicitContact, StepMatchesThePerSubstepDefinition) {
       EXPECT_GT(largeTouching, 0);
       if (implicit) {
         EXPECT_LT(worst, 1e-8) << "ratio " << ratio;
+        EXPECT_LT(worstQuick, 1e-8) << "ratio " << ratio << ", quick set-up";
         // At ratio 2 (omega hS = 2, more for the lighter corners) some springs are stiff at hS:
         // their blocks are in A^S, and checked here too.
         if (ratio == 2) EXPECT_GT(async.runStats().contactRegionFactorizations, 0);
         EXPECT_NE(async.report().lines.back().find("async implicit contact"), std::string::npos);
       } else {
         EXPECT_GT(worst, 1e-3);
+        EXPECT_GT(worstQuick, 1e-3);
       }
     }
   }
