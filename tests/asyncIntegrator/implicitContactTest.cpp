@@ -94,9 +94,10 @@ int inContact(const ContactBar& bar, const Eigen::VectorXd& u, const std::vector
 // contact force at each fast substep's own state and at L's end state, solved by Newton
 // (DefinitionStep), over three steps in which fast and L vertices touch the ground
 // (omega hL = 4 for the tip: 0.5 at hS = hL / 8, 2 at hL / 2), with the set-up's factors
-// and with the quick set-up (conjugate gradients to 1e-10 for L's system). Tolerance 1e-8: the contact iterations stop
-// at a relative change of 1e-13 and the definition's Newton at round-off; the two solve systems of condition ~1e6. The
-// explicit contact misses it by far more (so the check can fail).
+// and with the quick set-up (conjugate gradients to 1e-10 for L's system). Tolerance 1e-8:
+// the contact iterations stop at a relative residual of 1e-13 and the definition's Newton
+// at round-off; both solve systems of condition ~1e6. Explicit contact misses it by far
+// more (so the check can fail).
 TEST(AsyncImplicitContact, StepMatchesThePerSubstepDefinition) {
   for (const int ratio : {8, 2}) {
     for (const bool implicit : {true, false}) {
