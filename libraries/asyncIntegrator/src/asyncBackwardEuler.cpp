@@ -642,9 +642,9 @@ void AsyncBackwardEuler::step() {
   runStats_.stepSeconds += whole.stop() - (runStats_.setupSeconds + runStats_.rebuildSeconds - rebuildBefore);
 }
 
-// Implicit contact (Eqs. C1-C4): L's contact blocks in Â^L for this step, then solves
-// with the external force moved to the last solve's substep and end states until it no
-// longer changes.
+// Implicit contact (Eqs. C1-C4): Newton's method over the step (detail::SubstepContact),
+// the contact blocks in Â^L and in the A^S of regions stiff at hS, until the residual is
+// at most contactTolerance or contactIterations solves are spent.
 void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
   Impl& d = *impl_;
   const double hL = timestep();
@@ -909,8 +909,8 @@ void AsyncBackwardEuler::solveStructured() {
       runStats_.largestSchurResidual = std::max(runStats_.largestSchurResidual, result.residual);
     }
     if (!result.converged) {
-      // The old factor no longer preconditions well enough: rebuild now (exact solve). For
-      // linear forces only L's contact blocks changed (Z and C_i hold): H^{LL*} alone.
+      // The old factor no longer preconditions well enough: rebuild now (exact solve). With
+      // Z and C_i current (only L's contact blocks changed), H^{LL*} alone.
       Stopwatch rebuild;
       if (!d.schurLagging && !d.correctionsStale) {
         refactorLargeSystem();
@@ -1321,35 +1321,36 @@ RunReport AsyncBackwardEuler::report() const {
   RunReport report;
   report.factorNonZeros = factorNonZeros();
   report.mayGainEnergy = options_.coupling == AsyncCoupling::paper;
+  const auto addCaveat = [&report](const std::string& caveat) {
+    if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
+    report.resumeCaveat += caveat;
+  };
   if (options_.laggedSchur && !impl_->linear && options_.method == AsyncSolveMethod::structured) {
-    report.resumeCaveat =
+    addCaveat(
         "laggedSchur: the H^{LL*} factor kept as preconditioner is not in the checkpoint, so the resumed run "
         "refactors at its first step; its frames match an uninterrupted run to about the Schur tolerance (" +
-        shortNumber(options_.laggedSchurTolerance) + "), not bit for bit";
+        shortNumber(options_.laggedSchurTolerance) + "), not bit for bit");
   }
   if (options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
       options_.method == AsyncSolveMethod::structured) {
-    if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
-    report.resumeCaveat +=
+    addCaveat(
         "quickSetUp: whether the partition still solved on the whole system's factor is not in the checkpoint, "
         "so the resumed run starts on it again; its frames match an uninterrupted run to about the Schur "
         "tolerance (" +
-        shortNumber(options_.laggedSchurTolerance) + "), not bit for bit";
+        shortNumber(options_.laggedSchurTolerance) + "), not bit for bit");
   }
   if (implicitContact()) {
-    if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
-    report.resumeCaveat +=
+    addCaveat(
         "implicit contact: the contact blocks kept in the regions' A^S (and the factors built with them) are not in "
         "the checkpoint, so the resumed run's contact iterations start from other matrices; its frames match an "
         "uninterrupted run to about the contact tolerance (" +
-        shortNumber(options_.contactTolerance) + "), not bit for bit";
+        shortNumber(options_.contactTolerance) + "), not bit for bit");
   }
   if (policy_) {
-    if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
-    report.resumeCaveat +=
+    addCaveat(
         "adaptive regions: the partition in use and how long it has been kept are not in the checkpoint, so the "
         "resumed run chooses its regions afresh from the resumed state and its frames can differ from an "
-        "uninterrupted run's (by as much as two partitions' trajectories differ)";
+        "uninterrupted run's (by as much as two partitions' trajectories differ)");
   }
   std::vector<std::string>& lines = report.lines;
   if (!regionNote_.empty()) lines.push_back("regions " + regionNote_);

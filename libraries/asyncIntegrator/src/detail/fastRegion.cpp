@@ -3,9 +3,7 @@
 #include "detail/fastRegion.hpp"
 
 #include <algorithm>
-#include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/stepFormula.hpp>
-#include <string>
 
 #include "detail/multirateSupport.hpp"
 #include "detail/parallelTasks.hpp"
@@ -71,39 +69,21 @@ void FastRegion::factorize(IntegratorStats& stats) {
   factorizeCounted(*solver, systemMatrix, analyzed, stats);
 }
 
-void FastRegion::removeContactBlocks() {
-  for (auto it = contactSaved_.rbegin(); it != contactSaved_.rend(); ++it) *it->first = it->second;
-  contactSaved_.clear();
-}
-
 bool FastRegion::setContactBlocks(const std::vector<std::array<int, 3>>& positions,
                                   const std::vector<Eigen::Matrix3d>& blocks,
                                   const std::vector<Eigen::Matrix3d>& stiffness) {
   if (positions == contactPositions && blocks == contactBlocks && stiffness == contactStiffness) return false;
-  removeContactBlocks();
+  restoreEntries(contactSaved_);
   contactPositions = positions;
   contactBlocks = blocks;
   contactStiffness = stiffness;
   contactShortcut.clear();
-  const auto add = [&](SparseMatrix& matrix, int row, int column, double value) {
-    double* entry = findEntry(matrix, row, column);
-    if (entry == nullptr) {
-      throw Error("async integrator: implicit contact: vertex block (" + std::to_string(row) + ", " +
-                  std::to_string(column) + ") of a fast region is not in its matrix's pattern");
-    }
-    contactSaved_.emplace_back(entry, *entry);
-    *entry += value;
-  };
   for (std::size_t k = 0; k < positions.size(); ++k) {
     contactShortcut.push_back(rhsWeight * (((beta_ / smallStep) * stiffness[k]) - (blocks[k] - stiffness[k])));
-    for (int c = 0; c < 3; ++c) {
-      for (int r = 0; r < 3; ++r) {
-        const int row = positions[k][static_cast<std::size_t>(r)], column = positions[k][static_cast<std::size_t>(c)];
-        if (row < 0 || column < 0) continue;
-        add(systemMatrix, row, column, blocks[k](r, c));
-        add(G, row, column, stiffness[k](r, c));
-      }
-    }
+    forBlockEntries(positions[k], [&](int r, int c, int row, int column) {
+      addKeepingEntry(systemMatrix, row, column, blocks[k](r, c), contactSaved_, "a fast region's A^S");
+      addKeepingEntry(G, row, column, stiffness[k](r, c), contactSaved_, "a fast region's G");
+    });
   }
   transposeInto(G, GT, gtPattern_);
   if (denseG) Gdense = G;
@@ -112,35 +92,21 @@ bool FastRegion::setContactBlocks(const std::vector<std::array<int, 3>>& positio
 
 void FastRegion::addShortcutCorrection(const double* t, double* out) const {
   for (std::size_t k = 0; k < contactPositions.size(); ++k) {
-    const std::array<int, 3>& position = contactPositions[k];
-    for (int r = 0; r < 3; ++r) {
-      const int row = position[static_cast<std::size_t>(r)];
-      if (row < 0) continue;
-      for (int c = 0; c < 3; ++c) {
-        const int column = position[static_cast<std::size_t>(c)];
-        if (column >= 0) out[row] += contactShortcut[k](r, c) * t[column];
-      }
-    }
+    forBlockEntries(contactPositions[k],
+                    [&](int r, int c, int row, int column) { out[row] += contactShortcut[k](r, c) * t[column]; });
   }
 }
 
 void FastRegion::addContactProduct(const Eigen::MatrixXd& z, Eigen::MatrixXd& y) const {
   for (std::size_t k = 0; k < contactPositions.size(); ++k) {
-    const std::array<int, 3>& position = contactPositions[k];
     const Eigen::Matrix3d damping = contactBlocks[k] - contactStiffness[k];  // hS C_c
-    for (int r = 0; r < 3; ++r) {
-      const int row = position[static_cast<std::size_t>(r)];
-      if (row < 0) continue;
-      for (int c = 0; c < 3; ++c) {
-        const int column = position[static_cast<std::size_t>(c)];
-        if (column < 0) continue;
-        double running = 0.0;
-        for (Eigen::Index j = 0; j < z.cols(); ++j) {
-          running += z(column, j);
-          y(row, j) += (contactStiffness[k](r, c) * running) + (damping(r, c) * z(column, j));
-        }
+    forBlockEntries(contactPositions[k], [&](int r, int c, int row, int column) {
+      double running = 0.0;
+      for (Eigen::Index j = 0; j < z.cols(); ++j) {
+        running += z(column, j);
+        y(row, j) += (contactStiffness[k](r, c) * running) + (damping(r, c) * z(column, j));
       }
-    }
+    });
   }
 }
 

@@ -156,12 +156,10 @@ class FastRegion {
 
   /// out += Q t (the contact blocks' correction of the substitution shortcut) for one column.
   void addShortcutCorrection(const double* t, double* out) const;
-  /// Restores the entries of A^S and G that the contact blocks changed.
-  void removeContactBlocks();
 
   int denseDofs_ = 0;
   double beta_ = 0.0;
-  std::vector<std::pair<double*, double>> contactSaved_;  // A^S and G entries and their values before
+  KeptEntries contactSaved_;  // A^S and G entries the contact blocks changed, and their values before
   bool denseDecided_ = false;
   TransposePattern gtPattern_;  // G's pattern and where GT's entries come from
 };

@@ -2,7 +2,9 @@
 #include "detail/sparseBlocks.hpp"
 
 #include <algorithm>
+#include <asyncfem/core/error.hpp>
 #include <cmath>
+#include <string>
 
 namespace asyncfem::detail {
 
@@ -84,6 +86,21 @@ double largestMagnitude(const SparseMatrix& matrix) {
   double value = 0.0;
   for (Eigen::Index k = 0; k < matrix.nonZeros(); ++k) value = std::max(value, std::abs(matrix.valuePtr()[k]));
   return value;
+}
+
+void addKeepingEntry(SparseMatrix& matrix, int row, int column, double value, KeptEntries& kept, const char* what) {
+  double* entry = findEntry(matrix, row, column);
+  if (entry == nullptr) {
+    throw Error(std::string("async integrator: entry (") + std::to_string(row) + ", " + std::to_string(column) +
+                ") of " + what + " is not in its pattern");
+  }
+  kept.emplace_back(entry, *entry);
+  *entry += value;
+}
+
+void restoreEntries(KeptEntries& kept) {
+  for (auto it = kept.rbegin(); it != kept.rend(); ++it) *it->first = it->second;
+  kept.clear();
 }
 
 }  // namespace asyncfem::detail

@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <array>
+#include <utility>
 #include <vector>
 
 namespace asyncfem::detail {
@@ -42,5 +44,30 @@ void transposeInto(const SparseMatrix& matrix, SparseMatrix& out, TransposePatte
 
 /// Largest |entry| of a matrix (0 for an empty one).
 double largestMagnitude(const SparseMatrix& matrix);
+
+/// Entries of a compressed matrix changed in place, with their values before.
+using KeptEntries = std::vector<std::pair<double*, double>>;
+
+/// matrix(row, column) += value, the entry's value before kept in `kept` (restoreEntries
+/// puts it back exactly). Throws asyncfem::Error naming `what` if the entry is not stored.
+void addKeepingEntry(SparseMatrix& matrix, int row, int column, double value, KeptEntries& kept, const char* what);
+
+/// Puts every kept entry back (in reverse: an entry changed twice gets its first value) and
+/// clears `kept`.
+void restoreEntries(KeptEntries& kept);
+
+/// visit(r, c, row, column) for the entries of a vertex's 3 x 3 block whose row and column
+/// positions (position[r], position[c]) are both set (>= 0).
+template <class Visit>
+void forBlockEntries(const std::array<int, 3>& position, Visit&& visit) {
+  for (int c = 0; c < 3; ++c) {
+    const int column = position[static_cast<std::size_t>(c)];
+    if (column < 0) continue;
+    for (int r = 0; r < 3; ++r) {
+      const int row = position[static_cast<std::size_t>(r)];
+      if (row >= 0) visit(r, c, row, column);
+    }
+  }
+}
 
 }  // namespace asyncfem::detail

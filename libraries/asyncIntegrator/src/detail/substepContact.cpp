@@ -122,8 +122,8 @@ void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion
   std::vector<std::vector<std::array<int, 3>>> positionsS(count);
   std::vector<std::vector<Eigen::Matrix3d>> blocksS(count), stiffnessS(count);
   blocked_.assign(vertexRegion_.size(), 0);
-  // L's vertices at the end state; a region's at the end state, or else at the last of
-  // its substeps where it touches (in this order: later substeps first).
+  // L's vertices at the end state; a region's at the end state, or else at the first of
+  // its substeps where it touches.
   visitStates(regions, [&](double time, int only, int /*r*/) {
     system.externalForceJacobian(time, u_, v_, jacobian_);
     for (std::size_t k = 0; k < jacobian_.vertices.size(); ++k) {
@@ -166,27 +166,14 @@ void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion
   // Each touched entry's value is kept and restored exactly by removeBlocks (adding and
   // subtracting would leave round-off in Â^L, and a resumed run would then differ).
   for (std::size_t k = 0; k < inMatrix_.positions.size(); ++k) {
-    const std::array<int, 3>& position = inMatrix_.positions[k];
-    for (int c = 0; c < 3; ++c) {
-      for (int r = 0; r < 3; ++r) {
-        const int row = position[static_cast<std::size_t>(r)], column = position[static_cast<std::size_t>(c)];
-        if (row < 0 || column < 0) continue;
-        double* entry = findEntry(largeSystem, row, column);
-        if (entry == nullptr) {
-          throw Error("async integrator: implicit contact: vertex block (" + std::to_string(row) + ", " +
-                      std::to_string(column) + ") of L is not in the large system's pattern");
-        }
-        saved_.emplace_back(entry, *entry);
-        *entry += inMatrix_.values[k](r, c);
-      }
-    }
+    forBlockEntries(inMatrix_.positions[k], [&](int r, int c, int row, int column) {
+      addKeepingEntry(largeSystem, row, column, inMatrix_.values[k](r, c), saved_, "L's system");
+    });
   }
 }
 
 void SubstepContact::removeBlocks(SparseMatrix& /*largeSystem*/) {
-  // In reverse: an entry touched twice (a vertex listed twice) gets its first value back.
-  for (auto it = saved_.rbegin(); it != saved_.rend(); ++it) *it->first = it->second;
-  saved_.clear();
+  restoreEntries(saved_);
   inMatrix_.positions.clear();
   inMatrix_.values.clear();
 }
@@ -239,15 +226,8 @@ void SubstepContact::start(const ContactStep& step, const Eigen::VectorXd& rhsL,
 // y += B x for L's blocks (rows and columns of L).
 void SubstepContact::addBlockProduct(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   for (std::size_t b = 0; b < inMatrix_.positions.size(); ++b) {
-    const std::array<int, 3>& position = inMatrix_.positions[b];
-    for (int r = 0; r < 3; ++r) {
-      const int row = position[static_cast<std::size_t>(r)];
-      if (row < 0) continue;
-      for (int c = 0; c < 3; ++c) {
-        const int column = position[static_cast<std::size_t>(c)];
-        if (column >= 0) y[row] += inMatrix_.values[b](r, c) * x[column];
-      }
-    }
+    forBlockEntries(inMatrix_.positions[b],
+                    [&](int r, int c, int row, int column) { y[row] += inMatrix_.values[b](r, c) * x[column]; });
   }
 }
 

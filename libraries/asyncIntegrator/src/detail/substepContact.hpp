@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "detail/fastRegion.hpp"
+#include "detail/sparseBlocks.hpp"
 
 namespace asyncfem::detail {
 
@@ -46,9 +47,9 @@ struct ContactStep {
 /// external force at each fast substep's state and at L's end state (Eq. C3). The step's
 /// linear system is the one of every other step plus the contact blocks of the vertices in
 /// contact in the last iterate (Eq. C2: in Â^L for L's, at its end state; in A^S and G for
-/// a region's whose spring is stiff at hS, at the last of its substeps where it touches; a
-/// region's soft spring converges without). Updates are backtracked on the residual's norm
-/// (Eq. C4).
+/// a region's whose spring is stiff at hS, at the end state or else at the first substep
+/// where it touches; a region's soft spring converges without). Updates are backtracked on
+/// the residual's norm (Eq. C4).
 class SubstepContact {
  public:
   /// Where each full DOF sits in L or in its fast region, and the vertices' lumped masses
@@ -109,7 +110,7 @@ class SubstepContact {
   std::vector<int> largePosition_, regionPosition_, vertexRegion_, changedRegions_;
   Eigen::VectorXd vertexMass_;  // lumped (row sums of M), per DOF
   LargeContactBlocks inMatrix_, factored_;
-  std::vector<std::pair<double*, double>> saved_;  // entries of Â^L addBlocks changed, and their values before
+  KeptEntries saved_;  // entries of Â^L addBlocks changed, and their values before
   // The right-hand sides are base + g: g the force terms of the last solve (forceL_,
   // forceS_). The accepted state z (acceptedY_, acceptedX_), A_0 z - base there (operatorL_,
   // operatorS_; A_0 the step's operator without contact blocks) and its residual's norm
