@@ -54,25 +54,36 @@ inline IntegratorContext barContext() {
   return context;
 }
 
+/// M, K(0) and D = alpha M + beta K of a system, dense, on its free DOFs.
+struct DenseFreeMatrices {
+  Eigen::MatrixXd M, K, D;
+};
+
+inline DenseFreeMatrices denseFreeMatrices(const DynamicSystem& system) {
+  const std::vector<int>& free = system.freeDofs.freeToFull();
+  Eigen::SparseMatrix<double> stiffness = system.forceModel->createStiffnessMatrix();
+  system.forceModel->tangentStiffness(Eigen::VectorXd::Zero(system.numDofs()), stiffness);
+  const Eigen::MatrixXd fullM = Eigen::MatrixXd(system.mass), fullK = Eigen::MatrixXd(stiffness);
+  const auto nf = static_cast<Eigen::Index>(free.size());
+  DenseFreeMatrices out{Eigen::MatrixXd(nf, nf), Eigen::MatrixXd(nf, nf), {}};
+  for (Eigen::Index a = 0; a < nf; ++a)
+    for (Eigen::Index b = 0; b < nf; ++b) {
+      out.M(a, b) = fullM(free[static_cast<std::size_t>(a)], free[static_cast<std::size_t>(b)]);
+      out.K(a, b) = fullK(free[static_cast<std::size_t>(a)], free[static_cast<std::size_t>(b)]);
+    }
+  out.D = system.rayleighMass * out.M + system.rayleighStiffness * out.K;
+  return out;
+}
+
 /// Dense single-rate backward Euler on the free DOFs (design note, paper Eq. 5), the
 /// independent reference the asynchronous integrator is checked against.
 class DenseBackwardEuler {
  public:
   explicit DenseBackwardEuler(const DynamicSystem& system) : system_(system) {
-    const std::vector<int>& free = system.freeDofs.freeToFull();
-    const Eigen::MatrixXd M = Eigen::MatrixXd(system.mass);
-    Eigen::SparseMatrix<double> Ks = system.forceModel->createStiffnessMatrix();
-    system.forceModel->tangentStiffness(Eigen::VectorXd::Zero(system.numDofs()), Ks);
-    const Eigen::MatrixXd K = Eigen::MatrixXd(Ks);
-    const int nf = static_cast<int>(free.size());
-    M_.resize(nf, nf);
-    K_.resize(nf, nf);
-    for (int i = 0; i < nf; ++i)
-      for (int j = 0; j < nf; ++j) {
-        M_(i, j) = M(free[i], free[j]);
-        K_(i, j) = K(free[i], free[j]);
-      }
-    D_ = system.rayleighMass * M_ + system.rayleighStiffness * K_;
+    DenseFreeMatrices dense = denseFreeMatrices(system);
+    M_ = std::move(dense.M);
+    K_ = std::move(dense.K);
+    D_ = std::move(dense.D);
   }
 
   /// One step of size h from (u, v) at time t (full vectors), in place.

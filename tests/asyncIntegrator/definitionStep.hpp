@@ -9,7 +9,10 @@
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <map>
+#include <utility>
 #include <vector>
+
+#include "asyncTestSystem.hpp"
 
 namespace asyncfem::test {
 
@@ -33,18 +36,11 @@ class DefinitionStep {
     std::vector<int> vertexRegion(static_cast<std::size_t>(mesh.numVertices()), -1);
     for (std::size_t i = 0; i < regions_.size(); ++i)
       for (int v : regions_[i].vertices) vertexRegion[static_cast<std::size_t>(v)] = static_cast<int>(i);
-    Eigen::SparseMatrix<double> k = system.forceModel->createStiffnessMatrix();
-    system.forceModel->tangentStiffness(Eigen::VectorXd::Zero(n), k);
-    const Eigen::MatrixXd fullM = Eigen::MatrixXd(system.mass), fullK = Eigen::MatrixXd(k);
     const int nf = static_cast<int>(free.size());
-    M_.resize(nf, nf);
-    K_.resize(nf, nf);
-    for (int a = 0; a < nf; ++a)
-      for (int b = 0; b < nf; ++b) {
-        M_(a, b) = fullM(free[a], free[b]);
-        K_(a, b) = fullK(free[a], free[b]);
-      }
-    D_ = system.rayleighMass * M_ + system.rayleighStiffness * K_;
+    DenseFreeMatrices dense = denseFreeMatrices(system);
+    M_ = std::move(dense.M);
+    K_ = std::move(dense.K);
+    D_ = std::move(dense.D);
     regionOfFree_.resize(static_cast<std::size_t>(nf));
     for (int a = 0; a < nf; ++a) {
       const int region = vertexRegion[static_cast<std::size_t>(free[a] / 3)];

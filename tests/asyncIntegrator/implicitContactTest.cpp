@@ -136,7 +136,9 @@ TEST(AsyncImplicitContact, StepMatchesThePerSubstepDefinition) {
         EXPECT_LT(worstQuick, 1e-8) << "ratio " << ratio << ", quick set-up";
         // At ratio 2 (omega hS = 2, more for the lighter corners) some springs are stiff at hS:
         // their blocks are in A^S, and checked here too.
-        if (ratio == 2) EXPECT_GT(async.runStats().contactRegionFactorizations, 0);
+        if (ratio == 2) {
+          EXPECT_GT(async.runStats().contactRegionFactorizations, 0);
+        }
         EXPECT_NE(async.report().lines.back().find("async implicit contact"), std::string::npos);
       } else {
         EXPECT_GT(worst, 1e-3);
