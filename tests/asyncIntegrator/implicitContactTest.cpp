@@ -205,12 +205,13 @@ TEST(AsyncImplicitContact, WithoutRegionsItIsSingleRateImplicitContact) {
   EXPECT_NE(async.report().resumeCaveat.find("implicit contact"), std::string::npos) << async.report().resumeCaveat;
 }
 
-// A region whose contact springs are stiff at its own step (ratio 1: omega hS = 8) takes
-// their blocks into A^S (refactored, counted in the summary) and converges every step to
-// the tolerance. At ratio 16 (omega hS = 0.5) it needs no blocks; where a vertex's contact
-// starts or ends within the step the iteration converges only linearly, so a step may stop
-// at contactIterations: counted, and within 1e-3 (measured 5e-4).
-TEST(AsyncImplicitContact, RegionsStiffAtTheirStepTakeTheirBlocks) {
+// A region's vertices in contact take their blocks into A^S (refactored, counted in the
+// summary), whether their springs are stiff at hS (ratio 1: omega hS = 8) or not (ratio 16:
+// 0.5), and every step converges to the tolerance within contactIterations: where a
+// vertex's contact starts or ends within the step the block is exact for some substeps
+// only, and the mixing (Eq. C5) makes up the rest (without it, at ratio 16, steps stopped
+// unconverged at 5e-4).
+TEST(AsyncImplicitContact, RegionsInContactTakeTheirBlocksAndConverge) {
   const ContactBar bar(8.0, true, false);
   for (const int ratio : {1, 16}) {
     const std::vector<AsyncRegion> regions{{"tip", test::verticesBeyond(bar.ts.mesh, 0.75), ratio}};
@@ -220,16 +221,12 @@ TEST(AsyncImplicitContact, RegionsStiffAtTheirStepTakeTheirBlocks) {
     const AsyncRunStats& stats = async.runStats();
     EXPECT_EQ(stats.contactSteps, 20);
     EXPECT_TRUE(async.displacement().allFinite());
-    if (ratio == 1) {
-      EXPECT_GT(stats.contactRegionFactorizations, 0);
-      EXPECT_EQ(stats.unconvergedContactSteps, 0);
-    } else {
-      EXPECT_EQ(stats.contactRegionFactorizations, 0);
-      EXPECT_LE(stats.largestContactResidual, 1e-3);
-    }
+    EXPECT_GT(stats.contactRegionFactorizations, 0) << "ratio " << ratio;
+    EXPECT_EQ(stats.unconvergedContactSteps, 0) << "ratio " << ratio;
+    EXPECT_LT(stats.contactIterations, 20 * AsyncOptions{}.contactIterations) << "ratio " << ratio;
     bool reported = false;
     for (const std::string& line : async.report().lines)
-      reported = reported || line.find("steps stopped at 30 iterations unconverged") != std::string::npos;
+      reported = reported || line.find("0 steps stopped at 30 iterations unconverged") != std::string::npos;
     EXPECT_TRUE(reported);
   }
 }

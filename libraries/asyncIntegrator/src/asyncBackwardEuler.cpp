@@ -642,7 +642,7 @@ void AsyncBackwardEuler::step() {
   runStats_.stepSeconds += whole.stop() - (runStats_.setupSeconds + runStats_.rebuildSeconds - rebuildBefore);
 }
 
-// Implicit contact (Eqs. C1-C4): Newton's method over the step (detail::SubstepContact),
+// Implicit contact (Eqs. C1-C5): Newton's method over the step (detail::SubstepContact),
 // the contact blocks in Â^L and in the A^S of regions stiff at hS, until the residual is
 // at most contactTolerance or contactIterations solves are spent.
 void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {

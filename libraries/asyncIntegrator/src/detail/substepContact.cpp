@@ -3,6 +3,7 @@
 // docs/asynchronous-integrator.md, section "Implicit contact".
 #include "detail/substepContact.hpp"
 
+#include <Eigen/QR>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/contactBlock.hpp>
 #include <cmath>
@@ -20,6 +21,33 @@ int firstNonFinite(const Eigen::MatrixXd& values, const std::vector<int>& dofs) 
     for (Eigen::Index r = 0; r < values.rows(); ++r)
       if (!std::isfinite(values(r, c))) return dofs[static_cast<std::size_t>(r)] / 3;
   return -1;
+}
+
+/// L's vector, then each region's matrix column by column, as one vector.
+template <class Region>
+void pack(const Eigen::VectorXd& large, std::size_t count, Region&& region, Eigen::VectorXd& out) {
+  Eigen::Index size = large.size();
+  for (std::size_t i = 0; i < count; ++i) size += region(i).size();
+  out.resize(size);
+  out.head(large.size()) = large;
+  Eigen::Index at = large.size();
+  for (std::size_t i = 0; i < count; ++i) {
+    const Eigen::MatrixXd& values = region(i);
+    out.segment(at, values.size()) = values.reshaped();
+    at += values.size();
+  }
+}
+
+/// The inverse of pack (the matrices keep their shapes).
+template <class Region>
+void unpack(const Eigen::VectorXd& in, Eigen::VectorXd& large, std::size_t count, Region&& region) {
+  large = in.head(large.size());
+  Eigen::Index at = large.size();
+  for (std::size_t i = 0; i < count; ++i) {
+    Eigen::MatrixXd& values = region(i);
+    values.reshaped() = in.segment(at, values.size());
+    at += values.size();
+  }
 }
 
 }  // namespace
@@ -121,7 +149,8 @@ void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion
   const std::size_t count = regions.size();
   std::vector<std::vector<std::array<int, 3>>> positionsS(count);
   std::vector<std::vector<Eigen::Matrix3d>> blocksS(count), stiffnessS(count);
-  blocked_.assign(vertexRegion_.size(), 0);
+  blockSlot_.assign(vertexRegion_.size(), 0);
+  touches_.assign(vertexRegion_.size(), 0);
   // L's vertices at the end state; a region's at the end state, or else at the first of
   // its substeps where it touches.
   visitStates(regions, [&](double time, int only, int /*r*/) {
@@ -129,7 +158,7 @@ void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion
     for (std::size_t k = 0; k < jacobian_.vertices.size(); ++k) {
       const int vertex = jacobian_.vertices[k];
       const int region = vertexRegion_[static_cast<std::size_t>(vertex)];
-      if (only >= 0 && (region != only || blocked_[static_cast<std::size_t>(vertex)])) continue;
+      if (only >= 0 && region != only) continue;
       const std::vector<int>& positionOf = region < 0 ? largePosition_ : regionPosition_;
       std::array<int, 3> position{};
       for (int c = 0; c < 3; ++c)
@@ -138,27 +167,35 @@ void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion
       const double h = region < 0 ? step_.hL : regions[static_cast<std::size_t>(region)].smallStep;
       const Eigen::Matrix3d block = contactStepBlock(system.freeDofs, jacobian_, k, h * h, h);
       if (block.isZero(0.0)) continue;
-      // A region's vertex whose spring is not stiff at hS ((omega hS)^2 = hS^2 k / m <= 4)
-      // converges by the (backtracked) iteration alone: no block, and A^S, Z and H^{LL*} stay
-      // as they are. A block is exact only while the vertex touches at every substep (A^S
-      // is one matrix for all of them), so where the contact starts or ends within the step
-      // it slows Newton to a linear rate: it pays only where the iteration alone would not
-      // converge. Measured on the k = 2e4 ball at ratio 8 (omega hS about 0.9): blocks at
-      // (omega hS)^2 > 1 took 20 ms per step and left 45 of 240 steps unconverged, none
-      // 10.6 ms and 11.
-      if (region >= 0 && h * h * jacobian_.stiffness[k].norm() <= 4.0 * vertexMass_[3 * vertex]) continue;
+      // Every region vertex in contact takes a block, soft at hS or not: A^S is one matrix
+      // for all substeps, so the block (weighted below) is exact only while the vertex
+      // touches at every one, and the mixing (Eq. C5) makes up the rest. Measured on the
+      // k = 2e4 ball at ratio 8: blocks only where (omega hS)^2 > 4 took 2x the solves and
+      // left steps unconverged.
       if (region < 0) {
         inMatrix_.positions.push_back(position);
         inMatrix_.values.push_back(block);
         continue;
       }
-      blocked_[static_cast<std::size_t>(vertex)] = 1;
+      ++touches_[static_cast<std::size_t>(vertex)];
+      if (blockSlot_[static_cast<std::size_t>(vertex)]) continue;
       const auto i = static_cast<std::size_t>(region);
+      blockSlot_[static_cast<std::size_t>(vertex)] = static_cast<int>(positionsS[i].size()) + 1;
       positionsS[i].push_back(position);
       blocksS[i].push_back(block);
       stiffnessS[i].push_back(contactStepBlock(system.freeDofs, jacobian_, k, h * h, 0.0));
     }
   });
+  // A region's block weighted by the share of its substeps where the vertex touches (the
+  // substeps' mean linearization; exact where it touches at all of them).
+  for (std::size_t v = 0; v < blockSlot_.size(); ++v) {
+    if (blockSlot_[v] == 0) continue;
+    const auto i = static_cast<std::size_t>(vertexRegion_[v]);
+    const double share = static_cast<double>(touches_[v]) / regions[i].ratio;
+    const auto slot = static_cast<std::size_t>(blockSlot_[v] - 1);
+    blocksS[i][slot] *= share;
+    stiffnessS[i][slot] *= share;
+  }
   changedRegions_.clear();
   for (std::size_t i = 0; i < count; ++i)
     if (regions[i].setContactBlocks(positionsS[i], blocksS[i], stiffnessS[i]))
@@ -217,6 +254,9 @@ void SubstepContact::start(const ContactStep& step, const Eigen::VectorXd& rhsL,
     scale_ = std::max({scale_, rb.rhs.lpNorm<Eigen::Infinity>(), forceS_[i].lpNorm<Eigen::Infinity>()});
   }
   meritNorm_ = std::sqrt(squares);
+  mixStates_.clear();
+  mixOperators_.clear();
+  mixSteps_.clear();
   // The blocks at the predicted states; g = h f_ext there + J 0 is what the rhs holds.
   trialY_ = acceptedY_;
   trialX_ = acceptedX_;
@@ -266,10 +306,76 @@ double SubstepContact::trialResidual(const std::vector<FastRegion>& regions, dou
   return residual;
 }
 
+// The state at theta from the accepted one toward Y and each region's x, and its residual.
+double SubstepContact::tryState(const std::vector<FastRegion>& regions, const Eigen::VectorXd& Y, double theta,
+                                double& merit) {
+  const RegionPartition& partition = *step_.partition;
+  trialY_ = acceptedY_ + theta * (Y - acceptedY_);
+  for (std::size_t i = 0; i < regions.size(); ++i) trialX_[i] = acceptedX_[i] + theta * (regions[i].x - acceptedX_[i]);
+  int worst = firstNonFinite(trialY_, partition.largeDofs());
+  for (std::size_t i = 0; i < regions.size() && worst < 0; ++i)
+    worst = firstNonFinite(trialX_[i], partition.regionDofs(static_cast<int>(i)));
+  if (worst >= 0) {
+    worstVertex_ = worst;
+    return std::nan("");
+  }
+  return trialResidual(regions, theta, merit);
+}
+
+// Eq. (C5): with d_j = z_solve,j - z_j the step of solve j from the state it started at,
+// gamma minimizes |d_k - sum_j gamma_j (d_{j+1} - d_j)|_2 and the combination is
+// z_solve,k - sum_j gamma_j (z_solve,j+1 - z_solve,j) (A_0 z - base alike: it is affine).
+bool SubstepContact::mix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
+  const std::size_t count = regions.size();
+  if (mixSteps_.size() > static_cast<std::size_t>(kMixingDepth)) {
+    mixStates_.erase(mixStates_.begin());
+    mixOperators_.erase(mixOperators_.begin());
+    mixSteps_.erase(mixSteps_.begin());
+  }
+  mixStates_.emplace_back();
+  mixOperators_.emplace_back();
+  pack(
+      Y, count, [&](std::size_t i) -> const Eigen::MatrixXd& { return regions[i].x; }, mixStates_.back());
+  pack(
+      solvedOperatorL_, count, [&](std::size_t i) -> const Eigen::MatrixXd& { return solvedOperatorS_[i]; },
+      mixOperators_.back());
+  pack(
+      acceptedY_, count, [&](std::size_t i) -> const Eigen::MatrixXd& { return acceptedX_[i]; }, packed_);
+  mixSteps_.push_back(mixStates_.back() - packed_);
+  const std::size_t n = mixSteps_.size();
+  if (n < 2) return false;
+  Eigen::MatrixXd differences(mixSteps_.back().size(), static_cast<Eigen::Index>(n - 1));
+  for (std::size_t j = 0; j + 1 < n; ++j)
+    differences.col(static_cast<Eigen::Index>(j)) = mixSteps_[j + 1] - mixSteps_[j];
+  const Eigen::VectorXd gamma = differences.colPivHouseholderQr().solve(mixSteps_.back());
+  if (!gamma.allFinite()) return false;
+  packed_ = mixStates_.back();
+  Eigen::VectorXd mixedOperator = mixOperators_.back();
+  for (std::size_t j = 0; j + 1 < n; ++j) {
+    const double g = gamma[static_cast<Eigen::Index>(j)];
+    packed_ -= g * (mixStates_[j + 1] - mixStates_[j]);
+    mixedOperator -= g * (mixOperators_[j + 1] - mixOperators_[j]);
+  }
+  unpack(packed_, Y, count, [&](std::size_t i) -> Eigen::MatrixXd& { return regions[i].x; });
+  unpack(mixedOperator, solvedOperatorL_, count,
+         [&](std::size_t i) -> Eigen::MatrixXd& { return solvedOperatorS_[i]; });
+  return true;
+}
+
+// Back to the last solve's own state; the older solves are dropped (their combination did
+// not lower the residual).
+void SubstepContact::unmix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
+  const std::size_t count = regions.size();
+  unpack(mixStates_.back(), Y, count, [&](std::size_t i) -> Eigen::MatrixXd& { return regions[i].x; });
+  unpack(mixOperators_.back(), solvedOperatorL_, count,
+         [&](std::size_t i) -> Eigen::MatrixXd& { return solvedOperatorS_[i]; });
+  mixStates_.erase(mixStates_.begin(), mixStates_.end() - 1);
+  mixOperators_.erase(mixOperators_.begin(), mixOperators_.end() - 1);
+  mixSteps_.erase(mixSteps_.begin(), mixSteps_.end() - 1);
+}
+
 double SubstepContact::update(std::vector<FastRegion>& regions, Eigen::VectorXd& Y, SparseMatrix& largeSystem,
                               Eigen::VectorXd& rhsL) {
-  const RegionPartition& partition = *step_.partition;
-  const std::vector<int>& large = partition.largeDofs();
   // A_0 z - base at the solve's z (Eq. C4): the force terms it used less the contact
   // blocks' part J z (L's blocks B Y; a region's hS^2 K_c and hS C_c terms).
   solvedOperatorL_ = forceL_;
@@ -281,22 +387,21 @@ double SubstepContact::update(std::vector<FastRegion>& regions, Eigen::VectorXd&
     regions[i].addContactProduct(regions[i].x, solvedOperatorS_[i]);
     solvedOperatorS_[i] = -solvedOperatorS_[i];
   }
-  // Backtracking: z = z_k + theta (z_solve - z_k), A_0 z - base interpolated alike (it is
-  // affine in z), halved while |R|_2 rises above the accepted iterate's.
+  // Anderson's combination of the last solves (Eq. C5), taken whole when it lowers |R|_2;
+  // else the solve's own state, backtracked: z = z_k + theta (z_solve - z_k), A_0 z - base
+  // interpolated alike (it is affine in z), halved while |R|_2 rises above the accepted
+  // iterate's.
   double theta = 1.0, residual = 0.0, merit = 0.0;
-  for (int halvings = 0;; ++halvings) {
-    trialY_ = acceptedY_ + theta * (Y - acceptedY_);
-    for (std::size_t i = 0; i < regions.size(); ++i)
-      trialX_[i] = acceptedX_[i] + theta * (regions[i].x - acceptedX_[i]);
-    int worst = firstNonFinite(trialY_, large);
-    for (std::size_t i = 0; i < regions.size() && worst < 0; ++i)
-      worst = firstNonFinite(trialX_[i], partition.regionDofs(static_cast<int>(i)));
-    if (worst >= 0) {  // a non-finite state: reported at its first vertex
-      worstVertex_ = worst;
-      return std::nan("");
-    }
-    residual = trialResidual(regions, theta, merit);
-    if (merit < meritNorm_ || halvings == kMaxHalvings || !std::isfinite(residual)) break;
+  bool accepted = false;
+  if (mix(Y, regions)) {
+    residual = tryState(regions, Y, 1.0, merit);
+    accepted = std::isfinite(residual) && merit < meritNorm_;
+    if (!accepted) unmix(Y, regions);
+  }
+  for (int halvings = 0; !accepted; ++halvings) {
+    residual = tryState(regions, Y, theta, merit);
+    if (!std::isfinite(residual)) return std::nan("");  // reported at worstVertex_
+    if (merit < meritNorm_ || halvings == kMaxHalvings) break;
     theta *= 0.5;
   }
   // Accept z (the caller's state becomes it), take the contact blocks there and set the

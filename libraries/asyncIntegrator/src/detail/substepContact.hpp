@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Implicit penalty contact in one asynchronous large step (docs/asynchronous-integrator.md,
-// "Implicit contact", Eqs. C1-C4). Private to the library.
+// "Implicit contact", Eqs. C1-C5). Private to the library.
 #pragma once
 
 #include <Eigen/Core>
@@ -47,9 +47,9 @@ struct ContactStep {
 /// external force at each fast substep's state and at L's end state (Eq. C3). The step's
 /// linear system is the one of every other step plus the contact blocks of the vertices in
 /// contact in the last iterate (Eq. C2: in Â^L for L's, at its end state; in A^S and G for
-/// a region's whose spring is stiff at hS, at the end state or else at the first substep
-/// where it touches; a region's soft spring converges without). Updates are backtracked on
-/// the residual's norm (Eq. C4).
+/// a region's, at the end state or else at the first substep where it touches, weighted by
+/// the share of substeps where it touches). Each solve is mixed with the ones before
+/// (Anderson, Eq. C5) or else backtracked on the residual's norm (Eq. C4).
 class SubstepContact {
  public:
   /// Where each full DOF sits in L or in its fast region, and the vertices' lumped masses
@@ -64,8 +64,9 @@ class SubstepContact {
   void start(const ContactStep& step, const Eigen::VectorXd& rhsL, const Eigen::VectorXd& externalL,
              std::vector<FastRegion>& regions, Eigen::SparseMatrix<double>& largeSystem);
   /// One iteration after a solve (Y: L's velocity increments; each region's x: its
-  /// substeps' increments): the state moves from the last accepted one toward the solve's,
-  /// halved (up to kMaxHalvings times) while the residual's 2-norm would rise; Y and every
+  /// substeps' increments): the state becomes the Anderson combination of the last solves
+  /// where that lowers the residual's 2-norm, else it moves from the last accepted one
+  /// toward the solve's, halved (up to kMaxHalvings times) while the norm would rise; Y and every
   /// x become that state. The contact blocks are then taken there (addBlocks: see
   /// changedRegions()) and the right-hand sides (rhsL and each region's rhs) set for the
   /// next solve. Returns the state's largest residual, relative to the step's scale (the
@@ -88,6 +89,8 @@ class SubstepContact {
   int worstVertex() const { return worstVertex_; }
 
   static constexpr int kMaxHalvings = 8;
+  /// Earlier solves the Anderson mixing of update() combines (Eq. C5).
+  static constexpr int kMixingDepth = 8;
 
  private:
   /// Calls visit(time, region, r) at every state of the increments trialY_ and trialX_
@@ -105,6 +108,14 @@ class SubstepContact {
   double trialResidual(const std::vector<FastRegion>& regions, double theta, double& merit);
   /// y += B x, B L's blocks in the large system.
   void addBlockProduct(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+  /// Records the solve (its state Y, x and A_0 z - base there) and, with earlier solves
+  /// kept, replaces it by their Anderson combination (Eq. C5). Returns whether it did.
+  bool mix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions);
+  /// The state (and A_0 z - base) of the last solve recorded, back in Y, x and the solved operators.
+  void unmix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions);
+  /// The residual at theta from the accepted state toward Y, x (trialY_, trialX_ set);
+  /// NaN where that state is not finite (worstVertex_: its first vertex).
+  double tryState(const std::vector<FastRegion>& regions, const Eigen::VectorXd& Y, double theta, double& merit);
 
   ContactStep step_;
   std::vector<int> largePosition_, regionPosition_, vertexRegion_, changedRegions_;
@@ -124,8 +135,14 @@ class SubstepContact {
   std::vector<Eigen::MatrixXd> trialX_, trialForceS_;
   Eigen::VectorXd u_, v_, f_;       // full-size state and force
   Eigen::VectorXd running_, sums_;  // a region's sums of its substeps' increments
+  // The solves Anderson mixing combines: each one's state, A_0 z - base there and its step
+  // from the state it started at, flattened (L's, then each region's column-major), oldest first.
+  std::vector<Eigen::VectorXd> mixStates_, mixOperators_, mixSteps_;
+  Eigen::VectorXd packed_;
   VertexJacobian jacobian_;
-  std::vector<char> blocked_;  // per vertex: has a block from an earlier state of this addBlocks
+  // Per vertex in this addBlocks: 1 + the index of its block in its region's list (0:
+  // none yet), and at how many of its region's substeps it touches.
+  std::vector<int> blockSlot_, touches_;
 };
 
 }  // namespace asyncfem::detail
