@@ -346,7 +346,8 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   const std::vector<int>& large = partition_.largeDofs();
   if (d.sharedPattern < 0) d.sharedPattern = detail::samePattern(mass, d.stiffness) ? 1 : 0;
   d.massLL.rebuild(mass, large, large);  // in the storage of the previous partition's cut
-  d.contact.setPartition(partition_, mass);
+  // Only implicit contact needs the DOF maps (1.7 ms of a 25 ms re-partition of the 10k dragon).
+  if (implicitContact()) d.contact.setPartition(partition_, static_cast<int>(mass.rows()));
   if (d.sharedPattern != 1) d.stiffLL.rebuild(d.stiffness, large, large);
   d.cutLL = false;
   d.regions.clear();

@@ -59,9 +59,7 @@ bool LargeContactBlocks::operator==(const LargeContactBlocks& other) const {
   return true;
 }
 
-void SubstepContact::setPartition(const RegionPartition& partition, const Eigen::SparseMatrix<double>& mass) {
-  const auto numDofs = static_cast<int>(mass.rows());
-  vertexMass_ = mass * Eigen::VectorXd::Ones(numDofs);
+void SubstepContact::setPartition(const RegionPartition& partition, int numDofs) {
   largePosition_.assign(static_cast<std::size_t>(numDofs), -1);
   regionPosition_.assign(static_cast<std::size_t>(numDofs), -1);
   const std::vector<int>& large = partition.largeDofs();

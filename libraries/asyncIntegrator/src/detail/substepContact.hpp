@@ -52,9 +52,9 @@ struct ContactStep {
 /// (Anderson, Eq. C5) or else backtracked on the residual's norm (Eq. C4).
 class SubstepContact {
  public:
-  /// Where each full DOF sits in L or in its fast region, and the vertices' lumped masses
-  /// (call at each set-up).
-  void setPartition(const RegionPartition& partition, const Eigen::SparseMatrix<double>& mass);
+  /// Where each of the numDofs full DOFs sits in L or in its fast region (call at each
+  /// set-up).
+  void setPartition(const RegionPartition& partition, int numDofs);
 
   /// Starts a step from the predicted states (the increments zero): keeps the first
   /// solve's right-hand sides without their force terms g = h f_ext (externalL, full size,
@@ -119,7 +119,6 @@ class SubstepContact {
 
   ContactStep step_;
   std::vector<int> largePosition_, regionPosition_, vertexRegion_, changedRegions_;
-  Eigen::VectorXd vertexMass_;  // lumped (row sums of M), per DOF
   LargeContactBlocks inMatrix_, factored_;
   KeptEntries saved_;  // entries of Â^L addBlocks changed, and their values before
   // The right-hand sides are base + g: g the force terms of the last solve (forceL_,
