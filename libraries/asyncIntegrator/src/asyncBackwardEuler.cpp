@@ -644,7 +644,7 @@ void AsyncBackwardEuler::step() {
 }
 
 // Implicit contact (Eqs. C1-C5): Newton's method over the step (detail::SubstepContact),
-// the contact blocks in Â^L and in the A^S of regions stiff at hS, until the residual is
+// the contact blocks in Â^L and in the regions' A^S, until the residual is
 // at most contactTolerance or contactIterations solves are spent.
 void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
   Impl& d = *impl_;
@@ -1381,8 +1381,8 @@ RunReport AsyncBackwardEuler::report() const {
   if (r.contactSteps > 0) {
     std::snprintf(line, sizeof(line),
                   "async implicit contact: %lld solves over %lld steps (%.2f per step); %lld steps stopped at %d "
-                  "iterations unconverged (largest relative residual %.2e); A^S refactored %lld times for contact "
-                  "stiff at hS",
+                  "iterations unconverged (largest relative residual %.2e); A^S refactored %lld times for its "
+                  "contact blocks",
                   r.contactIterations, r.contactSteps,
                   static_cast<double>(r.contactIterations) / static_cast<double>(r.contactSteps),
                   r.unconvergedContactSteps, options_.contactIterations, r.largestContactResidual,

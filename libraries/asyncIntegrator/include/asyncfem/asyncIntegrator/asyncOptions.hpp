@@ -196,7 +196,7 @@ struct AsyncRunStats {
   long long contactIterations = 0;            ///< solves over those steps
   long long unconvergedContactSteps = 0;      ///< of those, stopped at AsyncOptions::contactIterations
   double largestContactResidual = 0.0;        ///< largest relative residual of those
-  long long contactRegionFactorizations = 0;  ///< A^S refactored for contact blocks (stiff at hS)
+  long long contactRegionFactorizations = 0;  ///< A^S refactored for its contact blocks
   /// Mean seconds of a steady-state large step (stepSeconds / steps), and with rebuilds.
   double meanStepSeconds() const { return steps > 0 ? stepSeconds / static_cast<double>(steps) : 0.0; }
   double meanStepWithRebuildSeconds() const {
