@@ -325,6 +325,8 @@ double SubstepContact::tryState(const std::vector<FastRegion>& regions, const Ei
 // z_solve,k - sum_j gamma_j (z_solve,j+1 - z_solve,j) (A_0 z - base alike: it is affine).
 bool SubstepContact::mix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
   const std::size_t count = regions.size();
+  const auto solvedX = [&](std::size_t i) -> Eigen::MatrixXd& { return regions[i].x; };
+  const auto solvedS = [&](std::size_t i) -> Eigen::MatrixXd& { return solvedOperatorS_[i]; };
   if (mixSteps_.size() > static_cast<std::size_t>(kMixingDepth)) {
     mixStates_.erase(mixStates_.begin());
     mixOperators_.erase(mixOperators_.begin());
@@ -332,11 +334,8 @@ bool SubstepContact::mix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
   }
   mixStates_.emplace_back();
   mixOperators_.emplace_back();
-  pack(
-      Y, count, [&](std::size_t i) -> const Eigen::MatrixXd& { return regions[i].x; }, mixStates_.back());
-  pack(
-      solvedOperatorL_, count, [&](std::size_t i) -> const Eigen::MatrixXd& { return solvedOperatorS_[i]; },
-      mixOperators_.back());
+  pack(Y, count, solvedX, mixStates_.back());
+  pack(solvedOperatorL_, count, solvedS, mixOperators_.back());
   pack(
       acceptedY_, count, [&](std::size_t i) -> const Eigen::MatrixXd& { return acceptedX_[i]; }, packed_);
   mixSteps_.push_back(mixStates_.back() - packed_);
@@ -354,9 +353,8 @@ bool SubstepContact::mix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
     packed_ -= g * (mixStates_[j + 1] - mixStates_[j]);
     mixedOperator -= g * (mixOperators_[j + 1] - mixOperators_[j]);
   }
-  unpack(packed_, Y, count, [&](std::size_t i) -> Eigen::MatrixXd& { return regions[i].x; });
-  unpack(mixedOperator, solvedOperatorL_, count,
-         [&](std::size_t i) -> Eigen::MatrixXd& { return solvedOperatorS_[i]; });
+  unpack(packed_, Y, count, solvedX);
+  unpack(mixedOperator, solvedOperatorL_, count, solvedS);
   return true;
 }
 

@@ -89,7 +89,8 @@ class SubstepContact {
   int worstVertex() const { return worstVertex_; }
 
   static constexpr int kMaxHalvings = 8;
-  /// Earlier solves the Anderson mixing of update() combines (Eq. C5).
+  /// Differences of solves the Anderson mixing of update() combines (Eq. C5): it keeps the
+  /// last kMixingDepth + 1 solves.
   static constexpr int kMixingDepth = 8;
 
  private:
