@@ -51,6 +51,8 @@ def main():
     parser.add_argument("csv")
     parser.add_argument("output")
     parser.add_argument("--title", default="")
+    parser.add_argument("--ylabel", default="centre-of-mass height (m)",
+                        help="y axis label (the series is what benchmarkAdaptive tracked)")
     args = parser.parse_args()
     try:
         series = read_series(args.csv)
@@ -72,7 +74,7 @@ def main():
             label, times, values = series[role]
             ax.plot(times, values, label=label, **STYLES[role])
     ax.set_xlabel("time (s)")
-    ax.set_ylabel("centre-of-mass height (m)")
+    ax.set_ylabel(args.ylabel)
     if args.title:
         ax.set_title(args.title)
     ax.grid(True, alpha=0.3)

@@ -7,19 +7,29 @@
 //   benchmarkAdaptive [--scene models/ball/ball.json] [--frames 90] [--repeats 1]
 //                     [--reference-steps 64] [--ladder 1,2,4,8,16] [--csv com.csv]
 //                     [--contact-stiffness K] [--implicit-contact]
+//                     [--track-set NAME] [--track-axis x|y|z] [--fixed-set NAME]
+//                     [--motion-verdict]
 //
 // --contact-stiffness replaces the scene's contact.stiffness; --implicit-contact runs every
 // row with contact.implicit (backward Euler solves the step with the contact at its end
 // state; async with it at every fast substep's state and L's end state).
+// --track-set and --track-axis measure the centre of one vertex set along one axis instead
+// of the whole body's height (a part that strikes an obstacle sideways, e.g. a rod tip);
+// --fixed-set makes the fixed-region row that vertex set at the contact ratio instead of
+// the lower cap; --motion-verdict judges equal cost and equal error on the motion error
+// over all frames (with the penetration) instead of the one rebound apex, which frames
+// sample coarsely where the part swings faster than the frame rate.
 //
 // The frames are sampled at the scene's large step (one step per frame), so penetration
 // and rebound are seen at every large step. Figures per run:
 //   ms/frame  median wall time per frame (frames 1.., re-partitions included)
-//   rebound   highest centre of mass (mass-weighted) between the first and second contact,
+//   rebound   highest centre of mass (mass-weighted; of the tracked set along the tracked
+//             axis when asked for) between the first and second contact,
 //             and its error against the reference's ("-" when the reference never leaves
-//             the obstacles: then the equal-error verdict uses the COM error instead)
+//             the obstacles, or with --motion-verdict: then the verdicts use the COM error)
 //   pen.      deepest penetration into any obstacle (planes, spheres) over the run, and its error
-//   COM err   relative L2 error of the centre-of-mass height over all frames
+//   COM err   relative L2 error of the centre-of-mass height (or the tracked centre) over
+//             all frames
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <asyncfem/benchmarkTools/benchmarkRun.hpp>
@@ -41,8 +51,19 @@ namespace {
 
 using namespace asyncfem;
 
+/// What the rebound and the COM error follow: the mass-weighted centre of some vertices
+/// (all by default) along one axis (y by default): its height by default, else its
+/// displacement from rest (a relative error of a position far from the origin would say
+/// little).
+struct Tracking {
+  std::vector<int> vertices;
+  int axis = 1;
+  bool displacement = false;
+  std::string name = "COM height";
+};
+
 struct Measures {
-  std::vector<double> comHeight;  // per frame
+  std::vector<double> comHeight;  // per frame: the tracked centre
   double rebound = 0.0;           // highest COM between the first two contacts
   double penetration = 0.0;       // deepest vertex inside an obstacle
 };
@@ -50,13 +71,16 @@ struct Measures {
 /// Per frame, the COM height and the deepest penetration into the scene's obstacles (the
 /// contact model's own measure, PenaltyContact::maxPenetration).
 Measures measure(const Trajectory& frames, const TetMesh& mesh, const Eigen::VectorXd& vertexMass,
-                 const PenaltyContact& obstacles) {
+                 const PenaltyContact& obstacles, const Tracking& tracking) {
   Measures out;
-  const double totalMass = vertexMass.sum();
+  double totalMass = 0.0;
+  for (int v : tracking.vertices) totalMass += vertexMass[v];
+  const int a = tracking.axis;
   std::vector<char> inContact;
   for (const Eigen::VectorXd& u : frames) {
     double com = 0.0;
-    for (int v = 0; v < mesh.numVertices(); ++v) com += vertexMass[v] * (mesh.restPosition(v).y() + u[3 * v + 1]);
+    for (int v : tracking.vertices)
+      com += vertexMass[v] * ((tracking.displacement ? 0.0 : mesh.restPosition(v)[a]) + u[(3 * v) + a]);
     const double deepest = obstacles.maxPenetration(u);
     out.comHeight.push_back(com / totalMass);
     out.penetration = std::max(out.penetration, deepest);
@@ -129,6 +153,15 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   bool implicitContact = false;
   app.add_flag("--implicit-contact", implicitContact, "Every row with contact.implicit (frictionless scenes)");
+  std::string trackSet, fixedSet;
+  char trackAxis = 'y';
+  app.add_option("--track-set", trackSet, "Measure this vertex set's centre instead of the whole body's");
+  app.add_option("--track-axis", trackAxis, "Measure along this axis (x, y or z; default y)")
+      ->check(CLI::IsMember({'x', 'y', 'z'}));
+  app.add_option("--fixed-set", fixedSet, "The fixed-region row: this vertex set at the contact ratio");
+  bool motionVerdict = false;
+  app.add_flag("--motion-verdict", motionVerdict,
+               "Equal-cost and equal-error verdicts on the motion error (all frames) instead of the rebound");
   CLI11_PARSE(app, argc, argv);
   try {
     Scene scene = loadScene(scenePath);
@@ -150,6 +183,16 @@ int main(int argc, char** argv) {
     for (int v = 0; v < mesh.numVertices(); ++v) vertexMass[v] = lumped[3 * v + 1];
     const PenaltyContact obstacles(mesh.restPositions(), scene.contact.planes, scene.contact.spheres,
                                    scene.contact.parameters);
+    Tracking tracking;
+    tracking.axis = trackAxis - 'x';
+    tracking.displacement = !trackSet.empty() || tracking.axis != 1;
+    if (trackSet.empty()) {
+      for (int v = 0; v < mesh.numVertices(); ++v) tracking.vertices.push_back(v);
+      if (tracking.axis != 1) tracking.name = std::string("COM ") + trackAxis + " displacement";
+    } else {
+      tracking.vertices = mesh.vertexSet(trackSet);  // names the set and the mesh when absent
+      tracking.name = trackSet + " " + trackAxis + " displacement";
+    }
 
     std::vector<BenchmarkConfiguration> configurations;
     configurations.push_back({"reference: backward Euler, hL/" + std::to_string(referenceSteps) + singleRateLabel,
@@ -196,8 +239,13 @@ int main(int argc, char** argv) {
     const bool joinSchedule = std::all_of(schedule.begin(), schedule.end(),
                                           [&](const nlohmann::json& r) { return r.value("ratio", 0) == ratio; });
     nlohmann::json cap = nlohmann::json::array();
-    for (int v = 0; v < mesh.numVertices(); ++v)
-      if ((scheduled[v] && joinSchedule) || (!scheduled[v] && mesh.restPosition(v).y() <= capHeight)) cap.push_back(v);
+    std::vector<char> inFixedSet(mesh.numVertices(), 0);
+    if (!fixedSet.empty())
+      for (int v : mesh.vertexSet(fixedSet)) inFixedSet[v] = 1;
+    for (int v = 0; v < mesh.numVertices(); ++v) {
+      const bool own = fixedSet.empty() ? mesh.restPosition(v).y() <= capHeight : inFixedSet[v] != 0;
+      if ((scheduled[v] && joinSchedule) || (!scheduled[v] && own)) cap.push_back(v);
+    }
     fixedOptions["regions"] = joinSchedule ? nlohmann::json::array() : schedule;
     for (nlohmann::json& region : fixedOptions["regions"]) {
       region.erase("start");
@@ -206,14 +254,15 @@ int main(int argc, char** argv) {
     fixedOptions["regions"].push_back({{"name", "cap"}, {"ratio", ratio}, {"vertices", cap}});
     capVertices = static_cast<int>(cap.size());
     joinsSchedule = joinSchedule && !schedule.empty();
-    configurations.push_back({"async, fixed lower cap", "async", 1, 0.0, fixedOptions});
+    configurations.push_back({fixedSet.empty() ? "async, fixed lower cap" : "async, fixed region " + fixedSet, "async",
+                              1, 0.0, fixedOptions});
 
     std::vector<Row> rows;
     for (const BenchmarkConfiguration& configuration : configurations) {
       Row row;
       row.run = runConfiguration(configuration.integrator == "backward-euler" ? singleRateScene : scene, configuration,
                                  frames, repeats);
-      row.measures = measure(row.run.frames, mesh, vertexMass, obstacles);
+      row.measures = measure(row.run.frames, mesh, vertexMass, obstacles, tracking);
       rows.push_back(std::move(row));
       std::fprintf(stderr, "ran %s\n", configuration.label.c_str());
     }
@@ -221,6 +270,7 @@ int main(int argc, char** argv) {
     // A scene whose reference never leaves the obstacles again (a body that lands and
     // stays) has no rebound: its error is not defined, and the COM error stands in for it.
     const bool hasRebound = reference.rebound > 0.0;
+    const bool byRebound = hasRebound && !motionVerdict;
     for (Row& row : rows) {
       row.reboundError = hasRebound ? std::abs(row.measures.rebound - reference.rebound) / reference.rebound
                                     : std::numeric_limits<double>::quiet_NaN();
@@ -229,14 +279,21 @@ int main(int argc, char** argv) {
       row.comError = relativeL2(row.measures.comHeight, reference.comHeight);
     }
     const double singleRateHL = rows[1].run.medianSecondsPerFrame;
+    char fixedWhat[96];
+    if (fixedSet.empty()) {
+      std::snprintf(fixedWhat, sizeof(fixedWhat), "fixed cap below y = %.3f", capHeight);
+    } else {
+      std::snprintf(fixedWhat, sizeof(fixedWhat), "fixed region %s", fixedSet.c_str());
+    }
     std::printf(
-        "scene %s, %d large steps of hL = %s, %d vertices, contact region ratio %d, fixed cap below y = %.3f (%d "
-        "vertices%s)\n\n",
-        scenePath.c_str(), frames, formatTimestep(hL).c_str(), mesh.numVertices(), ratio, capHeight, capVertices,
-        capVertices > 0 && joinsSchedule ? ", the scheduled regions included" : "");
+        "scene %s, %d large steps of hL = %s, %d vertices, contact region ratio %d, %s (%d vertices%s); "
+        "rebound and motion error: %s\n\n",
+        scenePath.c_str(), frames, formatTimestep(hL).c_str(), mesh.numVertices(), ratio, fixedWhat, capVertices,
+        capVertices > 0 && joinsSchedule ? ", the scheduled regions included" : "", tracking.name.c_str());
     std::printf(
         "| configuration | ms / large step | x single-rate hL | completed | rebound apex (m) | rebound error | max "
-        "penetration (m) | penetration error | COM height error |\n|---|---|---|---|---|---|---|---|---|\n");
+        "penetration (m) | penetration error | %s error |\n|---|---|---|---|---|---|---|---|---|\n",
+        tracking.name.c_str());
     for (const Row& row : rows) {
       char rebound[64] = "-";
       if (hasRebound) std::snprintf(rebound, sizeof(rebound), "%.3f", row.reboundError);
@@ -253,13 +310,13 @@ int main(int argc, char** argv) {
     for (std::size_t i = 1; i < rows.size() - 2; ++i) {
       const Row& r = rows[i];
       if (r.run.medianSecondsPerFrame <= adaptive.run.medianSecondsPerFrame) equalCost = &r;
-      const bool motion = hasRebound ? r.reboundError <= adaptive.reboundError : r.comError <= adaptive.comError;
+      const bool motion = byRebound ? r.reboundError <= adaptive.reboundError : r.comError <= adaptive.comError;
       if (!equalError && r.run.completed && motion && r.penetrationError <= adaptive.penetrationError) equalError = &r;
     }
     if (!csvPath.empty()) writeSeries(csvPath, rows, hL, equalCost);
     std::printf("\n");
-    const char* motionName = hasRebound ? "rebound" : "COM height";
-    const auto motionError = [&](const Row& r) { return hasRebound ? r.reboundError : r.comError; };
+    const char* motionName = byRebound ? "rebound" : tracking.name.c_str();
+    const auto motionError = [&](const Row& r) { return byRebound ? r.reboundError : r.comError; };
     if (equalCost) {
       std::printf(
           "equal cost: %s (%.2fx the adaptive run's time) has %s error %.3g and penetration error %.3f "
