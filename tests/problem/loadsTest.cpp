@@ -4,6 +4,8 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/problem/loads.hpp>
 #include <limits>
+#include <memory>
+#include <vector>
 
 namespace asyncfem {
 namespace {
@@ -78,6 +80,39 @@ TEST(Loads, ContactMakesTheLastChangeInfinite) {
                                                     std::vector<ContactSphere>{}, PenaltyContactParameters{}));
   EXPECT_EQ(loads.lastChange(), inf);
   EXPECT_FALSE(loads.empty());
+}
+
+// addTo at a few vertices (what the asynchronous integrator's substeps ask for): the same
+// values at those vertices as the whole-body addTo, to the bit (the same additions in the
+// same order), and every other entry left as it was. Constant part, two windows (one of
+// them partly on the subset) and a ground that two of the vertices are inside.
+TEST(Loads, AddToAtVerticesMatchesTheWholeBody) {
+  Eigen::Matrix3Xd rest(3, 5);
+  rest << 0, 1, 2, 3, 4, 0.5, -0.1, 0.3, -0.2, 0.4, 0, 0, 0, 0, 0;
+  PenaltyContactParameters parameters;
+  parameters.stiffness = 1e3;
+  parameters.damping = 2.0;
+  parameters.friction = 0.3;
+  auto contact = std::make_shared<PenaltyContact>(rest, std::vector<ContactPlane>{ContactPlane{}},
+                                                  std::vector<ContactSphere>{}, parameters);
+  Loads loads;
+  loads.addConstant(Eigen::VectorXd::LinSpaced(15, 0.1, 1.5));
+  loads.addWindow(pull({0, 1, 3}, Eigen::Vector3d(1, 2, 3), 0.0, 1.0));
+  loads.addWindow(pull({2, 4}, Eigen::Vector3d(-1, 0.5, 0.25), 0.0, inf));
+  loads.setContact(contact);
+  const Eigen::VectorXd u = Eigen::VectorXd::LinSpaced(15, -0.01, 0.02);
+  const Eigen::VectorXd v = Eigen::VectorXd::LinSpaced(15, 0.3, -0.2);
+  Eigen::VectorXd whole = Eigen::VectorXd::Zero(15);
+  loads.addTo(0.5, u, v, whole);
+  const std::vector<int> some{1, 3, 4};
+  Eigen::VectorXd part = Eigen::VectorXd::Constant(15, 7.0);
+  for (int vertex : some) part.segment<3>(3 * vertex).setZero();
+  loads.addTo(0.5, u, v, some, part);
+  ASSERT_GT(contact->activeContacts(u), 0);
+  for (int vertex = 0; vertex < 5; ++vertex) {
+    const bool listed = vertex == 1 || vertex == 3 || vertex == 4;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(part[3 * vertex + c], listed ? whole[3 * vertex + c] : 7.0) << vertex;
+  }
 }
 
 }  // namespace

@@ -155,6 +155,8 @@ DynamicSystem homogeneousLinearSystem(const DynamicSystem& system) {
   DynamicSystem out = system;
   out.externalForce = nullptr;
   out.externalForceJacobian = nullptr;
+  out.externalForceAt = nullptr;
+  out.externalForceJacobianAt = nullptr;
   if (!system.forceModel->isLinear()) {
     out.forceModel = std::make_shared<LinearForceModel>(restStiffness(*system.forceModel, system.numDofs()));
   }

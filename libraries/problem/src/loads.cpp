@@ -33,6 +33,23 @@ void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen:
   if (contact_) contact_->addForces(displacement, velocity, forces);
 }
 
+void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                  const std::vector<int>& vertices, Eigen::VectorXd& forces) const {
+  if (constant_.size() > 0)
+    for (const int v : vertices) forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += constant_.segment<3>(3 * v);
+  for (const VertexLoad& load : windows_) {
+    if (!load.active(time)) continue;
+    // Both lists ascending: their common vertices in one pass.
+    auto at = vertices.begin();
+    for (const int v : load.vertices) {
+      at = std::lower_bound(at, vertices.end(), v);
+      if (at == vertices.end()) break;
+      if (*at == v) forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
+    }
+  }
+  if (contact_) contact_->addForces(displacement, velocity, forces, &vertices);
+}
+
 std::vector<double> Loads::breakpoints() const {
   std::vector<double> times;
   for (const VertexLoad& load : windows_) {

@@ -160,6 +160,11 @@ DynamicSystem Problem::dynamicSystem() const {
                                       Eigen::VectorXd& forces) {
       external->addTo(time, displacement, velocity, forces);
     };
+    system.externalForceAt = [external](double time, const Eigen::VectorXd& displacement,
+                                        const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
+                                        Eigen::VectorXd& forces) {
+      external->addTo(time, displacement, velocity, vertices, forces);
+    };
     // Gravity is constant and contact depends on the state only; the windows open and
     // close at their bounds. A bound within a millionth of the interval of it counts as
     // inside, so that the snapping of bounds to step times never makes the answer wrong.
@@ -178,6 +183,11 @@ DynamicSystem Problem::dynamicSystem() const {
       system.externalForceJacobian = [contact = contact_](double, const Eigen::VectorXd& displacement,
                                                           const Eigen::VectorXd& velocity, VertexJacobian& jacobian) {
         jacobian = contact->jacobian(displacement, velocity);
+      };
+      system.externalForceJacobianAt = [contact = contact_](
+                                           double, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                           const std::vector<int>& vertices, VertexJacobian& jacobian) {
+        jacobian = contact->jacobian(displacement, velocity, &vertices);
       };
     }
   }

@@ -112,6 +112,7 @@ void bindIntegrators(py::module_& module) {
             // A Python function may change at any time: no multirate integrator may take it
             // as constant over a large step (what a Problem's loads allowed).
             s.system.externalForceChanges = nullptr;
+            s.system.externalForceAt = nullptr;
             s.externalForce = callable;
           },
           "callable f(time, u, v) -> (3n,) array or None, added to the external force; one Python call per "

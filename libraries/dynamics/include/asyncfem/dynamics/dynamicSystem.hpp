@@ -31,6 +31,19 @@ using ExternalForceChanges = std::function<bool(double from, double to)>;
 using ExternalForceJacobianFunction = std::function<void(double time, const Eigen::VectorXd& displacement,
                                                          const Eigen::VectorXd& velocity, VertexJacobian& jacobian)>;
 
+/// externalForce at some vertices only: adds the listed vertices' (ascending) entries of
+/// f_ext(t, u, v) to forces, the same values in the same order of additions as
+/// externalForce, and leaves every other entry as it is.
+using ExternalForceAtFunction =
+    std::function<void(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                       const std::vector<int>& vertices, Eigen::VectorXd& forces)>;
+
+/// externalForceJacobian at some vertices only: the entries of the listed vertices
+/// (ascending), in the order externalForceJacobian gives them.
+using ExternalForceJacobianAtFunction =
+    std::function<void(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                       const std::vector<int>& vertices, VertexJacobian& jacobian)>;
+
 /// The vertices (ascending) closer than margin (a length) to an obstacle of the external
 /// force at displacement u, into vertices: what lets an integrator follow contact.
 using ObstacleProximity =
@@ -57,6 +70,13 @@ struct DynamicSystem {
   /// IntegratorRegistry::create refuses to build them for such a system.
   /// Whoever replaces externalForce must reset or replace this too.
   ExternalForceJacobianFunction externalForceJacobian;
+  /// Optional shortcuts of externalForce and externalForceJacobian for a few vertices at a
+  /// time: an integrator that needs some vertices' force at many states (the asynchronous
+  /// one's fast substeps with implicit contact) calls them where set, else the whole-body
+  /// functions, with the same result. Whoever replaces externalForce or
+  /// externalForceJacobian must reset or replace these too.
+  ExternalForceAtFunction externalForceAt;
+  ExternalForceJacobianAtFunction externalForceJacobianAt;
   /// Where the external force's obstacles are (penalty contact); empty without obstacles.
   ObstacleProximity obstacleProximity;
   /// The mesh the matrices were built from (n vertices). Integrators that partition the

@@ -39,6 +39,10 @@ class Loads {
   /// Adds f_ext(t, u, v) to forces (size 3n).
   void addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
              Eigen::VectorXd& forces) const;
+  /// Adds f_ext(t, u, v) at the listed vertices only (ascending) to forces, the same values
+  /// as addTo, added in the same order; the other entries are left as they are.
+  void addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+             const std::vector<int>& vertices, Eigen::VectorXd& forces) const;
   /// Times at which the force changes (window bounds), sorted, unique, finite.
   std::vector<double> breakpoints() const;
   /// From this time on no load changes: the last finite window bound (0 when there is
