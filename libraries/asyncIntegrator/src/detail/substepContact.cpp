@@ -70,6 +70,10 @@ void SubstepContact::setPartition(const RegionPartition& partition, int numDofs)
     for (std::size_t k = 0; k < s.size(); ++k) regionPosition_[static_cast<std::size_t>(s[k])] = static_cast<int>(k);
   }
   vertexRegion_ = partition.vertexRegion();
+  regionVertices_.assign(static_cast<std::size_t>(partition.numRegions()), {});
+  for (std::size_t v = 0; v < vertexRegion_.size(); ++v)
+    if (vertexRegion_[v] >= 0)
+      regionVertices_[static_cast<std::size_t>(vertexRegion_[v])].push_back(static_cast<int>(v));
 }
 
 template <class Visit>
@@ -118,9 +122,19 @@ void SubstepContact::visitStates(const std::vector<FastRegion>& regions, Visit&&
 void SubstepContact::forcesAt(const std::vector<FastRegion>& regions) {
   const RegionPartition& partition = *step_.partition;
   const std::vector<int>& large = partition.largeDofs();
+  const DynamicSystem& system = *step_.system;
+  if (f_.size() != u_.size()) f_.setZero(u_.size());
   visitStates(regions, [&](double time, int region, int r) {
-    f_.setZero(u_.size());
-    step_.system->externalForce(time, u_, v_, f_);
+    // At a region's substep only its own DOFs are read: with externalForceAt only its
+    // vertices are evaluated (the same values), which keeps a substep's cost O(|S|).
+    if (region >= 0 && system.externalForceAt) {
+      const std::vector<int>& vertices = regionVertices_[static_cast<std::size_t>(region)];
+      for (const int v : vertices) f_.segment<3>(3 * static_cast<Eigen::Index>(v)).setZero();
+      system.externalForceAt(time, u_, v_, vertices, f_);
+    } else {
+      f_.setZero(u_.size());
+      system.externalForce(time, u_, v_, f_);
+    }
     if (region >= 0) {
       const FastRegion& rb = regions[static_cast<std::size_t>(region)];
       const std::vector<int>& s = partition.regionDofs(region);
@@ -152,7 +166,11 @@ void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion
   // L's vertices at the end state; a region's at the end state, or else at the first of
   // its substeps where it touches.
   visitStates(regions, [&](double time, int only, int /*r*/) {
-    system.externalForceJacobian(time, u_, v_, jacobian_);
+    if (only >= 0 && system.externalForceJacobianAt) {
+      system.externalForceJacobianAt(time, u_, v_, regionVertices_[static_cast<std::size_t>(only)], jacobian_);
+    } else {
+      system.externalForceJacobian(time, u_, v_, jacobian_);
+    }
     for (std::size_t k = 0; k < jacobian_.vertices.size(); ++k) {
       const int vertex = jacobian_.vertices[k];
       const int region = vertexRegion_[static_cast<std::size_t>(vertex)];

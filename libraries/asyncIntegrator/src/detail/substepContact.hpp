@@ -120,6 +120,9 @@ class SubstepContact {
 
   ContactStep step_;
   std::vector<int> largePosition_, regionPosition_, vertexRegion_, changedRegions_;
+  // Each region's vertices, ascending: at its substeps only they are evaluated (through
+  // DynamicSystem::externalForceAt and externalForceJacobianAt where the system has them).
+  std::vector<std::vector<int>> regionVertices_;
   LargeContactBlocks inMatrix_, factored_;
   KeptEntries saved_;  // entries of Â^L addBlocks changed, and their values before
   // The right-hand sides are base + g: g the force terms of the last solve (forceL_,

@@ -121,6 +121,7 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   bool implicitContact() const;
   void solveWithImplicitContact(double t0, double t1);
   void refactorContactRegions();
+  bool rebuildWithoutRegionBlocks();
   void keepLaggedFactor();
   /// Whether the lagged factor preconditions turned with the body (laggedSchurRotation).
   bool turnsLaggedFactor() const;
