@@ -739,7 +739,7 @@ void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
 // solves (each within the refinement's budget; one that does not converge in it forces a
 // rebuild with the blocks, solveStructured). Measured (offlineSimulator, one thread, the
 // same contact iterations; before, every rebuild took the step's blocks): antenna strike
-// 120 frames 11.1 -> 6.6 ms per frame (7 rebuilds -> 0), ball at k = 2e4 3.33 -> 3.10 s
+// at ratio 60, 120 frames 11.1 -> 6.6 ms per frame (7 rebuilds -> 0), ball at k = 2e4 3.33 -> 3.10 s
 // (1 -> 0), frictionless drop on the sphere at k = 2e4 19.1 -> 17.1 s (8 -> 0). Rebuilding
 // with the step's blocks where they were the last step's (a contact at rest) once the rent
 // reached twice the price cost 9% (ball) and 4% (drop) more in paired runs: not kept.
