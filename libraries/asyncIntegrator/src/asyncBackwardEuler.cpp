@@ -692,7 +692,7 @@ void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
   d.contact.start(step, d.rhsL, *d.externalL, d.regions, d.largeSystem);
   refactorContactRegions();
   // Rent or buy, as for the lagged factor: once the iterations that stale corrections cost
-  // have added up to a rebuild, rebuild (with this step's blocks).
+  // have added up to a rebuild, rebuild (without the regions' contact blocks, below).
   if (d.correctionsStale && !d.schur.borrowing() && d.laggedRent >= d.laggedRebuildFlops) {
     Stopwatch rebuild;
     if (rebuildWithoutRegionBlocks()) ++runStats_.rebuilds;

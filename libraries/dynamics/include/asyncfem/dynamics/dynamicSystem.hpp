@@ -72,8 +72,8 @@ struct DynamicSystem {
   ExternalForceJacobianFunction externalForceJacobian;
   /// Optional shortcuts of externalForce and externalForceJacobian for a few vertices at a
   /// time: an integrator that needs some vertices' force at many states (the asynchronous
-  /// one's fast substeps with implicit contact) calls them where set, else the whole-body
-  /// functions, with the same result. Whoever replaces externalForce or
+  /// one's fast substeps, at their predicted states or in its implicit contact iteration)
+  /// calls them where set, else the whole-body functions, with the same result. Whoever replaces externalForce or
   /// externalForceJacobian must reset or replace these too.
   ExternalForceAtFunction externalForceAt;
   ExternalForceJacobianAtFunction externalForceJacobianAt;
