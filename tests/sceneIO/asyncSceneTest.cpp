@@ -399,11 +399,16 @@ struct StrikeRun {
   std::vector<std::string> report;
 };
 
+/// The strike scene's simulation from its (edited) JSON, relative paths as in models/antenna.
+Simulation buildStrike(const nlohmann::json& json,
+                       const asyncfem::IntegratorRegistry& registry = asyncfem::defaultIntegratorRegistry()) {
+  const std::filesystem::path folder = std::filesystem::path(ASYNCFEM_MODELS_DIR) / "antenna";
+  return asyncfem::buildSimulation(asyncfem::parseScene(json, folder, "antenna-strike.json"), registry);
+}
+
 StrikeRun runStrike(const nlohmann::json& json,
                     const asyncfem::IntegratorRegistry& registry = asyncfem::defaultIntegratorRegistry()) {
-  const std::filesystem::path folder = std::filesystem::path(ASYNCFEM_MODELS_DIR) / "antenna";
-  Simulation simulation =
-      asyncfem::buildSimulation(asyncfem::parseScene(json, folder, "antenna-strike.json"), registry);
+  Simulation simulation = buildStrike(json, registry);
   const std::vector<int>& tip = simulation.mesh->vertexSet("rodTip");
   StrikeRun run;
   for (int frame = 0; frame < simulation.numFrames; ++frame) {
@@ -488,9 +493,7 @@ TEST(ContactScene, ForcesAtFewVerticesChangeNothingButTheCost) {
 // no such frame takes a lagged Schur step. Before, a rebuild took the strike's blocks and
 // the frames after it were lagged until the next one (frames 28-30 and 53-56 of this run).
 TEST(ContactScene, FramesAfterAStrikeSolveExactly) {
-  const std::filesystem::path folder = std::filesystem::path(ASYNCFEM_MODELS_DIR) / "antenna";
-  Simulation simulation =
-      asyncfem::buildSimulation(asyncfem::parseScene(antennaStrike(60), folder, "antenna-strike.json"));
+  Simulation simulation = buildStrike(antennaStrike(60));
   const auto* async = dynamic_cast<const asyncfem::AsyncBackwardEuler*>(simulation.integrator.get());
   ASSERT_NE(async, nullptr);
   int strikes = 0, quiet = 0;

@@ -83,8 +83,9 @@ struct AsyncBackwardEuler::Impl {
   std::vector<double> forceTimes;
   std::vector<Eigen::VectorXd> forceValues;
   std::size_t forcesUsed = 0;
-  // A region's vertices and its force at one predicted substep (externalForceAt).
-  std::vector<int> vertices;
+  // Each region's vertices with free DOFs (ascending), and a region's force at one
+  // predicted substep: where the system has externalForceAt, substeps evaluate only them.
+  std::vector<std::vector<int>> regionVertices;
   Eigen::VectorXd regionForce;
   // Implicit contact (DynamicSystem::externalForceJacobian): the contact iteration, and
   // whether a region's A^S holds contact blocks that Z and H^{LL*} were not built with.
@@ -387,9 +388,13 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   d.regions.reserve(static_cast<std::size_t>(partition_.numRegions()));
   runStats_.fastDofs = runStats_.interfaceDofs = 0;
   runStats_.largeDofs = static_cast<int>(large.size());
+  d.regionVertices.assign(static_cast<std::size_t>(partition_.numRegions()), {});
   for (int i = 0; i < partition_.numRegions(); ++i) {
     const detail::RegionLayout layout{&partition_.regionDofs(i), &partition_.interfaceDofs(i), partition_.ratio(i)};
     d.regions.emplace_back(mass, d.stiffness, layout, options_.regionSolver, options_.denseRegionDofs);
+    std::vector<int>& vertices = d.regionVertices[static_cast<std::size_t>(i)];
+    for (const int dof : partition_.regionDofs(i))  // ascending
+      if (vertices.empty() || vertices.back() != dof / 3) vertices.push_back(dof / 3);
     runStats_.fastDofs += static_cast<int>(partition_.regionDofs(i).size());
     runStats_.interfaceDofs += static_cast<int>(partition_.interfaceDofs(i).size());
   }
@@ -688,7 +693,7 @@ void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
     Impl& d;
     ~Restore() { d.contact.removeBlocks(d.largeSystem); }
   } restore{d};
-  const detail::ContactStep step{&system_, &partition_, &displacement_, &velocity_, t0, t1, hL};
+  const detail::ContactStep step{&system_, &partition_, &displacement_, &velocity_, t0, t1, hL, &d.regionVertices};
   d.contact.start(step, d.rhsL, *d.externalL, d.regions, d.largeSystem);
   refactorContactRegions();
   // Rent or buy, as for the lagged factor: once the iterations that stale corrections cost
@@ -832,19 +837,15 @@ void AsyncBackwardEuler::gatherExternalForces(double t0, double t1) {
     // At the predicted substep states only the region's own entries are read: with
     // externalForceAt only its vertices are evaluated (the same values).
     const bool atVertices = predict && static_cast<bool>(system_.externalForceAt);
-    if (atVertices) {
-      d.vertices.clear();
-      for (const int dof : s)
-        if (d.vertices.empty() || d.vertices.back() != dof / 3) d.vertices.push_back(dof / 3);
-      d.regionForce.resize(u0.size());
-    }
+    const std::vector<int>& vertices = d.regionVertices[static_cast<std::size_t>(i)];
+    if (atVertices) d.regionForce.resize(u0.size());
     for (int r = 1; r <= rb.ratio; ++r) {
       const double time = constantInStep ? t1 : substepTime(t0, t1, r, rb.ratio, rb.smallStep);
       const Eigen::VectorXd* f = nullptr;
       if (atVertices) {
         d.predicted = u0 + (r * rb.smallStep) * v0;
-        for (const int v : d.vertices) d.regionForce.segment<3>(3 * static_cast<Eigen::Index>(v)).setZero();
-        system_.externalForceAt(time, d.predicted, v0, d.vertices, d.regionForce);
+        for (const int v : vertices) d.regionForce.segment<3>(3 * static_cast<Eigen::Index>(v)).setZero();
+        system_.externalForceAt(time, d.predicted, v0, vertices, d.regionForce);
         f = &d.regionForce;
       } else if (predict) {
         d.predicted = u0 + (r * rb.smallStep) * v0;

@@ -70,10 +70,6 @@ void SubstepContact::setPartition(const RegionPartition& partition, int numDofs)
     for (std::size_t k = 0; k < s.size(); ++k) regionPosition_[static_cast<std::size_t>(s[k])] = static_cast<int>(k);
   }
   vertexRegion_ = partition.vertexRegion();
-  regionVertices_.assign(static_cast<std::size_t>(partition.numRegions()), {});
-  for (std::size_t v = 0; v < vertexRegion_.size(); ++v)
-    if (vertexRegion_[v] >= 0)
-      regionVertices_[static_cast<std::size_t>(vertexRegion_[v])].push_back(static_cast<int>(v));
 }
 
 template <class Visit>
@@ -128,7 +124,7 @@ void SubstepContact::forcesAt(const std::vector<FastRegion>& regions) {
     // At a region's substep only its own DOFs are read: with externalForceAt only its
     // vertices are evaluated (the same values), which keeps a substep's cost O(|S|).
     if (region >= 0 && system.externalForceAt) {
-      const std::vector<int>& vertices = regionVertices_[static_cast<std::size_t>(region)];
+      const std::vector<int>& vertices = (*step_.regionVertices)[static_cast<std::size_t>(region)];
       for (const int v : vertices) f_.segment<3>(3 * static_cast<Eigen::Index>(v)).setZero();
       system.externalForceAt(time, u_, v_, vertices, f_);
     } else {
@@ -167,7 +163,7 @@ void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion
   // its substeps where it touches.
   visitStates(regions, [&](double time, int only, int /*r*/) {
     if (only >= 0 && system.externalForceJacobianAt) {
-      system.externalForceJacobianAt(time, u_, v_, regionVertices_[static_cast<std::size_t>(only)], jacobian_);
+      system.externalForceJacobianAt(time, u_, v_, (*step_.regionVertices)[static_cast<std::size_t>(only)], jacobian_);
     } else {
       system.externalForceJacobian(time, u_, v_, jacobian_);
     }

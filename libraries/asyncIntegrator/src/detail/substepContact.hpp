@@ -41,6 +41,9 @@ struct ContactStep {
   const Eigen::VectorXd* u0 = nullptr;
   const Eigen::VectorXd* v0 = nullptr;
   double t0 = 0.0, t1 = 0.0, hL = 0.0;
+  /// Each region's vertices with free DOFs, ascending: at its substeps only they are
+  /// evaluated (DynamicSystem::externalForceAt and externalForceJacobianAt where set).
+  const std::vector<std::vector<int>>* regionVertices = nullptr;
 };
 
 /// The contact iteration of one large step: Newton's method on the step equations with the
@@ -120,9 +123,6 @@ class SubstepContact {
 
   ContactStep step_;
   std::vector<int> largePosition_, regionPosition_, vertexRegion_, changedRegions_;
-  // Each region's vertices, ascending: at its substeps only they are evaluated (through
-  // DynamicSystem::externalForceAt and externalForceJacobianAt where the system has them).
-  std::vector<std::vector<int>> regionVertices_;
   LargeContactBlocks inMatrix_, factored_;
   KeptEntries saved_;  // entries of Â^L addBlocks changed, and their values before
   // The right-hand sides are base + g: g the force terms of the last solve (forceL_,
