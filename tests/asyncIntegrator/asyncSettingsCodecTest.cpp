@@ -27,6 +27,7 @@ void expectSameSolverOptions(const AsyncOptions& a, const AsyncOptions& b) {
   EXPECT_EQ(a.threads, b.threads);
   EXPECT_EQ(a.contactIterations, b.contactIterations);
   EXPECT_EQ(a.contactTolerance, b.contactTolerance);
+  EXPECT_EQ(a.certifyContactFree, b.certifyContactFree);
 }
 
 void expectSameRegions(const std::vector<AsyncRegion>& a, const std::vector<AsyncRegion>& b) {
@@ -51,7 +52,7 @@ TEST(AsyncSettingsCodec, ExplicitSettingsRoundTrip) {
       {{"coupling", "paper"}, {"schur", "lu"}, {"method", "naive"}, {"recovery", "substitution"}},
       {{"schur", "symmetric"}, {"recovery", "dense-z"}, {"regionSolver", "eigen-ldlt"}, {"laggedSchur", false}},
       {{"regionSolver", "umfpack"}, {"threads", 3}, {"laggedSchurRotation", false}},
-      {{"contactIterations", 12}, {"contactTolerance", 1e-6}},
+      {{"contactIterations", 12}, {"contactTolerance", 1e-6}, {"certifyContactFree", false}},
       nlohmann::json::object()};
   for (nlohmann::json options : solverKeys) {
     options["regions"] = {{{"name", "stiff"}, {"ratio", 6}, {"elementSets", {"stiff"}}},

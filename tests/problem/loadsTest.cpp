@@ -113,6 +113,17 @@ TEST(Loads, AddToAtVerticesMatchesTheWholeBody) {
     const bool listed = vertex == 1 || vertex == 3 || vertex == 4;
     for (int c = 0; c < 3; ++c) EXPECT_EQ(part[3 * vertex + c], listed ? whole[3 * vertex + c] : 7.0) << vertex;
   }
+  // Only the listed vertices' state is read (what DynamicSystem::externalForceAt allows its
+  // callers to rely on): the others may hold another state, here one deep in the ground.
+  Eigen::VectorXd otherU = u, otherV = v;
+  for (int vertex : {0, 2}) {
+    otherU.segment<3>(3 * vertex).setConstant(-5.0);
+    otherV.segment<3>(3 * vertex).setConstant(9.0);
+  }
+  Eigen::VectorXd again = Eigen::VectorXd::Constant(15, 7.0);
+  for (int vertex : some) again.segment<3>(3 * vertex).setZero();
+  loads.addTo(0.5, otherU, otherV, some, again);
+  EXPECT_EQ(again, part);
 }
 
 }  // namespace

@@ -91,6 +91,13 @@ struct AsyncBackwardEuler::Impl {
   // whether a region's A^S holds contact blocks that Z and H^{LL*} were not built with.
   detail::SubstepContact contact;
   bool correctionsStale = false;
+  // The first solve of an implicit contact step recovers end states only, for the
+  // certificate (Eq. C6); its per-vertex motion bounds (squared) and the vertices near an
+  // obstacle.
+  bool certifying = false;
+  Eigen::VectorXd lowest, highest, centred, runningPath;
+  std::vector<double> reachSquares;
+  std::vector<int> nearObstacles;
   // Each region's contact blocks in A^S when Z and H^{LL*} were last built (none at a
   // set-up): a step whose blocks are back to them (contact over, A^S refactored to what Z
   // was built from) has current corrections again, without a rebuild.
@@ -392,6 +399,7 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   for (int i = 0; i < partition_.numRegions(); ++i) {
     const detail::RegionLayout layout{&partition_.regionDofs(i), &partition_.interfaceDofs(i), partition_.ratio(i)};
     d.regions.emplace_back(mass, d.stiffness, layout, options_.regionSolver, options_.denseRegionDofs);
+    d.regions.back().trackReach = certifiesContactFree();
     std::vector<int>& vertices = d.regionVertices[static_cast<std::size_t>(i)];
     for (const int dof : partition_.regionDofs(i))  // ascending
       if (vertices.empty() || vertices.back() != dof / 3) vertices.push_back(dof / 3);
@@ -434,6 +442,11 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
 
 bool AsyncBackwardEuler::implicitContact() const {
   return static_cast<bool>(system_.externalForceJacobian) && linearizesExternalForce();
+}
+
+bool AsyncBackwardEuler::certifiesContactFree() const {
+  return implicitContact() && options_.certifyContactFree && system_.stateDependentOnlyInContact &&
+         static_cast<bool>(system_.obstacleProximity);
 }
 
 bool AsyncBackwardEuler::linearizesExternalForce() const {
@@ -682,7 +695,7 @@ void AsyncBackwardEuler::step() {
   runStats_.stepSeconds += whole.stop() - (runStats_.setupSeconds + runStats_.rebuildSeconds - rebuildBefore);
 }
 
-// Implicit contact (Eqs. C1-C5): Newton's method over the step (detail::SubstepContact),
+// Implicit contact (Eqs. C1-C6): Newton's method over the step (detail::SubstepContact),
 // the contact blocks in Â^L and in the regions' A^S, until the residual is
 // at most contactTolerance or contactIterations solves are spent.
 void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
@@ -703,8 +716,23 @@ void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
     if (rebuildWithoutRegionBlocks()) ++runStats_.rebuilds;
     runStats_.rebuildSeconds += rebuild.stop();
   }
+  // Eq. (C6): where nothing touches at the predicted states, the first solve recovers end
+  // states only, and ends the step when no state of it can reach an obstacle.
+  d.certifying = certifiesContactFree() && !d.contact.blocksInMatrix();
+  for (const detail::FastRegion& rb : d.regions) d.certifying = d.certifying && !rb.hasContactBlocks();
   for (int iterations = 1;; ++iterations) {
     solveStructured();
+    if (d.certifying) {
+      d.certifying = false;
+      if (contactFreeCertified()) {
+        ++runStats_.contactIterations;
+        ++runStats_.contactSteps;
+        ++runStats_.contactFreeSteps;
+        return;
+      }
+      for (int i = 0; i < partition_.numRegions(); ++i)
+        if (!d.regions[static_cast<std::size_t>(i)].substituted) substituteRegion(i);
+    }
     const double residual = d.contact.update(d.regions, d.Y, d.largeSystem, d.rhsL);
     refactorContactRegions();
     ++runStats_.contactIterations;
@@ -838,12 +866,16 @@ void AsyncBackwardEuler::gatherExternalForces(double t0, double t1) {
     // externalForceAt only its vertices are evaluated (the same values).
     const bool atVertices = predict && static_cast<bool>(system_.externalForceAt);
     const std::vector<int>& vertices = d.regionVertices[static_cast<std::size_t>(i)];
-    if (atVertices) d.regionForce.resize(u0.size());
+    if (atVertices) {
+      d.regionForce.resize(u0.size());
+      d.predicted = u0;
+    }
     for (int r = 1; r <= rb.ratio; ++r) {
       const double time = constantInStep ? t1 : substepTime(t0, t1, r, rb.ratio, rb.smallStep);
       const Eigen::VectorXd* f = nullptr;
       if (atVertices) {
-        d.predicted = u0 + (r * rb.smallStep) * v0;
+        // Only the listed vertices' state is read (DynamicSystem::externalForceAt).
+        for (const int dof : s) d.predicted[dof] = u0[dof] + (r * rb.smallStep) * v0[dof];
         for (const int v : vertices) d.regionForce.segment<3>(3 * static_cast<Eigen::Index>(v)).setZero();
         system_.externalForceAt(time, d.predicted, v0, vertices, d.regionForce);
         f = &d.regionForce;
@@ -1065,8 +1097,10 @@ void AsyncBackwardEuler::recoverRegion(int i) {
     rb.substituted = true;
     return;
   }
-  // Implicit contact evaluates the force at every substep: x must hold them all.
-  if (rb.useDenseZ && !observer_ && !d.schurLagging && !d.schur.borrowing() && !implicitContact()) {
+  // Implicit contact evaluates the force at every substep: x must hold them all, unless
+  // the step may be certified free of contact (Eq. C6) with the bounds of Z.
+  const bool endStates = !implicitContact() || (d.certifying && rb.reach.size() == rb.y.rows());
+  if (rb.useDenseZ && !observer_ && !d.schurLagging && !d.schur.borrowing() && endStates) {
     rb.xLast = rb.y.col(rb.ratio - 1);
     rb.xLast.noalias() -= rb.zLast * rb.yInterface;
     rb.xSum = rb.y.rowwise().sum();
@@ -1074,6 +1108,13 @@ void AsyncBackwardEuler::recoverRegion(int i) {
     rb.substituted = false;
     return;
   }
+  substituteRegion(i);
+}
+
+// Every X_r of region i by the forward substitution of b^S - H^{SL} Y (yInterface gathered).
+void AsyncBackwardEuler::substituteRegion(int i) {
+  Impl& d = *impl_;
+  FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
   const bool damped = system_.damped();
   const detail::CouplingCoefficients& k = rb.coupling;
   rb.couplingProducts(damped);
@@ -1083,6 +1124,61 @@ void AsyncBackwardEuler::recoverRegion(int i) {
   }
   rb.forwardSubstitute(rb.rhs, rb.x);
   rb.substituted = true;
+}
+
+// Eq. (C6). Per DOF, the interval of its displacement from u_0 over every state the
+// iteration looks at: the predicted ones (r hS v_0, hL v_0), L's end state hL (v_0 + Y),
+// and a region's substeps along the substitution of b^S alone (y, or x where it was
+// substituted), hS (r v_0 + sum_{j<=r} y_j). Each vertex's states then lie within its
+// box's half-diagonal, plus reach |Y_I|_2 for a region's (the rows' bounds in 2-norm),
+// of the box's centre: no free vertex with its centre within the largest such radius of
+// an obstacle (depth is 1-Lipschitz in the position) means no state touches, and the force
+// at each is the predicted one (stateDependentOnlyInContact).
+bool AsyncBackwardEuler::contactFreeCertified() {
+  Impl& d = *impl_;
+  const Eigen::VectorXd& v0 = velocity_;
+  const double hL = timestep();
+  d.lowest = hL * v0;
+  d.highest = d.lowest;
+  const auto include = [&d](Eigen::Index dof, double value) {
+    d.lowest[dof] = std::min(d.lowest[dof], value);
+    d.highest[dof] = std::max(d.highest[dof], value);
+  };
+  const std::vector<int>& large = partition_.largeDofs();
+  for (std::size_t k = 0; k < large.size(); ++k)
+    include(large[k], hL * (v0[large[k]] + d.Y[static_cast<Eigen::Index>(k)]));
+  d.reachSquares.assign(static_cast<std::size_t>(v0.size() / 3), 0.0);
+  for (int i = 0; i < partition_.numRegions(); ++i) {
+    const FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
+    const std::vector<int>& s = partition_.regionDofs(i);
+    const Eigen::MatrixXd& path = rb.substituted ? rb.x : rb.y;
+    d.runningPath.setZero(path.rows());
+    for (int r = 1; r <= rb.ratio; ++r) {
+      d.runningPath += path.col(r - 1);
+      for (std::size_t k = 0; k < s.size(); ++k) {
+        include(s[k], rb.smallStep * (r * v0[s[k]]));
+        include(s[k], rb.smallStep * ((r * v0[s[k]]) + d.runningPath[static_cast<Eigen::Index>(k)]));
+      }
+    }
+    const double interface = rb.substituted ? 0.0 : rb.yInterface.norm();
+    for (std::size_t k = 0; k < s.size() && interface > 0.0; ++k) {
+      const double bound = rb.reach[static_cast<Eigen::Index>(k)] * interface;
+      d.reachSquares[static_cast<std::size_t>(s[k] / 3)] += bound * bound;
+    }
+  }
+  double radius = 0.0;
+  d.centred = displacement_ + (0.5 * (d.lowest + d.highest));
+  for (std::size_t v = 0; v < d.reachSquares.size(); ++v) {
+    const auto dof = static_cast<Eigen::Index>(3 * v);
+    const double halfDiagonal = 0.5 * (d.highest.segment<3>(dof) - d.lowest.segment<3>(dof)).norm();
+    radius = std::max(radius, halfDiagonal + std::sqrt(d.reachSquares[v]));
+  }
+  // A relative 1e-9 and 1e-12 (length) for the round-off of the states themselves.
+  system_.obstacleProximity(d.centred, (radius * (1.0 + 1e-9)) + 1e-12, d.nearObstacles);
+  for (const int v : d.nearObstacles)
+    for (int c = 0; c < 3; ++c)
+      if (!system_.freeDofs.isFixed((3 * v) + c)) return false;
+  return true;
 }
 
 // v^S_r = v^S_0 + X_r, u^S_m = u^S_0 + hS sum_r v^S_r; v^L = v^L_0 + Y, u^L = u^L_0 + hL v^L.
@@ -1399,6 +1495,30 @@ long long AsyncBackwardEuler::factorNonZeros() const {
   return total + (d.schur.solver() ? d.schur.solver()->stats().factorNonZeros : 0);
 }
 
+namespace {
+
+// The summary's lines on implicit contact (none without contact steps).
+void appendContactLines(const AsyncRunStats& r, int contactIterations, std::vector<std::string>& lines) {
+  if (r.contactSteps == 0) return;
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "async implicit contact: %lld solves over %lld steps (%.2f per step); %lld steps stopped at %d "
+                "iterations unconverged (largest relative residual %.2e); A^S refactored %lld times for its "
+                "contact blocks",
+                r.contactIterations, r.contactSteps,
+                static_cast<double>(r.contactIterations) / static_cast<double>(r.contactSteps),
+                r.unconvergedContactSteps, contactIterations, r.largestContactResidual, r.contactRegionFactorizations);
+  lines.emplace_back(line);
+  if (r.contactFreeSteps == 0) return;
+  std::snprintf(line, sizeof(line),
+                "async implicit contact: %lld of those steps certified free of contact after one solve (end states "
+                "only, Eq. C6)",
+                r.contactFreeSteps);
+  lines.emplace_back(line);
+}
+
+}  // namespace
+
 RunReport AsyncBackwardEuler::report() const {
   const AsyncRunStats& r = runStats_;
   char line[256];
@@ -1461,17 +1581,7 @@ RunReport AsyncBackwardEuler::report() const {
                   r.quickSteps, r.quickIterations, r.largestQuickResidual, r.quickEnds);
     lines.emplace_back(line);
   }
-  if (r.contactSteps > 0) {
-    std::snprintf(line, sizeof(line),
-                  "async implicit contact: %lld solves over %lld steps (%.2f per step); %lld steps stopped at %d "
-                  "iterations unconverged (largest relative residual %.2e); A^S refactored %lld times for its "
-                  "contact blocks",
-                  r.contactIterations, r.contactSteps,
-                  static_cast<double>(r.contactIterations) / static_cast<double>(r.contactSteps),
-                  r.unconvergedContactSteps, options_.contactIterations, r.largestContactResidual,
-                  r.contactRegionFactorizations);
-    lines.emplace_back(line);
-  }
+  appendContactLines(r, options_.contactIterations, lines);
   if (policy_) appendRepartitionLines(repartitions_, lines);
   return report;
 }

@@ -127,6 +127,7 @@ AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
   solver.threads = reader.integer("threads", solver.threads, 0, 1024);
   solver.contactIterations = reader.integer("contactIterations", solver.contactIterations, 1, 1000);
   solver.contactTolerance = reader.number("contactTolerance", solver.contactTolerance);
+  solver.certifyContactFree = reader.boolean("certifyContactFree", solver.certifyContactFree);
   if (!(solver.contactTolerance > 0.0 && solver.contactTolerance < 1.0)) {
     reader.fail("contactTolerance", "must be in (0, 1)");
   }
@@ -280,7 +281,8 @@ const std::vector<std::string>& asyncOptionKeys() {
                                              "auto",
                                              "nestedSolve",
                                              "contactIterations",
-                                             "contactTolerance"};
+                                             "contactTolerance",
+                                             "certifyContactFree"};
   return keys;
 }
 
@@ -393,6 +395,7 @@ nlohmann::json asyncSettingsJson(const AsyncSettings& settings) {
   if (solver.threads != defaults.threads) out["threads"] = solver.threads;
   if (solver.contactIterations != defaults.contactIterations) out["contactIterations"] = solver.contactIterations;
   if (solver.contactTolerance != defaults.contactTolerance) out["contactTolerance"] = solver.contactTolerance;
+  if (solver.certifyContactFree != defaults.certifyContactFree) out["certifyContactFree"] = solver.certifyContactFree;
   if (settings.nestedSolve != NestedSolve::automatic) out["nestedSolve"] = toString(settings.nestedSolve);
   out["regions"] =
       settings.adaptive ? nlohmann::json{{"adaptive", settings.adaptiveSource}} : asyncRegionsJson(settings.regions);

@@ -157,6 +157,7 @@ DynamicSystem homogeneousLinearSystem(const DynamicSystem& system) {
   out.externalForceJacobian = nullptr;
   out.externalForceAt = nullptr;
   out.externalForceJacobianAt = nullptr;
+  out.stateDependentOnlyInContact = false;
   if (!system.forceModel->isLinear()) {
     out.forceModel = std::make_shared<LinearForceModel>(restStiffness(*system.forceModel, system.numDofs()));
   }

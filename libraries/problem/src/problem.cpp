@@ -179,6 +179,8 @@ DynamicSystem Problem::dynamicSystem() const {
                                                     std::vector<int>& vertices) {
       vertices = contact->verticesWithin(displacement, margin);
     };
+    // The loads' only state-dependent part is the penalty force, zero out of contact.
+    system.stateDependentOnlyInContact = true;
     if (settings_.implicitContact) {
       system.externalForceJacobian = [contact = contact_](double, const Eigen::VectorXd& displacement,
                                                           const Eigen::VectorXd& velocity, VertexJacobian& jacobian) {

@@ -134,7 +134,8 @@ void bindAsyncOptions(py::module_& module) {
       .def_readwrite("dense_region_dofs", &AsyncOptions::denseRegionDofs)
       .def_readwrite("substep_state_prediction", &AsyncOptions::substepStatePrediction)
       .def_readwrite("contact_tolerance", &AsyncOptions::contactTolerance)
-      .def_readwrite("contact_iterations", &AsyncOptions::contactIterations);
+      .def_readwrite("contact_iterations", &AsyncOptions::contactIterations)
+      .def_readwrite("certify_contact_free", &AsyncOptions::certifyContactFree);
 
   py::class_<ScheduledRegion>(module, "ScheduledRegion",
                               "A fast region of the schedule policy: vertices at ratio from start to end (s)")

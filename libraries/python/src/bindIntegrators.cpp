@@ -113,6 +113,7 @@ void bindIntegrators(py::module_& module) {
             // as constant over a large step (what a Problem's loads allowed).
             s.system.externalForceChanges = nullptr;
             s.system.externalForceAt = nullptr;
+            s.system.stateDependentOnlyInContact = false;
             s.externalForce = callable;
           },
           "callable f(time, u, v) -> (3n,) array or None, added to the external force; one Python call per "

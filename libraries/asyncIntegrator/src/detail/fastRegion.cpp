@@ -212,6 +212,8 @@ void FastRegion::correctionColumns(SparseSolver& columnSolver, bool damped, Eige
   w.sumK.setZero(size, width);
   if (damped) w.sumD.setZero(size, width);
   if (useDenseZ) w.sum.setZero(size, width);
+  const bool reachToo = useDenseZ && trackReach;
+  if (reachToo) w.reach.setZero(size);
   // rhsColumns += scale * block(:, first .. first + width), for a sparse block of H^{SI}.
   const auto addColumns = [&](const SparseMatrix& matrix, double scale) {
     if (scale == 0.0) return;
@@ -238,6 +240,7 @@ void FastRegion::correctionColumns(SparseSolver& columnSolver, bool damped, Eige
     w.sumK += k.eK[r - 1] * w.z;
     if (damped) w.sumD += k.eD[r - 1] * w.z;
     if (useDenseZ) w.sum += w.z;
+    if (reachToo) w.reach = w.reach.cwiseMax(w.sum.rowwise().squaredNorm());
   }
   if (useDenseZ) {
     zLast.middleCols(first, width) = w.z;
@@ -341,6 +344,14 @@ CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOp
     SparseSolver& solver = task.block == 0 ? *rb.solver : *rb.helperSolvers[static_cast<std::size_t>(task.block - 1)];
     rb.correctionColumns(solver, damped, task.first, task.width, task.block);
   });
+  // Each block's squared row norms summed: the sum over blocks of each block's maximum over
+  // r bounds the maximum over r of the whole rows' squared norms.
+  for (FastRegion& rb : regions) rb.reach.setZero(rb.useDenseZ && rb.trackReach ? rb.systemMatrix.rows() : 0);
+  for (const ColumnTask& task : tasks) {
+    FastRegion& rb = regions[static_cast<std::size_t>(task.region)];
+    if (rb.reach.size() > 0) rb.reach += rb.columnScratch[static_cast<std::size_t>(task.block)].reach;
+  }
+  for (FastRegion& rb : regions) rb.reach = rb.smallStep * rb.reach.cwiseSqrt();
   return run;
 }
 

@@ -125,7 +125,12 @@ class FastRegion {
   std::vector<char> helperAnalyzed;
   bool useDenseZ = false;
   Eigen::MatrixXd zLast, zSum;  // Z_m and sum_r Z_r, |S| x q (dense recovery only)
-  Eigen::MatrixXd correction;   // C_i = H^{IS} Z, q x q
+  // Implicit contact's certificate (Eq. C6), with dense recovery: reach(k) bounds row k of
+  // hS sum_{j<=r} Z_j in 2-norm over every r, so that a substep's displacement differs
+  // from the substitution of b^S alone by at most reach(k) |Y_I|_2 in that DOF.
+  bool trackReach = false;
+  Eigen::VectorXd reach;
+  Eigen::MatrixXd correction;  // C_i = H^{IS} Z, q x q
   // Per-step buffers, sized once: no allocation in a steady-state step.
   Eigen::MatrixXd rhs;                   // |S| x m, column r - 1 = b_r
   Eigen::MatrixXd external;              // |S| x m, f_ext on S at the substeps
@@ -143,6 +148,7 @@ class FastRegion {
   /// time cost page faults (8% of the dinosaur's corotational steps).
   struct ColumnScratch {
     Eigen::MatrixXd rhsColumns, z, combinedT, productT, runningT, sumM, sumK, sumD, sum, columns;
+    Eigen::VectorXd reach;  // max over r of the squared row norms of this block's sum_{j<=r} Z_j
   };
   std::vector<ColumnScratch> columnScratch;  // one per column block
 

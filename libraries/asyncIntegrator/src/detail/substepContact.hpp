@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Implicit penalty contact in one asynchronous large step (docs/asynchronous-integrator.md,
-// "Implicit contact", Eqs. C1-C5). Private to the library.
+// "Implicit contact", Eqs. C1-C5; C6 in the integrator). Private to the library.
 #pragma once
 
 #include <Eigen/Core>

@@ -120,6 +120,10 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   /// contact is explicit, and IntegratorRegistry::create refuses the combination).
   bool implicitContact() const;
   void solveWithImplicitContact(double t0, double t1);
+  /// Implicit contact may end a step after one solve (AsyncOptions::certifyContactFree).
+  bool certifiesContactFree() const;
+  bool contactFreeCertified();
+  void substituteRegion(int i);
   void refactorContactRegions();
   bool rebuildWithoutRegionBlocks();
   void keepLaggedFactor();

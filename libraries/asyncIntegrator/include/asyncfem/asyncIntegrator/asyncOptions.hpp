@@ -79,6 +79,13 @@ struct AsyncOptions {
   /// counted as unconverged, or an error above a relative change of 1).
   double contactTolerance = 1e-8;
   int contactIterations = 30;
+  /// Implicit contact: a step whose first solve provably touches no obstacle at any
+  /// substep (Eq. C6 of docs/asynchronous-integrator.md: bounds on every vertex's motion,
+  /// DynamicSystem::stateDependentOnlyInContact) ends there, recovering each region's end
+  /// state from the stored Z instead of every substep's. false: every step evaluates the
+  /// force at every substep state (the same result to round-off, at about twice the cost
+  /// of a step far from contact).
+  bool certifyContactFree = true;
   /// Threads for the set-up and per-large-step rebuild (columns of Z in blocks, one A^S
   /// factor copy per block) and for the regions of a step: 0 = OpenMP's maximum.
   int threads = 0;
@@ -197,6 +204,7 @@ struct AsyncRunStats {
   long long unconvergedContactSteps = 0;      ///< of those, stopped at AsyncOptions::contactIterations
   double largestContactResidual = 0.0;        ///< largest relative residual of those
   long long contactRegionFactorizations = 0;  ///< A^S refactored for its contact blocks
+  long long contactFreeSteps = 0;             ///< of contactSteps, certified free of contact (Eq. C6)
   /// Mean seconds of a steady-state large step (stepSeconds / steps), and with rebuilds.
   double meanStepSeconds() const { return steps > 0 ? stepSeconds / static_cast<double>(steps) : 0.0; }
   double meanStepWithRebuildSeconds() const {

@@ -33,7 +33,9 @@ using ExternalForceJacobianFunction = std::function<void(double time, const Eige
 
 /// externalForce at some vertices only: adds the listed vertices' (ascending) entries of
 /// f_ext(t, u, v) to forces, the same values in the same order of additions as
-/// externalForce, and leaves every other entry as it is.
+/// externalForce, and leaves every other entry as it is. It may read the state of the
+/// listed vertices only (the caller may leave the others' entries at another time's state):
+/// per-vertex loads and penalty contact are such forces.
 using ExternalForceAtFunction =
     std::function<void(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                        const std::vector<int>& vertices, Eigen::VectorXd& forces)>;
@@ -79,6 +81,14 @@ struct DynamicSystem {
   ExternalForceJacobianAtFunction externalForceJacobianAt;
   /// Where the external force's obstacles are (penalty contact); empty without obstacles.
   ObstacleProximity obstacleProximity;
+  /// true when externalForce depends on the state (u, v) only at vertices in contact with
+  /// an obstacle of obstacleProximity (a vertex it does not list at some margin has no
+  /// state-dependent force while it stays within that distance of where it is), and on
+  /// time alone everywhere else: what a Problem's loads are (gravity, windows, penalty
+  /// contact). It lets the asynchronous integrator certify a step free of contact from
+  /// bounds on its motion instead of every substep's state. false (default) is always
+  /// correct. Whoever replaces externalForce or obstacleProximity must reset this too.
+  bool stateDependentOnlyInContact = false;
   /// The mesh the matrices were built from (n vertices). Integrators that partition the
   /// body by vertices or elements (the multirate ones) need it; single-rate ones do not,
   /// so it may be null for a system built from matrices alone.
