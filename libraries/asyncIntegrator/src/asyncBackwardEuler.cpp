@@ -92,8 +92,9 @@ struct AsyncBackwardEuler::Impl {
   detail::SubstepContact contact;
   bool correctionsStale = false;
   // The first solve of an implicit contact step recovers end states only, for the
-  // certificate (Eq. C6); its per-vertex motion bounds (squared) and the vertices near an
-  // obstacle.
+  // certificate (Eq. C6): each DOF's interval of displacements over the step's states, the
+  // boxes' centres, the interface's share of each vertex's radius (squared) and the
+  // vertices near an obstacle.
   bool certifying = false;
   Eigen::VectorXd lowest, highest, centred, runningPath;
   std::vector<double> reachSquares;
@@ -1152,13 +1153,13 @@ bool AsyncBackwardEuler::contactFreeCertified() {
     const FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& s = partition_.regionDofs(i);
     const Eigen::MatrixXd& path = rb.substituted ? rb.x : rb.y;
+    // The predicted states lie on the segment from hS v_0 to hL v_0 (the latter included).
+    for (const int dof : s) include(dof, rb.smallStep * v0[dof]);
     d.runningPath.setZero(path.rows());
     for (int r = 1; r <= rb.ratio; ++r) {
       d.runningPath += path.col(r - 1);
-      for (std::size_t k = 0; k < s.size(); ++k) {
-        include(s[k], rb.smallStep * (r * v0[s[k]]));
+      for (std::size_t k = 0; k < s.size(); ++k)
         include(s[k], rb.smallStep * ((r * v0[s[k]]) + d.runningPath[static_cast<Eigen::Index>(k)]));
-      }
     }
     const double interface = rb.substituted ? 0.0 : rb.yInterface.norm();
     for (std::size_t k = 0; k < s.size() && interface > 0.0; ++k) {

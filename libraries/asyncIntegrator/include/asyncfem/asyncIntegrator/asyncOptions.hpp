@@ -83,7 +83,7 @@ struct AsyncOptions {
   /// substep (Eq. C6 of docs/asynchronous-integrator.md: bounds on every vertex's motion,
   /// DynamicSystem::stateDependentOnlyInContact) ends there, recovering each region's end
   /// state from the stored Z instead of every substep's. false: every step evaluates the
-  /// force at every substep state (the same result to round-off, at about twice the cost
+  /// force at every substep state (the same result to round-off, at about 1.6x the cost
   /// of a step far from contact).
   bool certifyContactFree = true;
   /// Threads for the set-up and per-large-step rebuild (columns of Z in blocks, one A^S
