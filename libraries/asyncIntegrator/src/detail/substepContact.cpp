@@ -151,7 +151,7 @@ void SubstepContact::forcesAt(const std::vector<FastRegion>& regions) {
   });
 }
 
-void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion>& regions) {
+void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion>& regions, bool statesClear) {
   removeBlocks(largeSystem);
   const DynamicSystem& system = *step_.system;
   const std::size_t count = regions.size();
@@ -161,7 +161,7 @@ void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion
   touches_.assign(vertexRegion_.size(), 0);
   // L's vertices at the end state; a region's at the end state, or else at the first of
   // its substeps where it touches.
-  visitStates(regions, [&](double time, int only, int /*r*/) {
+  const auto takeBlocks = [&](double time, int only, int /*r*/) {
     if (only >= 0 && system.externalForceJacobianAt) {
       system.externalForceJacobianAt(time, u_, v_, (*step_.regionVertices)[static_cast<std::size_t>(only)], jacobian_);
     } else {
@@ -197,7 +197,8 @@ void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion
       blocksS[i].push_back(block);
       stiffnessS[i].push_back(contactStepBlock(system.freeDofs, jacobian_, k, h * h, 0.0));
     }
-  });
+  };
+  if (!statesClear) visitStates(regions, takeBlocks);
   // A region's block weighted by the share of its substeps where the vertex touches (the
   // substeps' mean linearization; exact where it touches at all of them).
   for (std::size_t v = 0; v < blockSlot_.size(); ++v) {
@@ -227,7 +228,7 @@ void SubstepContact::removeBlocks(SparseMatrix& /*largeSystem*/) {
   inMatrix_.values.clear();
 }
 
-void SubstepContact::start(const ContactStep& step, const Eigen::VectorXd& rhsL, const Eigen::VectorXd& externalL,
+bool SubstepContact::start(const ContactStep& step, const Eigen::VectorXd& rhsL, const Eigen::VectorXd& externalL,
                            std::vector<FastRegion>& regions, SparseMatrix& largeSystem) {
   step_ = step;
   const RegionPartition& partition = *step.partition;
@@ -272,7 +273,33 @@ void SubstepContact::start(const ContactStep& step, const Eigen::VectorXd& rhsL,
   // The blocks at the predicted states; g = h f_ext there + J 0 is what the rhs holds.
   trialY_ = acceptedY_;
   trialX_ = acceptedX_;
-  addBlocks(largeSystem, regions);
+  const bool clear = step.screenPredicted && predictedStatesClear();
+  addBlocks(largeSystem, regions, clear);
+  return clear;
+}
+
+// Eq. (C7). With the increments zero, every state addBlocks visits lies on the segment from
+// u_0 to u_0 + hL v_0 (L's end state; a region's substeps at r hS v_0), so within
+// hL |v_0| / 2 of the segment's midpoint. No free vertex whose midpoint is that close to an
+// obstacle (with the largest half-length of all vertices) means no visited state touches
+// (depth is 1-Lipschitz in the position), and where the force depends on the state only in
+// contact (DynamicSystem::stateDependentOnlyInContact) every block there is zero: the
+// visit of every substep's state can be skipped with the same result.
+bool SubstepContact::predictedStatesClear() {
+  const DynamicSystem& system = *step_.system;
+  if (!system.stateDependentOnlyInContact || !system.obstacleProximity) return false;
+  const Eigen::VectorXd& v0 = *step_.v0;
+  double largestSquare = 0.0;
+  for (Eigen::Index dof = 0; dof + 2 < v0.size(); dof += 3)
+    largestSquare = std::max(largestSquare, v0.segment<3>(dof).squaredNorm());
+  const double halfLength = 0.5 * step_.hL * std::sqrt(largestSquare);
+  u_ = *step_.u0 + ((0.5 * step_.hL) * v0);
+  // A relative 1e-9 and 1e-12 (length) for the round-off of the states, as in Eq. (C6).
+  system.obstacleProximity(u_, (halfLength * (1.0 + 1e-9)) + 1e-12, nearObstacles_);
+  for (const int vertex : nearObstacles_)
+    for (int c = 0; c < 3; ++c)
+      if (!system.freeDofs.isFixed((3 * vertex) + c)) return false;
+  return true;
 }
 
 // y += B x for L's blocks (rows and columns of L).

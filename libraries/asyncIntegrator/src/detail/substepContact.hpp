@@ -44,6 +44,9 @@ struct ContactStep {
   /// Each region's vertices with free DOFs, ascending: at its substeps only they are
   /// evaluated (DynamicSystem::externalForceAt and externalForceJacobianAt where set).
   const std::vector<std::vector<int>>* regionVertices = nullptr;
+  /// Whether start() may skip the predicted states where none can touch (Eq. C7; with
+  /// AsyncOptions::certifyContactFree).
+  bool screenPredicted = false;
 };
 
 /// The contact iteration of one large step: Newton's method on the step equations with the
@@ -62,9 +65,11 @@ class SubstepContact {
   /// Starts a step from the predicted states (the increments zero): keeps the first
   /// solve's right-hand sides without their force terms g = h f_ext (externalL, full size,
   /// at the predicted end state for L; each region's `external` columns at its predicted
-  /// substep states) and sets the contact blocks there (addBlocks). Throws NumericalError
+  /// substep states) and sets the contact blocks there (addBlocks; none, without visiting
+  /// the states, where ContactStep::screenPredicted and predictedStatesClear(): returns
+  /// whether it was so). Throws NumericalError
   /// naming the vertex where those forces are not finite.
-  void start(const ContactStep& step, const Eigen::VectorXd& rhsL, const Eigen::VectorXd& externalL,
+  bool start(const ContactStep& step, const Eigen::VectorXd& rhsL, const Eigen::VectorXd& externalL,
              std::vector<FastRegion>& regions, Eigen::SparseMatrix<double>& largeSystem);
   /// One iteration after a solve (Y: L's velocity increments; each region's x: its
   /// substeps' increments): the state becomes the Anderson combination of the last solves
@@ -105,8 +110,12 @@ class SubstepContact {
   /// G(z), the force terms h f_ext at the states of trialY_ and trialX_, into trialForceL_
   /// and trialForceS_.
   void forcesAt(const std::vector<FastRegion>& regions);
-  /// The contact blocks at the states of trialY_ and trialX_, in place of the ones before.
-  void addBlocks(Eigen::SparseMatrix<double>& largeSystem, std::vector<FastRegion>& regions);
+  /// The contact blocks at the states of trialY_ and trialX_, in place of the ones before;
+  /// none where statesClear (no state visited can touch: predictedStatesClear).
+  void addBlocks(Eigen::SparseMatrix<double>& largeSystem, std::vector<FastRegion>& regions, bool statesClear = false);
+  /// Whether no predicted state (the increments zero) comes within reach of an obstacle, so
+  /// that every contact block there is zero (Eq. C7).
+  bool predictedStatesClear();
   /// The largest residual of the trial state at theta along the update (worstVertex_:
   /// where), its 2-norm into merit.
   double trialResidual(const std::vector<FastRegion>& regions, double theta, double& merit);
@@ -137,6 +146,7 @@ class SubstepContact {
   Eigen::VectorXd trialY_, trialForceL_;
   std::vector<Eigen::MatrixXd> trialX_, trialForceS_;
   Eigen::VectorXd u_, v_, f_;       // full-size state and force
+  std::vector<int> nearObstacles_;  // predictedStatesClear's proximity query
   Eigen::VectorXd running_, sums_;  // a region's sums of its substeps' increments
   // The solves Anderson mixing combines: each one's state, A_0 z - base there and its step
   // from the state it started at, flattened (L's, then each region's column-major), oldest first.

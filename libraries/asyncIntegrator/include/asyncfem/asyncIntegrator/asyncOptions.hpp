@@ -205,6 +205,7 @@ struct AsyncRunStats {
   double largestContactResidual = 0.0;        ///< largest relative residual of those
   long long contactRegionFactorizations = 0;  ///< A^S refactored for its contact blocks
   long long contactFreeSteps = 0;             ///< of contactSteps, certified free of contact (Eq. C6)
+  long long contactScreenedSteps = 0;         ///< of contactSteps, predicted states clear of obstacles (Eq. C7)
   /// Mean seconds of a steady-state large step (stepSeconds / steps), and with rebuilds.
   double meanStepSeconds() const { return steps > 0 ? stepSeconds / static_cast<double>(steps) : 0.0; }
   double meanStepWithRebuildSeconds() const {
