@@ -3,6 +3,7 @@
 
 #include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/core/error.hpp>
+#include <cstdlib>
 
 namespace asyncfem {
 namespace {
@@ -56,6 +57,39 @@ TEST(PenaltyContact, FrictionOpposesSlidingUpToMuTimesNormal) {
   f.setZero();
   twoVertices(p).addForces(Eigen::VectorXd::Zero(6), v, f);
   EXPECT_DOUBLE_EQ(f[3], -2.0);
+}
+
+// The potential whose gradient the spring's force is: k d^2 / 2 for the vertex 0.01 below
+// the ground, and central differences of it equal minus the force at random states that
+// cross a plane and a sphere (tolerance: the differences' truncation, O(eps^2) = 1e-12
+// relative, and round-off 1e-16 / eps; 1e-7 of the force's size covers both).
+TEST(PenaltyContact, EnergyIsThePotentialOfTheSpringForce) {
+  PenaltyContactParameters p;
+  p.stiffness = 1000;
+  const PenaltyContact ground = twoVertices(p);
+  EXPECT_DOUBLE_EQ(ground.energy(Eigen::VectorXd::Zero(6)), 0.5 * 1000 * 0.01 * 0.01);
+  Eigen::VectorXd lifted = Eigen::VectorXd::Zero(6);
+  lifted[4] = 0.02;  // out of the ground: no potential
+  EXPECT_EQ(ground.energy(lifted), 0.0);
+  const PenaltyContact both = twoVertices(p, {ContactSphere{Eigen::Vector3d(0.05, 0.02, 0), 0.1}});
+  std::srand(7);
+  int compared = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::VectorXd u = 0.05 * Eigen::VectorXd::Random(6);
+    if (both.activeContacts(u) == 0) continue;
+    Eigen::VectorXd force = Eigen::VectorXd::Zero(6);
+    both.addForces(u, Eigen::VectorXd::Zero(6), force);
+    const double eps = 1e-6;
+    for (int dof = 0; dof < 6; ++dof) {
+      Eigen::VectorXd plus = u, minus = u;
+      plus[dof] += eps;
+      minus[dof] -= eps;
+      const double slope = (both.energy(plus) - both.energy(minus)) / (2 * eps);
+      EXPECT_NEAR(slope, -force[dof], 1e-7 * std::max(1.0, force.norm())) << "trial " << trial << " dof " << dof;
+    }
+    ++compared;
+  }
+  EXPECT_GE(compared, 5);
 }
 
 TEST(PenaltyContact, SpheresAndSubsets) {

@@ -79,6 +79,10 @@ TEST(Loads, ContactMakesTheLastChangeInfinite) {
   loads.setContact(std::make_shared<PenaltyContact>(rest, std::vector<ContactPlane>{ground},
                                                     std::vector<ContactSphere>{}, PenaltyContactParameters{}));
   EXPECT_EQ(loads.lastChange(), inf);
+  EXPECT_EQ(loads.lastWindowChange(), 0.0);  // contact aside, nothing changes
+  loads.addWindow(pull({0}, Eigen::Vector3d(1, 0, 0), 0.1, 0.4));
+  EXPECT_EQ(loads.lastChange(), inf);
+  EXPECT_DOUBLE_EQ(loads.lastWindowChange(), 0.4);
   EXPECT_FALSE(loads.empty());
 }
 

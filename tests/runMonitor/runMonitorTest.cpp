@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <asyncfem/asyncIntegrator/registration.hpp>
+#include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/integrator/factory.hpp>
 #include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/runMonitor/runMonitor.hpp>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 
 namespace asyncfem {
 namespace {
@@ -111,6 +113,72 @@ TEST(RunMonitor, EnergyGrowthAfterTheLoadsIsAnErrorAndNotBefore) {
   monitor.advanceFrame(run.integrator, 11, 1);                                // 2.25 x: below 10 x
   monitor.advanceFrame(run.integrator, 12, 1);                                // 5.1 x
   EXPECT_THROW(monitor.advanceFrame(run.integrator, 13, 1), NumericalError);  // 11.4 x
+}
+
+/// A free beam over a ground plane through its lowest vertices (k = 1e4 per vertex), its
+/// scripted step setting the state.
+struct ContactRun {
+  explicit ContactRun(Eigen::Vector3d gravity = Eigen::Vector3d::Zero()) {
+    ContactPlane ground;
+    ground.offset = mesh->restPositions().row(1).minCoeff();
+    PenaltyContactParameters parameters;
+    parameters.stiffness = 1e4;
+    contact = std::make_shared<PenaltyContact>(mesh->restPositions(), std::vector<ContactPlane>{ground},
+                                               std::vector<ContactSphere>{}, parameters);
+    ProblemSettings settings;
+    settings.gravity = gravity;
+    problem = std::make_unique<Problem>(mesh, std::vector<int>{}, settings, std::vector<VertexLoad>{}, contact);
+  }
+  std::shared_ptr<const TetMesh> mesh = beam();
+  std::shared_ptr<const PenaltyContact> contact;
+  std::unique_ptr<Problem> problem;
+};
+
+// With contact the energy check runs too (from the last window, here t = 0), the penalty
+// potential in the energy: a beam held at one depth in the ground keeps it, one sinking
+// deeper (the potential 4x per frame, nothing else changing) is stopped at the frame that
+// passes 10x, and the message names the contact's term.
+TEST(RunMonitor, ContactScenesAreCheckedWithTheirPenaltyEnergy) {
+  ContactRun run;
+  double depth = 1e-3;
+  ScriptedIntegrator integrator(run.problem->dynamicSystem(), 0.01, [&](long long, Eigen::VectorXd& u, auto& v) {
+    v.setZero();
+    for (Eigen::Index dof = 1; dof < u.size(); dof += 3) u[dof] = -depth;  // the whole beam, rigidly
+  });
+  RunMonitor monitor(*run.problem);
+  EXPECT_EQ(monitor.energyCheckFrom(), 0.0);
+  for (int frame = 0; frame < 5; ++frame) monitor.advanceFrame(integrator, frame, 1);
+  EXPECT_EQ(monitor.energyEvaluations(), 5);
+  depth *= 2;
+  monitor.advanceFrame(integrator, 5, 1);  // 4 x
+  depth *= 2;
+  try {
+    monitor.advanceFrame(integrator, 6, 1);  // 16 x
+    FAIL() << "no error";
+  } catch (const NumericalError& error) {
+    EXPECT_EQ(error.location().frame, 6);
+    EXPECT_NE(std::string(error.what()).find("kinetic + elastic + contact penalty"), std::string::npos) << error.what();
+  }
+  for (const std::string& line : monitor.skipped()) EXPECT_EQ(line.find("energy"), std::string::npos) << line;
+}
+
+// A body at rest under gravity starts the free phase at zero energy: the constant load's
+// work over the body's size sets the scale, so that a small gain (the kinetic energy of
+// 1 mm/s) does not stop the run, where 9 x zero would; a gain of 10 x that scale does.
+TEST(RunMonitor, ContactScenesAtRestTakeTheLoadWorkAsTheEnergyScale) {
+  ContactRun run(Eigen::Vector3d(0, -9.81, 0));
+  double speed = 0.0;
+  ScriptedIntegrator integrator(run.problem->dynamicSystem(), 0.01, [&](long long, Eigen::VectorXd& u, auto& v) {
+    u.setZero();                                                          // resting on the ground, no penetration
+    for (Eigen::Index dof = 0; dof < v.size(); dof += 3) v[dof] = speed;  // sliding along x
+  });
+  RunMonitor monitor(*run.problem);
+  monitor.advanceFrame(integrator, 0, 1);  // the reference: zero
+  speed = 1e-3;
+  EXPECT_NO_THROW(monitor.advanceFrame(integrator, 1, 1));
+  // m g diagonal = m v^2 / 2 at v = sqrt(2 g diagonal): 10 x that energy.
+  speed = std::sqrt(10.0 * 2.0 * 9.81 * monitor.boundingBoxDiagonal());
+  EXPECT_THROW(monitor.advanceFrame(integrator, 2, 1), NumericalError);
 }
 
 TEST(RunMonitor, EnergyReferenceCarriedThroughStateStopsAResumedRunAtTheSameFrame) {

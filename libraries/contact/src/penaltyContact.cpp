@@ -121,6 +121,13 @@ PenaltyContactJacobian PenaltyContact::jacobian(const Eigen::VectorXd& displacem
   return out;
 }
 
+double PenaltyContact::energy(const Eigen::VectorXd& displacement) const {
+  double squares = 0.0;
+  forEachContact(displacement, nullptr,
+                 [&](int, double depth, const Eigen::Vector3d&, double) { squares += depth * depth; });
+  return 0.5 * parameters_.stiffness * squares;
+}
+
 double PenaltyContact::maxPenetration(const Eigen::VectorXd& displacement) const {
   double worst = 0.0;
   forEachContact(displacement, nullptr,

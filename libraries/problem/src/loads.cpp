@@ -61,8 +61,9 @@ std::vector<double> Loads::breakpoints() const {
   return times;
 }
 
-double Loads::lastChange() const {
-  if (contact_) return std::numeric_limits<double>::infinity();
+double Loads::lastChange() const { return contact_ ? std::numeric_limits<double>::infinity() : lastWindowChange(); }
+
+double Loads::lastWindowChange() const {
   const std::vector<double> times = breakpoints();
   return times.empty() ? 0.0 : std::max(0.0, times.back());
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <Eigen/Dense>
 #include <algorithm>
+#include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/runMonitor/runMonitor.hpp>
@@ -52,10 +53,20 @@ RunMonitor::RunMonitor(const Problem& problem, Settings settings) : mesh_(&probl
   const BoundingBox box = boundingBox(problem.mesh());
   boundingBoxDiagonal_ = (box.max - box.min).norm();
   blowUpDisplacement_ = settings_.blowUpFactor * boundingBoxDiagonal_;
-  if (settings_.energyCheck && !problem.hasContact()) {
+  if (settings_.energyCheck) {
+    // Contact's forces do no net work with its penalty potential in the energy (only its
+    // damping, clamp and friction act on their own, and they dissipate).
     const Loads& loads = *problem.loads();
-    energyCheckFrom_ = loads.lastChange();
+    energyCheckFrom_ = loads.lastWindowChange();
     constantLoad_ = loads.constantPart(problem.numDofs());
+    contact_ = problem.contact();
+    if (contact_) {
+      // A body that starts at rest under gravity starts the free phase at zero energy: the
+      // work of its constant loads over the body's size sets the scale instead.
+      for (Eigen::Index dof = 0; dof + 2 < constantLoad_.size(); dof += 3)
+        loadWorkScale_ += constantLoad_.segment<3>(dof).norm();
+      loadWorkScale_ *= boundingBoxDiagonal_;
+    }
   }
   const ProblemSettings& physics = problem.settings();
   if (isHyperelastic(physics.forceModel) && !physics.hyperelastic.inversionHandlingEnabled()) {
@@ -69,11 +80,7 @@ RunMonitor::RunMonitor(const Problem& problem, Settings settings) : mesh_(&probl
 
 std::vector<std::string> RunMonitor::skipped() const {
   std::vector<std::string> skipped;
-  if (!settings_.energyCheck) {
-    skipped.emplace_back("energy blow-up check (switched off)");
-  } else if (!std::isfinite(energyCheckFrom_)) {
-    skipped.emplace_back("energy blow-up check (contact forces do work)");
-  }
+  if (!settings_.energyCheck) skipped.emplace_back("energy blow-up check (switched off)");
   return skipped;
 }
 
@@ -219,11 +226,12 @@ void RunMonitor::checkEnergy(const Integrator& integrator, long long frame) {
   const Eigen::VectorXd& u = integrator.displacement();
   const double mechanical = integrator.mechanicalEnergy();
   ++energyEvaluations_;
-  const double energy = mechanical - constantLoad_.dot(u);
+  const double penalty = contact_ ? contact_->energy(u) : 0.0;
+  const double energy = mechanical + penalty - constantLoad_.dot(u);
   if (!haveFreeEnergy_) {
     haveFreeEnergy_ = true;
     freeEnergy_ = energy;
-    freeEnergyScale_ = std::max(mechanical, std::abs(energy));
+    freeEnergyScale_ = std::max({mechanical + penalty, std::abs(energy), loadWorkScale_});
     freeEnergyTime_ = integrator.time();
     return;
   }
@@ -234,10 +242,10 @@ void RunMonitor::checkEnergy(const Integrator& integrator, long long frame) {
   std::ostringstream out;
   out << "frame " << frame << " (t = " << formatNumber(integrator.time())
       << "): energy blow-up: with no load changing since t = " << formatNumber(energyCheckFrom_)
-      << ", the total energy (kinetic + elastic - constant loads . u) grew from " << formatNumber(freeEnergy_)
-      << " at t = " << formatNumber(freeEnergyTime_) << " to " << formatNumber(energy)
-      << "; largest |u| = " << formatNumber(std::abs(u[largest])) << " at " << describeVertex(integrator, vertex)
-      << "; the simulation is unstable";
+      << ", the total energy (kinetic + elastic" << (contact_ ? " + contact penalty" : "")
+      << " - constant loads . u) grew from " << formatNumber(freeEnergy_) << " at t = " << formatNumber(freeEnergyTime_)
+      << " to " << formatNumber(energy) << "; largest |u| = " << formatNumber(std::abs(u[largest])) << " at "
+      << describeVertex(integrator, vertex) << "; the simulation is unstable";
   NumericalErrorLocation location = locate(integrator, frame, -1, integrator.time(), vertex);
   location.dof = static_cast<int>(largest);
   throw NumericalError(out.str(), location);

@@ -71,6 +71,10 @@ class PenaltyContact {
   PenaltyContactJacobian jacobian(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                                   const std::vector<int>* vertices = nullptr) const;
 
+  /// The penalty potential at u, k/2 times the sum of d^2 over the vertices in contact and
+  /// their obstacles: the normal spring's force is minus its gradient, so with it the
+  /// contact forces do no net work (damping, the clamp and friction only dissipate).
+  double energy(const Eigen::VectorXd& displacement) const;
   /// Largest penetration depth over all vertices and obstacles at u (0 if none).
   double maxPenetration(const Eigen::VectorXd& displacement) const;
   /// Number of vertices in contact at u.

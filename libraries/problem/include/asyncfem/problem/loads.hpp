@@ -48,6 +48,9 @@ class Loads {
   /// From this time on no load changes: the last finite window bound (0 when there is
   /// none); +infinity with contact, whose force depends on the state.
   double lastChange() const;
+  /// The last finite window bound (0 when there is none), contact aside: from this time on
+  /// only the constant part and the contact act.
+  double lastWindowChange() const;
   /// The force acting at every t >= lastChange() without contact (constant part plus the
   /// windows that never close), size numDofs.
   Eigen::VectorXd constantPart(Eigen::Index numDofs) const;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,10 +22,13 @@ namespace asyncfem {
 /// - after every step, for a hyperelastic model without inversion handling (no
 ///   inversionThreshold), no element inverted (det F <= 0): such a model's energy only
 ///   sees J^2, so an inverted element would go on as if it were a mirrored one;
-/// - after every frame, once no load changes any more (Loads::lastChange(); never with
-///   contact), the total energy E = kinetic + elastic - constant loads . u has not grown
-///   by more than 9 times its size at the start of that free phase (a stable integrator
-///   keeps or dissipates it; explicit ones let it oscillate by far less).
+/// - after every frame, once no load window changes any more (Loads::lastWindowChange()),
+///   the total energy E = kinetic + elastic + contact penalty (PenaltyContact::energy)
+///   - constant loads . u has not grown by more than 9 times its size at the start of that
+///   free phase (a stable integrator keeps or dissipates it; explicit ones let it
+///   oscillate by far less; with contact the size is at least the constant loads' work
+///   over the rest bounding-box diagonal, sum_v |f_v| times it, since a body dropped from
+///   rest starts at zero).
 /// Failures throw asyncfem::NumericalError whose location() carries the frame, step,
 /// time, vertex and region, and whose message says the same in words.
 class RunMonitor {
@@ -46,7 +50,7 @@ class RunMonitor {
 
   double blowUpDisplacement() const { return blowUpDisplacement_; }
   double boundingBoxDiagonal() const { return boundingBoxDiagonal_; }
-  /// Time from which the energy check runs (infinity: never, e.g. with contact).
+  /// Time from which the energy check runs (infinity: never).
   double energyCheckFrom() const { return energyCheckFrom_; }
   /// Energy evaluations made so far (one per frame in the free phase).
   long long energyEvaluations() const { return energyEvaluations_; }
@@ -80,6 +84,8 @@ class RunMonitor {
   double blowUpDisplacement_ = 0.0;
   double energyCheckFrom_ = std::numeric_limits<double>::infinity();
   Eigen::VectorXd constantLoad_;
+  std::shared_ptr<const PenaltyContact> contact_;  // its potential enters the energy
+  double loadWorkScale_ = 0.0;                     // with contact: sum_v |f_v| x the diagonal
   bool haveFreeEnergy_ = false;
   double freeEnergy_ = 0.0, freeEnergyScale_ = 0.0, freeEnergyTime_ = 0.0;
   long long energyEvaluations_ = 0;
