@@ -6,7 +6,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git
-  libeigen3-dev libsuitesparse-dev libmetis-dev libopenblas-dev
+  libeigen3-dev libsuitesparse-dev libmetis-dev libopenblas-dev zlib1g-dev
   nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format-14
   libpetsc-real-dev openmpi-bin ffmpeg
