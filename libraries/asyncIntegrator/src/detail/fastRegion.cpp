@@ -57,7 +57,7 @@ void FastRegion::updateBlocks(const SparseMatrix& stiffness, double largeStep, d
   const stepFormula::MatrixWeights weights = stepFormula::backwardEuler::systemMatrix(hS, alpha, beta);
   combineInto(weights.mass, Mss, weights.stiffness, Kss, systemMatrix);
   combineInto(0.0, Mss, hS * hS, Kss, G);
-  transposeInto(G, GT, gtPattern_);
+  refreshTranspose();
   if (denseG) Gdense = G;
   rhsWeight = 1.0 / (1.0 + hS * alpha);
   stepWeight = (1.0 + beta / hS) / (1.0 + hS * alpha);
@@ -85,7 +85,7 @@ bool FastRegion::setContactBlocks(const std::vector<std::array<int, 3>>& positio
       addKeepingEntry(G, row, column, stiffness[k](r, c), contactSaved_, "a fast region's G");
     });
   }
-  transposeInto(G, GT, gtPattern_);
+  refreshTranspose();
   if (denseG) Gdense = G;
   return true;
 }
@@ -125,10 +125,87 @@ void FastRegion::chooseDenseFactor() {
   Gdense = G;
 }
 
+namespace {
+
+/// The 3 x 3 block rows of a matrix given by its transpose's columns (see
+/// FastRegion::BlockRows); false where it has none.
+bool layOutBlockRows(const SparseMatrix& transposed, std::vector<int>& start, std::vector<int>& column) {
+  const int* outer = transposed.outerIndexPtr();
+  const int* inner = transposed.innerIndexPtr();
+  const Eigen::Index rows = transposed.outerSize();
+  start.assign(1, 0);
+  column.clear();
+  if (rows % 3 != 0) return false;
+  for (Eigen::Index b = 0; b < rows / 3; ++b) {
+    const int first = outer[3 * b], length = outer[(3 * b) + 1] - first;
+    if (length % 3 != 0) return false;
+    for (int i = 1; i < 3; ++i) {
+      const int other = outer[(3 * b) + i];
+      if (outer[(3 * b) + i + 1] - other != length || !std::equal(inner + first, inner + first + length, inner + other))
+        return false;
+    }
+    for (int k = first; k < first + length; k += 3) {
+      if (inner[k] % 3 != 0 || inner[k + 1] != inner[k] + 1 || inner[k + 2] != inner[k] + 2) return false;
+      column.push_back(inner[k] / 3);
+    }
+    start.push_back(static_cast<int>(column.size()));
+  }
+  return true;
+}
+
+}  // namespace
+
+void FastRegion::refreshTranspose() {
+  BlockRows& blocks = blockG_;
+  if (transposeInto(G, GT, gtPattern_)) {
+    if (!layOutBlockRows(GT, blocks.start, blocks.column)) blocks.column.clear();
+    blocks.values.resize(9 * blocks.column.size());
+  }
+  if (blocks.column.empty()) return;
+  // Block k of block row b holds, row by row, entries 3 t .. 3 t + 2 of G^T's columns
+  // 3 b, 3 b + 1, 3 b + 2 (t = k - start[b]).
+  const int* outer = GT.outerIndexPtr();
+  const double* values = GT.valuePtr();
+  for (std::size_t b = 0; b + 1 < blocks.start.size(); ++b) {
+    for (int k = blocks.start[b]; k < blocks.start[b + 1]; ++k) {
+      const int offset = 3 * (k - blocks.start[b]);
+      for (int i = 0; i < 3; ++i)
+        for (int c = 0; c < 3; ++c)
+          blocks.values[(9 * static_cast<std::size_t>(k)) + (3 * i) + c] = values[outer[(3 * b) + i] + offset + c];
+    }
+  }
+}
+
 void FastRegion::subtractStiffnessProduct(const double* t, double* out) const {
   if (denseG) {
     const Eigen::Index size = Gdense.rows();
     Eigen::Map<Eigen::VectorXd>(out, size).noalias() -= Gdense * Eigen::Map<const Eigen::VectorXd>(t, size);
+    return;
+  }
+  if (!blockG_.column.empty()) {
+    const int* start = blockG_.start.data();
+    const int* column = blockG_.column.data();
+    const double* values = blockG_.values.data();
+    const auto blockRows = static_cast<Eigen::Index>(blockG_.start.size()) - 1;
+    for (Eigen::Index b = 0; b < blockRows; ++b) {
+      double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+      for (int k = start[b]; k < start[b + 1]; ++k) {
+        const double* x = t + (3 * static_cast<std::ptrdiff_t>(column[k]));
+        const double* a = values + (9 * static_cast<std::ptrdiff_t>(k));
+        s0 += a[0] * x[0];
+        s0 += a[1] * x[1];
+        s0 += a[2] * x[2];
+        s1 += a[3] * x[0];
+        s1 += a[4] * x[1];
+        s1 += a[5] * x[2];
+        s2 += a[6] * x[0];
+        s2 += a[7] * x[1];
+        s2 += a[8] * x[2];
+      }
+      out[3 * b] -= s0;
+      out[(3 * b) + 1] -= s1;
+      out[(3 * b) + 2] -= s2;
+    }
     return;
   }
   // Row by row through G^T's columns: one gathered dot product and one write per row,

@@ -155,8 +155,12 @@ class FastRegion {
  private:
   /// Replaces the sparse solver by the dense one where that is cheaper (see factorize).
   void chooseDenseFactor();
-  /// out -= G t for one column t (|S| entries), row by row through G^T.
+  /// out -= G t for one column t (|S| entries), row by row through G^T (by 3 x 3 blocks
+  /// where blockG_ holds them).
   void subtractStiffnessProduct(const double* t, double* out) const;
+  /// G^T again after transposeInto: blockG_ taken anew where G's pattern changed, its
+  /// values copied always.
+  void refreshTranspose();
   /// outT = (G t)^T for tT = t^T (k x |S|), vectorized across the k columns.
   void rowWiseStiffnessProduct(const Eigen::MatrixXd& tT, Eigen::MatrixXd& outT) const;
 
@@ -168,6 +172,16 @@ class FastRegion {
   KeptEntries contactSaved_;  // A^S and G entries the contact blocks changed, and their values before
   bool denseDecided_ = false;
   TransposePattern gtPattern_;  // G's pattern and where GT's entries come from
+  /// G by 3 x 3 blocks, when every row triple 3b, 3b + 1, 3b + 2 of G has one pattern made
+  /// of column triples (a region whose vertices have all three DOFs free): per block row b
+  /// its blocks start[b] .. start[b + 1] - 1, each at column triple column[k], values row by
+  /// row. The product then reads each index once per block instead of once per entry, and
+  /// sums every row in the order of G^T's entries (the same result to the bit). Empty
+  /// otherwise.
+  struct BlockRows {
+    std::vector<int> start, column;
+    std::vector<double> values;
+  } blockG_;
 };
 
 /// What one computation of Z over every region did.

@@ -57,7 +57,7 @@ void combineInto(double a, const SparseMatrix& A, double b, const SparseMatrix& 
   for (Eigen::Index k = 0; k < A.nonZeros(); ++k) ov[k] = a * av[k] + b * bv[k];
 }
 
-void transposeInto(const SparseMatrix& matrix, SparseMatrix& out, TransposePattern& pattern) {
+bool transposeInto(const SparseMatrix& matrix, SparseMatrix& out, TransposePattern& pattern) {
   const int* outer = matrix.outerIndexPtr();
   const int* inner = matrix.innerIndexPtr();
   const auto columns = static_cast<std::size_t>(matrix.outerSize());
@@ -75,11 +75,12 @@ void transposeInto(const SparseMatrix& matrix, SparseMatrix& out, TransposePatte
     pattern.source.assign(entries, 0);
     for (std::size_t c = 0; c < columns; ++c)
       for (int k = outer[c]; k < outer[c + 1]; ++k) pattern.source[static_cast<std::size_t>(next[inner[k]]++)] = k;
-    return;
+    return true;
   }
   const double* values = matrix.valuePtr();
   double* target = out.valuePtr();
   for (std::size_t k = 0; k < entries; ++k) target[k] = values[pattern.source[k]];
+  return false;
 }
 
 double largestMagnitude(const SparseMatrix& matrix) {

@@ -40,7 +40,8 @@ struct TransposePattern {
   std::vector<int> outer, inner;  ///< matrix's pattern when the map was built
   std::vector<int> source;        ///< entry k of out is entry source[k] of matrix
 };
-void transposeInto(const SparseMatrix& matrix, SparseMatrix& out, TransposePattern& pattern);
+/// Returns whether the pattern was new (out laid out afresh).
+bool transposeInto(const SparseMatrix& matrix, SparseMatrix& out, TransposePattern& pattern);
 
 /// Largest |entry| of a matrix (0 for an empty one).
 double largestMagnitude(const SparseMatrix& matrix);
