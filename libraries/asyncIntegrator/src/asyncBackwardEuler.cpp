@@ -1175,12 +1175,7 @@ bool AsyncBackwardEuler::contactFreeCertified() {
     const double halfDiagonal = 0.5 * (d.highest.segment<3>(dof) - d.lowest.segment<3>(dof)).norm();
     radius = std::max(radius, halfDiagonal + std::sqrt(d.reachSquares[v]));
   }
-  // A relative 1e-9 and 1e-12 (length) for the round-off of the states themselves.
-  system_.obstacleProximity(d.centred, (radius * (1.0 + 1e-9)) + 1e-12, d.nearObstacles);
-  for (const int v : d.nearObstacles)
-    for (int c = 0; c < 3; ++c)
-      if (!system_.freeDofs.isFixed((3 * v) + c)) return false;
-  return true;
+  return !detail::freeVertexNearObstacle(system_, d.centred, radius, d.nearObstacles);
 }
 
 // v^S_r = v^S_0 + X_r, u^S_m = u^S_0 + hS sum_r v^S_r; v^L = v^L_0 + Y, u^L = u^L_0 + hL v^L.

@@ -294,12 +294,16 @@ bool SubstepContact::predictedStatesClear() {
     largestSquare = std::max(largestSquare, v0.segment<3>(dof).squaredNorm());
   const double halfLength = 0.5 * step_.hL * std::sqrt(largestSquare);
   u_ = *step_.u0 + ((0.5 * step_.hL) * v0);
-  // A relative 1e-9 and 1e-12 (length) for the round-off of the states, as in Eq. (C6).
-  system.obstacleProximity(u_, (halfLength * (1.0 + 1e-9)) + 1e-12, nearObstacles_);
-  for (const int vertex : nearObstacles_)
+  return !freeVertexNearObstacle(system, u_, halfLength, nearObstacles_);
+}
+
+bool freeVertexNearObstacle(const DynamicSystem& system, const Eigen::VectorXd& positions, double radius,
+                            std::vector<int>& near) {
+  system.obstacleProximity(positions, (radius * (1.0 + 1e-9)) + 1e-12, near);
+  for (const int vertex : near)
     for (int c = 0; c < 3; ++c)
-      if (!system.freeDofs.isFixed((3 * vertex) + c)) return false;
-  return true;
+      if (!system.freeDofs.isFixed((3 * vertex) + c)) return true;
+  return false;
 }
 
 // y += B x for L's blocks (rows and columns of L).

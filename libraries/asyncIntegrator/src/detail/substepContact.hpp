@@ -23,6 +23,12 @@ inline double substepTime(double t0, double t1, int r, int ratio, double smallSt
   return r == ratio ? t1 : t0 + (r * smallStep);
 }
 
+/// Whether a vertex with a free DOF lies within radius of an obstacle at `positions`
+/// (displacements), the radius widened by a relative 1e-9 and 1e-12 (length) for the
+/// round-off of the states it bounds: the search of Eqs. (C6) and (C7). near: scratch.
+bool freeVertexNearObstacle(const DynamicSystem& system, const Eigen::VectorXd& positions, double radius,
+                            std::vector<int>& near);
+
 /// Contact blocks of L's vertices in the large system: hL^2 K_c + hL C_c per vertex
 /// (contactStepBlock), at the L positions of its three DOFs (-1: fixed).
 struct LargeContactBlocks {
