@@ -6,9 +6,10 @@
     scripts/compare-trajectories.py compare DIR_BEFORE DIR_AFTER [--tolerance 1e-13]
 
 `run` simulates every shipped scene (models/*/*.json and tests/benchmarks/scenes/*.json)
-under a set of variants (the scene as shipped; backward Euler, trapezoidal and the
-uncoupled multirate integrator on it; the paper's coupling; corotational forces with the
-lagged and the rebuilt Schur factor; neo-Hookean backward Euler) for a few frames each,
+under a set of variants (the scene as shipped; backward Euler, trapezoidal, the uncoupled
+multirate integrator and Schroeder et al. 2011 on it; the paper's coupling; corotational
+forces with the lagged and the rebuilt Schur factor; neo-Hookean forces under the scene's
+integrator and under backward Euler) for a few frames each,
 writing DIR/CASE.afsim. `compare` reads two such folders and reports, per case, the
 largest difference of displacement and velocity over all frames relative to the largest
 magnitude in the first run; it exits 1 when a case differs by more than the tolerance or
@@ -32,6 +33,7 @@ VARIANTS = [
     ("backward-euler", ["--integrator", "backward-euler"], []),
     ("trapezoidal", ["--integrator", "trapezoidal"], []),
     ("uncoupled", ["--integrator", "multirate-uncoupled"], []),
+    ("schroeder2011", ["--integrator", "schroeder2011"], []),
     ("paper", [], [(r'"options"\s*:\s*\{', '"options": {"coupling": "paper", ')]),
     ("corotational", [], [(r'"forceModel"\s*:\s*\{[^}]*\}', '"forceModel": {"type": "corotational"}')]),
     ("corotational-rebuilt", [],
@@ -39,6 +41,7 @@ VARIANTS = [
       (r'"options"\s*:\s*\{', '"options": {"laggedSchur": false, ')]),
     ("neo-hookean-be", ["--integrator", "backward-euler"],
      [(r'"forceModel"\s*:\s*\{[^}]*\}', '"forceModel": {"type": "neo-hookean"}')]),
+    ("neo-hookean", [], [(r'"forceModel"\s*:\s*\{[^}]*\}', '"forceModel": {"type": "neo-hookean"}')]),
 ]
 
 

@@ -34,12 +34,31 @@ TEST(RegionPartition, RejectsOverlapNamingTheVertex) {
   EXPECT_NE(message.find("vertex " + std::to_string(tip.back())), std::string::npos) << message;
 }
 
-TEST(RegionPartition, RejectsElementTouchingTwoFastRegions) {
+// Regions that touch are a partition (the hierarchy solve runs them); a solve that couples
+// each region only to L refuses them, naming an element and both regions. Regions one
+// element layer apart do not touch.
+TEST(RegionPartition, TouchingRegionsAreNamedWhereTheyMustBeSeparated) {
   const test::TestSystem ts = test::makeTestSystem(0, 0);
-  const std::string message = partitionError(
-      ts, {{"a", test::verticesOnPlanes(ts.mesh, {0.5}), 2}, {"b", test::verticesOnPlanes(ts.mesh, {0.625}), 2}});
-  EXPECT_NE(message.find("element "), std::string::npos) << message;
-  EXPECT_NE(message.find("'a' and 'b'"), std::string::npos) << message;
+  const RegionPartition touching(
+      ts.mesh, ts.system.freeDofs,
+      {{"a", test::verticesOnPlanes(ts.mesh, {0.5}), 2}, {"b", test::verticesOnPlanes(ts.mesh, {0.625}), 2}});
+  EXPECT_TRUE(touching.touching());
+  EXPECT_EQ(touching.levels(), (std::vector<int>{1, 2}));
+  try {
+    touching.requireSeparated("two-level solve");
+    FAIL() << "touching regions passed requireSeparated";
+  } catch (const ValidationError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind("two-level solve: element ", 0), 0u) << message;
+    EXPECT_NE(message.find("'a' and 'b'"), std::string::npos) << message;
+  }
+  const RegionPartition apart(
+      ts.mesh, ts.system.freeDofs,
+      {{"a", test::verticesOnPlanes(ts.mesh, {0.25}), 2}, {"b", test::verticesOnPlanes(ts.mesh, {0.625}), 4}});
+  EXPECT_FALSE(apart.touching());
+  EXPECT_NO_THROW(apart.requireSeparated("two-level solve"));
+  EXPECT_EQ(apart.units(), 4);
+  EXPECT_EQ(apart.levels(), (std::vector<int>{1, 2, 4}));
 }
 
 TEST(RegionPartition, RejectsRegionWithoutFreeDofs) {

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
-#include <asyncfem/asyncIntegrator/nestedAsyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
@@ -287,9 +286,9 @@ TEST(ContactScene, AsyncImplicitContactFollowsTheContactAtALargeStep) {
   EXPECT_TRUE(reported);
 }
 
-// Regions that touch or nest: "async" builds the nested integrator by itself, refuses what it
-// does not have by name, and names the element where the ratios do not divide.
-TEST(AsyncScene, TouchingRegionsRunTheNestedIntegrator) {
+// Regions that touch or nest: "async" chooses its hierarchy solve by itself, refuses what that
+// solve does not have by the option's key, and names the element where the ratios do not divide.
+TEST(AsyncScene, TouchingRegionsRunTheHierarchySolve) {
   nlohmann::json scene = barScene();
   scene["mesh"]["cells"] = {8, 1, 1};  // vertices every 0.5 along x
   scene["integrator"]["options"]["regions"] = nlohmann::json::parse(R"([
@@ -299,19 +298,23 @@ TEST(AsyncScene, TouchingRegionsRunTheNestedIntegrator) {
   EXPECT_NE(errorOf(scene).find("vertex"), std::string::npos) << errorOf(scene);
   scene["integrator"]["options"]["regions"][0]["boxes"][0]["max"] = {3.6, 2, 2};
   Simulation simulation = build(scene);
-  auto* nested = dynamic_cast<asyncfem::NestedAsyncBackwardEuler*>(simulation.integrator.get());
+  auto* nested = dynamic_cast<asyncfem::AsyncBackwardEuler*>(simulation.integrator.get());
   ASSERT_NE(nested, nullptr);
-  EXPECT_TRUE(nested->counts().touching());
-  EXPECT_EQ(nested->counts().levels(), (std::vector<int>{1, 4, 16}));
+  EXPECT_EQ(nested->stepSolver(), asyncfem::AsyncStepSolver::hierarchy);
+  EXPECT_TRUE(nested->partition().touching());
+  EXPECT_EQ(nested->partition().levels(), (std::vector<int>{1, 4, 16}));
   for (int frame = 0; frame < simulation.numFrames; ++frame) asyncfem::advanceFrame(simulation, frame);
   EXPECT_GT(simulation.integrator->displacement().norm(), 0.0);
-  EXPECT_NE(simulation.integrator->report().lines.front().find("steps per large step 1, 4, 16"), std::string::npos);
+  const std::vector<std::string> lines = simulation.integrator->report().lines;
+  ASSERT_GE(lines.size(), 2u);
+  EXPECT_EQ(lines[0].rfind("async step solver: hierarchy", 0), 0u) << lines[0];
+  EXPECT_NE(lines[1].find("steps per large step 1, 4, 16"), std::string::npos) << lines[1];
 
   nlohmann::json paper = scene;
   paper["integrator"]["options"]["coupling"] = "paper";
-  EXPECT_NE(
-      errorOf(paper).find("integrator.options.coupling: the paper's coupling is not available when regions touch"),
-      std::string::npos)
+  EXPECT_NE(errorOf(paper).find("integrator.options.coupling: the paper's coupling is not available with the hierarchy "
+                                "solve (the regions given touch or nest)"),
+            std::string::npos)
       << errorOf(paper);
   nlohmann::json indivisible = scene;
   indivisible["integrator"]["options"]["regions"][1]["ratio"] = 6;
@@ -324,18 +327,18 @@ TEST(AsyncScene, TouchingRegionsRunTheNestedIntegrator) {
       << errorOf(uncoupled);
 }
 
-// "method": "nested" runs the nested integrator on regions that do not touch: the same
-// trajectory as the structured two-level solve, to round-off (1e-10 relative), through the
-// nested integrator's structured solve (the default) and through its LU ("nestedSolve").
-TEST(AsyncScene, NestedMethodMatchesTheStructuredSolve) {
+// "method": "hierarchy" runs the hierarchy solve on regions that do not touch: the same
+// trajectory as the structured two-level solve, to round-off (1e-10 relative), level by level
+// (the default) and through its LU ("nestedSolve").
+TEST(AsyncScene, HierarchyMethodMatchesTheStructuredSolve) {
   nlohmann::json scene = barScene();
   Simulation structured = build(scene);
-  scene["integrator"]["options"]["method"] = "nested";
+  scene["integrator"]["options"]["method"] = "hierarchy";
   Simulation nested = build(scene);
   scene["integrator"]["options"]["nestedSolve"] = "lu";
   Simulation nestedLU = build(scene);
-  auto* levels = dynamic_cast<asyncfem::NestedAsyncBackwardEuler*>(nested.integrator.get());
-  auto* lu = dynamic_cast<asyncfem::NestedAsyncBackwardEuler*>(nestedLU.integrator.get());
+  auto* levels = dynamic_cast<asyncfem::AsyncBackwardEuler*>(nested.integrator.get());
+  auto* lu = dynamic_cast<asyncfem::AsyncBackwardEuler*>(nestedLU.integrator.get());
   ASSERT_NE(levels, nullptr);
   ASSERT_NE(lu, nullptr);
   for (int frame = 0; frame < structured.numFrames; ++frame) {
@@ -343,8 +346,11 @@ TEST(AsyncScene, NestedMethodMatchesTheStructuredSolve) {
     asyncfem::advanceFrame(nested, frame);
     asyncfem::advanceFrame(nestedLU, frame);
   }
-  EXPECT_TRUE(levels->structuredSolve());
-  EXPECT_FALSE(lu->structuredSolve());
+  EXPECT_EQ(dynamic_cast<asyncfem::AsyncBackwardEuler*>(structured.integrator.get())->stepSolver(),
+            asyncfem::AsyncStepSolver::structuredSchur);
+  EXPECT_EQ(levels->stepSolver(), asyncfem::AsyncStepSolver::hierarchy);
+  EXPECT_TRUE(levels->hierarchyByLevel());
+  EXPECT_FALSE(lu->hierarchyByLevel());
   const Eigen::VectorXd& a = structured.integrator->displacement();
   for (const Simulation* other : {&nested, &nestedLU}) {
     const Eigen::VectorXd& b = other->integrator->displacement();
@@ -352,7 +358,7 @@ TEST(AsyncScene, NestedMethodMatchesTheStructuredSolve) {
   }
 }
 
-// "nestedSolve" is read only where the nested integrator runs, and "structured" is refused
+// "nestedSolve" is read only where the hierarchy solve runs, and "structured" is refused
 // by name where the ratios do not form a chain.
 TEST(AsyncScene, NestedSolveKey) {
   nlohmann::json scene = barScene();
@@ -362,7 +368,7 @@ TEST(AsyncScene, NestedSolveKey) {
       << errorOf(scene);
   scene["integrator"]["options"]["nestedSolve"] = "fast";
   EXPECT_NE(errorOf(scene).find("integrator.options.nestedSolve"), std::string::npos) << errorOf(scene);
-  scene["integrator"]["options"]["method"] = "nested";
+  scene["integrator"]["options"]["method"] = "hierarchy";
   scene["integrator"]["options"]["nestedSolve"] = "structured";
   scene["integrator"]["options"]["regions"][0]["ratio"] = 3;
   scene["integrator"]["options"]["regions"].push_back(nlohmann::json::parse(

@@ -823,17 +823,9 @@ asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options, cons
   const bool owned = options.petscRegions == "owned";
   asyncfem::registerMultirateIntegrators(
       registry, [solver, totals, owned](asyncfem::AsyncSettings& settings, const asyncfem::IntegratorContext& context) {
-        if (settings.nested) {
-          throw asyncfem::ValidationError(
-              "--backend petsc: touching or nested regions (NestedAsyncBackwardEuler) are not available on the PETSc "
-              "backend; run them locally");
-        }
-        if (settings.solver.coupling != asyncfem::AsyncCoupling::stable ||
-            settings.solver.method != asyncfem::AsyncSolveMethod::structured) {
-          throw asyncfem::ValidationError(
-              "--backend petsc: the asynchronous integrator runs there with the stable coupling and the structured "
-              "method only");
-        }
+        // What the backend's solvers need of the options and the partition (stable coupling,
+        // structured method, regions that do not touch) is checked where every option is:
+        // chooseStepSolver(), which names the refused option.
         settings.solver.largeSystemSolver = asyncfem::makePetscLargeSystemSolver(*context.mesh, solver, totals);
         if (owned) {
           asyncfem::PetscRegionDistribution distribution = asyncfem::makePetscRegionDistribution(*context.mesh, totals);

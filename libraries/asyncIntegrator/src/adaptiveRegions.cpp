@@ -96,6 +96,38 @@ std::vector<AsyncRegion> mergeTouching(const TetMesh& mesh, const std::vector<As
   return merged;
 }
 
+/// Regions kept at their own ratios (AdaptiveRegionOptions::nest): each vertex goes to the
+/// fastest region that claims it (the earlier one among equals), regions left without a
+/// vertex vanish; where an element joins two regions whose ratios do not divide one
+/// another (Eq. N6), every touching region is merged instead (mergeTouching).
+std::vector<AsyncRegion> nestTouching(const TetMesh& mesh, const std::vector<AsyncRegion>& regions) {
+  std::vector<int> owner(static_cast<std::size_t>(mesh.numVertices()), -1);
+  for (int i = 0; i < static_cast<int>(regions.size()); ++i)
+    for (int v : regions[static_cast<std::size_t>(i)].vertices) {
+      int& o = owner[static_cast<std::size_t>(v)];
+      if (o < 0 || regions[static_cast<std::size_t>(o)].ratio < regions[static_cast<std::size_t>(i)].ratio) o = i;
+    }
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    int fastest = 1;
+    for (int a = 0; a < 4; ++a) {
+      const int o = owner[static_cast<std::size_t>(mesh.elements()(a, e))];
+      if (o >= 0) fastest = std::max(fastest, regions[static_cast<std::size_t>(o)].ratio);
+    }
+    for (int a = 0; a < 4; ++a) {
+      const int o = owner[static_cast<std::size_t>(mesh.elements()(a, e))];
+      if (o >= 0 && fastest % regions[static_cast<std::size_t>(o)].ratio != 0) return mergeTouching(mesh, regions);
+    }
+  }
+  std::vector<AsyncRegion> out;
+  for (int i = 0; i < static_cast<int>(regions.size()); ++i) {
+    AsyncRegion region{regions[static_cast<std::size_t>(i)].name, {}, regions[static_cast<std::size_t>(i)].ratio};
+    for (int v = 0; v < mesh.numVertices(); ++v)
+      if (owner[static_cast<std::size_t>(v)] == i) region.vertices.push_back(v);
+    if (!region.vertices.empty()) out.push_back(std::move(region));
+  }
+  return out;
+}
+
 /// The vertices an indicator marks (ratio > 0), one region per set connected through
 /// elements, at the largest ratio its vertices want.
 std::vector<AsyncRegion> indicatorComponents(const TetMesh& mesh, const std::vector<int>& ratio) {
@@ -259,7 +291,7 @@ std::vector<AsyncRegion> AdaptiveRegionPolicy::assemble(double time, const std::
     if (contact[vertex]) touching.vertices.push_back(static_cast<int>(vertex));
   if (!touching.vertices.empty()) regions.push_back(std::move(touching));
   for (AsyncRegion& component : indicatorComponents(*mesh_, indicated)) regions.push_back(std::move(component));
-  std::vector<AsyncRegion> merged = mergeTouching(*mesh_, regions);
+  std::vector<AsyncRegion> merged = options_.nest ? nestTouching(*mesh_, regions) : mergeTouching(*mesh_, regions);
   // Vertices without a free DOF take no substeps; a region of only such vertices is none.
   std::vector<AsyncRegion> out;
   for (AsyncRegion& region : merged) {

@@ -18,9 +18,17 @@ const TetMesh& meshOf(const char* integratorName, const DynamicSystem& system) {
 }  // namespace
 
 PartitionedIntegrator::PartitionedIntegrator(const char* integratorName, DynamicSystem system, double largeTimestep,
-                                             std::vector<AsyncRegion> regions)
+                                             std::vector<AsyncRegion> regions, bool acceptsTouching)
     : Integrator(std::move(system), largeTimestep),
-      partition_(meshOf(integratorName, system_), system_.freeDofs, std::move(regions)) {}
+      partition_(meshOf(integratorName, system_), system_.freeDofs, std::move(regions)) {
+  if (!acceptsTouching) partition_.requireSeparated(std::string(integratorName) + " integrator");
+}
+
+PartitionedIntegrator::PartitionedIntegrator(const char* integratorName, DynamicSystem system, double largeTimestep,
+                                             RegionPartition partition)
+    : Integrator(std::move(system), largeTimestep), partition_(std::move(partition)) {
+  meshOf(integratorName, system_);
+}
 
 DynamicSystem PartitionedIntegrator::withMesh(const char* integratorName, const TetMesh& mesh, DynamicSystem system) {
   if (mesh.numDofs() != system.numDofs()) {

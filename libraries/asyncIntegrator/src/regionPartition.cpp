@@ -3,6 +3,8 @@
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/vertexSelection.hpp>
+#include <numeric>
+#include <set>
 #include <string>
 
 namespace asyncfem {
@@ -47,6 +49,7 @@ RegionPartition::RegionPartition(const TetMesh& mesh, const FreeDofs& freeDofs, 
                           " DOFs but the mesh has " + std::to_string(3 * n));
   }
   assignVertices(n);
+  countSteps(mesh);
   splitFreeDofs(freeDofs, classifyElements(mesh));
 }
 
@@ -78,39 +81,88 @@ std::vector<int> assignRegionVertices(std::vector<AsyncRegion>& regions, int num
 
 void RegionPartition::assignVertices(int numVertices) { vertexRegion_ = assignRegionVertices(regions_, numVertices); }
 
-int RegionPartition::fastRegionOfElement(const TetMesh& mesh, int e, bool& hasLarge) const {
-  int fast = -1;
-  hasLarge = false;
-  for (int a = 0; a < 4; ++a) {
-    const int region = vertexRegion_[static_cast<std::size_t>(mesh.elements()(a, e))];
-    if (region < 0) {
-      hasLarge = true;
-    } else if (fast < 0) {
-      fast = region;
-    } else if (fast != region) {
-      throw ValidationError("element " + std::to_string(e) + " has vertices in regions '" +
-                            regions_[static_cast<std::size_t>(fast)].name + "' and '" +
-                            regions_[static_cast<std::size_t>(region)].name +
-                            "': fast regions must be separated by at least one element layer of L");
+namespace {
+std::string describeRegion(const std::vector<AsyncRegion>& regions, int region) {
+  if (region < 0) return "L (ratio 1)";
+  const AsyncRegion& r = regions[static_cast<std::size_t>(region)];
+  return "'" + r.name + "' (ratio " + std::to_string(r.ratio) + ")";
+}
+}  // namespace
+
+// Eq. N6: an element is evaluated on its fastest vertex's steps, so every slower vertex's
+// step boundaries must be among them.
+void RegionPartition::countSteps(const TetMesh& mesh) {
+  vertexCounts_.assign(vertexRegion_.size(), 1);
+  for (std::size_t v = 0; v < vertexRegion_.size(); ++v)
+    if (vertexRegion_[v] >= 0) vertexCounts_[v] = regions_[static_cast<std::size_t>(vertexRegion_[v])].ratio;
+  elementCounts_.assign(static_cast<std::size_t>(mesh.numElements()), 1);
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    int fastest = mesh.elements()(0, e), firstFast = -1;
+    for (int a = 1; a < 4; ++a) {
+      const int v = mesh.elements()(a, e);
+      if (vertexCounts_[static_cast<std::size_t>(v)] > vertexCounts_[static_cast<std::size_t>(fastest)]) fastest = v;
     }
+    const int count = vertexCounts_[static_cast<std::size_t>(fastest)];
+    for (int a = 0; a < 4; ++a) {
+      const int v = mesh.elements()(a, e);
+      const int region = vertexRegion_[static_cast<std::size_t>(v)];
+      if (count % vertexCounts_[static_cast<std::size_t>(v)] != 0) {
+        throw ValidationError(
+            "element " + std::to_string(e) + " joins region " + describeRegion(regions_, region) + " and region " +
+            describeRegion(regions_, vertexRegion_[static_cast<std::size_t>(fastest)]) +
+            ": the ratios of regions that share an element must divide one another (e.g. 4 and 8, not 3 and 4)");
+      }
+      if (region >= 0 && firstFast >= 0 && region != firstFast && touchingElement_ < 0) {
+        touchingElement_ = e;
+        touchingRegions_ = {firstFast, region};
+      }
+      if (region >= 0 && firstFast < 0) firstFast = region;
+    }
+    elementCounts_[static_cast<std::size_t>(e)] = count;
   }
-  return fast;
+  for (const int count : vertexCounts_) {
+    if (units_ == 0) break;
+    units_ = std::lcm(units_, static_cast<long long>(count));
+    if (units_ > kMaxUnits) units_ = 0;
+  }
+  const std::set<int> distinct(vertexCounts_.begin(), vertexCounts_.end());
+  levels_.assign(distinct.begin(), distinct.end());
 }
 
+void RegionPartition::requireSeparated(const std::string& who) const {
+  if (!touching()) return;
+  throw ValidationError(who + ": element " + std::to_string(touchingElement_) + " has vertices in regions '" +
+                        regions_[static_cast<std::size_t>(touchingRegions_.first)].name + "' and '" +
+                        regions_[static_cast<std::size_t>(touchingRegions_.second)].name +
+                        "': fast regions must be separated by at least one element layer of L");
+}
+
+// Interface elements join L and a fast region (or two fast regions); each fast region's
+// interface is the DOFs of L its elements reach.
 std::vector<std::vector<char>> RegionPartition::classifyElements(const TetMesh& mesh) {
   std::vector<std::vector<char>> touchesRegion(static_cast<std::size_t>(numRegions()),
                                                std::vector<char>(static_cast<std::size_t>(mesh.numDofs()), 0));
   for (int e = 0; e < mesh.numElements(); ++e) {
     bool hasLarge = false;
-    const int fast = fastRegionOfElement(mesh, e, hasLarge);
-    if (fast < 0 || !hasLarge) continue;
-    interfaceElements_.push_back(e);
+    std::vector<int> fast;
     for (int a = 0; a < 4; ++a) {
-      const int v = mesh.elements()(a, e);
-      if (vertexRegion_[static_cast<std::size_t>(v)] >= 0) continue;
-      for (int c = 0; c < 3; ++c)
-        touchesRegion[static_cast<std::size_t>(fast)][static_cast<std::size_t>(3 * v + c)] = 1;
+      const int region = vertexRegion_[static_cast<std::size_t>(mesh.elements()(a, e))];
+      if (region < 0) {
+        hasLarge = true;
+      } else if (std::find(fast.begin(), fast.end(), region) == fast.end()) {
+        fast.push_back(region);
+      }
     }
+    if (fast.empty() || (!hasLarge && fast.size() == 1)) continue;
+    interfaceElements_.push_back(e);
+    if (!hasLarge) continue;
+    for (const int region : fast)
+      for (int a = 0; a < 4; ++a) {
+        const int v = mesh.elements()(a, e);
+        if (vertexRegion_[static_cast<std::size_t>(v)] >= 0) continue;
+        for (int c = 0; c < 3; ++c)
+          touchesRegion[static_cast<std::size_t>(region)][static_cast<std::size_t>(3 * v + c)] = 1;
+      }
   }
   return touchesRegion;
 }

@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/nestedAsyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/asyncIntegrator/schroeder2011.hpp>
 #include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
@@ -85,7 +84,7 @@ const ChoiceTable<SchurMode> kSchurModes{
     {"low-rank", SchurMode::lowRank}, {"lu", SchurMode::lu}, {"symmetric", SchurMode::symmetric}};
 const ChoiceTable<AsyncSolveMethod> kSolveMethods{{"structured", AsyncSolveMethod::structured},
                                                   {"naive", AsyncSolveMethod::naive},
-                                                  {"nested", AsyncSolveMethod::nested}};
+                                                  {"hierarchy", AsyncSolveMethod::hierarchy}};
 const ChoiceTable<RecoveryMode> kRecoveryModes{{"automatic", RecoveryMode::automatic},
                                                {"substitution", RecoveryMode::substitution},
                                                {"dense-z", RecoveryMode::denseZ}};
@@ -128,6 +127,7 @@ AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
   solver.contactIterations = reader.integer("contactIterations", solver.contactIterations, 1, 1000);
   solver.contactTolerance = reader.number("contactTolerance", solver.contactTolerance);
   solver.certifyContactFree = reader.boolean("certifyContactFree", solver.certifyContactFree);
+  solver.nestedSolve = parseNestedSolve(reader.choice("nestedSolve", "automatic", {"automatic", "structured", "lu"}));
   if (!(solver.contactTolerance > 0.0 && solver.contactTolerance < 1.0)) {
     reader.fail("contactTolerance", "must be in (0, 1)");
   }
@@ -184,6 +184,7 @@ AdaptiveRegionOptions parseAdaptive(const IntegratorContext& context, const nloh
   out.shrinkFactor = reader.number("shrink", out.shrinkFactor);
   if (!(out.shrinkFactor >= 1.0)) reader.fail("shrink", "must be >= 1");
   out.cacheSize = reader.integer("cache", out.cacheSize, 0, 64);
+  out.nest = reader.boolean("nest", out.nest);
   reader.finish();
   return out;
 }
@@ -293,8 +294,6 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
   JsonObjectReader reader(options, context.optionsPath, sourceName);
   AsyncSettings out;
   out.solver = parseSolverOptions(reader, context.hasContact);
-  out.nestedSolve = parseNestedSolve(reader.choice("nestedSolve", "automatic", {"automatic", "structured", "lu"}));
-  const std::string nestedSolvePath = reader.keyPath("nestedSolve");
   const std::string regionsPath = reader.keyPath("regions");
   parseRegions(reader, context, options, out);
   reader.finish();
@@ -309,53 +308,31 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
     }
     out.regions = out.proposal->asyncRegions();
   }
-  // Validate the partition here so its errors name the key. Regions that touch or nest are
-  // checked by the rules of the nested integrator instead (docs/asynchronous-integrator.md,
-  // "Nested and touching regions").
+  // The partition, built once here so that its errors name the key; its shape chooses the
+  // step solver when the integrator is made (chooseStepSolver, which checks the options).
   try {
-    RegionPartition check(mesh, freeDofs, out.regions);
-    if (out.solver.method == AsyncSolveMethod::nested) {
-      if (out.adaptive) reader.fail("method", "\"nested\" is not available with run-time (adaptive) regions");
-      const StepCounts counts(mesh, freeDofs, out.regions);
-      out.nested = true;
-    }
+    out.partition.emplace(mesh, freeDofs, out.regions);
   } catch (const ValidationError& e) {
-    std::optional<StepCounts> counts;
-    try {
-      counts.emplace(mesh, freeDofs, out.regions);
-    } catch (const ValidationError& nestedError) {
-      JsonObjectReader::failAt(sourceName, regionsPath, nestedError.what());
-    }
-    if (!counts->touching()) JsonObjectReader::failAt(sourceName, regionsPath, e.what());
-    out.nested = true;
-  }
-  if (out.nestedSolve != NestedSolve::automatic && !out.nested) {
-    JsonObjectReader::failAt(sourceName, nestedSolvePath,
-                             "only meaningful for regions that touch or nest, or with \"method\": \"nested\"");
+    JsonObjectReader::failAt(sourceName, regionsPath, e.what());
   }
   return out;
 }
 
 namespace {
 
-/// The nested integrator for touching or nested regions, refusing by name the options it
-/// does not have (the lagged Schur factor, recovery and Schur modes are solve strategies
-/// of the two-level solve and have no meaning for its one sparse LU).
-std::unique_ptr<Integrator> makeNested(IntegratorContext& context, const AsyncSettings& parsed) {
-  const auto refuse = [&](const char* key, const char* what) {
-    JsonObjectReader::failAt(context.sourceName, context.optionsPath + "." + key,
-                             std::string(what) + " is not available when regions touch or nest (the regions given do)");
-  };
-  if (parsed.solver.coupling != AsyncCoupling::stable) refuse("coupling", "the paper's coupling");
-  if (parsed.solver.quickSetUp) refuse("quickSetUp", "the quick set-up");
-  if (parsed.solver.substepStatePrediction) refuse("substepContact", "contact at the substeps' predicted states");
-  if (parsed.solver.method == AsyncSolveMethod::naive) refuse("method", "the naive solve method");
+/// AsyncBackwardEuler for the settings, on the partition they built; an option that
+/// chooseStepSolver() refuses is named by its scene key.
+std::unique_ptr<AsyncBackwardEuler> makeAsync(IntegratorContext& context, AsyncSettings& parsed) {
+  if (!context.system.mesh)
+    context.system = PartitionedIntegrator::withMesh("async", *context.mesh, std::move(context.system));
   try {
-    return std::make_unique<NestedAsyncBackwardEuler>(std::move(context.system), context.timestep, parsed.regions,
-                                                      parsed.nestedSolve);
-  } catch (const ValidationError& e) {
-    if (parsed.nestedSolve != NestedSolve::structured) throw;
-    JsonObjectReader::failAt(context.sourceName, context.optionsPath + ".nestedSolve", e.what());
+    return std::make_unique<AsyncBackwardEuler>(std::move(context.system), context.timestep,
+                                                std::move(*parsed.partition), parsed.solver);
+  } catch (const AsyncOptionError& e) {
+    const std::vector<std::string>& keys = asyncOptionKeys();
+    const bool sceneKey = std::find(keys.begin(), keys.end(), e.key()) != keys.end();
+    JsonObjectReader::failAt(context.sourceName, context.optionsPath + (sceneKey ? "." + e.key() : ""),
+                             sceneKey ? e.reason() : e.what());
   }
 }
 
@@ -396,7 +373,7 @@ nlohmann::json asyncSettingsJson(const AsyncSettings& settings) {
   if (solver.contactIterations != defaults.contactIterations) out["contactIterations"] = solver.contactIterations;
   if (solver.contactTolerance != defaults.contactTolerance) out["contactTolerance"] = solver.contactTolerance;
   if (solver.certifyContactFree != defaults.certifyContactFree) out["certifyContactFree"] = solver.certifyContactFree;
-  if (settings.nestedSolve != NestedSolve::automatic) out["nestedSolve"] = toString(settings.nestedSolve);
+  if (solver.nestedSolve != defaults.nestedSolve) out["nestedSolve"] = toString(solver.nestedSolve);
   out["regions"] =
       settings.adaptive ? nlohmann::json{{"adaptive", settings.adaptiveSource}} : asyncRegionsJson(settings.regions);
   return out;
@@ -414,9 +391,7 @@ void registerMultirateIntegrators(IntegratorRegistry& registry, AsyncSettingsHoo
       [asyncHook](IntegratorContext context, const nlohmann::json& options) -> std::unique_ptr<Integrator> {
         AsyncSettings parsed = parseAsyncSettings(context, options);
         if (asyncHook) asyncHook(parsed, context);
-        if (parsed.nested) return makeNested(context, parsed);
-        auto integrator = std::make_unique<AsyncBackwardEuler>(*context.mesh, std::move(context.system),
-                                                               context.timestep, parsed.regions, parsed.solver);
+        std::unique_ptr<AsyncBackwardEuler> integrator = makeAsync(context, parsed);
         if (parsed.adaptive) integrator->setAdaptiveRegions(*parsed.adaptive);
         if (parsed.automaticRegions && parsed.proposal) integrator->setRegionNote(autoRegionSummary(*parsed.proposal));
         return integrator;
@@ -440,7 +415,7 @@ void registerMultirateIntegrators(IntegratorRegistry& registry, AsyncSettingsHoo
           regionOptions.erase("compoundSolver");
         }
         const AsyncSettings parsed = parseAsyncSettings(context, regionOptions);
-        if (parsed.adaptive || parsed.nested) {
+        if (parsed.adaptive || parsed.partition->touching()) {
           JsonObjectReader::failAt(context.sourceName, path + ".regions",
                                    std::string(parsed.adaptive ? "run-time (adaptive)" : "touching or nested") +
                                        " regions are available with \"async\" only");
@@ -474,7 +449,7 @@ void registerMultirateIntegrators(IntegratorRegistry& registry, AsyncSettingsHoo
                  solverOptions.force = reader.boolean("force", solverOptions.force);
                  reader.finish();
                  const AsyncSettings parsed = parseAsyncSettings(context, regionOptions);
-                 if (parsed.nested) {
+                 if (parsed.partition->touching()) {
                    JsonObjectReader::failAt(context.sourceName, path + ".regions",
                                             "touching or nested regions are available with \"async\" only");
                  }

@@ -141,7 +141,7 @@ Schroeder2011::Schroeder2011(const TetMesh& mesh, DynamicSystem system, double l
 
 Schroeder2011::Schroeder2011(DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions,
                              Schroeder2011Options options)
-    : PartitionedIntegrator(kName, std::move(system), largeTimestep, std::move(regions)),
+    : PartitionedIntegrator(kName, std::move(system), largeTimestep, std::move(regions), false),
       options_(options),
       impl_(std::make_unique<Impl>()) {
   if (!(options_.rigidity >= 0.0 && options_.rigidity <= 1.0)) {

@@ -48,7 +48,7 @@ UncoupledMultirate::UncoupledMultirate(const TetMesh& mesh, DynamicSystem system
 
 UncoupledMultirate::UncoupledMultirate(DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions,
                                        UncoupledMultirateOptions options)
-    : PartitionedIntegrator("multirate-uncoupled", std::move(system), largeTimestep, std::move(regions)),
+    : PartitionedIntegrator("multirate-uncoupled", std::move(system), largeTimestep, std::move(regions), false),
       options_(options),
       impl_(std::make_unique<Impl>()) {
   Impl& d = *impl_;

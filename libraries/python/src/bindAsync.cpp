@@ -103,9 +103,9 @@ void bindAsyncOptions(py::module_& module) {
       .value("symmetric", SchurMode::symmetric);
   py::enum_<AsyncSolveMethod>(module, "AsyncSolveMethod",
                               "structured (block elimination, the default), naive (one big solve, for reference) or "
-                              "nested (the nested integrator, what touching or nested regions run)")
+                              "hierarchy (the time-local step system, what touching or nested regions run)")
       .value("structured", AsyncSolveMethod::structured)
-      .value("nested", AsyncSolveMethod::nested)
+      .value("hierarchy", AsyncSolveMethod::hierarchy)
       .value("naive", AsyncSolveMethod::naive);
   py::enum_<RecoveryMode>(module, "RecoveryMode",
                           "How the fast regions' states are recovered after the interface solve")

@@ -52,16 +52,24 @@ constexpr long long kMaxUnknowns = 1LL << 28;
 
 }  // namespace
 
-HierarchySystem::HierarchySystem(const TetMesh& mesh, const DynamicSystem& system, const StepCounts& counts,
+HierarchySystem::HierarchySystem(const TetMesh& mesh, const DynamicSystem& system, const RegionPartition& partition,
                                  NestedSolve solve)
-    : mesh_(mesh), system_(system), counts_(counts), units_(counts.units()), requested_(solve) {
+    : mesh_(mesh),
+      system_(system),
+      elementCounts_(partition.elementCounts()),
+      units_(partition.units()),
+      requested_(solve) {
+  if (units_ == 0) {
+    throw ValidationError("nested async regions: the least common multiple of the ratios exceeds " +
+                          std::to_string(RegionPartition::kMaxUnits) + "; use ratios that divide one another");
+  }
   free_ = system.freeDofs.freeToFull();
   freeIndex_ = system.freeDofs.fullToFree();
   dofCount_.resize(free_.size());
   offset_.assign(free_.size() + 1, 0);
   long long total = 0;
   for (std::size_t d = 0; d < free_.size(); ++d) {
-    dofCount_[d] = counts.vertexCounts()[static_cast<std::size_t>(free_[d] / 3)];
+    dofCount_[d] = partition.vertexCounts()[static_cast<std::size_t>(free_[d] / 3)];
     total += dofCount_[d];
     if (total > kMaxUnknowns) {
       throw ValidationError("nested async regions: the step system would have more than " +
@@ -143,7 +151,7 @@ void HierarchySystem::groupElements(const Eigen::VectorXd& u) {
   ElementBlock tangent;
   const bool needMass = elementMass_ != ElementMass::none && massByCount_.empty();
   for (int e = 0; e < mesh_.numElements(); ++e) {
-    const int count = counts_.elementCounts()[static_cast<std::size_t>(e)];
+    const int count = elementCounts_[static_cast<std::size_t>(e)];
     if (perElementTangent_) {
       system_.forceModel->elementTangent(u, e, tangent);
     } else {

@@ -7,7 +7,8 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
-#include <asyncfem/asyncIntegrator/nestedAsyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/asyncOptions.hpp>
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/dynamics/dynamicSystem.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <map>
@@ -26,9 +27,12 @@ class HierarchySystem {
  public:
   using SparseMatrix = Eigen::SparseMatrix<double>;
 
-  /// Checks the element tangents and masses the system needs (see
-  /// NestedAsyncBackwardEuler) and lays out the unknowns.
-  HierarchySystem(const TetMesh& mesh, const DynamicSystem& system, const StepCounts& counts, NestedSolve solve);
+  /// Checks the element tangents and masses the system needs (AsyncBackwardEuler, "The
+  /// hierarchy solve") and lays out the unknowns of partition's step counts (copied).
+  /// Throws asyncfem::ValidationError when the counts' least common multiple exceeds
+  /// RegionPartition::kMaxUnits, the system is too large, or a check fails.
+  HierarchySystem(const TetMesh& mesh, const DynamicSystem& system, const RegionPartition& partition,
+                  NestedSolve solve);
   ~HierarchySystem();
 
   /// Element tangents at u (the linear ones when the model has none), summed per element
@@ -80,7 +84,7 @@ class HierarchySystem {
 
   const TetMesh& mesh_;
   const DynamicSystem& system_;
-  const StepCounts& counts_;
+  std::vector<int> elementCounts_;
   std::vector<int> free_, freeIndex_, dofCount_, offset_;
   std::vector<long long> stepEndUnits_;
   int velocityUnknowns_ = 0;

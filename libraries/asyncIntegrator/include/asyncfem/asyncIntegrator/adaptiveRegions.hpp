@@ -27,7 +27,7 @@ struct ScheduledRegion {
 /// The policies of run-time regions and their hysteresis (docs/asynchronous-integrator.md,
 /// "Run-time regions"). Policies combine: the regions wanted at a large-step boundary are
 /// the contact region and every active scheduled region, merged where they touch (an
-/// element with vertices in both) at the larger ratio.
+/// element with vertices in both) at the larger ratio, or nested (AdaptiveRegionOptions::nest).
 struct AdaptiveRegionOptions {
   /// Contact policy: the vertices in contact or within contactMargin (a length) of an
   /// obstacle, at the step's start state or at the state predicted contactLookahead large
@@ -60,6 +60,11 @@ struct AdaptiveRegionOptions {
   /// when it holds more than shrinkFactor times the vertices needed (or none is needed).
   int minDwell = 8;
   double shrinkFactor = 2.0;
+  /// Regions that touch keep their own ratios where those divide one another across every
+  /// shared element (a nested partition, which AsyncBackwardEuler runs with its hierarchy
+  /// solve); a vertex claimed by several regions goes to the fastest. false (default): every
+  /// touching region is merged into one at the larger ratio (the two-level solve).
+  bool nest = false;
   /// Set-ups kept for reuse: with linear forces a partition that comes back (the same
   /// contact patch at the next bounce, the end of a scheduled window) costs no rebuild.
   int cacheSize = 4;

@@ -6,6 +6,7 @@
 #include <asyncfem/asyncIntegrator/asyncOptions.hpp>
 #include <asyncfem/asyncIntegrator/partitionedIntegrator.hpp>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
+#include <asyncfem/asyncIntegrator/stepSolver.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
@@ -20,7 +21,11 @@ class WholeSystemFactor;
 }
 
 /// Asynchronous implicit backward Euler (Zhao, Li & Barbič 2016, with the equations of
-/// docs/asynchronous-integrator.md). Fast regions S_i take m_i backward Euler substeps of
+/// docs/asynchronous-integrator.md), for any partition: fast regions that touch or nest
+/// too. Each set-up chooses its step solver (chooseStepSolver(), AsyncStepSolver): the
+/// two-level structured Schur solve or its naive LU reference for regions that each
+/// couple only to L, the hierarchy solve (Eqs. N1-N12) for regions that touch or nest or on
+/// request. Fast regions S_i take m_i backward Euler substeps of
 /// hS_i = hL / m_i per large step hL = timestep() while L takes one, coupled implicitly
 /// (AsyncCoupling: by default L moves at its end-of-step velocity and receives the
 /// interface elements' force averaged over the substeps, which never gains energy).
@@ -49,11 +54,27 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   /// The same for a system assembled by hand without its mesh: mesh is copied into it.
   AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system, double largeTimestep, std::vector<AsyncRegion> regions,
                      AsyncOptions options = {});
+  /// The same with a partition built already on system.mesh and system.freeDofs (a scene
+  /// reader that validated it builds it once).
+  AsyncBackwardEuler(DynamicSystem system, double largeTimestep, RegionPartition partition, AsyncOptions options = {});
   ~AsyncBackwardEuler() override;
 
   /// Takes a new partition of system().mesh's vertices (built on system().freeDofs) from
-  /// the next step on: every block, factor and analysis of the old one is dropped.
+  /// the next step on: every block, factor and analysis of the old one is dropped, and the
+  /// step solver is chosen anew (chooseStepSolver(); AsyncOptionError for what it refuses).
   void setUp(RegionPartition partition);
+  /// The step solver of the partition in use.
+  AsyncStepSolver stepSolver() const;
+
+  /// Hierarchy solve only (else asyncfem::Error): unknowns of the step system (2 sum over
+  /// free DOFs of their step counts), whether it is solved level by level (else by one LU;
+  /// known after the first step), and the last step's velocities v_{d,j} and displacement
+  /// changes u_{d,j} - u_{d,0} of free DOF d (index into system().freeDofs.freeToFull()) at
+  /// the end of its steps j = 1..N_d, in order (empty before the first step).
+  long long stepSystemUnknowns() const;
+  bool hierarchyByLevel() const;
+  Eigen::VectorXd stepVelocities(int freeDof) const;
+  Eigen::VectorXd stepDisplacements(int freeDof) const;
 
   /// Regions chosen at run time from the next step on (docs/asynchronous-integrator.md,
   /// "Run-time regions"): at every large-step boundary the policy may replace the
@@ -107,8 +128,13 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   struct Impl;
   struct CachedSetUp;
   std::unique_ptr<Impl> freshImpl() const;
+  void initialize();
   void maybeRepartition();
   void repartition(std::vector<AsyncRegion> regions, const std::string& reason);
+  void setUpHierarchy();
+  void stepHierarchy();
+  void hierarchyReportLines(std::vector<std::string>& lines) const;
+  const Impl& hierarchyImpl(const char* what) const;
   void refactor();
   void assembleBlocks();
   void subtractInterfaceStiffness();

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 // The choices and the run statistics of the asynchronous integrator (AsyncBackwardEuler).
@@ -26,16 +27,33 @@ enum class SchurMode {
   /// coupling; exact (to round-off) for the stable one, whose H^{LL*} is symmetric.
   symmetric,
 };
-/// How one large step's block system is solved.
+/// How one large step's system is solved (docs/asynchronous-integrator.md, "The step
+/// solvers"). AsyncBackwardEuler chooses the solver from this and the partition's shape
+/// (asyncStepSolver()): regions that touch or nest always take the hierarchy solve.
 enum class AsyncSolveMethod {
   structured,  ///< forward substitution + Schur complement on L: O(m) per step
   naive,       ///< the whole (sum_i 3 m_i |S_i| + 3|L|) system, LU: the reference
-  /// NestedAsyncBackwardEuler's one sparse LU of the time-local step system (Eq. N5): what
-  /// regions that touch or nest always run (scenes choose it by themselves then); for other
-  /// regions the same trajectory as structured, for comparison. AsyncBackwardEuler itself
-  /// refuses it.
-  nested,
+  /// The time-local step system of every DOF's steps (Eq. N5), solved level by level or by
+  /// one sparse LU (AsyncOptions::nestedSolve): what regions that touch or nest always run;
+  /// for other regions the same trajectory as structured, for comparison.
+  hierarchy,
 };
+/// How the hierarchy solve (AsyncSolveMethod::hierarchy, and every partition whose regions
+/// touch or nest) solves its step system (docs/asynchronous-integrator.md, "The solve").
+enum class NestedSolve {
+  /// structured when the step counts form a chain (each divides the next, e.g. 1, 8, 32),
+  /// the LU otherwise
+  automatic,
+  /// level by level, one factor per level (Eqs. N9-N12); asyncfem::ValidationError when the
+  /// counts do not form a chain
+  structured,
+  /// one sparse LU of the whole step system (Eq. N8), for any counts N6 allows
+  lu,
+};
+/// "automatic", "structured", "lu".
+std::string toString(NestedSolve solve);
+/// Inverse of toString; throws asyncfem::ValidationError naming the valid values.
+NestedSolve parseNestedSolve(const std::string& name);
 /// How the S unknowns are recovered once Y is known (structured method only).
 enum class RecoveryMode {
   automatic,     ///< per region, whichever of the two below needs fewer flops (Z up to 128 MiB)
@@ -64,6 +82,8 @@ struct AsyncOptions {
   SchurMode schur = SchurMode::lowRank;
   AsyncSolveMethod method = AsyncSolveMethod::structured;
   RecoveryMode recovery = RecoveryMode::automatic;
+  /// The hierarchy solve's strategy (only where that solve runs).
+  NestedSolve nestedSolve = NestedSolve::automatic;
   SolverKind regionSolver = SolverKind::cholmod;  ///< factors A^{S_i} (SPD)
   /// State passed to the external force function at substep r of a fast region: false
   /// (default) passes the large step's start state (u_0, v_0), so state-dependent forces

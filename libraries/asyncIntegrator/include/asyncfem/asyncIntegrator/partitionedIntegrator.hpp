@@ -14,10 +14,13 @@ namespace asyncfem {
 class PartitionedIntegrator : public Integrator, public MultirateIntegrator {
  public:
   /// system.mesh must be set; the partition is built on it and system.freeDofs. Throws
-  /// asyncfem::ValidationError (naming the integrator) without a mesh, and whatever
-  /// RegionPartition rejects.
+  /// asyncfem::ValidationError (naming the integrator) without a mesh, for whatever
+  /// RegionPartition rejects and, unless acceptsTouching, for regions that touch or nest.
   PartitionedIntegrator(const char* integratorName, DynamicSystem system, double largeTimestep,
-                        std::vector<AsyncRegion> regions);
+                        std::vector<AsyncRegion> regions, bool acceptsTouching);
+  /// The same with a partition built already (on system.mesh and system.freeDofs).
+  PartitionedIntegrator(const char* integratorName, DynamicSystem system, double largeTimestep,
+                        RegionPartition partition);
 
   const RegionPartition& partition() const { return partition_; }
   std::vector<RegionSummary> regionSummaries() const override { return summarizeRegions(partition_); }

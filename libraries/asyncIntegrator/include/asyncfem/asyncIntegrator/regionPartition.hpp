@@ -7,6 +7,7 @@
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <asyncfem/volumetricMesh/vertexSelection.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace asyncfem {
@@ -39,13 +40,18 @@ std::vector<int> regionVertices(const TetMesh& mesh, const RegionSelector& selec
 std::vector<int> assignRegionVertices(std::vector<AsyncRegion>& regions, int numVertices);
 
 /// A validated partition of the free DOFs into fast regions S_1..S_n and the rest L,
-/// with the interface data the asynchronous solve needs.
+/// with what both step solvers need: the interface data of the two-level structured solve
+/// and the step counts of the hierarchy solve (docs/asynchronous-integrator.md, "Method"
+/// and "Nested and touching regions"). Built once per set-up.
 ///
-/// Rejected with asyncfem::ValidationError (message names the culprit):
+/// Regions may touch one another and nest (an element with vertices in two fast regions):
+/// then touching() is true and only the hierarchy solve applies; integrators that couple
+/// each S_i only to L call requireSeparated(). Rejected with asyncfem::ValidationError
+/// (message names the culprit):
 /// - a ratio < 1;
 /// - a vertex listed in two regions (names the vertex and both regions);
-/// - an element with vertices in two different fast regions (names the element): the
-///   method couples each S_i only to L;
+/// - an element whose vertices' ratios do not divide one another (Eq. N6; names the
+///   element, its regions and their ratios);
 /// - a region with no free DOF (all its vertices fixed, or empty);
 /// - a vertex id out of range.
 class RegionPartition {
@@ -69,6 +75,23 @@ class RegionPartition {
   const std::vector<int>& interfaceElements() const { return interfaceElements_; }
   /// Region of every vertex: i for S_i, -1 for L.
   const std::vector<int>& vertexRegion() const { return vertexRegion_; }
+  /// Steps per large step of every vertex: its region's ratio, 1 in L.
+  const std::vector<int>& vertexCounts() const { return vertexCounts_; }
+  /// Steps per large step of every element: its fastest vertex's count (Eq. N6).
+  const std::vector<int>& elementCounts() const { return elementCounts_; }
+  /// The distinct step counts, ascending (1 first when L has a vertex): the levels.
+  const std::vector<int>& levels() const { return levels_; }
+  /// Least common multiple of every count: the large step in time units of the hierarchy
+  /// solve; 0 when it exceeds kMaxUnits (ratios that do not divide one another).
+  long long units() const { return units_; }
+  static constexpr long long kMaxUnits = 1LL << 20;
+  /// Whether an element has vertices in two different fast regions (regions that touch or
+  /// nest): only the hierarchy solve applies then.
+  bool touching() const { return touchingElement_ >= 0; }
+  /// Throws asyncfem::ValidationError naming the first element with vertices in two fast
+  /// regions, for a solve that couples each S_i only to L (who: the integrator or solve).
+  void requireSeparated(const std::string& who) const;
+
   /// vertexRegion()[vertex], or -1 for a vertex out of range.
   int regionOfVertex(int vertex) const {
     return vertex >= 0 && vertex < static_cast<int>(vertexRegion_.size())
@@ -79,9 +102,9 @@ class RegionPartition {
  private:
   /// vertexRegion_ from the regions (names defaulted, ratios and vertices checked).
   void assignVertices(int numVertices);
-  /// The one fast region element e touches (-1: none), hasLarge when it touches L too;
-  /// throws for an element touching two fast regions.
-  int fastRegionOfElement(const TetMesh& mesh, int e, bool& hasLarge) const;
+  /// Every vertex's and element's step count, the levels and the time units (Eq. N6
+  /// checked per element).
+  void countSteps(const TetMesh& mesh);
   /// interfaceElements_, and per region which DOFs of L its interface elements touch.
   std::vector<std::vector<char>> classifyElements(const TetMesh& mesh);
   /// regionDofs_, largeDofs_, interfaceDofs_ and interfacePositions_ from the free DOFs.
@@ -94,6 +117,10 @@ class RegionPartition {
   std::vector<std::vector<int>> interfacePositions_;
   std::vector<int> interfaceElements_;
   std::vector<int> vertexRegion_;
+  std::vector<int> vertexCounts_, elementCounts_, levels_;
+  long long units_ = 1;
+  int touchingElement_ = -1;  // first element with vertices in two fast regions
+  std::pair<int, int> touchingRegions_{-1, -1};
 };
 
 /// One RegionSummary per fast region of partition (name, vertices, interface DOFs, m).

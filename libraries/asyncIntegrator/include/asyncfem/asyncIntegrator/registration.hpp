@@ -4,7 +4,7 @@
 #include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
-#include <asyncfem/asyncIntegrator/nestedAsyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/integrator/registry.hpp>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -28,11 +28,10 @@ struct AsyncSettings {
   /// (written back by asyncSettingsJson).
   std::optional<AdaptiveRegionOptions> adaptive;
   nlohmann::json adaptiveSource;
-  /// The regions touch or nest (an element joins two fast regions), which only
-  /// NestedAsyncBackwardEuler runs; their ratios passed StepCounts' checks.
-  bool nested = false;
-  /// How the nested integrator solves ("nestedSolve"; only with nested regions).
-  NestedSolve nestedSolve = NestedSolve::automatic;
+  /// The partition of the regions, built once on the context's mesh and free DOFs (its
+  /// errors name the "regions" key); partition->touching(): the regions touch or nest, so
+  /// AsyncBackwardEuler runs its hierarchy solve (chooseStepSolver()).
+  std::optional<RegionPartition> partition;
 };
 
 /// The option keys "async" reads.
@@ -70,7 +69,8 @@ int largestRatio(const std::vector<AsyncRegion>& regions);
 
 /// Adjusts or refuses (by throwing ValidationError) the settings of each "async" integrator
 /// a registry builds, after they are read from the scene: e.g. the PETSc backend sets
-/// AsyncOptions::largeSystemSolver and refuses nested regions.
+/// AsyncOptions::largeSystemSolver (which chooseStepSolver() then refuses for regions that
+/// touch or nest, naming the option).
 /// The context is the integrator's (its mesh, system, timestep).
 using AsyncSettingsHook = std::function<void(AsyncSettings&, const IntegratorContext&)>;
 

@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The run summary of AsyncBackwardEuler (RunReport lines and resume caveats).
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/core/error.hpp>
+#include <asyncfem/core/stopwatch.hpp>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "detail/asyncBackwardEulerImpl.hpp"
+#include "detail/multirateSupport.hpp"
+
+namespace asyncfem {
+
+namespace {
+
+/// A tolerance as a reader writes it (1e-10, not to_string's 0.000000).
+std::string shortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+
+}  // namespace
+
+namespace {
+
+// The summary's lines on implicit contact (none without contact steps).
+void appendContactLines(const AsyncRunStats& r, int contactIterations, std::vector<std::string>& lines) {
+  if (r.contactSteps == 0) return;
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "async implicit contact: %lld solves over %lld steps (%.2f per step); %lld steps stopped at %d "
+                "iterations unconverged (largest relative residual %.2e); A^S refactored %lld times for its "
+                "contact blocks",
+                r.contactIterations, r.contactSteps,
+                static_cast<double>(r.contactIterations) / static_cast<double>(r.contactSteps),
+                r.unconvergedContactSteps, contactIterations, r.largestContactResidual, r.contactRegionFactorizations);
+  lines.emplace_back(line);
+  if (r.contactFreeSteps == 0 && r.contactScreenedSteps == 0) return;
+  std::snprintf(line, sizeof(line),
+                "async implicit contact: %lld of those steps certified free of contact after one solve (end states "
+                "only, Eq. C6); %lld started with no substep state to visit (predicted states clear, Eq. C7)",
+                r.contactFreeSteps, r.contactScreenedSteps);
+  lines.emplace_back(line);
+}
+
+}  // namespace
+
+RunReport AsyncBackwardEuler::report() const {
+  const AsyncRunStats& r = runStats_;
+  char line[256];
+  RunReport report;
+  report.factorNonZeros = factorNonZeros();
+  report.mayGainEnergy = options_.coupling == AsyncCoupling::paper;
+  const auto addCaveat = [&report](const std::string& caveat) {
+    if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
+    report.resumeCaveat += caveat;
+  };
+  if (options_.laggedSchur && !impl_->linear && impl_->solver == AsyncStepSolver::structuredSchur) {
+    addCaveat(
+        "laggedSchur: the H^{LL*} factor kept as preconditioner is not in the checkpoint, so the resumed run "
+        "refactors at its first step; its frames match an uninterrupted run to about the Schur tolerance (" +
+        shortNumber(options_.laggedSchurTolerance) + "), not bit for bit");
+  }
+  if (options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
+      options_.method == AsyncSolveMethod::structured) {
+    addCaveat(
+        "quickSetUp: whether the partition still solved on the whole system's factor is not in the checkpoint, "
+        "so the resumed run starts on it again; its frames match an uninterrupted run to about the Schur "
+        "tolerance (" +
+        shortNumber(options_.laggedSchurTolerance) + "), not bit for bit");
+  }
+  if (implicitContact()) {
+    addCaveat(
+        "implicit contact: the contact blocks kept in the regions' A^S (and the factors built with them) are not in "
+        "the checkpoint, so the resumed run's contact iterations start from other matrices; its frames match an "
+        "uninterrupted run to about the contact tolerance (" +
+        shortNumber(options_.contactTolerance) + "), not bit for bit");
+  }
+  if (policy_) {
+    addCaveat(
+        "adaptive regions: the partition in use and how long it has been kept are not in the checkpoint, so the "
+        "resumed run chooses its regions afresh from the resumed state and its frames can differ from an "
+        "uninterrupted run's (by as much as two partitions' trajectories differ)");
+  }
+  std::vector<std::string>& lines = report.lines;
+  if (!regionNote_.empty()) lines.push_back("regions " + regionNote_);
+  lines.push_back("async step solver: " + toString(impl_->solver) +
+                  (impl_->solver == AsyncStepSolver::hierarchy ? " (regions that touch or nest, or on request)"
+                                                               : " (each region coupled only to L)"));
+  if (impl_->solver == AsyncStepSolver::hierarchy) {
+    hierarchyReportLines(lines);
+    if (policy_) appendRepartitionLines(repartitions_, lines);
+    return report;
+  }
+  std::snprintf(line, sizeof(line),
+                "async set-up %.3f s (Z %.3f s over %lld right-hand sides on %d threads, H^LL* %.3f s); |S| %d, "
+                "|I| %d, |L| %d DOFs",
+                r.setupSeconds, r.setupZSeconds, r.zColumns, r.zThreads, r.setupSchurSeconds, r.fastDofs,
+                r.interfaceDofs, r.largeDofs);
+  lines.emplace_back(line);
+  std::snprintf(line, sizeof(line), "async steady large step %.3f ms over %lld steps; rebuilds %lld (%.3f s)",
+                1000.0 * r.meanStepSeconds(), r.steps, r.rebuilds, r.rebuildSeconds);
+  lines.emplace_back(line);
+  if (r.laggedSteps > 0) {
+    std::snprintf(line, sizeof(line),
+                  "async lagged Schur: %lld steps, %lld iterations, largest relative residual %.2e; %lld rebuilds "
+                  "refreshed without Z",
+                  r.laggedSteps, r.schurIterations, r.largestSchurResidual, r.laggedRefreshes);
+    lines.emplace_back(line);
+  }
+  if (r.quickSteps > 0 || r.quickEnds > 0) {
+    std::snprintf(line, sizeof(line),
+                  "async quick set-up: %lld steps on the whole system's factor, %lld iterations (largest relative "
+                  "residual %.2e); %lld partition(s) then built Z and H^LL*",
+                  r.quickSteps, r.quickIterations, r.largestQuickResidual, r.quickEnds);
+    lines.emplace_back(line);
+  }
+  appendContactLines(r, options_.contactIterations, lines);
+  if (policy_) appendRepartitionLines(repartitions_, lines);
+  return report;
+}
+
+}  // namespace asyncfem

@@ -1,0 +1,160 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The state AsyncBackwardEuler keeps per partition (its Impl) and a cached set-up, shared by
+// the files that implement its parts (asyncBackwardEuler.cpp: set-up and the structured
+// step; hierarchyStep.cpp; setUpCache.cpp; laggedSchur.cpp; quickSetUp.cpp;
+// implicitContact.cpp; regionDistribution.cpp). Private to the library.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <array>
+#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/detail/vertexRotations.hpp>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "detail/fastRegion.hpp"
+#include "detail/hierarchySystem.hpp"
+#include "detail/naiveSolver.hpp"
+#include "detail/schurSolver.hpp"
+#include "detail/sparseBlocks.hpp"
+#include "detail/substepContact.hpp"
+
+namespace asyncfem {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+struct AsyncBackwardEuler::Impl {
+  AsyncStepSolver solver = AsyncStepSolver::structuredSchur;  // chosen at each set-up
+  // The hierarchy solve (AsyncStepSolver::hierarchy) and f_ext at each time unit where some
+  // DOF's step ends (Eq. N3; the vectors are kept from step to step).
+  std::unique_ptr<detail::HierarchySystem> hierarchy;
+  std::map<long long, Eigen::VectorXd> unitForces;
+  bool linear = true;
+  bool factorsCurrent = false;     // linear forces: blocks and factors built for this timestep and partition
+  bool settingUp = false;          // the build under way is a set-up (for AsyncRunStats)
+  SparseMatrix stiffness;          // full 3n x 3n tangent K(u_0)
+  bool perElementTangent = false;  // interface element tangents from the force model (else cached linear ones)
+  Eigen::VectorXd internalForce;
+  std::vector<detail::FastRegion> regions;
+  SubmatrixExtractor massLL, stiffLL;
+  // M and K share one pattern (element matrices on the same mesh): K^{LL} is cut with
+  // massLL's map and stiffLL stays empty. Checked once (-1: not yet).
+  int sharedPattern = -1;
+  // Linear forces: K is in stiffness (constant), so a new partition need not evaluate it again.
+  bool linearStiffnessKnown = false;
+  SparseMatrix Mll, Kll;     // M^{LL} (constant), K^{LL}; only when M and K have different patterns
+  bool cutLL = false;        // L's blocks extracted once per partition; later only their values are updated
+  SparseMatrix largeSystem;  // Â^L
+  detail::SchurSolver schur;
+  detail::VertexRotations rotations;  // since the last rebuild (laggedSchurRotation)
+  detail::NaiveSolver naive;
+  // This step refactored A^S but keeps Z and H^{LL*} from an earlier tangent (laggedSchur).
+  bool schurLagging = false;
+  // The lagged factor's rent-or-buy prices (flops, set at each full rebuild): one
+  // refinement iteration, one rebuild, and the iterations paid since the last rebuild.
+  double laggedIterationFlops = 0.0, laggedRebuildFlops = 0.0, laggedRent = 0.0;
+  // Quick set-up (AsyncOptions::quickSetUp): L's system is solved on the whole system's
+  // factor until the iterations' extra flops reach the priced cost of the rebuild (Eq. Q4).
+  bool quick = false;
+  // Whether the lagged factor was last built with Z (not refreshed): the next rebuild
+  // the rule asks for may then be a refresh.
+  bool lastRebuildFull = false;
+  // The lagged solve converged with its tracker: recovery from the summed probes.
+  bool recoverFromProbes = false;
+  double quickExtraFlops = 0.0;
+  // Linear forces with a symmetric K (checked once): f_int(u_0) = K u_0 and K v_0 are taken
+  // row by row (row i = column i) on the DOFs that need them, and L's rows need only
+  // K (u_0 + (beta + hL) v_0), as in single-rate backward Euler.
+  bool symmetricStiffness = false;
+  bool symmetryChecked = false;
+  // Per-step buffers (full 3n, or |L|).
+  Eigen::VectorXd stiffVelocity, massVelocity, stateForce, predicted, newU, newV, work;
+  Eigen::VectorXd rhsL, rhsSchur, Y;
+  std::vector<double> interfaceSum;  // regionDistribution: every region's interface rows, summed
+  const Eigen::VectorXd* externalL = nullptr;
+  // External forces at the distinct times of one large step (shared by regions whose
+  // substeps fall on the same times), valid for one step.
+  std::vector<double> forceTimes;
+  std::vector<Eigen::VectorXd> forceValues;
+  std::size_t forcesUsed = 0;
+  // Each region's vertices with free DOFs (ascending), and a region's force at one
+  // predicted substep: where the system has externalForceAt, substeps evaluate only them.
+  std::vector<std::vector<int>> regionVertices;
+  Eigen::VectorXd regionForce;
+  // Implicit contact (DynamicSystem::externalForceJacobian): the contact iteration, and
+  // whether a region's A^S holds contact blocks that Z and H^{LL*} were not built with.
+  detail::SubstepContact contact;
+  bool correctionsStale = false;
+  // The first solve of an implicit contact step recovers end states only, for the
+  // certificate (Eq. C6): each DOF's interval of displacements over the step's states, the
+  // boxes' centres, the interface's share of each vertex's radius (squared) and the
+  // vertices near an obstacle.
+  bool certifying = false;
+  Eigen::VectorXd lowest, highest, centred, runningPath;
+  std::vector<double> reachSquares;
+  std::vector<int> nearObstacles;
+  // Each region's contact blocks in A^S when Z and H^{LL*} were last built (none at a
+  // set-up): a step whose blocks are back to them (contact over, A^S refactored to what Z
+  // was built from) has current corrections again, without a rebuild.
+  struct BuiltBlocks {
+    std::vector<std::array<int, 3>> positions;
+    std::vector<Eigen::Matrix3d> blocks, stiffness;
+  };
+  std::vector<BuiltBlocks> schurBlocks;
+
+  void noteSchurBlocks() {
+    schurBlocks.resize(regions.size());
+    for (std::size_t i = 0; i < regions.size(); ++i)
+      schurBlocks[i] = {regions[i].contactPositions, regions[i].contactBlocks, regions[i].contactStiffness};
+  }
+  bool blocksAsBuilt() const {
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+      const detail::FastRegion& rb = regions[i];
+      if (i >= schurBlocks.size()) {
+        if (rb.hasContactBlocks()) return false;
+        continue;
+      }
+      const BuiltBlocks& built = schurBlocks[i];
+      if (rb.contactPositions != built.positions || rb.contactBlocks != built.blocks ||
+          rb.contactStiffness != built.stiffness)
+        return false;
+    }
+    return true;
+  }
+
+  bool rowProducts() const { return linear && symmetricStiffness; }
+  /// f_ext at time and state (u, v0), evaluated in this thread (the callback need not be
+  /// thread-safe): once per distinct time at the start state u0, always anew at a predicted one.
+  const Eigen::VectorXd& forceAt(const DynamicSystem& system, double time, const Eigen::VectorXd& u,
+                                 const Eigen::VectorXd& u0, const Eigen::VectorXd& v0) {
+    if (&u == &u0) {
+      for (std::size_t k = 0; k < forcesUsed; ++k)
+        if (forceTimes[k] == time) return forceValues[k];
+    }
+    if (forcesUsed == forceValues.size()) {
+      forceValues.emplace_back();
+      forceTimes.push_back(0.0);
+    }
+    Eigen::VectorXd& f = forceValues[forcesUsed];
+    forceTimes[forcesUsed] = &u == &u0 ? time : std::nan("");  // predicted states are never shared
+    ++forcesUsed;
+    f.setZero(u0.size());
+    system.externalForce(time, u, v0, f);
+    return f;
+  }
+};
+
+// A set-up kept for reuse by run-time regions (the most recently used first).
+struct AsyncBackwardEuler::CachedSetUp {
+  std::vector<std::pair<int, std::vector<int>>> key;  // (ratio, vertices) of every region, sorted
+  RegionPartition partition;
+  std::unique_ptr<Impl> impl;
+  AsyncRunStats sizes;  // fastDofs, interfaceDofs, largeDofs
+  double timestep = 0.0;
+};
+
+}  // namespace asyncfem
