@@ -109,6 +109,40 @@ TEST(Composition, RunTimeRegionsNest) {
   EXPECT_GT(largestDifference(nested, merged), 1e-8);
 }
 
+// Twelve regions that touch at one ratio (a row of vertex slabs, each its own region) step
+// as the one region of their vertices: the set-up merges them (the same step counts, so the
+// same step, Eqs. N1-N6), and the structured Schur solve runs; bit for bit the one region's
+// run, and the hierarchy solve's to round-off (1e-10).
+TEST(Composition, TouchingRegionsAtOneRatioStepAsOneRegion) {
+  const test::TestSystem ts = test::makeTestSystem(0.1, 1e-3);
+  std::vector<AsyncRegion> slabs;
+  std::vector<int> all;
+  for (int k = 0; k < 4; ++k) {
+    const double x = 0.5 + 0.125 * k;
+    slabs.push_back({"slab" + std::to_string(k), test::verticesOnPlanes(ts.mesh, {x}), 8});
+    all.insert(all.end(), slabs.back().vertices.begin(), slabs.back().vertices.end());
+  }
+  AsyncOptions exact;
+  exact.laggedSchur = false;
+  AsyncBackwardEuler touching(ts.system, kLargeStep, slabs, exact);
+  AsyncBackwardEuler one(ts.system, kLargeStep, {{"all", all, 8}}, exact);
+  AsyncOptions hierarchyOptions;
+  hierarchyOptions.method = AsyncSolveMethod::hierarchy;
+  AsyncBackwardEuler hierarchy(ts.system, kLargeStep, slabs, hierarchyOptions);
+  EXPECT_EQ(touching.stepSolver(), AsyncStepSolver::structuredSchur);
+  ASSERT_EQ(touching.partition().numRegions(), 1);
+  EXPECT_EQ(touching.partition().region(0).name, "slab0+slab1+slab2+slab3");
+  for (Integrator* integrator :
+       {static_cast<Integrator*>(&touching), static_cast<Integrator*>(&one), static_cast<Integrator*>(&hierarchy)}) {
+    integrator->setState(ts.u0, ts.v0);
+    for (int k = 0; k < 5; ++k) integrator->step();
+  }
+  EXPECT_EQ((touching.displacement() - one.displacement()).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((touching.velocity() - one.velocity()).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LT(largestDifference(touching, hierarchy), 1e-10);
+  EXPECT_GT(touching.displacement().norm(), 0.0);
+}
+
 /// The key of the AsyncOptionError that building the integrator throws ("" for none).
 std::string refusedKey(const test::TestSystem& ts, DynamicSystem system, const std::vector<AsyncRegion>& regions,
                        const AsyncOptions& options) {

@@ -101,6 +101,12 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   Impl& d = *impl_;
   Stopwatch watch;
   checkPartitionFits(partition);
+  // Regions that touch at one ratio step as one region (the same step counts): the solve
+  // sees them merged, so only a partition with different ratios across an element needs the
+  // hierarchy solve.
+  if (std::vector<AsyncRegion> merged = partition.regionsMergedAtOneRatio(); !merged.empty()) {
+    partition = RegionPartition(*system_.mesh, system_.freeDofs, std::move(merged));
+  }
   d.solver = chooseStepSolver(options_, partition, system_);
   partition_ = std::move(partition);
   if (d.solver == AsyncStepSolver::hierarchy) {

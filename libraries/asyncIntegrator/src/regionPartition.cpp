@@ -112,9 +112,13 @@ void RegionPartition::countSteps(const TetMesh& mesh) {
             describeRegion(regions_, vertexRegion_[static_cast<std::size_t>(fastest)]) +
             ": the ratios of regions that share an element must divide one another (e.g. 4 and 8, not 3 and 4)");
       }
-      if (region >= 0 && firstFast >= 0 && region != firstFast && touchingElement_ < 0) {
-        touchingElement_ = e;
-        touchingRegions_ = {firstFast, region};
+      if (region >= 0 && firstFast >= 0 && region != firstFast) {
+        if (touchingElement_ < 0) {
+          touchingElement_ = e;
+          touchingRegions_ = {firstFast, region};
+        }
+        if (regions_[static_cast<std::size_t>(region)].ratio == regions_[static_cast<std::size_t>(firstFast)].ratio)
+          equalRatioContacts_.emplace_back(std::min(region, firstFast), std::max(region, firstFast));
       }
       if (region >= 0 && firstFast < 0) firstFast = region;
     }
@@ -127,6 +131,35 @@ void RegionPartition::countSteps(const TetMesh& mesh) {
   }
   const std::set<int> distinct(vertexCounts_.begin(), vertexCounts_.end());
   levels_.assign(distinct.begin(), distinct.end());
+}
+
+std::vector<AsyncRegion> RegionPartition::regionsMergedAtOneRatio() const {
+  if (equalRatioContacts_.empty()) return {};
+  std::vector<int> root(regions_.size());
+  std::iota(root.begin(), root.end(), 0);
+  const auto find = [&root](int i) {
+    while (root[static_cast<std::size_t>(i)] != i) i = root[static_cast<std::size_t>(i)];
+    return i;
+  };
+  for (const auto& [a, b] : equalRatioContacts_) {
+    const int ra = find(a), rb = find(b);
+    if (ra != rb) root[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+  }
+  std::vector<AsyncRegion> merged;
+  std::vector<int> slot(regions_.size(), -1);
+  for (std::size_t i = 0; i < regions_.size(); ++i) {
+    int& s = slot[static_cast<std::size_t>(find(static_cast<int>(i)))];
+    if (s < 0) {
+      s = static_cast<int>(merged.size());
+      merged.push_back(regions_[i]);
+      continue;
+    }
+    AsyncRegion& into = merged[static_cast<std::size_t>(s)];
+    into.name += "+" + regions_[i].name;
+    into.vertices.insert(into.vertices.end(), regions_[i].vertices.begin(), regions_[i].vertices.end());
+  }
+  for (AsyncRegion& region : merged) sortUnique(region.vertices);
+  return merged;
 }
 
 void RegionPartition::requireSeparated(const std::string& who) const {

@@ -91,6 +91,12 @@ class RegionPartition {
   /// Throws asyncfem::ValidationError naming the first element with vertices in two fast
   /// regions, for a solve that couples each S_i only to L (who: the integrator or solve).
   void requireSeparated(const std::string& who) const;
+  /// The regions with every pair that touches at one ratio (an element joins them, their
+  /// ratios are equal) merged into one region (vertices united, names joined by "+"): the
+  /// same step counts, so the same step (Eqs. N1-N6 depend on the counts alone), and where
+  /// no other regions touch, a partition the two-level solve runs. Empty when no two
+  /// regions touch at one ratio.
+  std::vector<AsyncRegion> regionsMergedAtOneRatio() const;
 
   /// vertexRegion()[vertex], or -1 for a vertex out of range.
   int regionOfVertex(int vertex) const {
@@ -119,7 +125,8 @@ class RegionPartition {
   std::vector<int> vertexRegion_;
   std::vector<int> vertexCounts_, elementCounts_, levels_;
   long long units_ = 1;
-  int touchingElement_ = -1;  // first element with vertices in two fast regions
+  int touchingElement_ = -1;                             // first element with vertices in two fast regions
+  std::vector<std::pair<int, int>> equalRatioContacts_;  // regions an element joins at one ratio
   std::pair<int, int> touchingRegions_{-1, -1};
 };
 
