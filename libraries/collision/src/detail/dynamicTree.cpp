@@ -19,9 +19,8 @@ class BoxTree {
       const btVector3 high(boxes.max(0, i), boxes.max(1, i), boxes.max(2, i));
       tree_.insert(btDbvtVolume::FromMM(low, high), reinterpret_cast<void*>(static_cast<std::intptr_t>(i)));
     }
-    // Incremental insertion leaves an unbalanced tree; rebuilding it top-down (surface-area
-    // split, bottom-up below 128 leaves) halves the traversal on the benchmark surfaces.
-    tree_.optimizeTopDown();
+    // Incremental insertion only: rebuilding top-down afterwards (optimizeTopDown) made
+    // each query 3 to 5 times slower on the benchmark surfaces (docs/collision.md).
   }
   BoxTree(const BoxTree&) = delete;
   BoxTree& operator=(const BoxTree&) = delete;
