@@ -2,8 +2,8 @@
 // Broad-phase cost per query (building the structure and finding every candidate pair) of
 // Bullet's dynamic AABB tree, the uniform spatial hash and brute force, on the same surfaces
 // and positions. Printed as a Markdown table; every time is the median wall time of
-// repeated calls after one untimed call, and every ratio compares two measurements of the
-// same run. Brute force runs only up to --brute-force-limit triangles.
+// repeated calls (at least --repeats and at least 0.5 s of them) after one untimed call,
+// and every ratio compares two measurements of the same run. Brute force runs only up to --brute-force-limit triangles.
 //
 //   benchmarkCollision [--repeats 5] [--brute-force-limit 12000]
 //
@@ -85,15 +85,19 @@ double meanEdgeLength(const Surface& s) {
   return sum / s.surface.numEdges();
 }
 
-/// Median seconds of call() over repeats calls after one untimed call.
+/// Median seconds of call() over at least `repeats` calls and at least 0.5 s of calls,
+/// after one untimed call (small surfaces get many samples, so that a burst of load from
+/// other processes moves the median little).
 double medianSeconds(const std::function<void()>& call, int repeats) {
   call();
   std::vector<double> samples;
-  for (int k = 0; k < repeats; ++k) {
+  double total = 0.0;
+  while (static_cast<int>(samples.size()) < repeats || total < 0.5) {
     Stopwatch watch;
     watch.start();
     call();
     samples.push_back(watch.stop());
+    total += samples.back();
   }
   std::sort(samples.begin(), samples.end());
   return samples[samples.size() / 2];
@@ -142,7 +146,9 @@ int main(int argc, char** argv) {
 
   std::printf("Machine: %s, %u hardware threads, load %s; one thread (both methods are serial)\n\n",
               bench::cpuModel().c_str(), std::thread::hardware_concurrency(), bench::loadAverage().c_str());
-  std::printf("dhat = 0.1 x mean edge length; times in ms per query (build + find), median of %d\n\n", repeats);
+  std::printf(
+      "dhat = 0.1 x mean edge length; times in ms per query (build + find), median of >= %d calls and >= 0.5 s\n\n",
+      repeats);
   std::printf(
       "| surface | scene | triangles | candidates | tree ms | hash ms | brute force ms | tree / hash | brute "
       "/ hash |\n");
