@@ -14,8 +14,9 @@ namespace {
 
 constexpr BroadPhaseMethod kFastMethods[] = {BroadPhaseMethod::DynamicTree, BroadPhaseMethod::SpatialHash};
 
-/// Random boxes in [0, 1]^3 of mixed sizes: points, boxes of up to 0.2 and a few of up to
-/// half the domain, the cases a uniform grid handles worst.
+/// Random boxes in [0, 1]^3 of mixed sizes: points, boxes of up to 0.2, a few of up to half
+/// the domain and one over all of it (the spatial hash's large-box path), the cases a
+/// uniform grid handles worst.
 BoxSet randomBoxes(int count, unsigned seed) {
   std::mt19937 generator(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -28,6 +29,10 @@ BoxSet randomBoxes(int count, unsigned seed) {
       boxes.min(axis, b) = unit(generator);
       boxes.max(axis, b) = boxes.min(axis, b) + size * unit(generator);
     }
+  }
+  if (count > 1) {  // one box over the whole domain
+    boxes.min.col(1).setZero();
+    boxes.max.col(1).setOnes();
   }
   return boxes;
 }

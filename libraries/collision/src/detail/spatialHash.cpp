@@ -48,19 +48,37 @@ struct CellEntry {
   bool operator<(const CellEntry& other) const { return key != other.key ? key < other.key : box < other.box; }
 };
 
-/// (cell, box) for every cell each box touches, sorted by cell.
-std::vector<CellEntry> cellEntries(const BoxSet& boxes, const Grid& grid) {
+/// A box touching more cells than this is "large": it is kept out of the grid and tested
+/// against every box of the other set, so that a few boxes much larger than the cell (a
+/// coarse obstacle under a fine body) cost a loop each instead of millions of cell entries.
+constexpr long long kLargeBoxCells = 64;
+
+/// The boxes in the grid as (cell, box) for every cell each touches, sorted by cell, and
+/// the large boxes.
+struct GridEntries {
   std::vector<CellEntry> entries;
-  entries.reserve(4 * static_cast<std::size_t>(boxes.size()));
+  std::vector<int> largeBoxes;
+  std::vector<char> isLarge;
+};
+
+GridEntries cellEntries(const BoxSet& boxes, const Grid& grid) {
+  GridEntries result;
+  result.entries.reserve(4 * static_cast<std::size_t>(boxes.size()));
+  result.isLarge.assign(static_cast<std::size_t>(boxes.size()), 0);
   for (int b = 0; b < boxes.size(); ++b) {
     const Eigen::Array3i low = grid.cell(boxes.min.col(b).array());
     const Eigen::Array3i high = grid.cell(boxes.max.col(b).array());
+    if ((high - low + 1).cast<long long>().prod() > kLargeBoxCells) {
+      result.largeBoxes.push_back(b);
+      result.isLarge[static_cast<std::size_t>(b)] = 1;
+      continue;
+    }
     for (int k = low.z(); k <= high.z(); ++k)
       for (int j = low.y(); j <= high.y(); ++j)
-        for (int i = low.x(); i <= high.x(); ++i) entries.push_back({Grid::key({i, j, k}), b});
+        for (int i = low.x(); i <= high.x(); ++i) result.entries.push_back({Grid::key({i, j, k}), b});
   }
-  std::sort(entries.begin(), entries.end());
-  return entries;
+  std::sort(result.entries.begin(), result.entries.end());
+  return result;
 }
 
 /// Whether `key` is the cell of the low corner of the boxes' intersection: the one cell of
@@ -81,8 +99,19 @@ BoxPairs spatialHashPairs(const BoxSet& first, const BoxSet& second) {
   BoxPairs pairs;
   if (first.size() == 0 || second.size() == 0) return pairs;
   const Grid grid = makeGrid(first, second);
-  const std::vector<CellEntry> firstEntries = cellEntries(first, grid);
-  const std::vector<CellEntry> secondEntries = cellEntries(second, grid);
+  const GridEntries firstGrid = cellEntries(first, grid);
+  const GridEntries secondGrid = cellEntries(second, grid);
+  // Pairs with a large box: each large box of the first set against every box of the
+  // second, each large box of the second against the first set's boxes in the grid.
+  for (const int i : firstGrid.largeBoxes)
+    for (int j = 0; j < second.size(); ++j)
+      if (boxesOverlap(first, i, second, j)) pairs.emplace_back(i, j);
+  for (const int j : secondGrid.largeBoxes)
+    for (int i = 0; i < first.size(); ++i)
+      if (!firstGrid.isLarge[static_cast<std::size_t>(i)] && boxesOverlap(first, i, second, j))
+        pairs.emplace_back(i, j);
+  const std::vector<CellEntry>& firstEntries = firstGrid.entries;
+  const std::vector<CellEntry>& secondEntries = secondGrid.entries;
   std::size_t a = 0, b = 0;
   while (a < firstEntries.size() && b < secondEntries.size()) {
     if (firstEntries[a].key < secondEntries[b].key) {
@@ -112,7 +141,16 @@ BoxPairs spatialHashSelfPairs(const BoxSet& boxes) {
   BoxPairs pairs;
   if (boxes.size() == 0) return pairs;
   const Grid grid = makeGrid(boxes, boxes);
-  const std::vector<CellEntry> entries = cellEntries(boxes, grid);
+  const GridEntries gridEntries = cellEntries(boxes, grid);
+  // Pairs with a large box, each once: a large box i against every other box j, except a
+  // large j < i (that pair came with j).
+  for (const int i : gridEntries.largeBoxes) {
+    for (int j = 0; j < boxes.size(); ++j) {
+      if (j == i || (gridEntries.isLarge[static_cast<std::size_t>(j)] && j < i)) continue;
+      if (boxesOverlap(boxes, i, boxes, j)) pairs.emplace_back(std::min(i, j), std::max(i, j));
+    }
+  }
+  const std::vector<CellEntry>& entries = gridEntries.entries;
   for (std::size_t begin = 0; begin < entries.size();) {
     const std::size_t end = rangeEnd(entries, begin);
     const std::uint64_t key = entries[begin].key;
