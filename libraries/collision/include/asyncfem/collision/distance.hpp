@@ -38,9 +38,10 @@ struct SquaredDistance {
 };
 
 /// Region of the closest point of the closed triangle (a, b, c) to p. The face counts when
-/// p projects inside or onto the boundary of a triangle of non-zero area; otherwise the
-/// closest point of the three edges decides (a zero-area triangle is its edges). Ties
-/// between edges go to the first of AB, BC, CA.
+/// p projects inside or onto the boundary of the triangle; otherwise the closest point of
+/// the three edges decides. A triangle whose sides at a make sin^2(angle) <= 1e-14 (zero or
+/// nearly zero area) is its edges: its closest point moves by at most its width, below 1e-7
+/// of its sides. Ties between edges go to the first of AB, BC, CA.
 PointTriangleRegion pointTriangleRegion(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                         const Eigen::Vector3d& c);
 
@@ -52,7 +53,9 @@ double pointTriangleDistanceSquared(const Eigen::Vector3d& p, const Eigen::Vecto
 /// respect to (p, a, b, c), from the closed form of `region` (Eqs. D1-D3). Pass the region
 /// pointTriangleRegion returns; another one gives that form's value (the distance to the
 /// line, plane or vertex it names), which is what a contact model that keeps a region
-/// fixed over a Newton step wants.
+/// fixed over a Newton step wants. A form that does not exist for the input (the line of a
+/// zero-length edge, the plane of a zero-area triangle, the common normal of parallel
+/// edges) gives NaN.
 SquaredDistance pointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                       const Eigen::Vector3d& c, PointTriangleRegion region);
 /// The same, in the region pointTriangleRegion finds.
@@ -62,7 +65,7 @@ SquaredDistance pointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vec
 /// Region of the closest points of the closed segments (a0, a1) and (b0, b1). Interior when
 /// the lines' closest points lie inside both segments and the edges are not parallel
 /// (sin^2 of their angle above 1e-14; below it the lines' distance is ill-conditioned and
-/// an endpoint form is used, which differs from the exact distance by at most
+/// an endpoint form is used, which differs from the exact squared distance by order
 /// 1e-14 * (edge length)^2); otherwise the endpoint whose point-segment distance is
 /// smallest (ties to the first in A0, A1, B0, B1 order).
 EdgeEdgeRegion edgeEdgeRegion(const Eigen::Vector3d& a0, const Eigen::Vector3d& a1, const Eigen::Vector3d& b0,
