@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libsuitesparse-dev libmetis-dev libopenblas-dev zlib1g-dev
-  nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
+  nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev libbullet-dev
   libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev clang-format-14
   libpetsc-real-dev openmpi-bin ffmpeg
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-scipy python3-pytest python3-matplotlib
