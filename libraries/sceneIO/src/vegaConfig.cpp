@@ -3,19 +3,21 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/vegaConfig.hpp>
 #include <cctype>
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string_view>
 
+#include "detail/vegaOptionFile.hpp"
+
 namespace asyncfem {
 
 namespace {
 
-namespace fs = std::filesystem;
+using detail::ConfigOptions;
+using detail::Option;
+using detail::splitOptions;
 using nlohmann::json;
 
 // Keys that only steer Vega's interactive program: the window, camera, lights, what is
@@ -103,144 +105,6 @@ std::string interactiveReason(std::string_view key) {
   if (key == "outputFilename") return "ignored: offlineSimulator writes an .afsim file (--output)";
   return "ignored: interactive only (window, camera, lighting or display)";
 }
-
-// One `*key` and its value line.
-struct Option {
-  std::string key;
-  std::string value;
-  std::size_t line = 0;  // of the key
-  bool done = false;     // given an outcome
-};
-
-std::string trim(std::string_view text) {
-  const auto isSpace = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
-  while (!text.empty() && isSpace(text.front())) text.remove_prefix(1);
-  while (!text.empty() && isSpace(text.back())) text.remove_suffix(1);
-  return std::string(text);
-}
-
-// The options in file order: each `*key` takes the next line that is neither blank nor a
-// `#` comment as its value (commented alternatives may sit between them).
-std::vector<Option> splitOptions(const std::string& text, const std::string& source) {
-  std::vector<Option> options;
-  std::istringstream in(text);
-  std::string raw;
-  std::size_t lineNumber = 0;
-  bool awaitingValue = false;
-  while (std::getline(in, raw)) {
-    ++lineNumber;
-    const std::string line = trim(raw);
-    if (line.empty() || line.front() == '#') continue;
-    if (line.front() == '*') {
-      if (awaitingValue) {
-        throw ParseError(source, options.back().line, "*" + options.back().key + ": no value before the next option");
-      }
-      const std::string key = trim(std::string_view(line).substr(1));
-      if (key.empty()) throw ParseError(source, lineNumber, "'*' without an option name");
-      for (const Option& earlier : options) {
-        if (earlier.key == key) {
-          throw ParseError(source, lineNumber,
-                           "*" + key + ": given twice (first on line " + std::to_string(earlier.line) + ")");
-        }
-      }
-      options.push_back({key, "", lineNumber, false});
-      awaitingValue = true;
-      continue;
-    }
-    if (!awaitingValue) {
-      throw ParseError(source, lineNumber, "\"" + line + "\" is not an option (option names start with '*')");
-    }
-    options.back().value = line;
-    awaitingValue = false;
-  }
-  if (awaitingValue) throw ParseError(source, options.back().line, "*" + options.back().key + ": no value");
-  return options;
-}
-
-// The options of one config and what each became.
-class ConfigOptions {
- public:
-  ConfigOptions(std::vector<Option> options, std::string source, fs::path base)
-      : options_(std::move(options)), source_(std::move(source)), base_(std::move(base)) {}
-
-  Option* find(std::string_view key) {
-    for (Option& option : options_) {
-      if (option.key == key) return &option;
-    }
-    return nullptr;
-  }
-  [[noreturn]] void fail(const Option& option, const std::string& message) const {
-    throw ParseError(source_, option.line, "*" + option.key + ": " + message);
-  }
-  const std::string& source() const { return source_; }
-  const std::vector<Option>& all() const { return options_; }
-
-  void note(std::string_view key, const std::string& outcome) {
-    if (Option* option = find(key)) {
-      option->done = true;
-      outcomes_[option->key] = outcome;
-    }
-  }
-  std::string outcome(const std::string& key) const {
-    const auto it = outcomes_.find(key);
-    return it == outcomes_.end() ? std::string() : it->second;
-  }
-
-  std::optional<std::string> text(std::string_view key) {
-    Option* option = find(key);
-    if (option == nullptr || option->value == "__none") return std::nullopt;
-    return option->value;
-  }
-  std::optional<double> number(std::string_view key) {
-    Option* option = find(key);
-    if (option == nullptr) return std::nullopt;
-    errno = 0;
-    char* end = nullptr;
-    const double value = std::strtod(option->value.c_str(), &end);
-    if (end == option->value.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(value)) {
-      fail(*option, "expected a finite number, got \"" + option->value + "\"");
-    }
-    return value;
-  }
-  std::optional<long> integer(std::string_view key) {
-    Option* option = find(key);
-    if (option == nullptr) return std::nullopt;
-    errno = 0;
-    char* end = nullptr;
-    const long value = std::strtol(option->value.c_str(), &end, 10);
-    if (end == option->value.c_str() || *end != '\0' || errno == ERANGE) {
-      fail(*option, "expected an integer, got \"" + option->value + "\"");
-    }
-    return value;
-  }
-  std::optional<bool> boolean(std::string_view key) {
-    Option* option = find(key);
-    if (option == nullptr) return std::nullopt;
-    std::string value = option->value;
-    std::transform(value.begin(), value.end(), value.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (value == "1" || value == "true") return true;
-    if (value == "0" || value == "false") return false;
-    fail(*option, "expected a boolean (1, 0, true or false), got \"" + option->value + "\"");
-  }
-  // A file value: as written (for the scene JSON) and resolved against the config's
-  // folder; it must exist.
-  std::optional<std::pair<std::string, fs::path>> file(std::string_view key) {
-    const std::optional<std::string> written = text(key);
-    if (!written) return std::nullopt;
-    const fs::path path(*written);
-    const fs::path resolved = path.is_absolute() || base_.empty() ? path : (base_ / path).lexically_normal();
-    std::error_code ignored;
-    if (!fs::is_regular_file(resolved, ignored)) fail(*find(key), "no such file: " + resolved.string());
-    return std::make_pair(*written, resolved);
-  }
-
- private:
-  std::vector<Option> options_;
-  std::string source_;
-  fs::path base_;
-  std::map<std::string, std::string> outcomes_;
-};
 
 std::string quoted(const std::string& text) { return "\"" + text + "\""; }
 
