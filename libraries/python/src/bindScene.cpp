@@ -73,12 +73,13 @@ void bindProblem(py::module_& module) {
       module, "Problem",
       "Mesh, fixed vertices, physics and loads; matrices are assembled on request (assemblies counts them)")
       .def(py::init([](const TetMesh& mesh, const py::handle& fixed, const ProblemSettings& settings,
-                       std::vector<VertexLoad> loads) {
+                       std::vector<VertexLoad> loads, std::shared_ptr<PenaltyContact> contact) {
              return std::make_shared<Problem>(std::make_shared<const TetMesh>(mesh),
-                                              indexListArgument(fixed, "fixed_vertices"), settings, std::move(loads));
+                                              indexListArgument(fixed, "fixed_vertices"), settings, std::move(loads),
+                                              std::move(contact));
            }),
            py::arg("mesh"), py::arg("fixed_vertices"), py::arg("settings") = ProblemSettings{},
-           py::arg("loads") = std::vector<VertexLoad>{})
+           py::arg("loads") = std::vector<VertexLoad>{}, py::arg("contact") = nullptr)
       .def_property_readonly("mesh", [](const Problem& p) { return p.mesh(); })
       .def_property_readonly("fixed_vertices", &Problem::fixedVertices)
       .def_property_readonly("free_dofs", &Problem::freeDofs)
@@ -95,6 +96,13 @@ void bindProblem(py::module_& module) {
       .def(
           "last_change", [](const Problem& p) { return p.loads()->lastChange(); },
           "the time after which no load changes any more")
+      .def(
+          "last_window_change", [](const Problem& p) { return p.loads()->lastWindowChange(); },
+          "the last time a load window opens or closes (0 if none), contact aside: from then on only the "
+          "constant load and the contact act")
+      .def_property_readonly(
+          "contact", [](const Problem& p) { return std::const_pointer_cast<PenaltyContact>(p.contact()); },
+          "the problem's PenaltyContact, or None")
       .def(
           "constant_load", [](const Problem& p) { return Eigen::VectorXd(p.loads()->constantPart(p.numDofs())); },
           "the part of the external force that never changes (3n), e.g. gravity")
