@@ -7,6 +7,7 @@
 #include <asyncfem/runMonitor/runMonitor.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/sceneIO/vegaConfig.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <bindings.hpp>
 #include <integrators.hpp>
@@ -132,6 +133,34 @@ void bindProblem(py::module_& module) {
         return std::const_pointer_cast<Problem>(buildProblem(loadScene(path)));
       },
       py::arg("path"), "The problem a scene file describes (mesh, boundary, physics, loads), nothing assembled");
+  module.def(
+      "read_vega_config",
+      [](const std::filesystem::path& path) {
+        const VegaConfig config = readVegaConfig(path);
+        py::dict result;
+        result["scene"] = py::module_::import("json").attr("loads")(config.sceneJson.dump());
+        py::list keys;
+        for (const VegaConfigKey& key : config.keys) {
+          py::dict entry;
+          entry["key"] = key.key;
+          entry["value"] = key.value;
+          entry["line"] = key.line;
+          entry["outcome"] = key.outcome;
+          keys.append(entry);
+        }
+        result["keys"] = keys;
+        const auto optionalPath = [](const std::optional<std::filesystem::path>& file) {
+          return file ? py::cast(file->string()) : py::none();
+        };
+        result["rendering_mesh"] = optionalPath(config.renderingMesh);
+        result["secondary_rendering_mesh"] = optionalPath(config.secondaryRenderingMesh);
+        result["secondary_interpolation"] = optionalPath(config.secondaryInterpolation);
+        return result;
+      },
+      py::arg("path"),
+      "A Vega FEM simulator .config translated (docs/file-formats.md): {'scene': the equivalent scene JSON as a "
+      "dict (paths relative to the config's folder), 'keys': [{key, value, line, outcome}] in file order, "
+      "'rendering_mesh', 'secondary_rendering_mesh', 'secondary_interpolation': paths or None}");
 }
 
 }  // namespace
