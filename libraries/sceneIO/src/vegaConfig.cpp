@@ -189,7 +189,7 @@ void mapSolver(ConfigOptions& options, json& scene) {
   options.note("solver", mapped);
   options.note("implicitSolverMethod", solverOption == options.find("implicitSolverMethod")
                                            ? mapped + " (obsolete spelling of *solver)"
-                                           : "ignored: obsolete spelling, *solver given");
+                                           : "ignored: obsolete spelling of *solver (none, or *solver given)");
 
   const bool implicit = solver == "implicitNewmark" || solver == "implicitBackwardEuler";
   const long maxIterations = options.integer("maxIterations").value_or(1);
