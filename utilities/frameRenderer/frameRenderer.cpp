@@ -22,8 +22,10 @@
 #include <asyncfem/render/renderer.hpp>
 #include <asyncfem/render/surfaceEmbedding.hpp>
 #include <asyncfem/render/surfaceMesh.hpp>
+#include <asyncfem/render/vegaInterpolation.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/sceneIO/vegaConfig.hpp>
 #include <asyncfem/simulationIO/frameSelection.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
@@ -66,6 +68,7 @@ struct CommandLine {
   bool tintRegions = false;
   std::vector<std::string> fixedSets;
   std::optional<std::string> renderMesh;
+  std::optional<std::string> interp;
   bool ground = false;
   bool noObstacles = false;
   std::optional<std::string> compare;
@@ -111,6 +114,8 @@ struct Shared {
   std::optional<ContactPlane> sceneGround;            // the scene's contact.ground, where --ground draws the floor
   std::vector<SurfaceMesh> obstacles;                 // the scene's contact spheres, drawn unless --no-obstacles
   std::vector<Eigen::Matrix3Xf> obstacleColors;       // one colour per obstacle vertex
+  std::string scenePath;                              // the scene the mesh came from, if any
+  std::string surfaceName = "tet mesh boundary";      // what the surface drawn is, for the summary
 };
 
 /// A worker's own state: readers of every run and warping objects (neither is
@@ -209,6 +214,8 @@ void addInputOptions(CLI::App& app, CommandLine& options) {
       ->delimiter(',');
   app.add_option("--render-mesh", options.renderMesh,
                  "Surface mesh (any format assimp reads) embedded in the tet mesh");
+  app.add_option("--interp", options.interp,
+                 "Vega .interp weights of --render-mesh (an OBJ) instead of locating its vertices in the tet mesh");
   app.add_flag("--ground", options.ground, "Draw a checkered ground plane with a shadow under the object");
   app.add_flag("--no-obstacles", options.noObstacles,
                "Do not draw the scene's contact spheres (drawn by default when the scene has them)");
@@ -268,6 +275,9 @@ void checkOptionCombinations(const CommandLine& options) {
   }
   if (options.labels && !options.compare) {
     throw Error("--labels needs --compare");
+  }
+  if (options.interp && !options.renderMesh) {
+    throw Error("--interp needs --render-mesh (the OBJ its weights belong to)");
   }
   if (options.fps != 30.0 && !options.video) {
     throw Error("--fps needs --video");
@@ -346,7 +356,8 @@ void loadMesh(const CommandLine& options, std::int64_t numVertices, Shared& shar
     const std::shared_ptr<const Problem> problem =
         options.scene ? buildProblem(loadScene(*options.scene), &warnings)
                       : recordedSceneProblem(header, shared.runs.front().file.string(), &warnings);
-    const Scene scene = loadScene(options.scene ? *options.scene : header.scenePath);
+    shared.scenePath = options.scene ? *options.scene : header.scenePath;
+    const Scene scene = loadScene(shared.scenePath);
     shared.sceneGround = scene.contact.ground;
     if (!options.noObstacles) addObstacles(scene.contact.spheres, shared);
     if (options.tintRegions && !header.hasRegionRatios) shared.fixedRegionRatios = fixedRegionRatios(scene, *problem);
@@ -603,8 +614,8 @@ void printSummary(const CommandLine& options, const Shared& shared, std::size_t 
   }
   out << " -> " << (fs::path(options.output) / "frame_NNNNN.png").string() << " (" << options.width << " x "
       << options.height << "), " << totalSeconds << " s\n";
-  out << "  surface     " << (options.renderMesh ? *options.renderMesh : std::string("tet mesh boundary")) << ", "
-      << shared.surface.numSurfaceVertices() << " vertices, " << shared.surface.triangles().size() << " triangles";
+  out << "  surface     " << shared.surfaceName << ", " << shared.surface.numSurfaceVertices() << " vertices, "
+      << shared.surface.triangles().size() << " triangles";
   if (shared.surface.numOutsideVertices() > 0) {
     out << " (" << shared.surface.numOutsideVertices() << " outside the tet mesh, up to "
         << shared.surface.maxOutsideDistance() << " away)";
@@ -639,6 +650,24 @@ std::optional<int> parseCommandLine(int argc, char** argv, CommandLine& options)
   return std::nullopt;
 }
 
+/// The surface drawn: --render-mesh (with --interp: placed by Vega's weights), a Vega
+/// config scene's secondary render mesh with its .interp weights, or the tet mesh's boundary.
+SurfaceEmbedding drawnSurface(const CommandLine& options, Shared& shared) {
+  if (options.renderMesh) {
+    shared.surfaceName = *options.renderMesh;
+    return options.interp ? embedWithVegaInterpolation(*shared.mesh, *options.renderMesh, *options.interp)
+                          : SurfaceEmbedding::embed(*shared.mesh, loadSurfaceMesh(*options.renderMesh));
+  }
+  if (!shared.scenePath.empty() && isVegaConfigPath(shared.scenePath)) {
+    const VegaConfig config = readVegaConfig(shared.scenePath);
+    if (config.secondaryRenderingMesh) {
+      shared.surfaceName = config.secondaryRenderingMesh->string();
+      return embedWithVegaInterpolation(*shared.mesh, *config.secondaryRenderingMesh, *config.secondaryInterpolation);
+    }
+  }
+  return SurfaceEmbedding::boundary(*shared.mesh);
+}
+
 /// The simulation files (checked first: a missing or broken file is the most common
 /// mistake), the selected frames, the mesh and the surface drawn, in surfaceColor with the
 /// tinted sets.
@@ -653,8 +682,7 @@ Shared openInputs(const CommandLine& options, const Eigen::Vector3f& surfaceColo
   numFrames = extent.numFrames;
   frames = frames::selectFrames(frames::parseFrameSelection(options.frames), extent.numFrames, framesSource);
   loadMesh(options, extent.numVertices, shared);
-  shared.surface = options.renderMesh ? SurfaceEmbedding::embed(*shared.mesh, loadSurfaceMesh(*options.renderMesh))
-                                      : SurfaceEmbedding::boundary(*shared.mesh);
+  shared.surface = drawnSurface(options, shared);
   chooseSurfaceColors(options, surfaceColor, shared);
   return shared;
 }

@@ -27,6 +27,7 @@
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/sceneIO/stepGrowthCheck.hpp>
+#include <asyncfem/sceneIO/vegaConfig.hpp>
 #include <asyncfem/simulationIO/checkpoint.hpp>
 #include <asyncfem/simulationIO/crc32.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
@@ -119,18 +120,10 @@ const char* signalName(int signal) {
   }
 }
 
-std::string readFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // The scene file as the run fingerprint sees it: without frames.count and output, which
-// a resumed run may change. Scenes may carry // comments, as loadScene accepts them.
+// a resumed run may change (a Vega .config: the scene JSON it stands for).
 std::string fingerprintText(const fs::path& sceneFile) {
-  nlohmann::json json = nlohmann::json::parse(readFile(sceneFile), nullptr, /*allow_exceptions=*/true,
-                                              /*ignore_comments=*/true);
+  nlohmann::json json = asyncfem::sceneFileJson(sceneFile);
   if (json.is_object()) {
     json.erase("output");
     if (json.contains("frames") && json["frames"].is_object()) json["frames"].erase("count");

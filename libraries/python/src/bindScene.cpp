@@ -7,6 +7,7 @@
 #include <asyncfem/runMonitor/runMonitor.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
+#include <asyncfem/sceneIO/vegaConfig.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <bindings.hpp>
 #include <integrators.hpp>
@@ -73,12 +74,13 @@ void bindProblem(py::module_& module) {
       module, "Problem",
       "Mesh, fixed vertices, physics and loads; matrices are assembled on request (assemblies counts them)")
       .def(py::init([](const TetMesh& mesh, const py::handle& fixed, const ProblemSettings& settings,
-                       std::vector<VertexLoad> loads) {
+                       std::vector<VertexLoad> loads, std::shared_ptr<PenaltyContact> contact) {
              return std::make_shared<Problem>(std::make_shared<const TetMesh>(mesh),
-                                              indexListArgument(fixed, "fixed_vertices"), settings, std::move(loads));
+                                              indexListArgument(fixed, "fixed_vertices"), settings, std::move(loads),
+                                              std::move(contact));
            }),
            py::arg("mesh"), py::arg("fixed_vertices"), py::arg("settings") = ProblemSettings{},
-           py::arg("loads") = std::vector<VertexLoad>{})
+           py::arg("loads") = std::vector<VertexLoad>{}, py::arg("contact") = nullptr)
       .def_property_readonly("mesh", [](const Problem& p) { return p.mesh(); })
       .def_property_readonly("fixed_vertices", &Problem::fixedVertices)
       .def_property_readonly("free_dofs", &Problem::freeDofs)
@@ -95,6 +97,13 @@ void bindProblem(py::module_& module) {
       .def(
           "last_change", [](const Problem& p) { return p.loads()->lastChange(); },
           "the time after which no load changes any more")
+      .def(
+          "last_window_change", [](const Problem& p) { return p.loads()->lastWindowChange(); },
+          "the last time a load window opens or closes (0 if none), contact aside: from then on only the "
+          "constant load and the contact act")
+      .def_property_readonly(
+          "contact", [](const Problem& p) { return std::const_pointer_cast<PenaltyContact>(p.contact()); },
+          "the problem's PenaltyContact, or None")
       .def(
           "constant_load", [](const Problem& p) { return Eigen::VectorXd(p.loads()->constantPart(p.numDofs())); },
           "the part of the external force that never changes (3n), e.g. gravity")
@@ -124,6 +133,34 @@ void bindProblem(py::module_& module) {
         return std::const_pointer_cast<Problem>(buildProblem(loadScene(path)));
       },
       py::arg("path"), "The problem a scene file describes (mesh, boundary, physics, loads), nothing assembled");
+  module.def(
+      "read_vega_config",
+      [](const std::filesystem::path& path) {
+        const VegaConfig config = readVegaConfig(path);
+        py::dict result;
+        result["scene"] = py::module_::import("json").attr("loads")(config.sceneJson.dump());
+        py::list keys;
+        for (const VegaConfigKey& key : config.keys) {
+          py::dict entry;
+          entry["key"] = key.key;
+          entry["value"] = key.value;
+          entry["line"] = key.line;
+          entry["outcome"] = key.outcome;
+          keys.append(entry);
+        }
+        result["keys"] = keys;
+        const auto optionalPath = [](const std::optional<std::filesystem::path>& file) {
+          return file ? py::cast(file->string()) : py::none();
+        };
+        result["rendering_mesh"] = optionalPath(config.renderingMesh);
+        result["secondary_rendering_mesh"] = optionalPath(config.secondaryRenderingMesh);
+        result["secondary_interpolation"] = optionalPath(config.secondaryInterpolation);
+        return result;
+      },
+      py::arg("path"),
+      "A Vega FEM simulator .config translated (docs/file-formats.md): {'scene': the equivalent scene JSON as a "
+      "dict (paths relative to the config's folder), 'keys': [{key, value, line, outcome}] in file order, "
+      "'rendering_mesh', 'secondary_rendering_mesh', 'secondary_interpolation': paths or None}");
 }
 
 }  // namespace

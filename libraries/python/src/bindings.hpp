@@ -32,6 +32,7 @@ void bindModal(py::module_& module);
 void bindOutput(py::module_& module);
 void bindRender(py::module_& module);
 void bindScene(py::module_& module);
+void bindContact(py::module_& module);
 
 /// A float64 1-D array of `size` entries (any size when size < 0) taken from value without
 /// a copy when it already is a contiguous float64 ndarray; other array-likes (lists) are

@@ -25,5 +25,6 @@ PYBIND11_MODULE(_asyncfem, module) {
 #if ASYNCFEM_PYTHON_WITH_RENDER
   python::bindRender(module);
 #endif
+  python::bindContact(module);  // before bindScene: Problem takes a PenaltyContact
   python::bindScene(module);
 }

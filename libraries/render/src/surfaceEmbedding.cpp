@@ -254,7 +254,39 @@ class ElementGrid {
   std::vector<int> visited_;
 };
 
+/// Throws ValidationError when a triangle of surface names a vertex it does not have.
+void checkTriangles(const SurfaceMesh& surface) {
+  const auto m = surface.vertices.cols();
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+    for (const int v : surface.triangles[t]) {
+      if (v < 0 || v >= m) {
+        throw ValidationError("surface triangle " + std::to_string(t) + " names vertex " + std::to_string(v) +
+                              ", out of range [0, " + std::to_string(m) + ")");
+      }
+    }
+  }
+}
+
 }  // namespace
+
+SurfaceEmbedding SurfaceEmbedding::withWeights(int numTetVertices, SurfaceMesh surface, Eigen::Matrix4Xi tetVertices,
+                                               Eigen::Matrix4Xd weights) {
+  checkTriangles(surface);
+  const auto m = surface.vertices.cols();
+  if (tetVertices.cols() != m || weights.cols() != m) {
+    throw ValidationError("embedding weights for " + std::to_string(tetVertices.cols()) +
+                          " vertices, but the surface has " + std::to_string(m));
+  }
+  if (m > 0 && (tetVertices.minCoeff() < 0 || tetVertices.maxCoeff() >= numTetVertices)) {
+    throw ValidationError("embedding names a tet vertex out of range [0, " + std::to_string(numTetVertices) + ")");
+  }
+  SurfaceEmbedding embedding;
+  embedding.numTetVertices_ = numTetVertices;
+  embedding.surface_ = std::move(surface);
+  embedding.tetVertices_ = std::move(tetVertices);
+  embedding.weights_ = std::move(weights);
+  return embedding;
+}
 
 SurfaceEmbedding SurfaceEmbedding::boundary(const TetMesh& mesh) {
   SurfaceEmbedding embedding;
@@ -290,14 +322,7 @@ SurfaceEmbedding SurfaceEmbedding::embed(const TetMesh& mesh, SurfaceMesh surfac
     throw ValidationError("cannot embed a surface in a tet mesh without elements");
   }
   const auto m = surface.vertices.cols();
-  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
-    for (const int v : surface.triangles[t]) {
-      if (v < 0 || v >= m) {
-        throw ValidationError("surface triangle " + std::to_string(t) + " names vertex " + std::to_string(v) +
-                              ", out of range [0, " + std::to_string(m) + ")");
-      }
-    }
-  }
+  checkTriangles(surface);
   SurfaceEmbedding embedding;
   embedding.numTetVertices_ = mesh.numVertices();
   embedding.tetVertices_.resize(4, m);

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
+#include <asyncfem/sceneIO/vegaConfig.hpp>
 #include <asyncfem/settings/jsonReader.hpp>
 #include <cctype>
 #include <cmath>
@@ -684,6 +685,7 @@ Scene loadScene(const std::filesystem::path& path) {
   if (std::filesystem::is_directory(path, ignored)) {
     throw Error(name + ": is a directory, not a scene file (scenes are JSON; see docs/scene-format.md)");
   }
+  if (isVegaConfigPath(path)) return readVegaConfig(path).scene;
   std::string extension = path.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });

@@ -33,6 +33,12 @@ class SurfaceEmbedding {
   /// Throws asyncfem::ValidationError if mesh has no element or a surface triangle names
   /// a vertex out of range.
   static SurfaceEmbedding embed(const TetMesh& mesh, SurfaceMesh surface);
+  /// surface with weights given by the caller (e.g. a Vega .interp file): tetVertices
+  /// (4 x m, ids in [0, numTetVertices)) and weights (4 x m) of its m vertices. Throws
+  /// asyncfem::ValidationError on a size mismatch, an id out of range or a triangle naming
+  /// a vertex out of range; the weights are used as given.
+  static SurfaceEmbedding withWeights(int numTetVertices, SurfaceMesh surface, Eigen::Matrix4Xi tetVertices,
+                                      Eigen::Matrix4Xd weights);
 
   int numSurfaceVertices() const { return static_cast<int>(surface_.vertices.cols()); }
   int numTetVertices() const { return numTetVertices_; }
