@@ -17,8 +17,9 @@ jobs=$(nproc)
 # step lists the parts it builds and fails when one of these is missing (the CMake cache
 # variable ASYNCFEM_REQUIRE_PARTS), so that no group of tests vanishes unnoticed.
 # ASYNCFEM_ALLOW_MISSING=petsc,python (a comma-separated list of these names) leaves parts
-# out on purpose, e.g. on a machine without PETSc.
-ci_parts="petsc python render utilities docs"
+# out on purpose, e.g. on a machine without PETSc. The benchmark drivers are compiled (not
+# run) so that they cannot rot unnoticed: about 120 s of CPU, 1 minute on 2 cores.
+ci_parts="petsc python render utilities docs benchmarks"
 required_parts() {  # the semicolon list of $1 less ASYNCFEM_ALLOW_MISSING
   local allowed=" ${ASYNCFEM_ALLOW_MISSING//,/ } " part required=""
   for part in ${ASYNCFEM_ALLOW_MISSING//,/ }; do
@@ -72,7 +73,7 @@ case "${1:-}" in
   "")
     parts=$(required_parts "$ci_parts")
     cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DASYNCFEM_BUILD_TESTS=ON \
-      "-DASYNCFEM_REQUIRE_PARTS=$parts"
+      -DASYNCFEM_BUILD_BENCHMARKS=ON "-DASYNCFEM_REQUIRE_PARTS=$parts"
     cmake --build build --parallel "$jobs"
     ctest --test-dir build --output-on-failure --parallel "$jobs"
     run_sanitized_library_tests
