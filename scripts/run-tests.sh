@@ -40,8 +40,9 @@ required_parts() {  # the semicolon list of $1 less ASYNCFEM_ALLOW_MISSING
 # Python, so that CI checks memory and undefined behaviour on every change
 # (docs/robustness.md, "Sanitizers"; about 2 minutes on 2 cores). The sparse solvers'
 # tests left this list when a fresh-clone CI run reached 33 minutes; --sanitize runs them.
-# Any report fails the run.
-sanitized_tests="volumetricMeshTests simulationIOTests"
+# fuzzFileCorpusTests replays the fuzz corpora of those readers (tests/fuzz; the scene
+# corpus needs every library and is replayed sanitized by --sanitize). Any report fails the run.
+sanitized_tests="volumetricMeshTests simulationIOTests fuzzFileCorpusTests"
 run_sanitized_library_tests() {
   cmake -S . -B build-asan-fast -G Ninja -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS=-O1 \
     -DASYNCFEM_SANITIZE=ON -DASYNCFEM_BUILD_TESTS=ON -DASYNCFEM_BUILD_UTILITIES=OFF \

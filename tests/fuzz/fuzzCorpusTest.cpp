@@ -143,7 +143,10 @@ TEST_P(FuzzCorpusTest, EverySeedHasItsExpectedOutcome) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Harnesses, FuzzCorpusTest, ::testing::ValuesIn(asyncfem::fuzz::allHarnesses()),
+// ASYNCFEM_FUZZ_REPLAYED_HARNESSES: allHarnesses (fuzzCorpusTests) or fileHarnesses
+// (fuzzFileCorpusTests, for the sanitized build without sceneIO; tests/fuzz/CMakeLists.txt).
+INSTANTIATE_TEST_SUITE_P(Harnesses, FuzzCorpusTest,
+                         ::testing::ValuesIn(asyncfem::fuzz::ASYNCFEM_FUZZ_REPLAYED_HARNESSES()),
                          [](const ::testing::TestParamInfo<Harness>& info) { return info.param.name; });
 
 }  // namespace

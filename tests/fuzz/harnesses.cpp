@@ -4,8 +4,6 @@
 #include <unistd.h>
 
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/sceneIO/scene.hpp>
-#include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/simulationIO/checkpoint.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
@@ -16,6 +14,8 @@
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
+
+#include "harnessSupport.hpp"
 
 namespace asyncfem::fuzz {
 
@@ -41,6 +41,8 @@ class ScratchFolder {
  private:
   fs::path path_;
 };
+
+}  // namespace
 
 const fs::path& scratchFolder() {
   static const ScratchFolder folder;
@@ -80,20 +82,7 @@ std::string describe(const Error& error) {
   return std::string(kind) + ": " + message;
 }
 
-// Runs one reader (read() returns the summary of what it read): an asyncfem::Error is the
-// documented rejection of bad input; any other exception is a finding.
-template <typename Read>
-Outcome classify(Read&& read) {
-  try {
-    return {OutcomeClass::accepted, read()};
-  } catch (const Error& error) {
-    return {OutcomeClass::rejected, describe(error)};
-  } catch (const std::exception& error) {
-    return {OutcomeClass::crashed, std::string("an exception not derived from asyncfem::Error: ") + error.what()};
-  } catch (...) {
-    return {OutcomeClass::crashed, "an exception not derived from std::exception"};
-  }
-}
+namespace {
 
 Outcome readMesh(const std::function<fs::path()>& writeFiles,
                  TetMesh (*reader)(const fs::path&, const MeshReadOptions&, MeshReadReport*)) {
@@ -107,14 +96,14 @@ Outcome readMesh(const std::function<fs::path()>& writeFiles,
   });
 }
 
+}  // namespace
+
 // libFuzzer's finding: the input that made a reader throw something undocumented.
 void abortOnCrash(const Outcome& outcome) {
   if (outcome.kind != OutcomeClass::crashed) return;
   std::fprintf(stderr, "fuzz harness: %s\n", outcome.text.c_str());
   std::abort();
 }
-
-}  // namespace
 
 Outcome vegOutcome(const std::uint8_t* data, std::size_t size) {
   return readMesh([&] { return writeInput("input.veg", data, size); }, readVeg);
@@ -169,33 +158,6 @@ Outcome checkpointOutcome(const std::uint8_t* data, std::size_t size) {
   });
 }
 
-namespace {
-
-// A box generator of at most 64 cells: built in milliseconds, so fuzzing stays fast and no
-// input can ask the harness for a huge mesh (beams and mesh files are parsed only).
-bool smallGeneratedMesh(const Scene& scene) {
-  constexpr long long kMaxCells = 64;
-  if (scene.mesh.source != Scene::MeshSource::box) return false;
-  const Eigen::Vector3i& cells = scene.mesh.box.cells;
-  return cells.minCoeff() > 0 && static_cast<long long>(cells.x()) * cells.y() * cells.z() <= kMaxCells;
-}
-
-}  // namespace
-
-Outcome sceneOutcome(const std::uint8_t* data, std::size_t size) {
-  return classify([&] {
-    // Relative paths in the scene (mesh files, .bou files) resolve against the scratch folder.
-    const Scene scene = loadScene(writeInput("fuzz.json", data, size));
-    if (!smallGeneratedMesh(scene)) return "integrator " + scene.integrator.name + " (parsed only)";
-    // Small generated meshes are built too, so that what parseScene passes on unread
-    // reaches its readers: the integrator's options (async regions, adaptive policies,
-    // reuseFactor, ...), the force model's options and the fixed and loaded vertices.
-    const Simulation simulation = buildSimulation(scene);
-    return "integrator " + simulation.integrator->name() + ", built with " +
-           std::to_string(simulation.mesh->numVertices()) + " vertices";
-  });
-}
-
 int fuzzVeg(const std::uint8_t* data, std::size_t size) {
   abortOnCrash(vegOutcome(data, size));
   return 0;
@@ -217,17 +179,11 @@ int fuzzSimulationFile(const std::uint8_t* data, std::size_t size) {
   return 0;
 }
 
-int fuzzScene(const std::uint8_t* data, std::size_t size) {
-  abortOnCrash(sceneOutcome(data, size));
-  return 0;
-}
-
-std::vector<Harness> allHarnesses() {
+std::vector<Harness> fileHarnesses() {
   return {{"veg", {{"veg", vegOutcome}}},
           {"tetgen", {{"tetgen", tetGenOutcome}}},
           {"gmsh", {{"gmsh", gmshOutcome}}},
-          {"simulationFile", {{"simulationReader", simulationReaderOutcome}, {"checkpoint", checkpointOutcome}}},
-          {"scene", {{"scene", sceneOutcome}}}};
+          {"simulationFile", {{"simulationReader", simulationReaderOutcome}, {"checkpoint", checkpointOutcome}}}};
 }
 
 }  // namespace asyncfem::fuzz

@@ -63,6 +63,11 @@ struct Harness {
   std::string name;
   std::vector<Reader> readers;
 };
+/// Every harness (sceneHarness.cpp).
 std::vector<Harness> allHarnesses();
+/// The harnesses of the mesh and output-file readers, without the scene (harnesses.cpp):
+/// they need only volumetricMesh and simulationIO, so the sanitized library build of
+/// scripts/run-tests.sh replays their corpora (fuzzFileCorpusTests).
+std::vector<Harness> fileHarnesses();
 
 }  // namespace asyncfem::fuzz
