@@ -8,9 +8,11 @@
 # for SECONDS in turn. BUILD_DIR (default build-fuzz) is configured with clang++ and
 # ASYNCFEM_FUZZ=ON and built if needed. Each target keeps a growing working corpus in
 # BUILD_DIR/fuzz/corpus/TARGET (seeded from tests/fuzz/corpus/TARGET, which it never
-# changes) and writes crashing, hanging or over-allocating inputs to
-# BUILD_DIR/fuzz/artifacts/TARGET/. The last lines print executions, coverage, corpus
-# units, peak RSS and findings per target; the exit status is 1 if any target found something.
+# changes) and writes crashing, hanging or over-allocating inputs to a folder of this run,
+# BUILD_DIR/fuzz/artifacts/TARGET/RUN (RUN: the UTC start time), so that the findings
+# counted are this run's only and earlier ones stay for inspection. The last lines print
+# executions, coverage, corpus units, peak RSS and findings per target; the exit status is
+# 1 if any target found something in this run.
 set -euo pipefail
 
 usage() {
@@ -44,11 +46,12 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=0:allocator_may_return_null=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 
+run=$(date -u +%Y%m%dT%H%M%SZ)
 status=0
 summary=()
 for name in "${targets[@]}"; do
   corpus=$build/fuzz/corpus/$name
-  artifacts=$build/fuzz/artifacts/$name
+  artifacts=$build/fuzz/artifacts/$name/$run
   log=$build/fuzz/$name.log
   mkdir -p "$corpus" "$artifacts"
   options=(-max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024

@@ -13,18 +13,40 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 jobs=$(nproc)
 
+# The optional parts CI is meant to test (docs/robustness.md, "What CI tests"). The configure
+# step lists the parts it builds and fails when one of these is missing (the CMake cache
+# variable ASYNCFEM_REQUIRE_PARTS), so that no group of tests vanishes unnoticed.
+# ASYNCFEM_ALLOW_MISSING=petsc,python (a comma-separated list of these names) leaves parts
+# out on purpose, e.g. on a machine without PETSc. The benchmark drivers are compiled (not
+# run) so that they cannot rot unnoticed: about 120 s of CPU, 1 minute on 2 cores.
+ci_parts="petsc python render utilities docs benchmarks"
+required_parts() {  # the semicolon list of $1 less ASYNCFEM_ALLOW_MISSING
+  local allowed=" ${ASYNCFEM_ALLOW_MISSING//,/ } " part required=""
+  for part in ${ASYNCFEM_ALLOW_MISSING//,/ }; do
+    if [[ " $ci_parts " != *" $part "* ]]; then
+      echo "ASYNCFEM_ALLOW_MISSING: unknown part '$part' (known: $ci_parts)" >&2
+      return 1
+    fi
+  done
+  for part in $1; do
+    [[ $allowed == *" $part "* ]] || required+="${required:+;}$part"
+  done
+  echo "$required"
+}
+
 # The library tests of what reads untrusted bytes (users' .veg, TetGen and Gmsh files, the
 # output file and checkpoints), built a second time with AddressSanitizer, LeakSanitizer
 # and UndefinedBehaviorSanitizer at -O1 and without the utilities, rendering, PETSc and
 # Python, so that CI checks memory and undefined behaviour on every change
 # (docs/robustness.md, "Sanitizers"; about 2 minutes on 2 cores). The sparse solvers'
 # tests left this list when a fresh-clone CI run reached 33 minutes; --sanitize runs them.
-# Any report fails the run.
-sanitized_tests="volumetricMeshTests simulationIOTests"
+# fuzzFileCorpusTests replays the fuzz corpora of those readers (tests/fuzz; the scene
+# corpus needs every library and is replayed sanitized by --sanitize). Any report fails the run.
+sanitized_tests="volumetricMeshTests simulationIOTests fuzzFileCorpusTests"
 run_sanitized_library_tests() {
   cmake -S . -B build-asan-fast -G Ninja -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS=-O1 \
     -DASYNCFEM_SANITIZE=ON -DASYNCFEM_BUILD_TESTS=ON -DASYNCFEM_BUILD_UTILITIES=OFF \
-    -DASYNCFEM_WITH_RENDER=OFF -DASYNCFEM_WITH_PETSC=OFF -DASYNCFEM_WITH_PYTHON=OFF
+    -DASYNCFEM_WITH_RENDER=OFF -DASYNCFEM_WITH_PETSC=OFF -DASYNCFEM_WITH_PYTHON=OFF -DASYNCFEM_REQUIRE_PARTS=
   # shellcheck disable=SC2086
   cmake --build build-asan-fast --parallel "$jobs" --target $sanitized_tests
   local leaks=1 test log
@@ -50,7 +72,9 @@ run_sanitized_library_tests() {
 }
 case "${1:-}" in
   "")
-    cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DASYNCFEM_BUILD_TESTS=ON
+    parts=$(required_parts "$ci_parts")
+    cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DASYNCFEM_BUILD_TESTS=ON \
+      -DASYNCFEM_BUILD_BENCHMARKS=ON "-DASYNCFEM_REQUIRE_PARTS=$parts"
     cmake --build build --parallel "$jobs"
     ctest --test-dir build --output-on-failure --parallel "$jobs"
     run_sanitized_library_tests
@@ -58,8 +82,10 @@ case "${1:-}" in
   --sanitize)
     # -O1: GCC takes several times longer on sanitized code at -O2 -g (test files 2-6
     # minutes each on 2 cores), while -O1 keeps the sanitizers' reports exact.
+    # Python stays off: an instrumented module cannot load into the uninstrumented interpreter.
+    parts=$(required_parts "petsc render utilities docs")
     cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS=-O1 -DASYNCFEM_SANITIZE=ON \
-      -DASYNCFEM_BUILD_TESTS=ON
+      -DASYNCFEM_BUILD_TESTS=ON "-DASYNCFEM_REQUIRE_PARTS=$parts"
     cmake --build build-asan --parallel "$jobs"
     ctest --test-dir build-asan --output-on-failure --parallel "$jobs"
     ;;

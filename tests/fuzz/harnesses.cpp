@@ -4,17 +4,18 @@
 #include <unistd.h>
 
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/sceneIO/scene.hpp>
-#include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/simulationIO/checkpoint.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
-#include <nlohmann/json.hpp>
+#include <functional>
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
+
+#include "harnessSupport.hpp"
 
 namespace asyncfem::fuzz {
 
@@ -41,6 +42,8 @@ class ScratchFolder {
   fs::path path_;
 };
 
+}  // namespace
+
 const fs::path& scratchFolder() {
   static const ScratchFolder folder;
   return folder.path();
@@ -58,9 +61,9 @@ fs::path writeInput(const std::string& name, const std::uint8_t* data, std::size
   return path;
 }
 
-// The outcome of a rejected input: the error's class and its message, with the scratch
-// folder (which holds the process id) replaced by "<scratch>".
-std::string rejected(const Error& error) {
+// A rejected input's summary: the error's class and its message, with the scratch folder
+// (which holds the process id) replaced by "<scratch>".
+std::string describe(const Error& error) {
   const char* kind = "Error";
   if (dynamic_cast<const TimestepError*>(&error) != nullptr) {
     kind = "TimestepError";
@@ -76,146 +79,111 @@ std::string rejected(const Error& error) {
   for (std::size_t at = message.find(folder); at != std::string::npos; at = message.find(folder, at)) {
     message.replace(at, folder.size(), "<scratch>");
   }
-  return "rejected: " + std::string(kind) + ": " + message;
+  return std::string(kind) + ": " + message;
 }
 
-std::string readMesh(const fs::path& path,
-                     TetMesh (*reader)(const fs::path&, const MeshReadOptions&, MeshReadReport*)) {
-  try {
+namespace {
+
+Outcome readMesh(const std::function<fs::path()>& writeFiles,
+                 TetMesh (*reader)(const fs::path&, const MeshReadOptions&, MeshReadReport*)) {
+  return classify([&] {
     MeshReadReport report;
-    const TetMesh mesh = reader(path, MeshReadOptions{}, &report);
+    const TetMesh mesh = reader(writeFiles(), MeshReadOptions{}, &report);
     // A mesh that reads is valid (the TetMesh constructor checks it); touch it so that a
     // broken one would show up under the sanitizers.
     if (mesh.numElements() <= 0 || !mesh.restPositions().allFinite()) std::abort();
-    return "accepted: " + std::to_string(mesh.numVertices()) + " vertices, " + std::to_string(mesh.numElements()) +
-           " elements";
-  } catch (const Error& error) {
-    // Rejected with a documented error: expected for most inputs.
-    return rejected(error);
-  }
+    return std::to_string(mesh.numVertices()) + " vertices, " + std::to_string(mesh.numElements()) + " elements";
+  });
 }
 
 }  // namespace
 
-std::string vegOutcome(const std::uint8_t* data, std::size_t size) {
-  return readMesh(writeInput("input.veg", data, size), readVeg);
+// libFuzzer's finding: the input that made a reader throw something undocumented.
+void abortOnCrash(const Outcome& outcome) {
+  if (outcome.kind != OutcomeClass::crashed) return;
+  std::fprintf(stderr, "fuzz harness: %s\n", outcome.text.c_str());
+  std::abort();
 }
 
-std::string tetGenOutcome(const std::uint8_t* data, std::size_t size) {
-  const std::string_view text(reinterpret_cast<const char*>(data), size);
-  constexpr std::string_view separator = "@@ele\n";
-  std::size_t split = text.find(separator);
-  std::size_t eleStart = split == std::string_view::npos ? size : split + separator.size();
-  if (split == std::string_view::npos) split = size;
-  writeInput("input.node", data, split);
-  writeInput("input.ele", data + eleStart, size - eleStart);
-  return readMesh(scratchFolder() / "input.node", readTetGen);
+Outcome vegOutcome(const std::uint8_t* data, std::size_t size) {
+  return readMesh([&] { return writeInput("input.veg", data, size); }, readVeg);
 }
 
-std::string gmshOutcome(const std::uint8_t* data, std::size_t size) {
-  return readMesh(writeInput("input.msh", data, size), readGmsh);
+Outcome tetGenOutcome(const std::uint8_t* data, std::size_t size) {
+  return readMesh(
+      [&] {
+        const std::string_view text(reinterpret_cast<const char*>(data), size);
+        constexpr std::string_view separator = "@@ele\n";
+        std::size_t split = text.find(separator);
+        const std::size_t eleStart = split == std::string_view::npos ? size : split + separator.size();
+        if (split == std::string_view::npos) split = size;
+        writeInput("input.ele", data + eleStart, size - eleStart);
+        return writeInput("input.node", data, split);
+      },
+      readTetGen);
 }
 
-std::string simulationFileOutcome(const std::uint8_t* data, std::size_t size) {
-  const fs::path path = writeInput("input.afsim", data, size);
-  std::string outcome = "reader: ";
-  try {
-    SimulationReader reader(path);
+Outcome gmshOutcome(const std::uint8_t* data, std::size_t size) {
+  return readMesh([&] { return writeInput("input.msh", data, size); }, readGmsh);
+}
+
+Outcome simulationReaderOutcome(const std::uint8_t* data, std::size_t size) {
+  std::string badFrames;
+  Outcome outcome = classify([&] {
+    SimulationReader reader(writeInput("input.afsim", data, size));
     SimulationFrame frame;
     std::int64_t good = 0;
-    std::string bad;
     for (std::int64_t k = 0; k < reader.numFrames(); ++k) {
       try {
         reader.readFrame(k, frame);
         ++good;
       } catch (const ParseError& error) {
         // A corrupted record is reported; the reader stays usable for the others.
-        bad += "; frame " + std::to_string(k) + ": " + rejected(error);
+        badFrames += "; frame " + std::to_string(k) + ": " + describe(error);
       }
     }
-    outcome += "accepted: " + std::to_string(reader.numVertices()) + " vertices, " + std::to_string(good) + " of " +
-               std::to_string(reader.numFrames()) + " frames read" + bad;
-  } catch (const Error& error) {
-    outcome += rejected(error);
-  }
-  outcome += "; checkpoint: ";
-  try {
-    const SimulationCheckpoint checkpoint = parseCheckpoint(data, size, "input.checkpoint");
-    if (checkpoint.displacement.size() != checkpoint.velocity.size()) std::abort();
-    outcome += "accepted: " + checkpoint.integrator + ", " + std::to_string(checkpoint.frames) + " frames, " +
-               std::to_string(checkpoint.displacement.size()) + " state entries";
-  } catch (const Error& error) {
-    outcome += rejected(error);
-  }
+    return std::to_string(reader.numVertices()) + " vertices, " + std::to_string(good) + " of " +
+           std::to_string(reader.numFrames()) + " frames read" + badFrames;
+  });
+  if (outcome.kind == OutcomeClass::accepted && !badFrames.empty()) outcome.kind = OutcomeClass::rejected;
   return outcome;
 }
 
-namespace {
-
-// A box generator of at most 64 cells: built in milliseconds, so fuzzing stays fast and no
-// input can ask the harness for a huge mesh (beams and mesh files are parsed only).
-bool smallGeneratedMesh(const Scene& scene) {
-  constexpr long long kMaxCells = 64;
-  if (scene.mesh.source != Scene::MeshSource::box) return false;
-  const Eigen::Vector3i& cells = scene.mesh.box.cells;
-  return cells.minCoeff() > 0 && static_cast<long long>(cells.x()) * cells.y() * cells.z() <= kMaxCells;
-}
-
-}  // namespace
-
-std::string sceneOutcome(const std::uint8_t* data, std::size_t size) {
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(data, data + size, nullptr, true, /*ignore_comments=*/true);
-  } catch (const nlohmann::json::exception& error) {
-    // Not JSON: loadScene reports it as a ParseError before parseScene runs.
-    return std::string("not JSON: ") + error.what();
-  }
-  try {
-    const Scene scene = parseScene(json, scratchFolder(), "fuzz.json");
-    if (!smallGeneratedMesh(scene)) return "accepted: integrator " + scene.integrator.name + " (parsed only)";
-    // Small generated meshes are built too, so that what parseScene passes on unread
-    // reaches its readers: the integrator's options (async regions, adaptive policies,
-    // reuseFactor, ...), the force model's options and the fixed and loaded vertices.
-    const Simulation simulation = buildSimulation(scene);
-    return "accepted: integrator " + simulation.integrator->name() + ", built with " +
-           std::to_string(simulation.mesh->numVertices()) + " vertices";
-  } catch (const Error& error) {
-    return rejected(error);
-  }
+Outcome checkpointOutcome(const std::uint8_t* data, std::size_t size) {
+  return classify([&] {
+    const SimulationCheckpoint checkpoint = parseCheckpoint(data, size, "input.checkpoint");
+    if (checkpoint.displacement.size() != checkpoint.velocity.size()) std::abort();
+    return checkpoint.integrator + ", " + std::to_string(checkpoint.frames) + " frames, " +
+           std::to_string(checkpoint.displacement.size()) + " state entries";
+  });
 }
 
 int fuzzVeg(const std::uint8_t* data, std::size_t size) {
-  static_cast<void>(vegOutcome(data, size));
+  abortOnCrash(vegOutcome(data, size));
   return 0;
 }
 
 int fuzzTetGen(const std::uint8_t* data, std::size_t size) {
-  static_cast<void>(tetGenOutcome(data, size));
+  abortOnCrash(tetGenOutcome(data, size));
   return 0;
 }
 
 int fuzzGmsh(const std::uint8_t* data, std::size_t size) {
-  static_cast<void>(gmshOutcome(data, size));
+  abortOnCrash(gmshOutcome(data, size));
   return 0;
 }
 
 int fuzzSimulationFile(const std::uint8_t* data, std::size_t size) {
-  static_cast<void>(simulationFileOutcome(data, size));
+  abortOnCrash(simulationReaderOutcome(data, size));
+  abortOnCrash(checkpointOutcome(data, size));
   return 0;
 }
 
-int fuzzScene(const std::uint8_t* data, std::size_t size) {
-  static_cast<void>(sceneOutcome(data, size));
-  return 0;
-}
-
-std::vector<Harness> allHarnesses() {
-  return {{"veg", fuzzVeg, vegOutcome},
-          {"tetgen", fuzzTetGen, tetGenOutcome},
-          {"gmsh", fuzzGmsh, gmshOutcome},
-          {"simulationFile", fuzzSimulationFile, simulationFileOutcome},
-          {"scene", fuzzScene, sceneOutcome}};
+std::vector<Harness> fileHarnesses() {
+  return {{"veg", {{"veg", vegOutcome}}},
+          {"tetgen", {{"tetgen", tetGenOutcome}}},
+          {"gmsh", {{"gmsh", gmshOutcome}}},
+          {"simulationFile", {{"simulationReader", simulationReaderOutcome}, {"checkpoint", checkpointOutcome}}}};
 }
 
 }  // namespace asyncfem::fuzz

@@ -11,6 +11,8 @@
 #include <asyncfem/simulationIO/simulationFile.hpp>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -35,6 +37,15 @@ std::int64_t SimulationFileHeader::recordBytes() const {
 void SimulationWriter::FileCloser::operator()(std::FILE* file) const { std::fclose(file); }
 
 namespace {
+
+// Fault-injection seam for the storage-fault tests (docs/robustness.md, "Faults, counted"),
+// off unless the environment sets it: ASYNCFEM_TEST_STOP_BEFORE_FRAME=K stops the process
+// (SIGSTOP) before frame K is checked and written, so that a test can delete, truncate or
+// protect the file at a known frame and then continue the process (SIGCONT).
+void stopBeforeFrameIfAsked(std::int64_t frame) {
+  const char* value = std::getenv("ASYNCFEM_TEST_STOP_BEFORE_FRAME");
+  if (value != nullptr && *value != '\0' && std::strtoll(value, nullptr, 10) == frame) std::raise(SIGSTOP);
+}
 
 std::string systemMessage() { return std::strerror(errno); }
 
@@ -324,6 +335,7 @@ void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::V
   if (!file_) {
     throw Error(where + ": the file is closed");
   }
+  stopBeforeFrameIfAsked(numFrames_);
   checkFileIntact(where);
   const Eigen::Index size = 3 * header_.numVertices;
   if (displacement.size() != size || (velocity != nullptr && velocity->size() != size)) {

@@ -92,7 +92,9 @@ struct SimulationFrame {
 /// (a full file system, a file size limit) cuts the file back to its complete frames
 /// before throwing; before every frame and at close() the writer checks that nothing else
 /// deleted, replaced or truncated the file, and throws if something did (a deleted file
-/// first gets its complete frames written back to the path).
+/// first gets its complete frames written back to the path). For tests only, the
+/// environment variable ASYNCFEM_TEST_STOP_BEFORE_FRAME=K stops the process with SIGSTOP
+/// before frame K is checked and appended (unset: no effect; docs/robustness.md).
 class SimulationWriter {
  public:
   struct Options {
