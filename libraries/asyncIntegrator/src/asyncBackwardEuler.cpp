@@ -25,6 +25,7 @@
 #include <string>
 
 #include "detail/asyncBackwardEulerImpl.hpp"
+#include "detail/contactIteration.hpp"
 #include "detail/fastRegion.hpp"
 #include "detail/flopPrices.hpp"
 #include "detail/hierarchySystem.hpp"
@@ -34,7 +35,6 @@
 #include "detail/parallelTasks.hpp"
 #include "detail/schurSolver.hpp"
 #include "detail/sparseBlocks.hpp"
-#include "detail/substepContact.hpp"
 #include "detail/wholeSystemFactor.hpp"
 
 namespace asyncfem {

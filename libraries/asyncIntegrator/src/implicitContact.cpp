@@ -28,7 +28,7 @@ bool AsyncBackwardEuler::certifiesContactFree() const {
          static_cast<bool>(system_.obstacleProximity);
 }
 
-// Implicit contact (Eqs. C1-C6): Newton's method over the step (detail::SubstepContact),
+// Implicit contact (Eqs. C1-C6): Newton's method over the step (detail::ContactIteration),
 // the contact blocks in Â^L and in the regions' A^S, until the residual is
 // at most contactTolerance or contactIterations solves are spent.
 void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {

@@ -14,9 +14,11 @@
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 
+#include "detail/elementTangents.hpp"
 #include "detail/fastRegion.hpp"
 #include "detail/multirateSupport.hpp"
 #include "detail/sparseBlocks.hpp"
@@ -116,8 +118,9 @@ struct Schroeder2011::Impl {
   bool linear = true;
   bool built = false;
   bool perElementTangents = false;
-  bool lumpedConsistentMass = false;  // the system's consistent M was replaced by its row sums
-  SparseMatrix stiffness;             // K(u_0), full
+  std::optional<detail::ElementTangents> tangents;  // where each interface element's K_e comes from
+  bool lumpedConsistentMass = false;                // the system's consistent M was replaced by its row sums
+  SparseMatrix stiffness;                           // K(u_0), full
   Eigen::VectorXd internalForce;
   Eigen::VectorXd lumpedMass;  // row sums of M (3n)
   SubmatrixExtractor freeMass, freeStiffness;
@@ -171,34 +174,18 @@ Schroeder2011::Schroeder2011(DynamicSystem system, double largeTimestep, std::ve
   d.stiffness = system_.forceModel->createStiffnessMatrix();
   system_.forceModel->tangentStiffness(Eigen::VectorXd::Zero(system_.numDofs()), d.stiffness);
   d.stiffness.makeCompressed();
-  const std::vector<int>& free = system_.freeDofs.freeToFull();
-  d.freeMass = SubmatrixExtractor(system_.mass, free, free);
-  d.freeStiffness = SubmatrixExtractor(d.stiffness, free, free);
-  d.Mff = d.freeMass.extract(system_.mass);
-  d.freeRegion.resize(free.size());
-  for (std::size_t k = 0; k < free.size(); ++k) {
-    d.freeRegion[k] = partition_.vertexRegion()[static_cast<std::size_t>(free[k] / 3)];
-  }
-  d.compoundSolver = makeSparseSolver(options_.compoundSolver);
+  detail::setUpCompoundBlocks(system_, partition_, options_.regionSolver, options_.compoundSolver, d);
   const int numRegions = partition_.numRegions();
-  d.regions.reserve(static_cast<std::size_t>(numRegions));
   for (int i = 0; i < numRegions; ++i) {
-    const detail::RegionLayout layout{&partition_.regionDofs(i), &partition_.interfaceDofs(i), partition_.ratio(i)};
-    d.regions.emplace_back(system_.mass, d.stiffness, layout, options_.regionSolver);
-    d.regions.back().updateStiffnessBlocks(d.stiffness);
+    detail::FastRegion& region = d.regions[static_cast<std::size_t>(i)];
+    region.updateStiffnessBlocks(d.stiffness);
   }
   d.lastU.resize(static_cast<std::size_t>(numRegions));
   d.lastV.resize(static_cast<std::size_t>(numRegions));
 
   collectInterfaceElements();
-  Eigen::Matrix<double, 12, 12> probe;
-  d.perElementTangents =
-      mesh.numElements() > 0 && system_.forceModel->elementTangent(Eigen::VectorXd::Zero(mesh.numDofs()), 0, probe);
-  if (!d.perElementTangents && !d.linear) {
-    throw ValidationError(std::string(kName) +
-                          ": the interface elements' stiffness is needed per element, and this nonlinear force model "
-                          "gives no element tangent (ForceModel::elementTangent)");
-  }
+  d.tangents.emplace(mesh, *system_.forceModel, kName);
+  d.perElementTangents = d.tangents->perElement();
   checkInterfaceStiffness();
 
   // The outer layer's omega_max (S7), from the tangent at rest.
@@ -289,13 +276,7 @@ void Schroeder2011::checkInterfaceStiffness() const {
 
 void Schroeder2011::interfaceTangent(const Eigen::VectorXd& u, int element,
                                      Eigen::Matrix<double, 12, 12>& tangent) const {
-  if (impl_->perElementTangents) {
-    system_.forceModel->elementTangent(u, element, tangent);
-    return;
-  }
-  const TetMesh& mesh = *system_.mesh;
-  const Material& material = mesh.elementMaterial(element);
-  tangent = linearElementStiffness(mesh.elementRestPositions(element), material.youngsModulus, material.poissonRatio);
+  impl_->tangents->tangent(u, element, tangent);
 }
 
 double Schroeder2011::outerLayerMaxFrequency(int region) const {

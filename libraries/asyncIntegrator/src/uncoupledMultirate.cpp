@@ -55,20 +55,7 @@ UncoupledMultirate::UncoupledMultirate(DynamicSystem system, double largeTimeste
   d.linear = system_.forceModel->isLinear();
   d.stiffness = system_.forceModel->createStiffnessMatrix();
   d.stiffness.makeCompressed();
-  const std::vector<int>& free = system_.freeDofs.freeToFull();
-  d.freeMass = SubmatrixExtractor(system_.mass, free, free);
-  d.freeStiffness = SubmatrixExtractor(d.stiffness, free, free);
-  d.Mff = d.freeMass.extract(system_.mass);
-  d.freeRegion.resize(free.size());
-  for (std::size_t k = 0; k < free.size(); ++k) {
-    d.freeRegion[k] = partition_.vertexRegion()[static_cast<std::size_t>(free[k] / 3)];
-  }
-  d.compoundSolver = makeSparseSolver(options_.compoundSolver);
-  d.regions.reserve(static_cast<std::size_t>(partition_.numRegions()));
-  for (int i = 0; i < partition_.numRegions(); ++i) {
-    const detail::RegionLayout layout{&partition_.regionDofs(i), &partition_.interfaceDofs(i), partition_.ratio(i)};
-    d.regions.emplace_back(system_.mass, d.stiffness, layout, options_.regionSolver);
-  }
+  detail::setUpCompoundBlocks(system_, partition_, options_.regionSolver, options_.compoundSolver, d);
   if (!system_.damped()) stats_.skipped.push_back("damping terms (alpha = beta = 0)");
   if (d.linear) stats_.skipped.push_back("per-step refactorization (linear forces: factored once)");
 }

@@ -16,12 +16,12 @@
 #include <utility>
 #include <vector>
 
+#include "detail/contactIteration.hpp"
 #include "detail/fastRegion.hpp"
 #include "detail/hierarchySystem.hpp"
 #include "detail/naiveSolver.hpp"
 #include "detail/schurSolver.hpp"
 #include "detail/sparseBlocks.hpp"
-#include "detail/substepContact.hpp"
 
 namespace asyncfem {
 
@@ -87,7 +87,7 @@ struct AsyncBackwardEuler::Impl {
   Eigen::VectorXd regionForce;
   // Implicit contact (DynamicSystem::externalForceJacobian): the contact iteration, and
   // whether a region's A^S holds contact blocks that Z and H^{LL*} were not built with.
-  detail::SubstepContact contact;
+  detail::ContactIteration contact;
   bool correctionsStale = false;
   // The first solve of an implicit contact step recovers end states only, for the
   // certificate (Eq. C6): each DOF's interval of displacements over the step's states, the

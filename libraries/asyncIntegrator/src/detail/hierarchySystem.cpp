@@ -56,6 +56,7 @@ HierarchySystem::HierarchySystem(const TetMesh& mesh, const DynamicSystem& syste
                                  NestedSolve solve)
     : mesh_(mesh),
       system_(system),
+      tangents_(mesh, *system.forceModel, "nested async regions"),
       elementCounts_(partition.elementCounts()),
       units_(partition.units()),
       requested_(solve) {
@@ -82,14 +83,7 @@ HierarchySystem::HierarchySystem(const TetMesh& mesh, const DynamicSystem& syste
   for (int count : std::set<int>(dofCount_.begin(), dofCount_.end()))
     for (long long j = 1; j <= count; ++j) ends.insert(j * (units_ / count));
   stepEndUnits_.assign(ends.begin(), ends.end());
-  ElementBlock probe;
-  perElementTangent_ =
-      mesh.numElements() > 0 && system.forceModel->elementTangent(Eigen::VectorXd::Zero(mesh.numDofs()), 0, probe);
-  if (!perElementTangent_ && !system.forceModel->isLinear()) {
-    throw ValidationError(
-        "nested async regions: the force model gives no element tangent (ForceModel::elementTangent), which the "
-        "coupling needs for every element");
-  }
+  perElementTangent_ = tangents_.perElement();
   if (!perElementTangent_) checkLinearStiffness();
   chooseElementMass();
   chooseOrder();
@@ -106,10 +100,7 @@ HierarchySystem::~HierarchySystem() = default;
 void HierarchySystem::checkLinearStiffness() {
   Triplets triplets;
   for (int e = 0; e < mesh_.numElements(); ++e) {
-    const Material& material = mesh_.elementMaterial(e);
-    appendElement(mesh_.element(e),
-                  linearElementStiffness(mesh_.elementRestPositions(e), material.youngsModulus, material.poissonRatio),
-                  triplets);
+    appendElement(mesh_.element(e), tangents_.linear(e), triplets);
   }
   SparseMatrix model = system_.forceModel->createStiffnessMatrix();
   system_.forceModel->tangentStiffness(Eigen::VectorXd::Zero(mesh_.numDofs()), model);
@@ -152,12 +143,7 @@ void HierarchySystem::groupElements(const Eigen::VectorXd& u) {
   const bool needMass = elementMass_ != ElementMass::none && massByCount_.empty();
   for (int e = 0; e < mesh_.numElements(); ++e) {
     const int count = elementCounts_[static_cast<std::size_t>(e)];
-    if (perElementTangent_) {
-      system_.forceModel->elementTangent(u, e, tangent);
-    } else {
-      const Material& material = mesh_.elementMaterial(e);
-      tangent = linearElementStiffness(mesh_.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
-    }
+    tangents_.tangent(u, e, tangent);
     appendElement(mesh_.element(e), tangent, stiffness[count]);
     if (needMass) appendElement(mesh_.element(e), elementMass(e), mass[count]);
   }

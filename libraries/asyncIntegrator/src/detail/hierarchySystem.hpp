@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "detail/elementTangents.hpp"
+
 namespace asyncfem::detail {
 
 class StructuredHierarchySolve;
@@ -84,6 +86,7 @@ class HierarchySystem {
 
   const TetMesh& mesh_;
   const DynamicSystem& system_;
+  ElementTangents tangents_;
   std::vector<int> elementCounts_;
   std::vector<int> free_, freeIndex_, dofCount_, offset_;
   std::vector<long long> stepEndUnits_;

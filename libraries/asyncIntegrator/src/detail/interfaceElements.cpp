@@ -6,6 +6,7 @@
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <string>
 
+#include "detail/elementTangents.hpp"
 #include "detail/sparseBlocks.hpp"
 
 namespace asyncfem::detail {
@@ -34,15 +35,14 @@ void checkLinearModelMatchesMesh(const TetMesh& mesh, const RegionPartition& par
   if (columns.empty()) return;
   // Sparse 3n x |columns| blocks, so the check costs O(interface elements), not O(n |I|).
   std::vector<Eigen::Triplet<double>> meshEntries, modelEntries;
+  const ElementTangents tangents(mesh, *system.forceModel, "async integrator");
   for (int e = 0; e < mesh.numElements(); ++e) {
     const Eigen::Vector4i vertices = mesh.element(e);
     bool touches = false;
     for (int a = 0; a < 4 && !touches; ++a)
       for (int c = 0; c < 3; ++c) touches = touches || columnOf[static_cast<std::size_t>(3 * vertices[a] + c)] >= 0;
     if (!touches) continue;
-    const Material& material = mesh.elementMaterial(e);
-    const ElementMatrix ke =
-        linearElementStiffness(mesh.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
+    const ElementMatrix ke = tangents.linear(e);
     for (int q = 0; q < 12; ++q) {
       const int column = columnOf[static_cast<std::size_t>(3 * vertices[q / 3] + q % 3)];
       if (column < 0) continue;
@@ -80,14 +80,9 @@ bool findInterfaceElements(const TetMesh& mesh, const RegionPartition& partition
     const std::vector<int>& iface = partition.interfaceDofs(i);
     for (std::size_t k = 0; k < iface.size(); ++k) index[static_cast<std::size_t>(iface[k])] = static_cast<int>(k);
   }
-  Eigen::VectorXd probe = Eigen::VectorXd::Zero(mesh.numDofs());
-  Eigen::Matrix<double, 12, 12> tangent;
-  const bool perElement = mesh.numElements() > 0 && system.forceModel->elementTangent(probe, 0, tangent);
-  if (!perElement && !system.forceModel->isLinear()) {
-    throw ValidationError(
-        "async integrator: the stable coupling needs the tangent of each interface element, and this nonlinear "
-        "force model gives none (ForceModel::elementTangent); use the coupling \"paper\"");
-  }
+  const ElementTangents tangents(mesh, *system.forceModel, "async integrator (stable coupling)",
+                                 "use the coupling \"paper\"");
+  const bool perElement = tangents.perElement();
   for (int e = 0; e < mesh.numElements(); ++e) {
     const Eigen::Vector4i vertices = mesh.element(e);
     int fast = -1;
@@ -104,11 +99,7 @@ bool findInterfaceElements(const TetMesh& mesh, const RegionPartition& partition
       for (int c = 0; c < 3; ++c)
         element.interfaceIndex[static_cast<std::size_t>(3 * a + c)] =
             interfaceIndex[static_cast<std::size_t>(fast)][static_cast<std::size_t>(3 * vertices[a] + c)];
-    if (!perElement) {
-      const Material& material = mesh.elementMaterial(e);
-      element.tangent =
-          linearElementStiffness(mesh.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
-    }
+    if (!perElement) element.tangent = tangents.linear(e);
     regions[static_cast<std::size_t>(fast)].interfaceElements.push_back(element);
   }
   if (perElement) return true;

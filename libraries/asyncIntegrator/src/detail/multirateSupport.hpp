@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/SparseCore>
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/integrator/integrator.hpp>
@@ -13,6 +14,8 @@
 #include <cmath>
 #include <string>
 #include <vector>
+
+#include "detail/fastRegion.hpp"
 
 namespace asyncfem::detail {
 
@@ -74,6 +77,28 @@ inline void evaluateForces(const DynamicSystem& system, bool linear, bool built,
 inline void addSolveCounts(const SparseSolver& solver, IntegratorStats& stats) {
   stats.solvedRightHandSides += solver.stats().solvedRightHandSides;
   stats.solveFlops += static_cast<double>(solver.stats().solvedRightHandSides) * solver.stats().solveFlopsPerRhs;
+}
+
+/// The set-up the two comparators share (UncoupledMultirate, Schroeder2011), on their Impl d:
+/// M and d.stiffness cut to the free DOFs (d.freeMass, d.freeStiffness, d.Mff), each free
+/// DOF's region (d.freeRegion, -1: L), the compound system's solver, and one d.regions entry
+/// per fast region (its blocks on the region's layout, factored by regionSolver).
+template <typename Impl>
+void setUpCompoundBlocks(const DynamicSystem& system, const RegionPartition& partition, SolverKind regionSolver,
+                         SolverKind compoundSolver, Impl& d) {
+  const std::vector<int>& free = system.freeDofs.freeToFull();
+  d.freeMass = SubmatrixExtractor(system.mass, free, free);
+  d.freeStiffness = SubmatrixExtractor(d.stiffness, free, free);
+  d.Mff = d.freeMass.extract(system.mass);
+  d.freeRegion.resize(free.size());
+  for (std::size_t k = 0; k < free.size(); ++k)
+    d.freeRegion[k] = partition.vertexRegion()[static_cast<std::size_t>(free[k] / 3)];
+  d.compoundSolver = makeSparseSolver(compoundSolver);
+  d.regions.reserve(static_cast<std::size_t>(partition.numRegions()));
+  for (int i = 0; i < partition.numRegions(); ++i) {
+    const RegionLayout layout{&partition.regionDofs(i), &partition.interfaceDofs(i), partition.ratio(i)};
+    d.regions.emplace_back(system.mass, d.stiffness, layout, regionSolver);
+  }
 }
 
 }  // namespace asyncfem::detail

@@ -62,7 +62,7 @@ struct ContactStep {
 /// a region's, at the end state or else at the first substep where it touches, weighted by
 /// the share of substeps where it touches). Each solve is mixed with the ones before
 /// (Anderson, Eq. C5) or else backtracked on the residual's norm (Eq. C4).
-class SubstepContact {
+class ContactIteration {
  public:
   /// Where each of the numDofs full DOFs sits in L or in its fast region (call at each
   /// set-up).

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The contact iteration of one asynchronous large step. Equation numbers refer to
 // docs/asynchronous-integrator.md, section "Implicit contact".
-#include "detail/substepContact.hpp"
+#include "detail/contactIteration.hpp"
 
 #include <Eigen/QR>
 #include <asyncfem/core/error.hpp>
@@ -59,7 +59,7 @@ bool LargeContactBlocks::operator==(const LargeContactBlocks& other) const {
   return true;
 }
 
-void SubstepContact::setPartition(const RegionPartition& partition, int numDofs) {
+void ContactIteration::setPartition(const RegionPartition& partition, int numDofs) {
   largePosition_.assign(static_cast<std::size_t>(numDofs), -1);
   regionPosition_.assign(static_cast<std::size_t>(numDofs), -1);
   const std::vector<int>& large = partition.largeDofs();
@@ -73,7 +73,7 @@ void SubstepContact::setPartition(const RegionPartition& partition, int numDofs)
 }
 
 template <class Visit>
-void SubstepContact::visitStates(const std::vector<FastRegion>& regions, Visit&& visit) {
+void ContactIteration::visitStates(const std::vector<FastRegion>& regions, Visit&& visit) {
   const Eigen::VectorXd& u0 = *step_.u0;
   const Eigen::VectorXd& v0 = *step_.v0;
   const RegionPartition& partition = *step_.partition;
@@ -115,7 +115,7 @@ void SubstepContact::visitStates(const std::vector<FastRegion>& regions, Visit&&
   }
 }
 
-void SubstepContact::forcesAt(const std::vector<FastRegion>& regions) {
+void ContactIteration::forcesAt(const std::vector<FastRegion>& regions) {
   const RegionPartition& partition = *step_.partition;
   const std::vector<int>& large = partition.largeDofs();
   const DynamicSystem& system = *step_.system;
@@ -151,7 +151,7 @@ void SubstepContact::forcesAt(const std::vector<FastRegion>& regions) {
   });
 }
 
-void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion>& regions, bool statesClear) {
+void ContactIteration::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion>& regions, bool statesClear) {
   removeBlocks(largeSystem);
   const DynamicSystem& system = *step_.system;
   const std::size_t count = regions.size();
@@ -222,14 +222,14 @@ void SubstepContact::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion
   }
 }
 
-void SubstepContact::removeBlocks(SparseMatrix& /*largeSystem*/) {
+void ContactIteration::removeBlocks(SparseMatrix& /*largeSystem*/) {
   restoreEntries(saved_);
   inMatrix_.positions.clear();
   inMatrix_.values.clear();
 }
 
-bool SubstepContact::start(const ContactStep& step, const Eigen::VectorXd& rhsL, const Eigen::VectorXd& externalL,
-                           std::vector<FastRegion>& regions, SparseMatrix& largeSystem) {
+bool ContactIteration::start(const ContactStep& step, const Eigen::VectorXd& rhsL, const Eigen::VectorXd& externalL,
+                             std::vector<FastRegion>& regions, SparseMatrix& largeSystem) {
   step_ = step;
   const RegionPartition& partition = *step.partition;
   const std::vector<int>& large = partition.largeDofs();
@@ -285,7 +285,7 @@ bool SubstepContact::start(const ContactStep& step, const Eigen::VectorXd& rhsL,
 // (depth is 1-Lipschitz in the position), and where the force depends on the state only in
 // contact (DynamicSystem::stateDependentOnlyInContact) every block there is zero: the
 // visit of every substep's state can be skipped with the same result.
-bool SubstepContact::predictedStatesClear() {
+bool ContactIteration::predictedStatesClear() {
   const DynamicSystem& system = *step_.system;
   if (!system.stateDependentOnlyInContact || !system.obstacleProximity) return false;
   const Eigen::VectorXd& v0 = *step_.v0;
@@ -307,7 +307,7 @@ bool freeVertexNearObstacle(const DynamicSystem& system, const Eigen::VectorXd& 
 }
 
 // y += B x for L's blocks (rows and columns of L).
-void SubstepContact::addBlockProduct(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+void ContactIteration::addBlockProduct(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   for (std::size_t b = 0; b < inMatrix_.positions.size(); ++b) {
     forBlockEntries(inMatrix_.positions[b],
                     [&](int r, int c, int row, int column) { y[row] += inMatrix_.values[b](r, c) * x[column]; });
@@ -316,7 +316,7 @@ void SubstepContact::addBlockProduct(const Eigen::VectorXd& x, Eigen::VectorXd& 
 
 // The residual of the trial state (trialY_, trialX_) at theta along the update: its
 // largest entry (worstVertex_ where), and its 2-norm into merit.
-double SubstepContact::trialResidual(const std::vector<FastRegion>& regions, double theta, double& merit) {
+double ContactIteration::trialResidual(const std::vector<FastRegion>& regions, double theta, double& merit) {
   const RegionPartition& partition = *step_.partition;
   const std::vector<int>& large = partition.largeDofs();
   forcesAt(regions);
@@ -350,8 +350,8 @@ double SubstepContact::trialResidual(const std::vector<FastRegion>& regions, dou
 }
 
 // The state at theta from the accepted one toward Y and each region's x, and its residual.
-double SubstepContact::tryState(const std::vector<FastRegion>& regions, const Eigen::VectorXd& Y, double theta,
-                                double& merit) {
+double ContactIteration::tryState(const std::vector<FastRegion>& regions, const Eigen::VectorXd& Y, double theta,
+                                  double& merit) {
   const RegionPartition& partition = *step_.partition;
   trialY_ = acceptedY_ + theta * (Y - acceptedY_);
   for (std::size_t i = 0; i < regions.size(); ++i) trialX_[i] = acceptedX_[i] + theta * (regions[i].x - acceptedX_[i]);
@@ -368,7 +368,7 @@ double SubstepContact::tryState(const std::vector<FastRegion>& regions, const Ei
 // Eq. (C5): with d_j = z_solve,j - z_j the step of solve j from the state it started at,
 // gamma minimizes |d_k - sum_j gamma_j (d_{j+1} - d_j)|_2 and the combination is
 // z_solve,k - sum_j gamma_j (z_solve,j+1 - z_solve,j) (A_0 z - base alike: it is affine).
-bool SubstepContact::mix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
+bool ContactIteration::mix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
   const std::size_t count = regions.size();
   const auto solvedX = [&](std::size_t i) -> Eigen::MatrixXd& { return regions[i].x; };
   const auto solvedS = [&](std::size_t i) -> Eigen::MatrixXd& { return solvedOperatorS_[i]; };
@@ -405,7 +405,7 @@ bool SubstepContact::mix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
 
 // Back to the last solve's own state; the older solves are dropped (their combination did
 // not lower the residual).
-void SubstepContact::unmix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
+void ContactIteration::unmix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
   const std::size_t count = regions.size();
   unpack(mixStates_.back(), Y, count, [&](std::size_t i) -> Eigen::MatrixXd& { return regions[i].x; });
   unpack(mixOperators_.back(), solvedOperatorL_, count,
@@ -415,8 +415,8 @@ void SubstepContact::unmix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions)
   mixSteps_.erase(mixSteps_.begin(), mixSteps_.end() - 1);
 }
 
-double SubstepContact::update(std::vector<FastRegion>& regions, Eigen::VectorXd& Y, SparseMatrix& largeSystem,
-                              Eigen::VectorXd& rhsL) {
+double ContactIteration::update(std::vector<FastRegion>& regions, Eigen::VectorXd& Y, SparseMatrix& largeSystem,
+                                Eigen::VectorXd& rhsL) {
   // A_0 z - base at the solve's z (Eq. C4): the force terms it used less the contact
   // blocks' part J z (L's blocks B Y; a region's hS^2 K_c and hS C_c terms).
   solvedOperatorL_ = forceL_;
