@@ -10,7 +10,9 @@
 #                                     build-asan/ (docs/robustness.md: before each release)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+installing=$SECONDS
 bash scripts/install-deps.sh
+echo "run-tests: packages checked or installed in $((SECONDS - installing)) s"
 jobs=$(nproc)
 
 # The optional parts CI is meant to test (docs/robustness.md, "What CI tests"). The configure
@@ -73,11 +75,17 @@ run_sanitized_library_tests() {
 case "${1:-}" in
   "")
     parts=$(required_parts "$ci_parts")
+    started=$SECONDS
     cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DASYNCFEM_BUILD_TESTS=ON \
       -DASYNCFEM_BUILD_BENCHMARKS=ON "-DASYNCFEM_REQUIRE_PARTS=$parts"
     cmake --build build --parallel "$jobs"
+    built=$SECONDS
     ctest --test-dir build --output-on-failure --parallel "$jobs"
+    tested=$SECONDS
     run_sanitized_library_tests
+    # Where the time went (packages before this script's build are not counted here).
+    echo "run-tests: build $((built - started)) s, tests $((tested - built)) s," \
+      "sanitized library tests $((SECONDS - tested)) s, total $((SECONDS - started)) s on $jobs cores"
     ;;
   --sanitize)
     # -O1: GCC takes several times longer on sanitized code at -O2 -g (test files 2-6
