@@ -95,6 +95,30 @@ def test_suggested_regions(beam):
         af.suggest_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler))
 
 
+def test_touching_regions_run_the_hierarchy_solve(beam):
+    """Regions that touch at different ratios run the hierarchy solve by themselves, the
+    same vertices as one region the structured Schur solve; at one ratio they are merged."""
+    system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))
+    tip = af.region_vertices(beam, element_sets=["tip"])
+    x = beam.rest_positions[:, 0]
+    inner = np.array([v for v in tip if x[v] < np.median(x[tip])])
+    outer = np.array([v for v in tip if x[v] >= np.median(x[tip])])
+    nested = af.AsyncBackwardEuler(beam, system, 0.01, [af.AsyncRegion("inner", inner, 4),
+                                                        af.AsyncRegion("outer", outer, 16)])
+    assert nested.step_solver == af.AsyncStepSolver.hierarchy
+    assert nested.partition.touching
+    nested.step(3)
+    assert np.abs(nested.displacement).max() > 0.0
+    merged = af.AsyncBackwardEuler(beam, system, 0.01, [af.AsyncRegion("inner", inner, 8),
+                                                        af.AsyncRegion("outer", outer, 8)])
+    assert merged.step_solver == af.AsyncStepSolver.structured_schur
+    assert merged.partition.num_regions == 1
+    options = af.AsyncOptions()
+    options.nested_solve = af.NestedSolve.lu
+    with pytest.raises(af.ValidationError, match="nestedSolve"):
+        af.AsyncBackwardEuler(beam, system, 0.01, [af.AsyncRegion("tip", tip, 4)], options)
+
+
 def test_schedule_policy_from_python(beam):
     """A scheduled window opens and closes the fast region at its large-step boundaries."""
     system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))

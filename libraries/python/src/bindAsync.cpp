@@ -4,6 +4,7 @@
 
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/stepSolver.hpp>
 #include <integrators.hpp>
 #include <limits>
 
@@ -91,7 +92,12 @@ void bindRegions(py::module_& module) {
                              [](const RegionPartition& p) { return intArray(p.interfaceElements()); })
       .def_property_readonly(
           "vertex_region", [](const RegionPartition& p) { return intArray(p.vertexRegion()); },
-          "region of every vertex: i for S_i, -1 for L");
+          "region of every vertex: i for S_i, -1 for L")
+      .def_property_readonly("touching", &RegionPartition::touching,
+                             "whether an element joins two fast regions (then the hierarchy solve runs)")
+      .def_property_readonly(
+          "levels", [](const RegionPartition& p) { return intArray(p.levels()); },
+          "the distinct steps per large step, ascending (1 first when L has a vertex)");
 }
 
 // The asynchronous integrator's solver options and run-time region policies.
@@ -107,6 +113,15 @@ void bindAsyncOptions(py::module_& module) {
       .value("structured", AsyncSolveMethod::structured)
       .value("hierarchy", AsyncSolveMethod::hierarchy)
       .value("naive", AsyncSolveMethod::naive);
+  py::enum_<NestedSolve>(module, "NestedSolve",
+                         "The hierarchy solve: level by level where the ratios form a chain (automatic), or one LU")
+      .value("automatic", NestedSolve::automatic)
+      .value("structured", NestedSolve::structured)
+      .value("lu", NestedSolve::lu);
+  py::enum_<AsyncStepSolver>(module, "AsyncStepSolver", "The step solver an AsyncBackwardEuler partition runs")
+      .value("structured_schur", AsyncStepSolver::structuredSchur)
+      .value("naive_lu", AsyncStepSolver::naiveLU)
+      .value("hierarchy", AsyncStepSolver::hierarchy);
   py::enum_<RecoveryMode>(module, "RecoveryMode",
                           "How the fast regions' states are recovered after the interface solve")
       .value("automatic", RecoveryMode::automatic)
@@ -121,7 +136,14 @@ void bindAsyncOptions(py::module_& module) {
       "Solver options of AsyncBackwardEuler: coupling, Schur mode, method, recovery, region solver")
       .def(py::init([](AsyncCoupling coupling, SchurMode schur, AsyncSolveMethod method, RecoveryMode recovery,
                        SolverKind regionSolver, bool prediction) {
-             return AsyncOptions{coupling, schur, method, recovery, regionSolver, prediction};
+             AsyncOptions options;
+             options.coupling = coupling;
+             options.schur = schur;
+             options.method = method;
+             options.recovery = recovery;
+             options.regionSolver = regionSolver;
+             options.substepStatePrediction = prediction;
+             return options;
            }),
            py::arg("coupling") = AsyncCoupling::stable, py::arg("schur") = SchurMode::lowRank,
            py::arg("method") = AsyncSolveMethod::structured, py::arg("recovery") = RecoveryMode::automatic,
@@ -130,6 +152,8 @@ void bindAsyncOptions(py::module_& module) {
       .def_readwrite("schur", &AsyncOptions::schur)
       .def_readwrite("method", &AsyncOptions::method)
       .def_readwrite("recovery", &AsyncOptions::recovery)
+      .def_readwrite("nested_solve", &AsyncOptions::nestedSolve,
+                     "how the hierarchy solve solves (regions that touch or nest, or method hierarchy)")
       .def_readwrite("region_solver", &AsyncOptions::regionSolver)
       .def_readwrite("dense_region_dofs", &AsyncOptions::denseRegionDofs)
       .def_readwrite("substep_state_prediction", &AsyncOptions::substepStatePrediction)
@@ -167,7 +191,9 @@ void bindAsyncOptions(py::module_& module) {
       .def_readwrite("schedule", &AdaptiveRegionOptions::schedule, "list of ScheduledRegion")
       .def_readwrite("min_dwell", &AdaptiveRegionOptions::minDwell, "large steps")
       .def_readwrite("shrink_factor", &AdaptiveRegionOptions::shrinkFactor)
-      .def_readwrite("cache_size", &AdaptiveRegionOptions::cacheSize);
+      .def_readwrite("cache_size", &AdaptiveRegionOptions::cacheSize)
+      .def_readwrite("nest", &AdaptiveRegionOptions::nest,
+                     "touching regions keep their own ratios (the hierarchy solve) instead of being merged");
   py::class_<RepartitionRecord>(module, "RepartitionRecord", "One change of partition at a large-step boundary")
       .def_readonly("time", &RepartitionRecord::time)
       .def_readonly("step", &RepartitionRecord::step)
@@ -196,6 +222,8 @@ void bindAsyncIntegrator(py::module_& module) {
            py::arg("options") = AsyncOptions{})
       .def_property_readonly("partition", &AsyncBackwardEuler::partition, py::return_value_policy::reference_internal)
       .def_property_readonly("options", &AsyncBackwardEuler::options)
+      .def_property_readonly("step_solver", &AsyncBackwardEuler::stepSolver,
+                             "the step solver of the partition in use (chosen at each set-up)")
       .def(
           "set_substep_observer",
           [](AsyncBackwardEuler& integrator, const py::object& callable) {
