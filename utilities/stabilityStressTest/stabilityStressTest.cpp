@@ -167,8 +167,7 @@ Scene sceneFor(const Case& run, const fs::path& meshFile, const std::vector<int>
   scene.rayleighAlpha = run.damping.alpha;
   scene.rayleighBeta = run.damping.beta;
   scene.integrator.name = run.integrator;
-  scene.integrator.timestep = 1.0 / 120.0;
-  scene.frames.rate = 30.0;
+  overrideFrameTiming(scene, {.timestep = 1.0 / 120.0, .frameCount = 60, .frameRate = 30.0});
   if (run.integrator != "backward-euler") {
     AsyncSettings settings;
     settings.regions = {{"stiff", stiffVertices, run.ratio}};
@@ -210,7 +209,7 @@ Outcome runSimulation(Simulation& simulation, int frames, double freeFrom, doubl
 
 Outcome runCase(const Case& run, const fs::path& meshFile, const std::vector<int>& stiffVertices, int frames) {
   Scene scene = sceneFor(run, meshFile, stiffVertices);
-  scene.frames.count = frames;
+  overrideFrameTiming(scene, {.frameCount = frames});
   Simulation simulation = buildSimulation(scene);
   Integrator& integrator = *simulation.integrator;
   const Eigen::Matrix3Xd& rest = simulation.mesh->restPositions();
@@ -438,7 +437,7 @@ std::vector<AsyncRegion> sceneRegions(const Scene& scene) {
 // The scene of a job: every region's ratio set to the job's m, or backward Euler.
 Scene sceneForJob(const Scene& base, std::vector<AsyncRegion> regions, const SceneJob& job, int frames) {
   Scene scene = base;
-  scene.frames.count = frames;
+  overrideFrameTiming(scene, {.frameCount = frames});
   if (job.integrator == "backward-euler") {
     scene.integrator.name = "backward-euler";
     scene.integrator.options = nlohmann::json::object();
@@ -492,13 +491,13 @@ int runScene(const Options& options) {
                 ": integrator: --scene needs an \"async\" or \"multirate-uncoupled\" scene with explicit "
                 "regions (not \"auto\")");
   }
-  const int frames = options.framesGiven ? options.frames : base.frames.count;
+  const int frames = options.framesGiven ? options.frames : base.timing.frameCount;
   const std::vector<AsyncRegion> regions = sceneRegions(base);
   const std::vector<SceneJob> jobs = sceneJobs(options, base);
   const int workers = std::max(1, std::min<int>(options.jobs, static_cast<int>(jobs.size())));
   std::cout
       << "# stabilityStressTest --scene " << options.scene << ": " << jobs.size() << " runs of " << frames
-      << " frames, hL = " << base.integrator.timestep
+      << " frames, hL = " << base.timing.timestep
       << "; energy growth from when the last load window closes (not measured with contact); step growth "
          "estimate: spectral radius of one (large) step of the linearized scene, estimated from a few dozen "
          "steps before the run (its own seconds in \"estimate s\")"
