@@ -121,7 +121,15 @@ void bindAsyncOptions(py::module_& module) {
       "Solver options of AsyncBackwardEuler: coupling, Schur mode, method, recovery, region solver")
       .def(py::init([](AsyncCoupling coupling, SchurMode schur, AsyncSolveMethod method, RecoveryMode recovery,
                        SolverKind regionSolver, bool prediction) {
-             return AsyncOptions{coupling, schur, method, recovery, regionSolver, prediction};
+             // By name: AsyncOptions gains fields between these (nestedSolve).
+             AsyncOptions options;
+             options.coupling = coupling;
+             options.schur = schur;
+             options.method = method;
+             options.recovery = recovery;
+             options.regionSolver = regionSolver;
+             options.substepStatePrediction = prediction;
+             return options;
            }),
            py::arg("coupling") = AsyncCoupling::stable, py::arg("schur") = SchurMode::lowRank,
            py::arg("method") = AsyncSolveMethod::structured, py::arg("recovery") = RecoveryMode::automatic,
