@@ -68,16 +68,18 @@ TEST(BenchmarkRun, ConfiguredScene) {
   scene.output.file = "out/run.afsim";
   const Scene bySteps = configuredScene(scene, configuration("trapezoidal", 4, {{"solver", "umfpack"}}), 7);
   EXPECT_EQ(bySteps.integrator.name, "trapezoidal");
-  EXPECT_EQ(bySteps.integrator.stepsPerFrame, 4);
-  EXPECT_DOUBLE_EQ(bySteps.integrator.timestep, 1.0 / 40.0);
+  EXPECT_EQ(bySteps.timing.stepsPerFrame, 4);
+  EXPECT_EQ(bySteps.timing.timestep, bySteps.timing.frameInterval / 4);
   EXPECT_EQ(bySteps.integrator.options, nlohmann::json({{"solver", "umfpack"}}));
-  EXPECT_EQ(bySteps.frames.count, 7);
+  EXPECT_EQ(bySteps.timing.frameCount, 7);
   EXPECT_TRUE(bySteps.output.file.empty());  // benchmark runs write nothing
   BenchmarkConfiguration byStep = configuration("backward-euler", 0);
   byStep.timestep = 0.025;
   const Scene configured = configuredScene(scene, byStep, 1);
-  EXPECT_EQ(configured.integrator.stepsPerFrame, 0);
-  EXPECT_EQ(configured.integrator.timestep, 0.025);
+  EXPECT_EQ(configured.timing.stepsPerFrame, 4);
+  EXPECT_EQ(configured.timing.timestep, 0.025);
+  byStep.timestep = 0.03;  // does not divide the frame interval 1/10 s
+  EXPECT_THROW((void)configuredScene(scene, byStep, 1), asyncfem::ValidationError);
   EXPECT_TRUE(isMultirate("async") && isMultirate("multirate-uncoupled"));
   EXPECT_FALSE(isMultirate("backward-euler"));
 }

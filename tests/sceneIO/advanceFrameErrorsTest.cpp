@@ -18,7 +18,7 @@ using asyncfem::test::smallScene;
 std::string failureOf(const nlohmann::json& json) {
   asyncfem::Simulation simulation = asyncfem::buildSimulation(asyncfem::parseScene(json, "", "scene.json"));
   try {
-    for (int frame = 0; frame < simulation.numFrames; ++frame) asyncfem::advanceFrame(simulation, frame);
+    for (int frame = 0; frame < simulation.timing.frameCount; ++frame) asyncfem::advanceFrame(simulation, frame);
   } catch (const asyncfem::NumericalError& error) {
     return error.what();
   }

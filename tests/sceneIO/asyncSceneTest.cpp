@@ -56,7 +56,7 @@ TEST(AsyncScene, BuildsAndRunsTheNamedRegions) {
   ASSERT_EQ(async->partition().numRegions(), 1);
   EXPECT_EQ(async->partition().ratio(0), 4);
   for (int dof : async->partition().regionDofs(0)) EXPECT_GE(simulation.mesh->restPosition(dof / 3).x(), 3.0 - 1e-12);
-  for (int frame = 0; frame < simulation.numFrames; ++frame) asyncfem::advanceFrame(simulation, frame);
+  for (int frame = 0; frame < simulation.timing.frameCount; ++frame) asyncfem::advanceFrame(simulation, frame);
   EXPECT_GT(simulation.integrator->displacement().norm(), 0.0);
 }
 
@@ -171,7 +171,7 @@ TEST(ContactScene, GroundStopsAFallingCube) {
   Simulation simulation = build(droppedCube());
   ASSERT_NE(simulation.contact, nullptr);
   double lowest = 1e9;
-  for (int frame = 0; frame < simulation.numFrames; ++frame) {
+  for (int frame = 0; frame < simulation.timing.frameCount; ++frame) {
     asyncfem::advanceFrame(simulation, frame);
     const Eigen::VectorXd& u = simulation.integrator->displacement();
     for (int v = 0; v < simulation.mesh->numVertices(); ++v) {
@@ -242,7 +242,7 @@ TEST(ContactScene, ImplicitContactRunsAtAStepTooLargeForTheExplicitSpring) {
   scene["integrator"]["timestep"] = 1.0 / 50.0;
   Simulation simulation = build(scene);
   EXPECT_TRUE(simulation.warnings.empty()) << simulation.warnings.front();
-  for (int frame = 0; frame < simulation.numFrames; ++frame) asyncfem::advanceFrame(simulation, frame);
+  for (int frame = 0; frame < simulation.timing.frameCount; ++frame) asyncfem::advanceFrame(simulation, frame);
   const Eigen::VectorXd& u = simulation.integrator->displacement();
   EXPECT_LT(simulation.contact->maxPenetration(u), 1e-3);
   EXPECT_GT(simulation.contact->activeContacts(u), 0);
@@ -270,7 +270,7 @@ TEST(ContactScene, AsyncImplicitContactFollowsTheContactAtALargeStep) {
   Simulation simulation = build(scene);
   EXPECT_TRUE(simulation.warnings.empty()) << simulation.warnings.front();
   int fastFrames = 0;
-  for (int frame = 0; frame < simulation.numFrames; ++frame) {
+  for (int frame = 0; frame < simulation.timing.frameCount; ++frame) {
     asyncfem::advanceFrame(simulation, frame);
     const auto* async = dynamic_cast<const asyncfem::AsyncBackwardEuler*>(simulation.integrator.get());
     ASSERT_NE(async, nullptr);
@@ -304,7 +304,7 @@ TEST(AsyncScene, TouchingRegionsRunTheHierarchySolve) {
   EXPECT_EQ(nested->stepSolver(), asyncfem::AsyncStepSolver::hierarchy);
   EXPECT_TRUE(nested->partition().touching());
   EXPECT_EQ(nested->partition().levels(), (std::vector<int>{1, 4, 16}));
-  for (int frame = 0; frame < simulation.numFrames; ++frame) asyncfem::advanceFrame(simulation, frame);
+  for (int frame = 0; frame < simulation.timing.frameCount; ++frame) asyncfem::advanceFrame(simulation, frame);
   EXPECT_GT(simulation.integrator->displacement().norm(), 0.0);
   const std::vector<std::string> lines = simulation.integrator->report().lines;
   ASSERT_GE(lines.size(), 2u);
@@ -342,7 +342,7 @@ TEST(AsyncScene, HierarchyMethodMatchesTheStructuredSolve) {
   auto* lu = dynamic_cast<asyncfem::AsyncBackwardEuler*>(nestedLU.integrator.get());
   ASSERT_NE(levels, nullptr);
   ASSERT_NE(lu, nullptr);
-  for (int frame = 0; frame < structured.numFrames; ++frame) {
+  for (int frame = 0; frame < structured.timing.frameCount; ++frame) {
     asyncfem::advanceFrame(structured, frame);
     asyncfem::advanceFrame(nested, frame);
     asyncfem::advanceFrame(nestedLU, frame);
@@ -420,7 +420,7 @@ StrikeRun runStrike(const nlohmann::json& json,
   Simulation simulation = buildStrike(json, registry);
   const std::vector<int>& tip = simulation.mesh->vertexSet("rodTip");
   StrikeRun run;
-  for (int frame = 0; frame < simulation.numFrames; ++frame) {
+  for (int frame = 0; frame < simulation.timing.frameCount; ++frame) {
     asyncfem::advanceFrame(simulation, frame);
     const Eigen::VectorXd& u = simulation.integrator->displacement();
     double x = 0.0;
@@ -514,7 +514,7 @@ TEST(ContactScene, FramesAfterAStrikeSolveExactly) {
   const auto* async = dynamic_cast<const asyncfem::AsyncBackwardEuler*>(simulation.integrator.get());
   ASSERT_NE(async, nullptr);
   int strikes = 0, quiet = 0;
-  for (int frame = 0; frame < simulation.numFrames; ++frame) {
+  for (int frame = 0; frame < simulation.timing.frameCount; ++frame) {
     const asyncfem::AsyncRunStats before = async->runStats();
     asyncfem::advanceFrame(simulation, frame);
     const asyncfem::AsyncRunStats& after = async->runStats();

@@ -8,7 +8,9 @@
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
 #include <cmath>
+#include <functional>
 #include <sstream>
+#include <vector>
 
 #include "sceneTestUtilities.hpp"
 
@@ -25,7 +27,7 @@ Simulation build(const nlohmann::json& json, const std::filesystem::path& base =
 // The frame timing of a scene (nothing is built); a timestep that does not divide the
 // frame interval is reported here, where the timing is used.
 asyncfem::FrameTiming timingOf(const nlohmann::json& json) {
-  return asyncfem::frameTimingOf(asyncfem::parseScene(json, "", "scene.json"));
+  return asyncfem::requireFrameTiming(asyncfem::parseScene(json, "", "scene.json"));
 }
 
 // f_ext(t) of a built simulation at rest (size 3n; zero when it has no external force).
@@ -132,6 +134,7 @@ TEST(BuildSimulation, TimingOverridesAreResolvedAgain) {
   EXPECT_EQ(scene.timing.stepsPerFrame, 4);
   EXPECT_EQ(scene.timing.frameCount, 7);
   EXPECT_EQ(asyncfem::buildSimulation(scene).integrator->timestep(), 0.025);
+  const asyncfem::FrameTiming before = scene.timing;
   try {
     asyncfem::overrideFrameTiming(scene, overrides(0.03, {}, {}));
     FAIL() << "expected a timing error";
@@ -141,17 +144,52 @@ TEST(BuildSimulation, TimingOverridesAreResolvedAgain) {
   }
   EXPECT_THROW(asyncfem::overrideFrameTiming(scene, overrides({}, {}, 0)), asyncfem::ValidationError);
   EXPECT_THROW(asyncfem::overrideFrameTiming(scene, overrides(0.02, 5, {})), asyncfem::ValidationError);
+  EXPECT_EQ(scene.timing, before);  // a refused override leaves the timing as it was
 }
 
-// A Scene built or edited in code (its timing not resolved from its keys) is resolved
-// when it is built.
-TEST(BuildSimulation, TimingOfAnEditedSceneIsResolvedFromItsKeys) {
-  Scene scene = asyncfem::parseScene(smallScene(), "", "scene.json");
-  scene.integrator.timestep = 0.05;
-  scene.frames.count = 2;
-  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
-  EXPECT_EQ(timing.stepsPerFrame, 2);
-  EXPECT_EQ(timing.frameCount, 2);
+// An override of the frame count or rate keeps the timestep as it was given, bit for bit
+// (the timing is not rebuilt from its steps per frame, which would round it to T / N).
+TEST(BuildSimulation, TimingOverridesKeepTheGivenTimestep) {
+  auto json = smallScene();
+  json["frames"]["rate"] = 30;
+  json["integrator"]["timestep"] = 0.001010101010;  // 1/990 to ten significant digits: 33 per frame
+  Scene scene = asyncfem::parseScene(json, "", "scene.json");
+  ASSERT_EQ(scene.timing.stepsPerFrame, 33);
+  ASSERT_NE(scene.timing.timestep, scene.timing.frameInterval / 33);  // the rounding the test guards against
+  asyncfem::overrideFrameTiming(scene, {.frameCount = 5});
+  EXPECT_EQ(scene.timing.timestep, 0.001010101010);
+  EXPECT_EQ(scene.timing.stepsPerFrame, 33);
+  EXPECT_EQ(scene.timing.frameCount, 5);
+  asyncfem::overrideFrameTiming(scene, {.frameRate = 30.0 / 11});  // one frame is 11 of the old ones
+  EXPECT_EQ(scene.timing.timestep, 0.001010101010);
+  EXPECT_EQ(scene.timing.stepsPerFrame, 363);
+  EXPECT_EQ(scene.timing.frameRate, 30.0 / 11);
+}
+
+// A timestep that does not divide the frame interval leaves the scene readable (its mesh,
+// its timing as written, not resolved); running it is refused with the timing error, and
+// an override of the step resolves it.
+TEST(BuildSimulation, UnresolvedTimingIsReportedWhenUsed) {
+  auto json = smallScene();  // rate 10, 3 frames
+  json["integrator"]["timestep"] = 0.03;
+  Scene scene = asyncfem::parseScene(json, "", "scene.json");
+  EXPECT_FALSE(scene.timing.resolved());
+  EXPECT_EQ(scene.timing.timestep, 0.03);
+  EXPECT_EQ(scene.timing.frameRate, 10.0);
+  EXPECT_EQ(scene.timing.frameCount, 3);
+  for (const auto& use : std::vector<std::function<void()>>{[&] { (void)asyncfem::requireFrameTiming(scene); },
+                                                            [&] { (void)asyncfem::buildSimulation(scene); },
+                                                            [&] { (void)asyncfem::integratorContext(scene); }}) {
+    try {
+      use();
+      ADD_FAILURE() << "expected a timing error";
+    } catch (const asyncfem::ValidationError& error) {
+      EXPECT_EQ(std::string(error.what()).rfind("scene.json: integrator.timestep: 0.03 does not divide", 0), 0U)
+          << error.what();
+    }
+  }
+  asyncfem::overrideFrameTiming(scene, {.stepsPerFrame = 2});
+  EXPECT_TRUE(scene.timing.resolved());
   EXPECT_EQ(asyncfem::buildSimulation(scene).integrator->timestep(), 0.05);
 }
 
@@ -560,7 +598,7 @@ TEST(AdvanceFrame, PulledBeamMovesAndReturns) {
   json["frames"]["count"] = 5;
   Simulation simulation = build(json);
   double previousTip = 0.0;
-  for (int frame = 0; frame < simulation.numFrames; ++frame) {
+  for (int frame = 0; frame < simulation.timing.frameCount; ++frame) {
     asyncfem::advanceFrame(simulation, frame);
     EXPECT_NEAR(simulation.integrator->time(), (frame + 1) * 0.1, 1e-12);
     const double tip = simulation.integrator->displacement()[(3 * simulation.mesh->vertexSet("xmax")[0]) + 1];
@@ -584,7 +622,7 @@ TEST(AdvanceFrame, UnstableExplicitRunNamesTheFrame) {
   json["frames"]["count"] = 50;
   Simulation simulation = build(json);
   try {
-    for (int frame = 0; frame < simulation.numFrames; ++frame) {
+    for (int frame = 0; frame < simulation.timing.frameCount; ++frame) {
       asyncfem::advanceFrame(simulation, frame);
     }
     FAIL() << "expected the forced explicit run to blow up";

@@ -163,8 +163,8 @@ BenchmarkConfiguration parseConfigurationSpec(const std::string& spec, const Sce
     }
   }
   if (c.stepsPerFrame <= 0 && !(c.timestep > 0.0)) {
-    if (scene.integrator.timestep > 0.0) {
-      c.timestep = scene.integrator.timestep;
+    if (scene.timing.timestep > 0.0) {
+      c.timestep = scene.timing.timestep;
     } else {
       throw ValidationError("--config \"" + spec + "\": give spf=N or dt=H");
     }
@@ -177,9 +177,9 @@ BenchmarkConfiguration parseConfigurationSpec(const std::string& spec, const Sce
 }
 
 std::vector<BenchmarkConfiguration> defaultConfigurations(const Scene& scene, const Simulation& baseline) {
-  const double frame = 1.0 / scene.frames.rate;
+  const double frame = scene.timing.frameInterval;
   // Steps per frame of the scene's own (large) timestep, at least 1.
-  const int sceneSteps = std::max(1, static_cast<int>(std::lround(frame / scene.integrator.timestep)));
+  const int sceneSteps = std::max(1, static_cast<int>(std::lround(frame / scene.timing.timestep)));
   const std::optional<std::vector<AsyncRegion>> sceneRegions =
       isMultirate(scene.integrator.name) ? explicitRegions(scene.integrator.options, scene, baseline) : std::nullopt;
   const bool explicitRegions = sceneRegions.has_value();
@@ -205,7 +205,7 @@ std::vector<BenchmarkConfiguration> defaultConfigurations(const Scene& scene, co
   const double omega = estimateMaxFrequency(*baseline.mesh, scene.mass);
   const int explicitSteps = static_cast<int>(std::ceil(frame / (0.95 * stableTimestepFromFrequency(omega))));
   // Skipped when it would dominate the run time (add it with --config central-differences:spf=N).
-  if (static_cast<long long>(explicitSteps) * scene.frames.count <= 100000) {
+  if (static_cast<long long>(explicitSteps) * scene.timing.frameCount <= 100000) {
     add("central-differences", explicitSteps, 0, nlohmann::json::object(), false);
   }
   if (explicitRegions) {

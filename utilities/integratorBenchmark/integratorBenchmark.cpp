@@ -106,7 +106,7 @@ void writeResultsCsv(const fs::path& path, const std::vector<BenchmarkRun>& resu
 // scene's own step and the largest ratio of any run.
 void writeMotionKept(const fs::path& path, const Scene& scene, const std::vector<BenchmarkRun>& results,
                      const ModalReference& modal, const BenchmarkReference& reference) {
-  const double hL = scene.integrator.timestep;
+  const double hL = scene.timing.timestep;
   const int maxRatio = largestRunRatio(results);
   const std::vector<double> edges = motionBandEdges(hL, maxRatio);
   const std::vector<std::string> names{"omega hL < 0.3", "0.3 to 1", "1 to " + std::to_string(maxRatio),
@@ -292,7 +292,7 @@ void writeVertexEqualCostCsv(const fs::path& path, const std::vector<BenchmarkRu
 std::vector<AsyncRegion> sceneRegions(const Scene& scene, const Simulation& baseline) {
   BenchmarkConfiguration own;
   own.integrator = scene.integrator.name;
-  own.timestep = scene.integrator.timestep;
+  own.timestep = scene.timing.timestep;
   own.options = scene.integrator.options;
   return configurationRegions(scene, baseline, own);
 }
@@ -316,7 +316,7 @@ void printSceneModes(const Scene& scene, const Simulation& baseline, int count) 
   std::cout << "\n## The " << modal.count << " lowest modes and the scene's fast regions (eigensolve "
             << formatDouble(modes.solveSeconds, 3) << " s)\n\n";
   printRegionModeReport(std::cout, analyseRegionModes(modes, matrices.mass, modalRegions(regions),
-                                                      scene.integrator.timestep, scene.frames.rate));
+                                                      scene.timing.timestep, scene.timing.frameRate));
 }
 
 // The configurations of the command line (file, then specs), else the scene's defaults.
@@ -436,8 +436,8 @@ void writePlots(const fs::path& outFolder, const std::vector<BenchmarkRun>& resu
 
 int runBenchmark(const CommandLine& options) {
   const Scene scene = loadScene(options.scene);
-  const int frames = options.quick ? std::min(options.frames.value_or(scene.frames.count), 30)
-                                   : options.frames.value_or(scene.frames.count);
+  const int frames = options.quick ? std::min(options.frames.value_or(scene.timing.frameCount), 30)
+                                   : options.frames.value_or(scene.timing.frameCount);
   const int repeats = options.quick ? 1 : options.repeats;
   const fs::path outFolder(options.out);
   fs::create_directories(outFolder);
@@ -451,7 +451,7 @@ int runBenchmark(const CommandLine& options) {
   std::cout << "Machine: " << machineDescription() << "\n";
   std::cout << "Mesh: " << baseline.mesh->numVertices() << " vertices, " << baseline.mesh->numElements() << " tets, "
             << baseline.integrator->system().freeDofs.numFree() << " free DOFs; " << frames << " frames at "
-            << scene.frames.rate << " per s; " << repeats
+            << scene.timing.frameRate << " per s; " << repeats
             << " repeats (time per frame: median over repeats of the mean over frames 1.., frame 0 is warm-up)\n";
   std::cout.flush();
 

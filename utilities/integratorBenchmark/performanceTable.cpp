@@ -52,10 +52,10 @@ std::string tableRow(const fs::path& path, int frames, int repeats) {
   if (scene.integrator.options.contains("regions") && scene.integrator.options["regions"].is_object()) {
     return "";  // run-time regions: no fixed m to compare single-rate at hS with
   }
-  const int count = std::min(frames, scene.frames.count);
+  const int count = std::min(frames, scene.timing.frameCount);
   BenchmarkConfiguration async;
   async.integrator = "async";
-  async.timestep = scene.integrator.timestep;
+  async.timestep = scene.timing.timestep;
   async.options = scene.integrator.options;
   async.label = "async";
   const Simulation simulation = buildSimulation(configuredScene(scene, async, 1));
@@ -74,9 +74,9 @@ std::string tableRow(const fs::path& path, int frames, int repeats) {
 
   BenchmarkConfiguration large;
   large.integrator = "backward-euler";
-  large.timestep = scene.integrator.timestep;
+  large.timestep = scene.timing.timestep;
   BenchmarkConfiguration small = large;
-  small.timestep = scene.integrator.timestep / largestRatio(parsed.regions);
+  small.timestep = scene.timing.timestep / largestRatio(parsed.regions);
   const BenchmarkRun largeRun = runConfiguration(scene, large, count, repeats);
   const BenchmarkRun smallRun = runConfiguration(scene, small, count, repeats);
   // Schroeder et al. 2011 on the same regions (its own keys only: the regions).
@@ -92,7 +92,7 @@ std::string tableRow(const fs::path& path, int frames, int repeats) {
   };
   std::ostringstream row;
   row << "| " << name << " | " << simulation.mesh->numVertices() << " | " << simulation.mesh->numElements() << " | "
-      << sizes.str() << " | " << formatTimestep(scene.integrator.timestep) << " | " << ratios.str() << " | "
+      << sizes.str() << " | " << formatTimestep(scene.timing.timestep) << " | " << ratios.str() << " | "
       << (scene.forceModel == Scene::ForceModelKind::linear ? "linear" : "corotational") << " | " << cell(asyncRun)
       << " | " << warping << " | " << cell(largeRun) << " | " << cell(smallRun) << " | " << cell(schroederRun) << " | ";
   if (asyncRun.completed && smallRun.completed && asyncRun.medianSecondsPerFrame > 0.0) {

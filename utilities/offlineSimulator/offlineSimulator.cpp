@@ -368,8 +368,7 @@ asyncfem::PetscSimulationSettings petscSettings(const CommandLine& options, cons
         name == "backward-euler" || name == "trapezoidal"
             ? asyncfem::parseIntegratorOptions(scene.integrator.options, "integrator.options", scene.sourceName)
             : asyncfem::IntegratorOptions{};
-    settings =
-        asyncfem::petscSettingsForProblem(problem, name, asyncfem::frameTimingOf(scene).timestep, integratorOptions);
+    settings = asyncfem::petscSettingsForProblem(problem, name, scene.timing.timestep, integratorOptions);
   } catch (const asyncfem::ValidationError& error) {
     throw asyncfem::Error(petscPrefix + scene.sourceName + ": " + error.what());
   }
@@ -379,7 +378,7 @@ asyncfem::PetscSimulationSettings petscSettings(const CommandLine& options, cons
 
 void printPetscSummary(const asyncfem::Scene& scene, const asyncfem::PetscRunStats& stats, double setupSeconds,
                        double loopSeconds) {
-  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
+  const asyncfem::FrameTiming& timing = scene.timing;
   std::ostringstream out;
   out.setf(std::ios::fixed);
   out.precision(3);
@@ -448,7 +447,7 @@ struct PetscOutput {
 // the frames already finished.
 int openPetscOutput(const CommandLine& options, const asyncfem::Scene& scene, const asyncfem::Problem& problem,
                     const asyncfem::PetscRuntime& runtime, asyncfem::PetscSimulation& simulation, PetscOutput& output) {
-  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
+  const asyncfem::FrameTiming& timing = scene.timing;
   output.header.numVertices = problem.mesh().numVertices();
   output.header.frameInterval = timing.frameInterval;
   output.header.timestep = simulation.timestep();
@@ -508,7 +507,7 @@ int openPetscOutput(const CommandLine& options, const asyncfem::Scene& scene, co
 // frame), so no rank waits for the others in a collective call. Returns the frames completed.
 int runPetscFrames(const CommandLine& options, const asyncfem::Scene& scene, const asyncfem::PetscRuntime& runtime,
                    asyncfem::PetscSimulation& simulation, PetscOutput& output, int firstFrame) {
-  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
+  const asyncfem::FrameTiming& timing = scene.timing;
   const bool root = simulation.rank() == 0;
   asyncfem::cli::ProgressReporter progress(
       "offlineSimulator",
@@ -548,7 +547,7 @@ int runPetsc(int argc, char** argv, const CommandLine& options, const asyncfem::
   asyncfem::Stopwatch setupWatch;
   setupWatch.start();
   asyncfem::PetscRuntime runtime(&argc, &argv, options.petscOptions);
-  const asyncfem::FrameTiming timing = asyncfem::frameTimingOf(scene);
+  const asyncfem::FrameTiming& timing = scene.timing;
   std::vector<std::string> warnings;
   const std::shared_ptr<const asyncfem::Problem> problem = asyncfem::buildProblem(scene, &warnings);
   asyncfem::PetscSimulation simulation(problem->mesh(), petscSettings(options, scene, *problem));

@@ -14,37 +14,27 @@
 // SCENE.json it runs a user's multirate scene at each --ratios value instead, printing
 // beside the measured energy growth the estimated spectral radius of the scene's linearized
 // step (estimateSceneStepGrowth).
-// docs/benchmarks.md lists the grid and the results.
+// The grid, the runs and the verdict are library benchmarkTools' (stabilityStress.hpp); this
+// program reads the options and prints the table. docs/benchmarks.md lists the grid and
+// the results.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <Eigen/Geometry>
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/registration.hpp>
+#include <asyncfem/benchmarkTools/stabilityStress.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/core/threading.hpp>
-#include <asyncfem/sceneIO/asyncScene.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/sceneIO/stepGrowthCheck.hpp>
-#include <asyncfem/volumetricMesh/generators.hpp>
-#include <asyncfem/volumetricMesh/writers.hpp>
-#include <atomic>
-#include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <iomanip>
 #include <iostream>
-#include <limits>
-#include <mutex>
-#include <nlohmann/json.hpp>
 #include <optional>
-#include <random>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "commandLine.hpp"
@@ -56,171 +46,16 @@ using namespace asyncfem;
 
 struct Options {
   int frames = 100;
-  bool full = false;
   std::vector<int> cells{8, 2, 2};
   unsigned seed = 1;
   std::string csv = "stability.csv";
   std::string scene;         // --scene: stress a user's scene instead of the built-in grid
   bool framesGiven = false;  // --frames was on the command line
   int jobs = 1;
-  // Narrow the grid (empty: all of it).
-  std::vector<double> stiffnessRatios;
-  std::vector<int> ratios;
-  std::vector<std::string> dampings;     // none, light, heavy
-  std::vector<std::string> integrators;  // async, async-symmetric, multirate-uncoupled, backward-euler
-  std::vector<std::string> meshes;       // regular, perturbed
+  StressGridSelection grid;  // --full and the lists that narrow the grid (--scene: ratios, integrators)
 };
 
-struct Damping {
-  std::string name;
-  double alpha, beta;
-};
-
-struct Case {
-  std::string integrator;  // registry name
-  std::string variant;     // "" or "symmetric"
-  double stiffnessRatio;
-  int ratio;
-  Damping damping;
-  bool perturbed;
-};
-
-struct Outcome {
-  double energyGrowth = 0.0;
-  bool energyMeasured = false;  ///< false when the loads never end or contact acts
-  int failedFrame = -1;
-  std::string failure;
-  double maxDisplacement = 0.0;
-  double seconds = 0.0;
-  /// --scene: estimateSceneStepGrowth() of the run's scene, before the run.
-  std::optional<StepGrowthEstimate> stepGrowth;
-};
-
-constexpr double kLength = 1.0;
-
-BoxMeshSpec barSpec(const Options& options, double stiffnessRatio) {
-  BoxMeshSpec spec;
-  spec.size = Eigen::Vector3d(kLength, 0.25, 0.25);
-  spec.cells = Eigen::Vector3i(options.cells[0], options.cells[1], options.cells[2]);
-  spec.material = Material{"soft", 1000.0, 1e5, 0.4};
-  // The last quarter is stiffer by stiffnessRatio (and lighter, as the paper's stiff parts).
-  spec.regions.push_back({"stiff", Eigen::Vector3d(0.75 * kLength, -1, -1), Eigen::Vector3d(2 * kLength, 2, 2),
-                          Material{"stiff", 500.0, 1e5 * stiffnessRatio, 0.4}});
-  return spec;
-}
-
-// The bar with interior vertices moved randomly by up to 0.4 cell widths per axis: slivers
-// and badly shaped elements, never degenerate ones (retries with a new draw otherwise).
-TetMesh perturbedBar(const BoxMeshSpec& spec, unsigned seed, double* worstQuality) {
-  const TetMesh regular = makeBoxMesh(spec);
-  const Eigen::Vector3d cell = spec.size.cwiseQuotient(spec.cells.cast<double>());
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> uniform(-0.4, 0.4);
-  for (int attempt = 0; attempt < 20; ++attempt) {
-    Eigen::Matrix3Xd positions = regular.restPositions();
-    for (int v = 0; v < regular.numVertices(); ++v) {
-      for (int c = 0; c < 3; ++c) {
-        const double x = positions(c, v);
-        const bool boundary =
-            std::abs(x - spec.origin[c]) < 1e-12 || std::abs(x - spec.origin[c] - spec.size[c]) < 1e-12;
-        const double shift = uniform(rng) * cell[c];
-        if (!boundary) positions(c, v) += shift;
-      }
-    }
-    // Quality: 6 sqrt(2) V / l_max^3 (1 for a regular tet, 0 for a flat one).
-    double worst = 1e300;
-    bool inverted = false;
-    for (int e = 0; e < regular.numElements(); ++e) {
-      const Eigen::Vector4i t = regular.element(e);
-      const Eigen::Vector3d a = positions.col(t[0]), b = positions.col(t[1]), c = positions.col(t[2]),
-                            d = positions.col(t[3]);
-      const double volume = (b - a).cross(c - a).dot(d - a) / 6.0;
-      double longest = 0.0;
-      for (const auto& [p, q] : {std::pair{a, b}, {a, c}, {a, d}, {b, c}, {b, d}, {c, d}}) {
-        longest = std::max(longest, (p - q).norm());
-      }
-      const double original = [&] {
-        const Eigen::Matrix<double, 3, 4> rest = regular.elementRestPositions(e);
-        return (rest.col(1) - rest.col(0)).cross(rest.col(2) - rest.col(0)).dot(rest.col(3) - rest.col(0));
-      }();
-      if (volume * original <= 0.0) inverted = true;
-      worst = std::min(worst, 6.0 * std::sqrt(2.0) * std::abs(volume) / std::pow(longest, 3));
-    }
-    if (inverted || worst < 1e-3) continue;
-    TetMesh mesh(positions, regular.elements(), regular.materials(), regular.elementMaterials());
-    for (const auto& [name, members] : regular.elementSets()) mesh.setElementSet(name, members);
-    for (const auto& [name, members] : regular.vertexSets()) mesh.setVertexSet(name, members);
-    *worstQuality = worst;
-    return mesh;
-  }
-  throw Error("could not perturb the bar without inverting or flattening an element; use more cells");
-}
-
-// The bar scene of a case; multirate integrators get one fast region, the stiff quarter
-// (stiffVertices: the vertices of its elements).
-Scene sceneFor(const Case& run, const fs::path& meshFile, const std::vector<int>& stiffVertices) {
-  Scene scene;
-  scene.sourceName = "stress";
-  scene.mesh.source = Scene::MeshSource::file;
-  scene.mesh.file = meshFile;
-  scene.fixed.sets = {"xmin"};
-  scene.rayleighAlpha = run.damping.alpha;
-  scene.rayleighBeta = run.damping.beta;
-  scene.integrator.name = run.integrator;
-  scene.integrator.timestep = 1.0 / 120.0;
-  scene.frames.rate = 30.0;
-  if (run.integrator != "backward-euler") {
-    AsyncSettings settings;
-    settings.regions = {{"stiff", stiffVertices, run.ratio}};
-    if (run.variant == "symmetric") settings.solver.schur = SchurMode::symmetric;
-    scene.integrator.options = asyncSettingsJson(settings);
-  }
-  return scene;
-}
-
-// Runs `frames` frames of a built simulation. Energy growth is max E / E_ref over the
-// frames that end at or after `freeFrom` (E = kinetic + elastic - constant loads . u): no
-// load changes from then on, so the energy may only stay or decrease. E_ref: `referenceEnergy` when given (> 0), else
-// the energy of the first of those frames.
-Outcome runSimulation(Simulation& simulation, int frames, double freeFrom, double referenceEnergy = -1.0) {
-  Outcome outcome;
-  Stopwatch watch;
-  Integrator& integrator = *simulation.integrator;
-  // The loads that stay constant (gravity, endless pulls), built once.
-  const Eigen::VectorXd constantLoad = simulation.problem->loads()->constantPart(simulation.problem->numDofs());
-  for (int frame = 0; frame < frames; ++frame) {
-    try {
-      advanceFrame(simulation, frame);
-    } catch (const NumericalError& error) {
-      outcome.failedFrame = frame;
-      outcome.failure = error.what();
-      break;
-    }
-    if (integrator.time() >= freeFrom) {
-      outcome.energyMeasured = true;
-      const double energy = integrator.mechanicalEnergy() - constantLoad.dot(integrator.displacement());
-      if (referenceEnergy < 0.0) referenceEnergy = energy;
-      if (referenceEnergy > 0.0) outcome.energyGrowth = std::max(outcome.energyGrowth, energy / referenceEnergy);
-    }
-    outcome.maxDisplacement = std::max(outcome.maxDisplacement, integrator.displacement().cwiseAbs().maxCoeff());
-  }
-  outcome.seconds = watch.stop();
-  return outcome;
-}
-
-Outcome runCase(const Case& run, const fs::path& meshFile, const std::vector<int>& stiffVertices, int frames) {
-  Scene scene = sceneFor(run, meshFile, stiffVertices);
-  scene.frames.count = frames;
-  Simulation simulation = buildSimulation(scene);
-  Integrator& integrator = *simulation.integrator;
-  const Eigen::Matrix3Xd& rest = simulation.mesh->restPositions();
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(integrator.system().numDofs());
-  for (int v = 0; v < rest.cols(); ++v) u[3 * v + 1] = 0.02 * rest(0, v) * rest(0, v) / kLength;
-  integrator.setState(u, Eigen::VectorXd::Zero(u.size()));
-  return runSimulation(simulation, frames, 0.0, integrator.mechanicalEnergy());  // free from t = 0: E / E_0
-}
-
-std::string describe(const Case& c) {
+std::string describe(const StressCase& c) {
   std::ostringstream out;
   out << c.integrator << (c.variant.empty() ? "" : " " + c.variant) << ", stiffness ratio " << c.stiffnessRatio;
   if (c.integrator != "backward-euler") out << ", m = " << c.ratio;
@@ -228,120 +63,34 @@ std::string describe(const Case& c) {
   return out.str();
 }
 
-// Runs work(i) for i in [0, count) on `workers` threads (cases are independent); calls
-// report(i, outcome) in index order, under a lock, as soon as cases 0..i are done. A case
-// that throws is reported as failed at frame 0.
-void runOrdered(std::size_t count, int workers, const std::function<Outcome(std::size_t)>& work,
-                const std::function<void(std::size_t, const Outcome&)>& report) {
-  std::vector<Outcome> outcomes(count);
-  std::vector<char> done(count, 0);
-  std::atomic<std::size_t> next{0};
-  std::mutex mutex;
-  std::size_t reported = 0;
-  auto worker = [&] {
-    for (std::size_t index = next++; index < count; index = next++) {
-      Outcome outcome;
-      try {
-        outcome = work(index);
-      } catch (const std::exception& error) {
-        outcome.failedFrame = 0;
-        outcome.failure = std::string("setup failed: ") + error.what();
-      }
-      const std::lock_guard<std::mutex> lock(mutex);
-      outcomes[index] = outcome;
-      done[index] = 1;
-      for (; reported < count && done[reported]; ++reported) report(reported, outcomes[reported]);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int w = 1; w < workers; ++w) pool.emplace_back(worker);
-  worker();
-  for (std::thread& thread : pool) thread.join();
-}
-
-// The selection lists the user can narrow: an empty list means the grid's default.
+// The selection lists the user can narrow: an empty list means the default.
 template <typename T>
-std::vector<T> chosen(const std::vector<T>& requested, std::vector<T> grid) {
-  return requested.empty() ? grid : requested;
+std::vector<T> chosen(const std::vector<T>& requested, std::vector<T> defaults) {
+  return requested.empty() ? defaults : requested;
 }
 
-// The grid a run covers: the full or default lists, narrowed by the options.
-struct Grid {
-  std::vector<double> stiffnessRatios;
-  std::vector<int> ratios;
-  std::vector<Damping> dampings;
-  std::vector<std::pair<std::string, std::string>> integrators;  // registry name, variant
-  std::vector<bool> meshes;                                      // perturbed?
-};
-
-// Whether name is in the requested list (an empty list requests everything).
-bool requested(const std::vector<std::string>& list, const std::string& name) {
-  return list.empty() || std::find(list.begin(), list.end(), name) != list.end();
-}
-
-Grid gridOf(const Options& options) {
-  Grid grid;
-  grid.stiffnessRatios =
-      chosen(options.stiffnessRatios, options.full ? std::vector<double>{1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6}
-                                                   : std::vector<double>{1, 1e2, 1e4, 1e6});
-  grid.ratios =
-      chosen(options.ratios, options.full ? std::vector<int>{1, 2, 8, 32, 100, 200} : std::vector<int>{1, 8, 50, 200});
-  for (const Damping& damping : std::vector<Damping>{{"none", 0.0, 0.0}, {"light", 0.1, 1e-4}, {"heavy", 5.0, 1e-2}}) {
-    if (requested(options.dampings, damping.name)) grid.dampings.push_back(damping);
+// The line of the closing list for a run that blew up or gained energy (stabilityVerdict);
+// empty for a stable one. energyRatio: how the growth is named (E/E0, E/E_free).
+std::string problemLine(const std::string& what, const StressOutcome& o, const std::string& energyRatio) {
+  std::ostringstream line;
+  switch (stabilityVerdict(o)) {
+    case StabilityVerdict::blowUp:
+      line << "BLOW-UP: " << what << ": frame " << o.failedFrame << ": " << o.failure;
+      break;
+    case StabilityVerdict::energyGrowth:
+      line << "ENERGY GROWTH: " << what << ": max " << energyRatio << " = " << o.energyGrowth;
+      break;
+    case StabilityVerdict::stable:
+      break;
   }
-  const std::vector<std::pair<std::string, std::string>> allIntegrators = {
-      {"async", ""}, {"async", "symmetric"}, {"multirate-uncoupled", ""}, {"backward-euler", ""}};
-  for (const auto& entry : allIntegrators) {
-    const std::string name = entry.second.empty() ? entry.first : entry.first + "-" + entry.second;
-    if (requested(options.integrators, name)) grid.integrators.push_back(entry);
-  }
-  for (const bool perturbed : {false, true}) {
-    if (requested(options.meshes, perturbed ? "perturbed" : "regular")) grid.meshes.push_back(perturbed);
-  }
-  return grid;
-}
-
-// One case of the grid with the mesh file it runs on (written once per mesh).
-struct Job {
-  Case c;
-  fs::path meshFile;
-  double quality;
-  std::vector<int> stiffVertices;  // the fast region of multirate cases
-};
-
-std::vector<Job> gridJobs(const Options& options, const Grid& grid, const fs::path& folder) {
-  std::vector<Job> jobs;
-  for (const double stiffnessRatio : grid.stiffnessRatios) {
-    const BoxMeshSpec spec = barSpec(options, stiffnessRatio);
-    for (const bool perturbed : grid.meshes) {
-      double quality = 1.0;
-      const TetMesh mesh = perturbed ? perturbedBar(spec, options.seed, &quality) : makeBoxMesh(spec);
-      const fs::path meshFile =
-          folder / ("bar-" + std::to_string(jobs.size()) + (perturbed ? "-perturbed" : "") + ".veg");
-      writeVeg(meshFile, mesh);
-      RegionSelector stiff;
-      stiff.elementSets = {"stiff"};
-      const std::vector<int> stiffVertices = regionVertices(mesh, stiff);
-      for (const Damping& damping : grid.dampings) {
-        for (const auto& [integrator, variant] : grid.integrators) {
-          for (const int ratio : grid.ratios) {
-            if (integrator == "backward-euler" && ratio != grid.ratios.front()) continue;  // m does not apply
-            jobs.push_back({Case{integrator, variant, stiffnessRatio, ratio, damping, perturbed}, meshFile, quality,
-                            stiffVertices});
-          }
-        }
-      }
-    }
-  }
-  return jobs;
+  return line.str();
 }
 
 // The table row and CSV line of a finished grid case; a blow-up or energy growth is added
 // to problems.
-void reportGridCase(const Job& job, const Outcome& o, int frames, std::ostream& csv,
+void reportGridCase(const StressJob& job, const StressOutcome& o, int frames, std::ostream& csv,
                     std::vector<std::string>& problems) {
-  const Case& c = job.c;
-  const bool grows = o.energyGrowth > 1.0 + 1e-9;
+  const StressCase& c = job.stressCase;
   std::cout << "| " << c.integrator << (c.variant.empty() ? "" : " " + c.variant) << " | " << c.stiffnessRatio << " | "
             << (c.integrator == "backward-euler" ? std::string("-") : std::to_string(c.ratio)) << " | "
             << c.damping.name << " | "
@@ -354,20 +103,15 @@ void reportGridCase(const Job& job, const Outcome& o, int frames, std::ostream& 
       << (c.perturbed ? "perturbed" : "regular") << ',' << frames << ',' << o.energyGrowth << ',' << o.failedFrame
       << ',' << o.maxDisplacement << ',' << o.seconds << ",\"" << o.failure << "\"\n";
   csv.flush();
-  if (o.failedFrame >= 0) {
-    problems.push_back("BLOW-UP: " + describe(c) + ": frame " + std::to_string(o.failedFrame) + ": " + o.failure);
-  } else if (grows) {
-    std::ostringstream line;
-    line << "ENERGY GROWTH: " << describe(c) << ": max E/E0 = " << o.energyGrowth;
-    problems.push_back(line.str());
-  }
+  if (const std::string line = problemLine(describe(c), o, "E/E0"); !line.empty()) problems.push_back(line);
 }
 
 int run(const Options& options) {
-  const int frames = options.full ? std::max(options.frames, 10000) : options.frames;
+  const int frames = options.grid.full ? std::max(options.frames, 10000) : options.frames;
   const fs::path folder = fs::temp_directory_path() / ("asyncfem-stress-" + std::to_string(::getpid()));
   fs::create_directories(folder);
-  const std::vector<Job> jobs = gridJobs(options, gridOf(options), folder);
+  const Eigen::Vector3i cells(options.cells[0], options.cells[1], options.cells[2]);
+  const std::vector<StressJob> jobs = stressJobs(stressGrid(options.grid), cells, options.seed, folder);
 
   std::ofstream csv(options.csv);
   if (!csv) throw Error(options.csv + ": cannot open for writing");
@@ -384,13 +128,9 @@ int run(const Options& options) {
 
   std::vector<std::string> problems;
   Stopwatch total;
-  runOrdered(
-      jobs.size(), workers,
-      [&](std::size_t index) {
-        const Job& job = jobs[index];
-        return runCase(job.c, job.meshFile, job.stiffVertices, frames);
-      },
-      [&](std::size_t index, const Outcome& o) { reportGridCase(jobs[index], o, frames, csv, problems); });
+  runStressJobsInOrder(
+      jobs.size(), workers, [&](std::size_t index) { return runStressJob(jobs[index], frames); },
+      [&](std::size_t index, const StressOutcome& o) { reportGridCase(jobs[index], o, frames, csv, problems); });
   std::cout << "\n"
             << jobs.size() << " runs in " << total.stop() << " s; " << problems.size()
             << " with a blow-up or energy growth (E/E0 > 1 + 1e-9)\n";
@@ -407,56 +147,7 @@ std::string formatGrowth(double value) {
   return out.str();
 }
 
-// --scene: one run, an integrator from the --integrators list at one ratio m.
-struct SceneJob {
-  std::string integrator;
-  int ratio;
-};
-
-std::vector<SceneJob> sceneJobs(const Options& options, const Scene& base) {
-  const std::vector<int> ratios = chosen(options.ratios, {2, 4, 8, 16, 32, 64});
-  const std::vector<std::string> integrators = chosen(
-      options.integrators, {base.integrator.name == "async" ? "async" : "multirate-uncoupled", "backward-euler"});
-  std::vector<SceneJob> jobs;
-  for (const std::string& integrator : integrators) {
-    for (const int ratio : ratios) {
-      if (integrator == "backward-euler" && ratio != ratios.front()) continue;  // m does not apply
-      jobs.push_back({integrator, ratio});
-    }
-  }
-  return jobs;
-}
-
-// The scene's regions as the simulator reads them (the mesh and constraints only, nothing
-// assembled).
-std::vector<AsyncRegion> sceneRegions(const Scene& scene) {
-  const std::shared_ptr<const Problem> problem = buildProblem(scene);
-  const nlohmann::json regionsOnly = {{"regions", scene.integrator.options.at("regions")}};
-  return parseAsyncOptions(scene, *problem->sharedMesh(), problem->freeDofs(), regionsOnly).regions;
-}
-
-// The scene of a job: every region's ratio set to the job's m, or backward Euler.
-Scene sceneForJob(const Scene& base, std::vector<AsyncRegion> regions, const SceneJob& job, int frames) {
-  Scene scene = base;
-  scene.frames.count = frames;
-  if (job.integrator == "backward-euler") {
-    scene.integrator.name = "backward-euler";
-    scene.integrator.options = nlohmann::json::object();
-    return scene;
-  }
-  scene.integrator.name = job.integrator == "multirate-uncoupled" ? "multirate-uncoupled" : "async";
-  for (AsyncRegion& region : regions) region.ratio = job.ratio;
-  scene.integrator.options["regions"] = asyncRegionsJson(regions);
-  if (job.integrator == "async-symmetric") scene.integrator.options["schur"] = "symmetric";
-  if (scene.integrator.name == "multirate-uncoupled") {
-    for (const char* key : {"coupling", "schur", "method", "recovery", "substepContact"}) {
-      scene.integrator.options.erase(key);
-    }
-  }
-  return scene;
-}
-
-void reportSceneCase(const SceneJob& job, const Outcome& o, std::vector<std::string>& problems) {
+void reportSceneCase(const SceneStressJob& job, const StressOutcome& o, std::vector<std::string>& problems) {
   const std::string m = job.integrator == "backward-euler" ? std::string("-") : std::to_string(job.ratio);
   std::ostringstream estimate;  // "-" when the scene failed before the estimate
   if (o.stepGrowth) {
@@ -472,13 +163,7 @@ void reportSceneCase(const SceneJob& job, const Outcome& o, std::vector<std::str
             << " |\n";
   std::cout.flush();
   const std::string what = job.integrator + (m == "-" ? "" : ", m = " + m);
-  if (o.failedFrame >= 0) {
-    problems.push_back("BLOW-UP: " + what + ": frame " + std::to_string(o.failedFrame) + ": " + o.failure);
-  } else if (o.energyMeasured && o.energyGrowth > 1.0 + 1e-9) {
-    std::ostringstream line;
-    line << "ENERGY GROWTH: " << what << ": max E/E_free = " << o.energyGrowth;
-    problems.push_back(line.str());
-  }
+  if (const std::string line = problemLine(what, o, "E/E_free"); !line.empty()) problems.push_back(line);
 }
 
 // --scene: a user's multirate scene under several ratios m (every region's ratio set to
@@ -486,19 +171,16 @@ void reportSceneCase(const SceneJob& job, const Outcome& o, std::vector<std::str
 // is measured once the loads are over.
 int runScene(const Options& options) {
   const Scene base = loadScene(options.scene);
-  const bool multirate = base.integrator.name == "async" || base.integrator.name == "multirate-uncoupled";
-  if (!multirate || !base.integrator.options.contains("regions") || !base.integrator.options["regions"].is_array()) {
-    throw Error(options.scene +
-                ": integrator: --scene needs an \"async\" or \"multirate-uncoupled\" scene with explicit "
-                "regions (not \"auto\")");
-  }
-  const int frames = options.framesGiven ? options.frames : base.frames.count;
-  const std::vector<AsyncRegion> regions = sceneRegions(base);
-  const std::vector<SceneJob> jobs = sceneJobs(options, base);
+  const std::vector<AsyncRegion> regions = sceneStressRegions(base);
+  const int frames = options.framesGiven ? options.frames : base.timing.frameCount;
+  const std::vector<SceneStressJob> jobs =
+      sceneStressJobs(chosen(options.grid.integrators,
+                             {base.integrator.name == "async" ? "async" : "multirate-uncoupled", "backward-euler"}),
+                      chosen(options.grid.ratios, {2, 4, 8, 16, 32, 64}));
   const int workers = std::max(1, std::min<int>(options.jobs, static_cast<int>(jobs.size())));
   std::cout
       << "# stabilityStressTest --scene " << options.scene << ": " << jobs.size() << " runs of " << frames
-      << " frames, hL = " << base.integrator.timestep
+      << " frames, hL = " << base.timing.timestep
       << "; energy growth from when the last load window closes (not measured with contact); step growth "
          "estimate: spectral radius of one (large) step of the linearized scene, estimated from a few dozen "
          "steps before the run (its own seconds in \"estimate s\")"
@@ -506,17 +188,17 @@ int runScene(const Options& options) {
          "|\n|---|---|---|---|---|---|---|---|\n";
   std::vector<std::string> problems;
   Stopwatch total;
-  runOrdered(
+  runStressJobsInOrder(
       jobs.size(), workers,
       [&](std::size_t index) {
-        const Scene scene = sceneForJob(base, regions, jobs[index], frames);
+        const Scene scene = sceneForStressJob(base, regions, jobs[index], frames);
         Simulation simulation = buildSimulation(scene);
         const StepGrowthEstimate stepGrowth = estimateSceneStepGrowth(scene, simulation);
-        Outcome outcome = runSimulation(simulation, frames, simulation.monitor->energyCheckFrom());
+        StressOutcome outcome = runStressFrames(simulation, frames, simulation.monitor->energyCheckFrom());
         outcome.stepGrowth = stepGrowth;
         return outcome;
       },
-      [&](std::size_t index, const Outcome& o) { reportSceneCase(jobs[index], o, problems); });
+      [&](std::size_t index, const StressOutcome& o) { reportSceneCase(jobs[index], o, problems); });
   std::cout << "\n"
             << jobs.size() << " runs in " << total.stop() << " s; " << problems.size()
             << " with a blow-up or energy growth (E/E_free > 1 + 1e-9)\n";
@@ -531,7 +213,7 @@ int main(int argc, char** argv) {
   Options options;
   app.add_option("--frames", options.frames, "Frames per run (default 100; --full: at least 10000)")
       ->check(asyncfem::cli::positive());
-  app.add_flag("--full", options.full, "The full grid: 7 stiffness ratios, 6 timestep ratios, >= 10000 frames");
+  app.add_flag("--full", options.grid.full, "The full grid: 7 stiffness ratios, 6 timestep ratios, >= 10000 frames");
   app.add_option("--cells", options.cells, "Cells of the bar along x, y, z")->expected(3);
   app.add_option("--seed", options.seed, "Seed of the vertex perturbation");
   app.add_option("--csv", options.csv, "CSV output file (grid mode)");
@@ -541,14 +223,14 @@ int main(int argc, char** argv) {
                  "gains energy after its loads end");
   app.add_option("--jobs", options.jobs, "Runs in parallel (each run is single-threaded work on a small mesh)")
       ->check(asyncfem::cli::positive());
-  app.add_option("--stiffness-ratios", options.stiffnessRatios, "Only these stiffness ratios")
+  app.add_option("--stiffness-ratios", options.grid.stiffnessRatios, "Only these stiffness ratios")
       ->check(asyncfem::cli::positive());
-  app.add_option("--ratios", options.ratios, "Only these timestep ratios m")->check(asyncfem::cli::positive());
-  app.add_option("--damping", options.dampings, "Only these damping levels")
+  app.add_option("--ratios", options.grid.ratios, "Only these timestep ratios m")->check(asyncfem::cli::positive());
+  app.add_option("--damping", options.grid.dampings, "Only these damping levels")
       ->check(CLI::IsMember({"none", "light", "heavy"}));
-  app.add_option("--integrators", options.integrators, "Only these integrators")
+  app.add_option("--integrators", options.grid.integrators, "Only these integrators")
       ->check(CLI::IsMember({"async", "async-symmetric", "multirate-uncoupled", "backward-euler"}));
-  app.add_option("--meshes", options.meshes, "Only these meshes")->check(CLI::IsMember({"regular", "perturbed"}));
+  app.add_option("--meshes", options.grid.meshes, "Only these meshes")->check(CLI::IsMember({"regular", "perturbed"}));
   if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "stabilityStressTest")) return *status;
   options.framesGiven = app.count("--frames") > 0;
   return asyncfem::cli::run("stabilityStressTest",

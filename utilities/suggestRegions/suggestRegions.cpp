@@ -118,8 +118,11 @@ Input readScene(CommandLine& cl) {
     if (scene.mesh.source == Scene::MeshSource::file) inputs.push_back({"the mesh", scene.mesh.file});
     cli::refuseOutputOverInputs({"--write", cl.writePath}, inputs, "write the regions to another file");
   }
-  if (cl.largeTimestep <= 0.0) cl.largeTimestep = scene.integrator.timestep;
-  if (cl.frameRate <= 0.0) cl.frameRate = scene.frames.rate;
+  // The scene's timing, at the large step asked for (no need to divide its frames).
+  FrameTiming timing = requireFrameTiming(scene);
+  if (cl.largeTimestep > 0.0) timing.timestep = cl.largeTimestep;
+  cl.largeTimestep = timing.timestep;
+  if (cl.frameRate <= 0.0) cl.frameRate = timing.frameRate;
   Input in;
   in.massType = scene.mass;
   in.corotational = scene.forceModel != Scene::ForceModelKind::linear;
@@ -137,9 +140,7 @@ Input readScene(CommandLine& cl) {
   } else if (integrator.name == "async") {
     // What the simulator would run: the scene's own auto settings (command-line
     // options given explicitly replace them).
-    Scene timed = scene;
-    timed.integrator.timestep = cl.largeTimestep;
-    in.sceneAuto = parseAutoRegionOptions(integratorContext(timed), integrator.options);
+    in.sceneAuto = parseAutoRegionOptions(integratorContext(scene, timing), integrator.options);
   }
   return in;
 }

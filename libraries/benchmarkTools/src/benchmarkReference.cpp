@@ -38,13 +38,14 @@ BenchmarkReference modalReference(const Scene& scene, const Simulation& baseline
 
 int referenceStepsPerFrame(const Scene& scene, const Simulation& baseline,
                            const std::vector<BenchmarkConfiguration>& configurations) {
-  const double frameInterval = 1.0 / scene.frames.rate;
-  double smallest = frameInterval;
+  // In steps per frame, which are whole numbers: frame interval / h_min is the most small
+  // steps per frame any configuration takes.
+  int finest = 1;
   for (const BenchmarkConfiguration& c : configurations) {
-    const double step = configuredScene(scene, c, 1).integrator.timestep;
-    smallest = std::min(smallest, step / largestRatio(configurationRegions(scene, baseline, c)));
+    const int steps = configuredScene(scene, c, 1).timing.stepsPerFrame;
+    finest = std::max(finest, steps * largestRatio(configurationRegions(scene, baseline, c)));
   }
-  return static_cast<int>(std::ceil(frameInterval / (smallest / 4.0)));
+  return 4 * finest;
 }
 
 BenchmarkReference computeReference(const Scene& scene, const Simulation& baseline,

@@ -18,11 +18,15 @@ bool isMultirate(const std::string& integrator) {
 Scene configuredScene(const Scene& scene, const BenchmarkConfiguration& configuration, int frames) {
   Scene out = scene;
   out.integrator.name = configuration.integrator;
-  out.integrator.timestep = configuration.stepsPerFrame > 0 ? 1.0 / (scene.frames.rate * configuration.stepsPerFrame)
-                                                            : configuration.timestep;
-  out.integrator.stepsPerFrame = configuration.stepsPerFrame > 0 ? configuration.stepsPerFrame : 0;
   out.integrator.options = configuration.options;
-  out.frames.count = frames;
+  TimingOverrides timing;
+  if (configuration.stepsPerFrame > 0) {
+    timing.stepsPerFrame = configuration.stepsPerFrame;
+  } else {
+    timing.timestep = configuration.timestep;
+  }
+  timing.frameCount = frames;
+  overrideFrameTiming(out, timing);
   out.output = Scene::OutputSettings{};
   return out;
 }
@@ -112,8 +116,8 @@ BenchmarkRun runConfiguration(const Scene& scene, const BenchmarkConfiguration& 
   BenchmarkRun result;
   result.configuration = configuration;
   const Scene configured = configuredScene(scene, configuration, frames);
-  result.timestep = configured.integrator.timestep;
-  result.stepsPerFrame = static_cast<int>(std::lround(1.0 / (scene.frames.rate * result.timestep)));
+  result.timestep = configured.timing.timestep;
+  result.stepsPerFrame = configured.timing.stepsPerFrame;
   for (int repeat = 0; repeat < std::max(1, repeats); ++repeat) {
     const Repeat timed = timedRepeat(configured, frames, repeat == 0, result);
     if (timed.failed) break;  // an unstable configuration is not timed again

@@ -90,7 +90,7 @@ PiecewiseConstantLoad sceneLoad(const Scene& scene, const Simulation& simulation
 
 std::vector<double> frameTimes(const Scene& scene, int count) {
   std::vector<double> times(static_cast<std::size_t>(std::max(0, count)));
-  for (int k = 0; k < count; ++k) times[static_cast<std::size_t>(k)] = (k + 1) / scene.frames.rate;
+  for (int k = 0; k < count; ++k) times[static_cast<std::size_t>(k)] = (k + 1) / scene.timing.frameRate;
   return times;
 }
 

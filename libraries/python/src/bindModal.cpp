@@ -80,8 +80,11 @@ struct SceneSuggestion {
 SceneSuggestion suggestSceneRegions(const std::filesystem::path& path, int modeCount, double largeTimestep,
                                     double frameRate) {
   const Scene scene = loadScene(path);
-  const double hL = largeTimestep > 0.0 ? largeTimestep : scene.integrator.timestep;
-  const double rate = frameRate > 0.0 ? frameRate : scene.frames.rate;
+  // The scene's timing, at the large step asked for (no need to divide its frames).
+  FrameTiming timing = requireFrameTiming(scene);
+  if (largeTimestep > 0.0) timing.timestep = largeTimestep;
+  const double hL = timing.timestep;
+  const double rate = frameRate > 0.0 ? frameRate : timing.frameRate;
   const std::shared_ptr<const Problem> problem = buildProblem(scene);
   const TetMesh& mesh = *problem->sharedMesh();
   const nlohmann::json& options = scene.integrator.options;
@@ -91,9 +94,7 @@ SceneSuggestion suggestSceneRegions(const std::filesystem::path& path, int modeC
   AutoRegionOptions automatic;
   automatic.modalCheck = true;
   if (isAsync && !explicitRegions) {
-    Scene timed = scene;
-    timed.integrator.timestep = hL;
-    automatic = parseAutoRegionOptions(integratorContext(timed), options);
+    automatic = parseAutoRegionOptions(integratorContext(scene, timing), options);
   }
   automatic.largeTimestep = hL;
   automatic.frameRate = rate;

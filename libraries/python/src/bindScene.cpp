@@ -210,7 +210,7 @@ void bindScene(py::module_& module) {
         if (integrator) switchIntegrator(scene, registry, *integrator);
         if (frames) {
           if (*frames < 1) throw py::value_error("frames: expected a count >= 1, got " + std::to_string(*frames));
-          scene.frames.count = *frames;
+          overrideFrameTiming(scene, {.frameCount = *frames});
         }
         Eigen::MatrixXd displacements;
         py::gil_scoped_release release;
@@ -219,12 +219,12 @@ void bindScene(py::module_& module) {
         if (output) {
           SimulationFileHeader header;
           header.numVertices = simulation.mesh->numVertices();
-          header.frameInterval = simulation.frameInterval;
-          header.timestep = simulation.timestep;
+          header.frameInterval = simulation.timing.frameInterval;
+          header.timestep = simulation.timing.timestep;
           writer = std::make_unique<SimulationWriter>(*output, header);
         }
-        displacements.resize(simulation.mesh->numDofs(), simulation.numFrames);
-        for (int frame = 0; frame < simulation.numFrames; ++frame) {
+        displacements.resize(simulation.mesh->numDofs(), simulation.timing.frameCount);
+        for (int frame = 0; frame < simulation.timing.frameCount; ++frame) {
           advanceFrame(simulation, frame);
           displacements.col(frame) = simulation.integrator->displacement();
           if (writer) writer->appendFrame(simulation.integrator->time(), simulation.integrator->displacement());

@@ -318,7 +318,7 @@ void parseForces(JsonObjectReader& top, Scene& scene) {
   }
 }
 
-void parseIntegrator(JsonObjectReader& top, Scene& scene) {
+void parseIntegrator(JsonObjectReader& top, Scene& scene, TimingKeys& timing) {
   JsonObjectReader reader(top.required("integrator"), "integrator", scene.sourceName);
   scene.integrator.name = reader.string("name", scene.integrator.name);
   if (scene.integrator.name.empty()) {
@@ -333,11 +333,11 @@ void parseIntegrator(JsonObjectReader& top, Scene& scene) {
                              "give either \"timestep\" or \"stepsPerFrame\" (steps per frame of 1 / frames.rate)");
   }
   if (hasTimestep) {
-    scene.integrator.timestep = reader.requiredNumber("timestep");
-    requirePositive(reader, "timestep", scene.integrator.timestep);
+    timing.timestep = reader.requiredNumber("timestep");
+    requirePositive(reader, "timestep", timing.timestep);
   } else {
     // The timestep follows once frames.rate is known (parseScene).
-    scene.integrator.stepsPerFrame = reader.integer("stepsPerFrame", 1, 1, maxStepsPerFrame);
+    timing.stepsPerFrame = reader.integer("stepsPerFrame", 1, 1, maxStepsPerFrame);
   }
   if (const json* options = reader.find("options")) {
     if (!options->is_object()) {
@@ -534,13 +534,13 @@ void parseForceModel(JsonObjectReader& top, Scene& scene) {
   reader.finish();
 }
 
-void parseFrames(JsonObjectReader& top, Scene& scene) {
+void parseFrames(JsonObjectReader& top, const Scene& scene, TimingKeys& timing) {
   const json* frames = top.find("frames");
   if (frames == nullptr) return;
   JsonObjectReader reader(*frames, "frames", scene.sourceName);
-  scene.frames.rate = reader.number("rate", scene.frames.rate);
-  requirePositive(reader, "rate", scene.frames.rate);
-  scene.frames.count = reader.integer("count", scene.frames.count, 1, maxInt);
+  timing.frameRate = reader.number("rate", timing.frameRate);
+  requirePositive(reader, "rate", timing.frameRate);
+  timing.frameCount = reader.integer("count", timing.frameCount, 1, maxInt);
   reader.finish();
 }
 
@@ -562,12 +562,39 @@ std::string describeTimestepMismatch(double rate, double h, double ratio) {
   return message + "; or give the steps per frame instead (integrator.stepsPerFrame)";
 }
 
-// Whether timing was resolved from the scene's current frames and integrator keys.
-bool resolvedFromKeys(const Scene& scene, const FrameTiming& timing) {
-  const bool sameStep = scene.integrator.stepsPerFrame > 0 ? timing.stepsPerFrame == scene.integrator.stepsPerFrame
-                                                           : timing.timestep == scene.integrator.timestep;
-  return timing.frameInterval > 0.0 && timing.frameRate == scene.frames.rate &&
-         timing.frameCount == scene.frames.count && sameStep;
+// Throws for timing keys out of range: frames.rate or frames.count, or a timestep that is
+// not > 0 when no steps per frame are given.
+void checkTimingKeys(const TimingKeys& keys, const std::string& sourceName) {
+  if (!(keys.frameRate > 0.0) || !std::isfinite(keys.frameRate)) {
+    JsonObjectReader::failAt(sourceName, "frames.rate", "expected a number > 0");
+  }
+  if (keys.frameCount < 1) JsonObjectReader::failAt(sourceName, "frames.count", "expected a count >= 1");
+  if (keys.stepsPerFrame > 0) return;
+  if (!(keys.timestep > 0.0) || !std::isfinite(keys.timestep)) {
+    JsonObjectReader::failAt(sourceName, "integrator.timestep", "expected a number > 0");
+  }
+}
+
+// The timing of keys that checkTimingKeys accepts; stepsPerFrame is left 0 (not resolved)
+// when the timestep does not divide the frame interval into whole steps.
+FrameTiming divideFrameInterval(const TimingKeys& keys) {
+  FrameTiming timing;
+  timing.frameRate = keys.frameRate;
+  timing.frameInterval = 1.0 / keys.frameRate;
+  timing.frameCount = keys.frameCount;
+  if (keys.stepsPerFrame > 0) {
+    timing.stepsPerFrame = keys.stepsPerFrame;
+    timing.timestep = timing.frameInterval / timing.stepsPerFrame;
+    return timing;
+  }
+  timing.timestep = keys.timestep;
+  const double ratio = timing.frameInterval / keys.timestep;
+  const double steps = std::round(ratio);
+  // |h - T / N| / (T / N) = |N - ratio| / ratio.
+  if (steps >= 1.0 && steps <= maxStepsPerFrame && std::abs(ratio - steps) <= timestepDivisorTolerance * ratio) {
+    timing.stepsPerFrame = static_cast<int>(steps);
+  }
+  return timing;
 }
 
 }  // namespace
@@ -602,81 +629,52 @@ Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePa
   parseDamping(top, scene);
   parseForceModel(top, scene);
   parseContact(top, scene);
-  parseIntegrator(top, scene);
-  parseFrames(top, scene);
+  TimingKeys timing;
+  parseIntegrator(top, scene, timing);
+  parseFrames(top, scene, timing);
   parseOutput(top, scene);
   top.finish();
-  checkTimingKeys(scene);
+  checkTimingKeys(timing, scene.sourceName);
   // A timestep that does not divide the frame interval is reported where the timing is
-  // used (frameTimingOf: buildSimulation, integratorContext), so that tools which only need
-  // the scene's mesh (afsimTool, frameRenderer) still read such a scene; timing then stays
-  // unresolved.
-  try {
-    scene.timing = resolveFrameTiming(scene);
-    // For programs that still read the key rather than timing.
-    scene.integrator.timestep = scene.timing.timestep;
-  } catch (const Error&) {
-    scene.timing = FrameTiming{};
-  }
+  // used (requireFrameTiming: buildSimulation, integratorContext), so that tools which only
+  // need the scene's mesh (afsimTool, frameRenderer) still read such a scene.
+  scene.timing = divideFrameInterval(timing);
   return scene;
 }
 
-void checkTimingKeys(const Scene& scene) {
-  const double rate = scene.frames.rate;
-  if (!(rate > 0.0) || !std::isfinite(rate)) {
-    throwSceneError(scene, "frames.rate", "expected a number > 0");
+FrameTiming resolveFrameTiming(const TimingKeys& keys, const std::string& sourceName) {
+  checkTimingKeys(keys, sourceName);
+  FrameTiming timing = divideFrameInterval(keys);
+  if (!timing.resolved()) {
+    JsonObjectReader::failAt(
+        sourceName, "integrator.timestep",
+        describeTimestepMismatch(keys.frameRate, keys.timestep, timing.frameInterval / keys.timestep));
   }
-  if (scene.frames.count < 1) throwSceneError(scene, "frames.count", "expected a count >= 1");
-  if (scene.integrator.stepsPerFrame > 0) return;
-  const double h = scene.integrator.timestep;
-  if (!(h > 0.0) || !std::isfinite(h)) {
-    throwSceneError(scene, "integrator.timestep", "expected a number > 0");
-  }
+  return timing;
 }
 
-FrameTiming resolveFrameTiming(const Scene& scene) {
-  checkTimingKeys(scene);
-  const double rate = scene.frames.rate;
-  FrameTiming timing;
-  timing.frameRate = rate;
-  timing.frameInterval = 1.0 / rate;
-  timing.frameCount = scene.frames.count;
-  if (scene.integrator.stepsPerFrame > 0) {
-    timing.stepsPerFrame = scene.integrator.stepsPerFrame;
-    timing.timestep = timing.frameInterval / timing.stepsPerFrame;
-    return timing;
+const FrameTiming& requireFrameTiming(const Scene& scene) {
+  if (!scene.timing.resolved()) {
+    // Throws: the keys of an unresolved timing are its rate, count and written timestep.
+    resolveFrameTiming({scene.timing.frameRate, scene.timing.frameCount, scene.timing.timestep, 0}, scene.sourceName);
   }
-  const double h = scene.integrator.timestep;
-  const double ratio = timing.frameInterval / h;
-  const double steps = std::round(ratio);
-  // |h - T / N| / (T / N) = |N - ratio| / ratio.
-  if (steps >= 1.0 && steps <= maxStepsPerFrame && std::abs(ratio - steps) <= timestepDivisorTolerance * ratio) {
-    timing.timestep = h;
-    timing.stepsPerFrame = static_cast<int>(steps);
-    return timing;
-  }
-  throwSceneError(scene, "integrator.timestep", describeTimestepMismatch(rate, h, ratio));
-}
-
-FrameTiming frameTimingOf(const Scene& scene) {
-  return resolvedFromKeys(scene, scene.timing) ? scene.timing : resolveFrameTiming(scene);
+  return scene.timing;
 }
 
 void overrideFrameTiming(Scene& scene, const TimingOverrides& overrides) {
   if (overrides.timestep && overrides.stepsPerFrame) {
     throwSceneError(scene, "integrator", "give either a timestep or steps per frame, not both");
   }
-  if (overrides.timestep) {
-    scene.integrator.timestep = *overrides.timestep;
-    scene.integrator.stepsPerFrame = 0;
+  if (overrides.stepsPerFrame && *overrides.stepsPerFrame < 1) {
+    throwSceneError(scene, "integrator.stepsPerFrame", "expected a count >= 1");
   }
-  if (overrides.stepsPerFrame) {
-    if (*overrides.stepsPerFrame < 1) throwSceneError(scene, "integrator.stepsPerFrame", "expected a count >= 1");
-    scene.integrator.stepsPerFrame = *overrides.stepsPerFrame;
-  }
-  if (overrides.frameCount) scene.frames.count = *overrides.frameCount;
-  scene.timing = resolveFrameTiming(scene);
-  scene.integrator.timestep = scene.timing.timestep;
+  // The timing as keys: its timestep, which resolves to its own steps per frame again.
+  TimingKeys keys{scene.timing.frameRate, scene.timing.frameCount, scene.timing.timestep, 0};
+  if (overrides.frameRate) keys.frameRate = *overrides.frameRate;
+  if (overrides.frameCount) keys.frameCount = *overrides.frameCount;
+  if (overrides.timestep) keys.timestep = *overrides.timestep;
+  if (overrides.stepsPerFrame) keys.stepsPerFrame = *overrides.stepsPerFrame;
+  scene.timing = resolveFrameTiming(keys, scene.sourceName);
 }
 
 Scene loadScene(const std::filesystem::path& path) {

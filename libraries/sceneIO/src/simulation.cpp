@@ -296,7 +296,7 @@ ProblemSettings problemSettings(const Scene& scene) {
 std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std::string>* warnings) {
   auto mesh = std::make_shared<const TetMesh>(buildSceneMesh(scene, warnings));
   std::vector<int> fixed = collectFixedVertices(scene, *mesh);
-  std::vector<VertexLoad> loads = collectLoads(scene, *mesh, frameTimingOf(scene).timestep);
+  std::vector<VertexLoad> loads = collectLoads(scene, *mesh, requireFrameTiming(scene).timestep);
   const ProblemSettings settings = problemSettings(scene);
   std::shared_ptr<const PenaltyContact> contact;
   if (scene.contact.enabled()) {
@@ -327,7 +327,7 @@ std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& 
   return problem;
 }
 
-IntegratorContext integratorContext(const Scene& scene) { return integratorContext(scene, frameTimingOf(scene)); }
+IntegratorContext integratorContext(const Scene& scene) { return integratorContext(scene, requireFrameTiming(scene)); }
 
 IntegratorContext integratorContext(const Scene& scene, const FrameTiming& timing) {
   IntegratorContext context;
@@ -401,11 +401,8 @@ std::string stableStepsPerFrameAdvice(const Scene& scene, const IntegratorRegist
 Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registry) {
   Simulation simulation;
   // Cheap checks first, so a bad scene fails before the mesh is read and matrices built.
-  simulation.timing = frameTimingOf(scene);
+  simulation.timing = requireFrameTiming(scene);
   requireKnownIntegrator(scene, registry);
-  simulation.timestep = simulation.timing.timestep;
-  simulation.frameInterval = simulation.timing.frameInterval;
-  simulation.numFrames = simulation.timing.frameCount;
 
   simulation.problem = buildProblem(scene, &simulation.warnings);
   const Problem& problem = *simulation.problem;

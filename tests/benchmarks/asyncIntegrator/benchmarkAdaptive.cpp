@@ -166,11 +166,9 @@ int main(int argc, char** argv) {
   try {
     Scene scene = loadScene(scenePath);
     if (contactStiffness > 0.0) scene.contact.parameters.stiffness = contactStiffness;
-    const FrameTiming timing = frameTimingOf(scene);
-    const double hL = timing.timestep;
+    const double hL = requireFrameTiming(scene).timestep;
     // One frame per large step.
-    scene.frames.rate = 1.0 / hL;
-    scene.frames.count = frames;
+    overrideFrameTiming(scene, {.frameCount = frames, .frameRate = 1.0 / hL});
     // contact.implicit for every row when asked for (the single-rate rows' scene is kept
     // apart: the same frames, other integrator options).
     scene.contact.implicit = implicitContact || scene.contact.implicit;

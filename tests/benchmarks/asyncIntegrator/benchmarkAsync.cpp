@@ -514,10 +514,10 @@ Scene steadyScene(const std::string& spec, bool corotational) {
     if (!std::ifstream(path)) writeVeg(path, makeExampleModel(ExampleModel::Dragon, spacing));
     scene = loadScene("models/dragon/dragon.json");
     scene.mesh.file = path;
-    scene.integrator.timestep = std::stod(parts[4]);
     scene.integrator.options["regions"] =
         nlohmann::json::array({{{"name", parts[2]}, {"ratio", std::stoi(parts[3])}, {"vertexSets", {parts[2]}}}});
-    scene.frames.rate = 1.0 / scene.integrator.timestep;
+    const double hL = std::stod(parts[4]);
+    overrideFrameTiming(scene, {.timestep = hL, .frameRate = 1.0 / hL});  // one frame per large step
     scene.sourceName = "dragon (spacing " + parts[1] + ", S = " + parts[2] + ")";
   } else {
     scene = loadScene(spec);

@@ -23,7 +23,7 @@ struct BenchmarkReference {
   std::shared_ptr<const ModalReference> modal;  ///< set when the reference is the exact modal solution
 };
 
-/// Steps per frame of the trapezoidal reference: ceil(frame interval / (h_min / 4)), h_min
+/// Steps per frame of the trapezoidal reference: frame interval / (h_min / 4), h_min
 /// the smallest step any configuration takes (its step divided by the largest ratio of the
 /// regions it resolves to, configurationRegions(): automatic regions included), at most
 /// the frame interval. A quarter of the smallest step makes the reference's own O(h^2)

@@ -18,7 +18,7 @@ namespace asyncfem {
 struct BenchmarkConfiguration {
   std::string label;
   std::string integrator = "backward-euler";          ///< registry name
-  int stepsPerFrame = 0;                              ///< > 0: h = 1 / (rate stepsPerFrame)
+  int stepsPerFrame = 0;                              ///< > 0: h = frame interval / stepsPerFrame
   double timestep = 0.0;                              ///< used when stepsPerFrame is 0
   nlohmann::json options = nlohmann::json::object();  ///< integrator.options
   bool plotTrajectory = false;                        ///< draw its vertex curve in the trajectory plot
@@ -28,8 +28,9 @@ struct BenchmarkConfiguration {
 /// "schroeder2011".
 bool isMultirate(const std::string& integrator);
 
-/// The scene with the configuration's integrator, timestep, options and frame count, and
-/// no output.
+/// The scene with the configuration's integrator, options, timestep and frame count (its
+/// timing resolved again by overrideFrameTiming, whose ValidationError it throws for a
+/// timestep that does not divide the frame interval), and no output.
 Scene configuredScene(const Scene& scene, const BenchmarkConfiguration& configuration, int frames);
 
 /// The fast regions a multirate configuration runs with, resolved on baseline's mesh and

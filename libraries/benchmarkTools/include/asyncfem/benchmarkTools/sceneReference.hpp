@@ -22,7 +22,7 @@ std::string modalReferenceUnsupportedReason(const Scene& scene, const Simulation
 /// asyncfem::ValidationError for an unknown vertex set (as buildSimulation would).
 PiecewiseConstantLoad sceneLoad(const Scene& scene, const Simulation& simulation);
 
-/// Frame times of a scene: (k + 1) / frames.rate for k = 0..count-1.
+/// Frame times of a scene: (k + 1) / timing.frameRate for k = 0..count-1.
 std::vector<double> frameTimes(const Scene& scene, int count);
 
 }  // namespace asyncfem

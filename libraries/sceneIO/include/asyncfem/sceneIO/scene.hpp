@@ -20,14 +20,27 @@ namespace asyncfem {
 
 /// How the integrator's steps fill the frames of a scene, resolved once from frames.rate,
 /// frames.count and integrator.timestep or integrator.stepsPerFrame (resolveFrameTiming).
-/// Everything downstream reads these values, not the scene keys they came from.
+/// Scene::timing holds the one copy of these values; everything downstream reads them
+/// there (or in Simulation::timing, built from it), never the scene keys they came from.
 struct FrameTiming {
   double frameRate = 0.0;      ///< frames per second (frames.rate)
   double frameInterval = 0.0;  ///< 1 / frameRate, seconds
-  int stepsPerFrame = 0;       ///< frameInterval / timestep, a whole number
-  double timestep = 0.0;       ///< h, seconds
-  int frameCount = 0;          ///< frames to run (frames.count)
+  /// frameInterval / timestep, a whole number >= 1; 0 while unresolved (see Scene::timing)
+  int stepsPerFrame = 0;
+  double timestep = 0.0;  ///< h, seconds
+  int frameCount = 0;     ///< frames to run (frames.count)
+  /// Whether the timestep divides the frame interval (stepsPerFrame >= 1).
+  bool resolved() const { return stepsPerFrame > 0; }
   bool operator==(const FrameTiming&) const = default;
+};
+
+/// The timing keys of a scene file as written: the input of resolveFrameTiming, read by
+/// parseScene and not kept (Scene::timing is what a scene holds).
+struct TimingKeys {
+  double frameRate = 30.0;  ///< frames.rate, frames per second
+  int frameCount = 60;      ///< frames.count
+  double timestep = 0.0;    ///< integrator.timestep, seconds; read when stepsPerFrame is 0
+  int stepsPerFrame = 0;    ///< integrator.stepsPerFrame; 0: the timestep is given instead
 };
 
 /// A scene as written in its JSON file (format: docs/scene-format.md), checked for types,
@@ -116,28 +129,18 @@ struct Scene {
 
   struct IntegratorSettings {
     std::string name = "backward-euler";
-    /// The timestep as written (integrator.timestep); with stepsPerFrame, parseScene and
-    /// overrideFrameTiming set it to timing.timestep for programs that still read it here.
-    /// The timestep a run uses is timing.timestep.
-    double timestep = 0.0;
-    /// Steps per frame given instead of the timestep (integrator.stepsPerFrame); 0: the
-    /// timestep was given, and must divide the frame interval (resolveFrameTiming).
-    int stepsPerFrame = 0;
     /// Integrator-specific keys, passed through unparsed to the integrator's factory
     /// (see IntegratorRegistry), which rejects keys it does not know.
     nlohmann::json options = nlohmann::json::object();
   } integrator;
 
-  /// The frames as written; read by resolveFrameTiming only (see timing).
-  struct FrameSettings {
-    double rate = 30.0;  ///< frames per time unit; frame interval = 1 / rate
-    int count = 60;
-  } frames;
-
-  /// The frame timing resolved from frames and integrator.timestep / stepsPerFrame by
-  /// parseScene (and again by overrideFrameTiming): the one place a run reads its
-  /// timestep, steps per frame and frame count from. A program that builds a Scene in
-  /// code or edits those keys itself leaves it stale; frameTimingOf() then resolves them.
+  /// The frame timing: frames.rate, frames.count and integrator.timestep or
+  /// integrator.stepsPerFrame resolved by parseScene, the one owner of the timestep, the
+  /// steps per frame and the frame count (the keys themselves are not kept). Change it
+  /// with overrideFrameTiming only, which resolves it again; read it for a run with
+  /// requireFrameTiming. When the written timestep does not divide the frame interval the
+  /// scene is still read (tools that only need its mesh use it) and timing holds the rate,
+  /// count and timestep as written with stepsPerFrame 0 (not resolved()).
   FrameTiming timing;
 
   struct OutputSettings {
@@ -161,34 +164,34 @@ struct Scene {
 /// (0.001010101010), far below the gap 1/N between neighbouring divisors (N <= 1e9).
 inline constexpr double timestepDivisorTolerance = 1e-9;
 
-/// The frame timing of a scene's keys: with integrator.stepsPerFrame N, h = frameInterval / N;
-/// otherwise N = frameInterval / integrator.timestep, which must be a whole number to
-/// timestepDivisorTolerance (h is then used as given). Throws asyncfem::ValidationError
-/// "<scene>: integrator.timestep: ..." naming the frame interval and the two nearest valid
-/// timesteps with their steps per frame when it is not, "<scene>: frames.rate: ..." for a
-/// bad rate and "<scene>: frames.count: ..." for a count below 1.
-/// Throws asyncfem::ValidationError naming the key for a frames.rate or frames.count out
-/// of range, or a timestep that is not > 0 (when no stepsPerFrame is given); parseScene
-/// checks these, resolveFrameTiming also whether the timestep divides the frame interval.
-void checkTimingKeys(const Scene& scene);
-FrameTiming resolveFrameTiming(const Scene& scene);
+/// The frame timing of timing keys: with stepsPerFrame N, h = frameInterval / N; otherwise
+/// N = frameInterval / timestep, which must be a whole number to timestepDivisorTolerance
+/// (h is then used as given). Throws asyncfem::ValidationError "<sourceName>: frames.rate:
+/// ..." for a rate that is not > 0, "<sourceName>: frames.count: ..." for a count below 1,
+/// and "<sourceName>: integrator.timestep: ..." for a timestep that is not > 0 or that does
+/// not divide the frame interval, naming the frame interval and the two nearest valid
+/// timesteps with their steps per frame.
+FrameTiming resolveFrameTiming(const TimingKeys& keys, const std::string& sourceName);
 
-/// scene.timing when it is the timing of the scene's keys (as parseScene and
-/// overrideFrameTiming leave it), otherwise resolveFrameTiming(scene): for Scenes built or
-/// edited in code.
-FrameTiming frameTimingOf(const Scene& scene);
+/// scene.timing, for a run: throws the asyncfem::ValidationError of resolveFrameTiming
+/// (naming integrator.timestep) when it is not resolved().
+const FrameTiming& requireFrameTiming(const Scene& scene);
 
 /// Timing values given outside the scene file (a utility's --dt, --steps-per-frame,
-/// --frames); an empty field keeps the scene's.
+/// --frames, a benchmark's configuration); an empty field keeps the scene's.
 struct TimingOverrides {
-  std::optional<double> timestep;    ///< replaces integrator.timestep or integrator.stepsPerFrame
-  std::optional<int> stepsPerFrame;  ///< replaces integrator.timestep or integrator.stepsPerFrame
-  std::optional<int> frameCount;     ///< replaces frames.count
+  // (Initialized members: designated initializers may leave any of them out.)
+  std::optional<double> timestep{};    ///< replaces integrator.timestep or integrator.stepsPerFrame
+  std::optional<int> stepsPerFrame{};  ///< replaces integrator.timestep or integrator.stepsPerFrame
+  std::optional<int> frameCount{};     ///< replaces frames.count
+  /// replaces frames.rate; the timestep (not the steps per frame) stays unless given
+  std::optional<double> frameRate{};
 };
 
-/// Applies overrides to the scene's keys and resolves scene.timing again, with the
-/// errors of resolveFrameTiming (named by the scene key the override replaces). Giving
-/// both timestep and stepsPerFrame is a ValidationError.
+/// The one way to change a scene's timing: applies overrides to scene.timing and resolves
+/// it again (resolveFrameTiming), with its errors named by the scene key each override
+/// replaces; scene is unchanged when it throws. Giving both timestep and stepsPerFrame is
+/// a ValidationError.
 void overrideFrameTiming(Scene& scene, const TimingOverrides& overrides);
 
 /// Whether the scene's integrator options ask for run-time regions

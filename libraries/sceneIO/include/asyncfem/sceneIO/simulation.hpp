@@ -59,7 +59,7 @@ std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& 
 /// for the caller to fill. A program that asks about another timestep than the scene's
 /// (suggestRegions --dt) passes a FrameTiming with that timestep.
 IntegratorContext integratorContext(const Scene& scene, const FrameTiming& timing);
-/// integratorContext(scene, frameTimingOf(scene)).
+/// integratorContext(scene, requireFrameTiming(scene)).
 IntegratorContext integratorContext(const Scene& scene);
 
 /// A scene ready to run: the problem, the integrator (which owns the state, starting at
@@ -71,14 +71,9 @@ struct Simulation {
   std::unique_ptr<Integrator> integrator;
   std::optional<RunMonitor> monitor;
 
-  /// The scene's frame timing (frameTimingOf): steps per frame and frame count for the
-  /// run loop; timing.timestep is the integrator's timestep().
+  /// The scene's frame timing (requireFrameTiming) as the run was built with it: steps per
+  /// frame and frame count for the run loop; timing.timestep is the integrator's timestep().
   FrameTiming timing;
-  /// Copies of timing.timestep, timing.frameInterval and timing.frameCount for the Python
-  /// module, which reads them under these names; new code reads timing.
-  double timestep = 0.0;
-  double frameInterval = 0.0;
-  int numFrames = 0;
 
   std::vector<int> fixedVertices;  ///< sorted, 0-based (the problem's)
   /// The penalty contact model when the scene has obstacles (for reports: penetration).
