@@ -23,8 +23,9 @@ jobs=$(nproc)
 # run) so that they cannot rot unnoticed: about 120 s of CPU, 1 minute on 2 cores.
 ci_parts="petsc python render utilities docs benchmarks"
 required_parts() {  # the semicolon list of $1 less ASYNCFEM_ALLOW_MISSING
-  local allowed=" ${ASYNCFEM_ALLOW_MISSING//,/ } " part required=""
-  for part in ${ASYNCFEM_ALLOW_MISSING//,/ }; do
+  local missing="${ASYNCFEM_ALLOW_MISSING:-}"
+  local allowed=" ${missing//,/ } " part required=""
+  for part in ${missing//,/ }; do
     if [[ " $ci_parts " != *" $part "* ]]; then
       echo "ASYNCFEM_ALLOW_MISSING: unknown part '$part' (known: $ci_parts)" >&2
       return 1

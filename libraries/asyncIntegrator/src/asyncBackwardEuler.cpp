@@ -24,7 +24,7 @@
 #include <optional>
 #include <string>
 
-#include "detail/asyncBackwardEulerImpl.hpp"
+#include "asyncBackwardEulerImpl.hpp"
 #include "detail/contactIteration.hpp"
 #include "detail/fastRegion.hpp"
 #include "detail/flopPrices.hpp"

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <string>
 
-#include "detail/asyncBackwardEulerImpl.hpp"
+#include "asyncBackwardEulerImpl.hpp"
 
 namespace asyncfem {
 

@@ -11,7 +11,6 @@
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/integrator/stableTimestep.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
-#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>
 #include <limits>
 #include <optional>

@@ -11,7 +11,7 @@
 #include <cmath>
 #include <string>
 
-#include "detail/asyncBackwardEulerImpl.hpp"
+#include "asyncBackwardEulerImpl.hpp"
 #include "detail/multirateSupport.hpp"
 #include "detail/parallelTasks.hpp"
 

@@ -10,6 +10,9 @@
 #include <limits>
 #include <sstream>
 
+#include "detail/frameTiming.hpp"
+#include "detail/sceneSections.hpp"
+
 namespace asyncfem {
 
 namespace {
@@ -17,33 +20,7 @@ namespace {
 using nlohmann::json;
 
 constexpr int maxInt = std::numeric_limits<int>::max();
-constexpr int maxStepsPerFrame = 1000000000;
 
-std::string formatNumber(double value, int precision = 6) {
-  std::ostringstream out;
-  out.precision(precision);
-  out << value;
-  return out.str();
-}
-
-// A duration 1 / (rate * steps) as "1/990 s" when rate is a whole number, else as a decimal.
-std::string describeDuration(double rate, long long steps) {
-  const double denominator = rate * static_cast<double>(steps);
-  if (rate == std::round(rate) && denominator < 1e15) {
-    return "1/" + std::to_string(static_cast<long long>(denominator)) + " s";
-  }
-  return formatNumber(1.0 / denominator, 9) + " s";
-}
-
-// "1/990 s = 0.0010101 (33 steps per frame)"
-std::string describeDivisor(double rate, long long steps) {
-  const std::string exact = describeDuration(rate, steps);
-  const std::string decimal = formatNumber(1.0 / (rate * static_cast<double>(steps)), 9) + " s";
-  return (exact == decimal ? exact : exact + " = " + decimal) + " (" + std::to_string(steps) +
-         (steps == 1 ? " step" : " steps") + " per frame)";
-}
-
-// Relative paths in a scene are relative to the scene file's folder.
 std::filesystem::path resolvePath(const std::filesystem::path& base, const std::string& text) {
   const std::filesystem::path path(text);
   return path.is_absolute() || base.empty() ? path.lexically_normal() : (base / path).lexically_normal();
@@ -337,7 +314,7 @@ void parseIntegrator(JsonObjectReader& top, Scene& scene, TimingKeys& timing) {
     requirePositive(reader, "timestep", timing.timestep);
   } else {
     // The timestep follows once frames.rate is known (parseScene).
-    timing.stepsPerFrame = reader.integer("stepsPerFrame", 1, 1, maxStepsPerFrame);
+    timing.stepsPerFrame = reader.integer("stepsPerFrame", 1, 1, detail::maxStepsPerFrame);
   }
   if (const json* options = reader.find("options")) {
     if (!options->is_object()) {
@@ -456,84 +433,6 @@ void parseDamping(JsonObjectReader& top, Scene& scene) {
   }
 }
 
-// forceModel's hyperelastic keys; rejects each one the chosen model does not read.
-void parseHyperelasticOptions(JsonObjectReader& reader, const Scene& scene, HyperelasticOptions& h) {
-  const bool hyperelastic =
-      scene.forceModel != Scene::ForceModelKind::linear && scene.forceModel != Scene::ForceModelKind::corotational;
-  for (const char* key : {"inversionThreshold", "inversionHandling", "compressionResistance", "enforceSPD",
-                          "stvkFormulation", "mooneyRivlin"}) {
-    if (reader.has(key) && !hyperelastic) {
-      reader.fail(key, "only the hyperelastic force models (stvk, neo-hookean, mooney-rivlin) read it");
-    }
-  }
-  if (reader.has("inversionThreshold")) {
-    h.inversionThreshold = reader.number("inversionThreshold", 0.0);
-    if (!(h.inversionThreshold > 0.0 && h.inversionThreshold < 1.0)) {
-      reader.fail("inversionThreshold", "expected a principal stretch in (0, 1)");
-    }
-  }
-  h.inversionHandling = reader.choice("inversionHandling", "extrapolate", {"extrapolate", "vega-clamp"}) == "vega-clamp"
-                            ? InversionHandling::vegaClamp
-                            : InversionHandling::extrapolate;
-  if (reader.has("compressionResistance")) {
-    h.enableCompressionResistance = true;
-    h.compressionResistance = reader.number("compressionResistance", h.compressionResistance);
-    if (!(h.compressionResistance >= 0.0)) reader.fail("compressionResistance", "expected a number >= 0");
-  }
-  h.enforceSPD = reader.boolean("enforceSPD", h.enforceSPD);
-  h.stvkFormulation =
-      reader.choice("stvkFormulation", "green-strain", {"green-strain", "principal-stretches"}) == "green-strain"
-          ? StVKFormulation::greenStrain
-          : StVKFormulation::principalStretches;
-  if (scene.forceModel == Scene::ForceModelKind::stvk && h.stvkFormulation == StVKFormulation::greenStrain) {
-    for (const char* key : {"inversionThreshold", "compressionResistance", "enforceSPD"}) {
-      if (reader.has(key)) {
-        reader.fail(key,
-                    "the Green-strain StVK has no inversion handling: set \"stvkFormulation\": "
-                    "\"principal-stretches\" to use it");
-      }
-    }
-  }
-}
-
-void parseMooneyRivlin(JsonObjectReader& reader, const Scene& scene, HyperelasticOptions& h) {
-  const json* mooney = reader.find("mooneyRivlin");
-  if (mooney == nullptr) return;
-  if (scene.forceModel != Scene::ForceModelKind::mooneyRivlin) {
-    reader.fail("mooneyRivlin", "only with \"type\": \"mooney-rivlin\"");
-  }
-  JsonObjectReader m(*mooney, reader.keyPath("mooneyRivlin"), scene.sourceName);
-  MooneyRivlinParameters parameters;
-  parameters.mu01 = m.number("mu01", parameters.mu01);
-  parameters.mu10 = m.number("mu10", parameters.mu10);
-  parameters.v1 = m.number("v1", parameters.v1);
-  m.finish();
-  h.mooneyRivlin = parameters;
-}
-
-void parseForceModel(JsonObjectReader& top, Scene& scene) {
-  const json* forceModel = top.find("forceModel");
-  if (forceModel == nullptr) return;
-  JsonObjectReader reader(*forceModel, "forceModel", scene.sourceName);
-  const std::string type =
-      reader.choice("type", "linear", {"linear", "corotational", "stvk", "neo-hookean", "mooney-rivlin"});
-  scene.forceModel = type == "linear"         ? Scene::ForceModelKind::linear
-                     : type == "corotational" ? Scene::ForceModelKind::corotational
-                     : type == "stvk"         ? Scene::ForceModelKind::stvk
-                     : type == "neo-hookean"  ? Scene::ForceModelKind::neoHookean
-                                              : Scene::ForceModelKind::mooneyRivlin;
-  if (reader.has("tangent")) {
-    if (scene.forceModel != Scene::ForceModelKind::corotational) {
-      reader.fail("tangent", "only the corotational force model has a tangent choice");
-    }
-    scene.tangent = reader.choice("tangent", "simple", {"simple", "exact"}) == "exact" ? Scene::Tangent::exact
-                                                                                       : Scene::Tangent::simple;
-  }
-  parseHyperelasticOptions(reader, scene, scene.hyperelastic);
-  parseMooneyRivlin(reader, scene, scene.hyperelastic);
-  reader.finish();
-}
-
 void parseFrames(JsonObjectReader& top, const Scene& scene, TimingKeys& timing) {
   const json* frames = top.find("frames");
   if (frames == nullptr) return;
@@ -542,59 +441,6 @@ void parseFrames(JsonObjectReader& top, const Scene& scene, TimingKeys& timing) 
   requirePositive(reader, "rate", timing.frameRate);
   timing.frameCount = reader.integer("count", timing.frameCount, 1, maxInt);
   reader.finish();
-}
-
-// Why the timestep h does not divide the frame interval 1 / rate into whole steps
-// (ratio of them), with the valid timesteps nearest to it.
-std::string describeTimestepMismatch(double rate, double h, double ratio) {
-  std::string message = formatNumber(h, 9) + " does not divide the frame interval " + describeDuration(rate, 1) +
-                        " (frames.rate " + formatNumber(rate, 9) + ") into whole steps: " + formatNumber(ratio, 12) +
-                        " steps per frame; ";
-  if (ratio > maxStepsPerFrame) {
-    message += "the smallest timestep allowed is " + describeDivisor(rate, maxStepsPerFrame);
-  } else if (ratio < 1.0) {
-    message += "the timestep is longer than a frame; the longest valid timestep is " + describeDivisor(rate, 1);
-  } else {
-    const auto fewer = static_cast<long long>(std::floor(ratio));
-    message +=
-        "the nearest valid timesteps are " + describeDivisor(rate, fewer) + " and " + describeDivisor(rate, fewer + 1);
-  }
-  return message + "; or give the steps per frame instead (integrator.stepsPerFrame)";
-}
-
-// Throws for timing keys out of range: frames.rate or frames.count, or a timestep that is
-// not > 0 when no steps per frame are given.
-void checkTimingKeys(const TimingKeys& keys, const std::string& sourceName) {
-  if (!(keys.frameRate > 0.0) || !std::isfinite(keys.frameRate)) {
-    JsonObjectReader::failAt(sourceName, "frames.rate", "expected a number > 0");
-  }
-  if (keys.frameCount < 1) JsonObjectReader::failAt(sourceName, "frames.count", "expected a count >= 1");
-  if (keys.stepsPerFrame > 0) return;
-  if (!(keys.timestep > 0.0) || !std::isfinite(keys.timestep)) {
-    JsonObjectReader::failAt(sourceName, "integrator.timestep", "expected a number > 0");
-  }
-}
-
-// The timing of keys that checkTimingKeys accepts; stepsPerFrame is left 0 (not resolved)
-// when the timestep does not divide the frame interval into whole steps.
-FrameTiming divideFrameInterval(const TimingKeys& keys) {
-  FrameTiming timing;
-  timing.frameRate = keys.frameRate;
-  timing.frameInterval = 1.0 / keys.frameRate;
-  timing.frameCount = keys.frameCount;
-  if (keys.stepsPerFrame > 0) {
-    timing.stepsPerFrame = keys.stepsPerFrame;
-    timing.timestep = timing.frameInterval / timing.stepsPerFrame;
-    return timing;
-  }
-  timing.timestep = keys.timestep;
-  const double ratio = timing.frameInterval / keys.timestep;
-  const double steps = std::round(ratio);
-  // |h - T / N| / (T / N) = |N - ratio| / ratio.
-  if (steps >= 1.0 && steps <= maxStepsPerFrame && std::abs(ratio - steps) <= timestepDivisorTolerance * ratio) {
-    timing.stepsPerFrame = static_cast<int>(steps);
-  }
-  return timing;
 }
 
 }  // namespace
@@ -627,54 +473,19 @@ Scene parseScene(const nlohmann::json& json, const std::filesystem::path& basePa
   scene.mass =
       top.choice("mass", "consistent", {"consistent", "lumped"}) == "lumped" ? MassType::lumped : MassType::consistent;
   parseDamping(top, scene);
-  parseForceModel(top, scene);
+  detail::parseForceModel(top, scene);
   parseContact(top, scene);
   TimingKeys timing;
   parseIntegrator(top, scene, timing);
   parseFrames(top, scene, timing);
   parseOutput(top, scene);
   top.finish();
-  checkTimingKeys(timing, scene.sourceName);
+  detail::checkTimingKeys(timing, scene.sourceName);
   // A timestep that does not divide the frame interval is reported where the timing is
   // used (requireFrameTiming: buildSimulation, integratorContext), so that tools which only
   // need the scene's mesh (afsimTool, frameRenderer) still read such a scene.
-  scene.timing = divideFrameInterval(timing);
+  scene.timing = detail::divideFrameInterval(timing);
   return scene;
-}
-
-FrameTiming resolveFrameTiming(const TimingKeys& keys, const std::string& sourceName) {
-  checkTimingKeys(keys, sourceName);
-  FrameTiming timing = divideFrameInterval(keys);
-  if (!timing.resolved()) {
-    JsonObjectReader::failAt(
-        sourceName, "integrator.timestep",
-        describeTimestepMismatch(keys.frameRate, keys.timestep, timing.frameInterval / keys.timestep));
-  }
-  return timing;
-}
-
-const FrameTiming& requireFrameTiming(const Scene& scene) {
-  if (!scene.timing.resolved()) {
-    // Throws: the keys of an unresolved timing are its rate, count and written timestep.
-    resolveFrameTiming({scene.timing.frameRate, scene.timing.frameCount, scene.timing.timestep, 0}, scene.sourceName);
-  }
-  return scene.timing;
-}
-
-void overrideFrameTiming(Scene& scene, const TimingOverrides& overrides) {
-  if (overrides.timestep && overrides.stepsPerFrame) {
-    throwSceneError(scene, "integrator", "give either a timestep or steps per frame, not both");
-  }
-  if (overrides.stepsPerFrame && *overrides.stepsPerFrame < 1) {
-    throwSceneError(scene, "integrator.stepsPerFrame", "expected a count >= 1");
-  }
-  // The timing as keys: its timestep, which resolves to its own steps per frame again.
-  TimingKeys keys{scene.timing.frameRate, scene.timing.frameCount, scene.timing.timestep, 0};
-  if (overrides.frameRate) keys.frameRate = *overrides.frameRate;
-  if (overrides.frameCount) keys.frameCount = *overrides.frameCount;
-  if (overrides.timestep) keys.timestep = *overrides.timestep;
-  if (overrides.stepsPerFrame) keys.stepsPerFrame = *overrides.stepsPerFrame;
-  scene.timing = resolveFrameTiming(keys, scene.sourceName);
 }
 
 Scene loadScene(const std::filesystem::path& path) {

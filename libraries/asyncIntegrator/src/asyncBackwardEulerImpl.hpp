@@ -2,7 +2,7 @@
 // The state AsyncBackwardEuler keeps per partition (its Impl) and a cached set-up, shared by
 // the files that implement its parts (asyncBackwardEuler.cpp: set-up and the structured
 // step; hierarchyStep.cpp; setUpCache.cpp; laggedSchur.cpp; quickSetUp.cpp;
-// implicitContact.cpp; regionDistribution.cpp). Private to the library.
+// implicitContact.cpp; regionDistribution.cpp; asyncReport.cpp). Private to the library.
 #pragma once
 
 #include <Eigen/Core>
