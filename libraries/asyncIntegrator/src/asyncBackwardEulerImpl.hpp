@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The state AsyncBackwardEuler keeps per partition (its Impl) and a cached set-up, shared by
-// the files that implement its parts (asyncBackwardEuler.cpp: set-up and the structured
+// The state AsyncBackwardEuler keeps per partition (its Impl: AsyncPartitionState) and a
+// cached set-up, shared by the files that implement its parts (asyncBackwardEuler.cpp: set-up and the structured
 // step; hierarchyStep.cpp; setUpCache.cpp; laggedSchur.cpp; quickSetUp.cpp;
 // implicitContact.cpp; regionDistribution.cpp; asyncReport.cpp). Private to the library.
 #pragma once
@@ -8,8 +8,11 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <array>
-#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/asyncIntegrator/asyncOptions.hpp>
 #include <asyncfem/asyncIntegrator/detail/vertexRotations.hpp>
+#include <asyncfem/asyncIntegrator/regionPartition.hpp>
+#include <asyncfem/asyncIntegrator/stepSolver.hpp>
+#include <asyncfem/dynamics/dynamicSystem.hpp>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -23,11 +26,11 @@
 #include "detail/schurSolver.hpp"
 #include "detail/sparseBlocks.hpp"
 
-namespace asyncfem {
+namespace asyncfem::detail {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
-struct AsyncBackwardEuler::Impl {
+struct AsyncPartitionState {
   AsyncStepSolver solver = AsyncStepSolver::structuredSchur;  // chosen at each set-up
   // The hierarchy solve (AsyncStepSolver::hierarchy) and f_ext at each time unit where some
   // DOF's step ends (Eq. N3; the vectors are kept from step to step).
@@ -149,12 +152,12 @@ struct AsyncBackwardEuler::Impl {
 };
 
 // A set-up kept for reuse by run-time regions (the most recently used first).
-struct AsyncBackwardEuler::CachedSetUp {
+struct CachedSetUp {
   std::vector<std::pair<int, std::vector<int>>> key;  // (ratio, vertices) of every region, sorted
   RegionPartition partition;
-  std::unique_ptr<Impl> impl;
+  std::unique_ptr<AsyncPartitionState> impl;
   AsyncRunStats sizes;  // fastDofs, interfaceDofs, largeDofs
   double timestep = 0.0;
 };
 
-}  // namespace asyncfem
+}  // namespace asyncfem::detail

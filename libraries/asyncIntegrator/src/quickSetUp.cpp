@@ -22,6 +22,7 @@ using detail::FastRegion;
 using detail::kBlockedFlopWeight;
 using detail::kQuickBlockedFlopWeight;
 using detail::kSolveCallFlops;
+using SparseMatrix = Eigen::SparseMatrix<double>;
 
 namespace {
 /// Most doubles the quick set-up's deflation directions and their products may hold (64 MiB).

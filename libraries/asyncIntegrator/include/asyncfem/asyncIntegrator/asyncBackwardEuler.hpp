@@ -18,7 +18,9 @@
 namespace asyncfem {
 namespace detail {
 class WholeSystemFactor;
-}
+struct AsyncPartitionState;
+struct CachedSetUp;
+}  // namespace detail
 
 /// Asynchronous implicit backward Euler (Zhao, Li & Barbič 2016, with the equations of
 /// docs/asynchronous-integrator.md), for any partition: fast regions that touch or nest
@@ -125,8 +127,9 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   long long factorNonZeros() const;
 
  private:
-  struct Impl;
-  struct CachedSetUp;
+  // The state kept per partition, and a set-up kept for reuse (src/asyncBackwardEulerImpl.hpp).
+  using Impl = detail::AsyncPartitionState;
+  using CachedSetUp = detail::CachedSetUp;
   std::unique_ptr<Impl> freshImpl() const;
   void initialize();
   void maybeRepartition();
