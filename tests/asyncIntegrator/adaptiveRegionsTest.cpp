@@ -317,7 +317,9 @@ TEST(AdaptiveRegions, IndicatorMarksWhereTheLargeStepErrs) {
       EXPECT_EQ(ratio, options.indicatorRatio) << "kick " << kick << ", wanted " << want;
     } else {
       EXPECT_GE(ratio, want) << "kick " << kick;
-      if (ratio > 2) EXPECT_LT(ratio / 2, want) << "kick " << kick << ": a smaller power of two reaches " << want;
+      if (ratio > 2) {
+        EXPECT_LT(ratio / 2, want) << "kick " << kick << ": a smaller power of two reaches " << want;
+      }
     }
     regimes.insert(want <= 2.0 ? 0 : want >= options.indicatorRatio ? 2 : 1);
     EXPECT_EQ((*next)[0].vertices, test::verticesBeyond(ts.mesh, 0.875));

@@ -104,9 +104,7 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   // Regions that touch at one ratio step as one region (the same step counts): the solve
   // sees them merged, so only a partition with different ratios across an element needs the
   // hierarchy solve.
-  if (std::vector<AsyncRegion> merged = partition.regionsMergedAtOneRatio(); !merged.empty()) {
-    partition = RegionPartition(*system_.mesh, system_.freeDofs, std::move(merged));
-  }
+  partition = mergeTouchingAtOneRatio(*system_.mesh, system_.freeDofs, std::move(partition));
   d.solver = chooseStepSolver(options_, partition, system_);
   partition_ = std::move(partition);
   if (d.solver == AsyncStepSolver::hierarchy) {

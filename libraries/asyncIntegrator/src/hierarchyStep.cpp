@@ -73,7 +73,6 @@ void AsyncBackwardEuler::stepHierarchy() {
   stats_.forceSeconds += forces.stop();
   d.hierarchy->step(displacement_, velocity_, d.internalForce, d.unitForces, d.newU, d.newV, stats_);
   commitStep(d.newU, d.newV);
-  if (!d.linear) d.factorsCurrent = false;  // the next step linearizes at its own start state
   ++runStats_.steps;
   ++stepsKept_;
   runStats_.stepSeconds += whole.stop() - rebuild;

@@ -227,6 +227,12 @@ void RegionPartition::splitFreeDofs(const FreeDofs& freeDofs, const std::vector<
   }
 }
 
+RegionPartition mergeTouchingAtOneRatio(const TetMesh& mesh, const FreeDofs& freeDofs, RegionPartition partition) {
+  std::vector<AsyncRegion> merged = partition.regionsMergedAtOneRatio();
+  if (merged.empty()) return partition;
+  return RegionPartition(mesh, freeDofs, std::move(merged));
+}
+
 std::vector<RegionSummary> summarizeRegions(const RegionPartition& partition) {
   std::vector<int> vertexCount(static_cast<std::size_t>(partition.numRegions()), 0);
   for (const int region : partition.vertexRegion()) {

@@ -116,7 +116,6 @@ Eigen::VectorXd RigidImpulseProjection::apply(const Eigen::VectorXd& impulse, do
 struct Schroeder2011::Impl {
   bool linear = true;
   bool built = false;
-  bool perElementTangents = false;
   std::optional<detail::ElementTangents> tangents;  // where each interface element's K_e comes from
   bool lumpedConsistentMass = false;                // the system's consistent M was replaced by its row sums
   SparseMatrix stiffness;                           // K(u_0), full
@@ -184,7 +183,6 @@ Schroeder2011::Schroeder2011(DynamicSystem system, double largeTimestep, std::ve
 
   collectInterfaceElements();
   d.tangents.emplace(mesh, *system_.forceModel, kName);
-  d.perElementTangents = d.tangents->perElement();
   checkInterfaceStiffness();
 
   // The outer layer's omega_max (S7), from the tangent at rest.

@@ -69,9 +69,7 @@ void AsyncBackwardEuler::repartition(std::vector<AsyncRegion> regions, const std
   RegionPartition next(*system_.mesh, system_.freeDofs, std::move(regions));
   // As setUp() will solve it (regions touching at one ratio merged), so the cache key is
   // the partition's set-up.
-  if (std::vector<AsyncRegion> merged = next.regionsMergedAtOneRatio(); !merged.empty()) {
-    next = RegionPartition(*system_.mesh, system_.freeDofs, std::move(merged));
-  }
+  next = mergeTouchingAtOneRatio(*system_.mesh, system_.freeDofs, std::move(next));
   auto key = partitionKey(next);
   auto hit = std::find_if(cache_.begin(), cache_.end(), [&](const CachedSetUp& c) { return c.key == key; });
   if (hit == cache_.end() && policy_) {

@@ -83,8 +83,7 @@ HierarchySystem::HierarchySystem(const TetMesh& mesh, const DynamicSystem& syste
   for (int count : std::set<int>(dofCount_.begin(), dofCount_.end()))
     for (long long j = 1; j <= count; ++j) ends.insert(j * (units_ / count));
   stepEndUnits_.assign(ends.begin(), ends.end());
-  perElementTangent_ = tangents_.perElement();
-  if (!perElementTangent_) checkLinearStiffness();
+  if (!tangents_.perElement()) checkLinearStiffness();
   chooseElementMass();
   chooseOrder();
   if (solve == NestedSolve::structured ||

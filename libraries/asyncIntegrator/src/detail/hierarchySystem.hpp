@@ -93,7 +93,6 @@ class HierarchySystem {
   int velocityUnknowns_ = 0;
   long long units_ = 1;
   double largeStep_ = 0.0;
-  bool perElementTangent_ = false;
   ElementMass elementMass_ = ElementMass::none;
   std::map<int, SparseMatrix> stiffnessByCount_, massByCount_;  // K_g, M_g per element count g
   SparseMatrix matrix_;

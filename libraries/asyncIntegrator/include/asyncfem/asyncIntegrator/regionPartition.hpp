@@ -130,6 +130,11 @@ class RegionPartition {
   std::pair<int, int> touchingRegions_{-1, -1};
 };
 
+/// partition with every pair of regions that touch at one ratio merged
+/// (RegionPartition::regionsMergedAtOneRatio), rebuilt on mesh and freeDofs; partition
+/// itself when no two regions touch at one ratio. What AsyncBackwardEuler solves.
+RegionPartition mergeTouchingAtOneRatio(const TetMesh& mesh, const FreeDofs& freeDofs, RegionPartition partition);
+
 /// One RegionSummary per fast region of partition (name, vertices, interface DOFs, m).
 std::vector<RegionSummary> summarizeRegions(const RegionPartition& partition);
 
