@@ -186,7 +186,9 @@ TEST(Composition, EveryRefusalNamesItsOption) {
   DynamicSystem implicitContact = ts.system;
   implicitContact.externalForceJacobian = [](double, const Eigen::VectorXd&, const Eigen::VectorXd&, VertexJacobian&) {
   };
-  EXPECT_EQ(refusedKey(ts, implicitContact, touching, {}), "contact");
+  // Implicit contact composes with the hierarchy solve (AsyncImplicitContact.*Hierarchy*,
+  // *Nested*): accepted on both.
+  EXPECT_EQ(refusedKey(ts, implicitContact, touching, {}), "");
   EXPECT_EQ(refusedKey(ts, implicitContact, apart, {}), "");
   const AsyncOptions lu = with([](AsyncOptions& o) { o.nestedSolve = NestedSolve::lu; });
   EXPECT_EQ(refusedKey(ts, ts.system, apart, lu), "nestedSolve");

@@ -25,7 +25,8 @@ struct ShippedCase {
 // ball's scenes, whose material nonlinearScene converts).
 std::vector<ShippedCase> shippedCases() {
   using M = asyncfem::ForceModelType;
-  return {{"antenna/antenna-nested.json", M::neoHookean},
+  return {{"antenna/antenna-nested-strike.json", M::corotational},
+          {"antenna/antenna-nested.json", M::neoHookean},
           {"antenna/antenna-strike.json", M::corotational},
           {"antenna/antenna-wide.json", M::stvk},
           {"antenna/antenna.json", M::neoHookean},
@@ -116,7 +117,15 @@ TEST(DefaultSolvePath, NonlinearBackwardEulerStaysWithin1e8OfExactSolvesOnEveryS
         c.scene.c_str(), asyncfem::toString(c.model).c_str(), worst, integrator->factorReuseStats()->refactorizations,
         integrator->stats().steps, integrator->factorReuseStats()->pcgIterations);
     EXPECT_LT(integrator->factorReuseStats()->refactorizations, integrator->stats().steps);
-    EXPECT_EQ(exact.integrator->stats().factorizations, exact.integrator->stats().steps);
+    // The exact path factors at every step; with implicit contact, steps in contact also
+    // refactor at each Newton iteration with the contact blocks (the nested strike touches in
+    // these frames).
+    const asyncfem::Scene scene = nonlinearScene(c, nlohmann::json{{"reuseFactor", false}});
+    if (scene.contact.implicit) {
+      EXPECT_GE(exact.integrator->stats().factorizations, exact.integrator->stats().steps);
+    } else {
+      EXPECT_EQ(exact.integrator->stats().factorizations, exact.integrator->stats().steps);
+    }
     // The reuse line (after the contact line in scenes with contact).
     const std::vector<std::string> lines = fast.integrator->report().lines;
     EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& line) {

@@ -66,7 +66,7 @@ AsyncBackwardEuler::AsyncBackwardEuler(DynamicSystem system, double largeTimeste
 void AsyncBackwardEuler::initialize() {
   const Impl& d = *impl_;
   if (!system_.damped()) stats_.skipped.push_back("damping blocks (alpha = beta = 0)");
-  if (d.linear)
+  if (d.model.linear)
     stats_.skipped.push_back("per-step refactorization (linear forces: blocks, Z and H^{LL*} factored once)");
   if (options_.method == AsyncSolveMethod::naive)
     stats_.skipped.push_back("Schur complement (naive full-system solve)");
@@ -77,7 +77,7 @@ AsyncBackwardEuler::~AsyncBackwardEuler() = default;
 
 std::unique_ptr<AsyncBackwardEuler::Impl> AsyncBackwardEuler::freshImpl() const {
   auto impl = std::make_unique<Impl>();
-  impl->linear = system_.forceModel->isLinear();
+  impl->model.linear = system_.forceModel->isLinear();
   impl->stiffness = system_.forceModel->createStiffnessMatrix();
   impl->stiffness.makeCompressed();
   return impl;
@@ -115,12 +115,12 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   d.hierarchy.reset();
   const SparseMatrix& mass = system_.mass;
   const std::vector<int>& large = partition_.largeDofs();
-  if (d.sharedPattern < 0) d.sharedPattern = detail::samePattern(mass, d.stiffness) ? 1 : 0;
+  if (d.build.sharedPattern < 0) d.build.sharedPattern = detail::samePattern(mass, d.stiffness) ? 1 : 0;
   d.massLL.rebuild(mass, large, large);  // in the storage of the previous partition's cut
   // Only implicit contact needs the DOF maps (1.7 ms of a 25 ms re-partition of the 10k dragon).
   if (implicitContact()) d.contact.setPartition(partition_, static_cast<int>(mass.rows()));
-  if (d.sharedPattern != 1) d.stiffLL.rebuild(d.stiffness, large, large);
-  d.cutLL = false;
+  if (d.build.sharedPattern != 1) d.stiffLL.rebuild(d.stiffness, large, large);
+  d.build.cutLL = false;
   d.regions.clear();
   d.schurBlocks.clear();
   d.regions.reserve(static_cast<std::size_t>(partition_.numRegions()));
@@ -130,7 +130,7 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   for (int i = 0; i < partition_.numRegions(); ++i) {
     const detail::RegionLayout layout{&partition_.regionDofs(i), &partition_.interfaceDofs(i), partition_.ratio(i)};
     d.regions.emplace_back(mass, d.stiffness, layout, options_.regionSolver, options_.denseRegionDofs);
-    d.regions.back().trackReach = certifiesContactFree();
+    d.regions.back().dense.trackReach = certifiesContactFree();
     std::vector<int>& vertices = d.regionVertices[static_cast<std::size_t>(i)];
     for (const int dof : partition_.regionDofs(i))  // ascending
       if (vertices.empty() || vertices.back() != dof / 3) vertices.push_back(dof / 3);
@@ -138,15 +138,15 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
     runStats_.interfaceDofs += static_cast<int>(partition_.interfaceDofs(i).size());
   }
   if (distributed()) assignRegionOwners();
-  if (d.linear && !d.linearStiffnessKnown) {
+  if (d.model.linear && !d.build.stiffnessKnown) {
     // K is constant: evaluated for the first partition, kept for the next ones (whose steps
     // evaluate f_int themselves).
     detail::evaluateForces(system_, true, false, displacement_, d.internalForce, d.stiffness, stats_);
-    d.linearStiffnessKnown = true;
+    d.build.stiffnessKnown = true;
   }
   if (options_.coupling == AsyncCoupling::stable) {
-    d.perElementTangent =
-        detail::findInterfaceElements(*system_.mesh, partition_, system_, d.regions, d.linear ? &d.stiffness : nullptr);
+    d.model.perElementTangent = detail::findInterfaceElements(*system_.mesh, partition_, system_, d.regions,
+                                                              d.model.linear ? &d.stiffness : nullptr);
   }
   d.schur.reset();
   if (options_.largeSystemSolver) {
@@ -155,30 +155,32 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
     d.schur.useExternalSolver(options_.largeSystemSolver, large, std::move(interfaces));
   }
   d.naive.reset();
-  d.schurLagging = false;
-  d.lastRebuildFull = false;  // no factor of H^{LL*} for this partition yet
-  d.quick = options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
-            options_.method == AsyncSolveMethod::structured;
-  d.quickExtraFlops = 0.0;
-  d.factorsCurrent = false;
-  if (d.linear) {
+  d.lagged.lagging = false;
+  d.lagged.lastRebuildFull = false;  // no factor of H^{LL*} for this partition yet
+  d.quickPath.active = options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
+                       options_.method == AsyncSolveMethod::structured;
+  d.quickPath.extraFlops = 0.0;
+  d.build.factorsCurrent = false;
+  if (d.model.linear) {
     // K is constant: build and factor everything now, so the first step costs a steady one.
-    d.settingUp = true;
+    d.build.settingUp = true;
     refactor();
-    d.settingUp = false;
-    d.factorsCurrent = true;
+    d.build.settingUp = false;
+    d.build.factorsCurrent = true;
   }
   runStats_.setupSeconds += watch.stop();
 }
 
 bool AsyncBackwardEuler::linearizesExternalForce() const {
-  return options_.coupling == AsyncCoupling::stable && options_.method == AsyncSolveMethod::structured &&
-         !options_.largeSystemSolver && !distributed() && (!impl_ || impl_->solver != AsyncStepSolver::hierarchy);
+  // The structured and the hierarchy solves take the contact Jacobian's blocks (Eqs. C2,
+  // N14); the naive reference, the paper's coupling and external solvers of L do not.
+  return options_.coupling == AsyncCoupling::stable && options_.method != AsyncSolveMethod::naive &&
+         !options_.largeSystemSolver && !distributed();
 }
 
 void AsyncBackwardEuler::setTimestep(double timestep) {
   Integrator::setTimestep(timestep);
-  if (impl_) impl_->factorsCurrent = false;
+  if (impl_) impl_->build.factorsCurrent = false;
 }
 
 // Every block from the current K (impl_->stiffness) and M, refactored, and the Schur
@@ -196,8 +198,8 @@ void AsyncBackwardEuler::refactor() {
   runOwnedTasks(1, [&](int i) { d.regions[static_cast<std::size_t>(i)].factorize(stats_); });
   stats_.factorizationSeconds += factor.stop();
   priceSubstitutions();
-  if (d.schurLagging) return;
-  if (d.quick) {
+  if (d.lagged.lagging) return;
+  if (d.quickPath.active) {
     borrowWholeFactor();
     return;
   }
@@ -213,25 +215,25 @@ void AsyncBackwardEuler::assembleBlocks() {
   Stopwatch assembly;
   // A^L = M^{LL} + hL D^{LL} + hL^2 K^{LL} (Eq. A1 at hL).
   const stepFormula::MatrixWeights weights = stepFormula::backwardEuler::systemMatrix(hL, alpha, beta);
-  if (d.sharedPattern == 1) {
+  if (d.build.sharedPattern == 1) {
     // One pass over L's entries of M and K (no M^{LL}, K^{LL} of their own).
-    if (!d.cutLL) {
+    if (!d.build.cutLL) {
       d.massLL.extractCombinationInto(weights.mass, system_.mass, weights.stiffness, d.stiffness, d.largeSystem);
     } else {
       d.massLL.updateCombination(weights.mass, system_.mass, weights.stiffness, d.stiffness, d.largeSystem);
     }
   } else {
-    if (!d.cutLL) d.Mll = d.massLL.extract(system_.mass);
-    detail::updateBlock(d.stiffLL, d.stiffness, d.Kll, d.cutLL);
+    if (!d.build.cutLL) d.Mll = d.massLL.extract(system_.mass);
+    detail::updateBlock(d.stiffLL, d.stiffness, d.Kll, d.build.cutLL);
     detail::combineInto(weights.mass, d.Mll, weights.stiffness, d.Kll, d.largeSystem);
   }
-  d.cutLL = true;
+  d.build.cutLL = true;
   for (FastRegion& rb : d.regions) rb.updateBlocks(d.stiffness, hL, alpha, beta, system_.damped(), options_.coupling);
   if (options_.coupling == AsyncCoupling::stable) subtractInterfaceStiffness();
-  if (d.linear && !d.symmetryChecked) {
+  if (d.model.linear && !d.model.symmetryChecked) {
     const SparseMatrix transposed = d.stiffness.transpose();
-    d.symmetricStiffness = (d.stiffness - transposed).norm() <= 1e-13 * d.stiffness.norm();
-    d.symmetryChecked = true;
+    d.model.symmetricStiffness = (d.stiffness - transposed).norm() <= 1e-13 * d.stiffness.norm();
+    d.model.symmetryChecked = true;
   }
   stats_.assemblySeconds += assembly.stop();
 }
@@ -239,7 +241,7 @@ void AsyncBackwardEuler::assembleBlocks() {
 // Z, the Schur corrections and the H^{LL*} factor from the current blocks.
 void AsyncBackwardEuler::fullSchurRebuild() {
   Impl& d = *impl_;
-  const bool setUpBuild = d.settingUp;
+  const bool setUpBuild = d.build.settingUp;
   Stopwatch factor;
   detail::CorrectionRun run;
   try {
@@ -267,13 +269,13 @@ void AsyncBackwardEuler::fullSchurRebuild() {
   d.schur.factor(d.largeSystem, partition_, d.regions, options_.schur, options_.coupling, schurAsymmetry_, stats_);
   schurModeUsed_ = d.schur.modeUsed();
   d.contact.noteFactored();
-  d.correctionsStale = false;
+  d.contactStep.correctionsStale = false;
   d.noteSchurBlocks();
   const double schurSeconds = factor.stop();
   stats_.factorizationSeconds += schurSeconds;
   if (setUpBuild) runStats_.setupSchurSeconds += schurSeconds;
-  d.schurLagging = false;
-  d.lastRebuildFull = true;
+  d.lagged.lagging = false;
+  d.lagged.lastRebuildFull = true;
   keepLaggedFactor();
 }
 
@@ -297,7 +299,7 @@ void AsyncBackwardEuler::subtractInterfaceStiffness() {
   for (int i = 0; i < partition_.numRegions(); ++i) {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& pos = partition_.interfacePositions(i);
-    rb.assembleInterfaceStiffness(*system_.forceModel, displacement_, d.perElementTangent);
+    rb.assembleInterfaceStiffness(*system_.forceModel, displacement_, d.model.perElementTangent);
     const auto q = static_cast<Eigen::Index>(pos.size());
     for (Eigen::Index b = 0; b < q; ++b) {
       for (Eigen::Index a = 0; a < q; ++a) {
@@ -352,23 +354,24 @@ void AsyncBackwardEuler::step() {
 // (or a linear one after setTimestep) needs.
 void AsyncBackwardEuler::evaluateStartOfStep() {
   Impl& d = *impl_;
-  if (!d.linear || !d.factorsCurrent || !d.symmetricStiffness) {
-    detail::evaluateForces(system_, d.linear, d.factorsCurrent, displacement_, d.internalForce, d.stiffness, stats_);
+  if (!d.model.linear || !d.build.factorsCurrent || !d.model.symmetricStiffness) {
+    detail::evaluateForces(system_, d.model.linear, d.build.factorsCurrent, displacement_, d.internalForce, d.stiffness,
+                           stats_);
   }
-  if (d.linear && d.factorsCurrent) return;
+  if (d.model.linear && d.build.factorsCurrent) return;
   Stopwatch rebuild;
   const bool first = runStats_.rebuilds == 0 && runStats_.steps == 0;
-  d.schurLagging = options_.laggedSchur && !d.linear && d.schur.factored() && !d.schur.refreshRequested() &&
-                   d.laggedRent < d.laggedRebuildFlops && options_.method == AsyncSolveMethod::structured;
+  d.lagged.lagging = options_.laggedSchur && !d.model.linear && d.schur.factored() && !d.schur.refreshRequested() &&
+                     d.lagged.rent < d.lagged.rebuildFlops && options_.method == AsyncSolveMethod::structured;
   // With the turned factor, every other rebuild the rule asks for is a refresh.
   // lastRebuildFull: this partition's H^{LL*} was factored with Z (so not borrowed, not quick).
-  const bool refresh = !first && !d.schurLagging && d.lastRebuildFull && turnsLaggedFactor();
-  if (refresh) d.schurLagging = true;  // refactor() then factors the regions' A^S only
-  d.settingUp = first;
+  const bool refresh = !first && !d.lagged.lagging && d.lagged.lastRebuildFull && turnsLaggedFactor();
+  if (refresh) d.lagged.lagging = true;  // refactor() then factors the regions' A^S only
+  d.build.settingUp = first;
   refactor();
   if (refresh) refreshLaggedFactor();
-  d.settingUp = false;
-  d.factorsCurrent = true;
+  d.build.settingUp = false;
+  d.build.factorsCurrent = true;
   const double seconds = rebuild.stop();
   if (first) {
     runStats_.setupSeconds += seconds;
@@ -451,7 +454,7 @@ void AsyncBackwardEuler::countSolves() {
 double AsyncBackwardEuler::solveFloorSeconds(int repeats) {
   Impl& d = *impl_;
   if (d.solver == AsyncStepSolver::hierarchy) throw Error("solveFloorSeconds: not measured for the hierarchy solve");
-  if (!d.factorsCurrent)
+  if (!d.build.factorsCurrent)
     throw Error("solveFloorSeconds: take one step first (the factors are built at the first step)");
   std::vector<double> samples;
   for (int k = 0; k < std::max(1, repeats); ++k) {
@@ -461,7 +464,7 @@ double AsyncBackwardEuler::solveFloorSeconds(int repeats) {
     } else {
       for (FastRegion& rb : d.regions) {
         if (!rb.owned) continue;
-        const bool dense = rb.useDenseZ || rb.Msi.cols() == 0;
+        const bool dense = rb.dense.recovery || rb.Msi.cols() == 0;
         const int solves = dense ? rb.ratio : 2 * rb.ratio;
         const Eigen::VectorXd rhs = Eigen::VectorXd::Random(rb.systemMatrix.rows());
         for (int r = 0; r < solves; ++r) rb.solver->solve(rhs);

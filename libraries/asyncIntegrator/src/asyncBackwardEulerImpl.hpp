@@ -36,44 +36,53 @@ struct AsyncPartitionState {
   // DOF's step ends (Eq. N3; the vectors are kept from step to step).
   std::unique_ptr<detail::HierarchySystem> hierarchy;
   std::map<long long, Eigen::VectorXd> unitForces;
-  bool linear = true;
-  bool factorsCurrent = false;     // linear forces: blocks and factors built for this timestep and partition
-  bool settingUp = false;          // the build under way is a set-up (for AsyncRunStats)
-  SparseMatrix stiffness;          // full 3n x 3n tangent K(u_0)
-  bool perElementTangent = false;  // interface element tangents from the force model (else cached linear ones)
+  // What the model is (set when the integrator is made; symmetry checked at the first
+  // linear set-up).
+  struct Model {
+    bool linear = true;
+    bool perElementTangent = false;  // interface element tangents from the force model (else cached linear ones)
+    // Linear forces with a symmetric K: f_int(u_0) = K u_0 and K v_0 are taken row by row
+    // (row i = column i) on the DOFs that need them, and L's rows need only
+    // K (u_0 + (beta + hL) v_0), as in single-rate backward Euler.
+    bool symmetricStiffness = false;
+    bool symmetryChecked = false;
+  } model;
+  // What has been built for this timestep and partition.
+  struct Build {
+    bool factorsCurrent = false;  // linear forces: blocks and factors built for this timestep and partition
+    bool settingUp = false;       // the build under way is a set-up (for AsyncRunStats)
+    // Linear forces: K is in stiffness (constant), so a new partition need not evaluate it again.
+    bool stiffnessKnown = false;
+    bool cutLL = false;  // L's blocks extracted once per partition; later only their values are updated
+    // M and K share one pattern (element matrices on the same mesh): K^{LL} is cut with
+    // massLL's map and stiffLL stays empty. Checked once (-1: not yet).
+    int sharedPattern = -1;
+  } build;
+  SparseMatrix stiffness;  // full 3n x 3n tangent K(u_0)
   Eigen::VectorXd internalForce;
   std::vector<detail::FastRegion> regions;
   SubmatrixExtractor massLL, stiffLL;
-  // M and K share one pattern (element matrices on the same mesh): K^{LL} is cut with
-  // massLL's map and stiffLL stays empty. Checked once (-1: not yet).
-  int sharedPattern = -1;
-  // Linear forces: K is in stiffness (constant), so a new partition need not evaluate it again.
-  bool linearStiffnessKnown = false;
   SparseMatrix Mll, Kll;     // M^{LL} (constant), K^{LL}; only when M and K have different patterns
-  bool cutLL = false;        // L's blocks extracted once per partition; later only their values are updated
   SparseMatrix largeSystem;  // Â^L
   detail::SchurSolver schur;
   detail::VertexRotations rotations;  // since the last rebuild (laggedSchurRotation)
   detail::NaiveSolver naive;
-  // This step refactored A^S but keeps Z and H^{LL*} from an earlier tangent (laggedSchur).
-  bool schurLagging = false;
-  // The lagged factor's rent-or-buy prices (flops, set at each full rebuild): one
-  // refinement iteration, one rebuild, and the iterations paid since the last rebuild.
-  double laggedIterationFlops = 0.0, laggedRebuildFlops = 0.0, laggedRent = 0.0;
+  // The lagged factor of H^{LL*} (AsyncOptions::laggedSchur) and its rent-or-buy prices
+  // (flops, set at each full rebuild).
+  struct LaggedFactor {
+    bool lagging = false;          // this step refactored A^S but keeps Z and H^{LL*} from an earlier tangent
+    bool lastRebuildFull = false;  // built with Z (not refreshed): the next rebuild the rule asks for may be a refresh
+    bool recoverFromProbes = false;  // the lagged solve converged with its tracker: recovery from the summed probes
+    double iterationFlops = 0.0;     // one refinement iteration
+    double rebuildFlops = 0.0;       // one rebuild
+    double rent = 0.0;               // the iterations paid since the last rebuild
+  } lagged;
   // Quick set-up (AsyncOptions::quickSetUp): L's system is solved on the whole system's
   // factor until the iterations' extra flops reach the priced cost of the rebuild (Eq. Q4).
-  bool quick = false;
-  // Whether the lagged factor was last built with Z (not refreshed): the next rebuild
-  // the rule asks for may then be a refresh.
-  bool lastRebuildFull = false;
-  // The lagged solve converged with its tracker: recovery from the summed probes.
-  bool recoverFromProbes = false;
-  double quickExtraFlops = 0.0;
-  // Linear forces with a symmetric K (checked once): f_int(u_0) = K u_0 and K v_0 are taken
-  // row by row (row i = column i) on the DOFs that need them, and L's rows need only
-  // K (u_0 + (beta + hL) v_0), as in single-rate backward Euler.
-  bool symmetricStiffness = false;
-  bool symmetryChecked = false;
+  struct QuickPath {
+    bool active = false;
+    double extraFlops = 0.0;
+  } quickPath;
   // Per-step buffers (full 3n, or |L|).
   Eigen::VectorXd stiffVelocity, massVelocity, stateForce, predicted, newU, newV, work;
   Eigen::VectorXd rhsL, rhsSchur, Y;
@@ -91,12 +100,14 @@ struct AsyncPartitionState {
   // Implicit contact (DynamicSystem::externalForceJacobian): the contact iteration, and
   // whether a region's A^S holds contact blocks that Z and H^{LL*} were not built with.
   detail::ContactIteration contact;
-  bool correctionsStale = false;
+  struct ContactStep {
+    bool correctionsStale = false;  // a region's A^S holds contact blocks Z and H^{LL*} were not built with
+    bool certifying = false;        // the first solve recovers end states only, for the certificate (Eq. C6)
+  } contactStep;
   // The first solve of an implicit contact step recovers end states only, for the
   // certificate (Eq. C6): each DOF's interval of displacements over the step's states, the
   // boxes' centres, the interface's share of each vertex's radius (squared) and the
   // vertices near an obstacle.
-  bool certifying = false;
   Eigen::VectorXd lowest, highest, centred, runningPath;
   std::vector<double> reachSquares;
   std::vector<int> nearObstacles;
@@ -129,7 +140,7 @@ struct AsyncPartitionState {
     return true;
   }
 
-  bool rowProducts() const { return linear && symmetricStiffness; }
+  bool rowProducts() const { return model.linear && model.symmetricStiffness; }
   /// f_ext at time and state (u, v0), evaluated in this thread (the callback need not be
   /// thread-safe): once per distinct time at the start state u0, always anew at a predicted one.
   const Eigen::VectorXd& forceAt(const DynamicSystem& system, double time, const Eigen::VectorXd& u,

@@ -60,7 +60,7 @@ RunReport AsyncBackwardEuler::report() const {
     if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
     report.resumeCaveat += caveat;
   };
-  if (options_.laggedSchur && !impl_->linear && impl_->solver == AsyncStepSolver::structuredSchur) {
+  if (options_.laggedSchur && !impl_->model.linear && impl_->solver == AsyncStepSolver::structuredSchur) {
     addCaveat(
         "laggedSchur: the H^{LL*} factor kept as preconditioner is not in the checkpoint, so the resumed run "
         "refactors at its first step; its frames match an uninterrupted run to about the Schur tolerance (" +

@@ -45,19 +45,20 @@ void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
   refactorContactRegions();
   // Rent or buy, as for the lagged factor: once the iterations that stale corrections cost
   // have added up to a rebuild, rebuild (without the regions' contact blocks, below).
-  if (d.correctionsStale && !d.schur.borrowing() && d.laggedRent >= d.laggedRebuildFlops) {
+  if (d.contactStep.correctionsStale && !d.schur.borrowing() && d.lagged.rent >= d.lagged.rebuildFlops) {
     Stopwatch rebuild;
     if (rebuildWithoutRegionBlocks()) ++runStats_.rebuilds;
     runStats_.rebuildSeconds += rebuild.stop();
   }
   // Eq. (C6): where nothing touches at the predicted states, the first solve recovers end
   // states only, and ends the step when no state of it can reach an obstacle.
-  d.certifying = certifiesContactFree() && !d.contact.blocksInMatrix();
-  for (const detail::FastRegion& rb : d.regions) d.certifying = d.certifying && !rb.hasContactBlocks();
+  d.contactStep.certifying = certifiesContactFree() && !d.contact.blocksInMatrix();
+  for (const detail::FastRegion& rb : d.regions)
+    d.contactStep.certifying = d.contactStep.certifying && !rb.hasContactBlocks();
   for (int iterations = 1;; ++iterations) {
     solveStructured();
-    if (d.certifying) {
-      d.certifying = false;
+    if (d.contactStep.certifying) {
+      d.contactStep.certifying = false;
       if (contactFreeCertified()) {
         ++runStats_.contactIterations;
         ++runStats_.contactSteps;
@@ -126,7 +127,7 @@ bool AsyncBackwardEuler::rebuildWithoutRegionBlocks() {
     detail::FastRegion& rb = d.regions[i];
     if (rb.setContactBlocks(kept[i].positions, kept[i].blocks, kept[i].stiffness)) rb.factorize(stats_);
   }
-  d.correctionsStale = !d.blocksAsBuilt();
+  d.contactStep.correctionsStale = !d.blocksAsBuilt();
   return true;
 }
 
@@ -140,7 +141,7 @@ void AsyncBackwardEuler::refactorContactRegions() {
   for (int i : changed) d.regions[static_cast<std::size_t>(i)].factorize(stats_);
   runStats_.contactRegionFactorizations += static_cast<long long>(changed.size());
   stats_.factorizationSeconds += factor.stop();
-  d.correctionsStale = !d.blocksAsBuilt();
+  d.contactStep.correctionsStale = !d.blocksAsBuilt();
 }
 
 // Eq. (C6). Per DOF, the interval of its displacement from u_0 over every state the

@@ -36,7 +36,7 @@ void AsyncBackwardEuler::refreshLaggedFactor() {
   d.contact.noteFactored();
   stats_.factorizationSeconds += factor.stop();
   ++runStats_.laggedRefreshes;
-  d.lastRebuildFull = false;
+  d.lagged.lastRebuildFull = false;
   keepLaggedFactor();
 }
 
@@ -54,7 +54,7 @@ void AsyncBackwardEuler::keepLaggedFactor() {
 
 bool AsyncBackwardEuler::turnsLaggedFactor() const {
   const Impl& d = *impl_;
-  return options_.laggedSchur && options_.laggedSchurRotation && !d.linear && system_.mesh &&
+  return options_.laggedSchur && options_.laggedSchurRotation && !d.model.linear && system_.mesh &&
          !options_.largeSystemSolver && options_.method == AsyncSolveMethod::structured;
 }
 
@@ -65,15 +65,15 @@ bool AsyncBackwardEuler::turnsLaggedFactor() const {
 void AsyncBackwardEuler::priceLaggedFactor() {
   Impl& d = *impl_;
   const SparseSolver* schur = d.schur.solver();
-  d.laggedRent = 0.0;
-  d.laggedIterationFlops = kSolveCallFlops + 2.0 * static_cast<double>(d.largeSystem.nonZeros()) +
-                           (schur != nullptr ? schur->stats().solveFlopsPerRhs : 0.0);
-  d.laggedRebuildFlops = schur != nullptr ? kBlockedFlopWeight * schur->stats().factorFlops : 0.0;
+  d.lagged.rent = 0.0;
+  d.lagged.iterationFlops = kSolveCallFlops + 2.0 * static_cast<double>(d.largeSystem.nonZeros()) +
+                            (schur != nullptr ? schur->stats().solveFlopsPerRhs : 0.0);
+  d.lagged.rebuildFlops = schur != nullptr ? kBlockedFlopWeight * schur->stats().factorFlops : 0.0;
   for (std::size_t i = 0; i < d.regions.size(); ++i) {
     const FastRegion& rb = d.regions[i];
     const double substitution = rb.substitutionFlops;
-    d.laggedIterationFlops += substitution + rb.ratio * kSolveCallFlops;
-    d.laggedRebuildFlops +=
+    d.lagged.iterationFlops += substitution + rb.ratio * kSolveCallFlops;
+    d.lagged.rebuildFlops +=
         kBlockedFlopWeight * substitution * static_cast<double>(partition_.interfaceDofs(static_cast<int>(i)).size());
   }
 }

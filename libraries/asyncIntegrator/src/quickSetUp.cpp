@@ -65,10 +65,10 @@ void AsyncBackwardEuler::borrowWholeFactor() {
                    system_.rayleighStiffness, stats_);
     const double seconds = factor.stop();
     stats_.factorizationSeconds += seconds;
-    if (d.settingUp) runStats_.setupSchurSeconds += seconds;
+    if (d.build.settingUp) runStats_.setupSchurSeconds += seconds;
   }
   if (!d.schur.borrowing()) d.schur.borrow(whole_.get(), partition_.largeDofs());
-  if (!d.linear) d.schur.forgetDirections();  // a new tangent: H^{LL*} changed
+  if (!d.model.linear) d.schur.forgetDirections();  // a new tangent: H^{LL*} changed
 }
 
 // Quick set-up (Eqs. Q1-Q3): deflated conjugate gradients on H^{LL*}, preconditioned by the
@@ -96,11 +96,12 @@ void AsyncBackwardEuler::solveOnWholeFactor() {
     runStats_.largestQuickResidual = std::max(runStats_.largestQuickResidual, result.residual);
     const QuickCosts costs = quickCosts(d.regions, d.largeSystem, partition_, *whole_);
     const double deflation = 2.0 * static_cast<double>(d.schur.keptDirections()) * static_cast<double>(d.Y.size());
-    d.quickExtraFlops += result.iterations * (costs.iteration + 2.0 * deflation) + 3.0 * deflation - costs.exactSolve;
-    if (d.quickExtraFlops < costs.rebuild || !options_.quickSetUpRebuild) return;
+    d.quickPath.extraFlops +=
+        result.iterations * (costs.iteration + 2.0 * deflation) + 3.0 * deflation - costs.exactSolve;
+    if (d.quickPath.extraFlops < costs.rebuild || !options_.quickSetUpRebuild) return;
   }
   Stopwatch rebuild;
-  d.quick = false;
+  d.quickPath.active = false;
   fullSchurRebuild();
   ++runStats_.quickEnds;
   runStats_.rebuildSeconds += rebuild.stop();

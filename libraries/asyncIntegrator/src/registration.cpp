@@ -6,6 +6,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
 #include <asyncfem/settings/jsonReader.hpp>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -109,28 +110,85 @@ const std::string& choiceName(const ChoiceTable<Enum>& table, Enum value) {
   throw Error("asyncSettingsJson: invalid enumerator " + std::to_string(static_cast<int>(value)));
 }
 
+// One key of the solver options: how it is read into AsyncOptions and written back (only
+// where it differs from the default). kSolverKeys below is the codec: every key is read,
+// written and listed from that one table, so the three cannot drift apart.
+struct SolverKey {
+  const char* key;
+  std::function<void(JsonObjectReader&, AsyncOptions&)> read;
+  std::function<void(const AsyncOptions& options, const AsyncOptions& defaults, nlohmann::json& out)> write;
+};
+
+template <typename T>
+SolverKey valueKey(const char* key, T AsyncOptions::*member, std::function<T(JsonObjectReader&, const char*, T)> read) {
+  return {key,
+          [key, member, read](JsonObjectReader& reader, AsyncOptions& o) { o.*member = read(reader, key, o.*member); },
+          [key, member](const AsyncOptions& o, const AsyncOptions& defaults, nlohmann::json& out) {
+            if (o.*member != defaults.*member) out[key] = o.*member;
+          }};
+}
+
+SolverKey booleanKey(const char* key, bool AsyncOptions::*member) {
+  return valueKey<bool>(key, member,
+                        [](JsonObjectReader& reader, const char* k, bool value) { return reader.boolean(k, value); });
+}
+
+SolverKey integerKey(const char* key, int AsyncOptions::*member, int lowest, int highest) {
+  return valueKey<int>(key, member, [lowest, highest](JsonObjectReader& reader, const char* k, int value) {
+    return reader.integer(k, value, lowest, highest);
+  });
+}
+
+template <typename Enum>
+SolverKey choiceKey(const char* key, Enum AsyncOptions::*member, const ChoiceTable<Enum>& table) {
+  return {
+      key,
+      [key, member, &table](JsonObjectReader& reader, AsyncOptions& o) { o.*member = readChoice(reader, key, table); },
+      [key, member, &table](const AsyncOptions& o, const AsyncOptions& defaults, nlohmann::json& out) {
+        if (o.*member != defaults.*member) out[key] = choiceName(table, o.*member);
+      }};
+}
+
+const ChoiceTable<SolverKind> kRegionSolvers{{"cholmod", SolverKind::cholmod},
+                                             {"umfpack", SolverKind::umfpack},
+                                             {"eigen-ldlt", SolverKind::eigenLDLT},
+                                             {"eigen-lu", SolverKind::eigenLU},
+                                             {"dense", SolverKind::dense}};
+const ChoiceTable<NestedSolve> kNestedSolves{
+    {"automatic", NestedSolve::automatic}, {"structured", NestedSolve::structured}, {"lu", NestedSolve::lu}};
+
+const std::vector<SolverKey>& solverKeys() {
+  static const std::vector<SolverKey> keys{
+      // What the step solves and how.
+      choiceKey("coupling", &AsyncOptions::coupling, kCouplings),
+      choiceKey("schur", &AsyncOptions::schur, kSchurModes),
+      choiceKey("method", &AsyncOptions::method, kSolveMethods),
+      choiceKey("recovery", &AsyncOptions::recovery, kRecoveryModes),
+      choiceKey("regionSolver", &AsyncOptions::regionSolver, kRegionSolvers),
+      integerKey("denseRegionDofs", &AsyncOptions::denseRegionDofs, 0, 4096),
+      choiceKey("nestedSolve", &AsyncOptions::nestedSolve, kNestedSolves),
+      integerKey("threads", &AsyncOptions::threads, 0, 1024),
+      // Nonlinear forces and set-ups: the kept factors.
+      booleanKey("laggedSchur", &AsyncOptions::laggedSchur),
+      booleanKey("laggedSchurRotation", &AsyncOptions::laggedSchurRotation),
+      booleanKey("quickSetUp", &AsyncOptions::quickSetUp),
+      // Contact.
+      booleanKey("substepContact", &AsyncOptions::substepStatePrediction),
+      integerKey("contactIterations", &AsyncOptions::contactIterations, 1, 1000),
+      valueKey<double>("contactTolerance", &AsyncOptions::contactTolerance,
+                       [](JsonObjectReader& reader, const char* k, double value) {
+                         const double tolerance = reader.number(k, value);
+                         if (!(tolerance > 0.0 && tolerance < 1.0)) reader.fail(k, "must be in (0, 1)");
+                         return tolerance;
+                       }),
+      booleanKey("certifyContactFree", &AsyncOptions::certifyContactFree),
+  };
+  return keys;
+}
+
 AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
   AsyncOptions solver;
-  solver.coupling = readChoice(reader, "coupling", kCouplings);
-  solver.schur = readChoice(reader, "schur", kSchurModes);
-  solver.method = readChoice(reader, "method", kSolveMethods);
-  solver.recovery = readChoice(reader, "recovery", kRecoveryModes);
-  const std::string regionSolver =
-      reader.choice("regionSolver", "cholmod", {"cholmod", "umfpack", "eigen-ldlt", "eigen-lu", "dense"});
-  solver.regionSolver = parseSolverKind(regionSolver);
-  solver.denseRegionDofs = reader.integer("denseRegionDofs", solver.denseRegionDofs, 0, 4096);
-  solver.substepStatePrediction = reader.boolean("substepContact", false);
-  solver.laggedSchur = reader.boolean("laggedSchur", solver.laggedSchur);
-  solver.laggedSchurRotation = reader.boolean("laggedSchurRotation", solver.laggedSchurRotation);
-  solver.quickSetUp = reader.boolean("quickSetUp", solver.quickSetUp);
-  solver.threads = reader.integer("threads", solver.threads, 0, 1024);
-  solver.contactIterations = reader.integer("contactIterations", solver.contactIterations, 1, 1000);
-  solver.contactTolerance = reader.number("contactTolerance", solver.contactTolerance);
-  solver.certifyContactFree = reader.boolean("certifyContactFree", solver.certifyContactFree);
-  solver.nestedSolve = parseNestedSolve(reader.choice("nestedSolve", "automatic", {"automatic", "structured", "lu"}));
-  if (!(solver.contactTolerance > 0.0 && solver.contactTolerance < 1.0)) {
-    reader.fail("contactTolerance", "must be in (0, 1)");
-  }
+  for (const SolverKey& key : solverKeys()) key.read(reader, solver);
   if (solver.substepStatePrediction && !hasContact) {
     reader.fail("substepContact", "only meaningful with a \"contact\" section");
   }
@@ -267,23 +325,11 @@ AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const
 }
 
 const std::vector<std::string>& asyncOptionKeys() {
-  static const std::vector<std::string> keys{"coupling",
-                                             "schur",
-                                             "method",
-                                             "recovery",
-                                             "regionSolver",
-                                             "denseRegionDofs",
-                                             "substepContact",
-                                             "laggedSchur",
-                                             "laggedSchurRotation",
-                                             "quickSetUp",
-                                             "threads",
-                                             "regions",
-                                             "auto",
-                                             "nestedSolve",
-                                             "contactIterations",
-                                             "contactTolerance",
-                                             "certifyContactFree"};
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> out{"regions", "auto"};
+    for (const SolverKey& key : solverKeys()) out.emplace_back(key.key);
+    return out;
+  }();
   return keys;
 }
 
@@ -350,30 +396,8 @@ nlohmann::json asyncRegionsJson(const std::vector<AsyncRegion>& regions) {
 
 nlohmann::json asyncSettingsJson(const AsyncSettings& settings) {
   const AsyncOptions defaults;
-  const AsyncOptions& solver = settings.solver;
   nlohmann::json out = nlohmann::json::object();
-  const auto writeChoice = [&out](const char* key, const auto& table, auto value, auto defaultValue) {
-    if (value != defaultValue) out[key] = choiceName(table, value);
-  };
-  writeChoice("coupling", kCouplings, solver.coupling, defaults.coupling);
-  writeChoice("schur", kSchurModes, solver.schur, defaults.schur);
-  writeChoice("method", kSolveMethods, solver.method, defaults.method);
-  writeChoice("recovery", kRecoveryModes, solver.recovery, defaults.recovery);
-  if (solver.regionSolver != defaults.regionSolver) out["regionSolver"] = toString(solver.regionSolver);
-  if (solver.denseRegionDofs != defaults.denseRegionDofs) out["denseRegionDofs"] = solver.denseRegionDofs;
-  if (solver.substepStatePrediction != defaults.substepStatePrediction) {
-    out["substepContact"] = solver.substepStatePrediction;
-  }
-  if (solver.laggedSchur != defaults.laggedSchur) out["laggedSchur"] = solver.laggedSchur;
-  if (solver.laggedSchurRotation != defaults.laggedSchurRotation) {
-    out["laggedSchurRotation"] = solver.laggedSchurRotation;
-  }
-  if (solver.quickSetUp != defaults.quickSetUp) out["quickSetUp"] = solver.quickSetUp;
-  if (solver.threads != defaults.threads) out["threads"] = solver.threads;
-  if (solver.contactIterations != defaults.contactIterations) out["contactIterations"] = solver.contactIterations;
-  if (solver.contactTolerance != defaults.contactTolerance) out["contactTolerance"] = solver.contactTolerance;
-  if (solver.certifyContactFree != defaults.certifyContactFree) out["certifyContactFree"] = solver.certifyContactFree;
-  if (solver.nestedSolve != defaults.nestedSolve) out["nestedSolve"] = toString(solver.nestedSolve);
+  for (const SolverKey& key : solverKeys()) key.write(settings.solver, defaults, out);
   out["regions"] =
       settings.adaptive ? nlohmann::json{{"adaptive", settings.adaptiveSource}} : asyncRegionsJson(settings.regions);
   return out;

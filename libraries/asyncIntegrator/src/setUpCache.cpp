@@ -36,7 +36,7 @@ void AsyncBackwardEuler::setAdaptiveRegions(AdaptiveRegionOptions options) {
     throw ValidationError(
         "async integrator: adaptive regions: the contact policy needs obstacles (a \"contact\" section)");
   }
-  if (options.nest) requireHierarchyComposes(options_, system_, "run-time regions that nest");
+  if (options.nest) requireHierarchyComposes(options_, "run-time regions that nest");
   policy_ = std::make_unique<AdaptiveRegionPolicy>(*system_.mesh, system_.freeDofs, std::move(options));
   stepsKept_ = 0;
   maybeRepartition();
@@ -92,7 +92,7 @@ void AsyncBackwardEuler::repartition(std::vector<AsyncRegion> regions, const std
     runStats_.fastDofs = hit->sizes.fastDofs;
     runStats_.interfaceDofs = hit->sizes.interfaceDofs;
     runStats_.largeDofs = hit->sizes.largeDofs;
-    if (hit->timestep != timestep()) impl_->factorsCurrent = false;
+    if (hit->timestep != timestep()) impl_->build.factorsCurrent = false;
     cache_.erase(hit);
     record.reused = true;
   } else {

@@ -82,12 +82,8 @@ void checkHierarchyOptions(const AsyncOptions& options, const std::string& why) 
 
 }  // namespace
 
-void requireHierarchyComposes(const AsyncOptions& options, const DynamicSystem& system, const std::string& why) {
+void requireHierarchyComposes(const AsyncOptions& options, const std::string& why) {
   checkHierarchyOptions(options, why);
-  if (system.externalForceJacobian) {
-    throw AsyncOptionError("contact", "implicit contact is not available with the hierarchy solve (" + why +
-                                          "): its step system has no contact Jacobian blocks; use explicit contact");
-  }
 }
 
 AsyncStepSolver chooseStepSolver(const AsyncOptions& options, const RegionPartition& partition,
@@ -101,7 +97,7 @@ AsyncStepSolver chooseStepSolver(const AsyncOptions& options, const RegionPartit
                              "the naive solve method couples each region only to L, but the regions given touch or "
                              "nest (\"hierarchy\" with \"nestedSolve\": \"lu\" is the reference there)");
     }
-    requireHierarchyComposes(options, system, why);
+    requireHierarchyComposes(options, why);
     return AsyncStepSolver::hierarchy;
   }
   if (options.nestedSolve != NestedSolve::automatic) {

@@ -123,17 +123,17 @@ void AsyncBackwardEuler::solveStructured() {
   d.rhsSchur = d.rhsL;
   subtractOwnedInterfaceRows(d.rhsSchur);
   const auto apply = [this](const Eigen::VectorXd& y, Eigen::VectorXd& out) { applySchur(y, out); };
-  d.recoverFromProbes = false;
+  d.lagged.recoverFromProbes = false;
   if (partition_.largeDofs().empty()) {
     d.Y.resize(0);
   } else if (d.schur.borrowing()) {
     solveOnWholeFactor();
-  } else if (!d.schurLagging && d.contact.factorIsExact() && !d.correctionsStale) {
+  } else if (!d.lagged.lagging && d.contact.factorIsExact() && !d.contactStep.correctionsStale) {
     d.schur.solve(d.rhsSchur, d.Y);
   } else {
     // At least laggedSchurIterations, and as many as one rebuild costs (rent or buy).
     if (turnsLaggedFactor()) d.rotations.update(*system_.mesh, displacement_);
-    const double affordable = d.laggedRebuildFlops / std::max(d.laggedIterationFlops, 1.0);
+    const double affordable = d.lagged.rebuildFlops / std::max(d.lagged.iterationFlops, 1.0);
     const int budget = std::max(options_.laggedSchurIterations, static_cast<int>(std::min(affordable, 1000.0)));
     const detail::SchurSolver::Tracker track = [this, threads](double coefficient, bool reset) {
       sumProbeSubstitutions(threads, coefficient, reset);
@@ -141,9 +141,9 @@ void AsyncBackwardEuler::solveStructured() {
     const detail::SchurSolver::Refinement result =
         d.schur.refine(d.rhsSchur, d.Y, apply, options_.coupling == AsyncCoupling::stable, budget,
                        options_.laggedSchurTolerance, track);
-    d.recoverFromProbes = result.converged;
+    d.lagged.recoverFromProbes = result.converged;
     runStats_.schurIterations += result.iterations;
-    d.laggedRent += result.iterations * d.laggedIterationFlops;
+    d.lagged.rent += result.iterations * d.lagged.iterationFlops;
     if (result.converged && !result.zeroRightHandSide) {
       ++runStats_.laggedSteps;
       runStats_.largestSchurResidual = std::max(runStats_.largestSchurResidual, result.residual);
@@ -152,7 +152,7 @@ void AsyncBackwardEuler::solveStructured() {
       // The old factor no longer preconditions well enough: rebuild now (exact solve). With
       // Z and C_i current (only L's contact blocks changed), H^{LL*} alone.
       Stopwatch rebuild;
-      if (!d.schurLagging && !d.correctionsStale) {
+      if (!d.lagged.lagging && !d.contactStep.correctionsStale) {
         refactorLargeSystem();
       } else {
         fullSchurRebuild();
@@ -177,7 +177,7 @@ void AsyncBackwardEuler::recoverRegion(int i) {
     return;
   }
   detail::gatherInto(d.Y, pos, rb.yInterface);
-  if (d.recoverFromProbes) {
+  if (d.lagged.recoverFromProbes) {
     // X = y - (H^{SS})^{-1} H^{SL} Y, the substitution of H^{SL} Y summed along the lagged
     // solve's iterations (forward substitution is linear): no substitution of its own.
     rb.x = rb.y;
@@ -187,8 +187,8 @@ void AsyncBackwardEuler::recoverRegion(int i) {
   }
   // Implicit contact evaluates the force at every substep: x must hold them all, unless
   // the step may be certified free of contact (Eq. C6) with the bounds of Z.
-  const bool endStates = !implicitContact() || (d.certifying && rb.reach.size() == rb.y.rows());
-  if (rb.useDenseZ && !observer_ && !d.schurLagging && !d.schur.borrowing() && endStates) {
+  const bool endStates = !implicitContact() || (d.contactStep.certifying && rb.reach.size() == rb.y.rows());
+  if (rb.dense.recovery && !observer_ && !d.lagged.lagging && !d.schur.borrowing() && endStates) {
     rb.xLast = rb.y.col(rb.ratio - 1);
     rb.xLast.noalias() -= rb.zLast * rb.yInterface;
     rb.xSum = rb.y.rowwise().sum();

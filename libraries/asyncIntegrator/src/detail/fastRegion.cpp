@@ -58,7 +58,7 @@ void FastRegion::updateBlocks(const SparseMatrix& stiffness, double largeStep, d
   combineInto(weights.mass, Mss, weights.stiffness, Kss, systemMatrix);
   combineInto(0.0, Mss, hS * hS, Kss, G);
   refreshTranspose();
-  if (denseG) Gdense = G;
+  if (dense.factor) Gdense = G;
   rhsWeight = 1.0 / (1.0 + hS * alpha);
   stepWeight = (1.0 + beta / hS) / (1.0 + hS * alpha);
   coupling = couplingCoefficients(couplingKind, ratio, largeStep);
@@ -86,7 +86,7 @@ bool FastRegion::setContactBlocks(const std::vector<std::array<int, 3>>& positio
     });
   }
   refreshTranspose();
-  if (denseG) Gdense = G;
+  if (dense.factor) Gdense = G;
   return true;
 }
 
@@ -121,7 +121,7 @@ void FastRegion::chooseDenseFactor() {
     if (systemMatrix.rows() == 0 || systemMatrix.rows() > denseDofs_) return;
     solver = makeSparseSolver(SolverKind::dense);
   }
-  denseG = true;
+  dense.factor = true;
   Gdense = G;
 }
 
@@ -177,7 +177,7 @@ void FastRegion::refreshTranspose() {
 }
 
 void FastRegion::subtractStiffnessProduct(const double* t, double* out) const {
-  if (denseG) {
+  if (dense.factor) {
     const Eigen::Index size = Gdense.rows();
     Eigen::Map<Eigen::VectorXd>(out, size).noalias() -= Gdense * Eigen::Map<const Eigen::VectorXd>(t, size);
     return;
@@ -223,7 +223,7 @@ void FastRegion::subtractStiffnessProduct(const double* t, double* out) const {
 
 // Column c of outT is a sum of length-k vector updates over column c of G^T (row c of G).
 void FastRegion::rowWiseStiffnessProduct(const Eigen::MatrixXd& tT, Eigen::MatrixXd& outT) const {
-  if (denseG) {
+  if (dense.factor) {
     outT.noalias() = tT * Gdense.transpose();
     return;
   }
@@ -288,8 +288,8 @@ void FastRegion::correctionColumns(SparseSolver& columnSolver, bool damped, Eige
   w.sumM.setZero(size, width);
   w.sumK.setZero(size, width);
   if (damped) w.sumD.setZero(size, width);
-  if (useDenseZ) w.sum.setZero(size, width);
-  const bool reachToo = useDenseZ && trackReach;
+  if (dense.recovery) w.sum.setZero(size, width);
+  const bool reachToo = dense.recovery && dense.trackReach;
   if (reachToo) w.reach.setZero(size);
   // rhsColumns += scale * block(:, first .. first + width), for a sparse block of H^{SI}.
   const auto addColumns = [&](const SparseMatrix& matrix, double scale) {
@@ -316,10 +316,10 @@ void FastRegion::correctionColumns(SparseSolver& columnSolver, bool damped, Eige
     if (k.eM[r - 1] != 0.0) w.sumM += k.eM[r - 1] * w.z;
     w.sumK += k.eK[r - 1] * w.z;
     if (damped) w.sumD += k.eD[r - 1] * w.z;
-    if (useDenseZ) w.sum += w.z;
+    if (dense.recovery) w.sum += w.z;
     if (reachToo) w.reach = w.reach.cwiseMax(w.sum.rowwise().squaredNorm());
   }
-  if (useDenseZ) {
+  if (dense.recovery) {
     zLast.middleCols(first, width) = w.z;
     zSum.middleCols(first, width) = w.sum;
   }
@@ -384,10 +384,10 @@ CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOp
     FastRegion& rb = regions[i];
     const Eigen::Index q = rb.Msi.cols();
     const Eigen::Index sizeS = rb.systemMatrix.rows();
-    rb.useDenseZ = rb.owned && chooseDenseZ(rb, options.recovery);
+    rb.dense.recovery = rb.owned && chooseDenseZ(rb, options.recovery);
     rb.correction.resize(q, q);
-    rb.zLast.resize(rb.useDenseZ ? sizeS : 0, rb.useDenseZ ? q : 0);
-    rb.zSum.resize(rb.useDenseZ ? sizeS : 0, rb.useDenseZ ? q : 0);
+    rb.zLast.resize(rb.dense.recovery ? sizeS : 0, rb.dense.recovery ? q : 0);
+    rb.zSum.resize(rb.dense.recovery ? sizeS : 0, rb.dense.recovery ? q : 0);
     if (!rb.owned) rb.correction.setZero();  // the owner's C_i arrives by the sum over processes
     if (q == 0 || !rb.owned) continue;
     run.columns += static_cast<long long>(rb.ratio) * q;
@@ -423,7 +423,8 @@ CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOp
   });
   // Each block's squared row norms summed: the sum over blocks of each block's maximum over
   // r bounds the maximum over r of the whole rows' squared norms.
-  for (FastRegion& rb : regions) rb.reach.setZero(rb.useDenseZ && rb.trackReach ? rb.systemMatrix.rows() : 0);
+  for (FastRegion& rb : regions)
+    rb.reach.setZero(rb.dense.recovery && rb.dense.trackReach ? rb.systemMatrix.rows() : 0);
   for (const ColumnTask& task : tasks) {
     FastRegion& rb = regions[static_cast<std::size_t>(task.region)];
     if (rb.reach.size() > 0) rb.reach += rb.columnScratch[static_cast<std::size_t>(task.block)].reach;

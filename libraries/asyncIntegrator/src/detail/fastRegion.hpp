@@ -105,9 +105,14 @@ class FastRegion {
   // Stable coupling: the interface elements and K_I^{II}, their stiffness on I x I (dense).
   std::vector<InterfaceElement> interfaceElements;
   Eigen::MatrixXd interfaceStiffness;
-  SparseMatrix GT;         // G^T, for products with many columns held row-wise
-  bool denseG = false;     // the region is small: A^S factored dense, G multiplied dense
-  Eigen::MatrixXd Gdense;  // G (denseG only)
+  SparseMatrix GT;  // G^T, for products with many columns held row-wise
+  // Where the region works dense rather than sparse.
+  struct DenseChoices {
+    bool factor = false;      // the region is small: A^S factored dense, G multiplied dense
+    bool recovery = false;    // RecoveryMode::denseZ: Z_m and sum_r Z_r stored (zLast, zSum)
+    bool trackReach = false;  // with recovery: the certificate's reach of Z (below)
+  } dense;
+  Eigen::MatrixXd Gdense;  // G (dense.factor only)
   // Implicit contact's blocks (setContactBlocks): positions in S, P = hS^2 K_c + hS C_c,
   // Gc = hS^2 K_c, and what the substitution's M^{SS} x_{r-1} shortcut misses with them in
   // A^S and G: Q = rhsWeight (beta / hS Gc - (P - Gc)), added as Q x_{r-1}.
@@ -123,12 +128,11 @@ class FastRegion {
   // Copies of the A^S factor for the column blocks of Z computed on other threads.
   std::vector<std::unique_ptr<SparseSolver>> helperSolvers;
   std::vector<char> helperAnalyzed;
-  bool useDenseZ = false;
   Eigen::MatrixXd zLast, zSum;  // Z_m and sum_r Z_r, |S| x q (dense recovery only)
   // Implicit contact's certificate (Eq. C6), with dense recovery: reach(k) bounds row k of
   // hS sum_{j<=r} Z_j in 2-norm over every r, so that a substep's displacement differs
-  // from the substitution of b^S alone by at most reach(k) |Y_I|_2 in that DOF.
-  bool trackReach = false;
+  // from the substitution of b^S alone by at most reach(k) |Y_I|_2 in that DOF
+  // (dense.trackReach).
   Eigen::VectorXd reach;
   Eigen::MatrixXd correction;  // C_i = H^{IS} Z, q x q
   // Per-step buffers, sized once: no allocation in a steady-state step.

@@ -21,10 +21,6 @@ namespace {
 using Triplets = std::vector<Eigen::Triplet<double>>;
 using ElementBlock = Eigen::Matrix<double, 12, 12>;
 
-/// The step of a DOF with `unitsPerStep` units per step that time unit t > 0 falls in:
-/// steps are (t_{j-1}, t_j], so ceil(t / unitsPerStep); 0 for t = 0 (the start state).
-long long stepContaining(long long t, long long unitsPerStep) { return (t + unitsPerStep - 1) / unitsPerStep; }
-
 void appendElement(const Eigen::Vector4i& vertices, const ElementBlock& block, Triplets& out) {
   for (int b = 0; b < 12; ++b)
     for (int a = 0; a < 12; ++a)
@@ -305,7 +301,7 @@ void HierarchySystem::factorize(IntegratorStats& stats) {
   factorizeLU(stats);
 }
 
-void HierarchySystem::factorizeLU(IntegratorStats& stats) {
+void HierarchySystem::scalePositionRows() {
   // Position rows (Eq. N5) are in metres; scaled by M_dd / h_d they weigh like the velocity
   // rows (momentum), so the LU's diagonal pivots stay the natural ones.
   rowScale_ = Eigen::VectorXd::Ones(unknowns());
@@ -315,6 +311,10 @@ void HierarchySystem::factorizeLU(IntegratorStats& stats) {
     for (long long j = 1; j <= dofCount_[static_cast<std::size_t>(d)]; ++j)
       rowScale_[displacementRow(d, j)] = system_.mass.coeff(dof, dof) / h;
   }
+}
+
+void HierarchySystem::factorizeLU(IntegratorStats& stats) {
+  scalePositionRows();
   const SparseMatrix scaled = rowScale_.asDiagonal() * matrix_;
   SparseMatrix ordered = order_ * scaled * order_.transpose();
   ordered.makeCompressed();
@@ -333,14 +333,10 @@ void HierarchySystem::factorizeLU(IntegratorStats& stats) {
   ++stats.factorizations;
 }
 
-// Eq. N3's right-hand side: h_d (f_ext,d(t_{d,j}) - f_int,d(u_0)), plus (M v_0)_d in d's
-// first step (the v_p(0) of every mass-coupled p).
-void HierarchySystem::step(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0, const Eigen::VectorXd& internalForce,
-                           const std::map<long long, Eigen::VectorXd>& external, Eigen::VectorXd& u1,
-                           Eigen::VectorXd& v1, IntegratorStats& stats) {
-  Stopwatch solve;
-  solve.start();
-  rhs_.setZero(unknowns());
+void HierarchySystem::loadRightHandSide(const Eigen::VectorXd& v0, const Eigen::VectorXd& internalForce,
+                                        const std::map<long long, Eigen::VectorXd>& external,
+                                        Eigen::VectorXd& rhs) const {
+  rhs.setZero(unknowns());
   const Eigen::VectorXd momentum = system_.mass * v0;
   for (int d = 0; d < static_cast<int>(free_.size()); ++d) {
     const int dof = free_[static_cast<std::size_t>(d)];
@@ -348,10 +344,19 @@ void HierarchySystem::step(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0,
     for (long long j = 1; j <= dofCount_[static_cast<std::size_t>(d)]; ++j) {
       const auto f = external.find(j * unitsPerStep(d));
       const double load = f == external.end() ? 0.0 : f->second[dof];
-      rhs_[velocityRow(d, j)] = h * (load - internalForce[dof]);
+      rhs[velocityRow(d, j)] = h * (load - internalForce[dof]);
     }
-    rhs_[velocityRow(d, 1)] += momentum[dof];
+    rhs[velocityRow(d, 1)] += momentum[dof];  // the v_p(0) of every mass-coupled p
   }
+}
+
+// Eq. N3's right-hand side (loadRightHandSide), solved with the kept factor.
+void HierarchySystem::step(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0, const Eigen::VectorXd& internalForce,
+                           const std::map<long long, Eigen::VectorXd>& external, Eigen::VectorXd& u1,
+                           Eigen::VectorXd& v1, IntegratorStats& stats) {
+  Stopwatch solve;
+  solve.start();
+  loadRightHandSide(v0, internalForce, external, rhs_);
   if (structured_) {
     structured_->solve(rhs_, solution_, false);
     solutionComplete_ = false;
@@ -360,6 +365,16 @@ void HierarchySystem::step(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0,
     solution_ = order_.transpose() * lu_.solve(ordered);
     solutionComplete_ = true;
   }
+  endState(u0, v0, u1, v1);
+  ++stats.solvedRightHandSides;
+  // As the other integrators count: the substitutions with factors (LU: one multiply-add
+  // per factor entry), not the sparse products around them.
+  stats.solveFlops += structured_ ? structured_->substitutionFlops() : 2.0 * static_cast<double>(factorNonZeros_);
+  stats.solveSeconds += solve.stop();
+}
+
+void HierarchySystem::endState(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0, Eigen::VectorXd& u1,
+                               Eigen::VectorXd& v1) const {
   u1 = u0;
   v1 = v0;
   for (int d = 0; d < static_cast<int>(free_.size()); ++d) {
@@ -368,11 +383,6 @@ void HierarchySystem::step(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0,
     u1[dof] = u0[dof] + solution_[displacementRow(d, last)];
     v1[dof] = solution_[velocityRow(d, last)];
   }
-  ++stats.solvedRightHandSides;
-  // As the other integrators count: the substitutions with factors (LU: one multiply-add
-  // per factor entry), not the sparse products around them.
-  stats.solveFlops += structured_ ? structured_->substitutionFlops() : 2.0 * static_cast<double>(factorNonZeros_);
-  stats.solveSeconds += solve.stop();
 }
 
 void HierarchySystem::completeSolution() const {

@@ -9,8 +9,10 @@
 #include <Eigen/SparseLU>
 #include <asyncfem/asyncIntegrator/asyncOptions.hpp>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
+#include <asyncfem/core/vertexJacobian.hpp>
 #include <asyncfem/dynamics/dynamicSystem.hpp>
 #include <asyncfem/integrator/integrator.hpp>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -21,6 +23,10 @@
 namespace asyncfem::detail {
 
 class StructuredHierarchySolve;
+
+/// The step of a DOF with `unitsPerStep` units per step that time unit t > 0 falls in:
+/// steps are (t_{j-1}, t_j], so ceil(t / unitsPerStep); 0 for t = 0 (the start state).
+inline long long stepContaining(long long t, long long unitsPerStep) { return (t + unitsPerStep - 1) / unitsPerStep; }
 
 /// Free DOF d (index into freeToFull) takes N_d steps of h_d = hL / N_d per large step; its
 /// unknowns are v_{d,j} (rows and columns offset_[d] + j - 1) and w_{d,j} = u_{d,j} - u_{d,0}
@@ -47,6 +53,33 @@ class HierarchySystem {
   void step(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0, const Eigen::VectorXd& internalForce,
             const std::map<long long, Eigen::VectorXd>& external, Eigen::VectorXd& u1, Eigen::VectorXd& v1,
             IntegratorStats& stats);
+  /// A force that depends on the state (implicit penalty contact): f_ext at a time and a
+  /// full state (into a zeroed vector), its vertex Jacobian there (stiffness = -df/du,
+  /// damping = -df/dv), and the time of a time unit of the step.
+  struct StateForce {
+    std::function<void(double time, const Eigen::VectorXd& u, const Eigen::VectorXd& v, Eigen::VectorXd& f)> force;
+    std::function<void(double time, const Eigen::VectorXd& u, const Eigen::VectorXd& v, VertexJacobian& jacobian)>
+        jacobian;
+    std::function<double(long long unit)> timeOf;
+  };
+  /// How solveWithStateForce ended: solves (the first one, step()'s, included), the largest
+  /// residual relative to the step's scale, and the free DOF where it is largest.
+  struct StateForceSolve {
+    int solves = 1;
+    double residual = 0.0;
+    bool converged = false;
+    int worstDof = -1;       ///< a full DOF index, -1 if none
+    int factorizations = 0;  ///< LU factorizations of the step system with contact blocks
+  };
+  /// After step() (its solution the first iterate): Newton's method on the step equations
+  /// with f_ext on each DOF's step evaluated at that DOF's own state at the step's end (Eq.
+  /// N13), the Jacobian's blocks added to the step system of the iterate (one sparse LU of
+  /// it, Eq. N14), each update halved while the residual's 2-norm would rise, until the
+  /// largest residual is at most tolerance relative to the step's scale or maxSolves solves
+  /// are spent. Writes the end state into u1, v1.
+  StateForceSolve solveWithStateForce(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0,
+                                      const Eigen::VectorXd& internalForce, const StateForce& force, double tolerance,
+                                      int maxSolves, Eigen::VectorXd& u1, Eigen::VectorXd& v1, IntegratorStats& stats);
   /// Time units at which some free DOF's step ends (where f_ext is needed), ascending.
   const std::vector<long long>& stepEndUnits() const { return stepEndUnits_; }
 
@@ -77,8 +110,28 @@ class HierarchySystem {
   void chooseOrder();
   void factorize(IntegratorStats& stats);
   void factorizeLU(IntegratorStats& stats);
+  /// The end of the step solved last (each DOF's last step; fixed DOFs at u0, v0).
+  void endState(const Eigen::VectorXd& u0, const Eigen::VectorXd& v0, Eigen::VectorXd& u1, Eigen::VectorXd& v1) const;
   /// Completes solution_ (every step's unknowns) after a structured solve.
   void completeSolution() const;
+  /// Eq. N3's right-hand side into rhs: h_d (f_ext,d(t_{d,j}) - f_int,d(u_0)), plus
+  /// (M v_0)_d in d's first step; external maps time units to f_ext (absent: zero).
+  void loadRightHandSide(const Eigen::VectorXd& v0, const Eigen::VectorXd& internalForce,
+                         const std::map<long long, Eigen::VectorXd>& external, Eigen::VectorXd& rhs) const;
+  /// The full state at time unit t of the step whose unknowns are x (Eq. N1; fixed DOFs
+  /// at u0, v0).
+  void stateAt(long long t, const Eigen::VectorXd& x, const Eigen::VectorXd& u0, const Eigen::VectorXd& v0,
+               Eigen::VectorXd& u, Eigen::VectorXd& v) const;
+  /// f_ext at every step end, each at the state of x (Eq. N13).
+  void forcesAt(const Eigen::VectorXd& x, const Eigen::VectorXd& u0, const Eigen::VectorXd& v0, const StateForce& force,
+                std::map<long long, Eigen::VectorXd>& out) const;
+  /// The largest entry of |matrix_ x - rhs| (its DOF into worstDof) and its 2-norm.
+  double residualOf(const Eigen::VectorXd& x, const Eigen::VectorXd& rhs, double& norm, int& worstDof) const;
+  /// Solves the step system plus blocks (triplets; none: with the kept factor).
+  void solveWith(const std::vector<Eigen::Triplet<double>>& blocks, const Eigen::VectorXd& rhs, Eigen::VectorXd& x,
+                 IntegratorStats& stats);
+  /// Row scales of the position rows (Eq. N5), for an LU of the step system.
+  void scalePositionRows();
 
   int velocityRow(int d, long long j) const { return offset_[static_cast<std::size_t>(d)] + static_cast<int>(j) - 1; }
   int displacementRow(int d, long long j) const { return velocityUnknowns_ + velocityRow(d, j); }
@@ -112,6 +165,8 @@ class HierarchySystem {
   std::unique_ptr<StructuredHierarchySolve> structured_;
   bool structureChecked_ = false;
   std::string fallbackReason_;
+  // Implicit contact: the LU of the step system with the Jacobian's blocks (Eq. N14).
+  Eigen::SparseLU<SparseMatrix, Eigen::NaturalOrdering<int>> contactLu_;
 };
 
 }  // namespace asyncfem::detail

@@ -136,6 +136,7 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   void repartition(std::vector<AsyncRegion> regions, const std::string& reason);
   void setUpHierarchy();
   void stepHierarchy();
+  void solveHierarchyContact();
   void hierarchyReportLines(std::vector<std::string>& lines) const;
   const Impl& hierarchyImpl(const char* what) const;
   void refactor();

@@ -206,26 +206,27 @@ struct AsyncRunStats {
   /// Everything else step() spends (forces, right-hand sides, solves, state update).
   double stepSeconds = 0.0;
   long long steps = 0;
-  int fastDofs = 0;                           ///< sum_i |S_i|
-  int interfaceDofs = 0;                      ///< sum_i |I_i|
-  int largeDofs = 0;                          ///< |L|
-  int zThreads = 1;                           ///< threads (A^S factor copies) the last Z computation used
-  long long zColumns = 0;                     ///< right-hand sides of one Z computation: sum_i m_i |I_i|
-  long long laggedSteps = 0;                  ///< steps solved with the lagged H^{LL*} (AsyncOptions::laggedSchur)
-  long long schurIterations = 0;              ///< iterative refinement iterations over those steps
-  long long laggedRefreshes = 0;              ///< rebuilds that turned the kept C_i instead of computing Z
-  double largestSchurResidual = 0.0;          ///< largest final relative residual of those steps
-  long long quickSteps = 0;                   ///< steps solved on the whole system's factor (quickSetUp)
-  long long quickIterations = 0;              ///< conjugate gradient iterations over those steps
-  double largestQuickResidual = 0.0;          ///< largest final relative residual of those steps
-  long long quickEnds = 0;                    ///< partitions that left quick set-up for Z and H^{LL*}
-  long long contactSteps = 0;                 ///< steps solved with implicit contact
-  long long contactIterations = 0;            ///< solves over those steps
-  long long unconvergedContactSteps = 0;      ///< of those, stopped at AsyncOptions::contactIterations
-  double largestContactResidual = 0.0;        ///< largest relative residual of those
-  long long contactRegionFactorizations = 0;  ///< A^S refactored for its contact blocks
-  long long contactFreeSteps = 0;             ///< of contactSteps, certified free of contact (Eq. C6)
-  long long contactScreenedSteps = 0;         ///< of contactSteps, predicted states clear of obstacles (Eq. C7)
+  int fastDofs = 0;                               ///< sum_i |S_i|
+  int interfaceDofs = 0;                          ///< sum_i |I_i|
+  int largeDofs = 0;                              ///< |L|
+  int zThreads = 1;                               ///< threads (A^S factor copies) the last Z computation used
+  long long zColumns = 0;                         ///< right-hand sides of one Z computation: sum_i m_i |I_i|
+  long long laggedSteps = 0;                      ///< steps solved with the lagged H^{LL*} (AsyncOptions::laggedSchur)
+  long long schurIterations = 0;                  ///< iterative refinement iterations over those steps
+  long long laggedRefreshes = 0;                  ///< rebuilds that turned the kept C_i instead of computing Z
+  double largestSchurResidual = 0.0;              ///< largest final relative residual of those steps
+  long long quickSteps = 0;                       ///< steps solved on the whole system's factor (quickSetUp)
+  long long quickIterations = 0;                  ///< conjugate gradient iterations over those steps
+  double largestQuickResidual = 0.0;              ///< largest final relative residual of those steps
+  long long quickEnds = 0;                        ///< partitions that left quick set-up for Z and H^{LL*}
+  long long contactSteps = 0;                     ///< steps solved with implicit contact
+  long long contactIterations = 0;                ///< solves over those steps
+  long long unconvergedContactSteps = 0;          ///< of those, stopped at AsyncOptions::contactIterations
+  double largestContactResidual = 0.0;            ///< largest relative residual of those
+  long long contactRegionFactorizations = 0;      ///< A^S refactored for its contact blocks
+  long long contactStepSystemFactorizations = 0;  ///< hierarchy solve: the step system's LU with contact blocks
+  long long contactFreeSteps = 0;                 ///< of contactSteps, certified free of contact (Eq. C6)
+  long long contactScreenedSteps = 0;             ///< of contactSteps, predicted states clear of obstacles (Eq. C7)
   /// Mean seconds of a steady-state large step (stepSeconds / steps), and with rebuilds.
   double meanStepSeconds() const { return steps > 0 ? stepSeconds / static_cast<double>(steps) : 0.0; }
   double meanStepWithRebuildSeconds() const {

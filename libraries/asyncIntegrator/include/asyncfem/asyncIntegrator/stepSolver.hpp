@@ -57,6 +57,6 @@ AsyncStepSolver chooseStepSolver(const AsyncOptions& options, const RegionPartit
 /// run-time regions that may nest (AdaptiveRegionOptions::nest), so that a refusal comes
 /// before the run rather than at the step where regions first touch. why: the reason the
 /// hierarchy solve would run, for the message.
-void requireHierarchyComposes(const AsyncOptions& options, const DynamicSystem& system, const std::string& why);
+void requireHierarchyComposes(const AsyncOptions& options, const std::string& why);
 
 }  // namespace asyncfem
