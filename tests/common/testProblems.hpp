@@ -51,15 +51,17 @@ inline Problem rubberBarProblem(const ProblemSettings& settings = {},
   return Problem(std::move(mesh), std::move(clamped), settings);
 }
 
-/// The bar [0, 1] x [0, 0.25] x [0, 0.25] of 8 x 2 x 2 cubes (192 tets, 135 vertices):
+/// The bar [0, 1] x [0, 0.25] x [0, 0.25] of 8 x 2 x 2 cubes (192 tets, 135 vertices; other
+/// cells on request):
 /// soft (density 1000, E = 1e5, nu = 0.4) with a stiff, light end x > 0.75 (density 200,
 /// E = 5e6, nu = 0.3; element and vertex set "stiff"), whose wave speed sqrt(E / density)
 /// is 16 times the rest's: the fast region of the multirate tests. Clamped at x = 0
 /// ("xmin"). No load.
-inline Problem stiffEndBarProblem(const ProblemSettings& settings = {}) {
+inline Problem stiffEndBarProblem(const ProblemSettings& settings = {},
+                                  const Eigen::Vector3i& cells = Eigen::Vector3i(8, 2, 2)) {
   BoxMeshSpec spec;
   spec.size = Eigen::Vector3d(1.0, 0.25, 0.25);
-  spec.cells = Eigen::Vector3i(8, 2, 2);
+  spec.cells = cells;
   spec.material = Material{"soft", 1000.0, 1e5, 0.4};
   spec.regions.push_back(
       {"stiff", Eigen::Vector3d(0.75, -1, -1), Eigen::Vector3d(2, 2, 2), Material{"stiff", 200.0, 5e6, 0.3}});

@@ -13,16 +13,13 @@
 //   build/bin/resumeMatrixTests --gtest_filter='Full/*'
 // or, configured with -DASYNCFEM_RESUME_MATRIX_FULL=ON, `ctest -L resume-matrix-full`.
 // ASYNCFEM_RESUME_MATRIX_SEED=N draws other interruption frames (and another subset).
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/simulationIO/checkpoint.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
-#include <chrono>
 #include <csignal>
 #include <cstdint>
 #include <cstdlib>
@@ -34,10 +31,9 @@
 #include <random>
 #include <set>
 #include <string>
-#include <thread>
 #include <vector>
 
-#include "utilityTest.hpp"
+#include "resumeHarness.hpp"
 
 namespace {
 
@@ -45,7 +41,12 @@ namespace fs = std::filesystem;
 
 const std::string simulatorPath = std::string(ASYNCFEM_BIN_DIR) + "/offlineSimulator";
 
+using asyncfem::test::Child;
+using asyncfem::test::compareFrames;
+using asyncfem::test::Difference;
+using asyncfem::test::matrixSeed;
 using asyncfem::test::readText;
+using asyncfem::test::stableHash;
 
 /// One combination: integrator, force model, stateful option, how the run is stopped.
 struct MatrixCase {
@@ -105,18 +106,6 @@ std::vector<MatrixCase> allCases() {
     }
   }
   return cases;
-}
-
-std::uint64_t matrixSeed() {
-  const char* text = std::getenv("ASYNCFEM_RESUME_MATRIX_SEED");
-  return text != nullptr ? std::strtoull(text, nullptr, 10) : 20261202ULL;
-}
-
-/// FNV-1a: a hash that is the same in every build, so a case's frame is reproducible.
-std::uint64_t stableHash(const std::string& text) {
-  std::uint64_t hash = 14695981039346656037ULL;
-  for (const char c : text) hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
-  return hash;
 }
 
 /// Every integrator twice (once per way of stopping), then one more case for each force
@@ -250,109 +239,22 @@ std::string inexactBecause(const MatrixCase& c) {
 /// catches any state that was really lost (those differ by percents).
 constexpr double caveatBound = 1e-6;
 
-struct Child {
-  pid_t pid = -1;
-  int status = 0;
-  bool done = false;
-};
-
-class ResumeMatrixTest : public asyncfem::test::UtilityTest, public ::testing::WithParamInterface<MatrixCase> {
+class ResumeMatrixTest : public asyncfem::test::ResumeHarness, public ::testing::WithParamInterface<MatrixCase> {
  protected:
-  /// Starts the simulator, one OpenMP thread (multi-threaded reductions are not
-  /// bit-reproducible run to run), stdout and stderr to files named by `tag`.
+  /// Starts the simulator with `arguments`, output to files named by `tag`.
   Child start(const std::vector<std::string>& arguments, const std::string& tag) const {
-    const std::string out = (folder_ / (tag + ".out")).string();
-    const std::string err = (folder_ / (tag + ".err")).string();
-    Child child;
-    child.pid = ::fork();
-    if (child.pid == 0) {
-      const int devNull = ::open("/dev/null", O_RDONLY);
-      const int outFd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      const int errFd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      ::dup2(devNull, STDIN_FILENO);
-      ::dup2(outFd, STDOUT_FILENO);
-      ::dup2(errFd, STDERR_FILENO);
-      ::setenv("OMP_NUM_THREADS", "1", 1);
-      std::vector<std::string> command{simulatorPath};
-      command.insert(command.end(), arguments.begin(), arguments.end());
-      asyncfem::test::execCommand(std::move(command));
-    }
-    return child;
-  }
-
-  /// Non-blocking: has the child ended?
-  static bool ended(Child& child) {
-    if (!child.done && ::waitpid(child.pid, &child.status, WNOHANG) == child.pid) child.done = true;
-    return child.done;
-  }
-
-  /// Waits for the child, killing it after `seconds` (a test never hangs).
-  static void finish(Child& child, double seconds) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (!ended(child)) {
-      if (std::chrono::steady_clock::now() > deadline) {
-        ::kill(child.pid, SIGKILL);
-        ::waitpid(child.pid, &child.status, 0);
-        child.done = true;
-        ADD_FAILURE() << "offlineSimulator did not end within " << seconds << " s";
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    std::vector<std::string> command{simulatorPath};
+    command.insert(command.end(), arguments.begin(), arguments.end());
+    return startCommand(command, tag);
   }
 
   /// Runs the simulator to its end; its exit status (-1 if it did not exit normally).
   int runToEnd(const std::vector<std::string>& arguments, const std::string& tag) const {
-    Child child = start(arguments, tag);
-    finish(child, 120.0);
-    return WIFEXITED(child.status) ? WEXITSTATUS(child.status) : -1;
-  }
-
-  std::string printed(const std::string& tag, const char* stream) const {
-    return readText(folder_ / (tag + "." + stream));
-  }
-
-  /// Polls the output until it holds `frames` complete frames; false if the run ended
-  /// first or 60 s passed.
-  static bool waitForFrames(const fs::path& file, std::int64_t frames, Child& child) {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (std::chrono::steady_clock::now() < deadline && !ended(child)) {
-      std::error_code ignored;
-      if (fs::exists(file, ignored)) {
-        try {
-          if (asyncfem::SimulationReader(file).numFrames() >= frames) return true;
-        } catch (const asyncfem::Error&) {
-          // the header is not complete yet
-        }
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    return false;
+    std::vector<std::string> command{simulatorPath};
+    command.insert(command.end(), arguments.begin(), arguments.end());
+    return runCommandToEnd(command, tag);
   }
 };
-
-/// The largest difference between the frames of two files, and the largest values.
-struct Difference {
-  double displacement = 0.0;
-  double velocity = 0.0;
-  double largestDisplacement = 0.0;
-  double largestVelocity = 0.0;
-  bool sameTimes = true;
-};
-
-Difference compareFrames(const fs::path& a, const fs::path& b, std::int64_t frames) {
-  asyncfem::SimulationReader ra(a), rb(b);
-  Difference d;
-  for (std::int64_t k = 0; k < frames; ++k) {
-    const asyncfem::SimulationFrame fa = ra.readFrame(k), fb = rb.readFrame(k);
-    d.sameTimes = d.sameTimes && fa.time == fb.time;
-    d.displacement = std::max(d.displacement, (fa.displacement - fb.displacement).cwiseAbs().maxCoeff());
-    d.velocity = std::max(d.velocity, (fa.velocity - fb.velocity).cwiseAbs().maxCoeff());
-    d.largestDisplacement = std::max(d.largestDisplacement, fb.displacement.cwiseAbs().maxCoeff());
-    d.largestVelocity = std::max(d.largestVelocity, fb.velocity.cwiseAbs().maxCoeff());
-  }
-  return d;
-}
 
 TEST_P(ResumeMatrixTest, ResumedRunMatchesAnUninterruptedOne) {
   const MatrixCase& c = GetParam();
@@ -377,12 +279,7 @@ TEST_P(ResumeMatrixTest, ResumedRunMatchesAnUninterruptedOne) {
     ASSERT_TRUE(WIFEXITED(child.status)) << "SIGINT was not handled";
     ASSERT_EQ(WEXITSTATUS(child.status), 128 + SIGINT) << printed("interrupted", "err");
   }
-  const std::int64_t onDisk = asyncfem::SimulationReader(output).numFrames();
-  const std::int64_t checkpointed = asyncfem::readCheckpoint(asyncfem::checkpointPathFor(output)).frames;
-  ASSERT_GE(onDisk, stopAfter);
-  if (!c.kill9) {
-    EXPECT_EQ(checkpointed, onDisk) << "SIGINT must checkpoint the last finished frame";
-  }
+  const auto [onDisk, checkpointed] = asyncfem::test::checkLeftBehind(output, stopAfter, c.kill9);
   const std::int64_t frames = onDisk + 3;
 
   const std::string count = std::to_string(frames);
