@@ -173,7 +173,7 @@ TEST(Composition, EveryRefusalNamesItsOption) {
   const std::vector<std::pair<std::string, AsyncOptions>> cells{
       {"coupling", with([](AsyncOptions& o) { o.coupling = AsyncCoupling::paper; })},
       {"quickSetUp", with([](AsyncOptions& o) { o.quickSetUp = true; })},
-      {"substepContact", with([](AsyncOptions& o) { o.substepStatePrediction = true; })},
+      {"substepStatePrediction", with([](AsyncOptions& o) { o.substepStatePrediction = true; })},
       {"method", with([](AsyncOptions& o) { o.method = AsyncSolveMethod::naive; })},
       {"schur", with([](AsyncOptions& o) { o.schur = SchurMode::lu; })},
       {"recovery", with([](AsyncOptions& o) { o.recovery = RecoveryMode::substitution; })},

@@ -52,7 +52,7 @@ using asyncfem::test::stableHash;
 struct MatrixCase {
   std::string integrator;  ///< backwardEuler, trapezoidal, ..., multirateUncoupled, schroeder2011, asyncNested
   std::string model;       ///< linear, corotational, stvk, neoHookean, mooneyRivlin
-  /// plain, lineSearch, reuseFactor, exactSolves, noLaggedSchur, contact, substepContact,
+  /// plain, lineSearch, reuseFactor, exactSolves, noLaggedSchur, contact, substepStatePrediction,
   /// implicitContact, quickSetUp, schedule, autoRegions
   std::string option;
   bool kill9 = false;  ///< SIGKILL instead of SIGINT
@@ -85,7 +85,7 @@ std::vector<std::string> optionsFor(const std::string& integrator, const std::st
   if (integrator == "backwardEuler" || integrator == "asyncStable") options.emplace_back("implicitContact");
   if (integrator == "asyncStable" || integrator == "asyncPaper") {
     if (nonlinear) options.emplace_back("noLaggedSchur");  // "plain" has laggedSchur on, the default
-    options.emplace_back("substepContact");
+    options.emplace_back("substepStatePrediction");
     options.emplace_back("autoRegions");
   }
   if (integrator == "asyncStable") {
@@ -190,7 +190,7 @@ nlohmann::json sceneFor(const MatrixCase& c) {
   if (c.option == "autoRegions") options["regions"] = "auto";
   if (c.integrator == "asyncPaper") options["coupling"] = "paper";
   if (c.option == "noLaggedSchur") options["laggedSchur"] = false;
-  if (c.option == "substepContact") options["substepContact"] = true;
+  if (c.option == "substepStatePrediction") options["substepStatePrediction"] = true;
   static const std::map<std::string, std::string> names = {{"backwardEuler", "backward-euler"},
                                                            {"trapezoidal", "trapezoidal"},
                                                            {"centralDifferences", "central-differences"},
@@ -202,7 +202,7 @@ nlohmann::json sceneFor(const MatrixCase& c) {
                                                            {"asyncNested", "async"}};
   scene["integrator"] = {
       {"name", names.at(c.integrator)}, {"stepsPerFrame", explicitMethod ? 100 : 5}, {"options", options}};
-  if (c.option == "contact" || c.option == "substepContact" || c.option == "implicitContact") {
+  if (c.option == "contact" || c.option == "substepStatePrediction" || c.option == "implicitContact") {
     // The bar sags onto a ground just below it and rubs on it (friction keeps v in the force).
     scene["gravity"] = {0, -9.81, 0};
     scene["contact"] = {

@@ -173,7 +173,7 @@ const std::vector<SolverKey>& solverKeys() {
       booleanKey("laggedSchurRotation", &AsyncOptions::laggedSchurRotation),
       booleanKey("quickSetUp", &AsyncOptions::quickSetUp),
       // Contact.
-      booleanKey("substepContact", &AsyncOptions::substepStatePrediction),
+      booleanKey("substepStatePrediction", &AsyncOptions::substepStatePrediction),
       integerKey("contactIterations", &AsyncOptions::contactIterations, 1, 1000),
       valueKey<double>("contactTolerance", &AsyncOptions::contactTolerance,
                        [](JsonObjectReader& reader, const char* k, double value) {
@@ -188,9 +188,13 @@ const std::vector<SolverKey>& solverKeys() {
 
 AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
   AsyncOptions solver;
+  if (reader.find("substepContact")) {
+    reader.fail("substepContact",
+                "renamed \"substepStatePrediction\" (f_ext at each substep's predicted state; it is not contact)");
+  }
   for (const SolverKey& key : solverKeys()) key.read(reader, solver);
   if (solver.substepStatePrediction && !hasContact) {
-    reader.fail("substepContact", "only meaningful with a \"contact\" section");
+    reader.fail("substepStatePrediction", "only meaningful with a \"contact\" section");
   }
   return solver;
 }
@@ -290,7 +294,7 @@ void rejectAsyncOnlyKeys(const IntegratorContext& context, const nlohmann::json&
     JsonObjectReader::failAt(context.sourceName, path,
                              "expected an object, got " + JsonObjectReader::describe(options));
   }
-  for (const char* key : {"coupling", "schur", "method", "recovery", "substepContact"}) {
+  for (const char* key : {"coupling", "schur", "method", "recovery", "substepStatePrediction"}) {
     if (options.contains(key)) {
       JsonObjectReader::failAt(context.sourceName, path + "." + key, "used by \"async\" only, not by \"" + name + "\"");
     }

@@ -71,7 +71,7 @@ void checkHierarchyOptions(const AsyncOptions& options, const std::string& why) 
   };
   if (options.coupling != AsyncCoupling::stable) refuse("coupling", "the paper's coupling");
   if (options.quickSetUp) refuse("quickSetUp", "the quick set-up");
-  if (options.substepStatePrediction) refuse("substepContact", "contact at the substeps' predicted states");
+  if (options.substepStatePrediction) refuse("substepStatePrediction", "contact at the substeps' predicted states");
   if (options.largeSystemSolver) refuse("largeSystemSolver", "an external solver of L's system (the PETSc backend)");
   if (options.regionDistribution.sum) refuse("regionDistribution", "regions owned by one process");
   if (options.schur != defaults.schur) refuse("schur", "a Schur mode");

@@ -294,7 +294,7 @@ Scene sceneForStressJob(const Scene& base, std::vector<AsyncRegion> regions, con
   scene.integrator.options["regions"] = asyncRegionsJson(regions);
   if (job.integrator == "async-symmetric") scene.integrator.options["schur"] = "symmetric";
   if (scene.integrator.name == "multirate-uncoupled") {
-    for (const char* key : {"coupling", "schur", "method", "recovery", "substepContact"}) {
+    for (const char* key : {"coupling", "schur", "method", "recovery", "substepStatePrediction"}) {
       scene.integrator.options.erase(key);
     }
   }

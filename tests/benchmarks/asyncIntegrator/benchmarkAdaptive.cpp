@@ -232,7 +232,7 @@ int main(int argc, char** argv) {
       }
     }
     // Scheduled regions of the contact ratio join the cap (one region: two that touch
-    // would need the nested integrator, which has no substepContact); others stay apart.
+    // would need the nested integrator, which has no substepStatePrediction); others stay apart.
     nlohmann::json schedule = adaptiveOptions["regions"]["adaptive"].value("schedule", nlohmann::json::array());
     const bool joinSchedule = std::all_of(schedule.begin(), schedule.end(),
                                           [&](const nlohmann::json& r) { return r.value("ratio", 0) == ratio; });

@@ -303,7 +303,7 @@ Scenario droppedBody(int cells) {
 /// The contact study's scene: the dropped bar tilted by 25 degrees so that its stiff end
 /// lands first, with a penalty stiffness chosen from the lightest vertex so that the
 /// contact spring is resolved by the small step (omega hS = 0.5) but not by the large one
-/// (omega hL = 0.5 m): the regime substepContact is meant for. Frictionless, no contact
+/// (omega hL = 0.5 m): the regime substepStatePrediction is meant for. Frictionless, no contact
 /// damping, so energy changes come from the integrators alone.
 Scenario tiltedDrop(int cells, double hS) {
   Scenario s;
