@@ -250,8 +250,9 @@ std::vector<std::string> surfaceContactSummary(const Simulation& simulation) {
   char line[400];
   std::snprintf(
       line, sizeof(line),
-      "surfaces: %d body and %d obstacle triangles, thickness %.4g; per step %.1f candidate pairs (%lld "
-      "broad-phase runs in %lld force evaluations), %.1f active pairs (most %lld), detection %.3f ms",
+      "surfaces: %d body and %d obstacle triangles, thickness %.4g; %.1f candidate pairs per broad-phase run "
+      "(%lld runs in %lld force evaluations), %.1f active pairs per evaluation (most %lld), detection %.3f ms per "
+      "step",
       surfaces.bodySurface().numTriangles(), surfaces.obstacleSurface().numTriangles(), surfaces.options().thickness,
       stats.detections > 0 ? static_cast<double>(stats.candidates) / static_cast<double>(stats.detections) : 0.0,
       stats.detections, stats.evaluations,
