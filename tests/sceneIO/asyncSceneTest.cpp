@@ -215,7 +215,7 @@ TEST(ContactScene, WarnsWhenTheExplicitContactIsTooStiffForTheStep) {
 
 TEST(ContactScene, ErrorsNameTheKey) {
   const std::pair<const char*, const char*> cases[] = {
-      {R"({"stiffness": 1e4})", "contact.ground: contact needs a ground, planes or spheres"},
+      {R"({"stiffness": 1e4})", "contact.ground: contact needs a ground, planes, spheres, obstacles or surfaces"},
       {R"({"ground": {"height": 0}, "stiffness": -1})", "contact.stiffness"},
       {R"({"ground": {"up": [0, 0, 0]}})", "contact.ground.up"},
       {R"({"spheres": [{"center": [0, 0, 0], "radius": 0}]})", "contact.spheres[0].radius"},

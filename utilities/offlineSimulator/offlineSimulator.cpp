@@ -25,6 +25,7 @@
 #include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/runMonitor/runMonitor.hpp>
 #include <asyncfem/sceneIO/scene.hpp>
+#include <asyncfem/sceneIO/sceneObjects.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/sceneIO/stepGrowthCheck.hpp>
 #include <asyncfem/sceneIO/vegaConfig.hpp>
@@ -277,6 +278,7 @@ void printRunHeader(std::ostream& out, const asyncfem::Scene& scene, const async
     }
   }
   for (const std::string& line : simulation.integrator->report().lines) out << "  integrator  " << line << "\n";
+  for (const std::string& line : asyncfem::surfaceContactSummary(simulation)) out << "  contact     " << line << "\n";
   out << "  setup       " << record.setupSeconds
       << " s (mesh, matrices, first factorization: " << record.before.factorizationSeconds << " s)\n";
   if (couplingCheck) {

@@ -1,18 +1,22 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
 #include <asyncfem/contact/penaltyContact.hpp>
+#include <asyncfem/contact/surfaceContact.hpp>
 #include <asyncfem/core/error.hpp>
 #include <cmath>
+#include <iterator>
 #include <string>
 
 namespace asyncfem {
 
 PenaltyContact::PenaltyContact(Eigen::Matrix3Xd restPositions, std::vector<ContactPlane> planes,
-                               std::vector<ContactSphere> spheres, PenaltyContactParameters parameters)
+                               std::vector<ContactSphere> spheres, PenaltyContactParameters parameters,
+                               std::shared_ptr<const SurfaceContact> surfaces)
     : restPositions_(std::move(restPositions)),
       planes_(std::move(planes)),
       spheres_(std::move(spheres)),
-      parameters_(parameters) {
+      parameters_(parameters),
+      surfaces_(std::move(surfaces)) {
   const PenaltyContactParameters& p = parameters_;
   if (!(p.stiffness > 0.0) || !std::isfinite(p.stiffness)) throw ValidationError("contact: stiffness must be > 0");
   if (!(p.damping >= 0.0) || !(p.friction >= 0.0) || !(p.frictionViscosity > 0.0)) {
@@ -57,7 +61,21 @@ void PenaltyContact::forEachContact(const Eigen::VectorXd& displacement, const s
   }
 }
 
+bool PenaltyContact::timeDependent() const { return surfaces_ && surfaces_->timeDependent(); }
+
 void PenaltyContact::addForces(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                               Eigen::VectorXd& forces, const std::vector<int>* vertices) const {
+  addForces(0.0, displacement, velocity, forces, vertices);
+}
+
+PenaltyContactJacobian PenaltyContact::jacobian(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                                const std::vector<int>* vertices) const {
+  return jacobian(0.0, displacement, velocity, vertices);
+}
+
+double PenaltyContact::energy(const Eigen::VectorXd& displacement) const { return energy(0.0, displacement); }
+
+void PenaltyContact::addForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                                Eigen::VectorXd& forces, const std::vector<int>* vertices) const {
   const PenaltyContactParameters& p = parameters_;
   forEachContact(displacement, vertices, [&](int v, double depth, const Eigen::Vector3d& normal, double) {
@@ -75,9 +93,11 @@ void PenaltyContact::addForces(const Eigen::VectorXd& displacement, const Eigen:
     }
     forces.segment<3>(3 * v) += f;
   });
+  if (surfaces_) surfaces_->addForces(time, displacement, velocity, forces, vertices);
 }
 
-PenaltyContactJacobian PenaltyContact::jacobian(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+PenaltyContactJacobian PenaltyContact::jacobian(double time, const Eigen::VectorXd& displacement,
+                                                const Eigen::VectorXd& velocity,
                                                 const std::vector<int>* vertices) const {
   const PenaltyContactParameters& p = parameters_;
   PenaltyContactJacobian out;
@@ -118,21 +138,22 @@ PenaltyContactJacobian PenaltyContact::jacobian(const Eigen::VectorXd& displacem
     out.stiffness.push_back(-dfdx);
     out.damping.push_back(-dfdv);
   });
+  if (surfaces_) surfaces_->addJacobian(time, displacement, velocity, out, vertices);
   return out;
 }
 
-double PenaltyContact::energy(const Eigen::VectorXd& displacement) const {
+double PenaltyContact::energy(double time, const Eigen::VectorXd& displacement) const {
   double squares = 0.0;
   forEachContact(displacement, nullptr,
                  [&](int, double depth, const Eigen::Vector3d&, double) { squares += depth * depth; });
-  return 0.5 * parameters_.stiffness * squares;
+  return (0.5 * parameters_.stiffness * squares) + (surfaces_ ? surfaces_->energy(time, displacement) : 0.0);
 }
 
 double PenaltyContact::maxPenetration(const Eigen::VectorXd& displacement) const {
   double worst = 0.0;
   forEachContact(displacement, nullptr,
                  [&](int, double depth, const Eigen::Vector3d&, double) { worst = std::max(worst, depth); });
-  return worst;
+  return surfaces_ ? std::max(worst, surfaces_->maxDepth(0.0, displacement)) : worst;
 }
 
 std::vector<int> PenaltyContact::verticesWithin(const Eigen::VectorXd& displacement, double margin) const {
@@ -143,10 +164,17 @@ std::vector<int> PenaltyContact::verticesWithin(const Eigen::VectorXd& displacem
         if (out.empty() || out.back() != v) out.push_back(v);
       },
       std::max(0.0, margin));
+  if (surfaces_) {
+    const std::vector<int> near = surfaces_->verticesWithin(0.0, displacement, margin);
+    std::vector<int> merged;
+    std::set_union(out.begin(), out.end(), near.begin(), near.end(), std::back_inserter(merged));
+    return merged;
+  }
   return out;
 }
 
 int PenaltyContact::activeContacts(const Eigen::VectorXd& displacement) const {
+  if (surfaces_) return static_cast<int>(verticesWithin(displacement, 0.0).size());
   int count = 0;
   int last = -1;
   forEachContact(displacement, nullptr, [&](int v, double, const Eigen::Vector3d&, double) {

@@ -30,7 +30,7 @@ void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen:
     if (!load.active(time)) continue;
     for (const int v : load.vertices) forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
   }
-  if (contact_) contact_->addForces(displacement, velocity, forces);
+  if (contact_) contact_->addForces(time, displacement, velocity, forces);
 }
 
 void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
@@ -47,7 +47,7 @@ void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen:
       if (*at == v) forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
     }
   }
-  if (contact_) contact_->addForces(displacement, velocity, forces, &vertices);
+  if (contact_) contact_->addForces(time, displacement, velocity, forces, &vertices);
 }
 
 std::vector<double> Loads::breakpoints() const {

@@ -168,7 +168,10 @@ DynamicSystem Problem::dynamicSystem() const {
     // Gravity is constant and contact depends on the state only; the windows open and
     // close at their bounds. A bound within a millionth of the interval of it counts as
     // inside, so that the snapping of bounds to step times never makes the answer wrong.
-    system.externalForceChanges = [breakpoints = external->breakpoints()](double from, double to) {
+    // A moving obstacle changes the force at any time.
+    const bool moving = contact_ && contact_->timeDependent();
+    system.externalForceChanges = [breakpoints = external->breakpoints(), moving](double from, double to) {
+      if (moving) return true;
       const double slack = 1e-6 * std::abs(to - from);
       const auto first = std::lower_bound(breakpoints.begin(), breakpoints.end(), from - slack);
       return first != breakpoints.end() && *first <= to + slack;
@@ -180,17 +183,17 @@ DynamicSystem Problem::dynamicSystem() const {
       vertices = contact->verticesWithin(displacement, margin);
     };
     // The loads' only state-dependent part is the penalty force, zero out of contact.
-    system.stateDependentOnlyInContact = true;
+    system.stateDependentOnlyInContact = !contact_->timeDependent();
     if (settings_.implicitContact) {
-      system.externalForceJacobian = [contact = contact_](double, const Eigen::VectorXd& displacement,
+      system.externalForceJacobian = [contact = contact_](double time, const Eigen::VectorXd& displacement,
                                                           const Eigen::VectorXd& velocity, VertexJacobian& jacobian) {
-        jacobian = contact->jacobian(displacement, velocity);
+        jacobian = contact->jacobian(time, displacement, velocity);
       };
-      system.externalForceJacobianAt = [contact = contact_](
-                                           double, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                                           const std::vector<int>& vertices, VertexJacobian& jacobian) {
-        jacobian = contact->jacobian(displacement, velocity, &vertices);
-      };
+      system.externalForceJacobianAt =
+          [contact = contact_](double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                               const std::vector<int>& vertices, VertexJacobian& jacobian) {
+            jacobian = contact->jacobian(time, displacement, velocity, &vertices);
+          };
     }
   }
   return system;

@@ -226,7 +226,7 @@ void RunMonitor::checkEnergy(const Integrator& integrator, long long frame) {
   const Eigen::VectorXd& u = integrator.displacement();
   const double mechanical = integrator.mechanicalEnergy();
   ++energyEvaluations_;
-  const double penalty = contact_ ? contact_->energy(u) : 0.0;
+  const double penalty = contact_ ? contact_->energy(integrator.time(), u) : 0.0;
   const double energy = mechanical + penalty - constantLoad_.dot(u);
   if (!haveFreeEnergy_) {
     haveFreeEnergy_ = true;

@@ -132,24 +132,12 @@ void parseBox(JsonObjectReader& reader, const std::string& source, BoxMeshSpec& 
 }
 
 void parseMesh(JsonObjectReader& top, Scene& scene) {
-  const std::string source = scene.sourceName;
-  JsonObjectReader reader(top.required("mesh"), "mesh", source);
-  const bool hasFile = reader.has("file");
-  const bool hasGenerator = reader.has("generator");
-  if (hasFile == hasGenerator) {
-    JsonObjectReader::failAt(source, "mesh", "give either \"file\" or \"generator\"");
+  if (const json* objects = top.find("objects")) {
+    if (top.has("mesh")) top.fail("mesh", "give either \"mesh\" (one body) or \"objects\" (several), not both");
+    detail::parseObjects(*objects, scene);
+    return;
   }
-  if (hasFile) {
-    scene.mesh.source = Scene::MeshSource::file;
-    scene.mesh.file = resolvePath(scene.baseDirectory, pathString(reader, "file"));
-  } else if (reader.choice("generator", "", {"beam", "box"}) == "beam") {
-    scene.mesh.source = Scene::MeshSource::beam;
-    parseBeam(reader, source, scene.mesh.beam);
-  } else {
-    scene.mesh.source = Scene::MeshSource::box;
-    parseBox(reader, source, scene.mesh.box);
-  }
-  reader.finish();
+  detail::parseMeshSection(top.required("mesh"), "mesh", scene, scene.mesh);
 }
 
 void parseMaterials(JsonObjectReader& top, Scene& scene) {
@@ -190,14 +178,47 @@ void parseFixed(JsonObjectReader& top, Scene& scene) {
   if (fixed == nullptr) {
     return;
   }
+  detail::parseFixedSection(*fixed, "fixed", scene, scene.fixed);
+}
+
+}  // namespace
+
+namespace detail {
+
+std::filesystem::path resolveScenePath(const Scene& scene, JsonObjectReader& reader, const std::string& key) {
+  return resolvePath(scene.baseDirectory, pathString(reader, key));
+}
+
+void parseMeshSection(const json& value, const std::string& path, const Scene& scene, Scene::Mesh& mesh) {
   const std::string& source = scene.sourceName;
-  JsonObjectReader reader(*fixed, "fixed", source);
+  JsonObjectReader reader(value, path, source);
+  const bool hasFile = reader.has("file");
+  const bool hasGenerator = reader.has("generator");
+  if (hasFile == hasGenerator) {
+    JsonObjectReader::failAt(source, path, "give either \"file\" or \"generator\"");
+  }
+  if (hasFile) {
+    mesh.source = Scene::MeshSource::file;
+    mesh.file = resolvePath(scene.baseDirectory, pathString(reader, "file"));
+  } else if (reader.choice("generator", "", {"beam", "box"}) == "beam") {
+    mesh.source = Scene::MeshSource::beam;
+    parseBeam(reader, source, mesh.beam);
+  } else {
+    mesh.source = Scene::MeshSource::box;
+    parseBox(reader, source, mesh.box);
+  }
+  reader.finish();
+}
+
+void parseFixedSection(const json& value, const std::string& path, const Scene& scene, Scene::Fixed& fixed) {
+  const std::string& source = scene.sourceName;
+  JsonObjectReader reader(value, path, source);
   if (const json* sets = reader.find("sets")) {
     if (!sets->is_array()) {
       reader.fail("sets", "expected an array of vertex set names");
     }
     for (std::size_t i = 0; i < sets->size(); ++i) {
-      scene.fixed.sets.push_back(JsonObjectReader::toString((*sets)[i], reader.elementPath("sets", i), source));
+      fixed.sets.push_back(JsonObjectReader::toString((*sets)[i], reader.elementPath("sets", i), source));
     }
   }
   if (const json* boxes = reader.find("boxes")) {
@@ -214,14 +235,18 @@ void parseFixed(JsonObjectReader& top, Scene& scene) {
       if ((box.min.array() > box.max.array()).any()) {
         JsonObjectReader::failAt(source, path, "expected min <= max in every coordinate");
       }
-      scene.fixed.boxes.push_back(box);
+      fixed.boxes.push_back(box);
     }
   }
   if (reader.has("bou")) {
-    scene.fixed.bouFile = resolvePath(scene.baseDirectory, pathString(reader, "bou"));
+    fixed.bouFile = resolvePath(scene.baseDirectory, pathString(reader, "bou"));
   }
   reader.finish();
 }
+
+}  // namespace detail
+
+namespace {
 
 // The vertices a force acts on: "set" or "vertices" (0-based ids).
 void parseForceTarget(JsonObjectReader& reader, const std::string& source, Scene::Force& force) {
@@ -401,6 +426,7 @@ void parseContact(JsonObjectReader& top, Scene& scene) {
   Scene::Contact& out = scene.contact;
   parseContactPlanes(reader, source, out);
   parseContactSpheres(reader, source, out);
+  detail::parseContactSurfaces(reader, scene);
   PenaltyContactParameters& p = out.parameters;
   p.stiffness = reader.number("stiffness", p.stiffness);
   requirePositive(reader, "stiffness", p.stiffness);
@@ -415,7 +441,7 @@ void parseContact(JsonObjectReader& top, Scene& scene) {
     reader.fail("implicit", "implicit contact is frictionless: set contact.friction to 0, or leave implicit out");
   }
   reader.finish();
-  if (!out.enabled()) reader.fail("ground", "contact needs a ground, planes or spheres");
+  if (!out.enabled()) reader.fail("ground", "contact needs a ground, planes, spheres, obstacles or surfaces");
 }
 
 void parseDamping(JsonObjectReader& top, Scene& scene) {

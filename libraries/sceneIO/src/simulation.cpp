@@ -4,6 +4,7 @@
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/multirateIntegrator.hpp>
+#include <asyncfem/sceneIO/sceneObjects.hpp>
 #include <asyncfem/sceneIO/simulation.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
@@ -31,6 +32,7 @@ std::vector<std::string> switchIntegrator(Scene& scene, const IntegratorRegistry
 namespace {
 
 TetMesh loadMesh(const Scene& scene, std::vector<std::string>* warnings) {
+  if (!scene.objects.empty()) return buildObjectsMesh(scene, warnings);
   switch (scene.mesh.source) {
     case Scene::MeshSource::beam:
       return makeBeamMesh(scene.mesh.beam);
@@ -298,11 +300,7 @@ std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std:
   std::vector<int> fixed = collectFixedVertices(scene, *mesh);
   std::vector<VertexLoad> loads = collectLoads(scene, *mesh, requireFrameTiming(scene).timestep);
   const ProblemSettings settings = problemSettings(scene);
-  std::shared_ptr<const PenaltyContact> contact;
-  if (scene.contact.enabled()) {
-    contact = std::make_shared<PenaltyContact>(mesh->restPositions(), scene.contact.planes, scene.contact.spheres,
-                                               scene.contact.parameters);
-  }
+  std::shared_ptr<const PenaltyContact> contact = buildSceneContact(scene, *mesh);
   return std::make_shared<const Problem>(mesh, std::move(fixed), settings, std::move(loads), std::move(contact));
 }
 
@@ -420,6 +418,7 @@ Simulation buildSimulation(const Scene& scene, const IntegratorRegistry& registr
     throw TimestepError(error.what() + stableStepsPerFrameAdvice(scene, registry, context, simulation.timing));
   }
   requireMultirateForRegionOutput(scene, *simulation.integrator);
+  applyInitialVelocities(scene, simulation);
   simulation.monitor.emplace(problem);
   for (const std::string& item : simulation.monitor->skipped()) simulation.skipped.push_back(item);
   return simulation;

@@ -33,7 +33,7 @@ std::string point(const Eigen::Vector3d& x) {
 
 }  // namespace
 
-TriangleSurface boundarySurface(const TetMesh& mesh) {
+TriangleSurface boundaryTriangleSurface(const TetMesh& mesh) {
   const auto triangles = boundaryTriangles(mesh);
   TriangleSurface surface;
   surface.vertices = mesh.restPositions();
@@ -48,7 +48,7 @@ TriangleSurface boundarySurface(const TetMesh& mesh) {
 
 SurfaceDeviation surfaceDeviation(const TetMesh& mesh, const SignedDistance& distance) {
   SurfaceDeviation deviation;
-  const TriangleSurface boundary = boundarySurface(mesh);
+  const TriangleSurface boundary = boundaryTriangleSurface(mesh);
   if (boundary.numTriangles() == 0) throw ValidationError("surfaceDeviation: the mesh has no boundary");
   forEachSample(boundary, [&](const Eigen::Vector3d& x, int) {
     const double d = distance.distance(x);
@@ -71,7 +71,7 @@ SurfaceDeviation surfaceDeviation(const TetMesh& mesh, const SignedDistance& dis
 
 double implicitDeviation(const TetMesh& mesh, const ImplicitFunction& f, Eigen::Vector3d* where) {
   double worst = 0.0;
-  forEachSample(boundarySurface(mesh), [&](const Eigen::Vector3d& x, int) {
+  forEachSample(boundaryTriangleSurface(mesh), [&](const Eigen::Vector3d& x, int) {
     const double d = std::abs(f(x));
     if (d > worst) {
       worst = d;
@@ -83,7 +83,7 @@ double implicitDeviation(const TetMesh& mesh, const ImplicitFunction& f, Eigen::
 
 double requireRepairableHoles(const TetMesh& mesh, const SignedDistance& distance, double spacing, double maxFraction,
                               const std::string& source) {
-  const TriangleSurface boundary = boundarySurface(mesh);
+  const TriangleSurface boundary = boundaryTriangleSurface(mesh);
   double total = 0.0, invented = 0.0, farthest = 0.0;
   Eigen::Vector3d farthestAt = Eigen::Vector3d::Zero();
   for (int t = 0; t < boundary.numTriangles(); ++t) {

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <asyncfem/core/vertexJacobian.hpp>
+#include <memory>
 #include <vector>
 
 namespace asyncfem {
@@ -49,12 +50,28 @@ struct PenaltyContactParameters {
 /// (linearized at that state).
 using PenaltyContactJacobian = VertexJacobian;
 
+class SurfaceContact;
+
 class PenaltyContact {
  public:
   /// restPositions: 3 x n. Throws asyncfem::ValidationError for a non-positive stiffness,
   /// negative damping/friction, a zero plane normal or a non-positive sphere radius.
+  /// surfaces: contact between the mesh's boundary surfaces and triangle-mesh obstacles
+  /// (SurfaceContact), added to every query below; null: planes and spheres only.
   PenaltyContact(Eigen::Matrix3Xd restPositions, std::vector<ContactPlane> planes, std::vector<ContactSphere> spheres,
-                 PenaltyContactParameters parameters);
+                 PenaltyContactParameters parameters, std::shared_ptr<const SurfaceContact> surfaces = nullptr);
+
+  /// The queries below at time t: moving obstacles (SurfaceContact) are where their paths
+  /// put them then; the overloads without a time evaluate at t = 0.
+  void addForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                 Eigen::VectorXd& forces, const std::vector<int>* vertices = nullptr) const;
+  PenaltyContactJacobian jacobian(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                  const std::vector<int>* vertices = nullptr) const;
+  double energy(double time, const Eigen::VectorXd& displacement) const;
+  /// Whether the force at a fixed state changes with time (a moving obstacle).
+  bool timeDependent() const;
+  /// The surface contact, or null.
+  const std::shared_ptr<const SurfaceContact>& surfaces() const { return surfaces_; }
 
   /// Adds the contact forces at state (u, v) (both 3n) to forces (3n). Only vertices in
   /// `vertices` are tested when it is non-null (e.g. a fast region's vertices).
@@ -97,6 +114,7 @@ class PenaltyContact {
   std::vector<ContactPlane> planes_;
   std::vector<ContactSphere> spheres_;
   PenaltyContactParameters parameters_;
+  std::shared_ptr<const SurfaceContact> surfaces_;
 };
 
 }  // namespace asyncfem

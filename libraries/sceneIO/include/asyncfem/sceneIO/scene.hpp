@@ -2,6 +2,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <asyncfem/collision/broadPhase.hpp>
+#include <asyncfem/contact/meshObstacle.hpp>
 #include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/hyperelasticFEM/hyperelasticOptions.hpp>
 #include <asyncfem/problem/problem.hpp>
@@ -77,6 +80,28 @@ struct Scene {
     std::optional<std::filesystem::path> bouFile;
   };
 
+  /// A rigid placement of an object or obstacle: x -> translation + rotation (scale x).
+  struct Placement {
+    Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();  ///< {"axis": [x, y, z], "angle": degrees}
+    double scale = 1.0;                                            ///< uniform, > 0
+    Eigen::Vector3d apply(const Eigen::Vector3d& x) const { return translation + rotation * (scale * x); }
+  };
+
+  /// One body of a scene of several (objects, docs/scene-format.md): its mesh is placed,
+  /// and the bodies are simulated as one mesh of disconnected parts, in which the object's
+  /// name is a vertex set and an element set, and its own sets are "<name>/<set>".
+  struct Object {
+    std::string name;
+    Mesh mesh;
+    /// The object's fixed vertices: its own sets, boxes in its mesh's coordinates (before
+    /// the placement), a .bou file of its ids; in the scene's mesh the vertex set
+    /// "<name>/fixed", which parseScene adds to fixed.sets.
+    Fixed fixed;
+    Placement placement;
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< initial velocity (length / time)
+  };
+
   enum class ForceType {
     pull,     ///< constant total force, split evenly over the vertices, during a window
     impulse,  ///< total impulse (force x time), split evenly, delivered within one step
@@ -104,7 +129,9 @@ struct Scene {
   std::filesystem::path baseDirectory;
   std::string description;
 
-  Mesh mesh;
+  Mesh mesh;  ///< unused when objects is not empty
+  /// Several bodies (objects) instead of mesh; empty: the scene's one body is mesh.
+  std::vector<Object> objects;
   std::vector<MaterialOverride> materials;
   Fixed fixed;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< acceleration, length / time^2
@@ -118,9 +145,29 @@ struct Scene {
     std::vector<ContactPlane> planes;    ///< the ground is one of them
     std::optional<ContactPlane> ground;  ///< contact.ground when given (also in planes), for renderers
     std::vector<ContactSphere> spheres;
+    /// A triangle-mesh obstacle (contact.obstacles[i]): a surface file read with assimp,
+    /// placed, and moved along path when it has keys.
+    struct Obstacle {
+      std::string name;
+      std::filesystem::path file;
+      bool closed = true;  ///< must be a closed, consistently oriented surface (inside known)
+      Placement placement;
+      std::vector<RigidKey> path;  ///< empty: static; else at least two keys
+    };
+    std::vector<Obstacle> obstacles;
+    /// contact.surfaces: contact between the bodies' boundary surfaces and the obstacles
+    /// (SurfaceContact); on when given or when there are obstacles.
+    struct Surfaces {
+      std::optional<double> thickness;  ///< dhat; default 0.2 x the mean boundary edge length
+      bool betweenBodies = true;
+      bool self = false;
+      bool edges = true;
+      BroadPhaseMethod broadPhase = kDefaultBroadPhase;
+    };
+    std::optional<Surfaces> surfaces;
     PenaltyContactParameters parameters;
     bool implicit = false;  ///< contact.implicit: linearized in the step (single-rate backward Euler)
-    bool enabled() const { return !planes.empty() || !spheres.empty(); }
+    bool enabled() const { return !planes.empty() || !spheres.empty() || surfaces.has_value(); }
   } contact;
   Tangent tangent = Tangent::simple;  ///< corotational only
   /// Hyperelastic kinds only: inversion threshold, compression resistance, SPD tangent,

@@ -30,7 +30,7 @@ SurfaceDeviation surfaceDeviation(const TetMesh& mesh, const SignedDistance& dis
 double implicitDeviation(const TetMesh& mesh, const ImplicitFunction& f, Eigen::Vector3d* where = nullptr);
 
 /// The surface made of the mesh's boundary triangles (outward), one part "boundary".
-TriangleSurface boundarySurface(const TetMesh& mesh);
+TriangleSurface boundaryTriangleSurface(const TetMesh& mesh);
 
 /// Throws a ValidationError when the mesh was built from an open surface through the winding
 /// number and had to invent too much of its boundary: more than maxFraction of the boundary
