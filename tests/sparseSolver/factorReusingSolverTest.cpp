@@ -294,6 +294,50 @@ TEST(FactorReusingSolver, DefaultFactorCostOfADenseFactorIsNOver36) {
   }
 }
 
+// A solver restored from another's rule state and the matrix of its kept factor continues
+// exactly as that one does: the same solutions bit for bit, the same refactorizations.
+TEST(FactorReusingSolver, RestoredRuleStateContinuesBitForBit) {
+  std::vector<SparseMatrix> matrices;
+  for (int k = 0; k < 24; ++k) matrices.push_back(driftingMatrix(6, 0.02 * k));
+  FactorReusingSolver whole;
+  std::vector<FactorReuseRuleState> states;
+  std::vector<int> factored;  // the matrix of the factor kept after each solve
+  std::vector<Eigen::VectorXd> solutions;
+  int lastFactored = -1;
+  for (int k = 0; k < 24; ++k) {
+    const long long before = whole.stats().refactorizations;
+    whole.setMatrix(matrices[static_cast<std::size_t>(k)]);
+    Eigen::VectorXd x;
+    whole.solve(randomVector(matrices[0].rows(), static_cast<unsigned>(k)), x);
+    if (whole.stats().refactorizations != before) lastFactored = k;
+    states.push_back(whole.ruleState());
+    factored.push_back(lastFactored);
+    solutions.push_back(x);
+  }
+  EXPECT_GT(whole.stats().pcgIterations, 0);
+  EXPECT_GT(whole.stats().refactorizations, 1);
+  for (int k = 0; k + 1 < 24; ++k) {
+    const FactorReuseRuleState& state = states[static_cast<std::size_t>(k)];
+    FactorReusingSolver resumed;
+    const bool needsMatrix = state.hasFactor && !state.refactorPending;
+    SparseMatrix kept = matrices[static_cast<std::size_t>(factored[static_cast<std::size_t>(k)])];
+    resumed.restoreRuleState(state, needsMatrix ? &kept : nullptr);
+    EXPECT_EQ(resumed.stats().refactorizations, needsMatrix ? 1 : 0);
+    for (int j = k + 1; j < 24; ++j) {
+      resumed.setMatrix(matrices[static_cast<std::size_t>(j)]);
+      Eigen::VectorXd x;
+      resumed.solve(randomVector(matrices[0].rows(), static_cast<unsigned>(j)), x);
+      ASSERT_TRUE(x == solutions[static_cast<std::size_t>(j)]) << "restored after solve " << k << ", solve " << j;
+    }
+  }
+  FactorReusingSolver refused;
+  FactorReuseRuleState state = states.back();
+  state.refactorPending = false;
+  EXPECT_THROW(refused.restoreRuleState(state, nullptr), Error);
+  state.cycleSolves = -1;
+  EXPECT_THROW(refused.restoreRuleState(state, &matrices[0]), Error);
+}
+
 TEST(FactorReusingSolver, MisuseIsReportedClearly) {
   EXPECT_THROW(FactorReusingSolver(SolverKind::cholmod, FactorReuseOptions{1.5, 10, 8, 3.0, 0.0, true}), Error);
   EXPECT_THROW(FactorReusingSolver(SolverKind::cholmod, FactorReuseOptions{1e-8, 0, 8, 3.0, 0.0, true}), Error);

@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/simulationIO/checkpoint.hpp>
+#include <asyncfem/simulationIO/crc32.hpp>
 #include <asyncfem/simulationIO/simulationFile.hpp>
+#include <cctype>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -514,10 +516,11 @@ TEST_F(OfflineSimulatorTest, ResumedRunIsBitIdenticalForEveryIntegrator) {
 }
 
 TEST_F(OfflineSimulatorTest, ResumeWithTheKeptFactorIsBitIdentical) {
-  // reuseFactor (the default for nonlinear models) keeps a factor across steps as PCG
-  // preconditioner, but drops it at every frame start (Integrator::restartPoint()), so a
-  // run resumed at a checkpoint continues bit for bit, with no "resume:" caveat. The run
-  // must really reuse (PCG iterations reported), or the comparison would not cover it.
+  // reuseFactor (the default for nonlinear models) keeps a factor across steps and frames
+  // as PCG preconditioner; the checkpoint holds what rebuilds it (BackwardEuler::
+  // internalState()), so a run resumed at a checkpoint continues bit for bit, with no
+  // "resume:" caveat. The run must really reuse (PCG iterations reported), or the
+  // comparison would not cover it.
   auto json = smallScene();
   json["mesh"]["cells"] = {6, 2, 2};
   json["forceModel"] = {{"type", "corotational"}};
@@ -541,6 +544,93 @@ TEST_F(OfflineSimulatorTest, ResumeWithTheKeptFactorIsBitIdentical) {
     EXPECT_EQ(resumed.out.find("resume:"), std::string::npos) << resumed.out;
     expectSameAsUninterrupted(scene, 10, output);
   }
+}
+
+// The number in the summary line "... N factorizations in M steps ..." (the kept factor's
+// report) and in "(N factorizations in the run)"; -1 when missing.
+long long countBefore(const std::string& text, const std::string& after) {
+  const std::size_t end = text.find(after);
+  if (end == std::string::npos || end == 0) return -1;
+  std::size_t start = end;
+  while (start > 0 && std::isdigit(static_cast<unsigned char>(text[start - 1])) != 0) --start;
+  return start == end ? -1 : std::stoll(text.substr(start, end - start));
+}
+
+TEST_F(OfflineSimulatorTest, KeptFactorLivesAcrossFramesOfOneStepAndResumesBitIdentically) {
+  // One step per frame, as graphics scenes at 30 or 60 frames per second often are: the
+  // default nonlinear backward Euler keeps its factor from frame to frame (it once
+  // refactored at every frame start, so that a resumed run would be bit-identical: as many
+  // factorizations as frames). Now it factors fewer times than it has frames, and a run
+  // resumed from any frame's checkpoint (every frame's, and a killed run's) still writes
+  // exactly the uninterrupted run's bytes.
+  auto json = smallScene();
+  json["mesh"]["cells"] = {6, 2, 2};
+  json["forceModel"] = {{"type", "corotational"}, {"tangent", "exact"}};
+  json["forces"][0]["force"] = {0, -2000, 0};
+  json["forces"][0]["window"] = {0, 0.08};
+  json["frames"] = {{"rate", 100}, {"count", 24}};  // h = 0.01: one step per frame
+  json["output"]["velocities"] = true;
+  const fs::path scene = writeScene(json, "oneStep.json");
+  const fs::path output = folder_ / "oneStep.afsim";
+  const RunResult whole = run(quoted(scene) + " --output " + quoted(output));
+  ASSERT_EQ(whole.exitCode, 0) << whole.err;
+  EXPECT_NE(whole.out.find("24 steps of h = 0.01 (1 per frame)"), std::string::npos) << whole.out;
+  const long long factorizations = countBefore(whole.out, " factorizations in 24 steps");
+  EXPECT_GE(factorizations, 1) << whole.out;
+  EXPECT_LT(factorizations, 24) << whole.out;
+  EXPECT_EQ(countBefore(whole.out, " factorizations in the run)"), factorizations) << whole.out;
+  EXPECT_EQ(whole.out.find(" 0 PCG iterations per step"), std::string::npos) << whole.out;
+  for (const int stopAt : {5, 11, 16}) {
+    SCOPED_TRACE("stopped after frame " + std::to_string(stopAt));
+    const RunResult first = run(quoted(scene) + " --quiet --checkpoint-every 1 --frames " + std::to_string(stopAt) +
+                                " --output " + quoted(output));
+    ASSERT_EQ(first.exitCode, 0) << first.err;
+    const RunResult resumed = run(quoted(scene) + " --resume --output " + quoted(output));
+    ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+    EXPECT_EQ(resumed.out.find("resume:"), std::string::npos) << resumed.out;
+    // The resumed run factors the kept factor's matrix once, and no more than it needs.
+    EXPECT_LT(countBefore(resumed.out, " factorizations in the run)"), 24 - stopAt) << resumed.out;
+    expectSameAsUninterrupted(scene, 24, output);
+  }
+}
+
+TEST_F(OfflineSimulatorTest, VersionTwoCheckpointOfTheKeptFactorStillResumesAndSaysHow) {
+  // A checkpoint written before format version 3 holds no kept-factor state (that run
+  // refactored at every frame start): the resume refactors at its first step, prints a
+  // "resume:" caveat and stays within the PCG tolerance's reach of the uninterrupted run.
+  auto json = smallScene();
+  json["mesh"]["cells"] = {6, 2, 2};
+  json["forceModel"] = {{"type", "corotational"}};
+  json["forces"][0]["force"] = {0, -2000, 0};
+  json["frames"] = {{"rate", 100}, {"count", 12}};
+  const fs::path scene = writeScene(json, "versionTwo.json");
+  const fs::path output = folder_ / "versionTwo.afsim";
+  ASSERT_EQ(run(quoted(scene) + " --quiet --frames 5 --output " + quoted(output)).exitCode, 0);
+  // The same checkpoint as version 2 wrote it: no internal state, version field 2.
+  const fs::path checkpointFile = asyncfem::checkpointPathFor(output);
+  asyncfem::SimulationCheckpoint checkpoint = asyncfem::readCheckpoint(checkpointFile);
+  ASSERT_GT(checkpoint.internalState.size(), 0);
+  checkpoint.internalState.resize(0);
+  asyncfem::writeCheckpoint(checkpointFile, checkpoint);
+  std::string bytes = readText(checkpointFile);
+  bytes[8] = 2;
+  const auto putCrc = [&](std::size_t offset, std::size_t length) {
+    const std::uint32_t crc = asyncfem::crc32(bytes.data(), length);
+    for (std::size_t b = 0; b < 4; ++b) bytes[offset + b] = static_cast<char>((crc >> (8 * b)) & 0xffU);
+  };
+  putCrc(60, 60);
+  putCrc(bytes.size() - 8, bytes.size() - 8);
+  std::ofstream(checkpointFile, std::ios::binary) << bytes;
+  const RunResult resumed = run(quoted(scene) + " --resume --output " + quoted(output));
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.err;
+  EXPECT_NE(resumed.out.find("resume: the checkpoint holds no kept-factor state"), std::string::npos) << resumed.out;
+  const fs::path reference = folder_ / "versionTwoReference.afsim";
+  ASSERT_EQ(run(quoted(scene) + " --quiet --output " + quoted(reference)).exitCode, 0);
+  asyncfem::SimulationReader a(output);
+  asyncfem::SimulationReader b(reference);
+  ASSERT_EQ(a.numFrames(), 12);
+  const Eigen::VectorXd last = b.readFrame(11).displacement;
+  EXPECT_LT((a.readFrame(11).displacement - last).cwiseAbs().maxCoeff(), 1e-6 * last.cwiseAbs().maxCoeff());
 }
 
 TEST_F(OfflineSimulatorTest, SignalStopsAfterTheFrameAndTheRunResumesBitIdentically) {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "detail/freeSystem.hpp"
+#include "detail/keptFactor.hpp"
 #include "detail/lowRankContact.hpp"
 
 namespace asyncfem {
@@ -50,6 +51,7 @@ BackwardEuler::BackwardEuler(DynamicSystem system, double timestep, const Integr
     reuseOptions.factorCostInIterations = options_.pcgFactorCost;
     reuseOptions.singlePrecisionPreconditioner = options_.pcgSinglePrecision;
     reuse_ = std::make_unique<FactorReusingSolver>(options_.solver, reuseOptions);
+    keptRecord_ = std::make_unique<detail::KeptFactorRecord>();
   }
   {
     TimeInto timer(stats_.assemblySeconds);
@@ -82,17 +84,35 @@ void BackwardEuler::setTimestep(double timestep) {
 }
 
 void BackwardEuler::assembleSystemMatrix(bool withContact) {
-  const stepFormula::MatrixWeights weights =
-      stepFormula::backwardEuler::systemMatrix(timestep_, system_.rayleighMass, system_.rayleighStiffness);
-  free_->assemble({weights.mass, weights.stiffness}, {&free_->mass, &free_->stiffness}, stats_);
-  if (withContact) addContactBlocks();
+  static const VertexJacobian noContact;
+  assembleStepMatrix(timestep_, withContact ? contact_ : noContact);
+  if (keptRecord_) {
+    keptRecord_->assembledKind = detail::KeptMatrix::Kind::step;
+    keptRecord_->assembledWithContact = withContact;
+    keptRecord_->assembledDampingAtIterate = false;
+  }
 }
 
-void BackwardEuler::addContactBlocks() {
+void BackwardEuler::assembleStepMatrix(double h, const VertexJacobian& contact) {
+  const stepFormula::MatrixWeights weights =
+      stepFormula::backwardEuler::systemMatrix(h, system_.rayleighMass, system_.rayleighStiffness);
+  free_->assemble({weights.mass, weights.stiffness}, {&free_->mass, &free_->stiffness}, stats_);
+  addContactBlocks(h, contact);
+}
+
+void BackwardEuler::assembleNewtonMatrix(double h, const Eigen::SparseMatrix<double>& damping,
+                                         const VertexJacobian& contact) {
+  // J = (1 + h alpha) M + h beta K_D + h^2 K(u_{k+1}^{(i)}), K_D the damping stiffness
+  detail::FreeSystem& free = *free_;
+  free.assemble({1.0 + (h * system_.rayleighMass), h * system_.rayleighStiffness, h * h},
+                {&free.mass, &damping, &free.iterateStiffness}, stats_);
+  addContactBlocks(h, contact);
+}
+
+void BackwardEuler::addContactBlocks(double h, const VertexJacobian& contact) {
   // The contact force linearized at its last evaluation (the prediction or an iterate):
   // f ~ f_i - (h K_c + C_c) (dv - dv_i), so the step's matrix gains h^2 K_c + h C_c.
-  const double h = timestep_;
-  if (!contact_.empty()) free_->addVertexBlocks(system_.freeDofs, contact_, h * h, h, stats_);
+  if (!contact.empty()) free_->addVertexBlocks(system_.freeDofs, contact, h * h, h, stats_);
 }
 
 void BackwardEuler::assembleAndFactor() {
@@ -104,13 +124,16 @@ void BackwardEuler::assembleAndFactor() {
 
 const FactorReuseStats* BackwardEuler::factorReuseStats() const { return reuse_ ? &reuse_->stats() : nullptr; }
 
-void BackwardEuler::restartPoint() {
-  if (reuse_) reuse_->requestRefactorization();
-}
-
 RunReport BackwardEuler::report() const {
   RunReport report;
   report.factorNonZeros = free_->solver().stats().factorNonZeros;
+  if (keptRecord_ && keptRecord_->restoredWithoutState) {
+    std::ostringstream caveat;
+    caveat << "the checkpoint holds no kept-factor state (written before checkpoint format version 3), so the resumed "
+              "run factors at its first step; its frames match an uninterrupted run to about the PCG tolerance ("
+           << options_.pcgTolerance << "), not bit for bit";
+    report.resumeCaveat = caveat.str();
+  }
   if (implicitExternal_) {
     std::ostringstream text;
     text << "implicit contact: " << contactSteps_ << " of " << stats_.steps
@@ -137,7 +160,8 @@ RunReport BackwardEuler::report() const {
          << (reuse.singlePrecisionPreconditioner ? ", applied in single precision" : "")
          << "): " << reuse.refactorizations << " factorizations in " << stats_.steps << " steps, "
          << std::setprecision(3) << static_cast<double>(reuse.pcgIterations) / static_cast<double>(steps)
-         << " PCG iterations per step; refactored at every frame start, so a resumed run continues bit for bit";
+         << " PCG iterations per step; the kept factor's state goes into checkpoints, so a resumed run continues "
+            "bit for bit";
   }
   report.lines.push_back(text.str());
   return report;
@@ -157,6 +181,7 @@ void BackwardEuler::updateReusedMatrix() {
     free_->rethrowWithMeshDof(error);
   }
   stats_.factorizations += reuse_->stats().refactorizations - before;
+  if (reuse_->stats().refactorizations != before) recordKeptMatrix();
 }
 
 void BackwardEuler::solveWithReuse(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
@@ -173,6 +198,7 @@ void BackwardEuler::solveWithReuse(const Eigen::VectorXd& rhs, Eigen::VectorXd& 
     }
   }
   stats_.factorizations += reuse_->stats().refactorizations - before;
+  if (reuse_->stats().refactorizations != before) recordKeptMatrix();  // PCG gave up: the matrix was factored
   ++stats_.solvedRightHandSides;
 }
 
@@ -498,12 +524,13 @@ int BackwardEuler::newtonIterations(double rhsNorm, Eigen::VectorXd& internal) {
 
 void BackwardEuler::solveNewtonCorrection(const Eigen::SparseMatrix<double>& dampingStiffness,
                                           const Eigen::VectorXd& residual, Eigen::VectorXd& correction) {
-  // J = (1 + h alpha) M + h beta K_D + h^2 K(u_{k+1}^{(i)}), K_D the damping stiffness
-  const double h = timestep_;
   detail::FreeSystem& free = *free_;
-  free.assemble({1.0 + (h * system_.rayleighMass), h * system_.rayleighStiffness, h * h},
-                {&free.mass, &dampingStiffness, &free.iterateStiffness}, stats_);
-  addContactBlocks();
+  assembleNewtonMatrix(timestep_, dampingStiffness, contact_);
+  if (keptRecord_) {
+    keptRecord_->assembledKind = detail::KeptMatrix::Kind::newton;
+    keptRecord_->assembledWithContact = true;
+    keptRecord_->assembledDampingAtIterate = &dampingStiffness == &free.iterateStiffness;
+  }
   if (reuse_) {
     updateReusedMatrix();
     solveWithReuse(-residual, correction);

@@ -150,8 +150,11 @@ void checkCheckpointHeader(const unsigned char* data, std::size_t size, const st
     throw ParseError(name, 0, "not an AsyncFEM checkpoint (bad magic)");
   }
   const std::uint32_t version = detail::getU32(data + offsetVersion);
-  if (version != 1 && version != checkpointFileVersion) {  // version 1: no monitor state
-    throw ParseError(name, 0, "unsupported checkpoint version " + std::to_string(version));
+  // Version 1: no monitor state; 1 and 2: no kept-factor state (the same layout as 3).
+  if (version < 1 || version > checkpointFileVersion) {
+    throw ParseError(name, 0,
+                     "unsupported checkpoint version " + std::to_string(version) + " (this build reads versions 1 to " +
+                         std::to_string(checkpointFileVersion) + "; it was written by a newer AsyncFEM)");
   }
   if (detail::getU32(data + offsetHeaderBytes) != headerBytes) {
     throw ParseError(name, 0, "checkpoint header size is not 64");
@@ -188,7 +191,9 @@ CheckpointCounts checkedCounts(const unsigned char* data, std::size_t size, cons
         "checkpoint integrator name has " + std::to_string(counts.nameLength) + " characters (expected 1 to 64)");
   }
   const std::uint64_t limit = 3 * static_cast<std::uint64_t>(maxSimulationFileVertices);
-  if (counts.numDofs > limit || counts.numDofs % 3 != 0 || counts.internal > 4 * limit ||
+  // The internal state: at most a few vectors of the state's size (backward Euler's kept
+  // factor: dv, two displacements and the contact blocks of every vertex).
+  if (counts.numDofs > limit || counts.numDofs % 3 != 0 || counts.internal > 16 * limit ||
       counts.monitor > maxMonitorState) {
     throw ParseError(name, 0,
                      "checkpoint claims " + std::to_string(counts.numDofs) + " state entries, " +

@@ -125,7 +125,7 @@ FactorReusingSolver::FactorReusingSolver(SolverKind direct, const FactorReuseOpt
 
 FactorReusingSolver::~FactorReusingSolver() = default;  // where SinglePrecisionFactor is complete
 
-void FactorReusingSolver::setMatrix(const Eigen::SparseMatrix<double>& matrix) {
+void FactorReusingSolver::analyseIfNeeded(const Eigen::SparseMatrix<double>& matrix) {
   // A new size or entry count needs a new analysis; a pattern changed in place with the
   // same counts is caught by the direct solver's own check at the next factorization.
   const bool samePattern =
@@ -137,12 +137,47 @@ void FactorReusingSolver::setMatrix(const Eigen::SparseMatrix<double>& matrix) {
     analysed_ = true;
     refactorPending_ = true;
   }
+}
+
+void FactorReusingSolver::setMatrix(const Eigen::SparseMatrix<double>& matrix) {
+  analyseIfNeeded(matrix);
   if (refactorPending_) refactor();
+}
+
+FactorReuseRuleState FactorReusingSolver::ruleState() const {
+  FactorReuseRuleState state;
+  state.hasFactor = hasFactor_;
+  state.refactorPending = refactorPending_;
+  state.firstStaleIterations = firstStaleIterations_;
+  state.cycleCost = cycleCost_;
+  state.cycleSolves = cycleSolves_;
+  return state;
+}
+
+void FactorReusingSolver::restoreRuleState(const FactorReuseRuleState& state,
+                                           const Eigen::SparseMatrix<double>* keptMatrix) {
+  if (state.firstStaleIterations < 0 || state.cycleSolves < 0 || !(state.cycleCost >= 0.0) ||
+      !std::isfinite(state.cycleCost)) {
+    throw Error("FactorReusingSolver::restoreRuleState: counters out of range");
+  }
+  const bool needsFactor = state.hasFactor && !state.refactorPending;
+  if (needsFactor) {
+    if (keptMatrix == nullptr)
+      throw Error("FactorReusingSolver::restoreRuleState: the kept factor's matrix is missing");
+    analyseIfNeeded(*keptMatrix);
+    refactor();
+  }
+  factorIsCurrent_ = false;
+  refactorPending_ = !needsFactor;
+  firstStaleIterations_ = state.firstStaleIterations;
+  cycleCost_ = state.cycleCost;
+  cycleSolves_ = state.cycleSolves;
 }
 
 void FactorReusingSolver::refactor() {
   direct_->factorize(*matrix_);
   ++stats_.refactorizations;
+  hasFactor_ = true;
   copySinglePrecisionFactor();
   factorIsCurrent_ = true;
   refactorPending_ = false;

@@ -12,6 +12,8 @@ namespace asyncfem {
 namespace detail {
 class FreeSystem;
 class LowRankContactSolver;
+struct KeptFactorRecord;
+struct KeptMatrix;
 }  // namespace detail
 
 /// Implicit backward Euler on the free DOFs (paper Eq. 5; shared design note, section
@@ -85,9 +87,12 @@ class LowRankContactSolver;
 /// options.reuseFactor (nonlinear models, the default): the system matrix is still
 /// assembled at every step, but solved by a FactorReusingSolver: PCG to
 /// options.pcgTolerance preconditioned by the last numeric factor, refactoring when the
-/// iteration count says the factor is stale and at every restartPoint() (so a run resumed
-/// at a frame start continues bit for bit). Its counters are factorReuseStats();
-/// refactorizations are also counted in stats().factorizations.
+/// iteration count says the factor is stale. The kept factor outlives frames: what it
+/// depends on is internalState() (how its matrix was assembled: the displacements of its
+/// tangents, its timestep and contact blocks; the reuse rule's counters; the last solution,
+/// where the next PCG starts), so a run resumed from a checkpoint factors that matrix once
+/// and continues bit for bit. Its counters are factorReuseStats(); refactorizations are
+/// also counted in stats().factorizations.
 class BackwardEuler final : public Integrator {
  public:
   /// system: validated; h > 0. Factors at once for linear force models.
@@ -97,9 +102,16 @@ class BackwardEuler final : public Integrator {
   std::string name() const override { return "backward-euler"; }
   void step() override;
   void setTimestep(double timestep) override;
-  /// With a kept factor (reuseFactor): the next step factors its own matrix, so it and the
-  /// steps after it do not depend on the matrices of earlier steps.
-  void restartPoint() override;
+  /// With a kept factor (reuseFactor; empty otherwise): the reuse rule's state, how the
+  /// kept factor's matrix was assembled and the last step's dv (detail/keptFactor.hpp has
+  /// the layout), so that setInternalState() continues bit for bit.
+  Eigen::VectorXd internalState() const override;
+  /// Restores internalState(): factors the kept factor's matrix again, rebuilt from the
+  /// displacements, timestep and contact blocks it was assembled from. An empty vector (a
+  /// checkpoint written before format version 3) refactors at the next step instead, and
+  /// report().resumeCaveat says so. Throws asyncfem::Error for a vector that is not such a
+  /// state of this integrator.
+  void setInternalState(const Eigen::VectorXd& state) override;
 
   const IntegratorOptions& options() const { return options_; }
   /// Newton iterations (factorizations) used by the last step: 1 for the linearized step.
@@ -156,8 +168,17 @@ class BackwardEuler final : public Integrator {
   /// free_->systemMatrix = the step formula's (A1) combination of M and K, plus the
   /// implicit contact blocks of contact_ when withContact.
   void assembleSystemMatrix(bool withContact);
-  /// free_->systemMatrix += h^2 K_c + h C_c (contact_'s blocks).
-  void addContactBlocks();
+  /// free_->systemMatrix = w_M M + w_K free_->stiffness at timestep h, plus contact's blocks.
+  void assembleStepMatrix(double h, const VertexJacobian& contact);
+  /// free_->systemMatrix = (1 + h alpha) M + h beta damping + h^2 free_->iterateStiffness,
+  /// plus contact's blocks (a Newton iteration's J).
+  void assembleNewtonMatrix(double h, const Eigen::SparseMatrix<double>& damping, const VertexJacobian& contact);
+  /// free_->systemMatrix += h^2 K_c + h C_c (contact's blocks).
+  void addContactBlocks(double h, const VertexJacobian& contact);
+  /// The reuse solver just factored free_->systemMatrix: records how it was assembled.
+  void recordKeptMatrix();
+  /// free_->systemMatrix = the kept factor's matrix, assembled again as recorded.
+  void rebuildKeptMatrix(const detail::KeptMatrix& kept);
   /// force (free) = f_ext(t_{k+1}) at the full state (u, v), and contact_ = its Jacobian there.
   void evaluateImplicitExternalForce(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                                      Eigen::VectorXd& force);
@@ -174,7 +195,8 @@ class BackwardEuler final : public Integrator {
 
   IntegratorOptions options_;
   std::unique_ptr<detail::FreeSystem> free_;
-  std::unique_ptr<FactorReusingSolver> reuse_;  // options_.reuseFactor, nonlinear models only
+  std::unique_ptr<FactorReusingSolver> reuse_;            // options_.reuseFactor, nonlinear models only
+  std::unique_ptr<detail::KeptFactorRecord> keptRecord_;  // with reuse_: how its factor's matrix was assembled
   bool linear_ = false;
   bool factorizationStale_ = true;
   bool implicitExternal_ = false;                          // system_.externalForceJacobian is set

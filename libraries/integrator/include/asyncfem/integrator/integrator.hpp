@@ -80,10 +80,12 @@ class Integrator {
   /// (u, v, t) with setState() and then this with setInternalState() makes the following
   /// steps bit-identical to those of the integrator it was taken from. Factorizations
   /// and other quantities recomputed deterministically from (u, v, t) and h are not part
-  /// of it. Empty when there is nothing (the default; backward Euler, symplectic Euler,
-  /// the asynchronous integrator) or when the quantity is stale and would be recomputed
-  /// from (u, v, t) anyway; the trapezoidal rule returns its acceleration a_k (3n), central
-  /// differences its a_k on the free DOFs.
+  /// of it; a factor kept from earlier steps is, as what rebuilds it. Empty when there is
+  /// nothing (the default; backward Euler without a kept factor, symplectic Euler, the
+  /// asynchronous integrator) or when the quantity is stale and would be recomputed from
+  /// (u, v, t) anyway; the trapezoidal rule returns its acceleration a_k (3n), central
+  /// differences its a_k on the free DOFs, backward Euler with a kept factor
+  /// (IntegratorOptions::reuseFactor) the factor's state (BackwardEuler::internalState()).
   virtual Eigen::VectorXd internalState() const;
   /// Restores internalState(); call after setState(). An empty vector keeps the default
   /// (quantities derived from (u, v, t)). Throws asyncfem::Error if the size is not one
@@ -95,10 +97,11 @@ class Integrator {
   double timestep() const { return timestep_; }
   /// Marks a point a run may later be resumed from (drivers call it at the start of every
   /// frame, where checkpoints are taken): an integrator whose steps depend on history that
-  /// no checkpoint holds (backward Euler's kept factor with IntegratorOptions::reuseFactor)
-  /// lets go of it here, so the steps that follow depend only on (u, v, t) and
-  /// internalState(), and a run resumed at this point continues bit for bit. Default:
-  /// nothing.
+  /// neither (u, v, t) nor internalState() holds would let go of it here, so that a run
+  /// resumed at this point continues bit for bit. Letting go costs speed at every frame
+  /// (backward Euler once refactored here, at every frame: its kept factor is now in
+  /// internalState() instead), so integrators should rather put such history into
+  /// internalState(). Default: nothing.
   virtual void restartPoint() {}
 
   /// Changes h; implicit integrators refactor lazily at the next step.

@@ -43,9 +43,10 @@ struct IntegratorOptions {
   /// Backward Euler, nonlinear force models (the default): instead of refactoring the
   /// system matrix at every step, keep the last numeric factor as the preconditioner of a
   /// PCG solve to pcgTolerance (relative residual) and refactor when PCG needs more than
-  /// pcgRefactorIterations iterations or refactoring pays (FactorReusingSolver), and at
-  /// every Integrator::restartPoint() (each frame's start), so that a run resumed from a
-  /// checkpoint continues bit for bit. Trajectories stay within 1e-8 of the exact path's
+  /// pcgRefactorIterations iterations or refactoring pays (FactorReusingSolver); the kept
+  /// factor lives across frames, and its state is in checkpoints
+  /// (BackwardEuler::internalState()), so that a run resumed from a checkpoint continues
+  /// bit for bit. Trajectories stay within 1e-8 of the exact path's
   /// relative to the largest displacement (test DefaultSolvePath.*, docs/benchmarks.md,
   /// "The default linear-solve path"). false: the exact path, one factorization and
   /// back-substitution per linear solve (Vega FEM's trajectory to rounding).

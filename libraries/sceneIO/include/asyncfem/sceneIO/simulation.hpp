@@ -121,7 +121,9 @@ void describeRegionOutput(const Scene& scene, const Simulation& simulation, Simu
 void appendSimulationFrame(SimulationWriter& writer, const Simulation& simulation);
 
 /// Advances the simulation by one frame (stepsPerFrame steps) under its RunMonitor, the
-/// frame's start being a restart point of the integrator (Integrator::restartPoint()):
+/// frame's start being a restart point of the integrator (Integrator::restartPoint(), which
+/// no shipped integrator needs any more: kept factors live across frames, their state in
+/// checkpoints):
 /// throws asyncfem::NumericalError with the frame, step, time, vertex and region (as
 /// fields and in the message) for a non-finite state, a blow-up or energy growth. The
 /// state is then unusable; the caller must not store it.

@@ -14,7 +14,8 @@ namespace asyncfem {
 ///
 ///     offset  size  field
 ///          0     8  magic "AFEMCKP\0"
-///          8     4  format version (u32, currently 2; version 1 has no monitor state)
+///          8     4  format version (u32, currently 3; version 1 has no monitor state,
+///                   versions 1 and 2 no kept-factor state in backward Euler's internal state)
 ///         12     4  header size in bytes (u32, 64)
 ///         16     8  frames: finished frames, i.e. records 0 .. frames-1 of the output (i64)
 ///         24     8  simulated time t after those frames (f64)
@@ -42,8 +43,11 @@ struct SimulationCheckpoint {
   Eigen::VectorXd monitorState;
 };
 
-/// Current checkpoint format version.
-inline constexpr std::uint32_t checkpointFileVersion = 2;
+/// Current checkpoint format version. Version 3 has the layout of version 2; what changed
+/// is what backward Euler with a kept factor stores as its internal state (the factor's
+/// state, where version 2 had none: that run refactored at every frame). Versions 1 and 2
+/// are still read (such a backward Euler run then refactors at its first step and says so).
+inline constexpr std::uint32_t checkpointFileVersion = 3;
 
 /// The checkpoint that belongs to an output file: the output's path with ".checkpoint"
 /// appended ("run.afsim" -> "run.afsim.checkpoint").

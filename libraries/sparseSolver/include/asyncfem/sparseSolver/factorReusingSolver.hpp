@@ -64,6 +64,18 @@ struct FactorReuseStats {
   bool singlePrecisionPreconditioner = false;  ///< whether PCG runs on the single-precision copy (of the last factor)
 };
 
+/// What a FactorReusingSolver's refactorization rule carries from one solve to the next,
+/// besides the kept factor itself: with the matrix that factor was computed from, enough
+/// for another solver to continue exactly as this one would (checkpoints; ruleState(),
+/// restoreRuleState()).
+struct FactorReuseRuleState {
+  bool hasFactor = false;        ///< a factor is kept (false before the first factorization)
+  bool refactorPending = true;   ///< the next setMatrix() factors its matrix (the kept factor is not needed)
+  int firstStaleIterations = 0;  ///< PCG iterations of the first solve with the kept factor (0: none yet)
+  double cycleCost = 0.0;        ///< the factorization and the PCG iterations since it, in PCG iterations
+  long long cycleSolves = 0;     ///< solves since the last factorization
+};
+
 /// Solves a sequence of systems A_k x = b_k whose matrices (one sparsity pattern, SPD,
 /// e.g. the backward Euler matrices M + h D + h^2 K(u_k) of a corotational model) change
 /// slowly: the last numeric factorization of some earlier A_j is kept as the
@@ -101,6 +113,17 @@ class FactorReusingSolver {
   void solve(const Eigen::VectorXd& rhs, const Eigen::VectorXd& initialGuess, Eigen::VectorXd& solution);
   /// Makes the next setMatrix() factor its matrix.
   void requestRefactorization() { refactorPending_ = true; }
+  /// The rule's state between solves (call it between a solve and the next setMatrix()).
+  FactorReuseRuleState ruleState() const;
+  /// Continues as the solver that `state` was taken from: when that solver kept a factor
+  /// it still meant to use (hasFactor and not refactorPending), factors keptMatrix, the
+  /// matrix of that factor rebuilt bit for bit by the caller (it must stay alive until the
+  /// next setMatrix(), like setMatrix()'s argument; counted in stats().refactorizations),
+  /// then takes the rule's counters. The following setMatrix() and solve() calls then give
+  /// that solver's results bit for bit (same direct solver, threads and options). Throws
+  /// asyncfem::Error when keptMatrix is needed and null, or the counters are out of range;
+  /// NumericalError when the factorization fails.
+  void restoreRuleState(const FactorReuseRuleState& state, const Eigen::SparseMatrix<double>* keptMatrix);
 
   const FactorReuseOptions& options() const { return options_; }
   const FactorReuseStats& stats() const { return stats_; }
@@ -110,6 +133,8 @@ class FactorReusingSolver {
 
  private:
   void refactor();
+  /// Analyses matrix's pattern unless the last analysis was of one with its size and entry count.
+  void analyseIfNeeded(const Eigen::SparseMatrix<double>& matrix);
   void applyPreconditioner(const Eigen::VectorXd& rhs, Eigen::VectorXd& out);
   void solveExactly(const Eigen::VectorXd& rhs, Eigen::VectorXd& out);
   void copySinglePrecisionFactor();
@@ -122,6 +147,7 @@ class FactorReusingSolver {
   bool analysed_ = false;
   bool factorIsCurrent_ = false;  // the factor is that of matrix_'s current values
   bool refactorPending_ = true;
+  bool hasFactor_ = false;        // a numeric factorization was made
   int firstStaleIterations_ = 0;  // iterations of the first PCG solve with this factor
   double cycleCost_ = 0.0;        // factorization + iterations since it, in PCG iterations
   long long cycleSolves_ = 0;     // solves since the last factorization
