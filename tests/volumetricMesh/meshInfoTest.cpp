@@ -163,5 +163,36 @@ TEST(MeshInfo, WarningsGoToStderr) {
   EXPECT_NE(loud.output.find("meshInfo: warning: "), std::string::npos) << loud.output;
 }
 
+const std::string kCubes = std::string(ASYNCFEM_TEST_DATA_DIR) + "/volumetricMesh/cubes.veg";
+
+TEST(MeshInfo, HexahedralMeshQualityInJson) {
+  const RunResult r = runMeshInfo(quoted(kCubes) + " --json", false);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["elementKind"], "hexahedra");
+  EXPECT_EQ(j["elements"], 4);
+  EXPECT_EQ(j["boundaryTriangles"], 32);
+  // Exact cubes: every corner's scaled Jacobian is 1 up to a rounding of its terms.
+  EXPECT_NEAR(j["quality"]["scaledJacobian"]["min"].get<double>(), 1.0, 1e-15);
+  EXPECT_TRUE(j["quality"]["invertedElements"].empty());
+}
+
+TEST(MeshInfo, HexToTetsConvertsAndWrites) {
+  const test::ScratchDir dir;
+  const std::string out = (dir.path() / "tets.veg").string();
+  const RunResult r = runMeshInfo(quoted(kCubes) + " --hex-to-tets --write " + quoted(out));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("split 4 hexahedra into 24 tetrahedra"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("elements: 24\n"), std::string::npos) << r.output;
+  const TetMesh tets = readMesh(out);
+  EXPECT_FALSE(tets.isHexahedral());
+  EXPECT_EQ(tets.numElements(), 24);
+  EXPECT_EQ(tets.elementSet("right").size(), 12U);
+  // On a tetrahedral mesh the option is an error.
+  const RunResult again = runMeshInfo(quoted(out) + " --hex-to-tets");
+  EXPECT_EQ(again.exitCode, 1);
+  EXPECT_NE(again.output.find("holds tetrahedra already"), std::string::npos) << again.output;
+}
+
 }  // namespace
 }  // namespace asyncfem

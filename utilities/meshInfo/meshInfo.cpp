@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// meshInfo: reads (or generates) a tetrahedral mesh and prints what it contains.
+// meshInfo: reads (or generates) a tetrahedral or hexahedral mesh and prints what it contains.
 //
 //   meshInfo FILE [--json] [--write OUT.veg|OUT.vtu] [--rename-set OLD=NEW]... [--angle-threshold DEG]
-//            [--default-material rho,E,nu]
+//            [--default-material rho,E,nu] [--hex-to-tets]
 //   meshInfo --generate beam|box|antenna|snail [--cells N] [--json] [--write OUT]
 //
 // Text goes to stdout, reader warnings to stderr; errors print "meshInfo: <message>"
@@ -12,6 +12,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/threading.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/hexToTets.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
@@ -58,12 +59,22 @@ nlohmann::json describe(const TetMesh& mesh, const std::string& source, const as
   const asyncfem::BoundingBox box = asyncfem::boundingBox(mesh);
   j["boundingBox"] = {{"min", {box.min.x(), box.min.y(), box.min.z()}},
                       {"max", {box.max.x(), box.max.y(), box.max.z()}}};
-  const asyncfem::QualitySummary q = asyncfem::summarizeQuality(mesh, angleThreshold);
-  j["quality"] = {
-      {"dihedralAngleDegrees", {{"min", q.minDihedralDegrees}, {"max", q.maxDihedralDegrees}}},
-      {"meanElementMinDihedralAngleDegrees", q.meanMinDihedralDegrees},
-      {"elementsBelowAngle", {{"thresholdDegrees", q.thresholdDegrees}, {"count", q.elementsBelowThreshold}}},
-      {"worstAspectRatio", q.worstAspectRatio}};
+  if (mesh.isHexahedral()) {
+    j["elementKind"] = "hexahedra";
+    const asyncfem::HexahedronQualitySummary q = asyncfem::summarizeHexahedronQuality(mesh);
+    std::vector<int> inverted;  // numbered from 1, as .veg files number elements
+    for (int e : q.invertedElements) inverted.push_back(e + 1);
+    j["quality"] = {{"scaledJacobian", {{"min", q.minScaledJacobian}, {"meanElementMin", q.meanMinScaledJacobian}}},
+                    {"worstEdgeRatio", q.worstEdgeRatio},
+                    {"invertedElements", inverted}};
+  } else {
+    const asyncfem::QualitySummary q = asyncfem::summarizeQuality(mesh, angleThreshold);
+    j["quality"] = {
+        {"dihedralAngleDegrees", {{"min", q.minDihedralDegrees}, {"max", q.maxDihedralDegrees}}},
+        {"meanElementMinDihedralAngleDegrees", q.meanMinDihedralDegrees},
+        {"elementsBelowAngle", {{"thresholdDegrees", q.thresholdDegrees}, {"count", q.elementsBelowThreshold}}},
+        {"worstAspectRatio", q.worstAspectRatio}};
+  }
   j["reorientedElements"] = report.reorientedElements;
   j["unusedVertices"] = report.unusedVertices;
   j["ignoredElements"] = report.ignoredElements;
@@ -75,8 +86,9 @@ void printText(const nlohmann::json& j) {
   std::cout << "file: " << j["file"].get<std::string>() << '\n'
             << "format: " << j["format"].get<std::string>() << '\n'
             << "vertices: " << j["vertices"] << '\n'
-            << "elements: " << j["elements"] << '\n'
-            << "materials:\n";
+            << "elements: " << j["elements"] << '\n';
+  if (j.contains("elementKind")) std::cout << "element kind: " << j["elementKind"].get<std::string>() << '\n';
+  std::cout << "materials:\n";
   for (const auto& m : j["materials"]) {
     std::cout << "  " << m["name"].get<std::string>() << ": density " << m["density"] << ", E " << m["youngsModulus"]
               << ", nu " << m["poissonRatio"] << ", elements " << m["elements"] << '\n';
@@ -92,6 +104,19 @@ void printText(const nlohmann::json& j) {
             << "bounding box: [" << box["min"][0] << ", " << box["min"][1] << ", " << box["min"][2] << "] - ["
             << box["max"][0] << ", " << box["max"][1] << ", " << box["max"][2] << "]\n";
   const auto& quality = j["quality"];
+  if (j.contains("elementKind")) {
+    std::cout << "scaled Jacobian at the corners: min " << quality["scaledJacobian"]["min"]
+              << " (mean of each element's smallest " << quality["scaledJacobian"]["meanElementMin"] << ")\n"
+              << "worst edge ratio: " << quality["worstEdgeRatio"] << '\n'
+              << "inverted elements: " << quality["invertedElements"].size();
+    const auto& inverted = quality["invertedElements"];
+    constexpr std::size_t kNamed = 20;
+    for (std::size_t i = 0; i < std::min(inverted.size(), kNamed); ++i)
+      std::cout << (i == 0 ? " (" : ", ") << inverted[i];
+    if (inverted.size() > kNamed) std::cout << ", and " << inverted.size() - kNamed << " more";
+    std::cout << (inverted.empty() ? "" : ")") << '\n' << "reoriented elements: " << j["reorientedElements"] << '\n';
+    return;
+  }
   const auto& below = quality["elementsBelowAngle"];
   std::cout << "dihedral angles (degrees): min " << quality["dihedralAngleDegrees"]["min"] << ", max "
             << quality["dihedralAngleDegrees"]["max"] << " (mean of each element's smallest "
@@ -114,6 +139,7 @@ struct Options {
   std::vector<std::string> renames;     ///< OLD=NEW
   double angleThreshold = 10.0;         ///< degrees
   std::vector<double> defaultMaterial;  ///< rho, E, nu
+  bool hexToTets = false;
 };
 
 void addOptions(CLI::App& app, Options& options) {
@@ -148,6 +174,9 @@ void addOptions(CLI::App& app, Options& options) {
                  "*REGION), instead of the default density 1000, E 1e6, nu 0.45")
       ->delimiter(',')
       ->expected(3);
+  app.add_flag("--hex-to-tets", options.hexToTets,
+               "split every hexahedron into 6 tetrahedra (conforming across faces) before printing and writing, so "
+               "that any model runs on a cube mesh");
 }
 
 /// The two names of a --rename-set OLD=NEW.
@@ -211,7 +240,7 @@ TetMesh generateMesh(const Options& options, std::string& source) {
 
 int run(int argc, char** argv) {
   CLI::App app{
-      "Print the contents of a tetrahedral mesh (.veg, TetGen .node/.ele, Gmsh .msh), "
+      "Print the contents of a tetrahedral or hexahedral mesh (.veg, TetGen .node/.ele, Gmsh .msh), "
       "or generate a beam, box, antenna or snail mesh."};
   Options options;
   addOptions(app, options);
@@ -231,6 +260,12 @@ int run(int argc, char** argv) {
                                                        options.defaultMaterial[1], options.defaultMaterial[2]};
     }
     mesh = asyncfem::readMesh(options.input, readOptions, &report);
+  }
+  if (options.hexToTets) {
+    if (!mesh.isHexahedral()) throw asyncfem::Error("--hex-to-tets: " + source + " holds tetrahedra already");
+    report.warnings.push_back("split " + std::to_string(mesh.numElements()) + " hexahedra into " +
+                              std::to_string(6 * mesh.numElements()) + " tetrahedra (--hex-to-tets)");
+    mesh = asyncfem::hexahedraToTetrahedra(mesh);
   }
   for (const std::string& rename : options.renames) {
     const auto [from, to] = splitRename(rename);

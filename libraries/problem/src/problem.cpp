@@ -20,6 +20,7 @@ Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVert
       windows_(std::move(windows)),
       contact_(std::move(contact)) {
   if (!mesh_) throw ValidationError("problem: no mesh");
+  mesh_->requireTetrahedra("a simulation (the force models, integrators, contact and rendering)");
   if (settings_.implicitContact && contact_ && contact_->parameters().friction > 0.0) {
     std::ostringstream friction;
     friction << contact_->parameters().friction;

@@ -303,10 +303,16 @@ inline void forEachElementByColor(const ColoredChunkSchedule& schedule, const Co
   }
 }
 
+/// The mesh's tetrahedra; a hexahedral mesh is refused by name (hexElements assembles those).
+const Eigen::Matrix4Xi& tetrahedraToAssemble(const TetMesh& mesh) {
+  mesh.requireTetrahedra("MatrixAssembler (the tetrahedral stiffness, mass and force-model assembly)");
+  return mesh.elements();
+}
+
 }  // namespace
 
 MatrixAssembler::MatrixAssembler(const TetMesh& mesh)
-    : numDofs_(mesh.numDofs()), numElements_(mesh.numElements()), elements_(mesh.elements()) {
+    : numDofs_(mesh.numDofs()), numElements_(mesh.numElements()), elements_(tetrahedraToAssemble(mesh)) {
   const int numVertices = mesh.numVertices();
   {
     const CompressedRows incidences = vertexIncidences(elements_, numVertices);

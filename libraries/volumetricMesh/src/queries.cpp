@@ -2,6 +2,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/volumetricMesh/hexahedron.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <cmath>
 #include <limits>
@@ -11,6 +12,7 @@
 namespace asyncfem {
 
 double signedElementVolume(const TetMesh& mesh, int e) {
+  if (mesh.isHexahedral()) return hexahedron::signedVolume(mesh.hexahedronRestPositions(e));
   const Eigen::Matrix<double, 3, 4> x = mesh.elementRestPositions(e);
   Eigen::Matrix3d edges;
   edges << x.col(1) - x.col(0), x.col(2) - x.col(0), x.col(3) - x.col(0);
@@ -39,21 +41,29 @@ namespace {
 constexpr std::array<std::array<int, 3>, 4> kTetFaces{{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
 
 /// The (element, local face) pairs of the faces that belong to one element only, in
-/// element order.
+/// element order. Faces are the tetrahedra's triangles or the hexahedra's quadrilaterals
+/// (keyed by their sorted vertex ids; a triangle's key ends with INT_MAX).
 std::vector<std::pair<int, int>> unsharedFaces(const TetMesh& mesh) {
   struct Face {
-    std::array<int, 3> key;  // sorted vertex ids
+    std::array<int, 4> key;  // sorted vertex ids
     int element;
     int local;
   };
+  const bool hexahedra = mesh.isHexahedral();
+  const int facesPerElement = hexahedra ? 6 : 4;
+  const int cornersPerFace = hexahedra ? 4 : 3;
+  const auto connectivity = mesh.connectivity();
   std::vector<Face> faces;
-  faces.reserve(4 * static_cast<std::size_t>(mesh.numElements()));
+  faces.reserve(static_cast<std::size_t>(facesPerElement) * static_cast<std::size_t>(mesh.numElements()));
   for (int e = 0; e < mesh.numElements(); ++e) {
-    const Eigen::Vector4i t = mesh.element(e);
-    for (int f = 0; f < 4; ++f) {
-      std::array<int, 3> key{};
-      for (int a = 0; a < 3; ++a)
-        key[static_cast<std::size_t>(a)] = t[kTetFaces[static_cast<std::size_t>(f)][static_cast<std::size_t>(a)]];
+    for (int f = 0; f < facesPerElement; ++f) {
+      constexpr int kNone = std::numeric_limits<int>::max();
+      std::array<int, 4> key{kNone, kNone, kNone, kNone};
+      for (int a = 0; a < cornersPerFace; ++a) {
+        const int local = hexahedra ? hexahedron::kFaces[static_cast<std::size_t>(f)][static_cast<std::size_t>(a)]
+                                    : kTetFaces[static_cast<std::size_t>(f)][static_cast<std::size_t>(a)];
+        key[static_cast<std::size_t>(a)] = connectivity(local, e);
+      }
       std::sort(key.begin(), key.end());
       faces.push_back({key, e, f});
     }
@@ -77,6 +87,17 @@ std::vector<std::pair<int, int>> unsharedFaces(const TetMesh& mesh) {
 std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh) {
   const std::vector<std::pair<int, int>> boundary = unsharedFaces(mesh);
   std::vector<std::array<int, 3>> triangles;
+  if (mesh.isHexahedral()) {
+    // Readers keep hexahedra positively oriented; each quadrilateral a b c d gives a b c and a c d.
+    triangles.reserve(2 * boundary.size());
+    for (const auto& [e, f] : boundary) {
+      const auto& local = hexahedron::kFaces[static_cast<std::size_t>(f)];
+      const auto h = mesh.connectivity().col(e);
+      triangles.push_back({h[local[0]], h[local[1]], h[local[2]]});
+      triangles.push_back({h[local[0]], h[local[2]], h[local[3]]});
+    }
+    return triangles;
+  }
   triangles.reserve(boundary.size());
   for (const auto& [e, f] : boundary) {
     const Eigen::Vector4i t = mesh.element(e);
@@ -92,15 +113,16 @@ std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh) {
 VertexElementAdjacency vertexElementAdjacency(const TetMesh& mesh) {
   VertexElementAdjacency adjacency;
   adjacency.offsets.assign(static_cast<std::size_t>(mesh.numVertices()) + 1, 0);
-  const Eigen::Matrix4Xi& elements = mesh.elements();
+  const auto elements = mesh.connectivity();
+  const int corners = mesh.verticesPerElement();
   for (int e = 0; e < mesh.numElements(); ++e)
-    for (int a = 0; a < 4; ++a) ++adjacency.offsets[static_cast<std::size_t>(elements(a, e)) + 1];
+    for (int a = 0; a < corners; ++a) ++adjacency.offsets[static_cast<std::size_t>(elements(a, e)) + 1];
   for (std::size_t v = 1; v < adjacency.offsets.size(); ++v) adjacency.offsets[v] += adjacency.offsets[v - 1];
   adjacency.elements.resize(static_cast<std::size_t>(adjacency.offsets.back()));
   std::vector<int> fill(adjacency.offsets.begin(), adjacency.offsets.end() - 1);
   // Visiting elements in increasing order leaves each vertex's list ascending.
   for (int e = 0; e < mesh.numElements(); ++e)
-    for (int a = 0; a < 4; ++a)
+    for (int a = 0; a < corners; ++a)
       adjacency.elements[static_cast<std::size_t>(fill[static_cast<std::size_t>(elements(a, e))]++)] = e;
   return adjacency;
 }
@@ -117,6 +139,7 @@ BoundingBox boundingBox(const TetMesh& mesh, const Eigen::VectorXd& displacement
 }
 
 ElementQuality elementQuality(const TetMesh& mesh, int e) {
+  mesh.requireTetrahedra("elementQuality (dihedral angles; hexahedra: hexahedronQuality)");
   if (e < 0 || e >= mesh.numElements())
     throw ValidationError("elementQuality: element " + std::to_string(e) + " out of range");
   const Eigen::Matrix<double, 3, 4> x = mesh.elementRestPositions(e);
@@ -178,11 +201,55 @@ QualitySummary summarizeQuality(const TetMesh& mesh, double thresholdDegrees) {
   return s;
 }
 
+HexahedronQuality hexahedronQuality(const TetMesh& mesh, int e) {
+  if (e < 0 || e >= mesh.numElements()) {
+    throw ValidationError("hexahedronQuality: element " + std::to_string(e) + " out of range");
+  }
+  const Eigen::Matrix<double, 3, 8> x = mesh.hexahedronRestPositions(e);
+  const Eigen::Matrix<double, 8, 1> scaled = hexahedron::cornerScaledJacobians(x);
+  HexahedronQuality q;
+  q.minScaledJacobian = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 8; ++a) {
+    // NaN (an edge of zero length) counts as the worst value, 0.
+    const double value = std::isnan(scaled[a]) ? 0.0 : scaled[a];
+    if (value < q.minScaledJacobian) {
+      q.minScaledJacobian = value;
+      q.worstCorner = a;
+    }
+  }
+  double shortest = std::numeric_limits<double>::infinity();
+  double longest = 0.0;
+  for (const auto& face : hexahedron::kFaces) {
+    for (std::size_t a = 0; a < 4; ++a) {
+      const double length = (x.col(face[a]) - x.col(face[(a + 1) % 4])).norm();
+      shortest = std::min(shortest, length);
+      longest = std::max(longest, length);
+    }
+  }
+  q.edgeRatio = shortest > 0.0 ? longest / shortest : std::numeric_limits<double>::infinity();
+  return q;
+}
+
+HexahedronQualitySummary summarizeHexahedronQuality(const TetMesh& mesh) {
+  (void)mesh.hexahedra();  // throws, naming the kind, on a tetrahedral mesh
+  HexahedronQualitySummary s;
+  if (mesh.numElements() == 0) return s;
+  s.minScaledJacobian = std::numeric_limits<double>::infinity();
+  double sum = 0.0;
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    const HexahedronQuality q = hexahedronQuality(mesh, e);
+    s.minScaledJacobian = std::min(s.minScaledJacobian, q.minScaledJacobian);
+    sum += q.minScaledJacobian;
+    s.worstEdgeRatio = std::max(s.worstEdgeRatio, q.edgeRatio);
+    if (q.minScaledJacobian <= 0.0) s.invertedElements.push_back(e);
+  }
+  s.meanMinScaledJacobian = sum / mesh.numElements();
+  return s;
+}
+
 std::vector<int> unusedVertices(const TetMesh& mesh) {
   std::vector<char> used(static_cast<std::size_t>(mesh.numVertices()), 0);
-  const Eigen::Matrix4Xi& elements = mesh.elements();
-  for (int e = 0; e < mesh.numElements(); ++e)
-    for (int a = 0; a < 4; ++a) used[static_cast<std::size_t>(elements(a, e))] = 1;
+  for (const int v : mesh.connectivity().reshaped()) used[static_cast<std::size_t>(v)] = 1;
   std::vector<int> unused;
   for (std::size_t v = 0; v < used.size(); ++v)
     if (!used[v]) unused.push_back(static_cast<int>(v));

@@ -26,6 +26,8 @@ std::vector<int> sortedUnique(std::vector<int> ids) {
 
 }  // namespace
 
+const char* elementKindPlural(ElementKind kind) { return kind == ElementKind::hexahedron ? "hexahedra" : "tetrahedra"; }
+
 TetMesh::TetMesh(Eigen::Matrix3Xd restPositions, Eigen::Matrix4Xi elements, std::vector<Material> materials,
                  std::vector<int> elementMaterials)
     : restPositions_(std::move(restPositions)),
@@ -33,6 +35,37 @@ TetMesh::TetMesh(Eigen::Matrix3Xd restPositions, Eigen::Matrix4Xi elements, std:
       materials_(std::move(materials)),
       elementMaterials_(std::move(elementMaterials)) {
   validate();
+}
+
+TetMesh::TetMesh(Eigen::Matrix3Xd restPositions, HexElements hexahedra, std::vector<Material> materials,
+                 std::vector<int> elementMaterials)
+    : kind_(ElementKind::hexahedron),
+      restPositions_(std::move(restPositions)),
+      hexahedra_(std::move(hexahedra)),
+      materials_(std::move(materials)),
+      elementMaterials_(std::move(elementMaterials)) {
+  validate();
+}
+
+void TetMesh::throwTetrahedraOnly(std::string_view what) const {
+  throw ValidationError(std::string(what) + " supports tetrahedral meshes only; this mesh has " +
+                        std::to_string(numElements()) + " " + elementKindPlural(kind_) +
+                        " (convert them into tetrahedra, 6 per hexahedron: meshInfo MESH --hex-to-tets "
+                        "--write OUT.veg)");
+}
+
+const HexElements& TetMesh::hexahedra() const {
+  if (kind_ != ElementKind::hexahedron) {
+    throw ValidationError("hexahedra() asked of a mesh of " + std::to_string(numElements()) + " tetrahedra");
+  }
+  return hexahedra_;
+}
+
+Eigen::Matrix<double, 3, 8> TetMesh::hexahedronRestPositions(int e) const {
+  const HexElements& hexahedra = this->hexahedra();
+  Eigen::Matrix<double, 3, 8> x;
+  for (int a = 0; a < 8; ++a) x.col(a) = restPositions_.col(hexahedra(a, e));
+  return x;
 }
 
 void TetMesh::validate() const {
@@ -46,9 +79,11 @@ void TetMesh::validate() const {
                           std::to_string(elementMaterials_.size()) + " element material entries");
   }
   for (const Material& m : materials_) checkMaterial(m);
+  const auto elements = connectivity();
+  const int corners = verticesPerElement();
   for (int e = 0; e < numElements(); ++e) {
-    const Eigen::Vector4i t = elements_.col(e);
-    for (int a = 0; a < 4; ++a) {
+    const auto t = elements.col(e);
+    for (int a = 0; a < corners; ++a) {
       if (t[a] < 0 || t[a] >= numVertices()) {
         throw ValidationError("element " + std::to_string(e) + " references vertex " + std::to_string(t[a]) +
                               ", outside [0, " + std::to_string(numVertices()) + ")");
@@ -68,8 +103,9 @@ void TetMesh::validate() const {
 }
 
 Eigen::Matrix<double, 3, 4> TetMesh::elementRestPositions(int e) const {
+  const Eigen::Matrix4Xi& elements = this->elements();
   Eigen::Matrix<double, 3, 4> x;
-  for (int a = 0; a < 4; ++a) x.col(a) = restPositions_.col(elements_(a, e));
+  for (int a = 0; a < 4; ++a) x.col(a) = restPositions_.col(elements(a, e));
   return x;
 }
 
@@ -122,9 +158,10 @@ std::vector<int> TetMesh::setVertices(const std::string& name) const {
   if (auto it = vertexSets_.find(name); it != vertexSets_.end()) return it->second;
   if (auto it = elementSets_.find(name); it != elementSets_.end()) {
     std::vector<int> vertices;
-    vertices.reserve(it->second.size() * 4);
+    const int corners = verticesPerElement();
+    vertices.reserve(it->second.size() * static_cast<std::size_t>(corners));
     for (int e : it->second)
-      for (int a = 0; a < 4; ++a) vertices.push_back(elements_(a, e));
+      for (int a = 0; a < corners; ++a) vertices.push_back(elementVertex(e, a));
     std::sort(vertices.begin(), vertices.end());
     vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
     return vertices;
@@ -180,6 +217,7 @@ void TetMesh::setVertexSet(const std::string& name, std::vector<int> vertices) {
 }
 
 void TetMesh::setElement(int e, const Eigen::Vector4i& vertices) {
+  requireTetrahedra("setElement");
   if (e < 0 || e >= numElements()) throw ValidationError("element " + std::to_string(e) + " out of range");
   for (int a = 0; a < 4; ++a) {
     if (vertices[a] < 0 || vertices[a] >= numVertices()) {

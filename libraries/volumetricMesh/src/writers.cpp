@@ -186,10 +186,15 @@ void writeVegGeometry(std::ostream& out, const TetMesh& mesh) {
     out << v + 1 << ' ' << detail::formatDouble(x.x()) << ' ' << detail::formatDouble(x.y()) << ' '
         << detail::formatDouble(x.z()) << '\n';
   }
-  out << "\n*ELEMENTS\nTET\n" << mesh.numElements() << " 4 0\n";
+  const int corners = mesh.verticesPerElement();
+  out << "\n*ELEMENTS\n"
+      << (mesh.isHexahedral() ? "CUBIC" : "TET") << '\n'
+      << mesh.numElements() << ' ' << corners << " 0\n";
+  const auto connectivity = mesh.connectivity();
   for (int e = 0; e < mesh.numElements(); ++e) {
-    const Eigen::Vector4i t = mesh.element(e);
-    out << e + 1 << ' ' << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << ' ' << t[3] + 1 << '\n';
+    out << e + 1;
+    for (int a = 0; a < corners; ++a) out << ' ' << connectivity(a, e) + 1;
+    out << '\n';
   }
 }
 
@@ -256,18 +261,18 @@ void appendVtuData(VtuBuilder& vtu, const TetMesh& mesh, const Eigen::VectorXd& 
   vtu.xml() << "      </CellData>\n";
 }
 
-/// The <Cells> arrays of the tetrahedra: connectivity, offsets and VTK types.
+/// The <Cells> arrays of the elements: connectivity, offsets and VTK types
+/// (VTK_TETRA 10, VTK_HEXAHEDRON 12, whose vertex order the mesh's hexahedra use).
 void appendVtuCells(VtuBuilder& vtu, const TetMesh& mesh) {
   const auto numElements = static_cast<std::size_t>(mesh.numElements());
-  std::vector<std::int32_t> connectivity(4 * numElements);
+  const auto corners = static_cast<std::size_t>(mesh.verticesPerElement());
+  const auto elements = mesh.connectivity();
+  std::vector<std::int32_t> connectivity(elements.data(), elements.data() + corners * numElements);
   std::vector<std::int32_t> offsets(numElements);
-  for (std::size_t e = 0; e < numElements; ++e) {
-    const Eigen::Vector4i t = mesh.element(static_cast<int>(e));
-    for (int corner = 0; corner < 4; ++corner) connectivity[4 * e + static_cast<std::size_t>(corner)] = t[corner];
-    offsets[e] = static_cast<std::int32_t>(4 * (e + 1));
-  }
+  for (std::size_t e = 0; e < numElements; ++e) offsets[e] = static_cast<std::int32_t>(corners * (e + 1));
   constexpr std::uint8_t vtkTetra = 10;
-  const std::vector<std::uint8_t> types(numElements, vtkTetra);
+  constexpr std::uint8_t vtkHexahedron = 12;
+  const std::vector<std::uint8_t> types(numElements, mesh.isHexahedral() ? vtkHexahedron : vtkTetra);
   vtu.array("Int32", "connectivity", 1, connectivity.data(), connectivity.size());
   vtu.array("Int32", "offsets", 1, offsets.data(), offsets.size());
   vtu.array("UInt8", "types", 1, types.data(), types.size());
@@ -278,8 +283,8 @@ void appendVtuCells(VtuBuilder& vtu, const TetMesh& mesh) {
 void writeVeg(const std::filesystem::path& path, const TetMesh& mesh) {
   checkVegNames(mesh);
   std::ostringstream out;
-  out << "# " << mesh.numVertices() << " vertices, " << mesh.numElements() << " tetrahedra, " << mesh.materials().size()
-      << " materials\n";
+  out << "# " << mesh.numVertices() << " vertices, " << mesh.numElements() << " "
+      << elementKindPlural(mesh.elementKind()) << ", " << mesh.materials().size() << " materials\n";
   writeVegGeometry(out, mesh);
   writeVegMaterials(out, mesh);
   for (const auto& [name, members] : mesh.elementSets()) {

@@ -20,8 +20,11 @@ namespace {
 
 using detail::LineCursor;
 
-constexpr long long kTetrahedron = 4;    // 4-node tetrahedron
-constexpr long long kQuadraticTet = 11;  // 10-node tetrahedron
+constexpr long long kTetrahedron = 4;      // 4-node tetrahedron
+constexpr long long kHexahedron = 5;       // 8-node hexahedron (VTK's vertex order)
+constexpr long long kQuadraticTet = 11;    // 10-node tetrahedron
+constexpr long long kQuadraticHex = 12;    // 27-node hexahedron
+constexpr long long kSerendipityHex = 17;  // 20-node hexahedron
 // Every element of a volume entity joins each of the entity's physical groups, so the
 // set memberships are (elements) x (groups per entity): a bound on the latter keeps
 // them linear in the file size.
@@ -64,6 +67,8 @@ std::string unnamedGroup(const PhysicalGroup& group) {
   static const char* const kinds[] = {"physical_point_", "physical_curve_", "physical_surface_", "physical_"};
   return kinds[group.first] + std::to_string(group.second);
 }
+
+std::string typeName(long long type) { return type == kHexahedron ? "8-node hexahedron" : "4-node tetrahedron"; }
 
 class GmshParser {
  public:
@@ -123,8 +128,8 @@ class GmshParser {
     if (!haveElements) cursor_.failAtEnd("no $Elements section");
   }
 
-  /// Counts the elements that are not 4-node tetrahedra into report, with a warning by
-  /// type; a file of 10-node tetrahedra only is an error.
+  /// Counts the elements that are neither 4-node tetrahedra nor 8-node hexahedra into
+  /// report, with a warning by type; a file of second-order volume elements only is an error.
   void reportIgnoredElements(MeshReadReport& report) const {
     report.ignoredElements = ignoredTotal_;
     if (ignoredTotal_ > 0) {
@@ -132,11 +137,16 @@ class GmshParser {
       for (const auto& [type, count] : ignoredByType_) {
         types += (types.empty() ? "" : ", ") + std::to_string(count) + " of type " + std::to_string(type);
       }
-      report.warnings.push_back("ignored " + std::to_string(ignoredTotal_) +
-                                " element(s) that are not 4-node tetrahedra (" + types + ")");
+      report.warnings.push_back("ignored " + std::to_string(ignoredTotal_) + " element(s) that are not " +
+                                (raw_.kind == ElementKind::hexahedron ? "8-node hexahedra" : "4-node tetrahedra") +
+                                " (" + types + ")");
     }
-    if (raw_.elements.empty() && ignoredByType_.count(kQuadraticTet)) {
+    if (raw_.numElements() == 0 && ignoredByType_.count(kQuadraticTet)) {
       cursor_.failAtEnd("only 10-node tetrahedra (type 11) found: export a first-order mesh (Mesh.ElementOrder = 1)");
+    }
+    if (raw_.numElements() == 0 && (ignoredByType_.count(kQuadraticHex) || ignoredByType_.count(kSerendipityHex))) {
+      cursor_.failAtEnd(
+          "only second-order hexahedra (type 12 or 17) found: export a first-order mesh (Mesh.ElementOrder = 1)");
     }
   }
 
@@ -369,11 +379,38 @@ class GmshParser {
     return inBlock;
   }
 
-  /// Appends one tetrahedron given its Gmsh element tag and four node tags.
-  void addTet(long long tag, const std::string_view* nodeTokens) {
+  /// Appends one tetrahedron (type 4) or hexahedron (type 5) given its Gmsh element tag
+  /// and node tags. A mesh holds one element kind, so the first volume element fixes it
+  /// and an element of the other kind is an error.
+  void addVolumeElement(long long type, long long tag, const std::string_view* nodeTokens) {
+    const ElementKind kind = type == kHexahedron ? ElementKind::hexahedron : ElementKind::tetrahedron;
+    if (raw_.numElements() == 0) {
+      raw_.kind = kind;
+    } else if (kind != raw_.kind) {
+      cursor_.fail("element " + std::to_string(tag) + " is " +
+                   (kind == ElementKind::hexahedron ? "an 8-node hexahedron" : "a 4-node tetrahedron") +
+                   ", but the file's first volume element was " +
+                   (raw_.kind == ElementKind::hexahedron ? "a hexahedron" : "a tetrahedron") +
+                   ": mixed tetrahedral and hexahedral meshes are not supported (a mesh holds one element kind; mesh "
+                   "the volume with one kind, e.g. Gmsh's Mesh.SubdivisionAlgorithm = 2 makes all hexahedra)");
+    }
+    if (kind == ElementKind::hexahedron) {
+      raw_.hexahedra.push_back(elementNodes<8>(tag, nodeTokens));
+    } else {
+      raw_.elements.push_back(elementNodes<4>(tag, nodeTokens));
+    }
+    if (!elementTags_.insert(tag).second) cursor_.fail("duplicate element tag " + std::to_string(tag));
+    raw_.elementLocations.push_back(cursor_.location());
+    raw_.elementFileIds.push_back(tag);
+    raw_.elementMaterials.push_back(-1);
+  }
+
+  /// The N vertex indices of element tag from its node tags, checked to exist and differ.
+  template <std::size_t N>
+  std::array<int, N> elementNodes(long long tag, const std::string_view* nodeTokens) {
     const std::string name = "element " + std::to_string(tag);
-    std::array<int, 4> t{};
-    for (std::size_t a = 0; a < 4; ++a) {
+    std::array<int, N> t{};
+    for (std::size_t a = 0; a < N; ++a) {
       const long long nodeTag = detail::integerAt(cursor_, nodeTokens[a], name + " node");
       auto it = nodeIndex_.find(nodeTag);
       if (it == nodeIndex_.end())
@@ -383,11 +420,7 @@ class GmshParser {
       }
       t[a] = it->second;
     }
-    if (!elementTags_.insert(tag).second) cursor_.fail("duplicate element tag " + std::to_string(tag));
-    raw_.elements.push_back(t);
-    raw_.elementLocations.push_back(cursor_.location());
-    raw_.elementFileIds.push_back(tag);
-    raw_.elementMaterials.push_back(-1);
+    return t;
   }
 
   void ignore(long long type) {
@@ -415,7 +448,7 @@ class GmshParser {
         cursor_.fail("element " + std::to_string(tag) + " claims " + std::to_string(numTags) +
                      " tags but the line has fewer fields");
       }
-      if (type != kTetrahedron) {
+      if (type != kTetrahedron && type != kHexahedron) {
         ignore(type);
         const long long dim = elementTypeDimension(type);
         if (numTags >= 1 && dim < 3) {
@@ -426,16 +459,16 @@ class GmshParser {
         }
         continue;
       }
-      const std::size_t expected = 3 + static_cast<std::size_t>(numTags) + 4;
+      const std::size_t expected = 3 + static_cast<std::size_t>(numTags) + (type == kHexahedron ? 8 : 4);
       if (tokens.size() != expected) {
-        cursor_.fail("element " + std::to_string(tag) + " (4-node tetrahedron) needs " + std::to_string(expected) +
+        cursor_.fail("element " + std::to_string(tag) + " (" + typeName(type) + ") needs " + std::to_string(expected) +
                      " fields, got " + std::to_string(tokens.size()));
       }
-      addTet(tag, &tokens[3 + static_cast<std::size_t>(numTags)]);
+      addVolumeElement(type, tag, &tokens[3 + static_cast<std::size_t>(numTags)]);
       if (numTags >= 1) {
         const long long physical =
             detail::integerAt(cursor_, tokens[3], "element " + std::to_string(tag) + " physical tag");
-        if (physical != 0) physicalElements_[physical].push_back(static_cast<int>(raw_.elements.size()) - 1);
+        if (physical != 0) physicalElements_[physical].push_back(static_cast<int>(raw_.numElements()) - 1);
       }
     }
     expectEnd("Elements", "$Elements says " + std::to_string(count) + " elements, but there are more element lines");
@@ -478,7 +511,7 @@ class GmshParser {
     if (auto it = entityPhysicals_.find({dim, entity}); it != entityPhysicals_.end()) physicals = &it->second;
     for (long long i = 0; i < inBlock; ++i) {
       const auto tokens = nextRecord("an element line");
-      if (type != kTetrahedron) {
+      if (type != kTetrahedron && type != kHexahedron) {
         ignore(type);
         if (physicals && dim >= 0 && dim < 3 && tokens.size() > 1) {
           const long long tag = detail::integerAt(cursor_, tokens[0], "element tag");
@@ -486,12 +519,14 @@ class GmshParser {
         }
         continue;
       }
-      if (tokens.size() != 5)
-        cursor_.fail("4-node tetrahedron line needs 'tag n1 n2 n3 n4', got " + std::to_string(tokens.size()) +
-                     " fields");
-      addTet(detail::integerAt(cursor_, tokens[0], "element tag"), &tokens[1]);
+      const std::size_t expected = type == kHexahedron ? 9 : 5;
+      if (tokens.size() != expected) {
+        cursor_.fail(typeName(type) + " line needs 'tag n1 ... n" + std::to_string(expected - 1) + "', got " +
+                     std::to_string(tokens.size()) + " fields");
+      }
+      addVolumeElement(type, detail::integerAt(cursor_, tokens[0], "element tag"), &tokens[1]);
       if (physicals && dim == 3) {
-        for (long long p : *physicals) physicalElements_[p].push_back(static_cast<int>(raw_.elements.size()) - 1);
+        for (long long p : *physicals) physicalElements_[p].push_back(static_cast<int>(raw_.numElements()) - 1);
       }
     }
     return inBlock;

@@ -38,7 +38,7 @@ int resolveDefaultMaterial(RawMesh& raw, const Material& material, const LineCur
 /// the format's default (with a warning), or an error naming the first of them.
 void assignMissingMaterials(RawMesh& raw, const LineCursor& cursor, const MeshReadOptions& options,
                             MeshReadReport& report, MissingMaterialPolicy policy) {
-  const std::size_t numElements = raw.elements.size();
+  const std::size_t numElements = raw.numElements();
   std::size_t firstMissing = numElements;
   for (std::size_t e = 0; e < numElements; ++e) {
     if (raw.elementMaterials[e] < 0) {
@@ -126,9 +126,9 @@ void reportUnusedVertices(const RawMesh& raw, const std::vector<char>& used, Mes
 
 TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions& options, MeshReadReport& report,
                    MissingMaterialPolicy policy) {
-  const std::size_t numElements = raw.elements.size();
+  const std::size_t numElements = raw.numElements();
   const std::size_t numVertices = raw.vertexFileIds.size();
-  if (numElements == 0) cursor.failAtEnd("the file has no tetrahedral elements");
+  if (numElements == 0) cursor.failAtEnd("the file has no tetrahedral elements (nor hexahedra)");
   assignMissingMaterials(raw, cursor, options, report, policy);
 
   Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(numVertices));
@@ -136,22 +136,36 @@ TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions&
     positions.col(static_cast<Eigen::Index>(v)) =
         Eigen::Vector3d(raw.positions[3 * v], raw.positions[3 * v + 1], raw.positions[3 * v + 2]);
   }
-  Eigen::Matrix4Xi elements(4, static_cast<Eigen::Index>(numElements));
   std::vector<char> used(numVertices, 0);
-  for (std::size_t e = 0; e < numElements; ++e) {
-    const std::array<int, 4> t = checkedElement(raw, e, positions, cursor, options, report);
-    for (int a = 0; a < 4; ++a) {
-      elements(a, static_cast<Eigen::Index>(e)) = t[static_cast<std::size_t>(a)];
-      used[static_cast<std::size_t>(t[static_cast<std::size_t>(a)])] = 1;
+  Eigen::Matrix4Xi elements;
+  HexElements hexahedra;
+  if (raw.kind == ElementKind::hexahedron) {
+    hexahedra = checkedHexahedra(raw, positions, cursor, options, report);
+    for (const int v : hexahedra.reshaped()) used[static_cast<std::size_t>(v)] = 1;
+  } else {
+    elements.resize(4, static_cast<Eigen::Index>(numElements));
+    for (std::size_t e = 0; e < numElements; ++e) {
+      const std::array<int, 4> t = checkedElement(raw, e, positions, cursor, options, report);
+      for (int a = 0; a < 4; ++a) {
+        elements(a, static_cast<Eigen::Index>(e)) = t[static_cast<std::size_t>(a)];
+        used[static_cast<std::size_t>(t[static_cast<std::size_t>(a)])] = 1;
+      }
     }
   }
   if (report.reorientedElements > 0) {
     report.warnings.push_back("reoriented " + std::to_string(report.reorientedElements) +
-                              " inverted element(s) (negative volume) by swapping their last two vertices");
+                              (raw.kind == ElementKind::hexahedron
+                                   ? " inverted hexahedra (negative Jacobian at every corner) by swapping their "
+                                     "bottom and top faces"
+                                   : " inverted element(s) (negative volume) by swapping their last two vertices"));
   }
   reportUnusedVertices(raw, used, report);
 
-  TetMesh mesh(std::move(positions), std::move(elements), std::move(raw.materials), std::move(raw.elementMaterials));
+  TetMesh mesh = raw.kind == ElementKind::hexahedron
+                     ? TetMesh(std::move(positions), std::move(hexahedra), std::move(raw.materials),
+                               std::move(raw.elementMaterials))
+                     : TetMesh(std::move(positions), std::move(elements), std::move(raw.materials),
+                               std::move(raw.elementMaterials));
   for (auto& [name, members] : raw.elementSets) mesh.setElementSet(name, std::move(members));
   for (auto& [name, members] : raw.vertexSets) mesh.setVertexSet(name, std::move(members));
   return mesh;

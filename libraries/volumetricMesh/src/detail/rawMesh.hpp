@@ -16,15 +16,22 @@ namespace asyncfem::detail {
 /// degeneracy, materials, unused vertices). Ids in the file's own numbering are kept so
 /// messages name elements and vertices as the user sees them.
 struct RawMesh {
-  std::vector<double> positions;             ///< x y z per vertex
-  std::vector<long long> vertexFileIds;      ///< id of each vertex in the file
-  std::vector<std::array<int, 4>> elements;  ///< 0-based vertex ids
-  std::vector<Location> elementLocations;    ///< where each element was read
-  std::vector<long long> elementFileIds;     ///< id of each element in the file
+  ElementKind kind = ElementKind::tetrahedron;
+  std::vector<double> positions;              ///< x y z per vertex
+  std::vector<long long> vertexFileIds;       ///< id of each vertex in the file
+  std::vector<std::array<int, 4>> elements;   ///< tetrahedra: 0-based vertex ids
+  std::vector<std::array<int, 8>> hexahedra;  ///< hexahedra: 0-based vertex ids (VTK order)
+  /// Vega CUBIC files: every hexahedron must be an axis-aligned cube of one size in
+  /// Vega's vertex order (Vega's elements assume it without checking).
+  bool vegaCubes = false;
+  std::vector<Location> elementLocations;  ///< where each element was read
+  std::vector<long long> elementFileIds;   ///< id of each element in the file
   std::vector<Material> materials;
   std::vector<int> elementMaterials;  ///< index into materials, -1 for none yet
   std::map<std::string, std::vector<int>> elementSets;
   std::map<std::string, std::vector<int>> vertexSets;
+
+  std::size_t numElements() const { return kind == ElementKind::hexahedron ? hexahedra.size() : elements.size(); }
 };
 
 /// What to do with elements that have no material after reading.
@@ -41,6 +48,13 @@ void checkMaterialAt(const LineCursor& cursor, const Material& material);
 
 /// Applies the material policy, checks every element for degeneracy and orientation
 /// (reorienting when options allow), reports unused vertices, and builds the TetMesh.
+/// The hexahedra of raw, checked (hexChecks.cpp): distinct vertex positions, a positive
+/// Jacobian at every corner (an element negative at all eight is reoriented by swapping its
+/// bottom and top faces when options allow, counted in report) and, with raw.vegaCubes,
+/// Vega's cube shape. Errors name the element, its line and the corner.
+HexElements checkedHexahedra(const RawMesh& raw, const Eigen::Matrix3Xd& positions, const LineCursor& cursor,
+                             const MeshReadOptions& options, MeshReadReport& report);
+
 TetMesh finishMesh(RawMesh raw, const LineCursor& cursor, const MeshReadOptions& options, MeshReadReport& report,
                    MissingMaterialPolicy policy);
 

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Vega .veg reader (tetrahedral subset); see docs/file-formats.md for what is accepted.
+// Vega .veg reader (TET and CUBIC elements); see docs/file-formats.md for what is accepted.
+#include <array>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
 #include <map>
@@ -148,7 +149,12 @@ class VegParser {
     const long long count = readElementsHeader();
     const Location headerAt = cursor_.location();
     const auto n = static_cast<std::size_t>(count);
-    raw_.elements.resize(n);
+    const std::size_t corners = raw_.kind == ElementKind::hexahedron ? 8 : 4;
+    if (corners == 8) {
+      raw_.hexahedra.resize(n);
+    } else {
+      raw_.elements.resize(n);
+    }
     raw_.elementLocations.resize(n);
     raw_.elementFileIds.resize(n);
     raw_.elementMaterials.assign(n, -1);
@@ -159,8 +165,9 @@ class VegParser {
                                      " elements, but the section has only " + std::to_string(i));
       }
       const auto tokens = detail::splitTokens(cursor_.line(), true);
-      if (tokens.size() != 5) {
-        cursor_.fail("element line needs 'index v1 v2 v3 v4', got " + std::to_string(tokens.size()) + " fields");
+      if (tokens.size() != corners + 1) {
+        cursor_.fail(std::string("element line needs 'index ") + (corners == 8 ? "v1 ... v8" : "v1 v2 v3 v4") +
+                     "', got " + std::to_string(tokens.size()) + " fields");
       }
       const long long id = detail::integerAt(cursor_, tokens[0], "element index");
       if (id < 1 || id > count) {
@@ -169,62 +176,72 @@ class VegParser {
       const auto e = static_cast<std::size_t>(id - 1);
       if (seen[e]) cursor_.fail("duplicate element index " + std::to_string(id));
       seen[e] = 1;
-      readElementVertices(tokens, e, id);
+      if (corners == 8) {
+        readElementVertices(tokens, id, raw_.hexahedra[e]);
+      } else {
+        readElementVertices(tokens, id, raw_.elements[e]);
+      }
       raw_.elementLocations[e] = cursor_.location();
       raw_.elementFileIds[e] = id;
     }
     expectSectionEnd("*ELEMENTS", count, "elements", "element");
   }
 
-  /// The line after *ELEMENTS must name the element type TET.
+  /// The line after *ELEMENTS must name the element type: TET or CUBIC (Vega's cubes).
   void readElementType() {
     if (!cursor_.next() || isKeywordLine(cursor_.line()))
-      cursor_.fail("*ELEMENTS needs the element type (TET) on the next line");
+      cursor_.fail("*ELEMENTS needs the element type (TET or CUBIC) on the next line");
     const std::string_view type = cursor_.line();
     long long ignored = 0;
     if (detail::equalsIgnoreCase(type, "CUBIC")) {
-      cursor_.fail("element type CUBIC (hexahedra) is not supported: only TET meshes can be read");
+      raw_.kind = ElementKind::hexahedron;
+      raw_.vegaCubes = true;
+      return;
     }
     if (!detail::equalsIgnoreCase(type, "TET")) {
       const auto typeTokens = detail::splitTokens(type, true);
       if (!typeTokens.empty() && detail::parseInteger(typeTokens.front(), ignored)) {
-        cursor_.fail("*ELEMENTS needs the element type (TET) on its own line before the count");
+        cursor_.fail("*ELEMENTS needs the element type (TET or CUBIC) on its own line before the count");
       }
-      cursor_.fail("unsupported element type '" + std::string(type) + "': only TET is supported");
+      cursor_.fail("unsupported element type '" + std::string(type) + "': TET and CUBIC are supported");
     }
   }
 
   /// The element count of the *ELEMENTS header line, checked.
   long long readElementsHeader() {
-    const auto header = headerLine("*ELEMENTS", "<count> 4 0");
-    if (header.size() > 3)
-      cursor_.fail("*ELEMENTS header has " + std::to_string(header.size()) + " fields; expected '<count> 4 0'");
+    const bool cubes = raw_.kind == ElementKind::hexahedron;
+    const std::string expected = cubes ? "<count> 8 0" : "<count> 4 0";
+    const auto header = headerLine("*ELEMENTS", expected);
+    if (header.size() > 3) {
+      cursor_.fail("*ELEMENTS header has " + std::to_string(header.size()) + " fields; expected '" + expected + "'");
+    }
     const long long count = detail::integerAt(cursor_, header[0], "*ELEMENTS count");
-    if (header.size() >= 2 && detail::integerAt(cursor_, header[1], "*ELEMENTS vertices per element") != 4) {
-      cursor_.fail("TET elements have 4 vertices, but the header says " + std::string(header[1]));
+    if (header.size() >= 2 &&
+        detail::integerAt(cursor_, header[1], "*ELEMENTS vertices per element") != (cubes ? 8 : 4)) {
+      cursor_.fail(std::string(cubes ? "CUBIC elements have 8" : "TET elements have 4") +
+                   " vertices, but the header says " + std::string(header[1]));
     }
     if (header.size() >= 3) detail::integerAt(cursor_, header[2], "*ELEMENTS header");
-    cursor_.checkCountFits(count, 9, "elements");
+    // A line holds at least the index and the vertices, each with a separator.
+    cursor_.checkCountFits(count, cubes ? 17 : 9, "elements");
     return count;
   }
 
-  /// Reads the four vertices of element e (file index id) from tokens[1 .. 4].
-  template <class Tokens>
-  void readElementVertices(const Tokens& tokens, std::size_t e, long long id) {
+  /// Reads the vertices of element id (its file index) from tokens[1 .. N] into element.
+  template <class Tokens, std::size_t N>
+  void readElementVertices(const Tokens& tokens, long long id, std::array<int, N>& element) {
     const auto numVertices = static_cast<long long>(raw_.vertexFileIds.size());
     const std::string name = "element " + std::to_string(id);
-    for (std::size_t a = 0; a < 4; ++a) {
+    for (std::size_t a = 0; a < N; ++a) {
       const long long v = detail::integerAt(cursor_, tokens[a + 1], name + " vertex");
       if (v < 1 || v > numVertices) {
         cursor_.fail(name + " references vertex " + std::to_string(v) + ", outside [1, " + std::to_string(numVertices) +
                      "]");
       }
       for (std::size_t b = 0; b < a; ++b) {
-        if (raw_.elements[e][b] == static_cast<int>(v - 1)) {
-          cursor_.fail(name + " uses vertex " + std::to_string(v) + " twice");
-        }
+        if (element[b] == static_cast<int>(v - 1)) cursor_.fail(name + " uses vertex " + std::to_string(v) + " twice");
       }
-      raw_.elements[e][a] = static_cast<int>(v - 1);
+      element[a] = static_cast<int>(v - 1);
     }
   }
 
@@ -351,7 +368,7 @@ class VegParser {
   /// Checks the ids of every set and stores the sets in raw_ (0-based); returns the
   /// element sets a *REGION line may name (material sets included).
   std::map<std::string, std::vector<int>> resolveSets() {
-    const auto numElements = static_cast<long long>(raw_.elements.size());
+    const auto numElements = static_cast<long long>(raw_.numElements());
     const auto numVertices = static_cast<long long>(raw_.vertexFileIds.size());
     std::map<std::string, std::vector<int>> regionSets;
     for (PendingSet& set : sets_) {
@@ -387,7 +404,7 @@ class VegParser {
       for (const auto& [n, s] : raw_.elementSets) known += ", " + n;
       cursor_.failAt(region.location, "*REGION refers to unknown set '" + region.setName + "' (known: " + known + ")");
     }
-    all.resize(raw_.elements.size());
+    all.resize(raw_.numElements());
     for (std::size_t e = 0; e < all.size(); ++e) all[e] = static_cast<int>(e);
     return all;
   }

@@ -8,8 +8,9 @@
 
 namespace asyncfem {
 
-/// Signed volume of element e at rest: det([x1-x0, x2-x0, x3-x0]) / 6.
-/// Positive for the orientation the toolkit uses.
+/// Signed volume of element e at rest: det([x1-x0, x2-x0, x3-x0]) / 6 for a tetrahedron,
+/// the integral of det J for a hexahedron (hexahedron::signedVolume). Positive for the
+/// orientation the toolkit uses.
 double signedElementVolume(const TetMesh& mesh, int e);
 /// |signed volume| of every element (size numElements).
 Eigen::VectorXd elementVolumes(const TetMesh& mesh);
@@ -19,7 +20,9 @@ double totalVolume(const TetMesh& mesh);
 double totalMass(const TetMesh& mesh);
 
 /// Boundary triangles: faces that belong to exactly one element, oriented so that
-/// their normal (b-a)x(c-a) points out of the mesh. Deterministic order.
+/// their normal (b-a)x(c-a) points out of the mesh. Deterministic order. A hexahedral
+/// mesh's boundary quadrilaterals a b c d (outward, hexahedron::kFaces) give the two
+/// triangles a b c and a c d each.
 std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh);
 
 /// Vertex -> incident elements in compressed form (offsets has numVertices + 1 entries): the elements of vertex v are
@@ -54,9 +57,9 @@ struct ElementQuality {
   /// the element degenerates.
   double aspectRatio = 0.0;
 };
-/// Quality of element e. Dihedral angle at an edge = angle between the two faces that
-/// share it (acos(1/3) for all six edges of the regular tetrahedron); a zero-volume
-/// element has aspect ratio +infinity.
+/// Quality of element e of a tetrahedral mesh (ValidationError on hexahedra). Dihedral angle at an edge = angle between
+/// the two faces that share it (acos(1/3) for all six edges of the regular tetrahedron); a zero-volume element has
+/// aspect ratio +infinity.
 ElementQuality elementQuality(const TetMesh& mesh, int e);
 /// elementQuality for every element, in element order.
 std::vector<ElementQuality> elementQualities(const TetMesh& mesh);
@@ -76,6 +79,26 @@ struct QualitySummary {
 /// QualitySummary of elementQualities(mesh), counting the elements with a dihedral angle
 /// below thresholdDegrees (10 by default: tetMesher's guard, docs/tet-mesher.md).
 QualitySummary summarizeQuality(const TetMesh& mesh, double thresholdDegrees = 10.0);
+
+/// Shape quality of one hexahedron.
+struct HexahedronQuality {
+  /// The smallest scaled Jacobian of the eight corners (hexahedron::cornerScaledJacobians;
+  /// 1 for a box, <= 0 where the element is inverted or flat; a zero-length edge counts 0).
+  double minScaledJacobian = 0.0;
+  int worstCorner = 0;     ///< the corner (0..7) where it is attained
+  double edgeRatio = 0.0;  ///< longest / shortest of the 12 edges (1 for a cube)
+};
+/// Quality of hexahedron e (ValidationError on a tetrahedral mesh or e out of range).
+HexahedronQuality hexahedronQuality(const TetMesh& mesh, int e);
+
+/// The spread of hexahedron quality over a mesh; all zero for a mesh without elements.
+struct HexahedronQualitySummary {
+  double minScaledJacobian = 0.0;      ///< smallest corner scaled Jacobian of any element
+  double meanMinScaledJacobian = 0.0;  ///< mean over elements of each element's smallest
+  double worstEdgeRatio = 0.0;
+  std::vector<int> invertedElements;  ///< elements with a corner scaled Jacobian <= 0, ascending
+};
+HexahedronQualitySummary summarizeHexahedronQuality(const TetMesh& mesh);
 
 /// Vertices referenced by no element.
 std::vector<int> unusedVertices(const TetMesh& mesh);

@@ -5,6 +5,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -65,12 +66,35 @@ struct Material {
   bool operator==(const Material&) const = default;
 };
 
-/// Linear (4-node) tetrahedral mesh with a material per element and named vertex and
-/// element sets. Indices are 0-based everywhere in the API; readers and writers convert.
+/// The element kind of a volumetric mesh; a mesh holds elements of one kind.
+enum class ElementKind {
+  tetrahedron,  ///< linear 4-node tetrahedron
+  hexahedron,   ///< trilinear 8-node hexahedron, vertices in VTK / Vega / Gmsh order (hexahedron.hpp)
+};
+/// 4 for tetrahedra, 8 for hexahedra.
+constexpr int verticesPerElement(ElementKind kind) { return kind == ElementKind::hexahedron ? 8 : 4; }
+/// "tetrahedra" or "hexahedra", for messages.
+const char* elementKindPlural(ElementKind kind);
+
+/// Connectivity of a hexahedral mesh: 8 x numElements, 0-based vertex ids per column.
+using HexElements = Eigen::Matrix<int, 8, Eigen::Dynamic>;
+using Vector8i = Eigen::Matrix<int, 8, 1>;
+
+/// The volumetric mesh of the toolkit: linear (4-node) tetrahedra or trilinear (8-node)
+/// hexahedra (elementKind(); one kind per mesh), with a material per element and named
+/// vertex and element sets. Indices are 0-based everywhere in the API; readers and
+/// writers convert. The name is historical (the toolkit began with tetrahedra only);
+/// `VolumetricMesh` is an alias.
+///
+/// Code that handles one kind only asks elementKind() or calls requireTetrahedra(what),
+/// which throws a ValidationError naming `what`. The tetrahedral accessors (elements(),
+/// element(e), elementRestPositions(e), setElement) throw the same error on a hexahedral
+/// mesh, so a tetrahedra-only path that forgot to check fails with a message instead of
+/// reading out of bounds; connectivity() and elementVertex() serve both kinds.
 ///
 /// Invariants (checked by the constructor and the mutators, which throw
 /// asyncfem::ValidationError naming the offending element, vertex, set or material):
-/// - every element index is in [0, numVertices), the four indices of an element differ;
+/// - every element index is in [0, numVertices), the indices of an element differ;
 /// - every element has a material index in [0, materials().size());
 /// - every material has E > 0, rho > 0, -1 < nu < 0.5, all finite;
 /// - all rest positions are finite;
@@ -84,18 +108,55 @@ class TetMesh {
   /// elementMaterials: numElements entries, each an index into materials.
   TetMesh(Eigen::Matrix3Xd restPositions, Eigen::Matrix4Xi elements, std::vector<Material> materials,
           std::vector<int> elementMaterials);
+  /// A hexahedral mesh. hexahedra: 8 x numElements (0-based vertex ids in VTK order,
+  /// hexahedron.hpp); the rest as for tetrahedra. Orientation and shape (a positive
+  /// Jacobian at every corner) are the readers' business, as for tetrahedra.
+  TetMesh(Eigen::Matrix3Xd restPositions, HexElements hexahedra, std::vector<Material> materials,
+          std::vector<int> elementMaterials);
+
+  ElementKind elementKind() const { return kind_; }
+  bool isHexahedral() const { return kind_ == ElementKind::hexahedron; }
+  /// 4 or 8.
+  int verticesPerElement() const { return asyncfem::verticesPerElement(kind_); }
+  /// Throws ValidationError "<what> supports tetrahedral meshes only; this mesh has N
+  /// hexahedra (...)" on a hexahedral mesh, with the command that converts it.
+  void requireTetrahedra(std::string_view what) const {
+    if (kind_ != ElementKind::tetrahedron) throwTetrahedraOnly(what);
+  }
 
   int numVertices() const { return static_cast<int>(restPositions_.cols()); }
-  int numElements() const { return static_cast<int>(elements_.cols()); }
+  int numElements() const {
+    return static_cast<int>(kind_ == ElementKind::tetrahedron ? elements_.cols() : hexahedra_.cols());
+  }
   /// Number of degrees of freedom, 3 * numVertices.
   int numDofs() const { return 3 * numVertices(); }
 
   const Eigen::Matrix3Xd& restPositions() const { return restPositions_; }
   Eigen::Vector3d restPosition(int vertex) const { return restPositions_.col(vertex); }
-  const Eigen::Matrix4Xi& elements() const { return elements_; }
-  Eigen::Vector4i element(int e) const { return elements_.col(e); }
+  /// Tetrahedra, 4 x numElements (throws on a hexahedral mesh, see requireTetrahedra).
+  const Eigen::Matrix4Xi& elements() const {
+    requireTetrahedra("this operation");
+    return elements_;
+  }
+  Eigen::Vector4i element(int e) const { return elements().col(e); }
   /// 3 x 4 matrix of the rest positions of element e's vertices (columns in element order).
   Eigen::Matrix<double, 3, 4> elementRestPositions(int e) const;
+
+  /// Hexahedra, 8 x numElements (throws ValidationError on a tetrahedral mesh).
+  const HexElements& hexahedra() const;
+  Vector8i hexahedron(int e) const { return hexahedra().col(e); }
+  /// 3 x 8 matrix of the rest positions of hexahedron e's vertices.
+  Eigen::Matrix<double, 3, 8> hexahedronRestPositions(int e) const;
+
+  /// Either kind: verticesPerElement() x numElements view of the connectivity.
+  Eigen::Map<const Eigen::MatrixXi> connectivity() const {
+    return {kind_ == ElementKind::tetrahedron ? elements_.data() : hexahedra_.data(), verticesPerElement(),
+            numElements()};
+  }
+  /// Either kind: vertex a (0 <= a < verticesPerElement()) of element e.
+  int elementVertex(int e, int a) const {
+    return kind_ == ElementKind::tetrahedron ? elements_(a, e) : hexahedra_(a, e);
+  }
 
   const std::vector<Material>& materials() const { return materials_; }
   const std::vector<int>& elementMaterials() const { return elementMaterials_; }
@@ -136,13 +197,19 @@ class TetMesh {
 
  private:
   void validate() const;
+  [[noreturn]] void throwTetrahedraOnly(std::string_view what) const;
 
+  ElementKind kind_ = ElementKind::tetrahedron;
   Eigen::Matrix3Xd restPositions_;
-  Eigen::Matrix4Xi elements_;
+  Eigen::Matrix4Xi elements_;  ///< tetrahedral meshes only (empty otherwise)
+  HexElements hexahedra_;      ///< hexahedral meshes only (empty otherwise)
   std::vector<Material> materials_;
   std::vector<int> elementMaterials_;
   std::map<std::string, std::vector<int>> elementSets_;
   std::map<std::string, std::vector<int>> vertexSets_;
 };
+
+/// The volumetric mesh under its general name (tetrahedra or hexahedra).
+using VolumetricMesh = TetMesh;
 
 }  // namespace asyncfem

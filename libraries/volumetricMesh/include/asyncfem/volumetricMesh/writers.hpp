@@ -10,7 +10,7 @@
 
 namespace asyncfem {
 
-/// Writes the mesh as Vega .veg: vertices, TET elements, one *MATERIAL per material,
+/// Writes the mesh as Vega .veg: vertices, TET elements (CUBIC for a hexahedral mesh), one *MATERIAL per material,
 /// one *SET per element set, one *VERTEXSET per vertex set, and one *REGION line per
 /// material naming a set with exactly that material's elements (an existing set, or an
 /// added `__material_<name>` set that readVeg does not keep), so that
@@ -44,10 +44,10 @@ enum class VtuEncoding {
 /// Writes an unstructured-grid VTK XML file (version 1.0) that ParaView opens: points at
 /// the **rest positions**, the point array "displacement" (3 components) when
 /// displacement is given (empty: the rest shape only; else 3n stacked x y z per vertex),
-/// tetrahedra (VTK type 10), a per-cell Int32 "material" array (material index), and the
-/// given point and cell arrays (ValidationError if a size or component count is wrong).
-/// The deformed shape is rest + displacement: in ParaView apply Warp By Vector with
-/// "displacement" (scale 1). Written to PATH.tmp and renamed over PATH.
+/// tetrahedra (VTK type 10) or hexahedra (VTK type 12, the mesh's vertex order), a per-cell Int32 "material" array
+/// (material index), and the given point and cell arrays (ValidationError if a size or component count is wrong). The
+/// deformed shape is rest + displacement: in ParaView apply Warp By Vector with "displacement" (scale 1). Written to
+/// PATH.tmp and renamed over PATH.
 void writeVtu(const std::filesystem::path& path, const TetMesh& mesh, const Eigen::VectorXd& displacement = {},
               const std::vector<VtuArray>& pointArrays = {}, const std::vector<VtuArray>& cellArrays = {},
               VtuEncoding encoding = VtuEncoding::binary);
