@@ -300,9 +300,8 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
   const FreeDofs& freeDofs = context.system.freeDofs;
   if (out.automaticRegions) {
     if (out.automatic.modalCheck) {
-      // The modal check needs the linear K (= the corotational rest tangent) and M.
-      const VibrationMatrices matrices = vibrationMatrices(mesh, context.massType);
-      out.proposal = suggestRegions(mesh, freeDofs, out.automatic, matrices.stiffness, matrices.mass);
+      // K and M are assembled only when the modal check runs (not after the pre-check).
+      out.proposal = suggestRegions(mesh, freeDofs, out.automatic, context.massType);
     } else {
       out.proposal = suggestRegions(mesh, freeDofs, out.automatic);
     }
