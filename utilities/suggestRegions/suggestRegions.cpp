@@ -241,21 +241,26 @@ void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const A
   std::printf("mesh: %d vertices, %d tets; hL = %g; target omega*h = %.3g%s\n", mesh.numVertices(), mesh.numElements(),
               largeTimestep, proposal.targetOmegaH, options.targetOmegaH > 0 ? "" : " (relative mode)");
   std::printf("L: max omega*hL = %.3g over the elements left in L\n", proposal.largeRegionMaxFrequency * largeTimestep);
-  if (proposal.regions.empty() && proposal.withdrawnRegions.empty()) {
+  if (proposal.regions.empty() && proposal.withdrawnRegions.empty() && proposal.precheckWithdrawnRegions.empty()) {
     std::printf("no fast region needed: every element meets the target at hL\n");
   }
   std::printf("%-8s %8s %10s %10s %12s %14s %12s\n", "region", "ratio", "vertices", "tets", "interface", "max omega",
               "omega*hS");
-  for (const std::vector<ProposedRegion>* list : {&proposal.regions, &proposal.withdrawnRegions}) {
+  for (const std::vector<ProposedRegion>* list :
+       {&proposal.regions, &proposal.withdrawnRegions, &proposal.precheckWithdrawnRegions}) {
     for (const ProposedRegion& r : *list) {
       std::printf("%-8s %8d %10zu %10d %12d %14.3g %12.3g%s\n", r.region.name.c_str(), r.region.ratio,
                   r.region.vertices.size(), r.numElements, r.numInterfaceDofs, r.maxFrequency,
                   r.maxFrequency * largeTimestep / r.region.ratio,
-                  list == &proposal.withdrawnRegions ? "  (withdrawn by the modal check)" : "");
+                  list == &proposal.withdrawnRegions           ? "  (withdrawn by the modal check)"
+                  : list == &proposal.precheckWithdrawnRegions ? "  (withdrawn by the pre-check)"
+                                                               : "");
     }
   }
-  std::printf("decided in %.3g ms (element frequencies %.3g ms%s)\n", 1e3 * proposal.decisionSeconds,
-              1e3 * proposal.frequencySeconds, proposal.modalReport ? ", modal check included" : "");
+  std::printf("decided in %.3g ms by the %s (element frequencies %.3g ms%s)\n", 1e3 * proposal.decisionSeconds,
+              toString(proposal.decidedBy), 1e3 * proposal.frequencySeconds,
+              proposal.modalReport ? ", modal check included" : "");
+  if (!proposal.precheckWithdrawnRegions.empty()) std::printf("%s\n", autoRegionSummary(proposal).c_str());
   // The cost check ran first; when the modal check then withdrew the regions, say so on the
   // same line, so that "kept" is never read as the final answer.
   if (proposal.cost.evaluated) {
@@ -263,8 +268,9 @@ void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const A
                 proposal.withdrawnRegions.empty() ? "" : " (then withdrawn by the modal check below)");
   }
   if (proposal.modalReport) {
-    std::printf("modal check (%zu lowest modes, %.3g s): %s\n", proposal.modalReport->modes.size(),
-                proposal.modalSeconds, proposal.modalReport->verdictText().c_str());
+    std::printf("modal check (%zu lowest modes, %.3g s: %d factorization, %d solves): %s\n",
+                proposal.modalReport->modes.size(), proposal.modalSeconds, proposal.modalFactorizations,
+                proposal.modalSolves, proposal.modalReport->verdictText().c_str());
     for (const ProposedRegion& r : proposal.regions) {
       std::printf("ratio of %s: %s\n", r.region.name.c_str(), ratioReason(proposal, r).c_str());
     }

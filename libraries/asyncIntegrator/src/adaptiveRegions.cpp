@@ -193,6 +193,20 @@ AdaptiveRegionPolicy::AdaptiveRegionPolicy(const TetMesh& mesh, const FreeDofs& 
   const std::vector<int>& fullToFree = freeDofs.fullToFree();
   for (std::size_t dof = 0; dof < fullToFree.size(); ++dof)
     if (fullToFree[dof] >= 0) hasFreeDof_[dof / 3] = 1;
+  if (o.loads) {
+    loads_.emplace(mesh, hasFreeDof_,
+                   LoadsPolicySettings{o.loadsRatio, o.loadsRings, o.loadsParts, o.loadsRelease, o.minDwell,
+                                       o.loadsNeighbourhood});
+  }
+}
+
+void AdaptiveRegionPolicy::setExternalForce(ExternalForceFunction force, ExternalForceChanges changes) {
+  if (loads_) loads_->setExternalForce(std::move(force), std::move(changes));
+}
+
+const std::vector<LoadsSwitch>& AdaptiveRegionPolicy::loadsSwitches() const {
+  static const std::vector<LoadsSwitch> none;
+  return loads_ ? loads_->switches() : none;
 }
 
 std::vector<char> AdaptiveRegionPolicy::contactVertices(double largeStep, const Eigen::VectorXd& u,
@@ -286,6 +300,8 @@ std::vector<AsyncRegion> AdaptiveRegionPolicy::assemble(double time, const std::
     regions.push_back(
         {window.name.empty() ? "schedule" + std::to_string(w) : window.name, window.vertices, window.ratio});
   }
+  if (loads_)
+    for (AsyncRegion& part : loads_->regions()) regions.push_back(std::move(part));
   AsyncRegion touching{"contact", {}, options_.contactRatio};
   for (std::size_t vertex = 0; vertex < contact.size(); ++vertex)
     if (contact[vertex]) touching.vertices.push_back(static_cast<int>(vertex));
@@ -336,6 +352,10 @@ bool AdaptiveRegionPolicy::canServe(const std::vector<AsyncRegion>& regions, con
   for (const ScheduledRegion& window : options_.schedule)
     for (const int vertex : window.vertices)
       if (have[static_cast<std::size_t>(vertex)] != want[static_cast<std::size_t>(vertex)]) return false;
+  // So do the loads policy's parts: fast exactly while the policy holds them fast.
+  if (loads_)
+    for (const int vertex : loads_->partVertices())
+      if (have[static_cast<std::size_t>(vertex)] != want[static_cast<std::size_t>(vertex)]) return false;
   return true;
 }
 
@@ -346,6 +366,8 @@ std::optional<std::vector<AsyncRegion>> AdaptiveRegionPolicy::decide(double time
                                                                      long long stepsKept, std::string& reason) {
   const int n = mesh_->numVertices();
   recordVelocity(time, v);
+  std::string loadsReason;
+  const bool loadsChanged = loads_ && loads_->update(time, largeStep, u, v, loadsReason);
   const std::vector<char> needed = contactVertices(largeStep, u, v, proximity, options_.contactRings);
   const std::vector<int> indicated = indicatorRatios(0);
   std::vector<char> generous = needed;
@@ -360,8 +382,12 @@ std::optional<std::vector<AsyncRegion>> AdaptiveRegionPolicy::decide(double time
     lastWindows_ = windows;
     return std::nullopt;
   }
-  if (!started_ || windows != lastWindows_) {
-    reason = started_ ? "schedule window opens or closes" : "initial regions";
+  if (!started_ || windows != lastWindows_ || loadsChanged) {
+    // Windows and the loads policy switch exactly when they say, whatever the dwell.
+    reason = loadsChanged ? loadsReason : "";
+    if (started_ && windows != lastWindows_)
+      reason += (reason.empty() ? "" : "; ") + std::string("schedule window opens or closes");
+    if (reason.empty()) reason = "initial regions";
   } else {
     // Replace at once when the regions in use miss a vertex a policy needs (or give it
     // fewer substeps); otherwise only after the dwell, and only to shrink by a margin.

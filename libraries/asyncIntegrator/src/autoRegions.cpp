@@ -5,12 +5,12 @@
 #include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
-#include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <string>
@@ -49,6 +49,42 @@ Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh) {
     omega[e] = elementMaxFrequency(mesh.elementRestPositions(e), mesh.elementMaterial(e));
   }
   return omega;
+}
+
+namespace {
+/// The regular tetrahedron of unit edge length.
+Eigen::Matrix<double, 3, 4> unitRegularTet() {
+  Eigen::Matrix<double, 3, 4> x;
+  x << 1, 1, -1, -1, 1, -1, 1, -1, 1, -1, -1, 1;
+  return x / std::sqrt(8.0);  // edges of length 2 sqrt(2) before
+}
+
+double rmsEdgeLength(const Eigen::Matrix<double, 3, 4>& x) {
+  double sum = 0.0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) sum += (x.col(a) - x.col(b)).squaredNorm();
+  return std::sqrt(sum / 6.0);
+}
+}  // namespace
+
+double elementSizeFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, const Material& material) {
+  // omega scales as 1 / length at a fixed shape: the unit regular tet's frequency over the edge.
+  const double edge = rmsEdgeLength(restPositions);
+  return edge > 0.0 ? elementMaxFrequency(unitRegularTet(), material) / edge : std::numeric_limits<double>::infinity();
+}
+
+const char* toString(AutoRegionPath path) {
+  switch (path) {
+    case AutoRegionPath::elementCriterion:
+      return "element criterion";
+    case AutoRegionPath::precheck:
+      return "pre-check";
+    case AutoRegionPath::costCheck:
+      return "cost check";
+    case AutoRegionPath::modalCheck:
+      return "modal check";
+  }
+  return "?";
 }
 
 std::vector<AsyncRegion> AutoRegionProposal::asyncRegions() const {
@@ -212,6 +248,7 @@ void capRegions(int maxRegions, AutoRegionProposal& proposal) {
 void costCheck(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
                AutoRegionProposal& proposal) {
   if (!options.costCheck || proposal.regions.empty()) return;
+  proposal.decidedBy = AutoRegionPath::costCheck;
   proposal.cost = estimateAsyncCost(mesh, freeDofs, proposal.asyncRegions(), options.nonlinear, options.costMargin);
   if (!proposal.cost.asyncCheaper) {
     proposal.costWithdrawnRegions = std::move(proposal.regions);
@@ -219,9 +256,61 @@ void costCheck(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOp
   }
 }
 
-}  // namespace
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+  return values[values.size() / 2];
+}
 
-AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options) {
+/// The pre-check (AutoRegionOptions::precheck): whether any element is fast by its material
+/// and size alone (elementSizeFrequency() above the target the element criterion uses: the
+/// relative threshold times their median, or the absolute target). When none is, the
+/// elements the criterion marked are fast by their shape only (flat, slim or cut elements,
+/// whose fastest modes are the element's own), and the regions are withdrawn.
+void precheckRegions(const TetMesh& mesh, const Eigen::VectorXd& omega, const AutoRegionOptions& options,
+                     AutoRegionProposal& proposal) {
+  AutoRegionPrecheck& check = proposal.precheck;
+  check.evaluated = true;
+  const int numElements = mesh.numElements();
+  std::vector<double> speed(mesh.materials().size());
+  for (std::size_t k = 0; k < speed.size(); ++k) speed[k] = elementMaxFrequency(unitRegularTet(), mesh.materials()[k]);
+  std::vector<double> sizeFrequency(static_cast<std::size_t>(numElements));
+  double minSpeed = std::numeric_limits<double>::infinity(), maxSpeed = 0.0;
+  double minEdge = std::numeric_limits<double>::infinity(), maxEdge = 0.0;
+  for (int e = 0; e < numElements; ++e) {
+    const double c = speed[static_cast<std::size_t>(mesh.elementMaterialIndex(e))];
+    const double edge = rmsEdgeLength(mesh.elementRestPositions(e));
+    sizeFrequency[static_cast<std::size_t>(e)] = c / edge;
+    minSpeed = std::min(minSpeed, c);
+    maxSpeed = std::max(maxSpeed, c);
+    minEdge = std::min(minEdge, edge);
+    maxEdge = std::max(maxEdge, edge);
+    if (omega[e] * proposal.largeTimestep > proposal.targetOmegaH) ++check.markedElements;
+  }
+  const double typical = median(sizeFrequency);
+  const double hL = proposal.largeTimestep;
+  check.sizeTarget = options.targetOmegaH > 0.0 ? options.targetOmegaH : options.relativeThreshold * typical * hL;
+  double largest = 0.0;
+  for (const double w : sizeFrequency) {
+    largest = std::max(largest, w);
+    if (w * hL > check.sizeTarget) ++check.sizeMarkedElements;
+  }
+  check.medianSizeFrequency = typical;
+  check.maxSizeFrequencyRatio = typical > 0.0 ? largest / typical : 0.0;
+  check.waveSpeedSpread = minSpeed > 0.0 ? maxSpeed / minSpeed : 1.0;
+  check.sizeSpread = minEdge > 0.0 ? maxEdge / minEdge : 1.0;
+  check.shapeOnly = check.sizeMarkedElements == 0;
+  if (check.shapeOnly) {
+    proposal.precheckWithdrawnRegions = std::move(proposal.regions);
+    proposal.regions.clear();
+    proposal.decidedBy = AutoRegionPath::precheck;
+  }
+}
+
+/// The element criterion, the cap, the pre-check when asked (with the modal check) and the
+/// cost check.
+AutoRegionProposal propose(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                           bool precheck) {
   validate(options);
   Stopwatch total;
   total.start();
@@ -239,6 +328,14 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   const std::vector<int> component = fastComponents(mesh, adjacency, fast, numComponents);
   collectRegions(mesh, freeDofs, omega, component, numComponents, options.maxRatio, proposal);
   capRegions(options.maxRegions, proposal);
+  if (precheck && !proposal.regions.empty()) {
+    precheckRegions(mesh, omega, options, proposal);
+    if (proposal.decidedBy == AutoRegionPath::precheck) {
+      total.stop();
+      proposal.decisionSeconds = total.totalSeconds();
+      return proposal;
+    }
+  }
   // Interface sizes, from the partition the proposal defines.
   const RegionPartition partition(mesh, freeDofs, proposal.asyncRegions());
   for (int i = 0; i < partition.numRegions(); ++i) {
@@ -251,122 +348,10 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   return proposal;
 }
 
-namespace {
-
-/// Cost of a Cholesky factor, from CHOLMOD's symbolic analysis (METIS ordering) of the
-/// pattern: the factor's non-zeros and the flops of a numeric factorization.
-struct FactorCost {
-  double entries = 0.0;
-  double flops = 0.0;
-  double solveFlops() const { return 4.0 * entries; }
-};
-
-/// The DOF-level pattern of the stiffness coupling (3 x 3 blocks of vertex pairs that share
-/// an element, diagonals included) restricted to `dofs`, plus a dense block over each of
-/// `denseBlocks` (DOFs in `dofs`), analysed symbolically; also returns its non-zeros.
-FactorCost analyseBlock(const std::vector<std::pair<int, int>>& vertexPairs, int numVertices,
-                        const std::vector<int>& dofs, const std::vector<const std::vector<int>*>& denseBlocks,
-                        double* patternEntries) {
-  FactorCost cost;
-  if (patternEntries != nullptr) *patternEntries = 0.0;
-  if (dofs.empty()) return cost;
-  std::vector<int> local(static_cast<std::size_t>(3 * numVertices), -1);
-  for (std::size_t k = 0; k < dofs.size(); ++k) local[static_cast<std::size_t>(dofs[k])] = static_cast<int>(k);
-  std::vector<Eigen::Triplet<double>> entries;
-  const auto add = [&](int a, int b) {
-    const int i = local[static_cast<std::size_t>(a)], j = local[static_cast<std::size_t>(b)];
-    if (i >= 0 && j >= 0) entries.emplace_back(i, j, 1.0);
-  };
-  for (const auto& [x, y] : vertexPairs)
-    for (int c = 0; c < 3; ++c)
-      for (int d = 0; d < 3; ++d) {
-        add(3 * x + c, 3 * y + d);
-        if (x != y) add(3 * y + d, 3 * x + c);
-      }
-  for (const std::vector<int>* block : denseBlocks)
-    for (int a : *block)
-      for (int b : *block) add(a, b);
-  const auto n = static_cast<Eigen::Index>(dofs.size());
-  Eigen::SparseMatrix<double> pattern(n, n);
-  pattern.setFromTriplets(entries.begin(), entries.end(), [](double a, double) { return a; });
-  if (patternEntries != nullptr) *patternEntries = static_cast<double>(pattern.nonZeros());
-  const std::unique_ptr<SparseSolver> solver = makeSparseSolver(SolverKind::cholmod);
-  solver->analyzePattern(pattern);
-  cost.entries = static_cast<double>(solver->stats().factorNonZeros);
-  cost.flops = solver->stats().factorFlops;
-  return cost;
-}
-
 }  // namespace
 
-AutoRegionCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs, const std::vector<AsyncRegion>& regions,
-                                 bool nonlinear, double costMargin) {
-  AutoRegionCost cost;
-  cost.evaluated = true;
-  const RegionPartition partition(mesh, freeDofs, regions);
-  const int nv = mesh.numVertices();
-  std::vector<std::pair<int, int>> pairs;
-  pairs.reserve(static_cast<std::size_t>(6 * mesh.numElements() + nv));
-  for (int v = 0; v < nv; ++v) pairs.emplace_back(v, v);
-  for (int e = 0; e < mesh.numElements(); ++e)
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) {
-        const int x = mesh.elements()(a, e), y = mesh.elements()(b, e);
-        pairs.emplace_back(std::min(x, y), std::max(x, y));
-      }
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  std::vector<int> allFree;
-  for (int dof = 0; dof < 3 * nv; ++dof)
-    if (!freeDofs.isFixed(dof)) allFree.push_back(dof);
-  const int numRegions = partition.numRegions();
-  const double nL = static_cast<double>(partition.largeDofs().size());
-  cost.freeDofs = freeDofs.numFree();
-  cost.largeDofs = static_cast<int>(nL);
-  // Single-rate: one back-substitution (plus the K v and f_int products) per step;
-  // nonlinear: a numeric factorization too.
-  double allEntries = 0.0;
-  const FactorCost full = analyseBlock(pairs, nv, allFree, {}, &allEntries);
-  const double singleStep = full.solveFlops() + 4.0 * allEntries + (nonlinear ? full.flops : 0.0);
-  int maxRatio = 1;
-  for (int i = 0; i < numRegions; ++i) maxRatio = std::max(maxRatio, partition.ratio(i));
-  cost.singleRateSubsteps = maxRatio;
-  cost.singleRateFlops = maxRatio * singleStep;
-  cost.singleRateSetupFlops = full.flops;
-  // Async: H^{LL*} is A^L plus a dense I_i x I_i block per region; per region m_i
-  // forward-substitution solves, and the recovery (a second forward substitution or the
-  // dense 4 |S| q products, whichever is cheaper).
-  double zSolves = 0.0, regionFactorFlops = 0.0, regionSteps = 0.0;
-  std::vector<const std::vector<int>*> interfaces;
-  for (int i = 0; i < numRegions; ++i) {
-    const double s = static_cast<double>(partition.regionDofs(i).size());
-    const double q = static_cast<double>(partition.interfaceDofs(i).size());
-    const double m = partition.ratio(i);
-    cost.interfaceDofs += static_cast<int>(q);
-    interfaces.push_back(&partition.interfaceDofs(i));
-    double entries = 0.0;
-    const FactorCost region = analyseBlock(pairs, nv, partition.regionDofs(i), {}, &entries);
-    const double substitution = m * (region.solveFlops() + 4.0 * entries);
-    regionSteps += substitution + std::min(substitution, 4.0 * s * q);
-    zSolves += m * q * (region.solveFlops() + 4.0 * entries);
-    regionFactorFlops += region.flops;
-  }
-  double largeEntries = 0.0;
-  const FactorCost schur = analyseBlock(pairs, nv, partition.largeDofs(), interfaces, &largeEntries);
-  const double asyncSetup = regionFactorFlops + zSolves + schur.flops;
-  cost.asyncSetupFlops = asyncSetup;
-  cost.asyncFlops = schur.solveFlops() + regionSteps + 4.0 * allEntries + (nonlinear ? asyncSetup : 0.0);
-  cost.asyncCheaper = cost.asyncFlops < costMargin * cost.singleRateFlops;
-  char line[400];
-  std::snprintf(line, sizeof line,
-                "%s: async %.3g Mflop per large step (%d regions, %d interface DOFs, |L| = %d) against %.3g Mflop for "
-                "%d single-rate step%s at hL/%d (ratio %.2f); set-up %.3g against %.3g Mflop",
-                cost.asyncCheaper ? "async regions kept" : "regions withdrawn, single-rate", 1e-6 * cost.asyncFlops,
-                numRegions, cost.interfaceDofs, cost.largeDofs, 1e-6 * cost.singleRateFlops, maxRatio,
-                maxRatio == 1 ? "" : "s", maxRatio, cost.ratio(), 1e-6 * cost.asyncSetupFlops,
-                1e-6 * cost.singleRateSetupFlops);
-  cost.decision = line;
-  return cost;
+AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options) {
+  return propose(mesh, freeDofs, options, false);
 }
 
 std::vector<ModalRegion> modalRegions(const std::vector<AsyncRegion>& regions) {
@@ -403,32 +388,55 @@ bool ratiosFromModes(const AutoRegionOptions& options, AutoRegionProposal& propo
   return raised;
 }
 
-/// The lowest modes of (stiffness, mass) on the free DOFs: options.modalCount, doubled
-/// while the highest is still below the Nyquist frequency (visible modes beyond the
-/// computed ones could live in S), up to maxModalCount.
+/// How many modes to ask for next when the highest of `frequencies` (ascending, k of them)
+/// is still below the Nyquist frequency: the count N(omega) = k (omega / omega_k)^p of a
+/// power law through the computed spectrum (p from modes k/2 and k) at the Nyquist
+/// frequency, plus a fifth, and at least 2k. One more Lanczos run then usually covers every
+/// visible mode, where doubling took up to three (each a basis of 2k + 1 solves).
+int nextModalCount(const Eigen::VectorXd& frequencies, double nyquist) {
+  const auto k = static_cast<int>(frequencies.size());
+  int next = 2 * k;
+  const double low = frequencies[k / 2 - 1], high = frequencies[k - 1];
+  if (k >= 4 && low > 0.0 && high > low) {
+    const double power = std::log(static_cast<double>(k) / (k / 2)) / std::log(high / low);
+    const double predicted = k * std::pow(nyquist / high, power);
+    if (std::isfinite(predicted)) next = std::max(next, static_cast<int>(std::ceil(1.2 * predicted)));
+  }
+  return next;
+}
+
+/// The lowest modes of (stiffness, mass) on the free DOFs: options.modalCount, raised by
+/// nextModalCount() while the highest is still below the Nyquist frequency (visible modes beyond the
+/// computed ones could live in S), up to maxModalCount; one factorization of K - sigma M
+/// for every count (LowestModesSolver), Ritz values to options.modalTolerance.
 ModalResult modesUpToNyquist(const FreeDofs& freeDofs, const AutoRegionOptions& options,
                              const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
-                             double& seconds) {
+                             AutoRegionProposal& proposal) {
+  Stopwatch watch;
   const double nyquist = modalCriteria::nyquistPerFrameRate * options.frameRate;
   const int largestCount = std::min(options.maxModalCount, freeDofs.numFree() - 1);
   ModalOptions modal;
-  modal.count = std::min(options.modalCount, largestCount);
-  ModalResult modes = lowestModes(stiffness, mass, freeDofs, modal);
-  seconds = modes.solveSeconds;
-  while (modes.frequencies[modes.frequencies.size() - 1] < nyquist && modal.count < largestCount) {
-    modal.count = std::min(2 * modal.count, largestCount);
-    modes = lowestModes(stiffness, mass, freeDofs, modal);
-    seconds += modes.solveSeconds;
+  modal.tolerance = options.modalTolerance;
+  int count = std::min(options.modalCount, largestCount);
+  modal.count = count;
+  const LowestModesSolver solver(stiffness, mass, freeDofs, modal);
+  ModalResult modes = solver.compute(count);
+  while (modes.frequencies[modes.frequencies.size() - 1] < nyquist && count < largestCount) {
+    count = std::min(nextModalCount(modes.frequencies, nyquist), largestCount);
+    modes = solver.compute(count);
   }
+  modes.factorSeconds = solver.factorSeconds();
+  proposal.modalFactorizations = 1;
+  proposal.modalSolves = solver.operatorApplications();
+  proposal.modalFactorSeconds = solver.factorSeconds();
+  proposal.modalSeconds = watch.stop();
   return modes;
 }
 
 /// The modal check of the element criterion's regions (options.modalCheck): ratios from
 /// the modes they keep (then priced again by the cost check), withdrawn when no visible
 /// mode lives in them.
-void checkModes(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
-                const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
-                AutoRegionProposal& proposal) {
+void validateModalCheck(const AutoRegionOptions& options) {
   if (!(options.frameRate > 0.0) || !std::isfinite(options.frameRate)) {
     throw ValidationError("automatic regions: the frame rate of the modal check must be positive");
   }
@@ -438,8 +446,17 @@ void checkModes(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionO
   if (!(options.modeOmegaSubstep > 0.0) || !std::isfinite(options.modeOmegaSubstep)) {
     throw ValidationError("automatic regions: modeOmegaSubstep must be positive");
   }
+  if (!(options.modalTolerance > 0.0) || !std::isfinite(options.modalTolerance)) {
+    throw ValidationError("automatic regions: modalTolerance must be positive");
+  }
+}
+
+void checkModes(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
+                AutoRegionProposal& proposal) {
   if (proposal.regions.empty()) return;
-  const ModalResult modes = modesUpToNyquist(freeDofs, options, stiffness, mass, proposal.modalSeconds);
+  const ModalResult modes = modesUpToNyquist(freeDofs, options, stiffness, mass, proposal);
+  proposal.decidedBy = AutoRegionPath::modalCheck;
   const auto report = [&] {
     return analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep,
                               options.frameRate);
@@ -449,6 +466,7 @@ void checkModes(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionO
     proposal.modalReport = report();
     costCheck(mesh, freeDofs, options, proposal);
   }
+  proposal.decidedBy = AutoRegionPath::modalCheck;  // also when its ratios sent the regions to the cost check again
   if (proposal.modalReport->verdict == ModalVerdict::noVisibleModeInFast) {
     proposal.withdrawnRegions = std::move(proposal.regions);
     proposal.regions.clear();
@@ -461,8 +479,29 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
                                   const Eigen::SparseMatrix<double>& mass) {
   Stopwatch total;
   total.start();
-  AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options);
-  if (options.modalCheck) checkModes(mesh, freeDofs, options, stiffness, mass, proposal);
+  AutoRegionProposal proposal = propose(mesh, freeDofs, options, options.modalCheck && options.precheck);
+  if (options.modalCheck) {
+    validateModalCheck(options);
+    checkModes(mesh, freeDofs, options, stiffness, mass, proposal);
+  }
+  total.stop();
+  proposal.decisionSeconds = total.totalSeconds();
+  return proposal;
+}
+
+AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                                  MassType massType) {
+  Stopwatch total;
+  total.start();
+  AutoRegionProposal proposal = propose(mesh, freeDofs, options, options.modalCheck && options.precheck);
+  if (options.modalCheck) {
+    validateModalCheck(options);
+    if (!proposal.regions.empty()) {
+      // K (the linear one: the corotational rest tangent) and M, only for a modal check that runs.
+      const VibrationMatrices matrices = vibrationMatrices(mesh, massType);
+      checkModes(mesh, freeDofs, options, matrices.stiffness, matrices.mass, proposal);
+    }
+  }
   total.stop();
   proposal.decisionSeconds = total.totalSeconds();
   return proposal;
@@ -496,6 +535,19 @@ std::string autoRegionDecision(const AutoRegionProposal& proposal) {
     }
     return line;
   }
+  if (!proposal.precheckWithdrawnRegions.empty()) {
+    const AutoRegionPrecheck& c = proposal.precheck;
+    char line[600];
+    std::snprintf(line, sizeof line,
+                  "no fast region kept, single-rate at hL: the pre-check found no light or stiff part: wave speeds "
+                  "within %.3gx and element sizes within %.3gx leave every element's frequency at its material and "
+                  "size (a regular tet's) within %.3gx of their median (the limit: %.3gx), so the %d element(s) above "
+                  "the target omega*hL = %.3g are fast by their shape alone; %zu region(s) withdrawn, no modal solve",
+                  c.waveSpeedSpread, c.sizeSpread, c.maxSizeFrequencyRatio,
+                  c.medianSizeFrequency > 0.0 ? c.sizeTarget / (proposal.largeTimestep * c.medianSizeFrequency) : 0.0,
+                  c.markedElements, proposal.targetOmegaH, proposal.precheckWithdrawnRegions.size());
+    return prefix + line;
+  }
   if (!proposal.withdrawnRegions.empty()) {
     return prefix + "no fast region kept, single-rate at hL: the modal check withdrew " +
            std::to_string(proposal.withdrawnRegions.size()) +
@@ -514,8 +566,16 @@ std::string autoRegionDecision(const AutoRegionProposal& proposal) {
 }  // namespace
 
 std::string autoRegionSummary(const AutoRegionProposal& proposal) {
-  char decided[80];
-  std::snprintf(decided, sizeof decided, " (decided in %.3g ms)", 1e3 * proposal.decisionSeconds);
+  char decided[200];
+  if (proposal.modalFactorizations > 0) {
+    std::snprintf(decided, sizeof decided,
+                  " (decided in %.3g ms by the %s; its modal solve %.3g ms: %d factorization (%.3g ms) and %d solves)",
+                  1e3 * proposal.decisionSeconds, toString(proposal.decidedBy), 1e3 * proposal.modalSeconds,
+                  proposal.modalFactorizations, 1e3 * proposal.modalFactorSeconds, proposal.modalSolves);
+  } else {
+    std::snprintf(decided, sizeof decided, " (decided in %.3g ms by the %s)", 1e3 * proposal.decisionSeconds,
+                  toString(proposal.decidedBy));
+  }
   return autoRegionDecision(proposal) + decided;
 }
 

@@ -239,8 +239,29 @@ AdaptiveRegionOptions parseAdaptive(const IntegratorContext& context, const nloh
       out.schedule.push_back(std::move(window));
     }
   }
-  if (!out.contact && !out.indicator && out.schedule.empty()) {
-    JsonObjectReader::failAt(sourceName, path, "give at least one policy: \"contact\", \"indicator\" or \"schedule\"");
+  if (const nlohmann::json* loads = reader.find("loads")) {  // the loads policy: loadsPolicy.hpp
+    JsonObjectReader c(*loads, reader.keyPath("loads"), sourceName);
+    out.loads = true;
+    out.loadsRatio = c.integer("ratio", out.loadsRatio, 2, 100000);
+    out.loadsRings = c.integer("rings", out.loadsRings, 0, 100);
+    out.loadsNeighbourhood = c.integer("neighbourhood", out.loadsNeighbourhood, 0, 100);
+    out.loadsRelease = c.number("release", out.loadsRelease);
+    if (!(out.loadsRelease >= 0.0 && out.loadsRelease < 1.0))
+      c.fail("release", "must be in [0, 1) (of the peak energy)");
+    if (const nlohmann::json* parts = c.find("parts")) {
+      if (!parts->is_array()) c.fail("parts", "expected an array of regions");
+      for (std::size_t i = 0; i < parts->size(); ++i) {
+        AsyncRegion part = parseRegion(sourceName, *context.mesh, (*parts)[i], c.elementPath("parts", i));
+        if (!(*parts)[i].contains("ratio")) part.ratio = out.loadsRatio;
+        if (part.ratio < 2) JsonObjectReader::failAt(sourceName, c.elementPath("parts", i) + ".ratio", "must be >= 2");
+        out.loadsParts.push_back(std::move(part));
+      }
+    }
+    c.finish();
+  }
+  if (!out.contact && !out.indicator && out.schedule.empty() && !out.loads) {
+    JsonObjectReader::failAt(sourceName, path,
+                             "give at least one policy: \"contact\", \"indicator\", \"schedule\" or \"loads\"");
   }
   out.minDwell = reader.integer("minDwell", out.minDwell, 0, 1000000);
   out.shrinkFactor = reader.number("shrink", out.shrinkFactor);
@@ -350,9 +371,8 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
   const FreeDofs& freeDofs = context.system.freeDofs;
   if (out.automaticRegions) {
     if (out.automatic.modalCheck) {
-      // The modal check needs the linear K (= the corotational rest tangent) and M.
-      const VibrationMatrices matrices = vibrationMatrices(mesh, context.massType);
-      out.proposal = suggestRegions(mesh, freeDofs, out.automatic, matrices.stiffness, matrices.mass);
+      // K and M are assembled only when the modal check runs (not after the pre-check).
+      out.proposal = suggestRegions(mesh, freeDofs, out.automatic, context.massType);
     } else {
       out.proposal = suggestRegions(mesh, freeDofs, out.automatic);
     }

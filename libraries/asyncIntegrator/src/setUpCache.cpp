@@ -37,7 +37,11 @@ void AsyncBackwardEuler::setAdaptiveRegions(AdaptiveRegionOptions options) {
         "async integrator: adaptive regions: the contact policy needs obstacles (a \"contact\" section)");
   }
   if (options.nest) requireHierarchyComposes(options_, "run-time regions that nest");
+  if (options.loads && !system_.externalForce) {
+    throw ValidationError("async integrator: adaptive regions: the loads policy needs loads (an external force)");
+  }
   policy_ = std::make_unique<AdaptiveRegionPolicy>(*system_.mesh, system_.freeDofs, std::move(options));
+  policy_->setExternalForce(system_.externalForce, system_.externalForceChanges);
   stepsKept_ = 0;
   maybeRepartition();
 }

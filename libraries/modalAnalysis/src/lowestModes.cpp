@@ -26,7 +26,9 @@ class ShiftInvertOperator {
   Eigen::Index rows() const { return stiffness_.rows(); }
   Eigen::Index cols() const { return stiffness_.cols(); }
 
+  // Factors once: a later solver built on this operator with the same shift keeps the factor.
   void set_shift(double sigma) {  // NOLINT(readability-identifier-naming): Spectra's interface
+    if (factored_ && sigma == sigma_) return;
     Stopwatch watch;
     Eigen::SparseMatrix<double> shifted = stiffness_ - sigma * mass_;
     shifted.makeCompressed();
@@ -38,6 +40,8 @@ class ShiftInvertOperator {
                            "): a Cholesky solver needs a shift below the lowest eigenvalue; " + e.what());
     }
     factorSeconds_ = watch.stop();
+    factored_ = true;
+    sigma_ = sigma;
   }
 
   void perform_op(const double* in, double* out) const {  // NOLINT(readability-identifier-naming)
@@ -57,6 +61,8 @@ class ShiftInvertOperator {
   mutable Eigen::MatrixXd scratch_;
   mutable int applications_ = 0;
   double factorSeconds_ = 0.0;
+  bool factored_ = false;
+  double sigma_ = 0.0;
 };
 
 // Spectra's operator for y = M x (the B of the generalized problem).
@@ -97,14 +103,15 @@ void checkModalProblem(const Eigen::SparseMatrix<double>& stiffness, const Eigen
                           std::to_string(mass.cols()) + ", expected " + std::to_string(numDofs) + "x" +
                           std::to_string(numDofs) + " (the DOFs of FreeDofs)");
   }
-  const int numFree = freeDofs.numFree();
-  if (options.count <= 0 || options.count >= numFree) {
-    throw ValidationError("modal analysis: the number of modes must be in [1, " + std::to_string(numFree - 1) +
-                          "] (fewer than the " + std::to_string(numFree) + " free DOFs), got " +
-                          std::to_string(options.count));
-  }
   if (!(options.tolerance > 0.0) || options.maxIterations < 1) {
     throw ValidationError("modal analysis: the tolerance must be > 0 and maxIterations >= 1");
+  }
+}
+
+void checkModeCount(int count, int numFree) {
+  if (count <= 0 || count >= numFree) {
+    throw ValidationError("modal analysis: the number of modes must be in [1, " + std::to_string(numFree - 1) +
+                          "] (fewer than the " + std::to_string(numFree) + " free DOFs), got " + std::to_string(count));
   }
 }
 
@@ -131,43 +138,79 @@ VibrationMatrices vibrationMatrices(const TetMesh& mesh, MassType massType) {
   return matrices;
 }
 
+struct LowestModesSolver::State {
+  State(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass, const FreeDofs& dofs,
+        const ModalOptions& modalOptions)
+      : options(modalOptions),
+        freeDofs(dofs),
+        stiffnessFree(SubmatrixExtractor(stiffness, dofs.freeToFull(), dofs.freeToFull()).extract(stiffness)),
+        massFree(SubmatrixExtractor(mass, dofs.freeToFull(), dofs.freeToFull()).extract(mass)),
+        sigma(std::isnan(modalOptions.shift) ? defaultShift(stiffnessFree, massFree) : modalOptions.shift),
+        shiftInvert(stiffnessFree, massFree, modalOptions.solver),
+        massProduct(massFree) {}
+  ModalOptions options;
+  FreeDofs freeDofs;
+  Eigen::SparseMatrix<double> stiffnessFree, massFree;
+  double sigma;
+  ShiftInvertOperator shiftInvert;
+  MassOperator massProduct;
+};
+
+LowestModesSolver::LowestModesSolver(const Eigen::SparseMatrix<double>& stiffness,
+                                     const Eigen::SparseMatrix<double>& mass, const FreeDofs& freeDofs,
+                                     const ModalOptions& options) {
+  checkModalProblem(stiffness, mass, freeDofs, options);
+  state_ = std::make_unique<State>(stiffness, mass, freeDofs, options);
+  if (!std::isfinite(state_->sigma)) throw ValidationError("modal analysis: the shift must be finite");
+  state_->shiftInvert.set_shift(state_->sigma);
+}
+
+LowestModesSolver::~LowestModesSolver() = default;
+
+int LowestModesSolver::numFree() const { return state_->freeDofs.numFree(); }
+double LowestModesSolver::shift() const { return state_->sigma; }
+double LowestModesSolver::factorSeconds() const { return state_->shiftInvert.factorSeconds(); }
+int LowestModesSolver::operatorApplications() const { return state_->shiftInvert.applications(); }
+
+ModalResult LowestModesSolver::compute(int count) const {
+  const int numFree = state_->freeDofs.numFree();
+  checkModeCount(count, numFree);
+  Stopwatch total;
+  const int applicationsBefore = state_->shiftInvert.applications();
+  // Lanczos basis: at least 2K + 1 vectors (Spectra's advice) and some slack for clusters
+  // such as the six rigid modes, never more than the problem size.
+  const int basisSize = std::min(numFree, std::max(2 * count + 1, count + 20));
+  using Solver = Spectra::SymGEigsShiftSolver<ShiftInvertOperator, MassOperator, Spectra::GEigsMode::ShiftInvert>;
+  // The operator is factored already at this shift: set_shift() keeps the factor.
+  Solver eigs(state_->shiftInvert, state_->massProduct, count, basisSize, state_->sigma);
+  eigs.init();  // Spectra's fixed-seed start vector: results are reproducible
+  const Eigen::Index converged = eigs.compute(Spectra::SortRule::LargestMagn, state_->options.maxIterations,
+                                              state_->options.tolerance, Spectra::SortRule::SmallestAlge);
+  if (eigs.info() != Spectra::CompInfo::Successful) {
+    throw NumericalError("modal analysis: the Lanczos iteration converged for " + std::to_string(converged) + " of " +
+                         std::to_string(count) + " modes after " + std::to_string(eigs.num_iterations()) +
+                         " restarts (shift " + std::to_string(state_->sigma) +
+                         "); ask for fewer modes, more iterations or a looser tolerance");
+  }
+  ModalResult result;
+  result.shift = state_->sigma;
+  result.eigenvalues = eigs.eigenvalues();
+  result.frequencies = result.eigenvalues.cwiseMax(0.0).cwiseSqrt();
+  result.modes = massNormalizedModes(eigs.eigenvectors(), state_->massFree, state_->freeDofs);
+  result.iterations = static_cast<int>(eigs.num_iterations());
+  result.operatorApplications = state_->shiftInvert.applications() - applicationsBefore;
+  result.solveSeconds = total.stop();
+  return result;
+}
+
 ModalResult lowestModes(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
                         const FreeDofs& freeDofs, const ModalOptions& options) {
   checkModalProblem(stiffness, mass, freeDofs, options);
-  const int numFree = freeDofs.numFree();
+  checkModeCount(options.count, freeDofs.numFree());
   Stopwatch total;
-  const SubmatrixExtractor extractor(stiffness, freeDofs.freeToFull(), freeDofs.freeToFull());
-  const Eigen::SparseMatrix<double> stiffnessFree = extractor.extract(stiffness);
-  const SubmatrixExtractor massExtractor(mass, freeDofs.freeToFull(), freeDofs.freeToFull());
-  const Eigen::SparseMatrix<double> massFree = massExtractor.extract(mass);
-  const double sigma = std::isnan(options.shift) ? defaultShift(stiffnessFree, massFree) : options.shift;
-  if (!std::isfinite(sigma)) throw ValidationError("modal analysis: the shift must be finite");
-
-  ShiftInvertOperator shiftInvert(stiffnessFree, massFree, options.solver);
-  MassOperator massProduct(massFree);
-  // Lanczos basis: at least 2K + 1 vectors (Spectra's advice) and some slack for clusters
-  // such as the six rigid modes, never more than the problem size.
-  const int basisSize = std::min(numFree, std::max(2 * options.count + 1, options.count + 20));
-  using Solver = Spectra::SymGEigsShiftSolver<ShiftInvertOperator, MassOperator, Spectra::GEigsMode::ShiftInvert>;
-  Solver eigs(shiftInvert, massProduct, options.count, basisSize, sigma);  // factors K - sigma M
-  eigs.init();  // Spectra's fixed-seed start vector: results are reproducible
-  const Eigen::Index converged = eigs.compute(Spectra::SortRule::LargestMagn, options.maxIterations, options.tolerance,
-                                              Spectra::SortRule::SmallestAlge);
-  if (eigs.info() != Spectra::CompInfo::Successful) {
-    throw NumericalError("modal analysis: the Lanczos iteration converged for " + std::to_string(converged) + " of " +
-                         std::to_string(options.count) + " modes after " + std::to_string(eigs.num_iterations()) +
-                         " restarts (shift " + std::to_string(sigma) +
-                         "); ask for fewer modes, more iterations or a looser tolerance");
-  }
-
-  ModalResult result;
-  result.shift = sigma;
-  result.eigenvalues = eigs.eigenvalues();
-  result.frequencies = result.eigenvalues.cwiseMax(0.0).cwiseSqrt();
-  result.modes = massNormalizedModes(eigs.eigenvectors(), massFree, freeDofs);
-  result.iterations = static_cast<int>(eigs.num_iterations());
-  result.operatorApplications = shiftInvert.applications();
-  result.factorSeconds = shiftInvert.factorSeconds();
+  const LowestModesSolver solver(stiffness, mass, freeDofs, options);
+  ModalResult result = solver.compute(options.count);
+  result.factorSeconds = solver.factorSeconds();
   result.solveSeconds = total.stop();
   return result;
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <asyncfem/asyncIntegrator/loadsPolicy.hpp>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/dynamics/dynamicSystem.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
@@ -54,10 +55,24 @@ struct AdaptiveRegionOptions {
   int indicatorRings = 1;
   /// Schedule policy.
   std::vector<ScheduledRegion> schedule;
+  /// Loads policy (LoadsPolicy): a part that a load (a pull window that opens or closes, an
+  /// impulse) reaches within the next large step is fast from that step: the given
+  /// loadsParts holding a reached vertex at their own ratios, else the reached vertices grown
+  /// by loadsRings at loadsRatio. It is released once the energy of its motion relative to
+  /// the rigid motion of its neighbourhood (the part grown by loadsNeighbourhood rings) has
+  /// stayed at or below loadsRelease times its peak since its last load change for minDwell
+  /// large steps. Needs the body's external force (AsyncBackwardEuler passes it).
+  bool loads = false;
+  int loadsRatio = 8;
+  int loadsRings = 1;
+  std::vector<AsyncRegion> loadsParts;
+  double loadsRelease = 0.01;
+  int loadsNeighbourhood = 2;
   /// Hysteresis. A contact region that no longer covers what the policy needs is replaced
   /// at once, grown by contactSlack rings more than needed (so small moves stay inside it); one that
   /// covers it is kept for at least minDwell large steps, then replaced by a smaller one
   /// when it holds more than shrinkFactor times the vertices needed (or none is needed).
+  /// The loads policy releases a part after minDwell quiet large steps.
   int minDwell = 8;
   double shrinkFactor = 2.0;
   /// Regions that touch keep their own ratios where those divide one another across every
@@ -114,6 +129,12 @@ class AdaptiveRegionPolicy {
 
   const AdaptiveRegionOptions& options() const { return options_; }
 
+  /// The body's external force, for the loads policy (DynamicSystem::externalForce and
+  /// externalForceChanges).
+  void setExternalForce(ExternalForceFunction force, ExternalForceChanges changes);
+  /// The loads policy's switches so far (empty without it).
+  const std::vector<LoadsSwitch>& loadsSwitches() const;
+
  private:
   std::vector<char> contactVertices(double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                                     const ObstacleProximity& proximity, int rings) const;
@@ -130,6 +151,7 @@ class AdaptiveRegionPolicy {
   AdaptiveRegionOptions options_;
   std::vector<int> lastWindows_;
   bool started_ = false;
+  std::optional<LoadsPolicy> loads_;
   // The indicator's history: the velocities at the last three large-step boundaries.
   std::vector<Eigen::VectorXd> velocities_;
   double lastRecorded_ = -std::numeric_limits<double>::infinity();

@@ -47,10 +47,24 @@ struct AutoRegionOptions {
   /// that single-rate at hL loses, at m times the cost in S. Off by default here; the scene
   /// path ("regions": "auto") and the suggestRegions utility turn it on.
   bool modalCheck = false;
+  /// The pre-check, run with the modal check before the cost check and instead of any
+  /// eigensolve (docs/asynchronous-integrator.md, "Automatic regions"): when no element is
+  /// fast by its material and size alone (elementSizeFrequency(), against the target the
+  /// element criterion uses), the marked elements are fast by their shape only, which no
+  /// visible mode of a part follows, and every region is withdrawn without a cost check or
+  /// a modal solve (AutoRegionPath::precheck). false: the checks run as they did before it.
+  bool precheck = true;
   double frameRate = 30.0;  ///< frames per second, for the visibility test
-  /// Modes computed first; doubled while the highest is still visible, up to maxModalCount.
+  /// Modes computed first; raised while the highest is still visible (to where a power law
+  /// through the computed spectrum puts the Nyquist frequency, plus a fifth, at least
+  /// doubled), up to maxModalCount. Every count uses the same factorization of K - sigma M
+  /// (LowestModesSolver).
   int modalCount = 20;
   int maxModalCount = 80;
+  /// Relative tolerance of the modal check's Ritz values (ModalOptions::tolerance). The
+  /// check compares omega hL with 0.5 and shares with 0.95, so 1e-6 is ample and needs
+  /// fewer restarts than lowestModes()'s 1e-10.
+  double modalTolerance = 1e-6;
   /// The omega hS the modal check gives the modes a region keeps (visible, living mainly
   /// in it, damped at hL): its ratio becomes at least ceil(omega hL / modeOmegaSubstep).
   /// 0.05 is the design note's resolution (backward Euler keeps 85% of the amplitude per
@@ -92,6 +106,38 @@ struct AutoRegionCost {
   double ratio() const { return singleRateFlops > 0.0 ? asyncFlops / singleRateFlops : 0.0; }
 };
 
+/// The frequency an element would have with its material and size but the best shape: the
+/// highest natural frequency (elementMaxFrequency()) of a regular tetrahedron of the
+/// element's material whose edge is the element's RMS edge length. It is the element
+/// frequency with the shape taken out: a slim or flat element has a much higher
+/// elementMaxFrequency() than this, a small one or one of a fast material (stiff or light)
+/// a higher value of this.
+double elementSizeFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, const Material& material);
+
+/// Which step of suggestRegions() made the decision.
+enum class AutoRegionPath {
+  elementCriterion,  ///< nothing marked (every element meets the target), or regions kept with every check off
+  precheck,          ///< the pre-check withdrew the marked regions: no cost check, no modal solve
+  costCheck,         ///< the cost check withdrew the regions, or kept them with the modal check off
+  modalCheck,        ///< the modal check (a modal solve) kept or withdrew the regions
+};
+const char* toString(AutoRegionPath path);
+
+/// What the pre-check (AutoRegionOptions::precheck) measured.
+struct AutoRegionPrecheck {
+  bool evaluated = false;
+  /// No element is fast by its material and size alone: every element's
+  /// elementSizeFrequency() times hL is at most sizeTarget.
+  bool shapeOnly = false;
+  double sizeTarget = 0.0;  ///< omega*hL limit: the relative threshold times the median, or the absolute target
+  double medianSizeFrequency = 0.0;    ///< median of elementSizeFrequency() over elements (rad/s)
+  double maxSizeFrequencyRatio = 0.0;  ///< max over elements of elementSizeFrequency() / its median
+  double waveSpeedSpread = 1.0;        ///< fastest material's regular-tet frequency / slowest's, over elements
+  double sizeSpread = 1.0;             ///< largest RMS edge length / smallest
+  int markedElements = 0;              ///< elements above the element criterion's target
+  int sizeMarkedElements = 0;          ///< elements above sizeTarget by material and size
+};
+
 /// One proposed fast region with its statistics.
 struct ProposedRegion {
   AsyncRegion region;
@@ -119,6 +165,16 @@ struct AutoRegionProposal {
   /// empty: the asynchronous integrator runs single-rate at hL).
   std::vector<ProposedRegion> withdrawnRegions;
   double modalSeconds = 0.0;  ///< time of the eigensolves of the modal check
+  /// The modal check's solve: factorizations of K - sigma M (one, kept for every count) and
+  /// back-substitutions with it (0 when it did not run).
+  int modalFactorizations = 0;
+  int modalSolves = 0;
+  double modalFactorSeconds = 0.0;
+  /// The pre-check's numbers, and the regions it withdrew (regions is then empty).
+  AutoRegionPrecheck precheck;
+  std::vector<ProposedRegion> precheckWithdrawnRegions;
+  /// Which step decided.
+  AutoRegionPath decidedBy = AutoRegionPath::elementCriterion;
   /// Wall time of suggestRegions(): the element frequencies, and the whole call (marking,
   /// partition, cost check, and the modal check when it ran; the K and M it is given are
   /// assembled by the caller and not counted).
@@ -151,8 +207,9 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
 AutoRegionCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs, const std::vector<AsyncRegion>& regions,
                                  bool nonlinear = false, double costMargin = 1.0);
 
-/// The same proposal, followed by the modal check when options.modalCheck is set and
-/// regions survived the cost check: lowestModes() of stiffness and mass (full 3n x 3n,
+/// The same proposal, with the pre-check (options.precheck) before the cost check and the
+/// modal check when options.modalCheck is set; the modal check runs when regions survived
+/// the pre-check and the cost check: lowestModes() of stiffness and mass (full 3n x 3n,
 /// e.g. vibrationMatrices()) and analyseRegionModes() of the proposed regions at
 /// hL = options.largeTimestep. The ratio of each region is then taken from the modes it
 /// keeps (visible, living mainly in it, damped at hL: omega hS <= options.modeOmegaSubstep,
@@ -165,6 +222,13 @@ AutoRegionCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs, 
 AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
                                   const Eigen::SparseMatrix<double>& stiffness,
                                   const Eigen::SparseMatrix<double>& mass);
+
+/// The same proposal with K and M assembled (vibrationMatrices(mesh, massType)) only when
+/// the modal check runs, so that a decision the element criterion, the pre-check or the cost
+/// check makes costs no assembly; decisionSeconds then counts the assembly when it ran.
+/// What the scene path ("regions": "auto") runs.
+AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+                                  MassType massType);
 
 /// Why the region has its ratio, one phrase: the mode it keeps that needed it (frequency,
 /// omega hL, omega hS against options.modeOmegaSubstep, and the element criterion's ratio),

@@ -7,6 +7,7 @@
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <limits>
+#include <memory>
 
 namespace asyncfem {
 
@@ -63,5 +64,34 @@ struct ModalResult {
 /// of the count modes converged).
 ModalResult lowestModes(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
                         const FreeDofs& freeDofs, const ModalOptions& options = {});
+
+/// lowestModes() for several counts on one factorization: the constructor factors
+/// K_ff - sigma M_ff once, and every compute(count) runs the Lanczos iteration with that
+/// factor (one back-substitution per Lanczos vector), so asking for more modes after a
+/// first answer costs solves, not another factorization. The matrices must outlive the
+/// solver. Throws as lowestModes() does (the count is checked by compute()).
+class LowestModesSolver {
+ public:
+  LowestModesSolver(const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
+                    const FreeDofs& freeDofs, const ModalOptions& options = {});
+  ~LowestModesSolver();
+  LowestModesSolver(const LowestModesSolver&) = delete;
+  LowestModesSolver& operator=(const LowestModesSolver&) = delete;
+
+  /// The count lowest modes (options.count is ignored here), as lowestModes() gives them
+  /// (the same numbers for the same options and count); the result's factorSeconds is 0
+  /// (the factor was made before) and its solveSeconds and operatorApplications are this
+  /// call's.
+  ModalResult compute(int count) const;
+
+  int numFree() const;
+  double shift() const;
+  double factorSeconds() const;      ///< the one factorization of K - sigma M
+  int operatorApplications() const;  ///< solves with the factor, over every compute()
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 }  // namespace asyncfem
