@@ -270,8 +270,9 @@ std::vector<std::string> contactStepWarnings(const Scene& scene, const TetMesh& 
         "; penalty contact is explicit, and beyond omega h = 2 its spring is unstable on its own and can add "
         "energy at impacts: lower contact.stiffness below " +
         formatNumber(4.0 * median / (h * h)) + " or the timestep" +
-        (scene.integrator.name == "async" ? ", or set contact.implicit (substepStatePrediction only helps the fast regions)"
-                                          : ", or set contact.implicit with \"backward-euler\""));
+        (scene.integrator.name == "async"
+             ? ", or set contact.implicit (substepStatePrediction only helps the fast regions)"
+             : ", or set contact.implicit with \"backward-euler\""));
   }
   return warnings;
 }
