@@ -53,12 +53,21 @@ function(asyncfem_add_utility name)
   install(TARGETS ${name} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 endfunction()
 
+# asyncfem_test_optimization(TARGET): a test executable compiles at ASYNCFEM_TEST_OPTIMIZATION
+# in optimized builds (the last -O on the command line wins).
+function(asyncfem_test_optimization target)
+  if(ASYNCFEM_TEST_OPTIMIZATION)
+    target_compile_options(${target} PRIVATE $<$<CONFIG:Release,RelWithDebInfo>:${ASYNCFEM_TEST_OPTIMIZATION}>)
+  endif()
+endfunction()
+
 # asyncfem_add_test(NAME SOURCES ... DEPS ...): a GoogleTest executable registered with CTest.
 function(asyncfem_add_test name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   target_compile_options(${name} PRIVATE ${ASYNCFEM_WARNING_FLAGS})
+  asyncfem_test_optimization(${name})
   target_compile_definitions(${name} PRIVATE
     ASYNCFEM_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data"
     ASYNCFEM_MODELS_DIR="${PROJECT_SOURCE_DIR}/models"

@@ -49,7 +49,7 @@ sanitized_tests="volumetricMeshTests simulationIOTests fuzzFileCorpusTests"
 run_sanitized_library_tests() {
   cmake -S . -B build-asan-fast -G Ninja -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS=-O1 \
     -DASYNCFEM_SANITIZE=ON -DASYNCFEM_BUILD_TESTS=ON -DASYNCFEM_BUILD_UTILITIES=OFF \
-    -DASYNCFEM_WITH_RENDER=OFF -DASYNCFEM_WITH_PETSC=OFF -DASYNCFEM_WITH_PYTHON=OFF -DASYNCFEM_REQUIRE_PARTS=
+    -DASYNCFEM_WITH_RENDER=OFF -DASYNCFEM_WITH_PETSC=OFF -DASYNCFEM_WITH_PYTHON=OFF -DASYNCFEM_REQUIRE_PARTS= "${launcher[@]}"
   # shellcheck disable=SC2086
   cmake --build build-asan-fast --parallel "$jobs" --target $sanitized_tests
   local leaks=1 test log
@@ -73,12 +73,18 @@ run_sanitized_library_tests() {
     rm -f "$log"
   done
 }
+# ccache, when installed, makes a second run of this script rebuild only what changed
+# (CCACHE_DISABLE=1 turns it off; CI's fresh machine has none, so nothing changes there).
+launcher=()
+if command -v ccache >/dev/null 2>&1; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+fi
 case "${1:-}" in
   "")
     parts=$(required_parts "$ci_parts")
     started=$SECONDS
     cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DASYNCFEM_BUILD_TESTS=ON \
-      -DASYNCFEM_BUILD_BENCHMARKS=ON "-DASYNCFEM_REQUIRE_PARTS=$parts"
+      -DASYNCFEM_BUILD_BENCHMARKS=ON "-DASYNCFEM_REQUIRE_PARTS=$parts" "${launcher[@]}"
     cmake --build build --parallel "$jobs"
     built=$SECONDS
     ctest --test-dir build --output-on-failure --parallel "$jobs"
