@@ -688,3 +688,50 @@ TEST(BuildSimulation, HyperelasticForceModelsRunFromTheScene) {
 }
 
 }  // namespace
+
+// A scene on Vega's CUBIC mesh runs linear FEM and StVK with the single-rate integrators; a model or
+// integrator that needs tetrahedra is refused with the scene key and the conversion.
+TEST(BuildSimulation, CubicVegSceneRunsLinearFemAndRefusesWhatNeedsTetrahedra) {
+  nlohmann::json json = nlohmann::json::parse(R"({
+    "mesh": {"file": "volumetricMesh/cubes.veg"},
+    "fixed": {"boxes": [{"min": [-0.01, -0.01, -0.01], "max": [0.01, 1.01, 0.51]}]},
+    "gravity": [0, 0, -9.81],
+    "integrator": {"name": "trapezoidal", "timestep": 0.01},
+    "frames": {"rate": 50, "count": 2}
+  })");
+  const std::filesystem::path data = ASYNCFEM_TEST_DATA_DIR;
+  Simulation simulation = build(json, data);
+  EXPECT_TRUE(simulation.problem->mesh().isHexahedral());
+  for (int k = 0; k < 4; ++k) simulation.integrator->step();
+  const Eigen::VectorXd& u = simulation.integrator->displacement();
+  EXPECT_TRUE(u.allFinite());
+  EXPECT_LT(u.minCoeff(), 0.0);  // gravity pulls the free end down
+  for (const int v : simulation.problem->fixedVertices()) EXPECT_EQ(u.segment<3>(3 * v).norm(), 0.0);
+
+  const auto refusal = [&](const nlohmann::json& scene) {
+    try {
+      build(scene, data);
+    } catch (const asyncfem::ValidationError& error) {
+      return std::string(error.what());
+    }
+    return std::string("accepted");
+  };
+  nlohmann::json stvk = json;
+  stvk["forceModel"] = {{"type", "stvk"}};
+  Simulation nonlinear = build(stvk, data);
+  EXPECT_FALSE(nonlinear.integrator->system().forceModel->isLinear());
+  nonlinear.integrator->step();
+  EXPECT_TRUE(nonlinear.integrator->displacement().allFinite());
+
+  nlohmann::json corotational = json;
+  corotational["forceModel"] = {{"type", "corotational"}};
+  const std::string model = refusal(corotational);
+  EXPECT_NE(model.find("scene.json: forceModel.type: \"corotational\""), std::string::npos) << model;
+  EXPECT_NE(model.find("4 hexahedra"), std::string::npos) << model;
+  nlohmann::json async = json;
+  async["integrator"] = nlohmann::json::parse(
+      R"({"name": "async", "timestep": 0.01, "options": {"regions": [{"name": "r", "ratio": 2, "elementSets": ["right"]}]}})");
+  const std::string integrator = refusal(async);
+  EXPECT_NE(integrator.find("scene.json: each multirate integrator"), std::string::npos) << integrator;
+  EXPECT_NE(integrator.find("--hex-to-tets"), std::string::npos) << integrator;
+}

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <sstream>
 #include <string>
 
 #include "utilityTest.hpp"
@@ -96,6 +97,45 @@ TEST_F(NumericalFaultsTest, InvertedElementUnderAModelWithoutInversionHandlingNa
   EXPECT_NE(fault.message.find("neo-hookean model, which has no inversion handling"), std::string::npos)
       << fault.message;
   EXPECT_NE(fault.message.find("forceModel.inversionThreshold"), std::string::npos) << fault.message;
+}
+
+// A bar 1 x 0.25 x 0.25 of 4 cubes in Vega's CUBIC format (vertex id = i + 5 (j + 2 k) + 1).
+std::string cubicBarVeg() {
+  std::ostringstream veg;
+  veg << "*VERTICES\n20 3 0 0\n";
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 5; ++i)
+        veg << (i + (5 * (j + (2 * k))) + 1) << ' ' << 0.25 * i << ' ' << 0.25 * j << ' ' << 0.25 * k << '\n';
+  veg << "*ELEMENTS\nCUBIC\n4 8 0\n";
+  const auto id = [](int i, int j, int k) { return i + (5 * (j + (2 * k))) + 1; };
+  for (int i = 0; i < 4; ++i) {
+    veg << (i + 1) << ' ' << id(i, 0, 0) << ' ' << id(i + 1, 0, 0) << ' ' << id(i + 1, 1, 0) << ' ' << id(i, 1, 0)
+        << ' ' << id(i, 0, 1) << ' ' << id(i + 1, 0, 1) << ' ' << id(i + 1, 1, 1) << ' ' << id(i, 1, 1) << '\n';
+  }
+  veg << "*MATERIAL bar\nENU, 1000, 1e6, 0.4\n*REGION\nallElements, bar\n";
+  return veg.str();
+}
+
+TEST_F(NumericalFaultsTest, InvertedHexahedronUnderStvkNamesTheElementAndTheConversion) {
+  // StVK on hexahedra has no inversion handling; its check compares the eight corner
+  // Jacobians. The x = 1 face (0-based vertices 4, 9, 14, 19) is pushed along -x far beyond
+  // what the bar carries once t >= 0.1.
+  std::ofstream(folder_ / "bar.veg") << cubicBarVeg();
+  nlohmann::json scene = nlohmann::json::parse(R"({
+    "mesh": {"file": "bar.veg"},
+    "fixed": {"boxes": [{"min": [-0.01, -0.01, -0.01], "max": [0.01, 0.26, 0.26]}]},
+    "forceModel": {"type": "stvk"},
+    "integrator": {"name": "symplectic-euler", "stepsPerFrame": 100},
+    "frames": {"rate": 20, "count": 20},
+    "output": {"file": "fault.afsim"}
+  })");
+  scene["forces"] = {{{"type", "pull"}, {"vertices", {4, 9, 14, 19}}, {"force", {-2e5, 0, 0}}, {"window", {0.1, 10}}}};
+  const Fault fault = runToFault(scene);
+  expectMatch(fault.message, R"(: element \d+ \(first vertex: vertex \d+ of the mesh)");
+  EXPECT_NE(fault.message.find(") inverted (J = det F = -"), std::string::npos) << fault.message;
+  EXPECT_NE(fault.message.find("stvk model, which has no inversion handling"), std::string::npos) << fault.message;
+  EXPECT_NE(fault.message.find("--hex-to-tets"), std::string::npos) << fault.message;
 }
 
 TEST_F(NumericalFaultsTest, DivergingNewtonIterationNamesTheVertex) {

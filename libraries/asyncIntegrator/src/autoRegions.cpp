@@ -43,6 +43,7 @@ double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, con
 }
 
 Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh) {
+  mesh.requireTetrahedra("elementMaxFrequencies");  // before the parallel loop, which must not throw
   Eigen::VectorXd omega(mesh.numElements());
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < mesh.numElements(); ++e) {

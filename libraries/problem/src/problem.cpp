@@ -3,6 +3,8 @@
 #include <asyncfem/core/enumNames.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
+#include <asyncfem/hexElements/hexAssembly.hpp>
+#include <asyncfem/hexElements/hexStvkForceModel.hpp>
 #include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <asyncfem/problem/problem.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
@@ -20,7 +22,7 @@ Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVert
       windows_(std::move(windows)),
       contact_(std::move(contact)) {
   if (!mesh_) throw ValidationError("problem: no mesh");
-  mesh_->requireTetrahedra("a simulation (the force models, integrators, contact and rendering)");
+  if (mesh_->isHexahedral()) requireHexahedralModel();
   if (settings_.implicitContact && contact_ && contact_->parameters().friction > 0.0) {
     std::ostringstream friction;
     friction << contact_->parameters().friction;
@@ -57,6 +59,23 @@ Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVert
   freeDofs_ = FreeDofs::fromFixedVertices(n, held);
 }
 
+void Problem::requireHexahedralModel() const {
+  const ForceModelType model = settings_.forceModel;
+  if (model != ForceModelType::linear && model != ForceModelType::stvk) {
+    // Linear FEM and StVK are the models with hexahedral elements so far (library hexElements).
+    mesh_->requireTetrahedra("the " + toString(model) + " force model (hexahedral meshes run linear and stvk)");
+  }
+  const HyperelasticOptions& options = settings_.hyperelastic;
+  if (model == ForceModelType::stvk &&
+      (options.inversionHandlingEnabled() || options.enableCompressionResistance || options.enforceSPD ||
+       options.stvkFormulation != StVKFormulation::greenStrain)) {
+    throw ValidationError(
+        "problem: StVK on hexahedra is the Green-strain form without inversion handling: it takes no inversion "
+        "threshold, compression resistance, enforceSPD or principal-stretch formulation (convert the mesh into "
+        "tetrahedra for those: meshInfo MESH --hex-to-tets --write OUT.veg)");
+  }
+}
+
 std::vector<int> Problem::heldVertices() const {
   std::vector<int> held;
   held.reserve(fixedVertices_.size() + unusedVertices_.size());
@@ -66,13 +85,15 @@ std::vector<int> Problem::heldVertices() const {
 }
 
 const std::shared_ptr<const MatrixAssembler>& Problem::assembler() const {
+  mesh_->requireTetrahedra("Problem::assembler() (the tetrahedral assembly)");
   if (!assembler_) assembler_ = std::make_shared<const MatrixAssembler>(*mesh_);
   return assembler_;
 }
 
 const Eigen::SparseMatrix<double>& Problem::massMatrix() const {
   if (!haveMass_) {
-    mass_ = asyncfem::massMatrix(*mesh_, *assembler(), settings_.mass);
+    mass_ = mesh_->isHexahedral() ? hexMassMatrix(*mesh_, settings_.mass)
+                                  : asyncfem::massMatrix(*mesh_, *assembler(), settings_.mass);
     haveMass_ = true;
     ++assemblies_;
   }
@@ -81,7 +102,7 @@ const Eigen::SparseMatrix<double>& Problem::massMatrix() const {
 
 const Eigen::SparseMatrix<double>& Problem::stiffnessMatrix() const {
   if (!haveStiffness_) {
-    stiffness_ = linearStiffnessMatrix(*mesh_, *assembler());
+    stiffness_ = mesh_->isHexahedral() ? hexLinearStiffnessMatrix(*mesh_) : linearStiffnessMatrix(*mesh_, *assembler());
     haveStiffness_ = true;
     ++assemblies_;
   }
@@ -136,6 +157,7 @@ std::shared_ptr<ForceModel> Problem::makeForceModel() const {
     case ForceModelType::corotational:
       return std::make_shared<CorotationalLinearFEM>(*mesh_, assembler(), settings_.tangent);
     case ForceModelType::stvk:
+      if (mesh_->isHexahedral()) return std::make_shared<HexStvkForceModel>(*mesh_);
       return makeHyperelasticForceModel(*mesh_, HyperelasticMaterialKind::stvk, settings_.hyperelastic, assembler());
     case ForceModelType::neoHookean:
       return makeHyperelasticForceModel(*mesh_, HyperelasticMaterialKind::neoHookean, settings_.hyperelastic,

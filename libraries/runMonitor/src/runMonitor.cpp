@@ -6,6 +6,7 @@
 #include <asyncfem/integrator/multirateIntegrator.hpp>
 #include <asyncfem/runMonitor/runMonitor.hpp>
 #include <asyncfem/simulationIO/crc32.hpp>
+#include <asyncfem/volumetricMesh/hexahedron.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <bit>
 #include <cmath>
@@ -36,6 +37,16 @@ double edgeDeterminant(const TetMesh& mesh, int e, const Eigen::VectorXd* displa
   Eigen::Matrix3d edges;
   for (int c = 1; c < 4; ++c) edges.col(c - 1) = position(c) - x0;
   return edges.determinant();
+}
+
+/// The smallest ratio of a hexahedron's corner Jacobians, deformed over rest: det F at its
+/// worst corner (<= 0 once a corner inverts).
+double smallestCornerRatio(const TetMesh& mesh, int e, const Eigen::VectorXd& displacement) {
+  const Eigen::Matrix<double, 3, 8> rest = mesh.hexahedronRestPositions(e);
+  Eigen::Matrix<double, 3, 8> x = rest;
+  for (int a = 0; a < 8; ++a)
+    x.col(a) += displacement.segment<3>(3 * static_cast<Eigen::Index>(mesh.elementVertex(e, a)));
+  return (hexahedron::cornerJacobians(x).array() / hexahedron::cornerJacobians(rest).array()).minCoeff();
 }
 
 bool isHyperelastic(ForceModelType type) {
@@ -71,9 +82,11 @@ RunMonitor::RunMonitor(const Problem& problem, Settings settings) : mesh_(&probl
   const ProblemSettings& physics = problem.settings();
   if (isHyperelastic(physics.forceModel) && !physics.hyperelastic.inversionHandlingEnabled()) {
     inversionCheckModel_ = toString(physics.forceModel);
-    restVolumes_.resize(static_cast<std::size_t>(mesh_->numElements()));
-    for (int e = 0; e < mesh_->numElements(); ++e) {
-      restVolumes_[static_cast<std::size_t>(e)] = edgeDeterminant(*mesh_, e, nullptr);
+    if (!mesh_->isHexahedral()) {  // hexahedra compare their corners at each check
+      restVolumes_.resize(static_cast<std::size_t>(mesh_->numElements()));
+      for (int e = 0; e < mesh_->numElements(); ++e) {
+        restVolumes_[static_cast<std::size_t>(e)] = edgeDeterminant(*mesh_, e, nullptr);
+      }
     }
   }
 }
@@ -207,17 +220,21 @@ void RunMonitor::checkInversion(const Integrator& integrator, long long frame, l
                                 const std::string& where) const {
   const Eigen::VectorXd& u = integrator.displacement();
   for (int e = 0; e < mesh_->numElements(); ++e) {
-    const double rest = restVolumes_[static_cast<std::size_t>(e)];
-    const double j = edgeDeterminant(*mesh_, e, &u) / rest;  // det F
+    const double j = mesh_->isHexahedral()  // det F (at the worst corner of a hexahedron)
+                         ? smallestCornerRatio(*mesh_, e, u)
+                         : edgeDeterminant(*mesh_, e, &u) / restVolumes_[static_cast<std::size_t>(e)];
     if (j > 0.0) continue;
-    const int vertex = mesh_->elements()(0, e);
+    const int vertex = mesh_->elementVertex(e, 0);
     NumericalErrorLocation location = locate(integrator, frame, step, stepEnd, vertex);
-    throw NumericalError(where + ": element " + std::to_string(e) +
-                             " (first vertex: " + describeVertex(integrator, vertex) +
-                             ") inverted (J = det F = " + formatNumber(j) + ") under the " + inversionCheckModel_ +
-                             " model, which has no inversion handling; set forceModel.inversionThreshold (e.g. 0.1) "
-                             "or reduce the step or the load",
-                         location);
+    throw NumericalError(
+        where + ": element " + std::to_string(e) + " (first vertex: " + describeVertex(integrator, vertex) +
+            ") inverted (J = det F = " + formatNumber(j) + ") under the " + inversionCheckModel_ +
+            " model, which has no inversion handling; " +
+            (mesh_->isHexahedral() ? std::string("reduce the step or the load, or convert the mesh into tetrahedra "
+                                                 "(meshInfo MESH --hex-to-tets) and set forceModel.inversionThreshold")
+                                   : std::string("set forceModel.inversionThreshold (e.g. 0.1) or reduce the step or "
+                                                 "the load")),
+        location);
   }
 }
 
@@ -268,7 +285,7 @@ std::uint32_t runFingerprint(const std::string& sceneText, const std::string& in
   crc = crcOf(std::bit_cast<std::uint64_t>(frameInterval), crc);
   const TetMesh& mesh = problem.mesh();
   crc = crc32(mesh.restPositions().data(), sizeof(double) * static_cast<std::size_t>(mesh.restPositions().size()), crc);
-  crc = crc32(mesh.elements().data(), sizeof(int) * static_cast<std::size_t>(mesh.elements().size()), crc);
+  crc = crc32(mesh.connectivity().data(), sizeof(int) * static_cast<std::size_t>(mesh.connectivity().size()), crc);
   crc = crc32(mesh.elementMaterials().data(), sizeof(int) * mesh.elementMaterials().size(), crc);
   for (const Material& material : mesh.materials()) {
     crc = crcOf(std::bit_cast<std::uint64_t>(material.density), crc);
@@ -283,7 +300,7 @@ std::uint32_t problemFingerprint(const Problem& problem) {
   const TetMesh& mesh = problem.mesh();
   std::uint32_t crc =
       crc32(mesh.restPositions().data(), sizeof(double) * static_cast<std::size_t>(mesh.restPositions().size()));
-  crc = crc32(mesh.elements().data(), sizeof(int) * static_cast<std::size_t>(mesh.elements().size()), crc);
+  crc = crc32(mesh.connectivity().data(), sizeof(int) * static_cast<std::size_t>(mesh.connectivity().size()), crc);
   const std::vector<int>& fixed = problem.fixedVertices();
   return crc32(fixed.data(), sizeof(int) * fixed.size(), crc);
 }

@@ -301,6 +301,11 @@ std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std:
   std::vector<int> fixed = collectFixedVertices(scene, *mesh);
   std::vector<VertexLoad> loads = collectLoads(scene, *mesh, requireFrameTiming(scene).timestep);
   const ProblemSettings settings = problemSettings(scene);
+  if (mesh->isHexahedral() && settings.forceModel != ForceModelType::linear &&
+      settings.forceModel != ForceModelType::stvk) {
+    mesh->requireTetrahedra(scene.sourceName + ": forceModel.type: \"" + toString(settings.forceModel) +
+                            "\" (hexahedral meshes run \"linear\" and \"stvk\")");
+  }
   std::shared_ptr<const PenaltyContact> contact = buildSceneContact(scene, *mesh);
   return std::make_shared<const Problem>(mesh, std::move(fixed), settings, std::move(loads), std::move(contact));
 }

@@ -48,6 +48,11 @@ struct ProblemSettings {
 /// The time-dependent operator of M a + D v + f_int(u) = f_ext(t, u, v): integrators get
 /// it as a DynamicSystem (dynamicSystem()), whose external force evaluates loads().
 ///
+/// Hexahedral meshes (Vega's CUBIC .veg, Gmsh hexahedra) run linear FEM and StVK (its
+/// Green-strain form, HexStvkForceModel), with K and M of library hexElements (trilinear
+/// elements, 2 x 2 x 2 Gauss points); the other models and assembler() refuse them with a
+/// ValidationError naming the conversion.
+///
 /// Vertices that no element uses (a stray surface in a Gmsh or TetGen file) carry no
 /// mass and no stiffness, so as free DOFs they would make every system matrix singular:
 /// they are left out of the free DOFs and stay at their rest positions, without being
@@ -94,6 +99,10 @@ class Problem {
   std::vector<std::string> skipped() const;
 
  private:
+  /// The hexahedral mesh's model: linear, or StVK in its Green-strain form; throws
+  /// ValidationError otherwise, naming the conversion into tetrahedra.
+  void requireHexahedralModel() const;
+
   std::shared_ptr<const TetMesh> mesh_;
   std::vector<int> fixedVertices_;
   std::vector<int> unusedVertices_;
