@@ -28,7 +28,7 @@ function(asyncfem_add_library name)
     target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
     target_compile_features(${target} PUBLIC cxx_std_20)
     target_compile_options(${target} PRIVATE ${ASYNCFEM_WARNING_FLAGS})
-    set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+    set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON UNITY_BUILD ${ASYNCFEM_UNITY_BUILD})
     if(ASYNCFEM_SANITIZE)
       # Sanitized static libraries need the sanitizer runtimes wherever they are linked,
       # including projects that find the installed package.
@@ -50,6 +50,7 @@ function(asyncfem_add_utility name)
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS})
   target_compile_options(${name} PRIVATE ${ASYNCFEM_WARNING_FLAGS})
+  set_target_properties(${name} PROPERTIES UNITY_BUILD ${ASYNCFEM_UNITY_BUILD})
   install(TARGETS ${name} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 endfunction()
 

@@ -84,7 +84,7 @@ case "${1:-}" in
     parts=$(required_parts "$ci_parts")
     started=$SECONDS
     cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DASYNCFEM_BUILD_TESTS=ON \
-      -DASYNCFEM_BUILD_BENCHMARKS=ON "-DASYNCFEM_REQUIRE_PARTS=$parts" "${launcher[@]}"
+      -DASYNCFEM_BUILD_BENCHMARKS=ON -DASYNCFEM_UNITY_BUILD=ON "-DASYNCFEM_REQUIRE_PARTS=$parts" "${launcher[@]}"
     cmake --build build --parallel "$jobs"
     built=$SECONDS
     ctest --test-dir build --output-on-failure --parallel "$jobs"

@@ -108,7 +108,7 @@ std::string interactiveReason(std::string_view key) {
 
 std::string quoted(const std::string& text) { return "\"" + text + "\""; }
 
-std::string formatNumber(double value) {
+std::string formatFullPrecision(double value) {
   std::ostringstream out;
   out.precision(12);
   out << value;
@@ -129,7 +129,7 @@ void requireNoEffect(ConfigOptions& options, std::string_view key, double neutra
   const std::optional<double> value = options.number(key);
   if (!value) return;
   if (*value != neutral) options.fail(*options.find(key), why);
-  options.note(key, "accepted: " + formatNumber(neutral) + " changes nothing");
+  options.note(key, "accepted: " + formatFullPrecision(neutral) + " changes nothing");
 }
 
 void refuseFile(ConfigOptions& options, std::string_view key, const std::string& why) {
@@ -207,7 +207,7 @@ void mapSolver(ConfigOptions& options, json& scene) {
     if (!(*epsilon > 0.0)) options.fail(*options.find("epsilon"), "expected a number > 0");
     if (implicit && maxIterations > 1) {
       integratorOptions["tolerance"] = *epsilon;
-      options.note("epsilon", "integrator.options.tolerance = " + formatNumber(*epsilon));
+      options.note("epsilon", "integrator.options.tolerance = " + formatFullPrecision(*epsilon));
     } else {
       options.note("epsilon", "ignored: no Newton iteration to stop (maxIterations 1 or an explicit solver)");
     }
@@ -242,7 +242,7 @@ void mapTiming(ConfigOptions& options, json& scene) {
   }
   scene["frames"] = {{"rate", 1.0 / timestep}};
   scene["integrator"]["stepsPerFrame"] = substeps;
-  options.note("timestep", "frames.rate = 1 / " + formatNumber(timestep) + " (one Vega frame per scene frame)");
+  options.note("timestep", "frames.rate = 1 / " + formatFullPrecision(timestep) + " (one Vega frame per scene frame)");
   options.note("substepsPerTimeStep", "integrator.stepsPerFrame = " + std::to_string(substeps) +
                                           " (integrator timestep = timestep / substepsPerTimeStep)");
 }
@@ -253,8 +253,8 @@ void mapDamping(ConfigOptions& options, json& scene) {
   if (alpha < 0.0) options.fail(*options.find("dampingMassCoef"), "expected a number >= 0");
   if (beta < 0.0) options.fail(*options.find("dampingStiffnessCoef"), "expected a number >= 0");
   scene["damping"] = {{"alpha", alpha}, {"beta", beta}};
-  options.note("dampingMassCoef", "damping.alpha = " + formatNumber(alpha));
-  options.note("dampingStiffnessCoef", "damping.beta = " + formatNumber(beta));
+  options.note("dampingMassCoef", "damping.alpha = " + formatFullPrecision(alpha));
+  options.note("dampingStiffnessCoef", "damping.beta = " + formatFullPrecision(beta));
   requireNoEffect(options, "dampingLaplacianCoef", 0.0, "Laplacian damping is not supported; set it to 0");
 }
 
@@ -276,8 +276,8 @@ void mapInvertible(ConfigOptions& options, json& model) {
     if (*threshold > 0.0 && *threshold < 1.0) {
       model["inversionThreshold"] = *threshold;
       model["inversionHandling"] = "vega-clamp";
-      options.note("inversionThreshold",
-                   "forceModel.inversionThreshold = " + formatNumber(*threshold) + ", inversionHandling vega-clamp");
+      options.note("inversionThreshold", "forceModel.inversionThreshold = " + formatFullPrecision(*threshold) +
+                                             ", inversionHandling vega-clamp");
     } else if (*threshold <= -1e300) {
       options.note("inversionThreshold", "accepted: Vega's default (no inversion handling)");
     } else {
@@ -290,7 +290,7 @@ void mapInvertible(ConfigOptions& options, json& model) {
     if (resistance < 0.0) options.fail(*options.find("compressionResistance"), "expected a number >= 0");
     model["compressionResistance"] = resistance;
     options.note("enableCompressionResistance", "forceModel.compressionResistance (with *compressionResistance)");
-    options.note("compressionResistance", "forceModel.compressionResistance = " + formatNumber(resistance));
+    options.note("compressionResistance", "forceModel.compressionResistance = " + formatFullPrecision(resistance));
   } else {
     options.note("enableCompressionResistance", "accepted: off");
     options.note("compressionResistance", "ignored: *enableCompressionResistance is off");
@@ -349,7 +349,7 @@ void mapGravity(ConfigOptions& options, json& scene) {
   if (add) {
     scene["gravity"] = {0.0, -g, 0.0};
     options.note("addGravity", "gravity = [0, -g, 0] (Vega pulls along -y)");
-    options.note("g", "gravity = [0, " + formatNumber(-g) + ", 0]");
+    options.note("g", "gravity = [0, " + formatFullPrecision(-g) + ", 0]");
   } else {
     options.note("addGravity", "accepted: no gravity");
     options.note("g", "ignored: *addGravity is off");
