@@ -86,31 +86,42 @@ TEST(HexahedralProblem, OtherModelsAndTheTetrahedralAssemblerAreRefused) {
   EXPECT_THROW(Problem(mesh, rootVertices(*mesh), threshold), ValidationError);
 }
 
-// Under a small load StVK settles where linear FEM does, up to the geometric nonlinearity:
-// of the order of (tip deflection / length)^2 (the bar sags by millimetres to centimetres).
-TEST(HexahedralProblem, StvkSettlesNextToLinearUnderASmallLoad) {
+// StVK's forces are K u + O(|u|^2), so its static deflection differs from linear FEM's by
+// O(sag^2): relative to the deflection O(sag / length), in proportion to the load while the
+// load is small. Gravity 0.5 and 1 (m/s^2) sag the 1 m bar by about 1 to 2 cm.
+TEST(HexahedralProblem, StvkDepartsFromLinearInProportionToTheLoad) {
   auto mesh = std::make_shared<const TetMesh>(test::hexBar(1));
-  ProblemSettings settings;
-  settings.gravity = Eigen::Vector3d(0.0, -9.81, 0.0);
-  settings.rayleighAlpha = 2.0;
-  settings.forceModel = ForceModelType::stvk;
-  const Problem problem(mesh, rootVertices(*mesh), settings);
-  BackwardEuler integrator(problem.dynamicSystem(), 0.1);
-  for (int i = 0; i < 300; ++i) integrator.step();
-  const Eigen::VectorXd linear = staticDeflection(*mesh, problem.freeDofs(), settings.gravity);
-  const double difference = (integrator.displacement() - linear).norm() / linear.norm();
-  RecordProperty("relativeDifference", std::to_string(difference));
-  const double sag = -linear.minCoeff();     // the bar is 1 long
-  EXPECT_LE(difference, 100.0 * sag * sag);  // 100x margin over the estimate
-  EXPECT_GE(difference, 1e-3 * sag * sag);   // but not linear: StVK's terms are there
-  EXPECT_TRUE(integrator.displacement().allFinite());
+  const auto relativeDifference = [&](double gravity, double& sag) {
+    ProblemSettings settings;
+    settings.gravity = Eigen::Vector3d(0.0, -gravity, 0.0);
+    settings.rayleighAlpha = 2.0;
+    settings.forceModel = ForceModelType::stvk;
+    const Problem problem(mesh, rootVertices(*mesh), settings);
+    BackwardEuler integrator(problem.dynamicSystem(), 0.1);
+    for (int i = 0; i < 300; ++i) integrator.step();
+    EXPECT_TRUE(integrator.displacement().allFinite());
+    const Eigen::VectorXd linear = staticDeflection(*mesh, problem.freeDofs(), settings.gravity);
+    sag = -linear.minCoeff();
+    return (integrator.displacement() - linear).norm() / linear.norm();
+  };
+  double sagHalf = 0.0;
+  double sagFull = 0.0;
+  const double half = relativeDifference(0.5, sagHalf);
+  const double full = relativeDifference(1.0, sagFull);
+  RecordProperty("relativeDifferenceHalf", std::to_string(half));
+  RecordProperty("relativeDifferenceFull", std::to_string(full));
+  // Leading order: the ratio is 2; the next order (relative sag^2, about 1e-4) moves it by
+  // far less than the 0.5 allowed. A linear model (difference at round-off) or a wrong
+  // stress factor (a difference of order 1 that does not scale) fails it.
+  EXPECT_NEAR(full / half, 2.0, 0.5);
+  EXPECT_LE(full, 2.0 * sagFull);  // an O(1) coefficient per unit of sag / length
 }
 
 // The compliance f . u with f = M g after the damped cantilever has settled under gravity
 // (the consistent mass makes f the exact load functional of gravity for either element).
 double settledCompliance(const TetMesh& mesh, ForceModelType model) {
   ProblemSettings settings;
-  settings.gravity = Eigen::Vector3d(0.0, -9.81, 0.0);
+  settings.gravity = Eigen::Vector3d(0.0, -1.0, 0.0);
   settings.rayleighAlpha = 2.0;
   settings.forceModel = model;
   const Problem problem(std::make_shared<const TetMesh>(mesh), rootVertices(mesh), settings);
@@ -122,9 +133,10 @@ double settledCompliance(const TetMesh& mesh, ForceModelType model) {
 
 TEST(HexahedralProblem, StvkOnCubesAndOnTheirTetrahedraAgreeOnlyToDiscretization) {
   // The same argument as HexVersusTets.CantileverAgreesOnlyToDiscretization, for StVK run
-  // through Problem and backward Euler: under this load StVK differs from linear FEM by
-  // about (sag / length)^2 ~ 1e-4 relative, far below the 20-60% the compliance changes by
-  // under refinement, so the linear theory's bounds apply: the compliance grows under
+  // through Problem and backward Euler: under gravity 1 m/s^2 StVK differs from linear FEM
+  // by about 1% (StvkDepartsFromLinearInProportionToTheLoad), far below the 30% and 89% the
+  // hexahedra's and the tetrahedra's compliance change by under refinement, so the linear
+  // theory's bounds apply: the compliance grows under
   // nested refinement, and the hexahedra's and the tetrahedra's values approach each other
   // within the sum of their own refinement steps.
   const TetMesh coarse = test::hexBar(1);
