@@ -38,15 +38,15 @@ TEST(AdditiveCcd, PointOntoFace) {
   motion.col(0) = Eigen::Vector3d(0, 0, -0.5);
   const TimeOfImpact hit = pointTriangleTimeOfImpact(start, motion);
   ASSERT_TRUE(hit.impact);
-  EXPECT_LE(hit.time, 0.6);
-  EXPECT_GE(hit.time, 0.9 * 0.6 - 1e-12);
-  EXPECT_GT(pointTriangleGap(start + hit.time * motion), 0.0);
+  EXPECT_LE(hit.stepFraction, 0.6);
+  EXPECT_GE(hit.stepFraction, 0.9 * 0.6 - 1e-12);
+  EXPECT_GT(pointTriangleGap(start + hit.stepFraction * motion), 0.0);
   // The same relative motion with the triangle moving up instead: the same answer.
   Points lifted = Points::Zero();
   for (int k = 1; k < 4; ++k) lifted.col(k) = Eigen::Vector3d(0, 0, 0.5);
   const TimeOfImpact mirrored = pointTriangleTimeOfImpact(start, lifted);
   ASSERT_TRUE(mirrored.impact);
-  EXPECT_NEAR(mirrored.time, hit.time, 1e-12);
+  EXPECT_NEAR(mirrored.stepFraction, hit.stepFraction, 1e-12);
 }
 
 // Stopping short: the point falls, but only half way to the face: no impact. Grazing: the
@@ -59,12 +59,12 @@ TEST(AdditiveCcd, PairsThatStayApart) {
   const Points grazing = triangleWithPoint({-0.5, 0.2, 0.01});
   const TimeOfImpact cut = pointTriangleTimeOfImpact(grazing, slide);
   ASSERT_TRUE(cut.impact);
-  EXPECT_GT(cut.time, 0.0);
-  EXPECT_GT(pointTriangleGap(grazing + cut.time * slide), 0.0);
-  double reached = cut.time;
+  EXPECT_GT(cut.stepFraction, 0.0);
+  EXPECT_GT(pointTriangleGap(grazing + cut.stepFraction * slide), 0.0);
+  double reached = cut.stepFraction;
   for (int query = 0; query < 100 && reached < 1.0; ++query) {
     const TimeOfImpact next = pointTriangleTimeOfImpact(grazing + reached * slide, (1.0 - reached) * slide);
-    reached = next.impact ? reached + (1.0 - reached) * next.time : 1.0;
+    reached = next.impact ? reached + (1.0 - reached) * next.stepFraction : 1.0;
   }
   EXPECT_EQ(reached, 1.0);
   Points half = Points::Zero();
@@ -83,8 +83,8 @@ TEST(AdditiveCcd, VertexOnEdgeAndEdgeEdge) {
   motion.col(0) = Eigen::Vector3d(0, 0.4, -0.2);  // from (0.5, -0.2, 0.1) to the edge ab at t = 0.5
   const TimeOfImpact onEdge = pointTriangleTimeOfImpact(triangleWithPoint({0.5, -0.2, 0.1}), motion);
   ASSERT_TRUE(onEdge.impact);
-  EXPECT_LE(onEdge.time, 0.5);
-  EXPECT_GE(onEdge.time, 0.45 - 1e-12);
+  EXPECT_LE(onEdge.stepFraction, 0.5);
+  EXPECT_GE(onEdge.stepFraction, 0.45 - 1e-12);
 
   Points edges;
   edges << Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, -1, 0.2), Eigen::Vector3d(0, 1, 0.2);
@@ -92,9 +92,9 @@ TEST(AdditiveCcd, VertexOnEdgeAndEdgeEdge) {
   down.col(2) = down.col(3) = Eigen::Vector3d(0, 0, -0.5);
   const TimeOfImpact crossing = edgeEdgeTimeOfImpact(edges, down);
   ASSERT_TRUE(crossing.impact);
-  EXPECT_LE(crossing.time, 0.4);
-  EXPECT_GE(crossing.time, 0.36 - 1e-12);
-  EXPECT_GT(edgeEdgeGap(edges + crossing.time * down), 0.0);
+  EXPECT_LE(crossing.stepFraction, 0.4);
+  EXPECT_GE(crossing.stepFraction, 0.36 - 1e-12);
+  EXPECT_GT(edgeEdgeGap(edges + crossing.stepFraction * down), 0.0);
 
   Points parallel;
   parallel << Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0.2, 0.1, 0),
@@ -103,8 +103,8 @@ TEST(AdditiveCcd, VertexOnEdgeAndEdgeEdge) {
   closing.col(2) = closing.col(3) = Eigen::Vector3d(0, -0.4, 0);
   const TimeOfImpact side = edgeEdgeTimeOfImpact(parallel, closing);
   ASSERT_TRUE(side.impact);
-  EXPECT_LE(side.time, 0.25);
-  EXPECT_GE(side.time, 0.225 - 1e-12);
+  EXPECT_LE(side.stepFraction, 0.25);
+  EXPECT_GE(side.stepFraction, 0.225 - 1e-12);
 }
 
 // Random moving triangles and a point built to pass through the triangle's interior at a
@@ -135,8 +135,10 @@ TEST(AdditiveCcd, NeverLaterThanAKnownContact) {
     const TimeOfImpact hit = pointTriangleTimeOfImpact(start, motion);
     ASSERT_TRUE(hit.impact) << "trial " << trial;
     ++impacts;
-    EXPECT_LE(hit.time, contact) << "trial " << trial;
-    if (hit.time > 0.0) EXPECT_GT(pointTriangleGap(start + hit.time * motion), 0.0) << "trial " << trial;
+    EXPECT_LE(hit.stepFraction, contact) << "trial " << trial;
+    if (hit.stepFraction > 0.0) {
+      EXPECT_GT(pointTriangleGap(start + hit.stepFraction * motion), 0.0) << "trial " << trial;
+    }
   }
   EXPECT_EQ(impacts, 500);
 }
@@ -153,7 +155,7 @@ TEST(AdditiveCcd, BadInputAndStartingInContact) {
   EXPECT_THROW(pointTriangleTimeOfImpact(start, nan), NumericalError);
   const TimeOfImpact touching = pointTriangleTimeOfImpact(triangleWithPoint({0.25, 0.25, 0.0}), Points::Zero());
   EXPECT_TRUE(touching.impact);
-  EXPECT_EQ(touching.time, 0.0);
+  EXPECT_EQ(touching.stepFraction, 0.0);
 }
 
 }  // namespace

@@ -10,10 +10,9 @@
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/hexToTets.hpp>
-#include <cmath>
-#include <string>
 #include <vector>
 
+#include "discretizationAgreement.hpp"
 #include "hexBar.hpp"
 
 namespace asyncfem {
@@ -60,30 +59,8 @@ TEST(HexVersusTets, CantileverAgreesOnlyToDiscretization) {
   const TetMesh coarse = hexBar(1);  // 4 x 1 x 1 cubes
   const TetMesh fine = hexBar(2);    // 8 x 2 x 2 cubes: each coarse cube cut into 8
   // Same cubes, same mass: the loads are the same functional.
-  const double hexCoarse = hexCompliance(coarse), hexFine = hexCompliance(fine);
-  const double tetCoarse = tetCompliance(coarse), tetFine = tetCompliance(fine);
-  // The values, for a reader (--gtest_output=xml lists them).
-  RecordProperty("hexCoarse", std::to_string(hexCoarse));
-  RecordProperty("hexFine", std::to_string(hexFine));
-  RecordProperty("tetCoarse", std::to_string(tetCoarse));
-  RecordProperty("tetFine", std::to_string(tetFine));
-  // Conforming displacement FEM with the exact load functional: the compliance is the
-  // strain energy of the Galerkin solution, which grows under refinement of nested spaces
-  // (trilinear on halved cubes contains trilinear on the cubes; the Kuhn split of the halved
-  // lattice refines that of the lattice) towards the exact compliance.
-  EXPECT_GT(hexFine, hexCoarse);
-  EXPECT_GT(tetFine, tetCoarse);
-  // The two spaces differ (neither contains the other), so neither value bounds the other.
-  // Agreement to discretization: each fine value's distance to the common limit C is
-  // estimated by Richardson from its own refinement step, (C_fine - C_coarse) / (2^p - 1)
-  // with p = 2 for the energy of a smooth solution; the clamped edge's singularity lowers
-  // p, so the bound takes p = 1 (a factor 3 safer): |C_hex - C_tet| <= sum of the two
-  // estimates.
-  const double bound = (hexFine - hexCoarse) + (tetFine - tetCoarse);
-  EXPECT_LE(std::abs(hexFine - tetFine), bound) << "hex " << hexFine << " tet " << tetFine;
-  // And they approach each other: the gap shrinks under refinement.
-  EXPECT_LT(std::abs(hexFine - tetFine), std::abs(hexCoarse - tetCoarse))
-      << "coarse: hex " << hexCoarse << " tet " << tetCoarse << "; fine: hex " << hexFine << " tet " << tetFine;
+  test::expectAgreementOnlyToDiscretization(
+      {hexCompliance(coarse), hexCompliance(fine), tetCompliance(coarse), tetCompliance(fine)});
 }
 
 }  // namespace

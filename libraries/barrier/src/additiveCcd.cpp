@@ -44,23 +44,23 @@ TimeOfImpact advance(const Points& start, const Points& displacement, const Addi
   TimeOfImpact out;
   if (!(gap > 0.0)) {
     out.impact = true;
-    out.time = 0.0;
+    out.stepFraction = 0.0;
     return out;
   }
   if (speed == 0.0) return out;  // the distance never changes
   const double floor = options.gapFraction * gap;
-  double time = 0.0;
+  double reached = 0.0;  // fraction of the motion advanced so far
   double step = (1.0 - options.gapFraction) * gap / speed;
   for (out.iterations = 1; out.iterations <= options.maxIterations; ++out.iterations) {
     x += step * relative;
     gap = gapAt(x);
-    if (time > 0.0 && gap < floor) break;
-    time += step;
-    if (time > 1.0) return {false, 1.0, out.iterations};
+    if (reached > 0.0 && gap < floor) break;
+    reached += step;
+    if (reached > 1.0) return {false, 1.0, out.iterations};
     step = 0.9 * gap / speed;
   }
   out.impact = true;
-  out.time = time;
+  out.stepFraction = reached;
   return out;
 }
 

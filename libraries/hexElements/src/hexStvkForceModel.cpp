@@ -16,6 +16,12 @@ HexStvkForceModel::HexStvkForceModel(const TetMesh& mesh)
   for (int e = 0; e < numElements; ++e) {
     const Material& material = mesh.elementMaterial(e);
     youngAndPoisson_.emplace_back(material.youngsModulus, material.poissonRatio);
+    try {  // the rest shape: det J > 0 at every Gauss point, as the linear stiffness checks
+      (void)hexStvk(mesh.hexahedronRestPositions(e), mesh.hexahedronRestPositions(e), material.youngsModulus,
+                    material.poissonRatio, false);
+    } catch (const ValidationError& error) {
+      throw ValidationError("HexStvkForceModel: element " + std::to_string(e) + ": " + error.what());
+    }
     for (int a = 0; a < 8; ++a)
       for (int b = 0; b < 8; ++b)
         for (int i = 0; i < 3; ++i)
@@ -37,15 +43,6 @@ HexStvkForceModel::HexStvkForceModel(const TetMesh& mesh)
         const int* found = std::lower_bound(inner + outer[column], inner + outer[column + 1], 3 * hexahedra_(a, e));
         blockSlots_[static_cast<std::size_t>(e)](a, b) = static_cast<int>(found - inner);
       }
-    }
-  }
-  // The rest shapes: the same check (and message) as the linear stiffness.
-  for (int e = 0; e < numElements; ++e) {
-    try {
-      const Eigen::Vector2d& material = youngAndPoisson_[static_cast<std::size_t>(e)];
-      (void)hexStvk(mesh.hexahedronRestPositions(e), mesh.hexahedronRestPositions(e), material[0], material[1], false);
-    } catch (const ValidationError& error) {
-      throw ValidationError("HexStvkForceModel: element " + std::to_string(e) + ": " + error.what());
     }
   }
 }

@@ -61,8 +61,7 @@ Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVert
 
 void Problem::requireHexahedralModel() const {
   const ForceModelType model = settings_.forceModel;
-  if (model != ForceModelType::linear && model != ForceModelType::stvk) {
-    // Linear FEM and StVK are the models with hexahedral elements so far (library hexElements).
+  if (!runsOnHexahedra(model)) {
     mesh_->requireTetrahedra("the " + toString(model) + " force model (hexahedral meshes run linear and stvk)");
   }
   const HyperelasticOptions& options = settings_.hyperelastic;
@@ -149,6 +148,8 @@ std::string toString(ForceModelType type) {
   if (const std::optional<HyperelasticMaterialKind> material = hyperelasticMaterial(type)) return toString(*material);
   return std::string(findEnumName(kForceModelNames, type).value_or("unknown"));
 }
+
+bool runsOnHexahedra(ForceModelType type) { return type == ForceModelType::linear || type == ForceModelType::stvk; }
 
 std::shared_ptr<ForceModel> Problem::makeForceModel() const {
   switch (settings_.forceModel) {

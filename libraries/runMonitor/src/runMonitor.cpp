@@ -25,28 +25,24 @@ std::string formatNumber(double value, int precision = 6) {
   return out.str();
 }
 
-/// det (x1 - x0, x2 - x0, x3 - x0) of element e at positions rest + u.
-double edgeDeterminant(const TetMesh& mesh, int e, const Eigen::VectorXd* displacement) {
-  const auto position = [&](int corner) {
-    const int v = mesh.elements()(corner, e);
-    Eigen::Vector3d x = mesh.restPositions().col(v);
-    if (displacement != nullptr) x += displacement->segment<3>(3 * static_cast<Eigen::Index>(v));
-    return x;
-  };
-  const Eigen::Vector3d x0 = position(0);
-  Eigen::Matrix3d edges;
-  for (int c = 1; c < 4; ++c) edges.col(c - 1) = position(c) - x0;
-  return edges.determinant();
-}
+/// Up to eight Jacobian determinants of one element.
+using ElementJacobians = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
 
-/// The smallest ratio of a hexahedron's corner Jacobians, deformed over rest: det F at its
-/// worst corner (<= 0 once a corner inverts).
-double smallestCornerRatio(const TetMesh& mesh, int e, const Eigen::VectorXd& displacement) {
-  const Eigen::Matrix<double, 3, 8> rest = mesh.hexahedronRestPositions(e);
-  Eigen::Matrix<double, 3, 8> x = rest;
-  for (int a = 0; a < 8; ++a)
-    x.col(a) += displacement.segment<3>(3 * static_cast<Eigen::Index>(mesh.elementVertex(e, a)));
-  return (hexahedron::cornerJacobians(x).array() / hexahedron::cornerJacobians(rest).array()).minCoeff();
+/// Element e's Jacobian determinants at positions rest + u (at rest when displacement is
+/// null): det (x1 - x0, x2 - x0, x3 - x0) of a tetrahedron, the eight corner Jacobians of a
+/// hexahedron. det F of the element is their ratio to the rest values.
+ElementJacobians elementJacobians(const TetMesh& mesh, int e, const Eigen::VectorXd* displacement) {
+  const int corners = mesh.verticesPerElement();
+  Eigen::Matrix<double, 3, 8> x;
+  for (int a = 0; a < corners; ++a) {
+    const int v = mesh.elementVertex(e, a);
+    x.col(a) = mesh.restPositions().col(v);
+    if (displacement != nullptr) x.col(a) += displacement->segment<3>(3 * static_cast<Eigen::Index>(v));
+  }
+  if (corners == 8) return hexahedron::cornerJacobians(x);
+  Eigen::Matrix3d edges;
+  for (int c = 1; c < 4; ++c) edges.col(c - 1) = x.col(c) - x.col(0);
+  return ElementJacobians::Constant(1, edges.determinant());
 }
 
 bool isHyperelastic(ForceModelType type) {
@@ -82,11 +78,10 @@ RunMonitor::RunMonitor(const Problem& problem, Settings settings) : mesh_(&probl
   const ProblemSettings& physics = problem.settings();
   if (isHyperelastic(physics.forceModel) && !physics.hyperelastic.inversionHandlingEnabled()) {
     inversionCheckModel_ = toString(physics.forceModel);
-    if (!mesh_->isHexahedral()) {  // hexahedra compare their corners at each check
-      restVolumes_.resize(static_cast<std::size_t>(mesh_->numElements()));
-      for (int e = 0; e < mesh_->numElements(); ++e) {
-        restVolumes_[static_cast<std::size_t>(e)] = edgeDeterminant(*mesh_, e, nullptr);
-      }
+    restJacobians_.reserve(static_cast<std::size_t>(mesh_->numElements()) * (mesh_->isHexahedral() ? 8 : 1));
+    for (int e = 0; e < mesh_->numElements(); ++e) {
+      const ElementJacobians rest = elementJacobians(*mesh_, e, nullptr);
+      restJacobians_.insert(restJacobians_.end(), rest.data(), rest.data() + rest.size());
     }
   }
 }
@@ -219,10 +214,12 @@ void RunMonitor::checkState(const Integrator& integrator, long long frame, long 
 void RunMonitor::checkInversion(const Integrator& integrator, long long frame, long long step, double stepEnd,
                                 const std::string& where) const {
   const Eigen::VectorXd& u = integrator.displacement();
+  const double* rest = restJacobians_.data();
   for (int e = 0; e < mesh_->numElements(); ++e) {
-    const double j = mesh_->isHexahedral()  // det F (at the worst corner of a hexahedron)
-                         ? smallestCornerRatio(*mesh_, e, u)
-                         : edgeDeterminant(*mesh_, e, &u) / restVolumes_[static_cast<std::size_t>(e)];
+    const ElementJacobians deformed = elementJacobians(*mesh_, e, &u);
+    // det F (at the worst corner of a hexahedron)
+    const double j = (deformed.array() / Eigen::Map<const ElementJacobians>(rest, deformed.size()).array()).minCoeff();
+    rest += deformed.size();
     if (j > 0.0) continue;
     const int vertex = mesh_->elementVertex(e, 0);
     NumericalErrorLocation location = locate(integrator, frame, step, stepEnd, vertex);

@@ -301,8 +301,7 @@ std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std:
   std::vector<int> fixed = collectFixedVertices(scene, *mesh);
   std::vector<VertexLoad> loads = collectLoads(scene, *mesh, requireFrameTiming(scene).timestep);
   const ProblemSettings settings = problemSettings(scene);
-  if (mesh->isHexahedral() && settings.forceModel != ForceModelType::linear &&
-      settings.forceModel != ForceModelType::stvk) {
+  if (mesh->isHexahedral() && !runsOnHexahedra(settings.forceModel)) {  // Problem refuses it too, without the key
     mesh->requireTetrahedra(scene.sourceName + ": forceModel.type: \"" + toString(settings.forceModel) +
                             "\" (hexahedral meshes run \"linear\" and \"stvk\")");
   }

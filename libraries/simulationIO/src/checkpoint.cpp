@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "detail/byteOrder.hpp"
+#include "detail/systemMessage.hpp"
 
 namespace asyncfem {
 
@@ -39,7 +40,7 @@ constexpr std::size_t suffixBytes = 8;
 
 std::size_t paddedName(std::size_t length) { return (length + 7) / 8 * 8; }
 
-std::string errnoText() { return std::strerror(errno); }
+using detail::systemMessage;
 
 // Owns a POSIX file descriptor.
 class Descriptor {
@@ -119,10 +120,10 @@ void replaceFile(const std::filesystem::path& path, const std::vector<unsigned c
   temporary += ".tmp";
   const std::string temporaryName = temporary.string();
   Descriptor fd(::open(temporaryName.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
-  if (fd.get() < 0) throw Error(temporaryName + ": cannot create: " + errnoText());
+  if (fd.get() < 0) throw Error(temporaryName + ": cannot create: " + systemMessage());
   // On failure the partial temporary file goes; the previous checkpoint stays as it was.
   const auto fail = [&](const std::string& message) {
-    const std::string cause = errnoText();
+    const std::string cause = systemMessage();
     if (fd.get() >= 0) ::close(fd.release());
     ::unlink(temporaryName.c_str());
     throw Error(message + ": " + cause + "; the previous checkpoint " + name + " is unchanged");
@@ -254,7 +255,7 @@ SimulationCheckpoint parseCheckpoint(const unsigned char* data, std::size_t size
 SimulationCheckpoint readCheckpoint(const std::filesystem::path& path) {
   const std::string name = path.string();
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(name + ": cannot open: " + errnoText());
+  if (!in) throw Error(name + ": cannot open: " + systemMessage());
   in.seekg(0, std::ios::end);
   const std::streamoff size = in.tellg();
   if (size < 0) throw Error(name + ": cannot read its size");
@@ -263,7 +264,7 @@ SimulationCheckpoint readCheckpoint(const std::filesystem::path& path) {
   std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
   in.seekg(0, std::ios::beg);
   if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) {
-    throw Error(name + ": read failed: " + errnoText());
+    throw Error(name + ": read failed: " + systemMessage());
   }
   return parseCheckpoint(bytes.data(), bytes.size(), name);
 }

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "detail/byteOrder.hpp"
+#include "detail/systemMessage.hpp"
 
 namespace asyncfem {
 
@@ -47,7 +48,7 @@ void stopBeforeFrameIfAsked(std::int64_t frame) {
   if (value != nullptr && *value != '\0' && std::strtoll(value, nullptr, 10) == frame) std::raise(SIGSTOP);
 }
 
-std::string systemMessage() { return std::strerror(errno); }
+using detail::systemMessage;
 
 std::string framesText(std::int64_t frames) {
   return std::to_string(frames) + (frames == 1 ? " complete frame" : " complete frames");

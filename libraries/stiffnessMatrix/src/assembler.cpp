@@ -13,14 +13,14 @@
 #include <string>
 
 #include "detail/linearStiffness.hpp"
+#include "detail/sizeIndex.hpp"
 
 namespace asyncfem {
 
 namespace {
 
-using Index = std::size_t;
-
-Index toIndex(int i) { return static_cast<Index>(i); }
+using detail::Index;
+using detail::toIndex;
 
 // Below this many elements an assembly takes about 2 ms on one core; the handful of
 // barriers (one per colour) of a threaded run then gains little and, on a loaded machine

@@ -4,13 +4,14 @@
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <string>
 
+#include "detail/sizeIndex.hpp"
+
 namespace asyncfem {
 
 namespace {
 
-using Index = std::size_t;
-
-Index toSizeIndex(int i) { return static_cast<Index>(i); }
+using detail::Index;
+using detail::toIndex;
 
 // Throws ValidationError unless indices is strictly ascending within [0, size).
 void checkIndexList(const std::vector<int>& indices, Eigen::Index size, const char* what) {
@@ -37,8 +38,8 @@ inline int columnEnd(const Eigen::SparseMatrix<double>& matrix, int c) {
 // Row map of a submatrix: entry r is the position of full row r in rows, -1 where r is
 // not kept.
 std::vector<int> subRowMap(const std::vector<int>& rows, Eigen::Index fullRows) {
-  std::vector<int> fullToSubRow(toSizeIndex(static_cast<int>(fullRows)), -1);
-  for (std::size_t k = 0; k < rows.size(); ++k) fullToSubRow[toSizeIndex(rows[k])] = static_cast<int>(k);
+  std::vector<int> fullToSubRow(toIndex(static_cast<int>(fullRows)), -1);
+  for (std::size_t k = 0; k < rows.size(); ++k) fullToSubRow[toIndex(rows[k])] = static_cast<int>(k);
   return fullToSubRow;
 }
 
@@ -46,18 +47,18 @@ std::vector<int> subRowMap(const std::vector<int>& rows, Eigen::Index fullRows) 
 
 FreeDofs::FreeDofs(int numDofs, const std::vector<int>& fixedDofs) {
   if (numDofs < 0) throw ValidationError("FreeDofs: negative number of DOFs " + std::to_string(numDofs));
-  fullToFree_.assign(toSizeIndex(numDofs), 0);
+  fullToFree_.assign(toIndex(numDofs), 0);
   for (int dof : fixedDofs) {
     if (dof < 0 || dof >= numDofs) {
       throw ValidationError("FreeDofs: fixed DOF " + std::to_string(dof) + " (vertex " +
                             std::to_string(dof >= 0 ? dof / 3 : -1) + ") is out of range [0, " +
                             std::to_string(numDofs) + ")");
     }
-    fullToFree_[toSizeIndex(dof)] = -1;
+    fullToFree_[toIndex(dof)] = -1;
   }
   for (int dof = 0; dof < numDofs; ++dof) {
-    if (fullToFree_[toSizeIndex(dof)] < 0) continue;
-    fullToFree_[toSizeIndex(dof)] = static_cast<int>(freeToFull_.size());
+    if (fullToFree_[toIndex(dof)] < 0) continue;
+    fullToFree_[toIndex(dof)] = static_cast<int>(freeToFull_.size());
     freeToFull_.push_back(dof);
   }
 }
@@ -82,7 +83,7 @@ Eigen::VectorXd FreeDofs::restrict(const Eigen::VectorXd& full) const {
                 std::to_string(numDofs()));
   }
   Eigen::VectorXd result(numFree());
-  for (int k = 0; k < numFree(); ++k) result[k] = full[freeToFull_[toSizeIndex(k)]];
+  for (int k = 0; k < numFree(); ++k) result[k] = full[freeToFull_[toIndex(k)]];
   return result;
 }
 
@@ -92,7 +93,7 @@ Eigen::VectorXd FreeDofs::expand(const Eigen::VectorXd& free) const {
                 std::to_string(numFree()));
   }
   Eigen::VectorXd result = Eigen::VectorXd::Zero(numDofs());
-  for (int k = 0; k < numFree(); ++k) result[freeToFull_[toSizeIndex(k)]] = free[k];
+  for (int k = 0; k < numFree(); ++k) result[freeToFull_[toIndex(k)]] = free[k];
   return result;
 }
 
@@ -123,9 +124,9 @@ void SubmatrixExtractor::rebuild(const Eigen::SparseMatrix<double>& full, const 
   int written = 0;
   for (int j = 0; j < numSubCols; ++j) {
     subOuter[j] = written;
-    const int c = cols[toSizeIndex(j)];
+    const int c = cols[toIndex(j)];
     for (int p = outer[c]; p < columnEnd(full, c); ++p) {
-      const int subRow = fullToSubRow[toSizeIndex(inner[p])];
+      const int subRow = fullToSubRow[toIndex(inner[p])];
       subInner[written] = subRow;
       slots[written] = p;
       written += subRow >= 0 ? 1 : 0;

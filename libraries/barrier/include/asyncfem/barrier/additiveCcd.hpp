@@ -9,13 +9,13 @@ namespace asyncfem {
 
 /// What a time-of-impact query found. `impact` false: the pair stays apart (above
 /// `minimumSeparation`) over the whole step, certified. `impact` true: the step is cut at
-/// `time` in [0, 1], no later than the first contact if there is one, where the pair is
-/// still apart; the query stops once the gap has fallen below `gapFraction` of its start,
-/// so a pair that only comes close (a point grazing a face) is cut too, and a line search
-/// queries again from there.
+/// `stepFraction` in [0, 1] (a fraction of the motion given, not a clock time), no later
+/// than the first contact if there is one, where the pair is still apart; the query stops
+/// once the gap has fallen below `gapFraction` of its start, so a pair that only comes
+/// close (a point grazing a face) is cut too, and a line search queries again from there.
 struct TimeOfImpact {
   bool impact = false;
-  double time = 1.0;
+  double stepFraction = 1.0;
   int iterations = 0;
 };
 

@@ -23,6 +23,8 @@ enum class ForceModelType { linear, corotational, stvk, neoHookean, mooneyRivlin
 
 /// "linear", "corotational", "stvk", "neo-hookean", "mooney-rivlin".
 std::string toString(ForceModelType type);
+/// Whether the model has hexahedral elements (library hexElements): linear and stvk.
+bool runsOnHexahedra(ForceModelType type);
 
 /// The physics of a problem beyond its mesh, boundary and loads.
 struct ProblemSettings {

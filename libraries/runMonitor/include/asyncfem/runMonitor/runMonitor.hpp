@@ -91,8 +91,9 @@ class RunMonitor {
   long long energyEvaluations_ = 0;
   /// The force model's name when the inversion check runs, empty otherwise.
   std::string inversionCheckModel_;
-  /// det of each element's rest edge matrix (x1 - x0, x2 - x0, x3 - x0).
-  std::vector<double> restVolumes_;
+  /// Each element's Jacobian determinants at rest, one per tetrahedron (its edge matrix
+  /// (x1 - x0, x2 - x0, x3 - x0)), eight per hexahedron (its corners'), element after element.
+  std::vector<double> restJacobians_;
 };
 
 /// When a run writes its checkpoint: every `everyFrames` frames (0: not by frames) and/or
