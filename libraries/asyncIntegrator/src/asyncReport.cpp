@@ -10,8 +10,9 @@
 #include <cstdio>
 #include <string>
 
-#include "asyncBackwardEulerImpl.hpp"
 #include "detail/multirateSupport.hpp"
+#include "stepSolvers.hpp"
+#include "twoLevelStepSolver.hpp"
 
 namespace asyncfem {
 
@@ -31,15 +32,10 @@ namespace {
 // The summary's lines on implicit contact (none without contact steps).
 void appendContactLines(const AsyncRunStats& r, int contactIterations, std::vector<std::string>& lines) {
   if (r.contactSteps == 0) return;
+  lines.push_back(detail::contactLine(
+      r, "", "iterations", contactIterations,
+      "A^S refactored " + std::to_string(r.contactRegionFactorizations) + " times for its contact blocks"));
   char line[256];
-  std::snprintf(line, sizeof(line),
-                "async implicit contact: %lld solves over %lld steps (%.2f per step); %lld steps stopped at %d "
-                "iterations unconverged (largest relative residual %.2e); A^S refactored %lld times for its "
-                "contact blocks",
-                r.contactIterations, r.contactSteps,
-                static_cast<double>(r.contactIterations) / static_cast<double>(r.contactSteps),
-                r.unconvergedContactSteps, contactIterations, r.largestContactResidual, r.contactRegionFactorizations);
-  lines.emplace_back(line);
   if (r.contactFreeSteps == 0 && r.contactScreenedSteps == 0) return;
   std::snprintf(line, sizeof(line),
                 "async implicit contact: %lld of those steps certified free of contact after one solve (end states "
@@ -51,8 +47,6 @@ void appendContactLines(const AsyncRunStats& r, int contactIterations, std::vect
 }  // namespace
 
 RunReport AsyncBackwardEuler::report() const {
-  const AsyncRunStats& r = runStats_;
-  char line[256];
   RunReport report;
   report.factorNonZeros = factorNonZeros();
   report.mayGainEnergy = options_.coupling == AsyncCoupling::paper;
@@ -60,7 +54,7 @@ RunReport AsyncBackwardEuler::report() const {
     if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
     report.resumeCaveat += caveat;
   };
-  if (options_.laggedSchur && !impl_->model.linear && impl_->solver == AsyncStepSolver::structuredSchur) {
+  if (options_.laggedSchur && !system_.forceModel->isLinear() && stepSolver() == AsyncStepSolver::structuredSchur) {
     addCaveat(
         "laggedSchur: the H^{LL*} factor kept as preconditioner is not in the checkpoint, so the resumed run "
         "refactors at its first step; its frames match an uninterrupted run to about the Schur tolerance (" +
@@ -74,7 +68,7 @@ RunReport AsyncBackwardEuler::report() const {
         "tolerance (" +
         shortNumber(options_.laggedSchurTolerance) + "), not bit for bit");
   }
-  if (implicitContact()) {
+  if (system_.externalForceJacobian && linearizesExternalForce()) {
     addCaveat(
         "implicit contact: the contact blocks kept in the regions' A^S (and the factors built with them) are not in "
         "the checkpoint, so the resumed run's contact iterations start from other matrices; its frames match an "
@@ -89,23 +83,25 @@ RunReport AsyncBackwardEuler::report() const {
   }
   std::vector<std::string>& lines = report.lines;
   if (!regionNote_.empty()) lines.push_back("regions " + regionNote_);
-  lines.push_back("async step solver: " + toString(impl_->solver) +
-                  (impl_->solver == AsyncStepSolver::hierarchy ? " (regions that touch or nest, or on request)"
-                                                               : " (each region coupled only to L)"));
-  if (impl_->solver == AsyncStepSolver::hierarchy) {
-    hierarchyReportLines(lines);
-    if (policy_) appendRepartitionLines(repartitions_, lines);
-    return report;
-  }
+  const AsyncStepSolver kind = stepSolver();
+  lines.push_back("async step solver: " + toString(kind) +
+                  (kind == AsyncStepSolver::hierarchy ? " (regions that touch or nest, or on request)"
+                                                      : " (each region coupled only to L)"));
+  solver_->reportLines(lines);
+  if (policy_) appendRepartitionLines(repartitions_, lines);
+  return report;
+}
+
+void detail::TwoLevelStepSolver::reportLines(std::vector<std::string>& lines) const {
+  const AsyncRunStats& r = runStats_;
+  char line[256];
   std::snprintf(line, sizeof(line),
                 "async set-up %.3f s (Z %.3f s over %lld right-hand sides on %d threads, H^LL* %.3f s); |S| %d, "
                 "|I| %d, |L| %d DOFs",
                 r.setupSeconds, r.setupZSeconds, r.zColumns, r.zThreads, r.setupSchurSeconds, r.fastDofs,
                 r.interfaceDofs, r.largeDofs);
   lines.emplace_back(line);
-  std::snprintf(line, sizeof(line), "async steady large step %.3f ms over %lld steps; rebuilds %lld (%.3f s)",
-                1000.0 * r.meanStepSeconds(), r.steps, r.rebuilds, r.rebuildSeconds);
-  lines.emplace_back(line);
+  lines.push_back(steadyStepLine(r));
   if (r.laggedSteps > 0) {
     std::snprintf(line, sizeof(line),
                   "async lagged Schur: %lld steps, %lld iterations, largest relative residual %.2e; %lld rebuilds "
@@ -121,8 +117,6 @@ RunReport AsyncBackwardEuler::report() const {
     lines.emplace_back(line);
   }
   appendContactLines(r, options_.contactIterations, lines);
-  if (policy_) appendRepartitionLines(repartitions_, lines);
-  return report;
 }
 
 }  // namespace asyncfem

@@ -4,26 +4,23 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <cmath>
 #include <string>
 
-#include "asyncBackwardEulerImpl.hpp"
 #include "detail/multirateSupport.hpp"
 #include "detail/parallelTasks.hpp"
+#include "twoLevelStepSolver.hpp"
 
 namespace asyncfem {
+
+using detail::TwoLevelStepSolver;
 
 using detail::FastRegion;
 using detail::substepTime;
 
-bool AsyncBackwardEuler::implicitContact() const {
-  return static_cast<bool>(system_.externalForceJacobian) && linearizesExternalForce();
-}
-
-bool AsyncBackwardEuler::certifiesContactFree() const {
+bool TwoLevelStepSolver::certifiesContactFree() const {
   return implicitContact() && options_.certifyContactFree && system_.stateDependentOnlyInContact &&
          static_cast<bool>(system_.obstacleProximity);
 }
@@ -31,7 +28,7 @@ bool AsyncBackwardEuler::certifiesContactFree() const {
 // Implicit contact (Eqs. C1-C6): Newton's method over the step (detail::ContactIteration),
 // the contact blocks in Â^L and in the regions' A^S, until the residual is
 // at most contactTolerance or contactIterations solves are spent.
-void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
+void TwoLevelStepSolver::solveWithImplicitContact(double t0, double t1) {
   Impl& d = *impl_;
   const double hL = timestep();
   if (d.externalL == nullptr) throw Error("async integrator: implicit contact without an external force function");
@@ -111,7 +108,7 @@ void AsyncBackwardEuler::solveWithImplicitContact(double t0, double t1) {
 // (1 -> 0), frictionless drop on the sphere at k = 2e4 19.1 -> 17.1 s (8 -> 0). Rebuilding
 // with the step's blocks where they were the last step's (a contact at rest) once the rent
 // reached twice the price cost 9% (ball) and 4% (drop) more in paired runs: not kept.
-bool AsyncBackwardEuler::rebuildWithoutRegionBlocks() {
+bool TwoLevelStepSolver::rebuildWithoutRegionBlocks() {
   Impl& d = *impl_;
   bool builtWithBlocks = false;
   for (const Impl::BuiltBlocks& built : d.schurBlocks) builtWithBlocks = builtWithBlocks || !built.positions.empty();
@@ -133,7 +130,7 @@ bool AsyncBackwardEuler::rebuildWithoutRegionBlocks() {
 
 // The regions whose A^S the contact blocks just changed: refactored, Z and H^{LL*} stale
 // unless every A^S is back to the blocks they were built with.
-void AsyncBackwardEuler::refactorContactRegions() {
+void TwoLevelStepSolver::refactorContactRegions() {
   Impl& d = *impl_;
   const std::vector<int>& changed = d.contact.changedRegions();
   if (changed.empty()) return;
@@ -152,7 +149,7 @@ void AsyncBackwardEuler::refactorContactRegions() {
 // of the box's centre: no free vertex with its centre within the largest such radius of
 // an obstacle (depth is 1-Lipschitz in the position) means no state touches, and the force
 // at each is the predicted one (stateDependentOnlyInContact).
-bool AsyncBackwardEuler::contactFreeCertified() {
+bool TwoLevelStepSolver::contactFreeCertified() {
   Impl& d = *impl_;
   const Eigen::VectorXd& v0 = velocity_;
   const double hL = timestep();

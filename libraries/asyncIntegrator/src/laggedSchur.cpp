@@ -5,18 +5,19 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <cmath>
 #include <string>
 
-#include "asyncBackwardEulerImpl.hpp"
 #include "detail/flopPrices.hpp"
 #include "detail/multirateSupport.hpp"
 #include "detail/parallelTasks.hpp"
+#include "twoLevelStepSolver.hpp"
 
 namespace asyncfem {
+
+using detail::TwoLevelStepSolver;
 
 using detail::FastRegion;
 using detail::kBlockedFlopWeight;
@@ -25,14 +26,15 @@ using detail::kSolveCallFlops;
 // A refresh (laggedSchurRotation): the kept corrections C_i turned with the body since the
 // factor was built (Eq. T2) and H^{LL*} refactored from the current A^L, without Z. The
 // next rebuild the rule asks for is a full one.
-void AsyncBackwardEuler::refreshLaggedFactor() {
+void TwoLevelStepSolver::refreshLaggedFactor() {
   Impl& d = *impl_;
   Stopwatch factor;
   d.rotations.update(*system_.mesh, displacement_);
   for (int i = 0; i < partition_.numRegions(); ++i) {
     d.rotations.turnBlock(partition_.interfaceDofs(i), d.regions[static_cast<std::size_t>(i)].correction);
   }
-  d.schur.factor(d.largeSystem, partition_, d.regions, options_.schur, options_.coupling, schurAsymmetry_, stats_);
+  d.schur.factor(d.largeSystem, partition_, d.regions, options_.schur, options_.coupling, schurReport_.asymmetry,
+                 stats_);
   d.contact.noteFactored();
   stats_.factorizationSeconds += factor.stop();
   ++runStats_.laggedRefreshes;
@@ -42,7 +44,7 @@ void AsyncBackwardEuler::refreshLaggedFactor() {
 
 // After a factor of H^{LL*}: the rent-or-buy prices and, with laggedSchurRotation, the
 // rotations measured from this state (where the factor's tangent was taken).
-void AsyncBackwardEuler::keepLaggedFactor() {
+void TwoLevelStepSolver::keepLaggedFactor() {
   Impl& d = *impl_;
   priceLaggedFactor();
   if (!turnsLaggedFactor()) return;
@@ -52,7 +54,7 @@ void AsyncBackwardEuler::keepLaggedFactor() {
       [&d, &large](Eigen::VectorXd& x, bool transpose) { d.rotations.rotate(large, x, transpose); });
 }
 
-bool AsyncBackwardEuler::turnsLaggedFactor() const {
+bool TwoLevelStepSolver::turnsLaggedFactor() const {
   const Impl& d = *impl_;
   return options_.laggedSchur && options_.laggedSchurRotation && !d.model.linear && system_.mesh &&
          !options_.largeSystemSolver && options_.method == AsyncSolveMethod::structured;
@@ -62,7 +64,7 @@ bool AsyncBackwardEuler::turnsLaggedFactor() const {
 // quick set-up's (Eq. Q4): an iteration is one forward substitution per region, one solve
 // with the kept factor and one product with A^L; a rebuild is Z (|I_i| substitutions per
 // region, in blocks) and the factorization of H^{LL*}.
-void AsyncBackwardEuler::priceLaggedFactor() {
+void TwoLevelStepSolver::priceLaggedFactor() {
   Impl& d = *impl_;
   const SparseSolver* schur = d.schur.solver();
   d.lagged.rent = 0.0;
@@ -80,7 +82,7 @@ void AsyncBackwardEuler::priceLaggedFactor() {
 
 // The lagged solve's tracker (SchurSolver::Tracker): every region's probeSum follows
 // (H^{SS})^{-1} H^{SL} Y as Y moves, from the substitutions applySchur made anyway.
-void AsyncBackwardEuler::sumProbeSubstitutions(int threads, double coefficient, bool reset) {
+void TwoLevelStepSolver::sumProbeSubstitutions(int threads, double coefficient, bool reset) {
   Impl& d = *impl_;
   runOwnedTasks(threads, [&](int i) {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
@@ -95,7 +97,7 @@ void AsyncBackwardEuler::sumProbeSubstitutions(int threads, double coefficient, 
 
 // out = H^{LL*} y for the current blocks: Â^L y minus, per region, the interface rows of
 // H^{LS} (H^{SS})^{-1} H^{SL} y (one forward substitution per region).
-void AsyncBackwardEuler::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out) {
+void TwoLevelStepSolver::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out) {
   Impl& d = *impl_;
   const bool damped = system_.damped();
   out.resize(y.size());

@@ -5,18 +5,19 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <cmath>
 #include <string>
 
-#include "asyncBackwardEulerImpl.hpp"
 #include "detail/flopPrices.hpp"
 #include "detail/multirateSupport.hpp"
 #include "detail/wholeSystemFactor.hpp"
+#include "twoLevelStepSolver.hpp"
 
 namespace asyncfem {
+
+using detail::TwoLevelStepSolver;
 
 using detail::FastRegion;
 using detail::kBlockedFlopWeight;
@@ -56,7 +57,7 @@ QuickCosts quickCosts(const std::vector<FastRegion>& regions, const SparseMatrix
 
 // Quick set-up: the whole single-rate system's factor, made once per hL (nonlinear forces:
 // from the first tangent, then kept as a preconditioner) and shared by every partition.
-void AsyncBackwardEuler::borrowWholeFactor() {
+void TwoLevelStepSolver::borrowWholeFactor() {
   Impl& d = *impl_;
   if (!whole_) whole_ = std::make_unique<detail::WholeSystemFactor>();
   if (!whole_->factoredFor(timestep())) {
@@ -76,7 +77,7 @@ void AsyncBackwardEuler::borrowWholeFactor() {
 // A). The flops beyond one solve are what the missing factor costs; once they add up to the
 // rebuild's price, or the iterations do not converge, Z and H^{LL*} are built (the rent-
 // or-buy rule: about twice what knowing the partition's lifetime would have cost at most).
-void AsyncBackwardEuler::solveOnWholeFactor() {
+void TwoLevelStepSolver::solveOnWholeFactor() {
   Impl& d = *impl_;
   if (partition_.numRegions() == 0 && !d.contact.blocksInMatrix()) {
     d.schur.solve(d.rhsSchur, d.Y);

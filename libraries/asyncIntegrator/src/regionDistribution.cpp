@@ -4,22 +4,23 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <cmath>
 #include <string>
 
-#include "asyncBackwardEulerImpl.hpp"
 #include "detail/multirateSupport.hpp"
 #include "detail/parallelTasks.hpp"
+#include "twoLevelStepSolver.hpp"
 
 namespace asyncfem {
+
+using detail::TwoLevelStepSolver;
 
 using detail::FastRegion;
 
 // task(i) for every region this process owns (all of them when not distributed).
-void AsyncBackwardEuler::runOwnedTasks(int threads, const std::function<void(int)>& task) {
+void TwoLevelStepSolver::runOwnedTasks(int threads, const std::function<void(int)>& task) {
   Impl& d = *impl_;
   if (!distributed()) {
     detail::parallelTasks(partition_.numRegions(), threads, task);
@@ -43,7 +44,7 @@ void AsyncBackwardEuler::runOwnedTasks(int threads, const std::function<void(int
 }
 
 // Inside a catch block: holds the exception in flight (region: -1 when not known).
-void AsyncBackwardEuler::holdFailure(int region) {
+void TwoLevelStepSolver::holdFailure(int region) {
   if (heldFailure_) return;
   heldFailure_ = std::current_exception();
   heldFailureRegion_ = region;
@@ -52,7 +53,7 @@ void AsyncBackwardEuler::holdFailure(int region) {
 // values summed over the processes, with two more entries that count the processes
 // holding a failure and add up their failing regions (+1): every process then throws,
 // the failing one its own exception, the others an Error naming the region.
-void AsyncBackwardEuler::sumOverProcesses(std::vector<double>& values) {
+void TwoLevelStepSolver::sumOverProcesses(std::vector<double>& values) {
   values.push_back(heldFailure_ ? 1.0 : 0.0);
   values.push_back(heldFailure_ ? heldFailureRegion_ + 1.0 : 0.0);
   options_.regionDistribution.sum(values.data(), values.size());
@@ -74,7 +75,7 @@ void AsyncBackwardEuler::sumOverProcesses(std::vector<double>& values) {
               "here");
 }
 
-void AsyncBackwardEuler::assignRegionOwners() {
+void TwoLevelStepSolver::assignRegionOwners() {
   Impl& d = *impl_;
   const int numRegions = partition_.numRegions();
   std::vector<std::vector<int>> regionDofs, interfaceDofs;
@@ -108,7 +109,7 @@ void AsyncBackwardEuler::assignRegionOwners() {
 }
 
 // Each region's substitution flops, from its owner's factor (the rent-or-buy prices).
-void AsyncBackwardEuler::priceSubstitutions() {
+void TwoLevelStepSolver::priceSubstitutions() {
   Impl& d = *impl_;
   std::vector<double> flops(d.regions.size(), 0.0);
   for (std::size_t i = 0; i < d.regions.size(); ++i) {
@@ -120,7 +121,7 @@ void AsyncBackwardEuler::priceSubstitutions() {
 }
 
 // Every C_i from its owner (the others hold zeros).
-void AsyncBackwardEuler::shareCorrections() {
+void TwoLevelStepSolver::shareCorrections() {
   Impl& d = *impl_;
   std::vector<double> all;
   for (const FastRegion& rb : d.regions)
@@ -136,7 +137,7 @@ void AsyncBackwardEuler::shareCorrections() {
 // target -= the interface rows of every region's last substitution (interfaceRow) at its
 // interface positions; distributed, from the owners' rows summed over the processes (only
 // the sum of |I_i| values travels, not vectors of L's size).
-void AsyncBackwardEuler::subtractOwnedInterfaceRows(Eigen::VectorXd& target) {
+void TwoLevelStepSolver::subtractOwnedInterfaceRows(Eigen::VectorXd& target) {
   Impl& d = *impl_;
   const int numRegions = partition_.numRegions();
   if (!distributed()) {
@@ -170,7 +171,7 @@ void AsyncBackwardEuler::subtractOwnedInterfaceRows(Eigen::VectorXd& target) {
 }
 
 // X_m and sum_r X_r of every region from its owner, for the new state.
-void AsyncBackwardEuler::shareRecoveries() {
+void TwoLevelStepSolver::shareRecoveries() {
   Impl& d = *impl_;
   std::vector<double> all;
   for (FastRegion& rb : d.regions) {

@@ -10,8 +10,8 @@
 #include <cmath>
 #include <string>
 
-#include "asyncBackwardEulerImpl.hpp"
 #include "detail/multirateSupport.hpp"
+#include "stepSolvers.hpp"
 
 namespace asyncfem {
 
@@ -88,21 +88,20 @@ void AsyncBackwardEuler::repartition(std::vector<AsyncRegion> regions, const std
                                system_.obstacleProximity);
     });
   }
-  CachedSetUp outgoing{partitionKey(partition_), std::move(partition_), std::move(impl_), runStats_, timestep()};
+  CachedSetUp outgoing{partitionKey(partition_), std::move(partition_), std::move(solver_), runStats_, timestep()};
   const double setupBefore = runStats_.setupSeconds;
   if (hit != cache_.end()) {
     partition_ = std::move(hit->partition);
-    impl_ = std::move(hit->impl);
+    solver_ = std::move(hit->solver);
     runStats_.fastDofs = hit->sizes.fastDofs;
     runStats_.interfaceDofs = hit->sizes.interfaceDofs;
     runStats_.largeDofs = hit->sizes.largeDofs;
-    if (hit->timestep != timestep()) impl_->build.factorsCurrent = false;
+    if (hit->timestep != timestep()) solver_->invalidateFactors();
     cache_.erase(hit);
     record.reused = true;
   } else {
     partition_ = RegionPartition(*system_.mesh, system_.freeDofs, {});  // placeholder until setUp
-    impl_ = freshImpl();
-    setUp(std::move(next));
+    setUp(std::move(next));  // solver_ is empty: a fresh solver for the new partition
   }
   const int keep = policy_ ? policy_->options().cacheSize : 0;
   if (keep > 0) cache_.insert(cache_.begin(), std::move(outgoing));

@@ -4,25 +4,26 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/integrator/stepFormula.hpp>
 #include <cmath>
 #include <string>
 
-#include "asyncBackwardEulerImpl.hpp"
 #include "detail/multirateSupport.hpp"
 #include "detail/parallelTasks.hpp"
+#include "twoLevelStepSolver.hpp"
 
 namespace asyncfem {
+
+using detail::TwoLevelStepSolver;
 
 using detail::FastRegion;
 using detail::substepTime;
 
 // b^L = hL (f_ext - f_int(u_0) - D v_0) - hL^2 K v_0 (Eq. A1 at hL); for linear forces
 // hL (f_ext - alpha M v_0 - K (u_0 + (beta + hL) v_0)). Stable coupling: plus Eq. (A12).
-void AsyncBackwardEuler::largeRightHandSide() {
+void TwoLevelStepSolver::largeRightHandSide() {
   Impl& d = *impl_;
   const Eigen::VectorXd& u0 = displacement_;
   const Eigen::VectorXd& v0 = velocity_;
@@ -60,7 +61,7 @@ void AsyncBackwardEuler::largeRightHandSide() {
 }
 
 // Stable coupling: b^L += (1 - theta) hL^2 (K^{IS} v^S_0 + K_I^{II} v^I_0) (Eq. A12).
-void AsyncBackwardEuler::addInterfaceVelocityTerms() {
+void TwoLevelStepSolver::addInterfaceVelocityTerms() {
   Impl& d = *impl_;
   const Eigen::VectorXd& v0 = velocity_;
   for (int i = 0; i < partition_.numRegions(); ++i) {
@@ -79,7 +80,7 @@ void AsyncBackwardEuler::addInterfaceVelocityTerms() {
 
 // Every region's b^S (|S| x m, Eq. A4): b_r = hS (f_ext(t_r) - f_int(u_0) - (D + r hS K) v_0),
 // from its DOFs only.
-void AsyncBackwardEuler::regionRightHandSides() {
+void TwoLevelStepSolver::regionRightHandSides() {
   Impl& d = *impl_;
   const Eigen::VectorXd& u0 = displacement_;
   const Eigen::VectorXd& v0 = velocity_;
@@ -111,7 +112,7 @@ void AsyncBackwardEuler::regionRightHandSides() {
 
 // Forward substitution y = (H^{SS})^{-1} b^S per region and its term of b^{L*} = b^L -
 // H^{LS} y (Eq. A7); Y from H^{LL*} (Eq. A13); the regions' unknowns recovered from Y.
-void AsyncBackwardEuler::solveStructured() {
+void TwoLevelStepSolver::solveStructured() {
   Impl& d = *impl_;
   const bool damped = system_.damped();
   const int threads = detail::threadBudget(options_.threads);
@@ -167,7 +168,7 @@ void AsyncBackwardEuler::solveStructured() {
 
 // X_m and sum_r X_r from the stored Z_m and sum_r Z_r, or every X_r by a second forward
 // substitution with b^S - H^{SL} Y (block r of H^{SL} Y = B_r Y_I).
-void AsyncBackwardEuler::recoverRegion(int i) {
+void TwoLevelStepSolver::recoverRegion(int i) {
   Impl& d = *impl_;
   FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
   const std::vector<int>& pos = partition_.interfacePositions(i);
@@ -200,7 +201,7 @@ void AsyncBackwardEuler::recoverRegion(int i) {
 }
 
 // Every X_r of region i by the forward substitution of b^S - H^{SL} Y (yInterface gathered).
-void AsyncBackwardEuler::substituteRegion(int i) {
+void TwoLevelStepSolver::substituteRegion(int i) {
   Impl& d = *impl_;
   FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
   const bool damped = system_.damped();
@@ -215,7 +216,7 @@ void AsyncBackwardEuler::substituteRegion(int i) {
 }
 
 // v^S_r = v^S_0 + X_r, u^S_m = u^S_0 + hS sum_r v^S_r; v^L = v^L_0 + Y, u^L = u^L_0 + hL v^L.
-void AsyncBackwardEuler::assembleNewState(double t0, double t1) {
+void TwoLevelStepSolver::assembleNewState(double t0, double t1) {
   Impl& d = *impl_;
   const Eigen::VectorXd& u0 = displacement_;
   const Eigen::VectorXd& v0 = velocity_;

@@ -18,7 +18,9 @@
 namespace asyncfem {
 namespace detail {
 class WholeSystemFactor;
-struct AsyncPartitionState;
+class StepSolver;
+class HierarchyStepSolver;
+struct StepContext;
 struct CachedSetUp;
 }  // namespace detail
 
@@ -102,14 +104,14 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
 
   /// max_i ||C_i - C_i^T||_F / ||C_i||_F of the Schur corrections C_i (0 with no
   /// interface): how far H^{LL*} is from symmetric, what the symmetric mode neglects.
-  double schurAsymmetry() const { return schurAsymmetry_; }
+  double schurAsymmetry() const { return schurReport_.asymmetry; }
   /// Seconds spent computing the Z columns and the Schur corrections C_i (included in
   /// stats().factorizationSeconds): the part of a refactorization the paper's Algorithm 2
   /// adds over single-rate.
-  double zColumnSeconds() const { return zColumnSeconds_; }
+  double zColumnSeconds() const { return schurReport_.zColumnSeconds; }
   /// The Schur mode in effect (lowRank is symmetric for the stable coupling, and may fall
   /// back to lu for very large interfaces).
-  SchurMode schurModeUsed() const { return schurModeUsed_; }
+  SchurMode schurModeUsed() const { return schurReport_.modeUsed; }
   /// Set-up, rebuild and steady-state step times, and the sizes that set them.
   const AsyncRunStats& runStats() const { return runStats_; }
   /// factorNonZeros(), the set-up, rebuild and steady-step times and the lagged-Schur
@@ -127,73 +129,21 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   long long factorNonZeros() const;
 
  private:
-  // The state kept per partition, and a set-up kept for reuse (src/asyncBackwardEulerImpl.hpp).
-  using Impl = detail::AsyncPartitionState;
+  // The step solvers and a set-up kept for reuse (src/stepSolvers.hpp).
   using CachedSetUp = detail::CachedSetUp;
-  std::unique_ptr<Impl> freshImpl() const;
   void initialize();
+  void checkPartitionFits(const RegionPartition& partition) const;
+  detail::StepContext stepContext();
+  const detail::HierarchyStepSolver& hierarchySolver(const char* what) const;
+  // Run-time regions (setUpCache.cpp).
   void maybeRepartition();
   void repartition(std::vector<AsyncRegion> regions, const std::string& reason);
-  void setUpHierarchy();
-  void stepHierarchy();
-  void solveHierarchyContact();
-  void hierarchyReportLines(std::vector<std::string>& lines) const;
-  const Impl& hierarchyImpl(const char* what) const;
-  void refactor();
-  void assembleBlocks();
-  void subtractInterfaceStiffness();
-  void fullSchurRebuild();
-  void priceLaggedFactor();
-  void refreshLaggedFactor();
-  void refactorLargeSystem();
-  /// The system asks for implicit contact and this integrator's options allow it (else the
-  /// contact is explicit, and IntegratorRegistry::create refuses the combination).
-  bool implicitContact() const;
-  void solveWithImplicitContact(double t0, double t1);
-  /// Implicit contact may end a step after one solve (AsyncOptions::certifyContactFree).
-  bool certifiesContactFree() const;
-  bool contactFreeCertified();
-  void substituteRegion(int i);
-  void refactorContactRegions();
-  bool rebuildWithoutRegionBlocks();
-  void keepLaggedFactor();
-  /// Whether the lagged factor preconditions turned with the body (laggedSchurRotation).
-  bool turnsLaggedFactor() const;
-  void borrowWholeFactor();
-  void solveOnWholeFactor();
-  void applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out);
-  void sumProbeSubstitutions(int threads, double coefficient, bool reset);
-  void evaluateStartOfStep();
-  void gatherExternalForces(double t0, double t1);
-  void largeRightHandSide();
-  void addInterfaceVelocityTerms();
-  void checkPartitionFits(const RegionPartition& partition) const;
-  void regionRightHandSides();
-  void solveStructured();
-  void recoverRegion(int region);
-  void assembleNewState(double t0, double t1);
-  void countSolves();
-  // AsyncOptions::regionDistribution (asyncBackwardEuler.cpp, "Regions owned by one process").
-  bool distributed() const { return static_cast<bool>(options_.regionDistribution.sum); }
-  void assignRegionOwners();
-  void priceSubstitutions();
-  void shareCorrections();
-  void subtractOwnedInterfaceRows(Eigen::VectorXd& target);
-  void shareRecoveries();
-  void runOwnedTasks(int threads, const std::function<void(int)>& task);
-  void holdFailure(int region);
-  void sumOverProcesses(std::vector<double>& values);
   AsyncOptions options_;
-  // Distributed: the first failure of this process's region work, held until the next sum
-  // over the processes, where every process learns of it and all stop (none waits).
-  std::exception_ptr heldFailure_;
-  int heldFailureRegion_ = -1;
   SubstepObserver observer_;
-  double schurAsymmetry_ = 0.0;
-  double zColumnSeconds_ = 0.0;
-  SchurMode schurModeUsed_ = SchurMode::lowRank;
+  detail::SchurReport schurReport_;
   AsyncRunStats runStats_;
-  std::unique_ptr<Impl> impl_;
+  // The step solver of the partition in use.
+  std::unique_ptr<detail::StepSolver> solver_;
   // The whole single-rate system's factor (quickSetUp), shared by every partition.
   std::unique_ptr<detail::WholeSystemFactor> whole_;
   std::unique_ptr<AdaptiveRegionPolicy> policy_;

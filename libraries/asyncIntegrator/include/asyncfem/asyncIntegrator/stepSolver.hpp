@@ -53,6 +53,16 @@ class AsyncOptionError : public ValidationError {
 AsyncStepSolver chooseStepSolver(const AsyncOptions& options, const RegionPartition& partition,
                                  const DynamicSystem& system);
 
+namespace detail {
+/// The structured Schur solve's reports kept across partitions (AsyncBackwardEuler's
+/// schurAsymmetry(), zColumnSeconds(), schurModeUsed()).
+struct SchurReport {
+  double asymmetry = 0.0;
+  double zColumnSeconds = 0.0;
+  SchurMode modeUsed = SchurMode::lowRank;
+};
+}  // namespace detail
+
 /// What chooseStepSolver() checks for the hierarchy solve, ahead of any partition: for
 /// run-time regions that may nest (AdaptiveRegionOptions::nest), so that a refusal comes
 /// before the run rather than at the step where regions first touch. why: the reason the

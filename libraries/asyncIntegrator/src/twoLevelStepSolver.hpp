@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The state AsyncBackwardEuler keeps per partition (its Impl: AsyncPartitionState) and a
-// cached set-up, shared by the files that implement its parts (asyncBackwardEuler.cpp: set-up and the structured
-// step; hierarchyStep.cpp; setUpCache.cpp; laggedSchur.cpp; quickSetUp.cpp;
-// implicitContact.cpp; regionDistribution.cpp; asyncReport.cpp). Private to the library.
+// The two-level step solvers (every fast region coupled only to L): the structured Schur
+// solve (Eqs. A13-A15) and its naive LU reference share the blocks, the right-hand sides and
+// the recovery of the end state; they differ in how the coupled block system is factored
+// and solved. Its parts, one concept per file: twoLevelStepSolver.cpp (set-up, blocks and
+// factors, one step), structuredStep.cpp (right-hand sides, Schur solve, recovery),
+// laggedSchur.cpp, quickSetUp.cpp, implicitContact.cpp, regionDistribution.cpp. Private to
+// the library.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,28 +17,25 @@
 #include <asyncfem/asyncIntegrator/stepSolver.hpp>
 #include <asyncfem/dynamics/dynamicSystem.hpp>
 #include <cmath>
-#include <map>
+#include <exception>
+#include <functional>
 #include <memory>
 #include <utility>
 #include <vector>
 
 #include "detail/contactIteration.hpp"
 #include "detail/fastRegion.hpp"
-#include "detail/hierarchySystem.hpp"
 #include "detail/naiveSolver.hpp"
 #include "detail/schurSolver.hpp"
 #include "detail/sparseBlocks.hpp"
+#include "stepSolvers.hpp"
 
 namespace asyncfem::detail {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
-struct AsyncPartitionState {
-  AsyncStepSolver solver = AsyncStepSolver::structuredSchur;  // chosen at each set-up
-  // The hierarchy solve (AsyncStepSolver::hierarchy) and f_ext at each time unit where some
-  // DOF's step ends (Eq. N3; the vectors are kept from step to step).
-  std::unique_ptr<detail::HierarchySystem> hierarchy;
-  std::map<long long, Eigen::VectorXd> unitForces;
+// What a two-level solver keeps for its partition.
+struct TwoLevelState {
   // What the model is (set when the integrator is made; symmetry checked at the first
   // linear set-up).
   struct Model {
@@ -162,13 +162,76 @@ struct AsyncPartitionState {
   }
 };
 
-// A set-up kept for reuse by run-time regions (the most recently used first).
-struct CachedSetUp {
-  std::vector<std::pair<int, std::vector<int>>> key;  // (ratio, vertices) of every region, sorted
-  RegionPartition partition;
-  std::unique_ptr<AsyncPartitionState> impl;
-  AsyncRunStats sizes;  // fastDofs, interfaceDofs, largeDofs
-  double timestep = 0.0;
+/// The structured Schur solve (kind structuredSchur) or the naive LU of the whole block
+/// system (kind naiveLU) for a partition whose regions each couple only to L.
+class TwoLevelStepSolver final : public StepSolver {
+ public:
+  TwoLevelStepSolver(AsyncStepSolver kind, const StepContext& context);
+  ~TwoLevelStepSolver() override;
+
+  AsyncStepSolver kind() const override { return kind_; }
+  void setUp() override;
+  void invalidateFactors() override { impl_->build.factorsCurrent = false; }
+  StepEnd step(double t0, double t1) override;
+  long long factorNonZeros() const override;
+  void reportLines(std::vector<std::string>& lines) const override;
+  /// AsyncBackwardEuler::solveFloorSeconds().
+  double solveFloorSeconds(int repeats);
+
+ private:
+  using Impl = TwoLevelState;
+  // Set-up, blocks and factors (twoLevelStepSolver.cpp).
+  void refactor();
+  void assembleBlocks();
+  void subtractInterfaceStiffness();
+  void fullSchurRebuild();
+  void refactorLargeSystem();
+  void evaluateStartOfStep();
+  void gatherExternalForces(double t0, double t1);
+  void countSolves();
+  // One step's right-hand sides, solve and recovery (structuredStep.cpp).
+  void largeRightHandSide();
+  void addInterfaceVelocityTerms();
+  void regionRightHandSides();
+  void solveStructured();
+  void recoverRegion(int region);
+  void substituteRegion(int i);
+  void assembleNewState(double t0, double t1);
+  // The lagged factor of H^{LL*} (laggedSchur.cpp).
+  void priceLaggedFactor();
+  void refreshLaggedFactor();
+  void keepLaggedFactor();
+  /// Whether the lagged factor preconditions turned with the body (laggedSchurRotation).
+  bool turnsLaggedFactor() const;
+  void applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& out);
+  void sumProbeSubstitutions(int threads, double coefficient, bool reset);
+  // The quick set-up (quickSetUp.cpp).
+  void borrowWholeFactor();
+  void solveOnWholeFactor();
+  // Implicit contact and its certificate (implicitContact.cpp).
+  void solveWithImplicitContact(double t0, double t1);
+  /// Implicit contact may end a step after one solve (AsyncOptions::certifyContactFree).
+  bool certifiesContactFree() const;
+  bool contactFreeCertified();
+  void refactorContactRegions();
+  bool rebuildWithoutRegionBlocks();
+  // AsyncOptions::regionDistribution (regionDistribution.cpp).
+  bool distributed() const { return static_cast<bool>(options_.regionDistribution.sum); }
+  void assignRegionOwners();
+  void priceSubstitutions();
+  void shareCorrections();
+  void subtractOwnedInterfaceRows(Eigen::VectorXd& target);
+  void shareRecoveries();
+  void runOwnedTasks(int threads, const std::function<void(int)>& task);
+  void holdFailure(int region);
+  void sumOverProcesses(std::vector<double>& values);
+
+  AsyncStepSolver kind_;
+  std::unique_ptr<Impl> impl_;
+  // Distributed: the first failure of this process's region work, held until the next sum
+  // over the processes, where every process learns of it and all stop (none waits).
+  std::exception_ptr heldFailure_;
+  int heldFailureRegion_ = -1;
 };
 
 }  // namespace asyncfem::detail
