@@ -21,13 +21,13 @@ void expectSameSolverOptions(const AsyncOptions& a, const AsyncOptions& b) {
   EXPECT_EQ(a.method, b.method);
   EXPECT_EQ(a.recovery, b.recovery);
   EXPECT_EQ(a.regionSolver, b.regionSolver);
-  EXPECT_EQ(a.substepStatePrediction, b.substepStatePrediction);
-  EXPECT_EQ(a.laggedSchur, b.laggedSchur);
-  EXPECT_EQ(a.laggedSchurRotation, b.laggedSchurRotation);
+  EXPECT_EQ(a.contact.substepStatePrediction, b.contact.substepStatePrediction);
+  EXPECT_EQ(a.keptFactors.laggedSchur, b.keptFactors.laggedSchur);
+  EXPECT_EQ(a.keptFactors.laggedSchurRotation, b.keptFactors.laggedSchurRotation);
   EXPECT_EQ(a.threads, b.threads);
-  EXPECT_EQ(a.contactIterations, b.contactIterations);
-  EXPECT_EQ(a.contactTolerance, b.contactTolerance);
-  EXPECT_EQ(a.certifyContactFree, b.certifyContactFree);
+  EXPECT_EQ(a.contact.iterations, b.contact.iterations);
+  EXPECT_EQ(a.contact.tolerance, b.contact.tolerance);
+  EXPECT_EQ(a.contact.certifyContactFree, b.contact.certifyContactFree);
 }
 
 void expectSameRegions(const std::vector<AsyncRegion>& a, const std::vector<AsyncRegion>& b) {

@@ -40,7 +40,7 @@ TEST(Composition, HierarchySolveTakesRunTimeRegions) {
   AsyncOptions hierarchy;
   hierarchy.method = AsyncSolveMethod::hierarchy;
   AsyncOptions exact;
-  exact.laggedSchur = false;
+  exact.keptFactors.laggedSchur = false;
   AsyncBackwardEuler structured(ts.system, kLargeStep, {}, exact);
   AsyncBackwardEuler levels(ts.system, kLargeStep, {}, hierarchy);
   structured.setState(ts.u0, ts.v0);
@@ -123,7 +123,7 @@ TEST(Composition, TouchingRegionsAtOneRatioStepAsOneRegion) {
     all.insert(all.end(), slabs.back().vertices.begin(), slabs.back().vertices.end());
   }
   AsyncOptions exact;
-  exact.laggedSchur = false;
+  exact.keptFactors.laggedSchur = false;
   AsyncBackwardEuler touching(ts.system, kLargeStep, slabs, exact);
   AsyncBackwardEuler one(ts.system, kLargeStep, {{"all", all, 8}}, exact);
   AsyncOptions hierarchyOptions;
@@ -172,8 +172,8 @@ TEST(Composition, EveryRefusalNamesItsOption) {
   };
   const std::vector<std::pair<std::string, AsyncOptions>> cells{
       {"coupling", with([](AsyncOptions& o) { o.coupling = AsyncCoupling::paper; })},
-      {"quickSetUp", with([](AsyncOptions& o) { o.quickSetUp = true; })},
-      {"substepStatePrediction", with([](AsyncOptions& o) { o.substepStatePrediction = true; })},
+      {"quickSetUp", with([](AsyncOptions& o) { o.keptFactors.quickSetUp = true; })},
+      {"substepStatePrediction", with([](AsyncOptions& o) { o.contact.substepStatePrediction = true; })},
       {"method", with([](AsyncOptions& o) { o.method = AsyncSolveMethod::naive; })},
       {"schur", with([](AsyncOptions& o) { o.schur = SchurMode::lu; })},
       {"recovery", with([](AsyncOptions& o) { o.recovery = RecoveryMode::substitution; })},
@@ -194,7 +194,7 @@ TEST(Composition, EveryRefusalNamesItsOption) {
   EXPECT_EQ(refusedKey(ts, ts.system, apart, lu), "nestedSolve");
   EXPECT_EQ(refusedKey(ts, ts.system, touching, lu), "");
   // Run-time regions that may nest are checked when the policy is set, before any step.
-  AsyncBackwardEuler quick(ts.system, kLargeStep, {}, with([](AsyncOptions& o) { o.quickSetUp = true; }));
+  AsyncBackwardEuler quick(ts.system, kLargeStep, {}, with([](AsyncOptions& o) { o.keptFactors.quickSetUp = true; }));
   try {
     quick.setAdaptiveRegions(windows({{"a", 0.0, 1.0, touching[0].vertices, 2}}, true));
     FAIL() << "nesting run-time regions accepted the quick set-up";

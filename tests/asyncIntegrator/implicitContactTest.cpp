@@ -79,8 +79,8 @@ struct ContactBar {
 
 AsyncOptions tightContact() {
   AsyncOptions options;
-  options.contactTolerance = 1e-13;
-  options.contactIterations = 200;
+  options.contact.tolerance = 1e-13;
+  options.contact.iterations = 200;
   return options;
 }
 
@@ -113,7 +113,7 @@ TEST(AsyncImplicitContact, StepMatchesThePerSubstepDefinition) {
       // The quick set-up's path too (L's system by conjugate gradients on the whole
       // system's factor, with the contact blocks in its operator).
       AsyncOptions quickOptions = tightContact();
-      quickOptions.quickSetUp = true;
+      quickOptions.keptFactors.quickSetUp = true;
       AsyncBackwardEuler quick(bar.ts.system, kLargeStep, regions, quickOptions);
       async.setState(bar.ts.u0, bar.ts.v0);
       quick.setState(bar.ts.u0, bar.ts.v0);
@@ -297,7 +297,7 @@ TEST(AsyncImplicitContact, RegionsInContactTakeTheirBlocksAndConverge) {
     EXPECT_TRUE(async.displacement().allFinite());
     EXPECT_GT(stats.contactRegionFactorizations, 0) << "ratio " << ratio;
     EXPECT_EQ(stats.unconvergedContactSteps, 0) << "ratio " << ratio;
-    EXPECT_LT(stats.contactIterations, 20 * AsyncOptions{}.contactIterations) << "ratio " << ratio;
+    EXPECT_LT(stats.contactIterations, 20 * AsyncOptions{}.contact.iterations) << "ratio " << ratio;
     bool reported = false;
     for (const std::string& line : async.report().lines)
       reported = reported || line.find("0 steps stopped at 30 iterations unconverged") != std::string::npos;

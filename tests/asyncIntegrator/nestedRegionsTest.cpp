@@ -183,7 +183,7 @@ TEST(NestedRegions, TwoLevelStepMapNeverGainsEnergy) {
   test::TestBody body = smallBar();
   const Eigen::MatrixXd energy = stateEnergyMatrix(body);
   AsyncOptions exact;
-  exact.laggedSchur = false;
+  exact.keptFactors.laggedSchur = false;
   for (int ratio : {1, 4, 64})
     for (double hL : {1e-3, 2e-2}) {
       AsyncBackwardEuler integrator(body.system, hL, {{"end", test::verticesBeyond(body.mesh, 0.5), ratio}}, exact);
@@ -242,7 +242,7 @@ TEST(NestedRegions, AllRatiosOneIsBackwardEuler) {
 /// integrator on the same regions; the largest relative difference of u and v.
 double twoLevelDifference(const test::TestSystem& ts, const std::vector<AsyncRegion>& regions) {
   AsyncOptions exact;
-  exact.laggedSchur = false;
+  exact.keptFactors.laggedSchur = false;
   AsyncBackwardEuler twoLevel(ts.system, 4e-3, regions, exact);
   const auto nestedOwner = hierarchyIntegrator(ts.system, 4e-3, regions);
   AsyncBackwardEuler& nested = *nestedOwner;

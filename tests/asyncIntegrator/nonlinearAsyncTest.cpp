@@ -75,7 +75,7 @@ TEST(NonlinearAsync, StructuredEqualsNaive) {
   EXPECT_LT(relativeDifference(structured->velocity(), naive->velocity()), 1e-9);
 }
 
-// The lagged Schur factor (AsyncOptions::laggedSchur) solves each step's Schur system by
+// The lagged Schur factor (AsyncOptions::KeptFactors::laggedSchur) solves each step's Schur system by
 // iterative refinement to a relative residual of 1e-10, so its trajectory follows the
 // rebuilt one: 1e-7 relative after 20 large, visibly nonlinear steps (the residual
 // tolerance times the growth of perturbations over the run, with margin), with damping and
@@ -86,21 +86,21 @@ TEST(NonlinearAsync, StructuredEqualsNaive) {
 TEST(NonlinearAsync, LaggedSchurFollowsTheRebuiltStep) {
   for (const AsyncCoupling coupling : {AsyncCoupling::stable, AsyncCoupling::paper}) {
     AsyncOptions lagged = test::withCoupling(coupling);
-    EXPECT_TRUE(lagged.laggedSchur);  // the default
+    EXPECT_TRUE(lagged.keptFactors.laggedSchur);  // the default
     AsyncOptions rebuilt = test::withCoupling(coupling);
-    rebuilt.laggedSchur = false;  // the paper's Algorithm 2: Z and H^{LL*} every step
+    rebuilt.keptFactors.laggedSchur = false;  // the paper's Algorithm 2: Z and H^{LL*} every step
     const auto [exact, approximate] = runSideBySide(rebuilt, lagged, 20);
     EXPECT_EQ(exact->runStats().laggedSteps, 0);
     EXPECT_LT(relativeDifference(approximate->displacement(), exact->displacement()), 1e-7);
     EXPECT_LT(relativeDifference(approximate->velocity(), exact->velocity()), 1e-7);
     const AsyncRunStats& stats = approximate->runStats();
     EXPECT_GE(stats.laggedSteps, coupling == AsyncCoupling::stable ? 5 : 1);
-    EXPECT_LE(stats.largestSchurResidual, lagged.laggedSchurTolerance);
+    EXPECT_LE(stats.largestSchurResidual, lagged.keptFactors.laggedSchurTolerance);
     EXPECT_GT(stats.schurIterations, 0);
   }
 }
 
-// The lagged factor turned with the body (AsyncOptions::laggedSchurRotation, default on):
+// The lagged factor turned with the body (AsyncOptions::KeptFactors::laggedSchurRotation, default on):
 // the clamped bar swung about z (v = omega z x x, omega = 20 rad/s, no load), so that its
 // stiff tip turns by tenths of a radian while the factor is kept. Turned and unturned runs
 // both follow the rebuilt one (1e-7 relative after 30 steps, as above: both solve to the
@@ -119,8 +119,8 @@ TEST(NonlinearAsync, TheLaggedFactorTurnedWithTheBodyIteratesLess) {
   ts.v0 = ts.system.freeDofs.expand(ts.system.freeDofs.restrict(ts.v0));  // clamped DOFs at rest
   const std::vector<AsyncRegion> regions{{"tip", test::verticesBeyond(ts.mesh, 0.75), 6}};
   AsyncOptions rebuiltOptions, unturnedOptions;
-  rebuiltOptions.laggedSchur = false;
-  unturnedOptions.laggedSchurRotation = false;
+  rebuiltOptions.keptFactors.laggedSchur = false;
+  unturnedOptions.keptFactors.laggedSchurRotation = false;
   std::vector<std::unique_ptr<AsyncBackwardEuler>> runs;
   for (const AsyncOptions& options : {rebuiltOptions, unturnedOptions, AsyncOptions{}}) {
     runs.push_back(std::make_unique<AsyncBackwardEuler>(ts.mesh, ts.system, 2e-3, regions, options));
@@ -133,7 +133,7 @@ TEST(NonlinearAsync, TheLaggedFactorTurnedWithTheBodyIteratesLess) {
   for (const AsyncBackwardEuler* run : {&unturned, &turned}) {
     EXPECT_LT(relativeDifference(run->displacement(), rebuilt.displacement()), 1e-7);
     EXPECT_LT(relativeDifference(run->velocity(), rebuilt.velocity()), 1e-7);
-    EXPECT_LE(run->runStats().largestSchurResidual, AsyncOptions{}.laggedSchurTolerance);
+    EXPECT_LE(run->runStats().largestSchurResidual, AsyncOptions{}.keptFactors.laggedSchurTolerance);
   }
   const long long unturnedRebuilds = unturned.runStats().steps - unturned.runStats().laggedSteps;
   const long long turnedRebuilds = turned.runStats().steps - turned.runStats().laggedSteps;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// AsyncOptions::quickSetUp: L's system solved by deflated conjugate gradients on the whole
+// AsyncOptions::KeptFactors::quickSetUp: L's system solved by deflated conjugate gradients on the whole
 // single-rate system's factor (docs/asynchronous-integrator.md, "Quick set-up"), against
 // the exact set-up (Z and the factor of H^{LL*}).
 #include <gtest/gtest.h>
@@ -20,7 +20,7 @@ constexpr double kLargeStep = 5e-3;
 
 AsyncOptions quick(bool on) {
   AsyncOptions options;
-  options.quickSetUp = on;
+  options.keptFactors.quickSetUp = on;
   return options;
 }
 
@@ -59,7 +59,7 @@ TEST(QuickSetUp, RatioOneIsExactInOneIteration) {
   const test::TestSystem ts = test::makeTestSystem(0.3, 2e-3);
   const std::vector<AsyncRegion> regions{{"tip", test::verticesBeyond(ts.mesh, 0.75), 1}};
   AsyncOptions options = quick(true);
-  options.quickSetUpRebuild = false;
+  options.keptFactors.quickSetUpRebuild = false;
   SideBySide runs(ts, regions, quick(false), options);
   for (int k = 0; k < 10; ++k) runs.step();
   EXPECT_LT(runs.difference(), 1e-12);
@@ -78,7 +78,7 @@ TEST(QuickSetUp, DeflationLearnsTheInterface) {
   const test::TestSystem ts = test::makeTestSystem(0.3, 2e-3);
   const std::vector<AsyncRegion> regions{{"tip", test::verticesBeyond(ts.mesh, 0.75), 8}};
   AsyncOptions options = quick(true);
-  options.quickSetUpRebuild = false;
+  options.keptFactors.quickSetUpRebuild = false;
   SideBySide runs(ts, regions, quick(false), options);
   std::vector<long long> iterations;
   for (int k = 0; k < 40; ++k) iterations.push_back(runs.step());
@@ -88,7 +88,7 @@ TEST(QuickSetUp, DeflationLearnsTheInterface) {
   EXPECT_GT(iterations.front(), 2);
   EXPECT_TRUE(std::is_sorted(iterations.rbegin(), iterations.rend())) << "iterations grew somewhere";
   EXPECT_EQ(iterations.back(), 1);
-  EXPECT_LE(fast.runStats().largestQuickResidual, options.laggedSchurTolerance);
+  EXPECT_LE(fast.runStats().largestQuickResidual, options.keptFactors.laggedSchurTolerance);
 }
 
 // With the rent-or-buy rule on (the default), a long run on a cheap-to-factor system
@@ -133,7 +133,7 @@ TEST(QuickSetUp, DeflationStorageKeptAcrossPartitionsOfEverySize) {
   const std::vector<AsyncRegion> small{{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}};
   const std::vector<AsyncRegion> large{{"half", test::verticesBeyond(ts.mesh, 0.5), 8}};
   AsyncOptions options = quick(true);
-  options.quickSetUpRebuild = false;
+  options.keptFactors.quickSetUpRebuild = false;
   SideBySide runs(ts, small, quick(false), options);
   for (const std::vector<AsyncRegion>* regions : {&large, &small}) {
     for (int k = 0; k < 5; ++k) runs.step();
@@ -155,7 +155,7 @@ TEST(QuickSetUp, CorotationalForcesStayWithinTheTolerance) {
   const test::TestSystem ts = test::makeTestSystem(test::testSettings(ForceModelType::corotational, 0.3, 2e-3));
   const std::vector<AsyncRegion> regions{{"tip", test::verticesBeyond(ts.mesh, 0.75), 4}};
   AsyncOptions exactOptions = quick(false);
-  exactOptions.laggedSchur = false;
+  exactOptions.keptFactors.laggedSchur = false;
   SideBySide runs(ts, regions, exactOptions, quick(true));
   for (int k = 0; k < 15; ++k) runs.step();
   EXPECT_LT(runs.difference(), 1e-8);
@@ -169,7 +169,7 @@ TEST(QuickSetUp, SceneKey) {
   const IntegratorContext context = test::barContext();
   const AsyncSettings settings =
       parseAsyncSettings(context, nlohmann::json{{"quickSetUp", true}, {"regions", nlohmann::json::array()}});
-  EXPECT_TRUE(settings.solver.quickSetUp);
+  EXPECT_TRUE(settings.solver.keptFactors.quickSetUp);
   EXPECT_EQ(asyncSettingsJson(settings).at("quickSetUp"), true);
   try {
     parseAsyncSettings(context, nlohmann::json{{"quickSetup", true}});

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// AsyncOptions::regionDistribution: fast regions computed by one process each, what the
+// AsyncOptions::Processes::regionDistribution: fast regions computed by one process each, what the
 // others need summed over the processes. The processes here are threads of this test, each
 // with its own integrator and its own copy of the system, joined by an in-process sum (the
 // MPI version is petscBackend's makePetscRegionDistribution, tested under mpiexec).
@@ -98,21 +98,23 @@ class ThreadGroup {
 /// Participant me of group owns the regions i with i % size == me.
 AsyncOptions distributedOptions(ThreadGroup& group, int me, int size) {
   AsyncOptions options;
-  options.regionDistribution.ownedRegions = [me, size](const std::vector<std::vector<int>>& regionDofs,
-                                                       const std::vector<std::vector<int>>&) {
+  options.processes.regionDistribution.ownedRegions = [me, size](const std::vector<std::vector<int>>& regionDofs,
+                                                                 const std::vector<std::vector<int>>&) {
     std::vector<char> owned(regionDofs.size());
     for (std::size_t i = 0; i < owned.size(); ++i) owned[i] = static_cast<int>(i) % size == me ? 1 : 0;
     return owned;
   };
-  options.regionDistribution.sum = [&group, me](double* values, std::size_t count) { group.sum(me, values, count); };
+  options.processes.regionDistribution.sum = [&group, me](double* values, std::size_t count) {
+    group.sum(me, values, count);
+  };
   return options;
 }
 
 /// As distributedOptions, but participant me claims every region when claim, none otherwise.
 AsyncOptions claimingAll(ThreadGroup& group, int me, int size, bool claim) {
   AsyncOptions options = distributedOptions(group, me, size);
-  options.regionDistribution.ownedRegions = [claim](const std::vector<std::vector<int>>& regionDofs,
-                                                    const std::vector<std::vector<int>>&) {
+  options.processes.regionDistribution.ownedRegions = [claim](const std::vector<std::vector<int>>& regionDofs,
+                                                              const std::vector<std::vector<int>>&) {
     return std::vector<char>(regionDofs.size(), claim ? 1 : 0);
   };
   return options;
@@ -156,14 +158,14 @@ TEST(AsyncRegionDistribution, TwoProcessesFollowTheOneProcessRun) {
     SCOPED_TRACE(c.name);
     const ProblemSettings settings = test::testSettings(c.model, 0.3, 2e-3);
     AsyncOptions local;
-    local.quickSetUp = c.quickSetUp;
+    local.keptFactors.quickSetUp = c.quickSetUp;
     const BarRun reference = runBar(test::makeTestSystem(settings), local);
     ThreadGroup group(2);
     std::vector<BarRun> runs(2);
     group.run([&](int me) {
       const test::TestSystem ts = test::makeTestSystem(settings);  // each process its own force model
       AsyncOptions options = distributedOptions(group, me, 2);
-      options.quickSetUp = c.quickSetUp;
+      options.keptFactors.quickSetUp = c.quickSetUp;
       runs[static_cast<std::size_t>(me)] = runBar(ts, options);
     });
     const double scale = reference.displacement.cwiseAbs().maxCoeff();
@@ -238,8 +240,8 @@ TEST(AsyncRegionDistribution, EveryRegionNeedsExactlyOneOwner) {
   pair.run([&](int me) {
     AsyncOptions options = claimingAll(pair, me, 2, me == 0);
     if (me == 1) {
-      options.regionDistribution.ownedRegions = [](const std::vector<std::vector<int>>&,
-                                                   const std::vector<std::vector<int>>&) {
+      options.processes.regionDistribution.ownedRegions = [](const std::vector<std::vector<int>>&,
+                                                             const std::vector<std::vector<int>>&) {
         return std::vector<char>(3, 0);
       };
     }
@@ -253,8 +255,8 @@ TEST(AsyncRegionDistribution, EveryRegionNeedsExactlyOneOwner) {
   EXPECT_NE(stops[1].find("answered for 3 regions, the partition has 1"), std::string::npos) << stops[1];
   ThreadGroup alone(1);
   AsyncOptions options = distributedOptions(alone, 0, 1);
-  options.regionDistribution.ownedRegions = [](const std::vector<std::vector<int>>&,
-                                               const std::vector<std::vector<int>>&) { return std::vector<char>(); };
+  options.processes.regionDistribution.ownedRegions =
+      [](const std::vector<std::vector<int>>&, const std::vector<std::vector<int>>&) { return std::vector<char>(); };
   try {
     AsyncBackwardEuler integrator(ts.mesh, ts.system, 5e-3, tip, options);
     ADD_FAILURE() << "an answer for no region was accepted";
@@ -263,7 +265,7 @@ TEST(AsyncRegionDistribution, EveryRegionNeedsExactlyOneOwner) {
         << error.what();
   }
   options = distributedOptions(alone, 0, 1);
-  options.regionDistribution.sum = nullptr;
+  options.processes.regionDistribution.sum = nullptr;
   EXPECT_THROW(AsyncBackwardEuler(ts.mesh, ts.system, 5e-3, tip, options), ValidationError);
   options = distributedOptions(alone, 0, 1);
   options.coupling = AsyncCoupling::paper;

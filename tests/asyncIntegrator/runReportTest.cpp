@@ -48,7 +48,7 @@ TEST(AsyncRunReport, TheLaggedSchurFactorIsAResumeCaveat) {
   AsyncBackwardEuler lagged(ts.mesh, ts.system, 5e-3, tipRegion(ts.mesh));
   EXPECT_NE(lagged.report().resumeCaveat.find("laggedSchur"), std::string::npos) << lagged.report().resumeCaveat;
   AsyncOptions rebuilt;
-  rebuilt.laggedSchur = false;
+  rebuilt.keptFactors.laggedSchur = false;
   AsyncBackwardEuler exact(ts.mesh, ts.system, 5e-3, tipRegion(ts.mesh), rebuilt);
   EXPECT_TRUE(exact.report().resumeCaveat.empty()) << exact.report().resumeCaveat;
 }

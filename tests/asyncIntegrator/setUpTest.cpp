@@ -83,7 +83,7 @@ TEST(AsyncSetUp, ASystemWithoutAMeshIsAnError) {
   }
 }
 
-// AsyncOptions::largeSystemSolver: the factory is called at each set-up with L's DOFs, its
+// AsyncOptions::Processes::largeSystemSolver: the factory is called at each set-up with L's DOFs, its
 // solver is given the assembled H^{LL*}, and the run equals the default (CHOLMOD) one to
 // the rounding of two direct factorizations (Eigen's LDLT here; kappa eps over a few steps,
 // 1e-10 of the largest displacement), before and after a new partition.
@@ -95,8 +95,8 @@ TEST(AsyncSetUp, AnExternalLargeSystemSolverSolvesLsSystem) {
   std::vector<std::size_t> largeSizes;
   AsyncOptions options;
   std::vector<std::vector<std::vector<int>>> interfaces;
-  options.largeSystemSolver = [&largeSizes, &interfaces](const std::vector<int>& largeDofs,
-                                                         const std::vector<std::vector<int>>& interfaceDofs) {
+  options.processes.largeSystemSolver = [&largeSizes, &interfaces](const std::vector<int>& largeDofs,
+                                                                   const std::vector<std::vector<int>>& interfaceDofs) {
     largeSizes.push_back(largeDofs.size());
     interfaces.push_back(interfaceDofs);
     return makeSparseSolver(SolverKind::eigenLDLT);

@@ -286,7 +286,7 @@ TEST_P(PetscAsync, TrajectoryMatchesTheLocalAsyncRun) {
   settings.relativeTolerance = kRelativeTolerance;
   auto totals = std::make_shared<PetscSolveCounts>();
   AsyncOptions options;
-  options.largeSystemSolver = makePetscLargeSystemSolver(*mesh, settings, totals);
+  options.processes.largeSystemSolver = makePetscLargeSystemSolver(*mesh, settings, totals);
   const std::vector<Eigen::VectorXd> distributed = asyncTrajectory(c.model, options);
   const double tolerance = c.solver == PetscSolverKind::mumps ? 1e-10 : 5e-6;
   EXPECT_LE(largestDifference(distributed, local), tolerance);
@@ -312,7 +312,7 @@ INSTANTIATE_TEST_SUITE_P(Models, PetscAsync,
                                            AsyncCase{Model::neoHookean, PetscSolverKind::mumps}),
                          asyncCaseName);
 
-// AsyncOptions::regionDistribution from makePetscRegionDistribution: each of two regions is
+// AsyncOptions::Processes::regionDistribution from makePetscRegionDistribution: each of two regions is
 // computed by one rank only (its A^S, Z, C_i, substitutions and recovery), the rest summed
 // with MPI_Allreduce. The trajectory follows the local run to the same tolerances as the
 // replicated regions (the sums add the owner's values to zeros, so they are exact; the rest
@@ -331,10 +331,10 @@ TEST(PetscAsync, RegionsOwnedByOneRankFollowTheLocalRun) {
     settings.kind = c.solver;
     settings.relativeTolerance = kRelativeTolerance;
     AsyncOptions options;
-    options.largeSystemSolver = makePetscLargeSystemSolver(*mesh, settings);
+    options.processes.largeSystemSolver = makePetscLargeSystemSolver(*mesh, settings);
     const PetscRegionDistribution distribution = makePetscRegionDistribution(*mesh);
-    options.regionDistribution.ownedRegions = distribution.ownedRegions;
-    options.regionDistribution.sum = distribution.sum;
+    options.processes.regionDistribution.ownedRegions = distribution.ownedRegions;
+    options.processes.regionDistribution.sum = distribution.sum;
     const std::vector<Eigen::VectorXd> distributed = asyncTrajectory(c.model, options, true, &factorizations);
     EXPECT_LE(largestDifference(distributed, local), c.solver == PetscSolverKind::mumps ? 1e-10 : 5e-6);
     EXPECT_TRUE(sameOnEveryRank(distributed.back()));
@@ -465,7 +465,7 @@ TEST(AssignVertexOwners, KeepsEachInterfaceOnTheRankThatHeldMostOfIt) {
 TEST(PetscAsync, OnlyTheStableStructuredSolveTakesAnExternalSolver) {
   auto mesh = std::make_shared<const TetMesh>(cantilever());
   AsyncOptions options;
-  options.largeSystemSolver = makePetscLargeSystemSolver(*mesh, PetscSolverSettings{});
+  options.processes.largeSystemSolver = makePetscLargeSystemSolver(*mesh, PetscSolverSettings{});
   options.coupling = AsyncCoupling::paper;
   try {
     AsyncBackwardEuler integrator(*mesh, cantileverSystem(mesh, Model::linear), kStep, tipRegion(*mesh), options);
@@ -588,10 +588,10 @@ TEST(PetscAsync, DistributedElementLoopsFollowTheLocalRun) {
     PetscSolverSettings settings;
     settings.kind = PetscSolverKind::mumps;
     AsyncOptions options;
-    options.largeSystemSolver = makePetscLargeSystemSolver(*mesh, settings);
+    options.processes.largeSystemSolver = makePetscLargeSystemSolver(*mesh, settings);
     const PetscRegionDistribution distribution = makePetscRegionDistribution(*mesh);
-    options.regionDistribution.ownedRegions = distribution.ownedRegions;
-    options.regionDistribution.sum = distribution.sum;
+    options.processes.regionDistribution.ownedRegions = distribution.ownedRegions;
+    options.processes.regionDistribution.sum = distribution.sum;
     const std::vector<Eigen::VectorXd> distributed = asyncTrajectory(model, options, true, nullptr, true);
     EXPECT_LE(largestDifference(distributed, local), 1e-10);
     EXPECT_GT(local.back().lpNorm<Eigen::Infinity>(), 1e-3);

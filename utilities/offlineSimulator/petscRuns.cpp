@@ -256,18 +256,18 @@ asyncfem::IntegratorRegistry petscAsyncRegistry(const CommandLine& options, cons
   solver.relativeTolerance = 1e-10;
   asyncfem::IntegratorRegistry registry = asyncfem::defaultIntegratorRegistry();
   const bool owned = options.petscRegions == "owned";
-  asyncfem::registerMultirateIntegrators(
-      registry, [solver, totals, owned](asyncfem::AsyncSettings& settings, const asyncfem::IntegratorContext& context) {
-        // What the backend's solvers need of the options and the partition (stable coupling,
-        // structured method, regions that do not touch) is checked where every option is:
-        // chooseStepSolver(), which names the refused option.
-        settings.solver.largeSystemSolver = asyncfem::makePetscLargeSystemSolver(*context.mesh, solver, totals);
-        if (owned) {
-          asyncfem::PetscRegionDistribution distribution = asyncfem::makePetscRegionDistribution(*context.mesh, totals);
-          settings.solver.regionDistribution.ownedRegions = std::move(distribution.ownedRegions);
-          settings.solver.regionDistribution.sum = std::move(distribution.sum);
-        }
-      });
+  asyncfem::registerMultirateIntegrators(registry, [solver, totals, owned](asyncfem::AsyncSettings& settings,
+                                                                           const asyncfem::IntegratorContext& context) {
+    // What the backend's solvers need of the options and the partition (stable coupling,
+    // structured method, regions that do not touch) is checked where every option is:
+    // chooseStepSolver(), which names the refused option.
+    settings.solver.processes.largeSystemSolver = asyncfem::makePetscLargeSystemSolver(*context.mesh, solver, totals);
+    if (owned) {
+      asyncfem::PetscRegionDistribution distribution = asyncfem::makePetscRegionDistribution(*context.mesh, totals);
+      settings.solver.processes.regionDistribution.ownedRegions = std::move(distribution.ownedRegions);
+      settings.solver.processes.regionDistribution.sum = std::move(distribution.sum);
+    }
+  });
   if (options.petscElements != "distributed" || scene.forceModel == asyncfem::ForceModelType::linear) return registry;
   // Each rank evaluates the nonlinear forces and tangent of its own elements; the sums reach every rank.
   const asyncfem::ProblemSettings physics = asyncfem::problemSettings(scene);

@@ -54,26 +54,27 @@ RunReport AsyncBackwardEuler::report() const {
     if (!report.resumeCaveat.empty()) report.resumeCaveat += "; ";
     report.resumeCaveat += caveat;
   };
-  if (options_.laggedSchur && !system_.forceModel->isLinear() && stepSolver() == AsyncStepSolver::structuredSchur) {
+  if (options_.keptFactors.laggedSchur && !system_.forceModel->isLinear() &&
+      stepSolver() == AsyncStepSolver::structuredSchur) {
     addCaveat(
         "laggedSchur: the H^{LL*} factor kept as preconditioner is not in the checkpoint, so the resumed run "
         "refactors at its first step; its frames match an uninterrupted run to about the Schur tolerance (" +
-        shortNumber(options_.laggedSchurTolerance) + "), not bit for bit");
+        shortNumber(options_.keptFactors.laggedSchurTolerance) + "), not bit for bit");
   }
-  if (options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
+  if (options_.keptFactors.quickSetUp && options_.coupling == AsyncCoupling::stable &&
       options_.method == AsyncSolveMethod::structured) {
     addCaveat(
         "quickSetUp: whether the partition still solved on the whole system's factor is not in the checkpoint, "
         "so the resumed run starts on it again; its frames match an uninterrupted run to about the Schur "
         "tolerance (" +
-        shortNumber(options_.laggedSchurTolerance) + "), not bit for bit");
+        shortNumber(options_.keptFactors.laggedSchurTolerance) + "), not bit for bit");
   }
   if (system_.externalForceJacobian && linearizesExternalForce()) {
     addCaveat(
         "implicit contact: the contact blocks kept in the regions' A^S (and the factors built with them) are not in "
         "the checkpoint, so the resumed run's contact iterations start from other matrices; its frames match an "
         "uninterrupted run to about the contact tolerance (" +
-        shortNumber(options_.contactTolerance) + "), not bit for bit");
+        shortNumber(options_.contact.tolerance) + "), not bit for bit");
   }
   if (policy_) {
     addCaveat(
@@ -116,7 +117,7 @@ void detail::TwoLevelStepSolver::reportLines(std::vector<std::string>& lines) co
                   r.quickSteps, r.quickIterations, r.largestQuickResidual, r.quickEnds);
     lines.emplace_back(line);
   }
-  appendContactLines(r, options_.contactIterations, lines);
+  appendContactLines(r, options_.contact.iterations, lines);
 }
 
 }  // namespace asyncfem

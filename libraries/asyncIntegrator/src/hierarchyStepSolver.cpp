@@ -87,8 +87,8 @@ void HierarchyStepSolver::solveContact(double t0, double t1) {
     return unit == units ? t1 : t0 + static_cast<double>(unit) * (hL / static_cast<double>(units));
   };
   const HierarchySystem::StateForceSolve result =
-      stepSystem_->solveWithStateForce(displacement_, velocity_, internalForce_, force, options_.contactTolerance,
-                                       options_.contactIterations, newU_, newV_, stats_);
+      stepSystem_->solveWithStateForce(displacement_, velocity_, internalForce_, force, options_.contact.tolerance,
+                                       options_.contact.iterations, newU_, newV_, stats_);
   ++runStats_.contactSteps;
   runStats_.contactIterations += result.solves;
   runStats_.contactStepSystemFactorizations += result.factorizations;
@@ -121,7 +121,7 @@ void HierarchyStepSolver::reportLines(std::vector<std::string>& lines) const {
   const AsyncRunStats& r = runStats_;
   if (r.contactSteps == 0) return;
   lines.push_back(contactLine(
-      r, "; Newton on the step system, Eqs. N13-N14", "solves", options_.contactIterations,
+      r, "; Newton on the step system, Eqs. N13-N14", "solves", options_.contact.iterations,
       "the step system factored " + std::to_string(r.contactStepSystemFactorizations) + " times with contact blocks"));
 }
 

@@ -21,7 +21,7 @@ using detail::FastRegion;
 using detail::substepTime;
 
 bool TwoLevelStepSolver::certifiesContactFree() const {
-  return implicitContact() && options_.certifyContactFree && system_.stateDependentOnlyInContact &&
+  return implicitContact() && options_.contact.certifyContactFree && system_.stateDependentOnlyInContact &&
          static_cast<bool>(system_.obstacleProximity);
 }
 
@@ -73,8 +73,8 @@ void TwoLevelStepSolver::solveWithImplicitContact(double t0, double t1) {
                            " has a non-finite state or external force with implicit contact (vertex " +
                            std::to_string(d.contact.worstVertex()) + ")");
     }
-    if (residual <= options_.contactTolerance) break;
-    if (iterations < options_.contactIterations) continue;
+    if (residual <= options_.contact.tolerance) break;
+    if (iterations < options_.contact.iterations) continue;
     if (residual > 1.0) {
       const int vertex = d.contact.worstVertex();
       const int region = vertex >= 0 ? partition_.vertexRegion()[static_cast<std::size_t>(vertex)] : -1;

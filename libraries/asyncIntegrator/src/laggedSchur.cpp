@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Nonlinear forces: the factor of H^{LL*} kept as a preconditioner across large steps, its
-// rent-or-buy price and the refreshes turned with the body (AsyncOptions::laggedSchur;
+// rent-or-buy price and the refreshes turned with the body (AsyncOptions::KeptFactors::laggedSchur;
 // docs/asynchronous-integrator.md, "Lagged Schur factor").
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
@@ -56,8 +56,8 @@ void TwoLevelStepSolver::keepLaggedFactor() {
 
 bool TwoLevelStepSolver::turnsLaggedFactor() const {
   const Impl& d = *impl_;
-  return options_.laggedSchur && options_.laggedSchurRotation && !d.model.linear && system_.mesh &&
-         !options_.largeSystemSolver && options_.method == AsyncSolveMethod::structured;
+  return options_.keptFactors.laggedSchur && options_.keptFactors.laggedSchurRotation && !d.model.linear &&
+         system_.mesh && !options_.processes.largeSystemSolver && options_.method == AsyncSolveMethod::structured;
 }
 
 // The flop prices of the lagged factor's rent-or-buy rule, with the same weights as the
@@ -120,7 +120,7 @@ void TwoLevelStepSolver::applySchur(const Eigen::VectorXd& y, Eigen::VectorXd& o
   subtractOwnedInterfaceRows(out);
 }
 
-// Regions owned by one process (AsyncOptions::regionDistribution). Every process steps the
+// Regions owned by one process (AsyncOptions::Processes::regionDistribution). Every process steps the
 // same state and cuts every region's blocks (Â^L and the right-hand sides need them); only
 // a region's owner factors A^S, computes Z and C_i, substitutes and recovers. The sums
 // over processes below hand the others what they need, at the same points on every

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The quick set-up: L's system solved by conjugate gradients on the whole single-rate
-// factor until the iterations have cost the rebuild they put off (AsyncOptions::quickSetUp;
+// factor until the iterations have cost the rebuild they put off (AsyncOptions::KeptFactors::quickSetUp;
 // docs/asynchronous-integrator.md, "Quick set-up", Eq. Q4).
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
@@ -90,7 +90,8 @@ void TwoLevelStepSolver::solveOnWholeFactor() {
   const double perDirection = 2.0 * static_cast<double>(d.rhsSchur.size());
   const int keep = static_cast<int>(std::min(runStats_.interfaceDofs + 16.0, kMaxDeflationEntries / perDirection));
   const detail::SchurSolver::Refinement result =
-      d.schur.solveDeflated(d.rhsSchur, d.Y, apply, options_.quickSetUpIterations, options_.laggedSchurTolerance, keep);
+      d.schur.solveDeflated(d.rhsSchur, d.Y, apply, options_.keptFactors.quickSetUpIterations,
+                            options_.keptFactors.laggedSchurTolerance, keep);
   runStats_.quickIterations += result.iterations;
   if (result.converged) {
     ++runStats_.quickSteps;
@@ -99,7 +100,7 @@ void TwoLevelStepSolver::solveOnWholeFactor() {
     const double deflation = 2.0 * static_cast<double>(d.schur.keptDirections()) * static_cast<double>(d.Y.size());
     d.quickPath.extraFlops +=
         result.iterations * (costs.iteration + 2.0 * deflation) + 3.0 * deflation - costs.exactSolve;
-    if (d.quickPath.extraFlops < costs.rebuild || !options_.quickSetUpRebuild) return;
+    if (d.quickPath.extraFlops < costs.rebuild || !options_.keptFactors.quickSetUpRebuild) return;
   }
   Stopwatch rebuild;
   d.quickPath.active = false;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Regions owned by one process (AsyncOptions::regionDistribution): each region computed by
+// Regions owned by one process (AsyncOptions::Processes::regionDistribution): each region computed by
 // its owner and what the others need of it summed over the processes.
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
@@ -56,7 +56,7 @@ void TwoLevelStepSolver::holdFailure(int region) {
 void TwoLevelStepSolver::sumOverProcesses(std::vector<double>& values) {
   values.push_back(heldFailure_ ? 1.0 : 0.0);
   values.push_back(heldFailure_ ? heldFailureRegion_ + 1.0 : 0.0);
-  options_.regionDistribution.sum(values.data(), values.size());
+  options_.processes.regionDistribution.sum(values.data(), values.size());
   const double failed = values[values.size() - 2], region = values.back() - 1.0;
   values.resize(values.size() - 2);
   if (failed == 0.0) return;
@@ -87,7 +87,7 @@ void TwoLevelStepSolver::assignRegionOwners() {
   std::vector<char> owned;
   std::vector<double> owners(static_cast<std::size_t>(numRegions), 0.0);
   try {
-    owned = options_.regionDistribution.ownedRegions(regionDofs, interfaceDofs);
+    owned = options_.processes.regionDistribution.ownedRegions(regionDofs, interfaceDofs);
     if (owned.size() != static_cast<std::size_t>(numRegions)) {
       throw ValidationError("async integrator: regionDistribution.ownedRegions answered for " +
                             std::to_string(owned.size()) + " regions, the partition has " + std::to_string(numRegions));

@@ -119,33 +119,54 @@ struct SolverKey {
   std::function<void(const AsyncOptions& options, const AsyncOptions& defaults, nlohmann::json& out)> write;
 };
 
+// Where a key's value lives in AsyncOptions: one of its members, or a member of one of its
+// groups (AsyncOptions::keptFactors, contact).
 template <typename T>
-SolverKey valueKey(const char* key, T AsyncOptions::*member, std::function<T(JsonObjectReader&, const char*, T)> read) {
-  return {key,
-          [key, member, read](JsonObjectReader& reader, AsyncOptions& o) { o.*member = read(reader, key, o.*member); },
-          [key, member](const AsyncOptions& o, const AsyncOptions& defaults, nlohmann::json& out) {
-            if (o.*member != defaults.*member) out[key] = o.*member;
-          }};
+struct Place {
+  std::function<T&(AsyncOptions&)> at;
+  std::function<const T&(const AsyncOptions&)> of;
+};
+
+template <typename T>
+Place<T> place(T AsyncOptions::*member) {
+  return {[member](AsyncOptions& o) -> T& { return o.*member; },
+          [member](const AsyncOptions& o) -> const T& { return o.*member; }};
 }
 
-SolverKey booleanKey(const char* key, bool AsyncOptions::*member) {
-  return valueKey<bool>(key, member,
+template <typename T, typename Group>
+Place<T> place(Group AsyncOptions::*group, T Group::*member) {
+  return {[group, member](AsyncOptions& o) -> T& { return (o.*group).*member; },
+          [group, member](const AsyncOptions& o) -> const T& { return (o.*group).*member; }};
+}
+
+template <typename T>
+SolverKey valueKey(const char* key, Place<T> where, std::function<T(JsonObjectReader&, const char*, T)> read) {
+  return {
+      key,
+      [key, where, read](JsonObjectReader& reader, AsyncOptions& o) { where.at(o) = read(reader, key, where.of(o)); },
+      [key, where](const AsyncOptions& o, const AsyncOptions& defaults, nlohmann::json& out) {
+        if (where.of(o) != where.of(defaults)) out[key] = where.of(o);
+      }};
+}
+
+SolverKey booleanKey(const char* key, Place<bool> where) {
+  return valueKey<bool>(key, std::move(where),
                         [](JsonObjectReader& reader, const char* k, bool value) { return reader.boolean(k, value); });
 }
 
-SolverKey integerKey(const char* key, int AsyncOptions::*member, int lowest, int highest) {
-  return valueKey<int>(key, member, [lowest, highest](JsonObjectReader& reader, const char* k, int value) {
+SolverKey integerKey(const char* key, Place<int> where, int lowest, int highest) {
+  return valueKey<int>(key, std::move(where), [lowest, highest](JsonObjectReader& reader, const char* k, int value) {
     return reader.integer(k, value, lowest, highest);
   });
 }
 
 template <typename Enum>
-SolverKey choiceKey(const char* key, Enum AsyncOptions::*member, const ChoiceTable<Enum>& table) {
+SolverKey choiceKey(const char* key, Place<Enum> where, const ChoiceTable<Enum>& table) {
   return {
       key,
-      [key, member, &table](JsonObjectReader& reader, AsyncOptions& o) { o.*member = readChoice(reader, key, table); },
-      [key, member, &table](const AsyncOptions& o, const AsyncOptions& defaults, nlohmann::json& out) {
-        if (o.*member != defaults.*member) out[key] = choiceName(table, o.*member);
+      [key, where, &table](JsonObjectReader& reader, AsyncOptions& o) { where.at(o) = readChoice(reader, key, table); },
+      [key, where, &table](const AsyncOptions& o, const AsyncOptions& defaults, nlohmann::json& out) {
+        if (where.of(o) != where.of(defaults)) out[key] = choiceName(table, where.of(o));
       }};
 }
 
@@ -160,28 +181,30 @@ const ChoiceTable<NestedSolve> kNestedSolves{
 const std::vector<SolverKey>& solverKeys() {
   static const std::vector<SolverKey> keys{
       // What the step solves and how.
-      choiceKey("coupling", &AsyncOptions::coupling, kCouplings),
-      choiceKey("schur", &AsyncOptions::schur, kSchurModes),
-      choiceKey("method", &AsyncOptions::method, kSolveMethods),
-      choiceKey("recovery", &AsyncOptions::recovery, kRecoveryModes),
-      choiceKey("regionSolver", &AsyncOptions::regionSolver, kRegionSolvers),
-      integerKey("denseRegionDofs", &AsyncOptions::denseRegionDofs, 0, 4096),
-      choiceKey("nestedSolve", &AsyncOptions::nestedSolve, kNestedSolves),
-      integerKey("threads", &AsyncOptions::threads, 0, 1024),
+      choiceKey("coupling", place(&AsyncOptions::coupling), kCouplings),
+      choiceKey("schur", place(&AsyncOptions::schur), kSchurModes),
+      choiceKey("method", place(&AsyncOptions::method), kSolveMethods),
+      choiceKey("recovery", place(&AsyncOptions::recovery), kRecoveryModes),
+      choiceKey("regionSolver", place(&AsyncOptions::regionSolver), kRegionSolvers),
+      integerKey("denseRegionDofs", place(&AsyncOptions::denseRegionDofs), 0, 4096),
+      choiceKey("nestedSolve", place(&AsyncOptions::nestedSolve), kNestedSolves),
+      integerKey("threads", place(&AsyncOptions::threads), 0, 1024),
       // Nonlinear forces and set-ups: the kept factors.
-      booleanKey("laggedSchur", &AsyncOptions::laggedSchur),
-      booleanKey("laggedSchurRotation", &AsyncOptions::laggedSchurRotation),
-      booleanKey("quickSetUp", &AsyncOptions::quickSetUp),
+      booleanKey("laggedSchur", place(&AsyncOptions::keptFactors, &AsyncOptions::KeptFactors::laggedSchur)),
+      booleanKey("laggedSchurRotation",
+                 place(&AsyncOptions::keptFactors, &AsyncOptions::KeptFactors::laggedSchurRotation)),
+      booleanKey("quickSetUp", place(&AsyncOptions::keptFactors, &AsyncOptions::KeptFactors::quickSetUp)),
       // Contact.
-      booleanKey("substepStatePrediction", &AsyncOptions::substepStatePrediction),
-      integerKey("contactIterations", &AsyncOptions::contactIterations, 1, 1000),
-      valueKey<double>("contactTolerance", &AsyncOptions::contactTolerance,
+      booleanKey("substepStatePrediction",
+                 place(&AsyncOptions::contact, &AsyncOptions::Contact::substepStatePrediction)),
+      integerKey("contactIterations", place(&AsyncOptions::contact, &AsyncOptions::Contact::iterations), 1, 1000),
+      valueKey<double>("contactTolerance", place(&AsyncOptions::contact, &AsyncOptions::Contact::tolerance),
                        [](JsonObjectReader& reader, const char* k, double value) {
                          const double tolerance = reader.number(k, value);
                          if (!(tolerance > 0.0 && tolerance < 1.0)) reader.fail(k, "must be in (0, 1)");
                          return tolerance;
                        }),
-      booleanKey("certifyContactFree", &AsyncOptions::certifyContactFree),
+      booleanKey("certifyContactFree", place(&AsyncOptions::contact, &AsyncOptions::Contact::certifyContactFree)),
   };
   return keys;
 }
@@ -193,7 +216,7 @@ AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
                 "renamed \"substepStatePrediction\" (f_ext at each substep's predicted state; it is not contact)");
   }
   for (const SolverKey& key : solverKeys()) key.read(reader, solver);
-  if (solver.substepStatePrediction && !hasContact) {
+  if (solver.contact.substepStatePrediction && !hasContact) {
     reader.fail("substepStatePrediction", "only meaningful with a \"contact\" section");
   }
   return solver;

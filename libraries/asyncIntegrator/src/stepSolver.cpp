@@ -44,20 +44,21 @@ namespace {
 
 // Options that hold for every solver.
 void checkCommonOptions(const AsyncOptions& options) {
-  const AsyncOptions::RegionDistribution& distribution = options.regionDistribution;
+  const AsyncOptions::Processes::RegionDistribution& distribution = options.processes.regionDistribution;
   if (static_cast<bool>(distribution.ownedRegions) != static_cast<bool>(distribution.sum)) {
     throw AsyncOptionError("regionDistribution", "needs both ownedRegions and sum");
   }
-  if (!(options.contactTolerance > 0.0 && options.contactTolerance < 1.0)) {
+  if (!(options.contact.tolerance > 0.0 && options.contact.tolerance < 1.0)) {
     throw AsyncOptionError("contactTolerance",
-                           "must be in (0, 1) (got " + std::to_string(options.contactTolerance) + ")");
+                           "must be in (0, 1) (got " + std::to_string(options.contact.tolerance) + ")");
   }
-  if (options.contactIterations < 1) {
-    throw AsyncOptionError("contactIterations", "must be >= 1 (got " + std::to_string(options.contactIterations) + ")");
+  if (options.contact.iterations < 1) {
+    throw AsyncOptionError("contactIterations",
+                           "must be >= 1 (got " + std::to_string(options.contact.iterations) + ")");
   }
   const bool stableStructured =
       options.coupling == AsyncCoupling::stable && options.method == AsyncSolveMethod::structured;
-  if (options.largeSystemSolver && !stableStructured) {
+  if (options.processes.largeSystemSolver && !stableStructured) {
     throw AsyncOptionError("largeSystemSolver",
                            "an external solver of L's system needs the stable coupling and the structured method (it "
                            "is given the symmetric H^{LL*})");
@@ -76,10 +77,12 @@ void checkHierarchyOptions(const AsyncOptions& options, const std::string& why) 
     throw AsyncOptionError(key, what + " is not available with the hierarchy solve (" + why + ")");
   };
   if (options.coupling != AsyncCoupling::stable) refuse("coupling", "the paper's coupling");
-  if (options.quickSetUp) refuse("quickSetUp", "the quick set-up");
-  if (options.substepStatePrediction) refuse("substepStatePrediction", "contact at the substeps' predicted states");
-  if (options.largeSystemSolver) refuse("largeSystemSolver", "an external solver of L's system (the PETSc backend)");
-  if (options.regionDistribution.sum) refuse("regionDistribution", "regions owned by one process");
+  if (options.keptFactors.quickSetUp) refuse("quickSetUp", "the quick set-up");
+  if (options.contact.substepStatePrediction)
+    refuse("substepStatePrediction", "contact at the substeps' predicted states");
+  if (options.processes.largeSystemSolver)
+    refuse("largeSystemSolver", "an external solver of L's system (the PETSc backend)");
+  if (options.processes.regionDistribution.sum) refuse("regionDistribution", "regions owned by one process");
   if (options.schur != defaults.schur) refuse("schur", "a Schur mode");
   if (options.recovery != defaults.recovery) refuse("recovery", "a recovery mode");
   if (options.regionSolver != defaults.regionSolver) refuse("regionSolver", "a region solver");
@@ -117,7 +120,7 @@ namespace detail {
 
 bool asyncLinearizesContact(const AsyncOptions& options) {
   return options.coupling == AsyncCoupling::stable && options.method != AsyncSolveMethod::naive &&
-         !options.largeSystemSolver && !options.regionDistribution.sum;
+         !options.processes.largeSystemSolver && !options.processes.regionDistribution.sum;
 }
 
 bool StepSolver::implicitContact() const {

@@ -38,7 +38,7 @@ struct StepContext {
   AsyncRunStats& runStats;
   const SubstepObserver& observer;
   SchurReport& schur;
-  /// The whole single-rate system's factor (AsyncOptions::quickSetUp), shared by every
+  /// The whole single-rate system's factor (AsyncOptions::KeptFactors::quickSetUp), shared by every
   /// partition; made by the first solver that needs it.
   std::unique_ptr<WholeSystemFactor>& whole;
 };

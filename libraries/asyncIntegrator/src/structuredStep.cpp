@@ -135,13 +135,14 @@ void TwoLevelStepSolver::solveStructured() {
     // At least laggedSchurIterations, and as many as one rebuild costs (rent or buy).
     if (turnsLaggedFactor()) d.rotations.update(*system_.mesh, displacement_);
     const double affordable = d.lagged.rebuildFlops / std::max(d.lagged.iterationFlops, 1.0);
-    const int budget = std::max(options_.laggedSchurIterations, static_cast<int>(std::min(affordable, 1000.0)));
+    const int budget =
+        std::max(options_.keptFactors.laggedSchurIterations, static_cast<int>(std::min(affordable, 1000.0)));
     const detail::SchurSolver::Tracker track = [this, threads](double coefficient, bool reset) {
       sumProbeSubstitutions(threads, coefficient, reset);
     };
     const detail::SchurSolver::Refinement result =
         d.schur.refine(d.rhsSchur, d.Y, apply, options_.coupling == AsyncCoupling::stable, budget,
-                       options_.laggedSchurTolerance, track);
+                       options_.keptFactors.laggedSchurTolerance, track);
     d.lagged.recoverFromProbes = result.converged;
     runStats_.schurIterations += result.iterations;
     d.lagged.rent += result.iterations * d.lagged.iterationFlops;

@@ -90,15 +90,15 @@ void TwoLevelStepSolver::setUp() {
                                                               d.model.linear ? &d.stiffness : nullptr);
   }
   d.schur.reset();
-  if (options_.largeSystemSolver) {
+  if (options_.processes.largeSystemSolver) {
     std::vector<std::vector<int>> interfaces;
     for (int i = 0; i < partition_.numRegions(); ++i) interfaces.push_back(partition_.interfaceDofs(i));
-    d.schur.useExternalSolver(options_.largeSystemSolver, large, std::move(interfaces));
+    d.schur.useExternalSolver(options_.processes.largeSystemSolver, large, std::move(interfaces));
   }
   d.naive.reset();
   d.lagged.lagging = false;
   d.lagged.lastRebuildFull = false;  // no factor of H^{LL*} for this partition yet
-  d.quickPath.active = options_.quickSetUp && options_.coupling == AsyncCoupling::stable &&
+  d.quickPath.active = options_.keptFactors.quickSetUp && options_.coupling == AsyncCoupling::stable &&
                        options_.method == AsyncSolveMethod::structured;
   d.quickPath.extraFlops = 0.0;
   d.build.factorsCurrent = false;
@@ -281,8 +281,9 @@ void TwoLevelStepSolver::evaluateStartOfStep() {
   if (d.model.linear && d.build.factorsCurrent) return;
   Stopwatch rebuild;
   const bool first = runStats_.rebuilds == 0 && runStats_.steps == 0;
-  d.lagged.lagging = options_.laggedSchur && !d.model.linear && d.schur.factored() && !d.schur.refreshRequested() &&
-                     d.lagged.rent < d.lagged.rebuildFlops && options_.method == AsyncSolveMethod::structured;
+  d.lagged.lagging = options_.keptFactors.laggedSchur && !d.model.linear && d.schur.factored() &&
+                     !d.schur.refreshRequested() && d.lagged.rent < d.lagged.rebuildFlops &&
+                     options_.method == AsyncSolveMethod::structured;
   // With the turned factor, every other rebuild the rule asks for is a refresh.
   // lastRebuildFull: this partition's H^{LL*} was factored with Z (so not borrowed, not quick).
   const bool refresh = !first && !d.lagged.lagging && d.lagged.lastRebuildFull && turnsLaggedFactor();
@@ -312,7 +313,7 @@ void TwoLevelStepSolver::gatherExternalForces(double t0, double t1) {
   const bool hasExternal = static_cast<bool>(system_.externalForce);
   // Implicit contact starts its iteration from the predicted states (Eq. C3 at X = 0).
   const bool implicit = implicitContact();
-  const bool predict = options_.substepStatePrediction || implicit;
+  const bool predict = options_.contact.substepStatePrediction || implicit;
   const bool constantInStep =
       hasExternal && !predict && system_.externalForceChanges && !system_.externalForceChanges(t0, t1);
   for (int i = 0; i < partition_.numRegions(); ++i) {

@@ -67,7 +67,7 @@ struct TwoLevelState {
   detail::SchurSolver schur;
   detail::VertexRotations rotations;  // since the last rebuild (laggedSchurRotation)
   detail::NaiveSolver naive;
-  // The lagged factor of H^{LL*} (AsyncOptions::laggedSchur) and its rent-or-buy prices
+  // The lagged factor of H^{LL*} (AsyncOptions::KeptFactors::laggedSchur) and its rent-or-buy prices
   // (flops, set at each full rebuild).
   struct LaggedFactor {
     bool lagging = false;          // this step refactored A^S but keeps Z and H^{LL*} from an earlier tangent
@@ -77,7 +77,7 @@ struct TwoLevelState {
     double rebuildFlops = 0.0;       // one rebuild
     double rent = 0.0;               // the iterations paid since the last rebuild
   } lagged;
-  // Quick set-up (AsyncOptions::quickSetUp): L's system is solved on the whole system's
+  // Quick set-up (AsyncOptions::KeptFactors::quickSetUp): L's system is solved on the whole system's
   // factor until the iterations' extra flops reach the priced cost of the rebuild (Eq. Q4).
   struct QuickPath {
     bool active = false;
@@ -210,13 +210,13 @@ class TwoLevelStepSolver final : public StepSolver {
   void solveOnWholeFactor();
   // Implicit contact and its certificate (implicitContact.cpp).
   void solveWithImplicitContact(double t0, double t1);
-  /// Implicit contact may end a step after one solve (AsyncOptions::certifyContactFree).
+  /// Implicit contact may end a step after one solve (AsyncOptions::Contact::certifyContactFree).
   bool certifiesContactFree() const;
   bool contactFreeCertified();
   void refactorContactRegions();
   bool rebuildWithoutRegionBlocks();
-  // AsyncOptions::regionDistribution (regionDistribution.cpp).
-  bool distributed() const { return static_cast<bool>(options_.regionDistribution.sum); }
+  // AsyncOptions::Processes::regionDistribution (regionDistribution.cpp).
+  bool distributed() const { return static_cast<bool>(options_.processes.regionDistribution.sum); }
   void assignRegionOwners();
   void priceSubstitutions();
   void shareCorrections();

@@ -142,7 +142,7 @@ void bindAsyncOptions(py::module_& module) {
              options.method = method;
              options.recovery = recovery;
              options.regionSolver = regionSolver;
-             options.substepStatePrediction = prediction;
+             options.contact.substepStatePrediction = prediction;
              return options;
            }),
            py::arg("coupling") = AsyncCoupling::stable, py::arg("schur") = SchurMode::lowRank,
@@ -156,10 +156,22 @@ void bindAsyncOptions(py::module_& module) {
                      "how the hierarchy solve solves (regions that touch or nest, or method hierarchy)")
       .def_readwrite("region_solver", &AsyncOptions::regionSolver)
       .def_readwrite("dense_region_dofs", &AsyncOptions::denseRegionDofs)
-      .def_readwrite("substep_state_prediction", &AsyncOptions::substepStatePrediction)
-      .def_readwrite("contact_tolerance", &AsyncOptions::contactTolerance)
-      .def_readwrite("contact_iterations", &AsyncOptions::contactIterations)
-      .def_readwrite("certify_contact_free", &AsyncOptions::certifyContactFree);
+      .def_property(
+          "substep_state_prediction", [](const AsyncOptions& o) { return o.contact.substepStatePrediction; },
+          [](AsyncOptions& o, decltype(AsyncOptions::Contact::substepStatePrediction) value) {
+            o.contact.substepStatePrediction = value;
+          })
+      .def_property(
+          "contact_tolerance", [](const AsyncOptions& o) { return o.contact.tolerance; },
+          [](AsyncOptions& o, decltype(AsyncOptions::Contact::tolerance) value) { o.contact.tolerance = value; })
+      .def_property(
+          "contact_iterations", [](const AsyncOptions& o) { return o.contact.iterations; },
+          [](AsyncOptions& o, decltype(AsyncOptions::Contact::iterations) value) { o.contact.iterations = value; })
+      .def_property(
+          "certify_contact_free", [](const AsyncOptions& o) { return o.contact.certifyContactFree; },
+          [](AsyncOptions& o, decltype(AsyncOptions::Contact::certifyContactFree) value) {
+            o.contact.certifyContactFree = value;
+          });
 
   py::class_<ScheduledRegion>(module, "ScheduledRegion",
                               "A fast region of the schedule policy: vertices at ratio from start to end (s)")

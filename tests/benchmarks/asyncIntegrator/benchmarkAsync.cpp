@@ -16,7 +16,7 @@
 //                                   frame against corotational single-rate at hS
 //   benchmarkAsync --study setup --scenes A.json B.json ...
 //                                   per scene: set-up and re-partition cost, exact against
-//                                   AsyncOptions::quickSetUp, in single-rate steps at hL
+//                                   AsyncOptions::KeptFactors::quickSetUp, in single-rate steps at hL
 //   benchmarkAsync --study steady --only async|single --scenes A.json --steps N
 //                                   one configuration only, for callgrind: the steady steps
 //                                   are the only ones collected (run under
@@ -401,7 +401,7 @@ void corotationalStudy(int cells, int ratio, double hL) {
   }
 }
 
-/// What testing S's contacts at every substep (AsyncOptions::substepStatePrediction)
+/// What testing S's contacts at every substep (AsyncOptions::Contact::substepStatePrediction)
 /// changes and costs, on the dropped bar whose stiff end lands on the ground: penetration
 /// of the fast region, its vibration after the impact and the energy after the impact,
 /// against contact once per large step and against single-rate backward Euler.
@@ -462,7 +462,7 @@ void contactStudy(int cells, int ratio, double hL) {
   AsyncBackwardEuler once(s.mesh, s.system, hL, {{"S", s.fast, ratio}});
   const double initialEnergy = energy(once);
   AsyncOptions substepOptions;
-  substepOptions.substepStatePrediction = true;
+  substepOptions.contact.substepStatePrediction = true;
   AsyncBackwardEuler substep(s.mesh, s.system, hL, {{"S", s.fast, ratio}}, substepOptions);
   const ContactRun a = measure(once);
   const ContactRun b = measure(substep);
@@ -559,13 +559,13 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
     if (async == nullptr) throw ValidationError(spec + ": the scene's integrator is not async");
     std::unique_ptr<AsyncBackwardEuler> rebuilt;
     if (rebuildSchur || laggedIterations > 0 || unturned) {
-      // The same scene with AsyncOptions::laggedSchur off (Z and H^{LL*} every large step),
+      // The same scene with AsyncOptions::KeptFactors::laggedSchur off (Z and H^{LL*} every large step),
       // with another iteration limit for the lagged factor, or with the lagged factor not
       // turned with the body.
       AsyncOptions options = async->options();
-      options.laggedSchur = !rebuildSchur;
-      options.laggedSchurRotation = !unturned;
-      if (laggedIterations > 0) options.laggedSchurIterations = laggedIterations;
+      options.keptFactors.laggedSchur = !rebuildSchur;
+      options.keptFactors.laggedSchurRotation = !unturned;
+      if (laggedIterations > 0) options.keptFactors.laggedSchurIterations = laggedIterations;
       std::vector<AsyncRegion> regions;
       for (int i = 0; i < async->partition().numRegions(); ++i) regions.push_back(async->partition().region(i));
       rebuilt =
@@ -707,8 +707,10 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
         "\nCost model: the flops automatic regions estimate (AutoRegionCost, from CHOLMOD's symbolic analysis); "
         "its ratios use the same denominators as the measured ones.\n");
   } else {
-    std::printf("%s", rebuildSchur ? "With AsyncOptions::laggedSchur off (Z and H^{LL*} rebuilt every large step).\n\n"
-                                   : "With AsyncOptions::laggedSchur (the default).\n\n");
+    std::printf("%s",
+                rebuildSchur
+                    ? "With AsyncOptions::KeptFactors::laggedSchur off (Z and H^{LL*} rebuilt every large step).\n\n"
+                    : "With AsyncOptions::KeptFactors::laggedSchur (the default).\n\n");
     std::printf(
         "Mean wall time of the %d timed steps (rebuilds and refactorizations included); medians in parentheses. "
         "Async and single-rate at hS timed in turn, %d large steps at a time.\n\n"
@@ -770,7 +772,7 @@ std::vector<AsyncRegion> grownByOneRing(const TetMesh& mesh, const std::vector<A
 }
 
 /// Set-up: per scene, the asynchronous integrator with the exact set-up (Z and H^{LL*}) and
-/// with AsyncOptions::quickSetUp (rent-or-buy rule on, as a user runs it): the set-up, then
+/// with AsyncOptions::KeptFactors::quickSetUp (rent-or-buy rule on, as a user runs it): the set-up, then
 /// what the next `steps` steps spend beyond the exact integrator's steady step, for the
 /// scene's partition and for a re-partition that grows every region by one ring; all in
 /// single-rate steps at hL.
@@ -805,7 +807,7 @@ void setUpStudy(const std::vector<std::string>& scenes, int steps) {
       if ((next.vertexRegion()[v] >= 0) != (shipped->partition().vertexRegion()[v] >= 0)) ++row.movedVertices;
     for (int kind = 0; kind < 2; ++kind) {
       AsyncOptions options = shipped->options();
-      options.quickSetUp = kind == 1;
+      options.keptFactors.quickSetUp = kind == 1;
       Stopwatch construction;
       AsyncBackwardEuler async(mesh, system, hL, regions, options);
       row.setup[kind] = construction.stop();
@@ -866,14 +868,15 @@ int main(int argc, char** argv) {
   app.add_option("--only", only, "steady study: time one configuration only (for callgrind)")
       ->check(CLI::IsMember({"async", "single", "single-hs"}));
   app.add_flag("--corotational", corotational, "steady study: corotational forces");
-  app.add_flag(
-      "--rebuild-schur", rebuildSchur,
-      "steady study: AsyncOptions::laggedSchur off, Z and H^{LL*} rebuilt every large step (nonlinear forces)");
+  app.add_flag("--rebuild-schur", rebuildSchur,
+               "steady study: AsyncOptions::KeptFactors::laggedSchur off, Z and H^{LL*} rebuilt every large step "
+               "(nonlinear forces)");
   app.add_option("--lagged-iterations", laggedIterations,
-                 "steady study: AsyncOptions::laggedSchurIterations (0: the default)")
+                 "steady study: AsyncOptions::KeptFactors::laggedSchurIterations (0: the default)")
       ->check(CLI::Range(0, 100000));
-  app.add_flag("--unturned-lagged-factor", unturned,
-               "steady study: AsyncOptions::laggedSchurRotation off (the lagged factor not turned with the body)");
+  app.add_flag(
+      "--unturned-lagged-factor", unturned,
+      "steady study: AsyncOptions::KeptFactors::laggedSchurRotation off (the lagged factor not turned with the body)");
   app.add_flag("--first", collectFirst, "with --only: collect the first step (set-up included) instead");
   app.add_option("--cells", cells, "cells along the bar for the growth and schur studies")->check(CLI::Range(2, 400));
   app.add_option("--ratio-cells", ratioCells, "cells along the bar for the ratio study")->check(CLI::Range(2, 400));

@@ -51,7 +51,7 @@ struct ContactStep {
   /// evaluated (DynamicSystem::externalForceAt and externalForceJacobianAt where set).
   const std::vector<std::vector<int>>* regionVertices = nullptr;
   /// Whether start() may skip the predicted states where none can touch (Eq. C7; with
-  /// AsyncOptions::certifyContactFree).
+  /// AsyncOptions::Contact::certifyContactFree).
   bool screenPredicted = false;
 };
 

@@ -90,7 +90,7 @@ class FastRegion {
 
   int ratio = 1;
   double smallStep = 0.0;  // hS
-  // AsyncOptions::regionDistribution: whether this process computes the region (its
+  // AsyncOptions::Processes::regionDistribution: whether this process computes the region (its
   // factor, Z, C_i, substitutions, recovery); the blocks are cut on every process.
   bool owned = true;
   // Flops of one forward substitution (m solves with A^S and m products with G), from the

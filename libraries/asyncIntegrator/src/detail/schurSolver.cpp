@@ -62,8 +62,8 @@ void SchurSolver::reset() {
   retired_ = old->retired_ ? std::move(old->retired_) : std::move(old);
 }
 
-void SchurSolver::useExternalSolver(AsyncOptions::LargeSystemSolverFactory factory, std::vector<int> largeDofs,
-                                    std::vector<std::vector<int>> interfaceDofs) {
+void SchurSolver::useExternalSolver(AsyncOptions::Processes::LargeSystemSolverFactory factory,
+                                    std::vector<int> largeDofs, std::vector<std::vector<int>> interfaceDofs) {
   external_ = std::move(factory);
   externalLarge_ = std::move(largeDofs);
   externalInterfaces_ = std::move(interfaceDofs);

@@ -43,8 +43,8 @@ class ColumnStore {
 
 /// Factors H^{LL*} in one of three strategies (SchurMode) and solves with it; with a
 /// factor kept from an earlier tangent, solves the current Schur system by preconditioned
-/// refinement (AsyncOptions::laggedSchur); or, before any factor of its own, borrows the
-/// whole single-rate system's factor as preconditioner (AsyncOptions::quickSetUp).
+/// refinement (AsyncOptions::KeptFactors::laggedSchur); or, before any factor of its own, borrows the
+/// whole single-rate system's factor as preconditioner (AsyncOptions::KeptFactors::quickSetUp).
 class SchurSolver {
  public:
   using SparseMatrix = Eigen::SparseMatrix<double>;
@@ -113,9 +113,9 @@ class SchurSolver {
   /// factor's memory is released by the next factor().
   void reset();
   /// From the next factor() on, H^{LL*} is assembled (symmetric mode) and factored by the
-  /// solver factory(largeDofs, interfaceDofs) returns (AsyncOptions::largeSystemSolver);
+  /// solver factory(largeDofs, interfaceDofs) returns (AsyncOptions::Processes::largeSystemSolver);
   /// empty: CHOLMOD.
-  void useExternalSolver(AsyncOptions::LargeSystemSolverFactory factory, std::vector<int> largeDofs,
+  void useExternalSolver(AsyncOptions::Processes::LargeSystemSolverFactory factory, std::vector<int> largeDofs,
                          std::vector<std::vector<int>> interfaceDofs);
   SchurMode modeUsed() const { return modeUsed_; }
   bool factored() const { return factored_; }
@@ -139,7 +139,7 @@ class SchurSolver {
                        const std::vector<FastRegion>& regions, IntegratorStats& stats);
 
   SchurMode modeUsed_ = SchurMode::lowRank;
-  AsyncOptions::LargeSystemSolverFactory external_;
+  AsyncOptions::Processes::LargeSystemSolverFactory external_;
   std::vector<int> externalLarge_;
   std::vector<std::vector<int>> externalInterfaces_;
   WholeSystemFactor* borrowed_ = nullptr;

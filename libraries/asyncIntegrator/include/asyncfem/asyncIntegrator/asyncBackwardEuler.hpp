@@ -46,7 +46,7 @@ struct CachedSetUp;
 /// it also builds and factors every block, Z and H^{LL*} (again only after setTimestep).
 /// Nonlinear force models (corotational, hyperelastic): f_int(u_0) and K(u_0) are evaluated
 /// once per large step and every block is refactored numerically (the paper's Algorithm 2,
-/// or with the H^{LL*} factor kept: AsyncOptions::laggedSchur); symbolic analyses are done
+/// or with the H^{LL*} factor kept: AsyncOptions::KeptFactors::laggedSchur); symbolic analyses are done
 /// once per partition.
 class AsyncBackwardEuler final : public PartitionedIntegrator {
  public:

@@ -77,7 +77,14 @@ enum class AsyncCoupling {
   paper,
 };
 
+/// The options of AsyncBackwardEuler, grouped by concern: how the step is solved (the
+/// members at the top), the factors kept across steps and set-ups (keptFactors), contact
+/// (contact) and runs on several processes (processes). The scene keys of
+/// docs/scene-format.md ("integrator.options") are read and written by one codec
+/// (asyncSettingsJson, registration.hpp); chooseStepSolver() checks them against the
+/// partition.
 struct AsyncOptions {
+  // How the step is solved.
   AsyncCoupling coupling = AsyncCoupling::stable;
   SchurMode schur = SchurMode::lowRank;
   AsyncSolveMethod method = AsyncSolveMethod::structured;
@@ -85,109 +92,120 @@ struct AsyncOptions {
   /// The hierarchy solve's strategy (only where that solve runs).
   NestedSolve nestedSolve = NestedSolve::automatic;
   SolverKind regionSolver = SolverKind::cholmod;  ///< factors A^{S_i} (SPD)
-  /// State passed to the external force function at substep r of a fast region: false
-  /// (default) passes the large step's start state (u_0, v_0), so state-dependent forces
-  /// such as penalty contact act once per large step, as in the paper; true passes the
-  /// predicted state (u_0 + r hS v_0, v_0), so contacts of S vertices are tested at every
-  /// substep (an explicit prediction: the substep states themselves are unknowns of the
-  /// implicit solve).
-  bool substepStatePrediction = false;
-  /// Implicit contact (DynamicSystem::externalForceJacobian; docs/asynchronous-integrator.md,
-  /// "Implicit contact"): the step is solved again with the external force at the last
-  /// solve's substep and end states until its largest change, relative to the step's
-  /// right-hand side, is at most contactTolerance, at most contactIterations solves (then
-  /// counted as unconverged, or an error above a relative change of 1).
-  double contactTolerance = 1e-8;
-  int contactIterations = 30;
-  /// Implicit contact: a step whose first solve provably touches no obstacle at any
-  /// substep (Eq. C6 of docs/asynchronous-integrator.md: bounds on every vertex's motion,
-  /// DynamicSystem::stateDependentOnlyInContact) ends there, recovering each region's end
-  /// state from the stored Z instead of every substep's. false: every step evaluates the
-  /// force at every substep state (the same result to round-off, at about 1.6x the cost
-  /// of a step far from contact).
-  bool certifyContactFree = true;
-  /// Threads for the set-up and per-large-step rebuild (columns of Z in blocks, one A^S
-  /// factor copy per block) and for the regions of a step: 0 = OpenMP's maximum.
-  int threads = 0;
-  /// Nonlinear forces only. false: every large step recomputes Z and refactors H^{LL*}
-  /// (the paper's Algorithm 2). true (default): the factor of H^{LL*} from the last full
-  /// rebuild is kept as a preconditioner and the Schur system of the current tangent is
-  /// solved by preconditioned iterative refinement (each iteration: one forward substitution
-  /// per region and one solve with the old factor) to a relative residual of
-  /// laggedSchurTolerance. Rent or buy, priced in flops: a step may take as many
-  /// iterations as one rebuild costs (at least laggedSchurIterations); beyond that it does
-  /// the full rebuild instead, and so does the next step after a slow convergence (more than
-  /// half of them) or once the iterations since the last rebuild have cost a rebuild.
-  /// A^S is refactored every step either way. The step then solves the coupled system to
-  /// the tolerance instead of to round-off.
-  bool laggedSchur = true;
-  /// With laggedSchur: the kept factor preconditions turned with the body, T P T^T with
-  /// T the block diagonal of every vertex's rotation since the factor was built (the polar
-  /// rotation of its elements' mean deformation gradient from that state; docs/
-  /// asynchronous-integrator.md, "The lagged factor turned with the body"). A corotational
-  /// or hyperelastic tangent that has turned with the body since the rebuild satisfies
-  /// K ~ T K_ref T^T, so fewer iterations and rebuilds are needed where parts of the body
-  /// swing. The solution is the same to laggedSchurTolerance either way. Not with
-  /// largeSystemSolver (an external solver's preconditioner is its own). Also, every other
-  /// rebuild that the rent-or-buy rule asks for is a refresh: the kept corrections C_i
-  /// turned with the body and H^{LL*} refactored from the current A^L, without Z (the
-  /// m |I| solves); the next one is a full rebuild.
-  bool laggedSchurRotation = true;
-  int laggedSchurIterations = 8;
-  double laggedSchurTolerance = 1e-10;
-  /// Stable coupling, structured method only (docs/asynchronous-integrator.md, "Quick
-  /// set-up"). false (default): a set-up computes Z and factors H^{LL*}, and every step
-  /// solves exactly. true: a set-up factors only the regions' A^S; L's system is solved
-  /// by conjugate gradients preconditioned with the factor of the whole single-rate system
-  /// A = M + hL D + hL^2 K (one factor for every partition, refactored only for a new hL;
-  /// exact when every ratio is 1) to a relative residual of laggedSchurTolerance. Once the
-  /// iterations have cost as much as the rebuild they put off (its estimate: the whole
-  /// factor's time plus one forward substitution per interface DOF), or when they need
-  /// more than quickSetUpIterations, Z and H^{LL*} are built as without it.
-  bool quickSetUp = false;
-  int quickSetUpIterations = 60;
-  /// false: a partition never leaves the quick path while its solves converge (studies of
-  /// the deflation; the rent-or-buy rule is off).
-  bool quickSetUpRebuild = true;
   /// Regions of at most this many free DOFs factor A^{S_i} dense (SolverKind::dense) and
   /// multiply by hS^2 K^{SS} dense, whatever regionSolver says: there the m substitutions
   /// per large step cost less dense than sparse (docs/asynchronous-integrator.md,
   /// "Performance notes"). 0: every region uses regionSolver.
   int denseRegionDofs = 128;
-  /// The solver of L's system H^{LL*} (structured method, stable coupling), or empty for
-  /// CHOLMOD. Called at each set-up with the global DOF ids of L (ascending; the rows of
-  /// H^{LL*}) and, for each fast region i, the global DOF ids of its interface I_i (the rows
-  /// and columns its dense block C_i couples; a distributed solver keeps each on one rank
-  /// where it can); the solver it returns is given the assembled H^{LL*} (every entry of each
-  /// dense interface block on a fixed pattern, both triangles, symmetric) and must solve it
-  /// to the accuracy the run needs; an iterative one that asks for a preconditioning matrix
-  /// (SparseSolver::usesPreconditionerMatrix) gets Â^L, the same without the dense blocks. The petscBackend library's
-  /// makePetscLargeSystemSolver() solves it distributed over MPI ranks (docs/petsc-backend.md, "The asynchronous
-  /// integrator over MPI"). The paper's coupling (unsymmetric H^{LL*}) is refused with it.
-  using LargeSystemSolverFactory = std::function<std::unique_ptr<SparseSolver>(
-      const std::vector<int>& largeDofs, const std::vector<std::vector<int>>& interfaceDofs)>;
-  LargeSystemSolverFactory largeSystemSolver{};
-
-  /// A run on several processes that step the same integrator on the same state (MPI
-  /// ranks): each fast region is computed by one process only, its owner (the factor of
-  /// A^S, Z and C_i, the forward substitutions and the recovery of its substeps), and
-  /// what the others need of it is summed over the processes: the corrections C_i (for
-  /// H^{LL*}), each substitution's interface rows, the region's end-of-step velocities and
-  /// the priced cost of its solves. Stable coupling and structured method only; a substep
-  /// observer sees only this process's regions. Both members empty (the default): this
-  /// process computes every region.
-  struct RegionDistribution {
-    /// At each set-up, with every region's free DOFs and interface DOFs (global ids): 1
-    /// for each region this process computes. Every region needs exactly one owner (checked
-    /// with sum; otherwise a ValidationError naming the region, on every process).
-    std::function<std::vector<char>(const std::vector<std::vector<int>>& regionDofs,
-                                    const std::vector<std::vector<int>>& interfaceDofs)>
-        ownedRegions;
-    /// values[0, count) replaced by their sum over the processes. Collective: every process
-    /// calls it at the same point with the same count, and all receive the same sums.
-    std::function<void(double* values, std::size_t count)> sum;
+  /// Threads for the set-up and per-large-step rebuild (columns of Z in blocks, one A^S
+  /// factor copy per block) and for the regions of a step: 0 = OpenMP's maximum.
+  int threads = 0;
+  /// Factors kept across large steps and partitions.
+  struct KeptFactors {
+    /// Nonlinear forces only. false: every large step recomputes Z and refactors H^{LL*}
+    /// (the paper's Algorithm 2). true (default): the factor of H^{LL*} from the last full
+    /// rebuild is kept as a preconditioner and the Schur system of the current tangent is
+    /// solved by preconditioned iterative refinement (each iteration: one forward substitution
+    /// per region and one solve with the old factor) to a relative residual of
+    /// laggedSchurTolerance. Rent or buy, priced in flops: a step may take as many
+    /// iterations as one rebuild costs (at least laggedSchurIterations); beyond that it does
+    /// the full rebuild instead, and so does the next step after a slow convergence (more than
+    /// half of them) or once the iterations since the last rebuild have cost a rebuild.
+    /// A^S is refactored every step either way. The step then solves the coupled system to
+    /// the tolerance instead of to round-off.
+    bool laggedSchur = true;
+    /// With laggedSchur: the kept factor preconditions turned with the body, T P T^T with
+    /// T the block diagonal of every vertex's rotation since the factor was built (the polar
+    /// rotation of its elements' mean deformation gradient from that state; docs/
+    /// asynchronous-integrator.md, "The lagged factor turned with the body"). A corotational
+    /// or hyperelastic tangent that has turned with the body since the rebuild satisfies
+    /// K ~ T K_ref T^T, so fewer iterations and rebuilds are needed where parts of the body
+    /// swing. The solution is the same to laggedSchurTolerance either way. Not with
+    /// largeSystemSolver (an external solver's preconditioner is its own). Also, every other
+    /// rebuild that the rent-or-buy rule asks for is a refresh: the kept corrections C_i
+    /// turned with the body and H^{LL*} refactored from the current A^L, without Z (the
+    /// m |I| solves); the next one is a full rebuild.
+    bool laggedSchurRotation = true;
+    int laggedSchurIterations = 8;
+    double laggedSchurTolerance = 1e-10;
+    /// Stable coupling, structured method only (docs/asynchronous-integrator.md, "Quick
+    /// set-up"). false (default): a set-up computes Z and factors H^{LL*}, and every step
+    /// solves exactly. true: a set-up factors only the regions' A^S; L's system is solved
+    /// by conjugate gradients preconditioned with the factor of the whole single-rate system
+    /// A = M + hL D + hL^2 K (one factor for every partition, refactored only for a new hL;
+    /// exact when every ratio is 1) to a relative residual of laggedSchurTolerance. Once the
+    /// iterations have cost as much as the rebuild they put off (its estimate: the whole
+    /// factor's time plus one forward substitution per interface DOF), or when they need
+    /// more than quickSetUpIterations, Z and H^{LL*} are built as without it.
+    bool quickSetUp = false;
+    int quickSetUpIterations = 60;
+    /// false: a partition never leaves the quick path while its solves converge (studies of
+    /// the deflation; the rent-or-buy rule is off).
+    bool quickSetUpRebuild = true;
   };
-  RegionDistribution regionDistribution{};
+  KeptFactors keptFactors{};
+  /// State-dependent external forces (contact).
+  struct Contact {
+    /// State passed to the external force function at substep r of a fast region: false
+    /// (default) passes the large step's start state (u_0, v_0), so state-dependent forces
+    /// such as penalty contact act once per large step, as in the paper; true passes the
+    /// predicted state (u_0 + r hS v_0, v_0), so contacts of S vertices are tested at every
+    /// substep (an explicit prediction: the substep states themselves are unknowns of the
+    /// implicit solve).
+    bool substepStatePrediction = false;
+    /// Implicit contact (DynamicSystem::externalForceJacobian; docs/asynchronous-integrator.md,
+    /// "Implicit contact"): the step is solved again with the external force at the last
+    /// solve's substep and end states until its largest change, relative to the step's
+    /// right-hand side, is at most tolerance, at most iterations solves (then
+    /// counted as unconverged, or an error above a relative change of 1).
+    double tolerance = 1e-8;
+    int iterations = 30;
+    /// Implicit contact: a step whose first solve provably touches no obstacle at any
+    /// substep (Eq. C6 of docs/asynchronous-integrator.md: bounds on every vertex's motion,
+    /// DynamicSystem::stateDependentOnlyInContact) ends there, recovering each region's end
+    /// state from the stored Z instead of every substep's. false: every step evaluates the
+    /// force at every substep state (the same result to round-off, at about 1.6x the cost
+    /// of a step far from contact).
+    bool certifyContactFree = true;
+  };
+  Contact contact{};
+  /// Runs on several processes (MPI): L's system solved outside, regions owned by one process.
+  struct Processes {
+    /// The solver of L's system H^{LL*} (structured method, stable coupling), or empty for
+    /// CHOLMOD. Called at each set-up with the global DOF ids of L (ascending; the rows of
+    /// H^{LL*}) and, for each fast region i, the global DOF ids of its interface I_i (the rows
+    /// and columns its dense block C_i couples; a distributed solver keeps each on one rank
+    /// where it can); the solver it returns is given the assembled H^{LL*} (every entry of each
+    /// dense interface block on a fixed pattern, both triangles, symmetric) and must solve it
+    /// to the accuracy the run needs; an iterative one that asks for a preconditioning matrix
+    /// (SparseSolver::usesPreconditionerMatrix) gets Â^L, the same without the dense blocks. The petscBackend library's
+    /// makePetscLargeSystemSolver() solves it distributed over MPI ranks (docs/petsc-backend.md, "The asynchronous
+    /// integrator over MPI"). The paper's coupling (unsymmetric H^{LL*}) is refused with it.
+    using LargeSystemSolverFactory = std::function<std::unique_ptr<SparseSolver>(
+        const std::vector<int>& largeDofs, const std::vector<std::vector<int>>& interfaceDofs)>;
+    LargeSystemSolverFactory largeSystemSolver{};
+    /// A run on several processes that step the same integrator on the same state (MPI
+    /// ranks): each fast region is computed by one process only, its owner (the factor of
+    /// A^S, Z and C_i, the forward substitutions and the recovery of its substeps), and
+    /// what the others need of it is summed over the processes: the corrections C_i (for
+    /// H^{LL*}), each substitution's interface rows, the region's end-of-step velocities and
+    /// the priced cost of its solves. Stable coupling and structured method only; a substep
+    /// observer sees only this process's regions. Both members empty (the default): this
+    /// process computes every region.
+    struct RegionDistribution {
+      /// At each set-up, with every region's free DOFs and interface DOFs (global ids): 1
+      /// for each region this process computes. Every region needs exactly one owner (checked
+      /// with sum; otherwise a ValidationError naming the region, on every process).
+      std::function<std::vector<char>(const std::vector<std::vector<int>>& regionDofs,
+                                      const std::vector<std::vector<int>>& interfaceDofs)>
+          ownedRegions;
+      /// values[0, count) replaced by their sum over the processes. Collective: every process
+      /// calls it at the same point with the same count, and all receive the same sums.
+      std::function<void(double* values, std::size_t count)> sum;
+    };
+    RegionDistribution regionDistribution{};
+  };
+  Processes processes{};
 };
 
 /// Where an asynchronous run's time went, set-up apart from the steady-state steps (the

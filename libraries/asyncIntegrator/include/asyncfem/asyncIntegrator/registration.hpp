@@ -69,7 +69,7 @@ int largestRatio(const std::vector<AsyncRegion>& regions);
 
 /// Adjusts or refuses (by throwing ValidationError) the settings of each "async" integrator
 /// a registry builds, after they are read from the scene: e.g. the PETSc backend sets
-/// AsyncOptions::largeSystemSolver (which chooseStepSolver() then refuses for regions that
+/// AsyncOptions::Processes::largeSystemSolver (which chooseStepSolver() then refuses for regions that
 /// touch or nest, naming the option).
 /// The context is the integrator's (its mesh, system, timestep).
 using AsyncSettingsHook = std::function<void(AsyncSettings&, const IntegratorContext&)>;

@@ -50,8 +50,8 @@ std::vector<int> regionOwners(const TetMesh& mesh, const std::vector<int>& eleme
                               const std::vector<std::vector<int>>& regionVertices,
                               const std::vector<std::vector<int>>& interfaceVertices, int maxGroupVertices);
 
-/// The members of AsyncOptions::RegionDistribution for a run on MPI_COMM_WORLD (assign them
-/// to options.regionDistribution.ownedRegions and .sum): each region is computed by the
+/// The members of AsyncOptions::Processes::RegionDistribution for a run on MPI_COMM_WORLD (assign them
+/// to options.processes.regionDistribution.ownedRegions and .sum): each region is computed by the
 /// rank regionOwners() names, from the same METIS partition and size limit that
 /// makePetscLargeSystemSolver() uses, so it owns the region's interface rows too; the sum
 /// is MPI_Allreduce. Collective (rank 0 partitions); needs a live PetscRuntime. totals, when
@@ -94,7 +94,7 @@ std::unique_ptr<SparseSolver> makePetscSparseSolver(const PetscSolverSettings& s
 const PetscSolveCounts* petscSolveCounts(const SparseSolver& solver);
 
 /// The solver factory of the asynchronous integrator's L system
-/// (AsyncOptions::largeSystemSolver, whose type this is) for a run on mesh: every rank runs
+/// (AsyncOptions::Processes::largeSystemSolver, whose type this is) for a run on mesh: every rank runs
 /// the integrator on the replicated state, and H^{LL*} is solved distributed. Rows (global
 /// DOF ids 3 v + c) are owned by their vertex's rank in METIS's element partition of mesh
 /// (partitionElements(), computed on rank 0 and broadcast; a vertex belongs to the lowest
