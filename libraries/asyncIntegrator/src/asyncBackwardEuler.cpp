@@ -17,6 +17,16 @@
 
 namespace asyncfem {
 
+namespace {
+
+// The solver of kind for the context's partition, not yet set up.
+std::unique_ptr<detail::StepSolver> makeStepSolver(AsyncStepSolver kind, const detail::StepContext& context) {
+  if (kind == AsyncStepSolver::hierarchy) return std::make_unique<detail::HierarchyStepSolver>(context);
+  return std::make_unique<detail::TwoLevelStepSolver>(kind, context);
+}
+
+}  // namespace
+
 AsyncBackwardEuler::AsyncBackwardEuler(const TetMesh& mesh, DynamicSystem system, double largeTimestep,
                                        std::vector<AsyncRegion> regions, AsyncOptions options)
     : AsyncBackwardEuler(withMesh("async", mesh, std::move(system)), largeTimestep, std::move(regions), options) {}
@@ -75,7 +85,7 @@ void AsyncBackwardEuler::setUp(RegionPartition partition) {
   const AsyncStepSolver kind = chooseStepSolver(options_, partition, system_);
   partition_ = std::move(partition);
   // A solver of the same kind is set up again in the storage of the previous partition.
-  if (!solver_ || solver_->kind() != kind) solver_ = detail::makeStepSolver(kind, stepContext());
+  if (!solver_ || solver_->kind() != kind) solver_ = makeStepSolver(kind, stepContext());
   solver_->setUp();
   runStats_.setupSeconds += watch.stop();
 }

@@ -1,12 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <asyncfem/asyncIntegrator/stepSolver.hpp>
-#include <cstdio>
-#include <memory>
 #include <string>
-
-#include "hierarchyStepSolver.hpp"
-#include "stepSolvers.hpp"
-#include "twoLevelStepSolver.hpp"
 
 namespace asyncfem {
 
@@ -115,42 +109,5 @@ AsyncStepSolver chooseStepSolver(const AsyncOptions& options, const RegionPartit
   }
   return options.method == AsyncSolveMethod::naive ? AsyncStepSolver::naiveLU : AsyncStepSolver::structuredSchur;
 }
-
-namespace detail {
-
-bool asyncLinearizesContact(const AsyncOptions& options) {
-  return options.coupling == AsyncCoupling::stable && options.method != AsyncSolveMethod::naive &&
-         !options.processes.largeSystemSolver && !options.processes.regionDistribution.sum;
-}
-
-bool StepSolver::implicitContact() const {
-  return static_cast<bool>(system_.externalForceJacobian) && asyncLinearizesContact(options_);
-}
-
-std::string steadyStepLine(const AsyncRunStats& r) {
-  char line[256];
-  std::snprintf(line, sizeof(line), "async steady large step %.3f ms over %lld steps; rebuilds %lld (%.3f s)",
-                1000.0 * r.meanStepSeconds(), r.steps, r.rebuilds, r.rebuildSeconds);
-  return line;
-}
-
-std::string contactLine(const AsyncRunStats& r, const char* perStep, const char* stopped, int limit,
-                        const std::string& refactored) {
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "async implicit contact: %lld solves over %lld steps (%.2f per step%s); %lld steps stopped at %d %s "
-                "unconverged (largest relative residual %.2e); ",
-                r.contactIterations, r.contactSteps,
-                static_cast<double>(r.contactIterations) / static_cast<double>(r.contactSteps), perStep,
-                r.unconvergedContactSteps, limit, stopped, r.largestContactResidual);
-  return line + refactored;
-}
-
-std::unique_ptr<StepSolver> makeStepSolver(AsyncStepSolver kind, const StepContext& context) {
-  if (kind == AsyncStepSolver::hierarchy) return std::make_unique<HierarchyStepSolver>(context);
-  return std::make_unique<TwoLevelStepSolver>(kind, context);
-}
-
-}  // namespace detail
 
 }  // namespace asyncfem

@@ -5,7 +5,7 @@
 // partition's blocks, factors and solve: TwoLevelStepSolver (the structured Schur solve and
 // its naive LU reference, twoLevelStepSolver.hpp) and HierarchyStepSolver (regions that
 // touch or nest, hierarchyStepSolver.hpp). chooseStepSolver() (stepSolver.hpp) decides the
-// kind, makeStepSolver() builds it. Private to the library.
+// kind, AsyncBackwardEuler::setUp builds it (makeStepSolver in asyncBackwardEuler.cpp). Private to the library.
 #pragma once
 
 #include <Eigen/Core>
@@ -111,9 +111,6 @@ std::string steadyStepLine(const AsyncRunStats& r);
 /// parenthesis, stopped names what the limit counts, refactored ends the line.
 std::string contactLine(const AsyncRunStats& r, const char* perStep, const char* stopped, int limit,
                         const std::string& refactored);
-
-/// The solver of kind for the context's partition, not yet set up.
-std::unique_ptr<StepSolver> makeStepSolver(AsyncStepSolver kind, const StepContext& context);
 
 /// A set-up kept for reuse by run-time regions (the most recently used first).
 struct CachedSetUp {
