@@ -8,21 +8,15 @@
 #include <asyncfem/volumetricMesh/hexahedron.hpp>
 #include <cmath>
 
+#include "hexElementShapes.hpp"
+
 namespace asyncfem {
 namespace {
 
-constexpr double kYoung = 1e6;
-constexpr double kPoisson = 0.35;
-
-HexElementPositions restShape() {
-  HexElementPositions x;
-  for (int a = 0; a < 8; ++a) {
-    const auto& c = hexahedron::kCorners[static_cast<std::size_t>(a)];
-    x.col(a) = Eigen::Vector3d(0.5 * (c[0] + 1), 0.4 * (c[1] + 1), 0.3 * (c[2] + 1));
-  }
-  x.col(6) += Eigen::Vector3d(0.1, -0.05, 0.08);  // not a parallelepiped
-  return x;
-}
+constexpr double kYoung = test::kHexYoung;
+constexpr double kPoisson = test::kHexPoisson;
+using test::hexRestShape;
+HexElementPositions restShape() { return hexRestShape(); }
 
 /// A large deformation: rotation, stretch and a vertex-wise perturbation.
 HexElementPositions deformedShape(const HexElementPositions& rest) {

@@ -689,8 +689,9 @@ TEST(BuildSimulation, HyperelasticForceModelsRunFromTheScene) {
 
 }  // namespace
 
-// A scene on Vega's CUBIC mesh runs linear FEM and StVK with the single-rate integrators; a model or
-// integrator that needs tetrahedra is refused with the scene key and the conversion.
+// A scene on Vega's CUBIC mesh runs linear FEM, StVK and corotational FEM with the single-rate
+// integrators; a model or integrator that needs tetrahedra is refused with the scene key and the
+// conversion.
 TEST(BuildSimulation, CubicVegSceneRunsLinearFemAndRefusesWhatNeedsTetrahedra) {
   nlohmann::json json = nlohmann::json::parse(R"({
     "mesh": {"file": "volumetricMesh/cubes.veg"},
@@ -716,17 +717,20 @@ TEST(BuildSimulation, CubicVegSceneRunsLinearFemAndRefusesWhatNeedsTetrahedra) {
     }
     return std::string("accepted");
   };
-  nlohmann::json stvk = json;
-  stvk["forceModel"] = {{"type", "stvk"}};
-  Simulation nonlinear = build(stvk, data);
-  EXPECT_FALSE(nonlinear.integrator->system().forceModel->isLinear());
-  nonlinear.integrator->step();
-  EXPECT_TRUE(nonlinear.integrator->displacement().allFinite());
+  for (const char* type : {"stvk", "corotational"}) {
+    nlohmann::json scene = json;
+    scene["forceModel"] = {{"type", type}};
+    Simulation nonlinear = build(scene, data);
+    EXPECT_FALSE(nonlinear.integrator->system().forceModel->isLinear()) << type;
+    nonlinear.integrator->step();
+    EXPECT_TRUE(nonlinear.integrator->displacement().allFinite()) << type;
+    EXPECT_LT(nonlinear.integrator->displacement().minCoeff(), 0.0) << type;
+  }
 
-  nlohmann::json corotational = json;
-  corotational["forceModel"] = {{"type", "corotational"}};
-  const std::string model = refusal(corotational);
-  EXPECT_NE(model.find("scene.json: forceModel.type: \"corotational\""), std::string::npos) << model;
+  nlohmann::json neoHookean = json;
+  neoHookean["forceModel"] = {{"type", "neo-hookean"}};
+  const std::string model = refusal(neoHookean);
+  EXPECT_NE(model.find("scene.json: forceModel.type: \"neo-hookean\""), std::string::npos) << model;
   EXPECT_NE(model.find("4 hexahedra"), std::string::npos) << model;
   nlohmann::json async = json;
   async["integrator"] = nlohmann::json::parse(

@@ -4,6 +4,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/hexElements/hexAssembly.hpp>
+#include <asyncfem/hexElements/hexCorotationalForceModel.hpp>
 #include <asyncfem/hexElements/hexStvkForceModel.hpp>
 #include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <asyncfem/problem/problem.hpp>
@@ -62,7 +63,8 @@ Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVert
 void Problem::requireHexahedralModel() const {
   const ForceModelType model = settings_.forceModel;
   if (!runsOnHexahedra(model)) {
-    mesh_->requireTetrahedra("the " + toString(model) + " force model (hexahedral meshes run linear and stvk)");
+    mesh_->requireTetrahedra("the " + toString(model) +
+                             " force model (hexahedral meshes run linear, corotational and stvk)");
   }
   const HyperelasticOptions& options = settings_.hyperelastic;
   if (model == ForceModelType::stvk &&
@@ -149,13 +151,18 @@ std::string toString(ForceModelType type) {
   return std::string(findEnumName(kForceModelNames, type).value_or("unknown"));
 }
 
-bool runsOnHexahedra(ForceModelType type) { return type == ForceModelType::linear || type == ForceModelType::stvk; }
+bool runsOnHexahedra(ForceModelType type) {
+  return type == ForceModelType::linear || type == ForceModelType::corotational || type == ForceModelType::stvk;
+}
 
 std::shared_ptr<ForceModel> Problem::makeForceModel() const {
   switch (settings_.forceModel) {
     case ForceModelType::linear:
       return std::make_shared<LinearForceModel>(stiffnessMatrix());
     case ForceModelType::corotational:
+      if (mesh_->isHexahedral()) {
+        return std::make_shared<HexCorotationalForceModel>(*mesh_, settings_.tangent == TangentKind::simple);
+      }
       return std::make_shared<CorotationalLinearFEM>(*mesh_, assembler(), settings_.tangent);
     case ForceModelType::stvk:
       if (mesh_->isHexahedral()) return std::make_shared<HexStvkForceModel>(*mesh_);

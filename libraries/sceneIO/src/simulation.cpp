@@ -303,7 +303,7 @@ std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std:
   const ProblemSettings settings = problemSettings(scene);
   if (mesh->isHexahedral() && !runsOnHexahedra(settings.forceModel)) {  // Problem refuses it too, without the key
     mesh->requireTetrahedra(scene.sourceName + ": forceModel.type: \"" + toString(settings.forceModel) +
-                            "\" (hexahedral meshes run \"linear\" and \"stvk\")");
+                            "\" (hexahedral meshes run \"linear\", \"corotational\" and \"stvk\")");
   }
   std::shared_ptr<const PenaltyContact> contact = buildSceneContact(scene, *mesh);
   return std::make_shared<const Problem>(mesh, std::move(fixed), settings, std::move(loads), std::move(contact));

@@ -11,6 +11,13 @@ using HexElementMatrix = Eigen::Matrix<double, 24, 24>;
 using HexElementVector = Eigen::Matrix<double, 24, 1>;
 using HexElementPositions = Eigen::Matrix<double, 3, 8>;  ///< columns = the element's vertices
 
+/// Energy, internal force and tangent of one hexahedron under a force model.
+struct HexElementEnergy {
+  double energy = 0.0;       ///< units of E times volume (e.g. J)
+  HexElementVector force;    ///< f_int = dE/dx (24, units of E times area, e.g. N)
+  HexElementMatrix tangent;  ///< K = df_int/dx (24 x 24), or the model's approximation of it
+};
+
 /// Gradients dN_a/dX of the eight trilinear shape functions at reference point xi (3 x 8,
 /// column a, units 1/length), and det J = det(dX/dxi) there (volume per reference volume;
 /// the reference cube [-1, 1]^3 has volume 8).

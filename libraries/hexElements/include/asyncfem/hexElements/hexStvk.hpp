@@ -5,12 +5,9 @@
 
 namespace asyncfem {
 
-/// Saint Venant-Kirchhoff energy, internal force and tangent of one trilinear hexahedron.
-struct HexStvkElement {
-  double energy = 0.0;       ///< sum_g det J_g psi(F_g) (units of E times volume, e.g. J)
-  HexElementVector force;    ///< f_int = dE/dx (24, units of E times area, e.g. N)
-  HexElementMatrix tangent;  ///< K = df_int/dx (24 x 24), exact derivative of force
-};
+/// Saint Venant-Kirchhoff energy sum_g det J_g psi(F_g), internal force and exact tangent of
+/// one trilinear hexahedron.
+using HexStvkElement = HexElementEnergy;
 
 /// StVK on the hexahedron with rest positions X and deformed positions x (3 x 8 each):
 /// psi(F) = lambda/2 (tr E)^2 + mu tr(E^2), E = (F^T F - I)/2, F = x dN/dX, integrated by

@@ -23,7 +23,7 @@ enum class ForceModelType { linear, corotational, stvk, neoHookean, mooneyRivlin
 
 /// "linear", "corotational", "stvk", "neo-hookean", "mooney-rivlin".
 std::string toString(ForceModelType type);
-/// Whether the model has hexahedral elements (library hexElements): linear and stvk.
+/// Whether the model has hexahedral elements (library hexElements): linear, corotational and stvk.
 bool runsOnHexahedra(ForceModelType type);
 
 /// The physics of a problem beyond its mesh, boundary and loads.
@@ -50,8 +50,9 @@ struct ProblemSettings {
 /// The time-dependent operator of M a + D v + f_int(u) = f_ext(t, u, v): integrators get
 /// it as a DynamicSystem (dynamicSystem()), whose external force evaluates loads().
 ///
-/// Hexahedral meshes (Vega's CUBIC .veg, Gmsh hexahedra) run linear FEM and StVK (its
-/// Green-strain form, HexStvkForceModel), with K and M of library hexElements (trilinear
+/// Hexahedral meshes (Vega's CUBIC .veg, Gmsh hexahedra) run linear FEM, StVK (its
+/// Green-strain form, HexStvkForceModel) and corotational FEM (HexCorotationalForceModel;
+/// settings.tangent picks its tangent), with K and M of library hexElements (trilinear
 /// elements, 2 x 2 x 2 Gauss points); the other models and assembler() refuse them with a
 /// ValidationError naming the conversion.
 ///
