@@ -76,6 +76,79 @@ TEST(SurfaceContact, ForcesAreMinusTheEnergyGradient) {
   }
 }
 
+// The dense 3n x 3n matrix of a Jacobian's stiffness (or damping) blocks and couplings.
+Eigen::MatrixXd denseOf(const VertexJacobian& jacobian, int numVertices, bool damping) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(3 * numVertices, 3 * numVertices);
+  for (std::size_t k = 0; k < jacobian.vertices.size(); ++k) {
+    out.block<3, 3>(3 * jacobian.vertices[k], 3 * jacobian.vertices[k]) +=
+        damping ? jacobian.damping[k] : jacobian.stiffness[k];
+  }
+  for (const VertexCoupling& coupling : jacobian.couplings) {
+    const Eigen::Matrix3d normalBlock = coupling.direction * coupling.direction.transpose();
+    const double scale = damping ? coupling.damping : coupling.stiffness;
+    for (std::size_t i = 0; i < 4; ++i) {
+      for (std::size_t j = 0; j < 4; ++j) {
+        if (coupling.vertices[i] < 0 || coupling.vertices[j] < 0) continue;
+        out.block<3, 3>(3 * coupling.vertices[i], 3 * coupling.vertices[j]) +=
+            scale * coupling.weights[i] * coupling.weights[j] * normalBlock;
+      }
+    }
+  }
+  return out;
+}
+
+TEST(SurfaceContact, CoupledJacobianIsTheForceDerivativeWithItsOffDiagonalBlocks) {
+  // Vertex 3 under B's face, 1e-4 inside a layer of 0.1 (one vertex-face pair between two
+  // bodies, k = 1000, c = 50), moving. The coupled Jacobian k (w w^T) (x) N N^T leaves out
+  // only the turning of N with the face, k (dhat - s) d^2 s / dx^2 = 1000 * 1e-4 * O(1 /
+  // edge) ~ 0.1 here, against entries k w_i w_j of up to 1000: central differences of the
+  // force (step 1e-6, error O(k step) ~ 1e-3) agree to 0.5. The damping part
+  // c (w w^T) (x) N N^T is exact (the force is linear in v), to round-off.
+  const double k = 1000.0;
+  const SurfaceContact contact = bodies(0.0999, 0.1, 50.0);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(24);
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(24);
+  v[3 * 3 + 1] = 0.001;  // closing slowly: the damping lowers F but does not clamp it
+  ASSERT_EQ(contact.pairs(0.0, u).size(), 1u);
+  VertexJacobian coupled;
+  contact.addCoupledJacobian(0.0, u, v, coupled);
+  ASSERT_EQ(coupled.couplings.size(), 1u);
+  EXPECT_TRUE(coupled.vertices.empty());
+  const Eigen::MatrixXd stiffness = denseOf(coupled, 8, false);
+  const Eigen::MatrixXd damping = denseOf(coupled, 8, true);
+  const auto forceAt = [&](const Eigen::VectorXd& du, const Eigen::VectorXd& dv) {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(24);
+    contact.addForces(0.0, u + du, v + dv, f);
+    return f;
+  };
+  const double step = 1e-6;
+  Eigen::MatrixXd differenceU(24, 24), differenceV(24, 24);
+  for (Eigen::Index j = 0; j < 24; ++j) {
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(24);
+    e[j] = step;
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(24);
+    differenceU.col(j) = -(forceAt(e, zero) - forceAt(-e, zero)) / (2 * step);
+    differenceV.col(j) = -(forceAt(zero, e) - forceAt(zero, -e)) / (2 * step);
+  }
+  EXPECT_LE((stiffness - differenceU).cwiseAbs().maxCoeff(), 0.5);
+  EXPECT_LE((damping - differenceV).cwiseAbs().maxCoeff(), 1e-6);
+  // The blocks between the vertex and the face's corners are there and large (the
+  // per-vertex bound has none): -k w_3 b_i in (y, y), about -k / 3 each.
+  for (const int corner : {4, 5, 6}) {
+    EXPECT_LT(stiffness(3 * 3 + 1, 3 * corner + 1), -0.1 * k);
+    EXPECT_NEAR(stiffness(3 * 3 + 1, 3 * corner + 1), differenceU(3 * 3 + 1, 3 * corner + 1), 0.5);
+  }
+  // The bound (addJacobian) is the couplings' Gershgorin bound: its diagonal blocks are at
+  // least the coupled ones' (here S = 2: |w| sums to 1 on each body).
+  VertexJacobian bound;
+  contact.addJacobian(0.0, u, v, bound);
+  const Eigen::MatrixXd bounded = denseOf(bound, 8, false);
+  for (int vertex : {3, 4, 5, 6}) {
+    EXPECT_NEAR(bounded(3 * vertex + 1, 3 * vertex + 1), 2.0 * std::sqrt(stiffness(3 * vertex + 1, 3 * vertex + 1) * k),
+                1e-9 * k);
+  }
+}
+
 TEST(SurfaceContact, ForcesBetweenBodiesSumToZeroWithDampingAndFriction) {
   const SurfaceContact contact = bodies(0.02, 0.3, 50.0, 0.4);
   std::mt19937 random(11);

@@ -99,6 +99,21 @@ void PenaltyContact::addForces(double time, const Eigen::VectorXd& displacement,
 PenaltyContactJacobian PenaltyContact::jacobian(double time, const Eigen::VectorXd& displacement,
                                                 const Eigen::VectorXd& velocity,
                                                 const std::vector<int>* vertices) const {
+  PenaltyContactJacobian out = primitiveJacobian(displacement, velocity, vertices);
+  if (surfaces_) surfaces_->addJacobian(time, displacement, velocity, out, vertices);
+  return out;
+}
+
+PenaltyContactJacobian PenaltyContact::coupledJacobian(double time, const Eigen::VectorXd& displacement,
+                                                       const Eigen::VectorXd& velocity) const {
+  PenaltyContactJacobian out = primitiveJacobian(displacement, velocity, nullptr);
+  if (surfaces_) surfaces_->addCoupledJacobian(time, displacement, velocity, out);
+  return out;
+}
+
+PenaltyContactJacobian PenaltyContact::primitiveJacobian(const Eigen::VectorXd& displacement,
+                                                         const Eigen::VectorXd& velocity,
+                                                         const std::vector<int>* vertices) const {
   const PenaltyContactParameters& p = parameters_;
   PenaltyContactJacobian out;
   const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
@@ -138,7 +153,6 @@ PenaltyContactJacobian PenaltyContact::jacobian(double time, const Eigen::Vector
     out.stiffness.push_back(-dfdx);
     out.damping.push_back(-dfdv);
   });
-  if (surfaces_) surfaces_->addJacobian(time, displacement, velocity, out, vertices);
   return out;
 }
 

@@ -393,6 +393,31 @@ void SurfaceContact::addJacobian(double time, const Eigen::VectorXd& displacemen
   }
 }
 
+void SurfaceContact::addCoupledJacobian(double time, const Eigen::VectorXd& displacement,
+                                        const Eigen::VectorXd& velocity, VertexJacobian& jacobian) const {
+  Points points;
+  const std::vector<SurfacePair> found = activePairs(time, displacement, &points);
+  const int n = static_cast<int>(rest_.cols());
+  for (const SurfacePair& pair : found) {
+    Eigen::Vector3d relative = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 4; ++i) {
+      relative += pair.weights[static_cast<std::size_t>(i)] *
+                  pointVelocity(pair.points[static_cast<std::size_t>(i)], velocity, points);
+    }
+    const double normalForce = (stiffness_ * (options_.thickness - pair.gap)) - (damping_ * pair.normal.dot(relative));
+    if (!(normalForce > 0.0)) continue;  // clamped: no force, no derivative
+    VertexCoupling coupling;
+    for (std::size_t i = 0; i < 4; ++i) {
+      coupling.vertices[i] = pair.points[i] < n ? pair.points[i] : -1;  // an obstacle point is no DOF
+      coupling.weights[i] = pair.weights[i];
+    }
+    coupling.direction = pair.normal;
+    coupling.stiffness = stiffness_;
+    coupling.damping = damping_;
+    jacobian.couplings.push_back(coupling);
+  }
+}
+
 double SurfaceContact::energy(double time, const Eigen::VectorXd& displacement) const {
   double squares = 0.0;
   for (const SurfacePair& pair : activePairs(time, displacement, nullptr)) {

@@ -41,6 +41,9 @@ BackwardEuler::BackwardEuler(DynamicSystem system, double timestep, const Integr
   }
   linear_ = system_.forceModel->isLinear();
   implicitExternal_ = static_cast<bool>(system_.externalForceJacobian);
+  // Couplings only where the low-rank update can take them (the constant K of a linear
+  // model); the nonlinear path assembles per-vertex blocks as before.
+  coupledContact_ = implicitExternal_ && linear_ && static_cast<bool>(system_.externalForceCoupledJacobian);
   lowRank_ = std::make_unique<detail::LowRankContactSolver>();
   // With implicit contact a linear model's matrix changes with the contact set too.
   if (options_.reuseFactor && (!linear_ || implicitExternal_)) {
@@ -140,9 +143,18 @@ RunReport BackwardEuler::report() const {
          << " steps predicted contact; Newton on the step equations with the contact at each iterate, "
          << unconvergedContactSteps_ << " steps stopped at "
          << std::max(options_.maxIterations, options_.contactIterations) << " iterations unconverged";
+    if (residualSteps_ > 0) {
+      text << " (" << std::setprecision(3)
+           << static_cast<double>(residualStepSolves_) / static_cast<double>(residualSteps_) << " solves per step in "
+           << residualSteps_ << " steps that iterated)";
+    }
     if (linear_) {
       text << "; " << lowRankSolves_ << " contact solves by a low-rank update of the kept factor ("
            << lowRank_->cachedVertices() << " vertices' columns cached)";
+    }
+    if (coupledContact_) {
+      text << "; surface pairs with their off-diagonal blocks (" << boundedCouplingSolves_
+           << " solves took their per-vertex bounds instead)";
     }
     if (unconvergedContactSteps_ > 0) {
       text << " (largest relative residual " << std::setprecision(3) << largestUnconvergedResidual_ << ")";
@@ -239,12 +251,20 @@ void BackwardEuler::evaluateImplicitExternalForce(const Eigen::VectorXd& displac
     fullForce_.setZero(system_.numDofs());
     system_.externalForce(stepEndTime(), displacement, velocity, fullForce_);
     contact_.clear();
-    system_.externalForceJacobian(stepEndTime(), displacement, velocity, contact_);
+    if (coupledContact_) {
+      system_.externalForceCoupledJacobian(stepEndTime(), displacement, velocity, contact_);
+    } else {
+      system_.externalForceJacobian(stepEndTime(), displacement, velocity, contact_);
+    }
   }
   detail::restrictTo(system_.freeDofs, fullForce_, force);
 }
 
 void BackwardEuler::finishStep() {
+  if (implicitExternal_ && lastRelativeResidual_ >= 0.0) {
+    ++residualSteps_;
+    residualStepSolves_ += lastIterations_;
+  }
   v_ += dv_;
   u_ += timestep_ * v_;
   detail::expandTo(system_.freeDofs, u_, fullU_);
@@ -301,6 +321,7 @@ void BackwardEuler::solveLinearStep(const Eigen::VectorXd& rhs, Eigen::VectorXd&
 }
 
 void BackwardEuler::solveWithContactMatrix(const Eigen::VectorXd& rhs, Eigen::VectorXd& solution) {
+  if (!contact_.couplings.empty()) ++boundedCouplingSolves_;
   assembleSystemMatrix(true);
   if (reuse_) {
     updateReusedMatrix();

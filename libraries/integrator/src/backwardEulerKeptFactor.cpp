@@ -3,6 +3,7 @@
 // how setInternalState() factors the same matrix again (detail/keptFactor.hpp).
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
+#include <asyncfem/integrator/contactBlock.hpp>
 #include <sstream>
 #include <string>
 
@@ -35,7 +36,7 @@ void BackwardEuler::recordKeptMatrix() {
     kept.iterate.resize(0);
   }
   if (record.assembledWithContact) {
-    kept.contact = contact_;
+    kept.contact = contact_.couplings.empty() ? contact_ : boundCouplings(contact_);  // as assembled
   } else {
     kept.contact.clear();
   }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <Eigen/Eigenvalues>
 #include <asyncfem/integrator/contactBlock.hpp>
+#include <cmath>
 
 namespace asyncfem {
 
@@ -27,6 +28,25 @@ Eigen::Matrix3d contactStepBlock(const FreeDofs& dofs, const VertexJacobian& jac
     }
   }
   return block;
+}
+
+VertexJacobian boundCouplings(const VertexJacobian& jacobian) {
+  VertexJacobian out = jacobian;
+  out.couplings.clear();
+  for (const VertexCoupling& coupling : jacobian.couplings) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < 4; ++i)
+      if (coupling.vertices[i] >= 0) sum += std::abs(coupling.weights[i]);
+    const Eigen::Matrix3d normalBlock = coupling.direction * coupling.direction.transpose();
+    for (std::size_t i = 0; i < 4; ++i) {
+      if (coupling.vertices[i] < 0) continue;
+      const double scale = std::abs(coupling.weights[i]) * sum;
+      out.vertices.push_back(coupling.vertices[i]);
+      out.stiffness.push_back(coupling.stiffness * scale * normalBlock);
+      out.damping.push_back(coupling.damping * scale * normalBlock);
+    }
+  }
+  return out;
 }
 
 }  // namespace asyncfem

@@ -225,6 +225,13 @@ DynamicSystem Problem::dynamicSystem() const {
                                const std::vector<int>& vertices, VertexJacobian& jacobian) {
             jacobian = contact->jacobian(time, displacement, velocity, &vertices);
           };
+      if (contact_->surfaces()) {
+        system.externalForceCoupledJacobian = [contact = contact_](double time, const Eigen::VectorXd& displacement,
+                                                                   const Eigen::VectorXd& velocity,
+                                                                   VertexJacobian& jacobian) {
+          jacobian = contact->coupledJacobian(time, displacement, velocity);
+        };
+      }
     }
   }
   return system;

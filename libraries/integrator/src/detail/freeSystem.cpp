@@ -134,6 +134,11 @@ void FreeSystem::assemble(const std::vector<double>& coefficients,
 
 void FreeSystem::addVertexBlocks(const FreeDofs& dofs, const VertexJacobian& jacobian, double stiffnessWeight,
                                  double dampingWeight, IntegratorStats& stats) {
+  if (!jacobian.couplings.empty()) {
+    // No room for the couplings' off-diagonal blocks in the pattern: their bounds instead.
+    addVertexBlocks(dofs, boundCouplings(jacobian), stiffnessWeight, dampingWeight, stats);
+    return;
+  }
   TimeInto timer(stats.assemblySeconds);
   const std::vector<int>& fullToFree = dofs.fullToFree();
   const int* outer = systemMatrix.outerIndexPtr();

@@ -63,7 +63,8 @@ class FreeSystem {
                 const std::vector<const Eigen::SparseMatrix<double>*>& matrices, IntegratorStats& stats);
   /// systemMatrix += every contactStepBlock of jacobian on its vertex's free DOFs (the
   /// symmetric positive semi-definite part, so that the matrix stays one for Cholesky). The blocks lie in the pattern
-  /// (a vertex's own block is in K's).
+  /// (a vertex's own block is in K's). Couplings go in as their per-vertex bounds
+  /// (boundCouplings): the pattern has no room for their off-diagonal blocks.
   void addVertexBlocks(const FreeDofs& dofs, const VertexJacobian& jacobian, double stiffnessWeight,
                        double dampingWeight, IntegratorStats& stats);
   /// Numeric factorization of systemMatrix (symbolic analysis the first time only). A

@@ -6,6 +6,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/contactBlock.hpp>
 #include <cmath>
+#include <unordered_set>
 
 namespace asyncfem::detail {
 
@@ -18,9 +19,21 @@ constexpr double kMaxCachedDoubles = 32.0 * 1024 * 1024;
 
 bool LowRankContactSolver::pays(const FreeSystem& free, const FreeDofs& dofs, const VertexJacobian& contact) const {
   const double n = dofs.numFree();
-  const double rank = 3.0 * static_cast<double>(contact.vertices.size());  // at most
+  // At most three columns per block, one per coupling.
+  const double rank =
+      (3.0 * static_cast<double>(contact.vertices.size())) + static_cast<double>(contact.couplings.size());
   int uncached = 0;
-  for (const int v : contact.vertices) uncached += columns_.count(v) == 0 ? 1 : 0;
+  if (contact.couplings.empty()) {
+    for (const int v : contact.vertices) uncached += columns_.count(v) == 0 ? 1 : 0;
+  } else {
+    std::unordered_set<int> seen;
+    const auto count = [&](int v) {
+      if (v >= 0 && columns_.count(v) == 0 && seen.insert(v).second) ++uncached;
+    };
+    for (const int v : contact.vertices) count(v);
+    for (const VertexCoupling& coupling : contact.couplings)
+      for (const int v : coupling.vertices) count(v);
+  }
   const double cached = static_cast<double>(columns_.size() + static_cast<std::size_t>(uncached));
   if (cached * 3.0 * n > kMaxCachedDoubles) return false;
   const SolverStats& solver = free.solver().stats();
@@ -55,9 +68,12 @@ void LowRankContactSolver::solve(FreeSystem& free, const FreeDofs& dofs, const V
                                  Eigen::VectorXd& x, IntegratorStats& stats) {
   const std::vector<int>& fullToFree = dofs.fullToFree();
   // U: per block, sqrt(lambda) q for the positive eigenpairs of the block the step matrix
-  // would take (contactStepBlock, as addVertexBlocks adds it).
-  u_.resize(3, static_cast<Eigen::Index>(3 * contact.vertices.size()));
-  vertexOf_.clear();
+  // would take (contactStepBlock, as addVertexBlocks adds it); per coupling, one column
+  // sqrt(h^2 k + h c) g, g = w_i N at its vertices. Column j has the entries
+  // [start_[j], start_[j + 1]): vertex entryVertex_[e], 3-vector u_.col(e).
+  u_.resize(3, static_cast<Eigen::Index>((3 * contact.vertices.size()) + (4 * contact.couplings.size())));
+  entryVertex_.clear();
+  start_.assign(1, 0);
   for (std::size_t k = 0; k < contact.vertices.size(); ++k) {
     const int vertex = contact.vertices[k];
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(
@@ -66,32 +82,50 @@ void LowRankContactSolver::solve(FreeSystem& free, const FreeDofs& dofs, const V
     for (int i = 0; i < 3; ++i) {
       const double lambda = eigen.eigenvalues()[i];
       if (!(lambda > 1e-14 * largest)) continue;
-      u_.col(static_cast<Eigen::Index>(vertexOf_.size())) = std::sqrt(lambda) * eigen.eigenvectors().col(i);
-      vertexOf_.push_back(vertex);
+      u_.col(static_cast<Eigen::Index>(entryVertex_.size())) = std::sqrt(lambda) * eigen.eigenvectors().col(i);
+      entryVertex_.push_back(vertex);
+      start_.push_back(static_cast<int>(entryVertex_.size()));
     }
   }
-  const auto rank = static_cast<Eigen::Index>(vertexOf_.size());
+  for (const VertexCoupling& coupling : contact.couplings) {
+    const double weight = (stiffnessWeight * coupling.stiffness) + (dampingWeight * coupling.damping);
+    if (!(weight > 0.0)) continue;
+    const double root = std::sqrt(weight);
+    for (std::size_t i = 0; i < 4; ++i) {
+      if (coupling.vertices[i] < 0 || coupling.weights[i] == 0.0) continue;
+      u_.col(static_cast<Eigen::Index>(entryVertex_.size())) = (root * coupling.weights[i]) * coupling.direction;
+      entryVertex_.push_back(coupling.vertices[i]);
+    }
+    if (static_cast<int>(entryVertex_.size()) > start_.back()) start_.push_back(static_cast<int>(entryVertex_.size()));
+  }
+  const auto rank = static_cast<Eigen::Index>(start_.size() - 1);
   free.solve(rhs, base_, stats);
   if (rank == 0) {
     x = base_;
     return;
   }
   // The vertices' cached columns first (substitutions, timed as solves by free), then the
-  // dense work, timed here. Y = A_0^{-1} U, column j = C_v u_j.
-  std::vector<const Eigen::MatrixXd*> columns(static_cast<std::size_t>(rank));
-  for (Eigen::Index j = 0; j < rank; ++j) {
-    columns[static_cast<std::size_t>(j)] = &columnsOf(vertexOf_[static_cast<std::size_t>(j)], free, dofs, stats);
-  }
+  // dense work, timed here. Y = A_0^{-1} U, column j = sum over its entries e of C_v u_e.
+  std::vector<const Eigen::MatrixXd*> columns(entryVertex_.size());
+  for (std::size_t e = 0; e < entryVertex_.size(); ++e) columns[e] = &columnsOf(entryVertex_[e], free, dofs, stats);
   TimeInto timer(stats.solveSeconds);
   y_.resize(base_.size(), rank);
-  for (Eigen::Index j = 0; j < rank; ++j) y_.col(j).noalias() = *columns[static_cast<std::size_t>(j)] * u_.col(j);
-  // U^T z for a free vector z: u_i . z at vertex(i)'s free DOFs (fixed ones are zero in u).
+  for (Eigen::Index j = 0; j < rank; ++j) {
+    const auto first = static_cast<std::size_t>(start_[static_cast<std::size_t>(j)]);
+    const auto last = static_cast<std::size_t>(start_[static_cast<std::size_t>(j) + 1]);
+    y_.col(j).noalias() = *columns[first] * u_.col(static_cast<Eigen::Index>(first));
+    for (std::size_t e = first + 1; e < last; ++e)
+      y_.col(j).noalias() += *columns[e] * u_.col(static_cast<Eigen::Index>(e));
+  }
+  // U^T z for a free vector z: u_e . z at vertex(e)'s free DOFs (fixed ones are zero in u).
   const auto projectOnto = [&](const auto& z, Eigen::Index i) {
-    const int vertex = vertexOf_[static_cast<std::size_t>(i)];
     double sum = 0.0;
-    for (int c = 0; c < 3; ++c) {
-      const int dof = fullToFree[static_cast<std::size_t>((3 * vertex) + c)];
-      if (dof >= 0) sum += u_(c, i) * z[dof];
+    for (int e = start_[static_cast<std::size_t>(i)]; e < start_[static_cast<std::size_t>(i) + 1]; ++e) {
+      const int vertex = entryVertex_[static_cast<std::size_t>(e)];
+      for (int c = 0; c < 3; ++c) {
+        const int dof = fullToFree[static_cast<std::size_t>((3 * vertex) + c)];
+        if (dof >= 0) sum += u_(c, e) * z[dof];
+      }
     }
     return sum;
   };

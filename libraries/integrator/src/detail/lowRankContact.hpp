@@ -11,15 +11,18 @@
 
 namespace asyncfem::detail {
 
-/// Solves (A_0 + sum_k E_k B_k E_k^T) x = b, A_0 a matrix kept factored (a linear model's
-/// M + h D + h^2 K) and B_k the 3 x 3 contact blocks of a few vertices (E_k: the vertex's
-/// free DOFs), without factoring the sum: with U the columns sqrt(lambda) q of every
-/// block's eigenpairs (lambda > 0; a plane's k n n^T gives one), the Sherman-Morrison-
+/// Solves (A_0 + sum_k E_k B_k E_k^T + sum_p s_p g_p g_p^T) x = b, A_0 a matrix kept
+/// factored (a linear model's M + h D + h^2 K), B_k the 3 x 3 contact blocks of a few
+/// vertices (E_k: the vertex's free DOFs) and g_p the couplings' vectors (a surface pair's
+/// w_i N at its up to four vertices, off-diagonal blocks included), without factoring the
+/// sum: with U the columns sqrt(lambda) q of every block's eigenpairs (lambda > 0; a
+/// plane's k n n^T gives one) and sqrt(s_p) g_p of every coupling, the Sherman-Morrison-
 /// Woodbury identity
 ///
 ///     (A_0 + U U^T)^{-1} b = y - Y (I + U^T Y)^{-1} U^T y,   y = A_0^{-1} b, Y = A_0^{-1} U
 ///
 /// costs one substitution with A_0's factor, Y from columns A_0^{-1} E_v cached per vertex
+/// (a coupling's column is the sum of its vertices' cached columns times w_i N)
 /// (three substitutions the first time a vertex is in contact, none after while A_0
 /// stands) and a dense Cholesky factorization of the r x r matrix I + U^T Y (r the rank).
 /// Deterministic: the cached columns do not depend on when they were computed, so a
@@ -44,8 +47,9 @@ class LowRankContactSolver {
 
   std::unordered_map<int, Eigen::MatrixXd> columns_;
   // Scratch.
-  Eigen::MatrixXd u_;  // 3 x r: each column's block coordinates
-  std::vector<int> vertexOf_;
+  Eigen::MatrixXd u_;             // 3 x entries: each entry's block coordinates
+  std::vector<int> entryVertex_;  // per entry: its vertex
+  std::vector<int> start_;        // column j's entries are [start_[j], start_[j + 1])
   Eigen::MatrixXd y_, small_;
   Eigen::VectorXd base_, projected_;
 };

@@ -67,6 +67,10 @@ class PenaltyContact {
                  Eigen::VectorXd& forces, const std::vector<int>* vertices = nullptr) const;
   PenaltyContactJacobian jacobian(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                                   const std::vector<int>* vertices = nullptr) const;
+  /// jacobian() with the surface contact's pairs as couplings (SurfaceContact::addCoupledJacobian)
+  /// instead of per-vertex bounds; the planes' and spheres' blocks as jacobian() gives them.
+  PenaltyContactJacobian coupledJacobian(double time, const Eigen::VectorXd& displacement,
+                                         const Eigen::VectorXd& velocity) const;
   double energy(double time, const Eigen::VectorXd& displacement) const;
   /// Whether the force at a fixed state changes with time (a moving obstacle).
   bool timeDependent() const;
@@ -103,6 +107,9 @@ class PenaltyContact {
   const PenaltyContactParameters& parameters() const { return parameters_; }
 
  private:
+  /// jacobian()'s blocks of the planes and spheres (no surface contact).
+  PenaltyContactJacobian primitiveJacobian(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                           const std::vector<int>* vertices) const;
   template <class Visitor>
   /// visit(vertex, depth, normal, curvature) for every vertex and obstacle with depth >
   /// -margin (margin 0: the vertices in contact), vertices in ascending order; curvature is

@@ -92,6 +92,14 @@ class SurfaceContact {
   /// triangle they are exact. Curvature of N and friction are left out.
   void addJacobian(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                    VertexJacobian& jacobian, const std::vector<int>* vertices = nullptr) const;
+  /// Appends each pair with F > 0 as one VertexCoupling (its mesh vertices, weights w, N,
+  /// k and c): the pair's Gauss-Newton Hessian k (w w^T) (x) N N^T and damping
+  /// c (w w^T) (x) N N^T with their off-diagonal blocks, exact but for the turning of N
+  /// (a term k (dhat - s) d^2 s / dx^2, small against k where the layer is thin against
+  /// the surface's edges) and friction. For integrators that can take couplings
+  /// (DynamicSystem::externalForceCoupledJacobian).
+  void addCoupledJacobian(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                          VertexJacobian& jacobian) const;
   /// The potential sum k/2 (dhat - s)^2 over the pairs at time t and displacement u.
   double energy(double time, const Eigen::VectorXd& displacement) const;
   /// The largest dhat - s over the pairs (0 if none).

@@ -72,6 +72,14 @@ struct DynamicSystem {
   /// IntegratorRegistry::create refuses to build them for such a system.
   /// Whoever replaces externalForce must reset or replace this too.
   ExternalForceJacobianFunction externalForceJacobian;
+  /// Optional: the same derivatives with the terms that couple vertices kept as
+  /// VertexJacobian::couplings (surface contact pairs' k (w w^T) (x) N N^T) instead of
+  /// externalForceJacobian's per-vertex bounds of them. Single-rate backward Euler on a
+  /// linear force model uses it where set (its Newton iteration then converges
+  /// quadratically where the bounds made it linear); the other integrators use
+  /// externalForceJacobian. Ignored without externalForceJacobian (clearing that turns
+  /// implicit treatment off for every integrator, as before this field existed).
+  ExternalForceJacobianFunction externalForceCoupledJacobian;
   /// Optional shortcuts of externalForce and externalForceJacobian for a few vertices at a
   /// time: an integrator that needs some vertices' force at many states (the asynchronous
   /// one's fast substeps, at their predicted states or in its implicit contact iteration)

@@ -81,7 +81,12 @@ struct KeptMatrix;
 /// one adds energy at impacts. Linear models keep M + h D + h^2 K factored and solve a step
 /// with contact by a low-rank (Woodbury) update of that factor where cheaper
 /// (options.contactLowRank), else with the step's own matrix (kept-factor PCG under
-/// options.reuseFactor, or a factorization). The line search is off with implicit contact
+/// options.reuseFactor, or a factorization). With DynamicSystem::externalForceCoupledJacobian
+/// (surface contact) a linear model takes each pair as one rank-one coupling, its
+/// off-diagonal blocks included, in that low-rank update; a solve with the step's own
+/// matrix, and every nonlinear model, takes the pairs' per-vertex bounds instead
+/// (boundCouplings: the pattern has no off-diagonal blocks between bodies), with which
+/// Newton converges only linearly. The line search is off with implicit contact
 /// (contact damping is no potential's gradient).
 ///
 /// options.reuseFactor (nonlinear models, the default): the system matrix is still
@@ -199,13 +204,17 @@ class BackwardEuler final : public Integrator {
   std::unique_ptr<detail::KeptFactorRecord> keptRecord_;  // with reuse_: how its factor's matrix was assembled
   bool linear_ = false;
   bool factorizationStale_ = true;
-  bool implicitExternal_ = false;                          // system_.externalForceJacobian is set
-  bool factorHasContact_ = false;                          // linear model: free_'s factor holds contact blocks
-  VertexJacobian contact_;                                 // the external force's Jacobian at the last evaluation
-  long long contactSteps_ = 0;                             // steps whose prediction had vertices in contact
+  bool implicitExternal_ = false;        // system_.externalForceJacobian is set
+  bool factorHasContact_ = false;        // linear model: free_'s factor holds contact blocks
+  bool coupledContact_ = false;          // linear model: contact_ from externalForceCoupledJacobian (couplings)
+  long long boundedCouplingSolves_ = 0;  // contact solves that took the couplings' per-vertex bounds
+  VertexJacobian contact_;               // the external force's Jacobian at the last evaluation
+  long long contactSteps_ = 0;           // steps whose prediction had vertices in contact
   std::unique_ptr<detail::LowRankContactSolver> lowRank_;  // linear models: Woodbury updates of the kept factor
   long long lowRankSolves_ = 0;
   long long unconvergedContactSteps_ = 0;
+  long long residualSteps_ = 0;       // steps whose contact iterations evaluated a residual
+  long long residualStepSolves_ = 0;  // the solves those steps took
   double largestUnconvergedResidual_ = 0.0;
   double contactPreviousResidual_ = 0.0;  // backtracking of the contact Newton updates
   double contactStepFraction_ = 1.0;

@@ -20,4 +20,10 @@ namespace asyncfem {
 Eigen::Matrix3d contactStepBlock(const FreeDofs& dofs, const VertexJacobian& jacobian, std::size_t k,
                                  double stiffnessWeight, double dampingWeight);
 
+/// jacobian with each coupling replaced by per-vertex blocks that bound it from above
+/// (Gershgorin): at each of its vertices i, (stiffness, damping) |w_i| S N N^T, S the sum
+/// of |w_j| over its vertices. What a step matrix whose pattern holds no off-diagonal
+/// vertex blocks takes instead of the couplings (SurfaceContact::addJacobian's blocks).
+VertexJacobian boundCouplings(const VertexJacobian& jacobian);
+
 }  // namespace asyncfem
