@@ -66,16 +66,16 @@ def test_async_with_ratio_one_is_backward_euler(beam):
     np.testing.assert_allclose(one.displacement, reference.displacement, rtol=0, atol=1e-9 * scale)
 
 
-def test_suggested_regions(beam):
+def test_proposed_regions(beam):
     """The stiff, light tip of the generated beam is proposed as a fast region (its element
     frequencies are about sqrt(50e6/200 / (1e6/1000)) = 16 times the body's)."""
     free = af.FreeDofs.from_fixed_vertices(beam.num_vertices, beam.vertex_set("root"))
     frequencies = af.element_max_frequencies(beam)
     tip_elements = beam.element_set("tip")
     assert frequencies[tip_elements].min() > 10 * np.delete(frequencies, tip_elements).max()
-    options = af.AutoRegionOptions()
+    options = af.RegionProposalOptions()
     options.large_timestep = 1 / 120
-    proposal = af.suggest_regions(beam, free, options)
+    proposal = af.propose_regions(beam, free, options)
     assert len(proposal.regions) == 1 and not proposal.has_modal_report
     proposed = proposal.regions[0]
     assert set(beam.set_vertices("tip")) <= set(proposed.region.vertices) and proposed.region.ratio > 1
@@ -88,11 +88,11 @@ def test_suggested_regions(beam):
         assert getattr(options, field) > 0
     options.modal_check = True
     assembler = af.MatrixAssembler(beam)
-    checked = af.suggest_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler),
+    checked = af.propose_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler),
                                  af.mass_matrix(beam, assembler))
     assert checked.has_modal_report and checked.modal_seconds > 0
     with pytest.raises(ValueError, match="give both"):
-        af.suggest_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler))
+        af.propose_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler))
 
 
 def test_touching_regions_run_the_hierarchy_solve(beam):

@@ -84,8 +84,8 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   /// Throws asyncfem::ValidationError for options AdaptiveRegionPolicy rejects, and for the
   /// contact policy on a system without obstacles (DynamicSystem::obstacleProximity).
   void setAdaptiveRegions(AdaptiveRegionOptions options);
-  /// A line the run summary (report().lines) starts with, e.g. what an automatic region
-  /// proposal decided (autoRegionSummary); empty: none.
+  /// A line the run summary (report().lines) starts with, e.g. what an proposed region
+  /// proposal decided (regionProposalSummary); empty: none.
   void setRegionNote(std::string note) { regionNote_ = std::move(note); }
   /// Every change of partition so far, in order.
   const std::vector<RepartitionRecord>& repartitions() const { return repartitions_; }
