@@ -124,9 +124,9 @@ def test_schedule_policy_from_python(beam):
     system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))
     tip = af.region_vertices(beam, element_sets=["tip"])
     integrator = af.AsyncBackwardEuler(beam, system, 0.01, [])
-    options = af.AdaptiveRegionOptions()
+    options = af.RunTimeRegionOptions()
     options.schedule = [af.ScheduledRegion("tip", tip, 4, start=0.015, end=0.035)]
-    integrator.set_adaptive_regions(options)
+    integrator.set_run_time_regions(options)
     assert integrator.partition.num_regions == 0
     integrator.step(5)
     records = integrator.repartitions
@@ -134,19 +134,19 @@ def test_schedule_policy_from_python(beam):
     assert [r.regions for r in records] == [1, 0]
     assert records[0].fast_vertices == len(tip) and records[1].reused
     with pytest.raises(af.ValidationError):
-        bad = af.AdaptiveRegionOptions()
+        bad = af.RunTimeRegionOptions()
         bad.contact = True  # this system has no obstacles
-        integrator.set_adaptive_regions(bad)
+        integrator.set_run_time_regions(bad)
 
 
 def test_indicator_policy_from_python(beam):
     """The indicator policy marks where the large step errs once three velocities are known."""
     system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))
     integrator = af.AsyncBackwardEuler(beam, system, 0.01, [])
-    options = af.AdaptiveRegionOptions()
+    options = af.RunTimeRegionOptions()
     options.indicator = True
     options.indicator_tolerance = 0.05
-    integrator.set_adaptive_regions(options)
+    integrator.set_run_time_regions(options)
     integrator.step(4)
     records = integrator.repartitions
     assert records and records[0].step == 2 and records[0].reason == "indicator region grows"

@@ -200,11 +200,11 @@ AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
 }
 
 // "adaptive": {"contact": {...}, "schedule": [...], "minDwell", "shrink", "cache"}.
-AdaptiveRegionOptions parseAdaptive(const IntegratorContext& context, const nlohmann::json& value,
-                                    const std::string& path) {
+RunTimeRegionOptions parseAdaptive(const IntegratorContext& context, const nlohmann::json& value,
+                                   const std::string& path) {
   const std::string& sourceName = context.sourceName;
   JsonObjectReader reader(value, path, sourceName);
-  AdaptiveRegionOptions out;
+  RunTimeRegionOptions out;
   if (const nlohmann::json* contact = reader.find("contact")) {
     if (!context.hasContact) reader.fail("contact", "needs obstacles: add a \"contact\" section to the scene");
     JsonObjectReader c(*contact, reader.keyPath("contact"), sourceName);
@@ -441,7 +441,7 @@ void registerMultirateIntegrators(IntegratorRegistry& registry, AsyncSettingsHoo
         AsyncSettings parsed = parseAsyncSettings(context, options);
         if (asyncHook) asyncHook(parsed, context);
         std::unique_ptr<AsyncBackwardEuler> integrator = makeAsync(context, parsed);
-        if (parsed.adaptive) integrator->setAdaptiveRegions(*parsed.adaptive);
+        if (parsed.adaptive) integrator->setRunTimeRegions(*parsed.adaptive);
         if (parsed.automaticRegions && parsed.proposal)
           integrator->setRegionNote(regionProposalSummary(*parsed.proposal));
         return integrator;

@@ -173,26 +173,26 @@ void bindAsyncOptions(py::module_& module) {
       .def_readwrite("end", &ScheduledRegion::end)
       .def_readwrite("ratio", &ScheduledRegion::ratio)
       .def_property_readonly("vertices", [](const ScheduledRegion& r) { return intArray(r.vertices); });
-  py::class_<AdaptiveRegionOptions>(module, "AdaptiveRegionOptions",
-                                    "Policies of run-time regions (docs/asynchronous-integrator.md, Run-time regions)")
+  py::class_<RunTimeRegionOptions>(module, "RunTimeRegionOptions",
+                                   "Policies of run-time regions (docs/asynchronous-integrator.md, Run-time regions)")
       .def(py::init<>())
-      .def_readwrite("contact", &AdaptiveRegionOptions::contact, "follow contact (needs obstacles in the system)")
-      .def_readwrite("contact_ratio", &AdaptiveRegionOptions::contactRatio)
-      .def_readwrite("contact_margin", &AdaptiveRegionOptions::contactMargin, "length")
-      .def_readwrite("contact_lookahead", &AdaptiveRegionOptions::contactLookahead, "large steps")
-      .def_readwrite("contact_rings", &AdaptiveRegionOptions::contactRings)
-      .def_readwrite("contact_slack", &AdaptiveRegionOptions::contactSlack, "extra rings of a new contact region")
-      .def_readwrite("indicator", &AdaptiveRegionOptions::indicator,
+      .def_readwrite("contact", &RunTimeRegionOptions::contact, "follow contact (needs obstacles in the system)")
+      .def_readwrite("contact_ratio", &RunTimeRegionOptions::contactRatio)
+      .def_readwrite("contact_margin", &RunTimeRegionOptions::contactMargin, "length")
+      .def_readwrite("contact_lookahead", &RunTimeRegionOptions::contactLookahead, "large steps")
+      .def_readwrite("contact_rings", &RunTimeRegionOptions::contactRings)
+      .def_readwrite("contact_slack", &RunTimeRegionOptions::contactSlack, "extra rings of a new contact region")
+      .def_readwrite("indicator", &RunTimeRegionOptions::indicator,
                      "mark where the large step errs: |v_k - 2 v_(k-1) + v_(k-2)| / 2 against the tolerance")
-      .def_readwrite("indicator_tolerance", &AdaptiveRegionOptions::indicatorTolerance,
+      .def_readwrite("indicator_tolerance", &RunTimeRegionOptions::indicatorTolerance,
                      "fraction of the RMS vertex speed")
-      .def_readwrite("indicator_ratio", &AdaptiveRegionOptions::indicatorRatio, "largest ratio it asks for")
-      .def_readwrite("indicator_rings", &AdaptiveRegionOptions::indicatorRings)
-      .def_readwrite("schedule", &AdaptiveRegionOptions::schedule, "list of ScheduledRegion")
-      .def_readwrite("min_dwell", &AdaptiveRegionOptions::minDwell, "large steps")
-      .def_readwrite("shrink_factor", &AdaptiveRegionOptions::shrinkFactor)
-      .def_readwrite("cache_size", &AdaptiveRegionOptions::cacheSize)
-      .def_readwrite("nest", &AdaptiveRegionOptions::nest,
+      .def_readwrite("indicator_ratio", &RunTimeRegionOptions::indicatorRatio, "largest ratio it asks for")
+      .def_readwrite("indicator_rings", &RunTimeRegionOptions::indicatorRings)
+      .def_readwrite("schedule", &RunTimeRegionOptions::schedule, "list of ScheduledRegion")
+      .def_readwrite("min_dwell", &RunTimeRegionOptions::minDwell, "large steps")
+      .def_readwrite("shrink_factor", &RunTimeRegionOptions::shrinkFactor)
+      .def_readwrite("cache_size", &RunTimeRegionOptions::cacheSize)
+      .def_readwrite("nest", &RunTimeRegionOptions::nest,
                      "touching regions keep their own ratios (the hierarchy solve) instead of being merged");
   py::class_<RepartitionRecord>(module, "RepartitionRecord", "One change of partition at a large-step boundary")
       .def_readonly("time", &RepartitionRecord::time)
@@ -241,9 +241,9 @@ void bindAsyncIntegrator(py::module_& module) {
       .def_property_readonly("factor_non_zeros", &AsyncBackwardEuler::factorNonZeros)
       .def("set_up", &AsyncBackwardEuler::setUp, py::arg("partition"), py::call_guard<py::gil_scoped_release>(),
            "take another partition of the same mesh from the next step on")
-      .def("set_adaptive_regions", &AsyncBackwardEuler::setAdaptiveRegions, py::arg("options"),
+      .def("set_run_time_regions", &AsyncBackwardEuler::setRunTimeRegions, py::arg("options"),
            py::call_guard<py::gil_scoped_release>(),
-           "choose the regions at every large-step boundary with these policies (AdaptiveRegionOptions)")
+           "choose the regions at every large-step boundary with these policies (RunTimeRegionOptions)")
       .def_property_readonly("repartitions", &AsyncBackwardEuler::repartitions,
                              "every change of partition so far (RepartitionRecord)");
 }

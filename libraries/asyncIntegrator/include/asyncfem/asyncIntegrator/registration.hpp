@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
 #include <asyncfem/asyncIntegrator/regionProposal.hpp>
+#include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <asyncfem/integrator/registry.hpp>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -26,7 +26,7 @@ struct AsyncSettings {
   std::optional<RegionProposal> proposal;
   /// Run-time regions ("regions": {"adaptive": {...}}): the policy, and the object as given
   /// (written back by asyncSettingsJson).
-  std::optional<AdaptiveRegionOptions> adaptive;
+  std::optional<RunTimeRegionOptions> adaptive;
   nlohmann::json adaptiveSource;
   /// The partition of the regions, built once on the context's mesh and free DOFs (its
   /// errors name the "regions" key); partition->touching(): the regions touch or nest, so

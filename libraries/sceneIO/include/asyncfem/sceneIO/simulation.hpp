@@ -103,7 +103,7 @@ std::vector<int> vertexStepRatios(const Integrator& integrator, int numVertices)
 /// Each vertex's step ratio under the scene's fixed regions (integrator.options.regions
 /// given as an array of regions, resolved on problem's mesh as the multirate integrators
 /// resolve them): the partition of every frame of such a run. nullopt when the scene has
-/// none (single-rate, or automatic or adaptive regions). Throws asyncfem::ValidationError
+/// none (single-rate, or proposed or run-time regions). Throws asyncfem::ValidationError
 /// naming the key for regions that do not fit the mesh.
 std::optional<std::vector<int>> fixedRegionRatios(const Scene& scene, const Problem& problem);
 
