@@ -54,7 +54,7 @@ AsyncStepSolver chooseStepSolver(const AsyncOptions& options, const RegionPartit
                                  const DynamicSystem& system);
 
 /// What chooseStepSolver() checks for the hierarchy solve, ahead of any partition: for
-/// run-time regions that may nest (AdaptiveRegionOptions::nest), so that a refusal comes
+/// run-time regions that may nest (RunTimeRegionOptions::nest), so that a refusal comes
 /// before the run rather than at the step where regions first touch. why: the reason the
 /// hierarchy solve would run, for the message.
 void requireHierarchyComposes(const AsyncOptions& options, const std::string& why);
