@@ -89,7 +89,7 @@ TEST(RegionProposal, ClosedFormElementFrequencyEqualsTheElementEigenproblem) {
 
 // On every shipped mesh the closed form gives the 12x12 eigen-solve's frequencies (relative
 // 1e-9, as above) and the same decision: the same elements above the default relative
-// target (3x the median), so suggestRegions proposes what it proposed before.
+// target (3x the median), so proposeRegions proposes what it proposed before.
 TEST(RegionProposal, ClosedFormDecidesAsTheElementEigenproblemOnShippedMeshes) {
   for (const char* name : {"antenna/antenna", "antenna/antenna-wide", "ball/ball", "beam/beam", "dinosaur/dinosaur",
                            "dragon/dragon", "drop/drop", "flower/flower", "snail/snail"}) {

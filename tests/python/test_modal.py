@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """Modal analysis and region proposal from Python: lowest_modes, region_modes (the per-mode
-S-share report) and propose_scene_regions (what suggestRegions --json reports)."""
+S-share report) and propose_scene_regions (what proposeRegions --json reports)."""
 import json
 import os
 import subprocess
@@ -118,9 +118,9 @@ def assert_same_document(ours, theirs, path="$"):
 
 
 def test_scene_proposal_is_what_propose_regions_json_prints():
-    utility = BINARY_DIR / "bin" / "suggestRegions"
+    utility = BINARY_DIR / "bin" / "proposeRegions"
     if not utility.exists():
-        pytest.skip("suggestRegions not built (ASYNCFEM_BUILD_UTILITIES=OFF)")
+        pytest.skip("proposeRegions not built (ASYNCFEM_BUILD_UTILITIES=OFF)")
     printed = subprocess.run([str(utility), str(BEAM_SCENE), "--json", "--modes", "6"], check=True,
                              capture_output=True, text=True, env=dict(os.environ, OMP_WAIT_POLICY="passive"))
     theirs = json.loads(printed.stdout)

@@ -249,9 +249,9 @@ void bindAsyncIntegrator(py::module_& module) {
 }
 
 // Proposed regions: the options and the proposal (what a scene's "regions": "auto" and
-// suggestRegions use).
+// proposeRegions use).
 void bindRegionProposal(py::module_& module) {
-  // Proposed regions (what a scene's "regions": "auto" and suggestRegions use).
+  // Proposed regions (what a scene's "regions": "auto" and proposeRegions use).
   module.def("element_max_frequencies", &elementMaxFrequencies, py::arg("mesh"),
              py::call_guard<py::gil_scoped_release>(), "omega_e per element (rad/s), lumped element mass");
   py::class_<RegionProposalOptions>(module, "RegionProposalOptions",
@@ -298,7 +298,7 @@ void bindRegionProposal(py::module_& module) {
       .def_readonly("decision", &RegionProposalCost::decision, "one line: the numbers and what was decided")
       .def("ratio", &RegionProposalCost::ratio, "async flops / single-rate flops");
   py::class_<RegionProposal>(module, "RegionProposal",
-                             "What propose_regions proposes, withdraws and why (as_dict: the suggestRegions "
+                             "What propose_regions proposes, withdraws and why (as_dict: the proposeRegions "
                              "--json document)")
       .def_readonly("regions", &RegionProposal::regions, "the kept regions (ProposedRegion)")
       .def_readonly("withdrawn_regions", &RegionProposal::withdrawnRegions,

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // libraries/modalAnalysis (lowest modes, per-mode shares of the fast regions and the
-// verdict) and the scene-level region proposal, the document suggestRegions --json prints.
+// verdict) and the scene-level region proposal, the document proposeRegions --json prints.
 
 #include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
@@ -20,12 +20,12 @@ namespace asyncfem::python {
 
 namespace {
 
-/// A list of regions as the "regions" array of suggestRegions --json (name, ratio, vertices).
+/// A list of regions as the "regions" array of proposeRegions --json (name, ratio, vertices).
 py::object regionsObject(const std::vector<AsyncRegion>& regions) {
   return py::module_::import("json").attr("loads")(asyncRegionsJson(regions).dump());
 }
 
-/// The "modes" object of suggestRegions --json --modes K, as a dict with the same keys.
+/// The "modes" object of proposeRegions --json --modes K, as a dict with the same keys.
 py::dict reportDict(const RegionModeReport& report) {
   py::list rows;
   for (const ModeInRegions& mode : report.modes) {
@@ -55,7 +55,7 @@ std::vector<AsyncRegion> regionsOf(const std::vector<ProposedRegion>& proposed) 
   return regions;
 }
 
-/// The proposal part of suggestRegions --json (all but "modes"), as a dict.
+/// The proposal part of proposeRegions --json (all but "modes"), as a dict.
 py::dict proposalDict(const RegionProposal& proposal) {
   py::dict result;
   result["largeTimestep"] = proposal.largeTimestep;
@@ -74,7 +74,7 @@ struct SceneProposal {
   std::optional<RegionModeReport> modes;
 };
 
-/// suggestRegions SCENE --json [--modes K] [--dt H] [--frame-rate F]: the scene's own
+/// proposeRegions SCENE --json [--modes K] [--dt H] [--frame-rate F]: the scene's own
 /// "auto" settings when its async regions are proposed, else the default ones with the
 /// modal check; the modal report is of the scene's explicit regions, else of the proposal.
 SceneProposal proposeSceneRegions(const std::filesystem::path& path, int modeCount, double largeTimestep,
@@ -194,7 +194,7 @@ void bindRegionModes(py::module_& module) {
                     "the highest mode computed is still visible: visible modes above it were not examined")
       .def_readonly("verdict", &RegionModeReport::verdict, "ModalVerdict")
       .def_readonly("kept_modes", &RegionModeReport::keptModes, "indices into modes of the keepable ones")
-      .def("verdict_text", &RegionModeReport::verdictText, "the verdict as one line, as suggestRegions prints it")
+      .def("verdict_text", &RegionModeReport::verdictText, "the verdict as one line, as proposeRegions prints it")
       .def(
           "table",
           [](const RegionModeReport& report) {
@@ -202,9 +202,9 @@ void bindRegionModes(py::module_& module) {
             printRegionModeReport(out, report);
             return out.str();
           },
-          "the table suggestRegions --modes prints (mode, Hz, rad/s, omega hL, per region omega hS and share, "
+          "the table proposeRegions --modes prints (mode, Hz, rad/s, omega hL, per region omega hS and share, "
           "S share, flags) and the verdict line")
-      .def("as_dict", &reportDict, "the report as suggestRegions --json --modes K puts it under \"modes\"");
+      .def("as_dict", &reportDict, "the report as proposeRegions --json --modes K puts it under \"modes\"");
   module.def(
       "region_modes",
       [](const ModalResult& result, const Eigen::SparseMatrix<double>& mass, const std::vector<AsyncRegion>& regions,
@@ -227,7 +227,7 @@ void bindModal(py::module_& module) {
   py::object proposalClass = module.attr("RegionProposal");
   proposalClass.attr("as_dict") =
       py::cpp_function(&proposalDict, py::name("as_dict"), py::is_method(proposalClass),
-                       "The proposal as the document suggestRegions --json prints (largeTimestep, target, "
+                       "The proposal as the document proposeRegions --json prints (largeTimestep, target, "
                        "largeRegionOmegaH, regions, withdrawnRegions, modalVerdict)");
   module.def(
       "propose_scene_regions",
@@ -243,7 +243,7 @@ void bindModal(py::module_& module) {
         return document;
       },
       py::arg("path"), py::arg("modes") = 0, py::arg("large_timestep") = py::none(), py::arg("frame_rate") = py::none(),
-      "What `suggestRegions SCENE --json [--modes K] [--dt H] [--frame-rate F]` prints, as a dict: the proposed "
+      "What `proposeRegions SCENE --json [--modes K] [--dt H] [--frame-rate F]` prints, as a dict: the proposed "
       "and withdrawn fast regions with their ratios, the target, the modal verdict and, with modes > 0, the "
       "per-mode report (frequency, omega h, shares, flags, verdict) of the scene's own regions (or the "
       "proposal's). The scene's \"regions\": \"auto\" settings are used when it has them.");

@@ -45,7 +45,7 @@ struct RegionProposalOptions {
   /// visible mode (omega below pi * frameRate) among the lowest ones has a share of modal
   /// mass >= modalCriteria::minFastShare in them. Async with such regions keeps nothing
   /// that single-rate at hL loses, at m times the cost in S. Off by default here; the scene
-  /// path ("regions": "auto") and the suggestRegions utility turn it on.
+  /// path ("regions": "auto") and the proposeRegions utility turn it on.
   bool modalCheck = false;
   /// The pre-check, run with the modal check before the cost check and instead of any
   /// eigensolve (docs/asynchronous-integrator.md, "Proposed regions"): when no element is

@@ -57,7 +57,7 @@ std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& 
 /// The context registry factories get for scene at the given timing (timestep, frame
 /// rate), with its mass type, contact and names for messages; mesh and system are left
 /// for the caller to fill. A program that asks about another timestep than the scene's
-/// (suggestRegions --dt) passes a FrameTiming with that timestep.
+/// (proposeRegions --dt) passes a FrameTiming with that timestep.
 IntegratorContext integratorContext(const Scene& scene, const FrameTiming& timing);
 /// integratorContext(scene, requireFrameTiming(scene)).
 IntegratorContext integratorContext(const Scene& scene);

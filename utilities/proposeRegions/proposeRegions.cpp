@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// suggestRegions: proposes fast regions and ratios for the asynchronous integrator from the
+// proposeRegions: proposes fast regions and ratios for the asynchronous integrator from the
 // materials and element sizes of a mesh, checks them against the lowest modes, and with
 // --modes K prints the modal table of the given or proposed regions (see
 // docs/asynchronous-integrator.md, "Which modes can async keep?").
@@ -58,7 +58,7 @@ struct Input {
   std::vector<AsyncRegion> givenRegions;  // a scene's explicit regions
   bool corotational = false;
   std::optional<RegionProposalOptions> sceneAuto;  // an async scene with "regions": "auto"
-  std::optional<Scene> adaptiveScene;              // an async scene with "regions": {"adaptive": ...}
+  std::optional<Scene> runTimeScene;               // an async scene with "regions": {"adaptive": ...}
 };
 
 void addOptions(CLI::App& app, CommandLine& cl) {
@@ -134,7 +134,7 @@ Input readScene(CommandLine& cl) {
                                       ? &integrator.options["regions"]
                                       : nullptr;
   if (integrator.name == "async" && regions && regions->is_object() && regions->contains("adaptive")) {
-    in.adaptiveScene = scene;
+    in.runTimeScene = scene;
   } else if (integrator.name == "async" && regions && regions->is_array()) {
     in.givenRegions = parseAsyncOptions(scene, *in.mesh, in.freeDofs, integrator.options).regions;
   } else if (integrator.name == "async") {
@@ -174,7 +174,7 @@ Input readMesh(const CommandLine& cl) {
   if (cl.largeTimestep <= 0.0) throw Error("give the large timestep with --dt for a mesh input");
   MeshReadReport report;
   auto loaded = std::make_shared<TetMesh>(readMesh(cl.input, {}, &report));
-  for (const std::string& w : report.warnings) std::cerr << "suggestRegions: warning: " << w << "\n";
+  for (const std::string& w : report.warnings) std::cerr << "proposeRegions: warning: " << w << "\n";
   Input in;
   in.massType = cl.massName == "lumped" ? MassType::lumped : MassType::consistent;
   in.freeDofs = FreeDofs::fromFixedVertices(loaded->numVertices(), fixedVertices(cl, *loaded));
@@ -323,8 +323,8 @@ void writeRegions(const std::string& writePath, const RegionProposal& proposal) 
 
 // A scene whose regions are chosen at run time: run its first steps and explain each
 // partition its policies chose, priced by the cost model against single-rate at hL.
-void explainAdaptive(const CommandLine& cl, const Input& in) {
-  const Scene& scene = *in.adaptiveScene;
+void explainRunTimeRegions(const CommandLine& cl, const Input& in) {
+  const Scene& scene = *in.runTimeScene;
   std::printf("settings: the scene chooses its regions at run time (integrator.options.regions.adaptive: %s)\n",
               scene.integrator.options["regions"]["adaptive"].dump().c_str());
   Simulation simulation = buildSimulation(scene);
@@ -382,8 +382,8 @@ void explainAdaptive(const CommandLine& cl, const Input& in) {
 
 int run(CommandLine& cl) {
   const Input in = std::filesystem::path(cl.input).extension() == ".json" ? readScene(cl) : readMesh(cl);
-  if (in.adaptiveScene && !cl.json) {
-    explainAdaptive(cl, in);
+  if (in.runTimeScene && !cl.json) {
+    explainRunTimeRegions(cl, in);
     std::printf("\nfor comparison, fixed regions from element frequencies (what \"regions\": \"auto\" would run):\n");
   }
   if (cl.frameRate <= 0.0) cl.frameRate = 30.0;
@@ -414,10 +414,10 @@ int main(int argc, char** argv) {
       "Input: a scene (.json: its mesh, fixed vertices and integrator.timestep) or a mesh file."};
   CommandLine cl;
   addOptions(app, cl);
-  if (const std::optional<int> status = cli::parse(app, argc, argv, "suggestRegions")) return *status;
+  if (const std::optional<int> status = cli::parse(app, argc, argv, "proposeRegions")) return *status;
   cl.givenTarget = app.count("--target") > 0;
   cl.givenRelative = app.count("--relative") > 0;
   cl.givenGrow = app.count("--grow") > 0;
   cl.givenMaxRatio = app.count("--max-ratio") > 0;
-  return cli::run("suggestRegions", [&] { return run(cl); });
+  return cli::run("proposeRegions", [&] { return run(cl); });
 }
