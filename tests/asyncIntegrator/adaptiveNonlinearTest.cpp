@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
+#include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -85,18 +85,18 @@ EnergyRecord runAndMeasure(AsyncBackwardEuler& async, ForceModel& evaluator, int
 
 struct PolicyCase {
   const char* name;
-  AdaptiveRegionOptions options;
+  RunTimeRegionOptions options;
 };
 
 std::vector<PolicyCase> policies() {
-  AdaptiveRegionOptions contact;
+  RunTimeRegionOptions contact;
   contact.contact = true;
   contact.contactRatio = 4;
   contact.contactMargin = 0.01;
   contact.contactLookahead = 1.0;
   contact.contactRings = 1;
   contact.minDwell = 2;
-  AdaptiveRegionOptions indicator;
+  RunTimeRegionOptions indicator;
   indicator.indicator = true;
   indicator.indicatorTolerance = 0.05;
   indicator.indicatorRatio = 8;
@@ -119,7 +119,7 @@ void checkFreeRun(ForceModelType model, double bend, const char* modelName) {
     test::TestSystem ts = swingingBar(model, bend, u0);
     AsyncBackwardEuler async(ts.mesh, ts.system, kLargeStep, {});
     async.setState(u0, ts.v0);
-    async.setAdaptiveRegions(policy.options);
+    async.setRunTimeRegions(policy.options);
     const std::shared_ptr<ForceModel> evaluator = ts.problem->makeForceModel();
     const EnergyRecord record = runAndMeasure(async, *evaluator, 60);
     const auto& records = async.repartitions();

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // AsyncSettings to JSON and back: asyncSettingsJson() is read by parseAsyncSettings() to
-// the same solver options and regions, automatic regions included.
+// the same solver options and regions, proposed regions included.
 #include <gtest/gtest.h>
 
 #include <asyncfem/asyncIntegrator/registration.hpp>
@@ -77,7 +77,7 @@ TEST(AsyncSettingsCodec, DefaultsWriteRegionsAlone) {
   EXPECT_EQ(written.at("regions"), nlohmann::json::parse(R"([{"name": "tip", "ratio": 8, "vertices": [4, 2, 9]}])"));
 }
 
-// Automatic regions are written as the regions the proposal kept: reading them back runs
+// Proposed regions are written as the regions the proposal kept: reading them back runs
 // no proposal and gives the same partition.
 TEST(AsyncSettingsCodec, AutomaticRegionsAreWrittenResolved) {
   const IntegratorContext context = test::barContext();

@@ -18,8 +18,8 @@ namespace {
 
 constexpr double kLargeStep = 5e-3;
 
-AdaptiveRegionOptions windows(std::vector<ScheduledRegion> schedule, bool nest) {
-  AdaptiveRegionOptions options;
+RunTimeRegionOptions windows(std::vector<ScheduledRegion> schedule, bool nest) {
+  RunTimeRegionOptions options;
   options.schedule = std::move(schedule);
   options.nest = nest;
   return options;
@@ -46,8 +46,8 @@ TEST(Composition, HierarchySolveTakesRunTimeRegions) {
   structured.setState(ts.u0, ts.v0);
   levels.setState(ts.u0, ts.v0);
   const auto schedule = windows({{"tip", 1.5 * kLargeStep, 5.5 * kLargeStep, tip, 4}}, false);
-  structured.setAdaptiveRegions(schedule);
-  levels.setAdaptiveRegions(schedule);
+  structured.setRunTimeRegions(schedule);
+  levels.setRunTimeRegions(schedule);
   for (int k = 0; k < 9; ++k) {
     structured.step();
     levels.step();
@@ -80,8 +80,8 @@ TEST(Composition, RunTimeRegionsNest) {
   for (Integrator* integrator :
        {static_cast<Integrator*>(&nested), static_cast<Integrator*>(&byHand), static_cast<Integrator*>(&merged)})
     integrator->setState(ts.u0, ts.v0);
-  nested.setAdaptiveRegions(windows(schedule, true));
-  merged.setAdaptiveRegions(windows(schedule, false));
+  nested.setRunTimeRegions(windows(schedule, true));
+  merged.setRunTimeRegions(windows(schedule, false));
   const std::vector<std::vector<AsyncRegion>> byStep{{},
                                                      {},
                                                      {{"end", end, 4}},
@@ -196,7 +196,7 @@ TEST(Composition, EveryRefusalNamesItsOption) {
   // Run-time regions that may nest are checked when the policy is set, before any step.
   AsyncBackwardEuler quick(ts.system, kLargeStep, {}, with([](AsyncOptions& o) { o.keptFactors.quickSetUp = true; }));
   try {
-    quick.setAdaptiveRegions(windows({{"a", 0.0, 1.0, touching[0].vertices, 2}}, true));
+    quick.setRunTimeRegions(windows({{"a", 0.0, 1.0, touching[0].vertices, 2}}, true));
     FAIL() << "nesting run-time regions accepted the quick set-up";
   } catch (const AsyncOptionError& e) {
     EXPECT_EQ(e.key(), "quickSetUp");

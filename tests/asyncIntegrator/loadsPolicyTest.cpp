@@ -6,9 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/loadsPolicy.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
+#include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -47,12 +47,12 @@ TEST(LoadsPolicy, APartIsFastFromTheStepItsLoadStartsAndEqualsTheRunSetByHand) {
   const test::TestBody body =
       pulledBar(60.0, {VertexLoad{face, Eigen::Vector3d(0.0, -0.5, 0.2), 2.5 * kLargeStep, 5.5 * kLargeStep}});
   const std::vector<int> tip = test::verticesBeyond(body.mesh, 0.75);
-  AdaptiveRegionOptions options;
+  RunTimeRegionOptions options;
   options.loads = true;
   options.loadsParts = {{"tip", tip, 4}};
   options.minDwell = 4;
   AsyncBackwardEuler adaptive(body.mesh, body.system, kLargeStep, {});
-  adaptive.setAdaptiveRegions(options);
+  adaptive.setRunTimeRegions(options);
   EXPECT_EQ(adaptive.partition().numRegions(), 0);  // nothing reaches the tip in the first step
   const int steps = 60;
   for (int k = 0; k < steps; ++k) adaptive.step();
@@ -75,7 +75,7 @@ TEST(LoadsPolicy, APartIsFastFromTheStepItsLoadStartsAndEqualsTheRunSetByHand) {
 
   AsyncBackwardEuler byHand(body.mesh, body.system, kLargeStep, {});
   AsyncBackwardEuler replay(body.mesh, body.system, kLargeStep, {});
-  replay.setAdaptiveRegions(options);
+  replay.setRunTimeRegions(options);
   for (int k = 0; k < steps; ++k) {
     if (k == 2) byHand.setUp(RegionPartition(body.mesh, body.system.freeDofs, {{"tip", tip, 4}}));
     if (k == released) byHand.setUp(RegionPartition(body.mesh, body.system.freeDofs, {}));
@@ -102,12 +102,12 @@ TEST(LoadsPolicy, ALoadFromTheStartMakesTheLoadedVerticesAPartFromTheFirstStep) 
   const Problem bar = test::stiffEndBarProblem();
   const std::vector<int> face = bar.mesh().vertexSet("xmax");
   const test::TestBody body = pulledBar(0.0, {VertexLoad{face, Eigen::Vector3d(0.0, -0.5, 0.0), 0.0}});
-  AdaptiveRegionOptions options;
+  RunTimeRegionOptions options;
   options.loads = true;
   options.loadsRatio = 4;
   options.loadsRings = 1;
   AsyncBackwardEuler async(body.mesh, body.system, kLargeStep, {});
-  async.setAdaptiveRegions(options);
+  async.setRunTimeRegions(options);
   ASSERT_EQ(async.partition().numRegions(), 1);  // from the first step
   EXPECT_EQ(async.partition().region(0).vertices, test::verticesBeyond(body.mesh, 0.875));
   EXPECT_EQ(async.partition().ratio(0), 4);
@@ -189,7 +189,7 @@ TEST(LoadsPolicy, SceneKeysAndErrors) {
                 {"name": "end", "ratio": 3, "vertexSets": ["xmax"]}]}, "minDwell": 3}}})");
   const AsyncSettings parsed = parseAsyncSettings(context, options);
   ASSERT_TRUE(parsed.adaptive);
-  const AdaptiveRegionOptions& adaptive = *parsed.adaptive;
+  const RunTimeRegionOptions& adaptive = *parsed.adaptive;
   EXPECT_TRUE(adaptive.loads);
   EXPECT_EQ(adaptive.loadsRatio, 6);
   EXPECT_EQ(adaptive.loadsRings, 2);
@@ -223,9 +223,9 @@ TEST(LoadsPolicy, SceneKeysAndErrors) {
   test::TestSystem free = test::makeTestSystem(0.0, 0.0);
   free.system.externalForce = nullptr;
   AsyncBackwardEuler async(free.mesh, free.system, kLargeStep, {});
-  AdaptiveRegionOptions loads;
+  RunTimeRegionOptions loads;
   loads.loads = true;
-  EXPECT_THROW(async.setAdaptiveRegions(loads), ValidationError);
+  EXPECT_THROW(async.setRunTimeRegions(loads), ValidationError);
 }
 
 }  // namespace

@@ -66,16 +66,16 @@ def test_async_with_ratio_one_is_backward_euler(beam):
     np.testing.assert_allclose(one.displacement, reference.displacement, rtol=0, atol=1e-9 * scale)
 
 
-def test_suggested_regions(beam):
+def test_proposed_regions(beam):
     """The stiff, light tip of the generated beam is proposed as a fast region (its element
     frequencies are about sqrt(50e6/200 / (1e6/1000)) = 16 times the body's)."""
     free = af.FreeDofs.from_fixed_vertices(beam.num_vertices, beam.vertex_set("root"))
     frequencies = af.element_max_frequencies(beam)
     tip_elements = beam.element_set("tip")
     assert frequencies[tip_elements].min() > 10 * np.delete(frequencies, tip_elements).max()
-    options = af.AutoRegionOptions()
+    options = af.RegionProposalOptions()
     options.large_timestep = 1 / 120
-    proposal = af.suggest_regions(beam, free, options)
+    proposal = af.propose_regions(beam, free, options)
     assert len(proposal.regions) == 1 and not proposal.has_modal_report
     proposed = proposal.regions[0]
     assert set(beam.set_vertices("tip")) <= set(proposed.region.vertices) and proposed.region.ratio > 1
@@ -88,11 +88,11 @@ def test_suggested_regions(beam):
         assert getattr(options, field) > 0
     options.modal_check = True
     assembler = af.MatrixAssembler(beam)
-    checked = af.suggest_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler),
+    checked = af.propose_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler),
                                  af.mass_matrix(beam, assembler))
     assert checked.has_modal_report and checked.modal_seconds > 0
     with pytest.raises(ValueError, match="give both"):
-        af.suggest_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler))
+        af.propose_regions(beam, free, options, af.linear_stiffness_matrix(beam, assembler))
 
 
 def test_touching_regions_run_the_hierarchy_solve(beam):
@@ -124,9 +124,9 @@ def test_schedule_policy_from_python(beam):
     system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))
     tip = af.region_vertices(beam, element_sets=["tip"])
     integrator = af.AsyncBackwardEuler(beam, system, 0.01, [])
-    options = af.AdaptiveRegionOptions()
+    options = af.RunTimeRegionOptions()
     options.schedule = [af.ScheduledRegion("tip", tip, 4, start=0.015, end=0.035)]
-    integrator.set_adaptive_regions(options)
+    integrator.set_run_time_regions(options)
     assert integrator.partition.num_regions == 0
     integrator.step(5)
     records = integrator.repartitions
@@ -134,19 +134,19 @@ def test_schedule_policy_from_python(beam):
     assert [r.regions for r in records] == [1, 0]
     assert records[0].fast_vertices == len(tip) and records[1].reused
     with pytest.raises(af.ValidationError):
-        bad = af.AdaptiveRegionOptions()
+        bad = af.RunTimeRegionOptions()
         bad.contact = True  # this system has no obstacles
-        integrator.set_adaptive_regions(bad)
+        integrator.set_run_time_regions(bad)
 
 
 def test_indicator_policy_from_python(beam):
     """The indicator policy marks where the large step errs once three velocities are known."""
     system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))
     integrator = af.AsyncBackwardEuler(beam, system, 0.01, [])
-    options = af.AdaptiveRegionOptions()
+    options = af.RunTimeRegionOptions()
     options.indicator = True
     options.indicator_tolerance = 0.05
-    integrator.set_adaptive_regions(options)
+    integrator.set_run_time_regions(options)
     integrator.step(4)
     records = integrator.repartitions
     assert records and records[0].step == 2 and records[0].reason == "indicator region grows"

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""Modal analysis and region suggestion from Python: lowest_modes, region_modes (the per-mode
-S-share report) and suggest_scene_regions (what suggestRegions --json reports)."""
+"""Modal analysis and region proposal from Python: lowest_modes, region_modes (the per-mode
+S-share report) and propose_scene_regions (what proposeRegions --json reports)."""
 import json
 import os
 import subprocess
@@ -83,10 +83,10 @@ def test_bad_counts_and_regions_are_errors(box_modes):
 
 def test_proposal_reports_its_modal_check_and_cost(box_modes):
     mesh, free, stiffness, mass, _ = box_modes
-    options = af.AutoRegionOptions()
+    options = af.RegionProposalOptions()
     options.large_timestep, options.modal_check, options.target_omega_h = 0.01, True, 1.0
     options.cost_check = False
-    proposal = af.suggest_regions(mesh, free, options, stiffness, mass)
+    proposal = af.propose_regions(mesh, free, options, stiffness, mass)
     document = proposal.as_dict()
     assert set(document) == {"largeTimestep", "target", "largeRegionOmegaH", "regions", "withdrawnRegions",
                              "modalVerdict"}
@@ -117,16 +117,16 @@ def assert_same_document(ours, theirs, path="$"):
         assert ours == theirs, path
 
 
-def test_scene_suggestion_is_what_suggest_regions_json_prints():
-    utility = BINARY_DIR / "bin" / "suggestRegions"
+def test_scene_proposal_is_what_propose_regions_json_prints():
+    utility = BINARY_DIR / "bin" / "proposeRegions"
     if not utility.exists():
-        pytest.skip("suggestRegions not built (ASYNCFEM_BUILD_UTILITIES=OFF)")
+        pytest.skip("proposeRegions not built (ASYNCFEM_BUILD_UTILITIES=OFF)")
     printed = subprocess.run([str(utility), str(BEAM_SCENE), "--json", "--modes", "6"], check=True,
                              capture_output=True, text=True, env=dict(os.environ, OMP_WAIT_POLICY="passive"))
     theirs = json.loads(printed.stdout)
-    ours = af.suggest_scene_regions(BEAM_SCENE, modes=6)
+    ours = af.propose_scene_regions(BEAM_SCENE, modes=6)
     assert_same_document(ours, theirs)
     # The beam's stiff tip is proposed and withdrawn: no visible mode lives in it.
     assert ours["regions"] == [] and [r["name"] for r in ours["withdrawnRegions"]] == ["auto1"]
     assert ours["modes"]["regions"] == ["tip"] and len(ours["modes"]["modes"]) == 6
-    assert "modes" not in af.suggest_scene_regions(BEAM_SCENE)
+    assert "modes" not in af.propose_scene_regions(BEAM_SCENE)

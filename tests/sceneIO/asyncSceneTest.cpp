@@ -97,7 +97,7 @@ TEST(AsyncScene, AutomaticRegionsByDefault) {
 }
 
 // output.regions: each frame's step ratio per vertex (1 in L, m_i in S_i); on by default
-// for adaptive regions only.
+// for run-time regions only.
 TEST(AsyncScene, RegionOutputGivesEachVertexItsStepRatio) {
   nlohmann::json json = barScene();
   EXPECT_FALSE(asyncfem::recordsRegionRatios(asyncfem::parseScene(json, "", "scene.json")));

@@ -53,7 +53,7 @@ struct MatrixCase {
   std::string integrator;  ///< backwardEuler, trapezoidal, ..., multirateUncoupled, schroeder2011, asyncNested
   std::string model;       ///< linear, corotational, stvk, neoHookean, mooneyRivlin
   /// plain, lineSearch, reuseFactor, exactSolves, noLaggedSchur, contact, substepStatePrediction,
-  /// implicitContact, quickSetUp, schedule, autoRegions
+  /// implicitContact, quickSetUp, schedule, proposedRegions
   std::string option;
   bool kill9 = false;  ///< SIGKILL instead of SIGINT
 
@@ -86,7 +86,7 @@ std::vector<std::string> optionsFor(const std::string& integrator, const std::st
   if (integrator == "asyncStable" || integrator == "asyncPaper") {
     if (nonlinear) options.emplace_back("noLaggedSchur");  // "plain" has laggedSchur on, the default
     options.emplace_back("substepStatePrediction");
-    options.emplace_back("autoRegions");
+    options.emplace_back("proposedRegions");
   }
   if (integrator == "asyncStable") {
     options.emplace_back("quickSetUp");
@@ -187,7 +187,7 @@ nlohmann::json sceneFor(const MatrixCase& c) {
     options["regions"] = {{"adaptive", {{"schedule", schedule}, {"nest", c.integrator == "asyncNested"}}}};
   }
   if (c.option == "quickSetUp") options["quickSetUp"] = true;
-  if (c.option == "autoRegions") options["regions"] = "auto";
+  if (c.option == "proposedRegions") options["regions"] = "auto";
   if (c.integrator == "asyncPaper") options["coupling"] = "paper";
   if (c.option == "noLaggedSchur") options["laggedSchur"] = false;
   if (c.option == "substepStatePrediction") options["substepStatePrediction"] = true;

@@ -40,7 +40,7 @@ class UtilityErrorsTest : public asyncfem::test::UtilityTest {
 
 TEST_F(UtilityErrorsTest, UsageErrorsArePrefixedAndExitWithTwo) {
   for (const std::string program :
-       {"meshInfo", "suggestRegions", "tetMesher", "offlineSimulator", "integratorBenchmark", "stabilityStressTest"}) {
+       {"meshInfo", "proposeRegions", "tetMesher", "offlineSimulator", "integratorBenchmark", "stabilityStressTest"}) {
     const RunResult r = run(program, "--no-such-option x");
     EXPECT_EQ(r.exitCode, 2) << program << ": " << r.err;
     EXPECT_EQ(r.err.rfind(program + ": ", 0), 0U) << r.err;
@@ -48,9 +48,9 @@ TEST_F(UtilityErrorsTest, UsageErrorsArePrefixedAndExitWithTwo) {
     EXPECT_EQ(run(program, "--help").exitCode, 0) << program;
   }
   // Range errors read as a bound, not as CLI11's "not in range 2.2e-308 to 1.797...e+308".
-  const RunResult negative = run("suggestRegions", "scene.json --dt -1");
+  const RunResult negative = run("proposeRegions", "scene.json --dt -1");
   EXPECT_EQ(negative.exitCode, 2);
-  EXPECT_EQ(negative.err, "suggestRegions: --dt: must be > 0 (got -1) (see --help)\n");
+  EXPECT_EQ(negative.err, "proposeRegions: --dt: must be > 0 (got -1) (see --help)\n");
   const RunResult cells = run("meshInfo", "--generate beam --cells 0");
   EXPECT_EQ(cells.exitCode, 2);
   EXPECT_EQ(cells.err, "meshInfo: --cells: must be in [1, 1000] (got 0) (see --help)\n");
@@ -74,14 +74,14 @@ TEST_F(UtilityErrorsTest, MeshInfoReadsATetGenBaseName) {
   EXPECT_NE(r.out.find("elements: 1"), std::string::npos) << r.out;
 }
 
-TEST_F(UtilityErrorsTest, SuggestRegionsRefusesToWriteOverItsInput) {
+TEST_F(UtilityErrorsTest, ProposeRegionsRefusesToWriteOverItsInput) {
   const fs::path scene = writeScene();
   const std::string text = readText(scene);
   fs::create_symlink(scene, folder_ / "link.json");
   for (const std::string target : {"scene.json", "./scene.json", "link.json"}) {
-    const RunResult r = run("suggestRegions", "scene.json --write " + target);
+    const RunResult r = run("proposeRegions", "scene.json --write " + target);
     EXPECT_EQ(r.exitCode, 1) << target;
-    EXPECT_EQ(r.err, "suggestRegions: --write " + target +
+    EXPECT_EQ(r.err, "proposeRegions: --write " + target +
                          " is the scene scene.json: writing it would destroy the "
                          "input; write the regions to another file\n");
   }
@@ -98,9 +98,9 @@ TEST_F(UtilityErrorsTest, IntegratorBenchmarkRejectsABadConfigurationFirst) {
   EXPECT_EQ(r.out.find("Reference:"), std::string::npos) << r.out;
 }
 
-// suggestRegions proposes what the simulator would run: an async scene's "auto" settings
+// proposeRegions proposes what the simulator would run: an async scene's "auto" settings
 // (here maxRatio 2) apply, and a typo inside "auto" is an unknown key there too.
-TEST_F(UtilityErrorsTest, SuggestRegionsHonoursTheScenesAutoSettings) {
+TEST_F(UtilityErrorsTest, ProposeRegionsHonoursTheScenesAutoSettings) {
   std::ofstream(folder_ / "scene.json") << R"({
     "mesh": {"generator": "box", "size": [1, 0.25, 0.25], "cells": [8, 2, 2],
              "material": {"density": 1000, "youngsModulus": 1e5, "poissonRatio": 0.4},
@@ -111,17 +111,17 @@ TEST_F(UtilityErrorsTest, SuggestRegionsHonoursTheScenesAutoSettings) {
                    "options": {"regions": "auto", "auto": {"maxRatio": 2, "modalCheck": false}}},
     "frames": {"rate": 10, "count": 1}
   })";
-  const RunResult r = run("suggestRegions", "scene.json --json");
+  const RunResult r = run("proposeRegions", "scene.json --json");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const nlohmann::json proposal = nlohmann::json::parse(r.out);
   ASSERT_FALSE(proposal.at("regions").empty()) << r.out;
   for (const auto& region : proposal.at("regions")) EXPECT_LE(region.at("ratio").get<int>(), 2) << r.out;
   // An explicit option replaces the scene's.
-  const RunResult wider = run("suggestRegions", "scene.json --json --max-ratio 64");
+  const RunResult wider = run("proposeRegions", "scene.json --json --max-ratio 64");
   ASSERT_EQ(wider.exitCode, 0) << wider.err;
   EXPECT_GT(nlohmann::json::parse(wider.out).at("regions").at(0).at("ratio").get<int>(), 2) << wider.out;
   // With --modes the modal report is part of the one JSON document (nothing else on stdout).
-  const RunResult withModes = run("suggestRegions", "scene.json --json --modes 3");
+  const RunResult withModes = run("proposeRegions", "scene.json --json --modes 3");
   ASSERT_EQ(withModes.exitCode, 0) << withModes.err;
   const nlohmann::json document = nlohmann::json::parse(withModes.out);
   ASSERT_EQ(document.at("modes").at("modes").size(), 3U) << withModes.out;
@@ -134,7 +134,7 @@ TEST_F(UtilityErrorsTest, SuggestRegionsHonoursTheScenesAutoSettings) {
     "integrator": {"name": "async", "timestep": 0.1, "options": {"auto": {"maxRatoi": 2}}},
     "frames": {"rate": 10, "count": 1}
   })";
-  const RunResult typo = run("suggestRegions", "typo.json");
+  const RunResult typo = run("proposeRegions", "typo.json");
   EXPECT_EQ(typo.exitCode, 1);
   EXPECT_NE(typo.err.find("typo.json: integrator.options.auto.maxRatoi"), std::string::npos) << typo.err;
   const RunResult simulator = run("offlineSimulator", "typo.json -o out.afsim");
@@ -145,12 +145,12 @@ TEST_F(UtilityErrorsTest, SuggestRegionsHonoursTheScenesAutoSettings) {
 // A bare mesh is fixed by a box or a Vega .bou file as well as by a named set: the three
 // ways give the same proposal when they select the same vertices (the beam's root face,
 // x = 0), and a box selecting nothing or a missing .bou file is named by its option.
-// A scene with run-time regions: suggestRegions runs its first steps and lists every
+// A scene with run-time regions: proposeRegions runs its first steps and lists every
 // partition its policies chose, with the cost model's price against single-rate at hL.
 // The ball falls for about 50 large steps before its contact patch needs a region.
-TEST_F(UtilityErrorsTest, SuggestRegionsExplainsRunTimeRegions) {
+TEST_F(UtilityErrorsTest, ProposeRegionsExplainsRunTimeRegions) {
   const RunResult result =
-      run("suggestRegions", std::string("'") + ASYNCFEM_MODELS_DIR + "/ball/ball.json' --adaptive-steps 70");
+      run("proposeRegions", std::string("'") + ASYNCFEM_MODELS_DIR + "/ball/ball.json' --adaptive-steps 70");
   ASSERT_EQ(result.exitCode, 0) << result.err;
   EXPECT_NE(result.out.find("the scene chooses its regions at run time"), std::string::npos) << result.out;
   EXPECT_NE(result.out.find("\"contact\""), std::string::npos) << result.out;
@@ -161,11 +161,11 @@ TEST_F(UtilityErrorsTest, SuggestRegionsExplainsRunTimeRegions) {
   EXPECT_NE(result.out.find("expected cost per large step"), std::string::npos) << result.out;
 }
 
-TEST_F(UtilityErrorsTest, SuggestRegionsFixesABareMeshByBoxOrBouFile) {
+TEST_F(UtilityErrorsTest, ProposeRegionsFixesABareMeshByBoxOrBouFile) {
   const std::string beam = std::string("'") + ASYNCFEM_MODELS_DIR + "/beam/beam.veg' --dt 0.0083333 --json";
-  const RunResult bySet = run("suggestRegions", beam + " --fixed-set xmin");
+  const RunResult bySet = run("proposeRegions", beam + " --fixed-set xmin");
   ASSERT_EQ(bySet.exitCode, 0) << bySet.err;
-  const RunResult byBox = run("suggestRegions", beam + " --fixed-box -1 -1 -1 1e-9 1 1");
+  const RunResult byBox = run("proposeRegions", beam + " --fixed-box -1 -1 -1 1e-9 1 1");
   ASSERT_EQ(byBox.exitCode, 0) << byBox.err;
   // The .bou file of the same vertices: Vega's 1-based ids, one a line.
   std::ofstream bou(folder_ / "root.bou");
@@ -184,20 +184,20 @@ TEST_F(UtilityErrorsTest, SuggestRegionsFixesABareMeshByBoxOrBouFile) {
     if (vertices && std::sscanf(line.c_str(), "%d %lf", &id, &x) == 2 && x == 0.0) bou << id << "\n";
   }
   bou.close();
-  const RunResult byBou = run("suggestRegions", beam + " --fixed-bou root.bou");
+  const RunResult byBou = run("proposeRegions", beam + " --fixed-bou root.bou");
   ASSERT_EQ(byBou.exitCode, 0) << byBou.err;
   EXPECT_EQ(byBox.out, bySet.out);
   EXPECT_EQ(byBou.out, bySet.out);
   // A scene fixes its vertices with its own "fixed" key: the options are refused there.
   writeScene();
-  const RunResult scene = run("suggestRegions", "scene.json --fixed-box 0 0 0 1 1 1");
+  const RunResult scene = run("proposeRegions", "scene.json --fixed-box 0 0 0 1 1 1");
   EXPECT_EQ(scene.exitCode, 1);
   EXPECT_NE(scene.err.find("mesh inputs only"), std::string::npos) << scene.err;
 
-  const RunResult empty = run("suggestRegions", beam + " --fixed-box 5 5 5 6 6 6");
+  const RunResult empty = run("proposeRegions", beam + " --fixed-box 5 5 5 6 6 6");
   EXPECT_EQ(empty.exitCode, 1);
   EXPECT_NE(empty.err.find("--fixed-box #1: "), std::string::npos) << empty.err;
-  const RunResult missing = run("suggestRegions", beam + " --fixed-bou missing.bou");
+  const RunResult missing = run("proposeRegions", beam + " --fixed-bou missing.bou");
   EXPECT_EQ(missing.exitCode, 1);
   EXPECT_NE(missing.err.find("--fixed-bou: "), std::string::npos) << missing.err;
   EXPECT_NE(missing.err.find("missing.bou"), std::string::npos) << missing.err;

@@ -204,7 +204,7 @@ void addInputOptions(CLI::App& app, CommandLine& options) {
   app.add_flag("--tint-regions", options.tintRegions,
                "Tint the vertices of fast regions (step ratio above 1) in --tint-color, deeper for larger ratios "
                "(ratio 2 light, 16 and above full): each frame's regions when the .afsim records them (scene key "
-               "\"output\": {\"regions\": true}, the default for adaptive regions), else the scene's fixed regions");
+               "\"output\": {\"regions\": true}, the default for run-time regions), else the scene's fixed regions");
   app.add_option("--tint-color", options.tintColor, "Tint colour r,g,b in [0, 1]")
       ->delimiter(',')
       ->expected(3)
@@ -438,7 +438,7 @@ void chooseSurfaceColors(const CommandLine& options, const Eigen::Vector3f& surf
     throw Error("--tint-regions: " + shared.runs.front().file.string() + " does not record region ratios, and " +
                 (options.mesh ? "--mesh gives no scene, so there are" : "its scene has") +
                 " no fixed regions to tint: record them by adding \"output\": {\"regions\": true} to the scene "
-                "(the default for adaptive regions) and running offlineSimulator again");
+                "(the default for run-time regions) and running offlineSimulator again");
   } else {
     shared.colors = shared.surface.interpolate(base);
   }

@@ -16,7 +16,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/benchmarkTools/benchmarkReference.hpp>
 #include <asyncfem/benchmarkTools/benchmarkRun.hpp>
 #include <asyncfem/benchmarkTools/costInterpolation.hpp>

@@ -78,7 +78,7 @@ RunReport AsyncBackwardEuler::report() const {
   }
   if (policy_) {
     addCaveat(
-        "adaptive regions: the partition in use and how long it has been kept are not in the checkpoint, so the "
+        "run-time regions: the partition in use and how long it has been kept are not in the checkpoint, so the "
         "resumed run chooses its regions afresh from the resumed state and its frames can differ from an "
         "uninterrupted run's (by as much as two partitions' trajectories differ)");
   }

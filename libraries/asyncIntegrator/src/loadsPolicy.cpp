@@ -2,8 +2,8 @@
 // The loads policy of run-time regions: docs/asynchronous-integrator.md, "Run-time regions".
 #include <Eigen/Dense>
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/loadsPolicy.hpp>
+#include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>
@@ -92,17 +92,17 @@ LoadsPolicy::LoadsPolicy(const TetMesh& mesh, std::vector<char> hasFreeDof, Load
     : mesh_(&mesh), hasFreeDof_(std::move(hasFreeDof)), settings_(std::move(settings)) {
   const LoadsPolicySettings& s = settings_;
   if (s.ratio < 2 || s.rings < 0 || s.neighbourhood < 0 || s.minDwell < 0) {
-    throw ValidationError("adaptive regions: loads: ratio must be >= 2 and rings, neighbourhood and minDwell >= 0");
+    throw ValidationError("run-time regions: loads: ratio must be >= 2 and rings, neighbourhood and minDwell >= 0");
   }
   if (!(s.release >= 0.0 && s.release < 1.0)) {
-    throw ValidationError("adaptive regions: loads: release must be in [0, 1) (a fraction of the peak energy)");
+    throw ValidationError("run-time regions: loads: release must be in [0, 1) (a fraction of the peak energy)");
   }
   vertexMass_ = lumpedVertexMasses(mesh);
   partsOfVertex_.assign(static_cast<std::size_t>(mesh.numVertices()), {});
   probeRatio_ = s.ratio;
   for (std::size_t k = 0; k < s.parts.size(); ++k) {
     const AsyncRegion& part = s.parts[k];
-    const std::string where = "adaptive regions: loads: part " + std::to_string(k);
+    const std::string where = "run-time regions: loads: part " + std::to_string(k);
     if (part.ratio < 2) throw ValidationError(where + ": ratio must be >= 2");
     for (const int vertex : part.vertices) {
       if (vertex < 0 || vertex >= mesh.numVertices()) {

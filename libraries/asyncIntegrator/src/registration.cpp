@@ -223,11 +223,11 @@ AsyncOptions parseSolverOptions(JsonObjectReader& reader, bool hasContact) {
 }
 
 // "adaptive": {"contact": {...}, "schedule": [...], "minDwell", "shrink", "cache"}.
-AdaptiveRegionOptions parseAdaptive(const IntegratorContext& context, const nlohmann::json& value,
-                                    const std::string& path) {
+RunTimeRegionOptions parseAdaptive(const IntegratorContext& context, const nlohmann::json& value,
+                                   const std::string& path) {
   const std::string& sourceName = context.sourceName;
   JsonObjectReader reader(value, path, sourceName);
-  AdaptiveRegionOptions out;
+  RunTimeRegionOptions out;
   if (const nlohmann::json* contact = reader.find("contact")) {
     if (!context.hasContact) reader.fail("contact", "needs obstacles: add a \"contact\" section to the scene");
     JsonObjectReader c(*contact, reader.keyPath("contact"), sourceName);
@@ -302,15 +302,15 @@ void parseRegions(JsonObjectReader& reader, const IntegratorContext& context, co
   static const nlohmann::json automaticRegions = "auto";
   const std::string& sourceName = context.sourceName;
   const nlohmann::json* given = reader.find("regions");
-  const nlohmann::json& regions = given ? *given : automaticRegions;  // default: automatic regions
+  const nlohmann::json& regions = given ? *given : automaticRegions;  // default: proposed regions
   const std::string regionsPath = reader.keyPath("regions");
   if (regions.is_string()) {
     if (regions.get<std::string>() != "auto") {
       JsonObjectReader::failAt(sourceName, regionsPath, "expected \"auto\" or an array of regions");
     }
     out.automaticRegions = true;
-    out.automatic = parseAutoRegionOptions(context, options);
-    (void)reader.find("auto");  // read by parseAutoRegionOptions
+    out.automatic = parseRegionProposalOptions(context, options);
+    (void)reader.find("auto");  // read by parseRegionProposalOptions
   } else if (regions.is_object()) {
     if (reader.find("auto")) reader.fail("auto", "only with \"regions\": \"auto\"");
     JsonObjectReader object(regions, regionsPath, sourceName);
@@ -347,8 +347,8 @@ void rejectAsyncOnlyKeys(const IntegratorContext& context, const nlohmann::json&
 
 }  // namespace
 
-AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const nlohmann::json& options) {
-  AutoRegionOptions automatic;
+RegionProposalOptions parseRegionProposalOptions(const IntegratorContext& context, const nlohmann::json& options) {
+  RegionProposalOptions automatic;
   automatic.largeTimestep = context.timestep;
   // Nonlinear forces refactor every step on both sides: the cost check counts that.
   automatic.nonlinear = context.system.forceModel && !context.system.forceModel->isLinear();
@@ -396,9 +396,9 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
   if (out.automaticRegions) {
     if (out.automatic.modalCheck) {
       // K and M are assembled only when the modal check runs (not after the pre-check).
-      out.proposal = suggestRegions(mesh, freeDofs, out.automatic, context.massType);
+      out.proposal = proposeRegions(mesh, freeDofs, out.automatic, context.massType);
     } else {
-      out.proposal = suggestRegions(mesh, freeDofs, out.automatic);
+      out.proposal = proposeRegions(mesh, freeDofs, out.automatic);
     }
     out.regions = out.proposal->asyncRegions();
   }
@@ -464,8 +464,9 @@ void registerMultirateIntegrators(IntegratorRegistry& registry, AsyncSettingsHoo
         AsyncSettings parsed = parseAsyncSettings(context, options);
         if (asyncHook) asyncHook(parsed, context);
         std::unique_ptr<AsyncBackwardEuler> integrator = makeAsync(context, parsed);
-        if (parsed.adaptive) integrator->setAdaptiveRegions(*parsed.adaptive);
-        if (parsed.automaticRegions && parsed.proposal) integrator->setRegionNote(autoRegionSummary(*parsed.proposal));
+        if (parsed.adaptive) integrator->setRunTimeRegions(*parsed.adaptive);
+        if (parsed.automaticRegions && parsed.proposal)
+          integrator->setRegionNote(regionProposalSummary(*parsed.proposal));
         return integrator;
       },
       asyncOptionKeys());

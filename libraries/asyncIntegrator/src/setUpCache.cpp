@@ -31,16 +31,16 @@ std::vector<std::pair<int, std::vector<int>>> partitionKey(const RegionPartition
 
 }  // namespace
 
-void AsyncBackwardEuler::setAdaptiveRegions(AdaptiveRegionOptions options) {
+void AsyncBackwardEuler::setRunTimeRegions(RunTimeRegionOptions options) {
   if (options.contact && !system_.obstacleProximity) {
     throw ValidationError(
-        "async integrator: adaptive regions: the contact policy needs obstacles (a \"contact\" section)");
+        "async integrator: run-time regions: the contact policy needs obstacles (a \"contact\" section)");
   }
   if (options.nest) requireHierarchyComposes(options_, "run-time regions that nest");
   if (options.loads && !system_.externalForce) {
-    throw ValidationError("async integrator: adaptive regions: the loads policy needs loads (an external force)");
+    throw ValidationError("async integrator: run-time regions: the loads policy needs loads (an external force)");
   }
-  policy_ = std::make_unique<AdaptiveRegionPolicy>(*system_.mesh, system_.freeDofs, std::move(options));
+  policy_ = std::make_unique<RunTimeRegionPolicy>(*system_.mesh, system_.freeDofs, std::move(options));
   policy_->setExternalForce(system_.externalForce, system_.externalForceChanges);
   stepsKept_ = 0;
   maybeRepartition();

@@ -3,7 +3,7 @@
 // implicit backward Euler integrator.
 
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/asyncIntegrator/stepSolver.hpp>
 #include <integrators.hpp>
 #include <limits>
@@ -185,26 +185,26 @@ void bindAsyncOptions(py::module_& module) {
       .def_readwrite("end", &ScheduledRegion::end)
       .def_readwrite("ratio", &ScheduledRegion::ratio)
       .def_property_readonly("vertices", [](const ScheduledRegion& r) { return intArray(r.vertices); });
-  py::class_<AdaptiveRegionOptions>(module, "AdaptiveRegionOptions",
-                                    "Policies of run-time regions (docs/asynchronous-integrator.md, Run-time regions)")
+  py::class_<RunTimeRegionOptions>(module, "RunTimeRegionOptions",
+                                   "Policies of run-time regions (docs/asynchronous-integrator.md, Run-time regions)")
       .def(py::init<>())
-      .def_readwrite("contact", &AdaptiveRegionOptions::contact, "follow contact (needs obstacles in the system)")
-      .def_readwrite("contact_ratio", &AdaptiveRegionOptions::contactRatio)
-      .def_readwrite("contact_margin", &AdaptiveRegionOptions::contactMargin, "length")
-      .def_readwrite("contact_lookahead", &AdaptiveRegionOptions::contactLookahead, "large steps")
-      .def_readwrite("contact_rings", &AdaptiveRegionOptions::contactRings)
-      .def_readwrite("contact_slack", &AdaptiveRegionOptions::contactSlack, "extra rings of a new contact region")
-      .def_readwrite("indicator", &AdaptiveRegionOptions::indicator,
+      .def_readwrite("contact", &RunTimeRegionOptions::contact, "follow contact (needs obstacles in the system)")
+      .def_readwrite("contact_ratio", &RunTimeRegionOptions::contactRatio)
+      .def_readwrite("contact_margin", &RunTimeRegionOptions::contactMargin, "length")
+      .def_readwrite("contact_lookahead", &RunTimeRegionOptions::contactLookahead, "large steps")
+      .def_readwrite("contact_rings", &RunTimeRegionOptions::contactRings)
+      .def_readwrite("contact_slack", &RunTimeRegionOptions::contactSlack, "extra rings of a new contact region")
+      .def_readwrite("indicator", &RunTimeRegionOptions::indicator,
                      "mark where the large step errs: |v_k - 2 v_(k-1) + v_(k-2)| / 2 against the tolerance")
-      .def_readwrite("indicator_tolerance", &AdaptiveRegionOptions::indicatorTolerance,
+      .def_readwrite("indicator_tolerance", &RunTimeRegionOptions::indicatorTolerance,
                      "fraction of the RMS vertex speed")
-      .def_readwrite("indicator_ratio", &AdaptiveRegionOptions::indicatorRatio, "largest ratio it asks for")
-      .def_readwrite("indicator_rings", &AdaptiveRegionOptions::indicatorRings)
-      .def_readwrite("schedule", &AdaptiveRegionOptions::schedule, "list of ScheduledRegion")
-      .def_readwrite("min_dwell", &AdaptiveRegionOptions::minDwell, "large steps")
-      .def_readwrite("shrink_factor", &AdaptiveRegionOptions::shrinkFactor)
-      .def_readwrite("cache_size", &AdaptiveRegionOptions::cacheSize)
-      .def_readwrite("nest", &AdaptiveRegionOptions::nest,
+      .def_readwrite("indicator_ratio", &RunTimeRegionOptions::indicatorRatio, "largest ratio it asks for")
+      .def_readwrite("indicator_rings", &RunTimeRegionOptions::indicatorRings)
+      .def_readwrite("schedule", &RunTimeRegionOptions::schedule, "list of ScheduledRegion")
+      .def_readwrite("min_dwell", &RunTimeRegionOptions::minDwell, "large steps")
+      .def_readwrite("shrink_factor", &RunTimeRegionOptions::shrinkFactor)
+      .def_readwrite("cache_size", &RunTimeRegionOptions::cacheSize)
+      .def_readwrite("nest", &RunTimeRegionOptions::nest,
                      "touching regions keep their own ratios (the hierarchy solve) instead of being merged");
   py::class_<RepartitionRecord>(module, "RepartitionRecord", "One change of partition at a large-step boundary")
       .def_readonly("time", &RepartitionRecord::time)
@@ -253,101 +253,100 @@ void bindAsyncIntegrator(py::module_& module) {
       .def_property_readonly("factor_non_zeros", &AsyncBackwardEuler::factorNonZeros)
       .def("set_up", &AsyncBackwardEuler::setUp, py::arg("partition"), py::call_guard<py::gil_scoped_release>(),
            "take another partition of the same mesh from the next step on")
-      .def("set_adaptive_regions", &AsyncBackwardEuler::setAdaptiveRegions, py::arg("options"),
+      .def("set_run_time_regions", &AsyncBackwardEuler::setRunTimeRegions, py::arg("options"),
            py::call_guard<py::gil_scoped_release>(),
-           "choose the regions at every large-step boundary with these policies (AdaptiveRegionOptions)")
+           "choose the regions at every large-step boundary with these policies (RunTimeRegionOptions)")
       .def_property_readonly("repartitions", &AsyncBackwardEuler::repartitions,
                              "every change of partition so far (RepartitionRecord)");
 }
 
-// Automatic regions: the options and the proposal (what a scene's "regions": "auto" and
-// suggestRegions use).
-void bindAutoRegions(py::module_& module) {
-  // Automatic regions (what a scene's "regions": "auto" and suggestRegions use).
+// Proposed regions: the options and the proposal (what a scene's "regions": "auto" and
+// proposeRegions use).
+void bindRegionProposal(py::module_& module) {
+  // Proposed regions (what a scene's "regions": "auto" and proposeRegions use).
   module.def("element_max_frequencies", &elementMaxFrequencies, py::arg("mesh"),
              py::call_guard<py::gil_scoped_release>(), "omega_e per element (rad/s), lumped element mass");
-  py::class_<AutoRegionOptions>(module, "AutoRegionOptions",
-                                "Settings of suggest_regions (the scene's integrator.options.auto)")
+  py::class_<RegionProposalOptions>(module, "RegionProposalOptions",
+                                    "Settings of propose_regions (the scene's integrator.options.auto)")
       .def(py::init<>())
-      .def_readwrite("large_timestep", &AutoRegionOptions::largeTimestep, "hL (s)")
-      .def_readwrite("target_omega_h", &AutoRegionOptions::targetOmegaH,
+      .def_readwrite("large_timestep", &RegionProposalOptions::largeTimestep, "hL (s)")
+      .def_readwrite("target_omega_h", &RegionProposalOptions::targetOmegaH,
                      "target omega h in every region; <= 0: relative mode")
-      .def_readwrite("relative_threshold", &AutoRegionOptions::relativeThreshold,
+      .def_readwrite("relative_threshold", &RegionProposalOptions::relativeThreshold,
                      "relative mode: elements above this multiple of the median element frequency become fast")
-      .def_readwrite("grow_layers", &AutoRegionOptions::growLayers, "vertex rings added around each region")
-      .def_readwrite("max_ratio", &AutoRegionOptions::maxRatio, "largest ratio m proposed")
-      .def_readwrite("modal_check", &AutoRegionOptions::modalCheck,
+      .def_readwrite("grow_layers", &RegionProposalOptions::growLayers, "vertex rings added around each region")
+      .def_readwrite("max_ratio", &RegionProposalOptions::maxRatio, "largest ratio m proposed")
+      .def_readwrite("modal_check", &RegionProposalOptions::modalCheck,
                      "withdraw the regions when no visible mode lives in them (needs stiffness and mass)")
-      .def_readwrite("frame_rate", &AutoRegionOptions::frameRate, "frames per second, for the visibility test")
-      .def_readwrite("modal_count", &AutoRegionOptions::modalCount, "modes computed first by the modal check")
-      .def_readwrite("max_modal_count", &AutoRegionOptions::maxModalCount,
+      .def_readwrite("frame_rate", &RegionProposalOptions::frameRate, "frames per second, for the visibility test")
+      .def_readwrite("modal_count", &RegionProposalOptions::modalCount, "modes computed first by the modal check")
+      .def_readwrite("max_modal_count", &RegionProposalOptions::maxModalCount,
                      "modes computed at most (doubled while the highest is still visible)")
-      .def_readwrite("max_regions", &AutoRegionOptions::maxRegions,
+      .def_readwrite("max_regions", &RegionProposalOptions::maxRegions,
                      "regions kept at most; the others move to capped_regions")
-      .def_readwrite("cost_check", &AutoRegionOptions::costCheck,
+      .def_readwrite("cost_check", &RegionProposalOptions::costCheck,
                      "withdraw the regions unless async is estimated cheaper than single-rate")
-      .def_readwrite("cost_margin", &AutoRegionOptions::costMargin, "async must cost below this times single-rate")
-      .def_readwrite("nonlinear", &AutoRegionOptions::nonlinear,
+      .def_readwrite("cost_margin", &RegionProposalOptions::costMargin, "async must cost below this times single-rate")
+      .def_readwrite("nonlinear", &RegionProposalOptions::nonlinear,
                      "corotational forces: both sides refactor every step in the cost model");
-  py::class_<ProposedRegion>(module, "ProposedRegion", "One region of an AutoRegionProposal with its statistics")
+  py::class_<ProposedRegion>(module, "ProposedRegion", "One region of an RegionProposal with its statistics")
       .def_readonly("region", &ProposedRegion::region, "the AsyncRegion")
       .def_readonly("max_frequency", &ProposedRegion::maxFrequency, "max omega_e over its elements (rad/s)")
       .def_readonly("num_elements", &ProposedRegion::numElements, "elements with every vertex in the region")
       .def_readonly("num_interface_dofs", &ProposedRegion::numInterfaceDofs, "|I| once partitioned")
       .def_readonly("ratio_from_elements", &ProposedRegion::ratioFromElements,
                     "the element criterion's ratio when the modal check raised it, else 0");
-  py::class_<AutoRegionCost>(module, "AutoRegionCost",
-                             "The cost check of a proposal: flops per large step of async against single-rate")
-      .def_readonly("evaluated", &AutoRegionCost::evaluated, "whether the check ran")
-      .def_readonly("free_dofs", &AutoRegionCost::freeDofs, "free DOFs of the problem")
-      .def_readonly("large_dofs", &AutoRegionCost::largeDofs, "|L| once the regions are taken out")
-      .def_readonly("interface_dofs", &AutoRegionCost::interfaceDofs, "sum of |I_i|")
-      .def_readonly("single_rate_substeps", &AutoRegionCost::singleRateSubsteps,
+  py::class_<RegionProposalCost>(module, "RegionProposalCost",
+                                 "The cost check of a proposal: flops per large step of async against single-rate")
+      .def_readonly("evaluated", &RegionProposalCost::evaluated, "whether the check ran")
+      .def_readonly("free_dofs", &RegionProposalCost::freeDofs, "free DOFs of the problem")
+      .def_readonly("large_dofs", &RegionProposalCost::largeDofs, "|L| once the regions are taken out")
+      .def_readonly("interface_dofs", &RegionProposalCost::interfaceDofs, "sum of |I_i|")
+      .def_readonly("single_rate_substeps", &RegionProposalCost::singleRateSubsteps,
                     "single-rate steps per large step (the largest ratio)")
-      .def_readonly("single_rate_flops", &AutoRegionCost::singleRateFlops, "per large step")
-      .def_readonly("async_flops", &AutoRegionCost::asyncFlops, "per large step, steady state")
-      .def_readonly("async_cheaper", &AutoRegionCost::asyncCheaper, "the verdict of the check")
-      .def_readonly("decision", &AutoRegionCost::decision, "one line: the numbers and what was decided")
-      .def("ratio", &AutoRegionCost::ratio, "async flops / single-rate flops");
-  py::class_<AutoRegionProposal>(module, "AutoRegionProposal",
-                                 "What suggest_regions proposes, withdraws and why (as_dict: the suggestRegions "
-                                 "--json document)")
-      .def_readonly("regions", &AutoRegionProposal::regions, "the kept regions (ProposedRegion)")
-      .def_readonly("withdrawn_regions", &AutoRegionProposal::withdrawnRegions,
+      .def_readonly("single_rate_flops", &RegionProposalCost::singleRateFlops, "per large step")
+      .def_readonly("async_flops", &RegionProposalCost::asyncFlops, "per large step, steady state")
+      .def_readonly("async_cheaper", &RegionProposalCost::asyncCheaper, "the verdict of the check")
+      .def_readonly("decision", &RegionProposalCost::decision, "one line: the numbers and what was decided")
+      .def("ratio", &RegionProposalCost::ratio, "async flops / single-rate flops");
+  py::class_<RegionProposal>(module, "RegionProposal",
+                             "What propose_regions proposes, withdraws and why (as_dict: the proposeRegions "
+                             "--json document)")
+      .def_readonly("regions", &RegionProposal::regions, "the kept regions (ProposedRegion)")
+      .def_readonly("withdrawn_regions", &RegionProposal::withdrawnRegions,
                     "regions the modal check withdrew (no visible mode lives in them)")
-      .def_readonly("cost_withdrawn_regions", &AutoRegionProposal::costWithdrawnRegions,
-                    "regions the cost check withdrew")
-      .def_readonly("capped_regions", &AutoRegionProposal::cappedRegions, "regions beyond max_regions")
-      .def_readonly("large_region_max_frequency", &AutoRegionProposal::largeRegionMaxFrequency,
+      .def_readonly("cost_withdrawn_regions", &RegionProposal::costWithdrawnRegions, "regions the cost check withdrew")
+      .def_readonly("capped_regions", &RegionProposal::cappedRegions, "regions beyond max_regions")
+      .def_readonly("large_region_max_frequency", &RegionProposal::largeRegionMaxFrequency,
                     "max omega_e over the elements left in L (rad/s)")
-      .def_readonly("large_timestep", &AutoRegionProposal::largeTimestep, "hL (s)")
-      .def_readonly("target_omega_h", &AutoRegionProposal::targetOmegaH, "the target omega h in effect")
-      .def_readonly("modal_seconds", &AutoRegionProposal::modalSeconds, "time of the modal check's eigensolves")
+      .def_readonly("large_timestep", &RegionProposal::largeTimestep, "hL (s)")
+      .def_readonly("target_omega_h", &RegionProposal::targetOmegaH, "the target omega h in effect")
+      .def_readonly("modal_seconds", &RegionProposal::modalSeconds, "time of the modal check's eigensolves")
       .def_property_readonly(
-          "has_modal_report", [](const AutoRegionProposal& proposal) { return proposal.modalReport.has_value(); },
+          "has_modal_report", [](const RegionProposal& proposal) { return proposal.modalReport.has_value(); },
           "whether the modal check ran")
-      .def_readonly("modal_report", &AutoRegionProposal::modalReport,
+      .def_readonly("modal_report", &RegionProposal::modalReport,
                     "the modal check's RegionModeReport of the proposed regions, or None")
-      .def_readonly("cost", &AutoRegionProposal::cost, "the cost check (AutoRegionCost)")
-      .def("summary", &autoRegionSummary, "one line: the regions kept, or which check withdrew them and why")
-      .def("async_regions", &AutoRegionProposal::asyncRegions, "the proposed regions, ready for AsyncBackwardEuler");
+      .def_readonly("cost", &RegionProposal::cost, "the cost check (RegionProposalCost)")
+      .def("summary", &regionProposalSummary, "one line: the regions kept, or which check withdrew them and why")
+      .def("async_regions", &RegionProposal::asyncRegions, "the proposed regions, ready for AsyncBackwardEuler");
 }
 
-// suggest_regions, the proposal itself.
-void bindSuggestRegions(py::module_& module) {
+// propose_regions, the proposal itself.
+void bindProposeRegions(py::module_& module) {
   module.def(
-      "suggest_regions",
-      [](const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+      "propose_regions",
+      [](const TetMesh& mesh, const FreeDofs& freeDofs, const RegionProposalOptions& options,
          const std::optional<Eigen::SparseMatrix<double>>& stiffness,
          const std::optional<Eigen::SparseMatrix<double>>& mass) {
         if (stiffness.has_value() != mass.has_value()) {
           throw py::value_error("stiffness, mass: give both (for the modal check) or neither");
         }
         py::gil_scoped_release release;
-        return stiffness ? suggestRegions(mesh, freeDofs, options, *stiffness, *mass)
-                         : suggestRegions(mesh, freeDofs, options);
+        return stiffness ? proposeRegions(mesh, freeDofs, options, *stiffness, *mass)
+                         : proposeRegions(mesh, freeDofs, options);
       },
-      py::arg("mesh"), py::arg("free_dofs"), py::arg("options") = AutoRegionOptions{},
+      py::arg("mesh"), py::arg("free_dofs"), py::arg("options") = RegionProposalOptions{},
       py::arg("stiffness") = py::none(), py::arg("mass") = py::none(),
       "fast regions and ratios from the element frequencies (modal check with K and M, full 3n matrices)");
 }
@@ -358,8 +357,8 @@ void bindAsync(py::module_& module) {
   bindRegions(module);
   bindAsyncOptions(module);
   bindAsyncIntegrator(module);
-  bindAutoRegions(module);
-  bindSuggestRegions(module);
+  bindRegionProposal(module);
+  bindProposeRegions(module);
 }
 
 }  // namespace asyncfem::python

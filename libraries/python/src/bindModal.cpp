@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // libraries/modalAnalysis (lowest modes, per-mode shares of the fast regions and the
-// verdict) and the scene-level region suggestion, the document suggestRegions --json prints.
+// verdict) and the scene-level region proposal, the document proposeRegions --json prints.
 
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
 #include <asyncfem/modalAnalysis/regionModes.hpp>
@@ -20,12 +20,12 @@ namespace asyncfem::python {
 
 namespace {
 
-/// A list of regions as the "regions" array of suggestRegions --json (name, ratio, vertices).
+/// A list of regions as the "regions" array of proposeRegions --json (name, ratio, vertices).
 py::object regionsObject(const std::vector<AsyncRegion>& regions) {
   return py::module_::import("json").attr("loads")(asyncRegionsJson(regions).dump());
 }
 
-/// The "modes" object of suggestRegions --json --modes K, as a dict with the same keys.
+/// The "modes" object of proposeRegions --json --modes K, as a dict with the same keys.
 py::dict reportDict(const RegionModeReport& report) {
   py::list rows;
   for (const ModeInRegions& mode : report.modes) {
@@ -55,8 +55,8 @@ std::vector<AsyncRegion> regionsOf(const std::vector<ProposedRegion>& proposed) 
   return regions;
 }
 
-/// The proposal part of suggestRegions --json (all but "modes"), as a dict.
-py::dict proposalDict(const AutoRegionProposal& proposal) {
+/// The proposal part of proposeRegions --json (all but "modes"), as a dict.
+py::dict proposalDict(const RegionProposal& proposal) {
   py::dict result;
   result["largeTimestep"] = proposal.largeTimestep;
   result["target"] = proposal.targetOmegaH;
@@ -67,18 +67,18 @@ py::dict proposalDict(const AutoRegionProposal& proposal) {
   return result;
 }
 
-/// What the scene-level suggestion found: the proposal and, when modes were asked for, the
+/// What the scene-level proposal found: the proposal and, when modes were asked for, the
 /// report of the scene's regions (or the proposal's).
-struct SceneSuggestion {
-  AutoRegionProposal proposal;
+struct SceneProposal {
+  RegionProposal proposal;
   std::optional<RegionModeReport> modes;
 };
 
-/// suggestRegions SCENE --json [--modes K] [--dt H] [--frame-rate F]: the scene's own
-/// "auto" settings when its async regions are automatic, else the default ones with the
+/// proposeRegions SCENE --json [--modes K] [--dt H] [--frame-rate F]: the scene's own
+/// "auto" settings when its async regions are proposed, else the default ones with the
 /// modal check; the modal report is of the scene's explicit regions, else of the proposal.
-SceneSuggestion suggestSceneRegions(const std::filesystem::path& path, int modeCount, double largeTimestep,
-                                    double frameRate) {
+SceneProposal proposeSceneRegions(const std::filesystem::path& path, int modeCount, double largeTimestep,
+                                  double frameRate) {
   const Scene scene = loadScene(path);
   // The scene's timing, at the large step asked for (no need to divide its frames).
   FrameTiming timing = requireFrameTiming(scene);
@@ -91,16 +91,16 @@ SceneSuggestion suggestSceneRegions(const std::filesystem::path& path, int modeC
   const bool isAsync = scene.integrator.name == "async";
   const bool explicitRegions =
       isAsync && options.is_object() && options.contains("regions") && options["regions"].is_array();
-  AutoRegionOptions automatic;
+  RegionProposalOptions automatic;
   automatic.modalCheck = true;
   if (isAsync && !explicitRegions) {
-    automatic = parseAutoRegionOptions(integratorContext(scene, timing), options);
+    automatic = parseRegionProposalOptions(integratorContext(scene, timing), options);
   }
   automatic.largeTimestep = hL;
   automatic.frameRate = rate;
   const VibrationMatrices matrices = vibrationMatrices(mesh, scene.mass);
-  SceneSuggestion result{suggestRegions(mesh, problem->freeDofs(), automatic, matrices.stiffness, matrices.mass), {}};
-  const AutoRegionProposal& proposal = result.proposal;
+  SceneProposal result{proposeRegions(mesh, problem->freeDofs(), automatic, matrices.stiffness, matrices.mass), {}};
+  const RegionProposal& proposal = result.proposal;
   if (modeCount <= 0) return result;
   const std::vector<AsyncRegion> regions =
       explicitRegions ? parseAsyncOptions(scene, mesh, problem->freeDofs(), options).regions
@@ -194,7 +194,7 @@ void bindRegionModes(py::module_& module) {
                     "the highest mode computed is still visible: visible modes above it were not examined")
       .def_readonly("verdict", &RegionModeReport::verdict, "ModalVerdict")
       .def_readonly("kept_modes", &RegionModeReport::keptModes, "indices into modes of the keepable ones")
-      .def("verdict_text", &RegionModeReport::verdictText, "the verdict as one line, as suggestRegions prints it")
+      .def("verdict_text", &RegionModeReport::verdictText, "the verdict as one line, as proposeRegions prints it")
       .def(
           "table",
           [](const RegionModeReport& report) {
@@ -202,9 +202,9 @@ void bindRegionModes(py::module_& module) {
             printRegionModeReport(out, report);
             return out.str();
           },
-          "the table suggestRegions --modes prints (mode, Hz, rad/s, omega hL, per region omega hS and share, "
+          "the table proposeRegions --modes prints (mode, Hz, rad/s, omega hL, per region omega hS and share, "
           "S share, flags) and the verdict line")
-      .def("as_dict", &reportDict, "the report as suggestRegions --json --modes K puts it under \"modes\"");
+      .def("as_dict", &reportDict, "the report as proposeRegions --json --modes K puts it under \"modes\"");
   module.def(
       "region_modes",
       [](const ModalResult& result, const Eigen::SparseMatrix<double>& mass, const std::vector<AsyncRegion>& regions,
@@ -223,27 +223,27 @@ void bindRegionModes(py::module_& module) {
 void bindModal(py::module_& module) {
   bindModalResult(module);
   bindRegionModes(module);
-  // A method of AutoRegionProposal (bound with the asynchronous integrator).
-  py::object proposalClass = module.attr("AutoRegionProposal");
+  // A method of RegionProposal (bound with the asynchronous integrator).
+  py::object proposalClass = module.attr("RegionProposal");
   proposalClass.attr("as_dict") =
       py::cpp_function(&proposalDict, py::name("as_dict"), py::is_method(proposalClass),
-                       "The proposal as the document suggestRegions --json prints (largeTimestep, target, "
+                       "The proposal as the document proposeRegions --json prints (largeTimestep, target, "
                        "largeRegionOmegaH, regions, withdrawnRegions, modalVerdict)");
   module.def(
-      "suggest_scene_regions",
+      "propose_scene_regions",
       [](const std::filesystem::path& path, int modes, std::optional<double> largeTimestep,
          std::optional<double> frameRate) {
-        std::optional<SceneSuggestion> suggestion;
+        std::optional<SceneProposal> sceneProposal;
         {
           py::gil_scoped_release release;
-          suggestion = suggestSceneRegions(path, modes, largeTimestep.value_or(0.0), frameRate.value_or(0.0));
+          sceneProposal = proposeSceneRegions(path, modes, largeTimestep.value_or(0.0), frameRate.value_or(0.0));
         }
-        py::dict document = proposalDict(suggestion->proposal);
-        if (suggestion->modes) document["modes"] = reportDict(*suggestion->modes);
+        py::dict document = proposalDict(sceneProposal->proposal);
+        if (sceneProposal->modes) document["modes"] = reportDict(*sceneProposal->modes);
         return document;
       },
       py::arg("path"), py::arg("modes") = 0, py::arg("large_timestep") = py::none(), py::arg("frame_rate") = py::none(),
-      "What `suggestRegions SCENE --json [--modes K] [--dt H] [--frame-rate F]` prints, as a dict: the proposed "
+      "What `proposeRegions SCENE --json [--modes K] [--dt H] [--frame-rate F]` prints, as a dict: the proposed "
       "and withdrawn fast regions with their ratios, the target, the modal verdict and, with modes > 0, the "
       "per-mode report (frequency, omega h, shares, flags, verdict) of the scene's own regions (or the "
       "proposal's). The scene's \"regions\": \"auto\" settings are used when it has them.");

@@ -20,7 +20,7 @@ PYBIND11_MODULE(_asyncfem, module) {
   python::bindForceModels(module);
   python::bindIntegrators(module);
   python::bindAsync(module);
-  python::bindModal(module);  // after bindAsync: adds AutoRegionProposal.as_dict
+  python::bindModal(module);  // after bindAsync: adds RegionProposal.as_dict
   python::bindOutput(module);
 #if ASYNCFEM_PYTHON_WITH_RENDER
   python::bindRender(module);

@@ -471,14 +471,14 @@ void parseFrames(JsonObjectReader& top, const Scene& scene, TimingKeys& timing) 
 
 }  // namespace
 
-bool hasAdaptiveRegions(const Scene& scene) {
+bool hasRunTimeRegions(const Scene& scene) {
   const json& options = scene.integrator.options;
   if (!options.is_object()) return false;
   const auto regions = options.find("regions");
   return regions != options.end() && regions->is_object() && regions->contains("adaptive");
 }
 
-bool recordsRegionRatios(const Scene& scene) { return scene.output.regions.value_or(hasAdaptiveRegions(scene)); }
+bool recordsRegionRatios(const Scene& scene) { return scene.output.regions.value_or(hasRunTimeRegions(scene)); }
 
 void throwSceneError(const Scene& scene, const std::string& keyPath, const std::string& message) {
   JsonObjectReader::failAt(scene.sourceName, keyPath, message);

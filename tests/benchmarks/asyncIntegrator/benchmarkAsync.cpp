@@ -26,7 +26,7 @@
 #include <algorithm>
 #include <array>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/contact/penaltyContact.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
@@ -539,7 +539,7 @@ struct SteadyRow {
   // Wall time per step over all timed steps (the mean): steps that rebuild or refactor are
   // part of the cost, which a median leaves out.
   double asyncMeanWall = 0, singleMeanHS = 0;
-  AutoRegionCost model;  // the automatic regions' cost model of the same partition
+  RegionProposalCost model;  // the proposed regions' cost model of the same partition
 };
 
 /// Steady state: per scene, the async step (median wall, and the integrator's own mean of
@@ -704,7 +704,7 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
           r.model.asyncSetupFlops / modelStep);
     }
     std::printf(
-        "\nCost model: the flops automatic regions estimate (AutoRegionCost, from CHOLMOD's symbolic analysis); "
+        "\nCost model: the flops proposed regions estimate (RegionProposalCost, from CHOLMOD's symbolic analysis); "
         "its ratios use the same denominators as the measured ones.\n");
   } else {
     std::printf("%s",

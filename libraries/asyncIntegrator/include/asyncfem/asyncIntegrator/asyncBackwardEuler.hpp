@@ -2,10 +2,10 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/asyncOptions.hpp>
 #include <asyncfem/asyncIntegrator/partitionedIntegrator.hpp>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
+#include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <asyncfem/asyncIntegrator/stepSolver.hpp>
 #include <asyncfem/integrator/integrator.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
@@ -83,11 +83,11 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   /// Regions chosen at run time from the next step on (docs/asynchronous-integrator.md,
   /// "Run-time regions"): at every large-step boundary the policy may replace the
   /// partition (setUp with the new one, or a cached set-up of an earlier identical one).
-  /// Throws asyncfem::ValidationError for options AdaptiveRegionPolicy rejects, and for the
+  /// Throws asyncfem::ValidationError for options RunTimeRegionPolicy rejects, and for the
   /// contact policy on a system without obstacles (DynamicSystem::obstacleProximity).
-  void setAdaptiveRegions(AdaptiveRegionOptions options);
-  /// A line the run summary (report().lines) starts with, e.g. what an automatic region
-  /// proposal decided (autoRegionSummary); empty: none.
+  void setRunTimeRegions(RunTimeRegionOptions options);
+  /// A line the run summary (report().lines) starts with, e.g. what an proposed region
+  /// proposal decided (regionProposalSummary); empty: none.
   void setRegionNote(std::string note) { regionNote_ = std::move(note); }
   /// Every change of partition so far, in order.
   const std::vector<RepartitionRecord>& repartitions() const { return repartitions_; }
@@ -146,7 +146,7 @@ class AsyncBackwardEuler final : public PartitionedIntegrator {
   std::unique_ptr<detail::StepSolver> solver_;
   // The whole single-rate system's factor (quickSetUp), shared by every partition.
   std::unique_ptr<detail::WholeSystemFactor> whole_;
-  std::unique_ptr<AdaptiveRegionPolicy> policy_;
+  std::unique_ptr<RunTimeRegionPolicy> policy_;
   std::vector<RepartitionRecord> repartitions_;
   long long stepsKept_ = 0;  // large steps since the last change of partition
   std::vector<CachedSetUp> cache_;

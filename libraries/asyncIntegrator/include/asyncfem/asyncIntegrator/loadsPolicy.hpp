@@ -41,7 +41,7 @@ std::vector<int> verticesReachedByLoads(const ExternalForceFunction& force, cons
                                         double from, double t0, double largeStep, int ratio, const Eigen::VectorXd& u,
                                         const Eigen::VectorXd& v);
 
-/// The settings of the loads policy (AdaptiveRegionOptions::loads*).
+/// The settings of the loads policy (RunTimeRegionOptions::loads*).
 struct LoadsPolicySettings {
   int ratio = 8;                   ///< ratio of a part made of loaded vertices, and the probe's substeps
   int rings = 1;                   ///< element rings grown around loaded vertices that no given part holds

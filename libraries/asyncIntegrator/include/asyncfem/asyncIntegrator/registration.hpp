@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
 #include <asyncfem/asyncIntegrator/regionPartition.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
+#include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <asyncfem/integrator/registry.hpp>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -20,13 +20,13 @@ namespace asyncfem {
 struct AsyncSettings {
   AsyncOptions solver;
   bool automaticRegions = false;
-  AutoRegionOptions automatic;       ///< largeTimestep and frameRate from the context; modalCheck on
-  std::vector<AsyncRegion> regions;  ///< explicit regions, or those the automatic proposal kept
-  /// The automatic proposal (regions "auto"), for reports: what was proposed, withdrawn, why.
-  std::optional<AutoRegionProposal> proposal;
+  RegionProposalOptions automatic;   ///< largeTimestep and frameRate from the context; modalCheck on
+  std::vector<AsyncRegion> regions;  ///< explicit regions, or those the region proposal kept
+  /// The region proposal (regions "auto"), for reports: what was proposed, withdrawn, why.
+  std::optional<RegionProposal> proposal;
   /// Run-time regions ("regions": {"adaptive": {...}}): the policy, and the object as given
   /// (written back by asyncSettingsJson).
-  std::optional<AdaptiveRegionOptions> adaptive;
+  std::optional<RunTimeRegionOptions> adaptive;
   nlohmann::json adaptiveSource;
   /// The partition of the regions, built once on the context's mesh and free DOFs (its
   /// errors name the "regions" key); partition->touching(): the regions touch or nest, so
@@ -37,15 +37,15 @@ struct AsyncSettings {
 /// The option keys "async" reads.
 const std::vector<std::string>& asyncOptionKeys();
 
-/// The automatic-region settings an "async" options object gives: hL and the frame rate
+/// The proposed-region settings an "async" options object gives: hL and the frame rate
 /// from the context, modal check on, then its "auto" object (target, growLayers,
 /// maxRatio, modalCheck; other keys are errors naming them). What "regions": "auto" runs
 /// with, for tools that propose regions the way the simulator would.
-AutoRegionOptions parseAutoRegionOptions(const IntegratorContext& context, const nlohmann::json& options);
+RegionProposalOptions parseRegionProposalOptions(const IntegratorContext& context, const nlohmann::json& options);
 
 /// Reads options (a JSON object) as "async" does; errors name the key under
 /// context.optionsPath ("integrator.options.regions[1].ratio: ..."). Regions "auto" (the
-/// default) runs suggestRegions() with the modal check on the context's mesh and mass type.
+/// default) runs proposeRegions() with the modal check on the context's mesh and mass type.
 AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohmann::json& options);
 
 /// The other direction: the options object that parseAsyncSettings() reads back to the same

@@ -64,7 +64,7 @@ struct SchurReport {
 }  // namespace detail
 
 /// What chooseStepSolver() checks for the hierarchy solve, ahead of any partition: for
-/// run-time regions that may nest (AdaptiveRegionOptions::nest), so that a refusal comes
+/// run-time regions that may nest (RunTimeRegionOptions::nest), so that a refusal comes
 /// before the run rather than at the step where regions first touch. why: the reason the
 /// hierarchy solve would run, for the message.
 void requireHierarchyComposes(const AsyncOptions& options, const std::string& why);

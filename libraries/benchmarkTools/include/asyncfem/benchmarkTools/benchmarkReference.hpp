@@ -25,7 +25,7 @@ struct BenchmarkReference {
 
 /// Steps per frame of the trapezoidal reference: frame interval / (h_min / 4), h_min
 /// the smallest step any configuration takes (its step divided by the largest ratio of the
-/// regions it resolves to, configurationRegions(): automatic regions included), at most
+/// regions it resolves to, configurationRegions(): proposed regions included), at most
 /// the frame interval. A quarter of the smallest step makes the reference's own O(h^2)
 /// error about 16 times smaller than the finest configuration's would be at second order.
 int referenceStepsPerFrame(const Scene& scene, const Simulation& baseline,

@@ -35,7 +35,7 @@ Scene configuredScene(const Scene& scene, const BenchmarkConfiguration& configur
 
 /// The fast regions a multirate configuration runs with, resolved on baseline's mesh and
 /// free DOFs as the integrator resolves them (parseAsyncSettings: explicit regions, or the
-/// automatic proposal at the configuration's step); empty for a single-rate integrator.
+/// region proposal at the configuration's step); empty for a single-rate integrator.
 /// Throws what parseAsyncSettings throws for bad regions.
 std::vector<AsyncRegion> configurationRegions(const Scene& scene, const Simulation& baseline,
                                               const BenchmarkConfiguration& configuration);

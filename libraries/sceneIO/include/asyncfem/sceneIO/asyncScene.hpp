@@ -10,7 +10,7 @@
 namespace asyncfem {
 
 /// parseAsyncSettings() for a scene's async options (mesh and free DOFs as the scene
-/// builds them): what suggestRegions and the benchmark utilities use to see the regions
+/// builds them): what proposeRegions and the benchmark utilities use to see the regions
 /// the simulator would run, without building an integrator.
 AsyncSettings parseAsyncOptions(const Scene& scene, const TetMesh& mesh, const FreeDofs& freeDofs,
                                 const nlohmann::json& options);

@@ -197,7 +197,7 @@ struct Scene {
     bool velocities = false;          ///< also store velocities in the .afsim file
     bool sync = false;                ///< fsync after every frame
     /// output.regions: each .afsim record also carries every vertex's step ratio (the fast
-    /// regions in use at that frame); unset: on exactly for adaptive (run-time) regions
+    /// regions in use at that frame); unset: on exactly for run-time regions
     /// (recordsRegionRatios()).
     std::optional<bool> regions;
     /// output.vtu.encoding: how the .vtu files store their arrays
@@ -243,9 +243,9 @@ void overrideFrameTiming(Scene& scene, const TimingOverrides& overrides);
 
 /// Whether the scene's integrator options ask for run-time regions
 /// (integrator.options.regions = {"adaptive": ...}).
-bool hasAdaptiveRegions(const Scene& scene);
+bool hasRunTimeRegions(const Scene& scene);
 /// Whether a run of the scene records region ratios in its .afsim records: output.regions
-/// when given, else hasAdaptiveRegions().
+/// when given, else hasRunTimeRegions().
 bool recordsRegionRatios(const Scene& scene);
 
 /// Reads and parses a scene file. Relative paths in it resolve against its folder.

@@ -57,7 +57,7 @@ std::shared_ptr<const Problem> recordedSceneProblem(const SimulationFileHeader& 
 /// The context registry factories get for scene at the given timing (timestep, frame
 /// rate), with its mass type, contact and names for messages; mesh and system are left
 /// for the caller to fill. A program that asks about another timestep than the scene's
-/// (suggestRegions --dt) passes a FrameTiming with that timestep.
+/// (proposeRegions --dt) passes a FrameTiming with that timestep.
 IntegratorContext integratorContext(const Scene& scene, const FrameTiming& timing);
 /// integratorContext(scene, requireFrameTiming(scene)).
 IntegratorContext integratorContext(const Scene& scene);
@@ -103,7 +103,7 @@ std::vector<int> vertexStepRatios(const Integrator& integrator, int numVertices)
 /// Each vertex's step ratio under the scene's fixed regions (integrator.options.regions
 /// given as an array of regions, resolved on problem's mesh as the multirate integrators
 /// resolve them): the partition of every frame of such a run. nullopt when the scene has
-/// none (single-rate, or automatic or adaptive regions). Throws asyncfem::ValidationError
+/// none (single-rate, or proposed or run-time regions). Throws asyncfem::ValidationError
 /// naming the key for regions that do not fit the mesh.
 std::optional<std::vector<int>> fixedRegionRatios(const Scene& scene, const Problem& problem);
 

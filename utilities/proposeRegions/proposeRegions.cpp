@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// suggestRegions: proposes fast regions and ratios for the asynchronous integrator from the
+// proposeRegions: proposes fast regions and ratios for the asynchronous integrator from the
 // materials and element sizes of a mesh, checks them against the lowest modes, and with
 // --modes K prints the modal table of the given or proposed regions (see
 // docs/asynchronous-integrator.md, "Which modes can async keep?").
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/threading.hpp>
@@ -34,7 +34,7 @@ using namespace asyncfem;
 struct CommandLine {
   std::string input, writePath;
   double largeTimestep = 0.0;
-  AutoRegionOptions options;
+  RegionProposalOptions options;
   std::vector<std::string> fixedSets;
   std::vector<std::vector<double>> fixedBoxes;  // min x y z, max x y z each
   std::string fixedBou;
@@ -44,21 +44,21 @@ struct CommandLine {
   bool noModalCheck = false;
   std::string massName = "consistent";
   int adaptiveSteps = 120;
-  // Which of the automatic-region options were given (they replace a scene's own).
+  // Which of the proposed-region options were given (they replace a scene's own).
   bool givenTarget = false, givenRelative = false, givenGrow = false, givenMaxRatio = false;
   bool anyGiven() const { return givenTarget || givenRelative || givenGrow || givenMaxRatio; }
 };
 
 // What the input gives: the mesh and constraints, and from a scene its regions or its
-// automatic-region settings.
+// proposed-region settings.
 struct Input {
   std::shared_ptr<const TetMesh> mesh;
   FreeDofs freeDofs;
   MassType massType = MassType::consistent;
   std::vector<AsyncRegion> givenRegions;  // a scene's explicit regions
   bool corotational = false;
-  std::optional<AutoRegionOptions> sceneAuto;  // an async scene with "regions": "auto"
-  std::optional<Scene> adaptiveScene;          // an async scene with "regions": {"adaptive": ...}
+  std::optional<RegionProposalOptions> sceneAuto;  // an async scene with "regions": "auto"
+  std::optional<Scene> runTimeScene;               // an async scene with "regions": {"adaptive": ...}
 };
 
 void addOptions(CLI::App& app, CommandLine& cl) {
@@ -134,13 +134,13 @@ Input readScene(CommandLine& cl) {
                                       ? &integrator.options["regions"]
                                       : nullptr;
   if (integrator.name == "async" && regions && regions->is_object() && regions->contains("adaptive")) {
-    in.adaptiveScene = scene;
+    in.runTimeScene = scene;
   } else if (integrator.name == "async" && regions && regions->is_array()) {
     in.givenRegions = parseAsyncOptions(scene, *in.mesh, in.freeDofs, integrator.options).regions;
   } else if (integrator.name == "async") {
     // What the simulator would run: the scene's own auto settings (command-line
     // options given explicitly replace them).
-    in.sceneAuto = parseAutoRegionOptions(integratorContext(scene, timing), integrator.options);
+    in.sceneAuto = parseRegionProposalOptions(integratorContext(scene, timing), integrator.options);
   }
   return in;
 }
@@ -174,7 +174,7 @@ Input readMesh(const CommandLine& cl) {
   if (cl.largeTimestep <= 0.0) throw Error("give the large timestep with --dt for a mesh input");
   MeshReadReport report;
   auto loaded = std::make_shared<TetMesh>(readMesh(cl.input, {}, &report));
-  for (const std::string& w : report.warnings) std::cerr << "suggestRegions: warning: " << w << "\n";
+  for (const std::string& w : report.warnings) std::cerr << "proposeRegions: warning: " << w << "\n";
   Input in;
   in.massType = cl.massName == "lumped" ? MassType::lumped : MassType::consistent;
   in.freeDofs = FreeDofs::fromFixedVertices(loaded->numVertices(), fixedVertices(cl, *loaded));
@@ -184,8 +184,8 @@ Input readMesh(const CommandLine& cl) {
 
 // The proposal's settings: a scene's "auto" settings with the options given here
 // replacing theirs, else the command line's.
-AutoRegionOptions proposalOptions(const CommandLine& cl, const Input& in) {
-  AutoRegionOptions options = cl.options;
+RegionProposalOptions proposalOptions(const CommandLine& cl, const Input& in) {
+  RegionProposalOptions options = cl.options;
   if (in.sceneAuto) {
     options = *in.sceneAuto;
     if (cl.givenTarget) options.targetOmegaH = cl.options.targetOmegaH;
@@ -201,7 +201,7 @@ AutoRegionOptions proposalOptions(const CommandLine& cl, const Input& in) {
   return options;
 }
 
-std::vector<AsyncRegion> withdrawnRegions(const AutoRegionProposal& proposal) {
+std::vector<AsyncRegion> withdrawnRegions(const RegionProposal& proposal) {
   std::vector<AsyncRegion> regions;
   for (const ProposedRegion& r : proposal.withdrawnRegions) regions.push_back(r.region);
   return regions;
@@ -225,7 +225,7 @@ nlohmann::json modesJson(const RegionModeReport& report) {
       {"regions", report.regionNames}, {"ratios", report.ratios}, {"modes", modes}, {"verdict", report.verdictText()}};
 }
 
-void printJson(const AutoRegionProposal& proposal, double largeTimestep, const std::optional<RegionModeReport>& modes) {
+void printJson(const RegionProposal& proposal, double largeTimestep, const std::optional<RegionModeReport>& modes) {
   nlohmann::json out{{"largeTimestep", largeTimestep},
                      {"target", proposal.targetOmegaH},
                      {"largeRegionOmegaH", proposal.largeRegionMaxFrequency * largeTimestep},
@@ -236,7 +236,7 @@ void printJson(const AutoRegionProposal& proposal, double largeTimestep, const s
   std::cout << out.dump(2) << "\n";
 }
 
-void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const AutoRegionOptions& options) {
+void printTable(const RegionProposal& proposal, const TetMesh& mesh, const RegionProposalOptions& options) {
   const double largeTimestep = options.largeTimestep;
   std::printf("mesh: %d vertices, %d tets; hL = %g; target omega*h = %.3g%s\n", mesh.numVertices(), mesh.numElements(),
               largeTimestep, proposal.targetOmegaH, options.targetOmegaH > 0 ? "" : " (relative mode)");
@@ -260,7 +260,7 @@ void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const A
   std::printf("decided in %.3g ms by the %s (element frequencies %.3g ms%s)\n", 1e3 * proposal.decisionSeconds,
               toString(proposal.decidedBy), 1e3 * proposal.frequencySeconds,
               proposal.modalReport ? ", modal check included" : "");
-  if (!proposal.precheckWithdrawnRegions.empty()) std::printf("%s\n", autoRegionSummary(proposal).c_str());
+  if (!proposal.precheckWithdrawnRegions.empty()) std::printf("%s\n", regionProposalSummary(proposal).c_str());
   // The cost check ran first; when the modal check then withdrew the regions, say so on the
   // same line, so that "kept" is never read as the final answer.
   if (proposal.cost.evaluated) {
@@ -284,7 +284,7 @@ void printTable(const AutoRegionProposal& proposal, const TetMesh& mesh, const A
 
 // The modal report of the scene's given regions, else of the proposal (withdrawn or not),
 // printed as a table unless --json (the caller then puts it in the JSON document).
-RegionModeReport printModes(const CommandLine& cl, const Input& in, const AutoRegionProposal& proposal,
+RegionModeReport printModes(const CommandLine& cl, const Input& in, const RegionProposal& proposal,
                             const VibrationMatrices& matrices) {
   const bool given = !in.givenRegions.empty();
   const std::vector<AsyncRegion> regions =
@@ -310,7 +310,7 @@ RegionModeReport printModes(const CommandLine& cl, const Input& in, const AutoRe
 
 // The proposed regions to writePath, through a temporary file so a failed write leaves
 // no partial file behind.
-void writeRegions(const std::string& writePath, const AutoRegionProposal& proposal) {
+void writeRegions(const std::string& writePath, const RegionProposal& proposal) {
   const std::filesystem::path target(writePath);
   const std::filesystem::path temporary = target.string() + ".tmp";
   {
@@ -323,8 +323,8 @@ void writeRegions(const std::string& writePath, const AutoRegionProposal& propos
 
 // A scene whose regions are chosen at run time: run its first steps and explain each
 // partition its policies chose, priced by the cost model against single-rate at hL.
-void explainAdaptive(const CommandLine& cl, const Input& in) {
-  const Scene& scene = *in.adaptiveScene;
+void explainRunTimeRegions(const CommandLine& cl, const Input& in) {
+  const Scene& scene = *in.runTimeScene;
   std::printf("settings: the scene chooses its regions at run time (integrator.options.regions.adaptive: %s)\n",
               scene.integrator.options["regions"]["adaptive"].dump().c_str());
   Simulation simulation = buildSimulation(scene);
@@ -363,7 +363,7 @@ void explainAdaptive(const CommandLine& cl, const Input& in) {
     double relative = 1.0;
     int interface = 0;
     if (!span.regions.empty()) {
-      const AutoRegionCost cost = estimateAsyncCost(*in.mesh, in.freeDofs, span.regions, in.corotational);
+      const RegionProposalCost cost = estimateAsyncCost(*in.mesh, in.freeDofs, span.regions, in.corotational);
       relative = cost.asyncFlops / (cost.singleRateFlops / cost.singleRateSubsteps);
       interface = cost.interfaceDofs;
     }
@@ -382,18 +382,18 @@ void explainAdaptive(const CommandLine& cl, const Input& in) {
 
 int run(CommandLine& cl) {
   const Input in = std::filesystem::path(cl.input).extension() == ".json" ? readScene(cl) : readMesh(cl);
-  if (in.adaptiveScene && !cl.json) {
-    explainAdaptive(cl, in);
+  if (in.runTimeScene && !cl.json) {
+    explainRunTimeRegions(cl, in);
     std::printf("\nfor comparison, fixed regions from element frequencies (what \"regions\": \"auto\" would run):\n");
   }
   if (cl.frameRate <= 0.0) cl.frameRate = 30.0;
-  const AutoRegionOptions options = proposalOptions(cl, in);
+  const RegionProposalOptions options = proposalOptions(cl, in);
   if (in.sceneAuto && !cl.json) {
     std::printf("settings: the scene's \"regions\": \"auto\" (integrator.options.auto%s), as the simulator runs it\n",
                 cl.anyGiven() ? ", with the options given here" : "");
   }
   const VibrationMatrices matrices = vibrationMatrices(*in.mesh, in.massType);
-  const AutoRegionProposal proposal = suggestRegions(*in.mesh, in.freeDofs, options, matrices.stiffness, matrices.mass);
+  const RegionProposal proposal = proposeRegions(*in.mesh, in.freeDofs, options, matrices.stiffness, matrices.mass);
   if (!cl.json) printTable(proposal, *in.mesh, options);
   std::optional<RegionModeReport> modes;
   if (cl.modeCount > 0) modes = printModes(cl, in, proposal, matrices);
@@ -414,10 +414,10 @@ int main(int argc, char** argv) {
       "Input: a scene (.json: its mesh, fixed vertices and integrator.timestep) or a mesh file."};
   CommandLine cl;
   addOptions(app, cl);
-  if (const std::optional<int> status = cli::parse(app, argc, argv, "suggestRegions")) return *status;
+  if (const std::optional<int> status = cli::parse(app, argc, argv, "proposeRegions")) return *status;
   cl.givenTarget = app.count("--target") > 0;
   cl.givenRelative = app.count("--relative") > 0;
   cl.givenGrow = app.count("--grow") > 0;
   cl.givenMaxRatio = app.count("--max-ratio") > 0;
-  return cli::run("suggestRegions", [&] { return run(cl); });
+  return cli::run("proposeRegions", [&] { return run(cl); });
 }

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // How "regions": "auto" decides, and what it costs: the pre-check that needs no modal solve
 // where materials and element sizes leave no light or stiff part, and the modal check's one
-// factorization where it is needed (docs/asynchronous-integrator.md, "Automatic regions").
+// factorization where it is needed (docs/asynchronous-integrator.md, "Proposed regions").
 #include <gtest/gtest.h>
 
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
 #include <asyncfem/volumetricMesh/readers.hpp>
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "autoRegionMeshes.hpp"
+#include "regionProposalMeshes.hpp"
 
 namespace asyncfem {
 namespace {
@@ -20,7 +20,7 @@ namespace {
 // The frequency with the shape taken out: a regular tet's own frequency, inversely
 // proportional to the edge length, the same for a flat tet with the same edges (whose
 // element frequency is far higher), and proportional to the material's wave speed.
-TEST(AutoRegionDecision, SizeFrequencyIsTheRegularTetsAtTheElementsEdgeLength) {
+TEST(RegionProposalDecision, SizeFrequencyIsTheRegularTetsAtTheElementsEdgeLength) {
   Eigen::Matrix<double, 3, 4> regular;
   regular << 1, 1, -1, -1, 1, -1, 1, -1, 1, -1, -1, 1;  // edge 2 sqrt(2)
   const Material rubber{"rubber", 1000.0, 1e6, 0.45};
@@ -45,23 +45,23 @@ TEST(AutoRegionDecision, SizeFrequencyIsTheRegularTetsAtTheElementsEdgeLength) {
 // every element rubber): its cut elements near the surface are marked by the element
 // criterion (omega_e above 3x the median) for their shape, but no element is fast by its
 // material and size, so the pre-check withdraws the regions: no cost check, no modal solve.
-TEST(AutoRegionDecision, OneMaterialMeshIsDecidedByThePrecheckWithoutAModalSolve) {
+TEST(RegionProposalDecision, OneMaterialMeshIsDecidedByThePrecheckWithoutAModalSolve) {
   const TetMesh mesh = test::withOneMaterial(readMesh(std::string(ASYNCFEM_MODELS_DIR) + "/drop/drop.veg"),
                                              Material{"rubber", 1000.0, 1e6, 0.45});
   const FreeDofs freeDofs = test::clampedBelow(mesh, mesh.restPositions().row(2).minCoeff() + 0.02);
   const VibrationMatrices matrices = vibrationMatrices(mesh, MassType::consistent);
-  AutoRegionOptions options;
+  RegionProposalOptions options;
   options.largeTimestep = 0.01;
   options.modalCheck = true;  // as the scene path runs it
-  const AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
-  EXPECT_EQ(proposal.decidedBy, AutoRegionPath::precheck) << autoRegionSummary(proposal);
+  const RegionProposal proposal = proposeRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
+  EXPECT_EQ(proposal.decidedBy, RegionProposalPath::precheck) << regionProposalSummary(proposal);
   EXPECT_TRUE(proposal.regions.empty());
   EXPECT_FALSE(proposal.precheckWithdrawnRegions.empty());
   EXPECT_FALSE(proposal.modalReport.has_value());
   EXPECT_EQ(proposal.modalFactorizations, 0);
   EXPECT_EQ(proposal.modalSolves, 0);
   EXPECT_FALSE(proposal.cost.evaluated);
-  const AutoRegionPrecheck& check = proposal.precheck;
+  const RegionProposalPrecheck& check = proposal.precheck;
   ASSERT_TRUE(check.evaluated);
   EXPECT_TRUE(check.shapeOnly);
   EXPECT_GT(check.markedElements, 0);  // the element criterion did mark elements
@@ -69,7 +69,7 @@ TEST(AutoRegionDecision, OneMaterialMeshIsDecidedByThePrecheckWithoutAModalSolve
   EXPECT_EQ(check.waveSpeedSpread, 1.0);
   EXPECT_LE(check.maxSizeFrequencyRatio, options.relativeThreshold);
   EXPECT_GT(check.sizeSpread, 1.0);
-  const std::string summary = autoRegionSummary(proposal);
+  const std::string summary = regionProposalSummary(proposal);
   EXPECT_NE(summary.find("no fast region kept, single-rate at hL: the pre-check found no light or stiff part"),
             std::string::npos)
       << summary;
@@ -78,12 +78,12 @@ TEST(AutoRegionDecision, OneMaterialMeshIsDecidedByThePrecheckWithoutAModalSolve
 
   // Without the pre-check the same regions go to the cost check and the modal check, as
   // before it; the modal solve then takes one factorization, whatever the mode count.
-  AutoRegionOptions checked = options;
+  RegionProposalOptions checked = options;
   checked.precheck = false;
   checked.costCheck = false;  // reach the modal check whatever the cost model says
   checked.maxModalCount = 40;
-  const AutoRegionProposal modal = suggestRegions(mesh, freeDofs, checked, matrices.stiffness, matrices.mass);
-  EXPECT_EQ(modal.decidedBy, AutoRegionPath::modalCheck);
+  const RegionProposal modal = proposeRegions(mesh, freeDofs, checked, matrices.stiffness, matrices.mass);
+  EXPECT_EQ(modal.decidedBy, RegionProposalPath::modalCheck);
   EXPECT_FALSE(modal.precheck.evaluated);
   ASSERT_TRUE(modal.modalReport.has_value());
   EXPECT_EQ(modal.modalFactorizations, 1);
@@ -94,28 +94,28 @@ TEST(AutoRegionDecision, OneMaterialMeshIsDecidedByThePrecheckWithoutAModalSolve
 // Two materials: the antenna's rod (rho 50 on a block of rho 1000, the same E) is 4.5x
 // faster by its material, so the pre-check leaves the decision to the modal check, which
 // keeps the rod with the ratio its modes need, exactly as without the pre-check.
-TEST(AutoRegionDecision, TwoMaterialsStillFindTheLightPart) {
+TEST(RegionProposalDecision, TwoMaterialsStillFindTheLightPart) {
   const TetMesh mesh = test::antennaOnBlock();
   const FreeDofs freeDofs = test::clampedBelow(mesh, 1e-12);
   const VibrationMatrices matrices = vibrationMatrices(mesh, MassType::consistent);
-  AutoRegionOptions options = test::antennaModalOptions();
-  options.costCheck = false;  // as AutoRegions.ModalCheckKeepsARegionWhoseModesLiveInIt
-  const AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
+  RegionProposalOptions options = test::antennaModalOptions();
+  options.costCheck = false;  // as RegionProposal.ModalCheckKeepsARegionWhoseModesLiveInIt
+  const RegionProposal proposal = proposeRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
   ASSERT_TRUE(proposal.precheck.evaluated);
   EXPECT_FALSE(proposal.precheck.shapeOnly);
   EXPECT_GT(proposal.precheck.sizeMarkedElements, 0);
   EXPECT_NEAR(proposal.precheck.waveSpeedSpread, std::sqrt(20.0), 1e-9);
-  EXPECT_EQ(proposal.decidedBy, AutoRegionPath::modalCheck);
-  ASSERT_EQ(proposal.regions.size(), 1u) << autoRegionSummary(proposal);
+  EXPECT_EQ(proposal.decidedBy, RegionProposalPath::modalCheck);
+  ASSERT_EQ(proposal.regions.size(), 1u) << regionProposalSummary(proposal);
   ASSERT_TRUE(proposal.modalReport.has_value());
   EXPECT_EQ(proposal.modalReport->verdict, ModalVerdict::asyncKeepsModes);
   EXPECT_EQ(proposal.modalFactorizations, 1);
   for (int v : proposal.regions[0].region.vertices) EXPECT_GE(mesh.restPosition(v).z(), 0.1 - 1e-12);
 
-  AutoRegionOptions before = options;
+  RegionProposalOptions before = options;
   before.precheck = false;
   before.modalTolerance = 1e-10;  // lowestModes()'s default, as the check ran before
-  const AutoRegionProposal old = suggestRegions(mesh, freeDofs, before, matrices.stiffness, matrices.mass);
+  const RegionProposal old = proposeRegions(mesh, freeDofs, before, matrices.stiffness, matrices.mass);
   ASSERT_EQ(old.regions.size(), 1u);
   EXPECT_EQ(proposal.regions[0].region.vertices, old.regions[0].region.vertices);
   EXPECT_EQ(proposal.regions[0].region.ratio, old.regions[0].region.ratio);
@@ -129,7 +129,7 @@ TEST(AutoRegionDecision, TwoMaterialsStillFindTheLightPart) {
     EXPECT_EQ(a.keepable, b.keepable) << "mode " << k;
   }
   options.modalTolerance = 0.0;
-  EXPECT_THROW(suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass), ValidationError);
+  EXPECT_THROW(proposeRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass), ValidationError);
 }
 
 }  // namespace

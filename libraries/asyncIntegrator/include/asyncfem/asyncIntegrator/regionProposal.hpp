@@ -17,7 +17,7 @@ namespace asyncfem {
 /// every DOF). Computed in closed form, exactly (to rounding): from the eigenvalues g_i of
 /// G = sum_a grad N_a grad N_a^T, omega_e^2 = 4 / rho times the largest eigenvalue of
 /// 2 mu diag(g) + lambda sqrt(g) sqrt(g)^T (Lame constants lambda, mu): two 3x3 eigenvalue
-/// problems instead of the 12x12 one (docs/asynchronous-integrator.md, "Automatic regions").
+/// problems instead of the 12x12 one (docs/asynchronous-integrator.md, "Proposed regions").
 double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, const Material& material);
 
 /// elementMaxFrequency() of every element. By the element eigenvalue inequality,
@@ -25,7 +25,7 @@ double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, con
 /// safe measure of how small a timestep an element wants.
 Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh);
 
-struct AutoRegionOptions {
+struct RegionProposalOptions {
   double largeTimestep = 1e-2;  ///< hL (s)
   /// Target for omega * h in every region: an element with omega_e hL above it wants a
   /// fast region with ratio ceil(omega_e hL / target). <= 0: relative mode (below).
@@ -41,18 +41,18 @@ struct AutoRegionOptions {
   int growLayers = 1;
   int maxRatio = 256;
   /// Modal check (docs/asynchronous-integrator.md, "Which modes can async keep?"), run by
-  /// the overload of suggestRegions() that takes K and M: the regions are withdrawn when no
+  /// the overload of proposeRegions() that takes K and M: the regions are withdrawn when no
   /// visible mode (omega below pi * frameRate) among the lowest ones has a share of modal
   /// mass >= modalCriteria::minFastShare in them. Async with such regions keeps nothing
   /// that single-rate at hL loses, at m times the cost in S. Off by default here; the scene
-  /// path ("regions": "auto") and the suggestRegions utility turn it on.
+  /// path ("regions": "auto") and the proposeRegions utility turn it on.
   bool modalCheck = false;
   /// The pre-check, run with the modal check before the cost check and instead of any
-  /// eigensolve (docs/asynchronous-integrator.md, "Automatic regions"): when no element is
+  /// eigensolve (docs/asynchronous-integrator.md, "Proposed regions"): when no element is
   /// fast by its material and size alone (elementSizeFrequency(), against the target the
   /// element criterion uses), the marked elements are fast by their shape only, which no
   /// visible mode of a part follows, and every region is withdrawn without a cost check or
-  /// a modal solve (AutoRegionPath::precheck). false: the checks run as they did before it.
+  /// a modal solve (RegionProposalPath::precheck). false: the checks run as they did before it.
   bool precheck = true;
   double frameRate = 30.0;  ///< frames per second, for the visibility test
   /// Modes computed first; raised while the highest is still visible (to where a power law
@@ -71,9 +71,9 @@ struct AutoRegionOptions {
   /// period); the check's own floor, modalCriteria::maxResolvedOmegaSubstep = 0.1, keeps 73%.
   double modeOmegaSubstep = 0.05;
   /// At most this many regions: beyond it the regions needing the smallest ratio (then the
-  /// smallest) move to AutoRegionProposal::cappedRegions and run at hL.
+  /// smallest) move to RegionProposal::cappedRegions and run at hL.
   int maxRegions = 4;
-  /// Cost check (AutoRegionCost): the regions are withdrawn unless the estimated cost of an
+  /// Cost check (RegionProposalCost): the regions are withdrawn unless the estimated cost of an
   /// asynchronous large step is below costMargin times the cost of the single-rate steps
   /// that would meet the target everywhere (hL / max ratio) over the same time.
   bool costCheck = true;
@@ -88,7 +88,7 @@ struct AutoRegionOptions {
 /// factorization flops are CHOLMOD's own, from a symbolic analysis (METIS ordering) of each
 /// block's pattern: the whole free system, every region's A^S, and A^L with each region's
 /// dense interface block (H^{LL*}); a solve costs 4 flops per factor non-zero.
-struct AutoRegionCost {
+struct RegionProposalCost {
   bool evaluated = false;
   int freeDofs = 0;
   int largeDofs = 0;      ///< |L| once the regions are taken out
@@ -114,17 +114,17 @@ struct AutoRegionCost {
 /// a higher value of this.
 double elementSizeFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, const Material& material);
 
-/// Which step of suggestRegions() made the decision.
-enum class AutoRegionPath {
+/// Which step of proposeRegions() made the decision.
+enum class RegionProposalPath {
   elementCriterion,  ///< nothing marked (every element meets the target), or regions kept with every check off
   precheck,          ///< the pre-check withdrew the marked regions: no cost check, no modal solve
   costCheck,         ///< the cost check withdrew the regions, or kept them with the modal check off
   modalCheck,        ///< the modal check (a modal solve) kept or withdrew the regions
 };
-const char* toString(AutoRegionPath path);
+const char* toString(RegionProposalPath path);
 
-/// What the pre-check (AutoRegionOptions::precheck) measured.
-struct AutoRegionPrecheck {
+/// What the pre-check (RegionProposalOptions::precheck) measured.
+struct RegionProposalPrecheck {
   bool evaluated = false;
   /// No element is fast by its material and size alone: every element's
   /// elementSizeFrequency() times hL is at most sizeTarget.
@@ -148,11 +148,11 @@ struct ProposedRegion {
   /// region needed more substeps); 0 when it was kept.
   int ratioFromElements = 0;
   /// When the modal check set the ratio: the mode that needed it (0-based index into
-  /// AutoRegionProposal::modalReport->modes, the fastest one the region keeps); else -1.
+  /// RegionProposal::modalReport->modes, the fastest one the region keeps); else -1.
   int modeForRatio = -1;
 };
 
-struct AutoRegionProposal {
+struct RegionProposal {
   std::vector<ProposedRegion> regions;
   double largeRegionMaxFrequency = 0.0;  ///< max omega_e over elements touching no fast vertex
   double largeTimestep = 0.0;
@@ -171,18 +171,18 @@ struct AutoRegionProposal {
   int modalSolves = 0;
   double modalFactorSeconds = 0.0;
   /// The pre-check's numbers, and the regions it withdrew (regions is then empty).
-  AutoRegionPrecheck precheck;
+  RegionProposalPrecheck precheck;
   std::vector<ProposedRegion> precheckWithdrawnRegions;
   /// Which step decided.
-  AutoRegionPath decidedBy = AutoRegionPath::elementCriterion;
-  /// Wall time of suggestRegions(): the element frequencies, and the whole call (marking,
+  RegionProposalPath decidedBy = RegionProposalPath::elementCriterion;
+  /// Wall time of proposeRegions(): the element frequencies, and the whole call (marking,
   /// partition, cost check, and the modal check when it ran; the K and M it is given are
   /// assembled by the caller and not counted).
   double frequencySeconds = 0.0;
   double decisionSeconds = 0.0;
   /// The cost check (options.costCheck) of the regions after the cap, and the regions it
   /// withdrew (regions is then empty: single-rate at hL).
-  AutoRegionCost cost;
+  RegionProposalCost cost;
   std::vector<ProposedRegion> costWithdrawnRegions;
   /// Regions beyond options.maxRegions, dropped (they run at hL).
   std::vector<ProposedRegion> cappedRegions;
@@ -196,16 +196,17 @@ struct AutoRegionProposal {
 /// connected component becomes one region (so regions never share an element: components
 /// that would touch are one component) with ratio = ceil(max omega_e hL / target), capped
 /// at maxRatio. Components without free DOFs are dropped. At most options.maxRegions are
-/// kept (cappedRegions), then the cost check (AutoRegionCost) withdraws them all unless
+/// kept (cappedRegions), then the cost check (RegionProposalCost) withdraws them all unless
 /// async is estimated cheaper than single-rate at the step they would otherwise need. The
 /// proposal is a valid partition for RegionPartition.
 /// Ignores options.modalCheck (it needs K and M: use the overload below).
-AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options);
+RegionProposal proposeRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const RegionProposalOptions& options);
 
 /// The cost model alone, for any regions (e.g. a scene's own): flops per large step of
 /// async with these regions against single-rate at hL / (largest ratio).
-AutoRegionCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs, const std::vector<AsyncRegion>& regions,
-                                 bool nonlinear = false, double costMargin = 1.0);
+RegionProposalCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs,
+                                     const std::vector<AsyncRegion>& regions, bool nonlinear = false,
+                                     double costMargin = 1.0);
 
 /// The same proposal, with the pre-check (options.precheck) before the cost check and the
 /// modal check when options.modalCheck is set; the modal check runs when regions survived
@@ -219,27 +220,26 @@ AutoRegionCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs, 
 /// ModalVerdict::noVisibleModeInFast the regions move to withdrawnRegions.
 /// The mode counts are clamped to the free DOFs - 1. Throws ValidationError for frameRate <= 0,
 /// modeOmegaSubstep <= 0 or counts out of order, and what lowestModes() throws.
-AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
-                                  const Eigen::SparseMatrix<double>& stiffness,
-                                  const Eigen::SparseMatrix<double>& mass);
+RegionProposal proposeRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const RegionProposalOptions& options,
+                              const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass);
 
 /// The same proposal with K and M assembled (vibrationMatrices(mesh, massType)) only when
 /// the modal check runs, so that a decision the element criterion, the pre-check or the cost
 /// check makes costs no assembly; decisionSeconds then counts the assembly when it ran.
 /// What the scene path ("regions": "auto") runs.
-AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
-                                  MassType massType);
+RegionProposal proposeRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const RegionProposalOptions& options,
+                              MassType massType);
 
 /// Why the region has its ratio, one phrase: the mode it keeps that needed it (frequency,
 /// omega hL, omega hS against options.modeOmegaSubstep, and the element criterion's ratio),
 /// or the element criterion (max omega_e hL against the target).
-std::string ratioReason(const AutoRegionProposal& proposal, const ProposedRegion& region);
+std::string ratioReason(const RegionProposal& proposal, const ProposedRegion& region);
 
-/// One line for a run summary saying what the automatic proposal decided and why: the
+/// One line for a run summary saying what the region proposal decided and why: the
 /// regions kept (vertices, and why each has its ratio: ratioReason()), or that none was kept
 /// and which check withdrew them (the modal verdict, the cost decision), or that every
 /// element meets the target; then the time the decision took (decisionSeconds).
-std::string autoRegionSummary(const AutoRegionProposal& proposal);
+std::string regionProposalSummary(const RegionProposal& proposal);
 
 /// The regions as the modal report takes them (name, vertices, ratio).
 std::vector<ModalRegion> modalRegions(const std::vector<AsyncRegion>& regions);

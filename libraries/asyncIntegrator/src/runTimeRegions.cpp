@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Run-time regions: docs/asynchronous-integrator.md, section "Run-time regions".
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
+#include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <cmath>
 #include <cstdio>
@@ -96,7 +96,7 @@ std::vector<AsyncRegion> mergeTouching(const TetMesh& mesh, const std::vector<As
   return merged;
 }
 
-/// Regions kept at their own ratios (AdaptiveRegionOptions::nest): each vertex goes to the
+/// Regions kept at their own ratios (RunTimeRegionOptions::nest): each vertex goes to the
 /// fastest region that claims it (the earlier one among equals), regions left without a
 /// vertex vanish; where an element joins two regions whose ratios do not divide one
 /// another (Eq. N6), every touching region is merged instead (mergeTouching).
@@ -164,22 +164,22 @@ std::vector<AsyncRegion> indicatorComponents(const TetMesh& mesh, const std::vec
 
 }  // namespace
 
-AdaptiveRegionPolicy::AdaptiveRegionPolicy(const TetMesh& mesh, const FreeDofs& freeDofs, AdaptiveRegionOptions options)
+RunTimeRegionPolicy::RunTimeRegionPolicy(const TetMesh& mesh, const FreeDofs& freeDofs, RunTimeRegionOptions options)
     : mesh_(&mesh), options_(std::move(options)) {
-  const AdaptiveRegionOptions& o = options_;
-  if (o.contactRatio < 1) throw ValidationError("adaptive regions: contact ratio must be >= 1");
+  const RunTimeRegionOptions& o = options_;
+  if (o.contactRatio < 1) throw ValidationError("run-time regions: contact ratio must be >= 1");
   if (!(o.contactMargin >= 0.0) || !(o.contactLookahead >= 0.0) || o.contactRings < 0 || o.contactSlack < 0) {
-    throw ValidationError("adaptive regions: contact margin, lookahead, rings and slack must be >= 0");
+    throw ValidationError("run-time regions: contact margin, lookahead, rings and slack must be >= 0");
   }
   if (o.indicator && (!(o.indicatorTolerance > 0.0) || o.indicatorRatio < 2 || o.indicatorRings < 0)) {
-    throw ValidationError("adaptive regions: indicator tolerance must be > 0, ratio >= 2 and rings >= 0");
+    throw ValidationError("run-time regions: indicator tolerance must be > 0, ratio >= 2 and rings >= 0");
   }
   if (o.minDwell < 0 || !(o.shrinkFactor >= 1.0) || o.cacheSize < 0) {
-    throw ValidationError("adaptive regions: minDwell and cache must be >= 0 and shrink >= 1");
+    throw ValidationError("run-time regions: minDwell and cache must be >= 0 and shrink >= 1");
   }
   for (std::size_t w = 0; w < o.schedule.size(); ++w) {
     const ScheduledRegion& window = o.schedule[w];
-    const std::string where = "adaptive regions: schedule[" + std::to_string(w) + "]";
+    const std::string where = "run-time regions: schedule[" + std::to_string(w) + "]";
     if (!(window.end > window.start)) throw ValidationError(where + ": end must be after start");
     if (window.ratio < 1) throw ValidationError(where + ": ratio must be >= 1");
     for (int v : window.vertices) {
@@ -200,18 +200,18 @@ AdaptiveRegionPolicy::AdaptiveRegionPolicy(const TetMesh& mesh, const FreeDofs& 
   }
 }
 
-void AdaptiveRegionPolicy::setExternalForce(ExternalForceFunction force, ExternalForceChanges changes) {
+void RunTimeRegionPolicy::setExternalForce(ExternalForceFunction force, ExternalForceChanges changes) {
   if (loads_) loads_->setExternalForce(std::move(force), std::move(changes));
 }
 
-const std::vector<LoadsSwitch>& AdaptiveRegionPolicy::loadsSwitches() const {
+const std::vector<LoadsSwitch>& RunTimeRegionPolicy::loadsSwitches() const {
   static const std::vector<LoadsSwitch> none;
   return loads_ ? loads_->switches() : none;
 }
 
-std::vector<char> AdaptiveRegionPolicy::contactVertices(double largeStep, const Eigen::VectorXd& u,
-                                                        const Eigen::VectorXd& v, const ObstacleProximity& proximity,
-                                                        int rings) const {
+std::vector<char> RunTimeRegionPolicy::contactVertices(double largeStep, const Eigen::VectorXd& u,
+                                                       const Eigen::VectorXd& v, const ObstacleProximity& proximity,
+                                                       int rings) const {
   std::vector<char> marked(static_cast<std::size_t>(mesh_->numVertices()), 0);
   if (!options_.contact || !proximity) return marked;
   std::vector<int> near;
@@ -226,7 +226,7 @@ std::vector<char> AdaptiveRegionPolicy::contactVertices(double largeStep, const 
   return marked;
 }
 
-void AdaptiveRegionPolicy::recordVelocity(double time, const Eigen::VectorXd& v) {
+void RunTimeRegionPolicy::recordVelocity(double time, const Eigen::VectorXd& v) {
   if (!options_.indicator) return;
   if (time == lastRecorded_ && !velocities_.empty()) {
     velocities_.back() = v;  // the same boundary again (a set-up before its first step)
@@ -239,7 +239,7 @@ void AdaptiveRegionPolicy::recordVelocity(double time, const Eigen::VectorXd& v)
 }
 
 // Eq. (R1): e_v = |v_k - 2 v_{k-1} + v_{k-2}| / 2 against tolerance times the RMS speed.
-std::vector<int> AdaptiveRegionPolicy::indicatorRatios(int extraRings) const {
+std::vector<int> RunTimeRegionPolicy::indicatorRatios(int extraRings) const {
   const auto n = static_cast<std::size_t>(mesh_->numVertices());
   std::vector<int> ratio(n, 0);
   if (!options_.indicator || velocities_.size() < 3) return ratio;
@@ -283,7 +283,7 @@ std::vector<int> AdaptiveRegionPolicy::indicatorRatios(int extraRings) const {
   return ratio;
 }
 
-std::vector<int> AdaptiveRegionPolicy::activeWindows(double time) const {
+std::vector<int> RunTimeRegionPolicy::activeWindows(double time) const {
   std::vector<int> active;
   for (std::size_t w = 0; w < options_.schedule.size(); ++w) {
     const ScheduledRegion& window = options_.schedule[w];
@@ -292,8 +292,8 @@ std::vector<int> AdaptiveRegionPolicy::activeWindows(double time) const {
   return active;
 }
 
-std::vector<AsyncRegion> AdaptiveRegionPolicy::assemble(double time, const std::vector<char>& contact,
-                                                        const std::vector<int>& indicated) const {
+std::vector<AsyncRegion> RunTimeRegionPolicy::assemble(double time, const std::vector<char>& contact,
+                                                       const std::vector<int>& indicated) const {
   std::vector<AsyncRegion> regions;
   for (int w : activeWindows(time)) {
     const ScheduledRegion& window = options_.schedule[static_cast<std::size_t>(w)];
@@ -319,9 +319,9 @@ std::vector<AsyncRegion> AdaptiveRegionPolicy::assemble(double time, const std::
   return out;
 }
 
-std::vector<AsyncRegion> AdaptiveRegionPolicy::wanted(double time, double largeStep, const Eigen::VectorXd& u,
-                                                      const Eigen::VectorXd& v,
-                                                      const ObstacleProximity& proximity) const {
+std::vector<AsyncRegion> RunTimeRegionPolicy::wanted(double time, double largeStep, const Eigen::VectorXd& u,
+                                                     const Eigen::VectorXd& v,
+                                                     const ObstacleProximity& proximity) const {
   return assemble(time, contactVertices(largeStep, u, v, proximity, options_.contactRings), indicatorRatios(0));
 }
 
@@ -338,9 +338,9 @@ bool covers(int numVertices, const std::vector<AsyncRegion>& regions, const std:
 }
 }  // namespace
 
-bool AdaptiveRegionPolicy::canServe(const std::vector<AsyncRegion>& regions, const std::vector<AsyncRegion>& proposal,
-                                    double time, double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
-                                    const ObstacleProximity& proximity) const {
+bool RunTimeRegionPolicy::canServe(const std::vector<AsyncRegion>& regions, const std::vector<AsyncRegion>& proposal,
+                                   double time, double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                                   const ObstacleProximity& proximity) const {
   if (static_cast<double>(countFast(regions)) > options_.shrinkFactor * countFast(proposal)) return false;
   const int n = mesh_->numVertices();
   const std::vector<int> have = vertexRatios(n, regions);
@@ -359,11 +359,11 @@ bool AdaptiveRegionPolicy::canServe(const std::vector<AsyncRegion>& regions, con
   return true;
 }
 
-std::optional<std::vector<AsyncRegion>> AdaptiveRegionPolicy::decide(double time, double largeStep,
-                                                                     const Eigen::VectorXd& u, const Eigen::VectorXd& v,
-                                                                     const ObstacleProximity& proximity,
-                                                                     const std::vector<AsyncRegion>& current,
-                                                                     long long stepsKept, std::string& reason) {
+std::optional<std::vector<AsyncRegion>> RunTimeRegionPolicy::decide(double time, double largeStep,
+                                                                    const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                                                                    const ObstacleProximity& proximity,
+                                                                    const std::vector<AsyncRegion>& current,
+                                                                    long long stepsKept, std::string& reason) {
   const int n = mesh_->numVertices();
   recordVelocity(time, v);
   std::string loadsReason;
@@ -419,7 +419,7 @@ void appendRepartitionLines(const std::vector<RepartitionRecord>& records, std::
     seconds += r.seconds;
   }
   char line[320];
-  std::snprintf(line, sizeof(line), "adaptive regions: %zu re-partitions (%d from the set-up cache), %.3f s of set-up",
+  std::snprintf(line, sizeof(line), "run-time regions: %zu re-partitions (%d from the set-up cache), %.3f s of set-up",
                 records.size(), reused, seconds);
   lines.emplace_back(line);
   constexpr std::size_t kShown = 10;

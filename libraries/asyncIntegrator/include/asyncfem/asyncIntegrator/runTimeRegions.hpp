@@ -28,8 +28,8 @@ struct ScheduledRegion {
 /// The policies of run-time regions and their hysteresis (docs/asynchronous-integrator.md,
 /// "Run-time regions"). Policies combine: the regions wanted at a large-step boundary are
 /// the contact region and every active scheduled region, merged where they touch (an
-/// element with vertices in both) at the larger ratio, or nested (AdaptiveRegionOptions::nest).
-struct AdaptiveRegionOptions {
+/// element with vertices in both) at the larger ratio, or nested (RunTimeRegionOptions::nest).
+struct RunTimeRegionOptions {
   /// Contact policy: the vertices in contact or within contactMargin (a length) of an
   /// obstacle, at the step's start state or at the state predicted contactLookahead large
   /// steps ahead (u + k hL v), grown by contactRings element rings, at ratio contactRatio.
@@ -99,13 +99,13 @@ struct RepartitionRecord {
 };
 
 /// Decides, at each large-step boundary, which fast regions a run needs.
-class AdaptiveRegionPolicy {
+class RunTimeRegionPolicy {
  public:
   /// Throws asyncfem::ValidationError for a ratio < 1, a negative margin, lookahead or
   /// ring count, minDwell < 0, shrinkFactor < 1, a schedule window with end <= start or
   /// vertices out of range, or contact requested for a system without obstacles
   /// (checked by the integrator).
-  AdaptiveRegionPolicy(const TetMesh& mesh, const FreeDofs& freeDofs, AdaptiveRegionOptions options);
+  RunTimeRegionPolicy(const TetMesh& mesh, const FreeDofs& freeDofs, RunTimeRegionOptions options);
 
   /// The regions wanted now (time t, start state u, v, large step hL), merged and with
   /// vertices that have no free DOF left out. Empty: no fast region.
@@ -127,7 +127,7 @@ class AdaptiveRegionPolicy {
                 double largeStep, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                 const ObstacleProximity& proximity) const;
 
-  const AdaptiveRegionOptions& options() const { return options_; }
+  const RunTimeRegionOptions& options() const { return options_; }
 
   /// The body's external force, for the loads policy (DynamicSystem::externalForce and
   /// externalForceChanges).
@@ -148,7 +148,7 @@ class AdaptiveRegionPolicy {
 
   const TetMesh* mesh_;
   std::vector<char> hasFreeDof_;
-  AdaptiveRegionOptions options_;
+  RunTimeRegionOptions options_;
   std::vector<int> lastWindows_;
   bool started_ = false;
   std::optional<LoadsPolicy> loads_;

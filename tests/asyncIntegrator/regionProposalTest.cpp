@@ -3,7 +3,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/problem/problem.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
@@ -14,14 +14,14 @@
 #include <sstream>
 
 #include "asyncTestSystem.hpp"
-#include "autoRegionMeshes.hpp"
+#include "regionProposalMeshes.hpp"
 
 namespace asyncfem {
 namespace {
 
 // The element bound is >= the assembled system's highest frequency (element eigenvalue
 // inequality), checked against a dense generalized eigen-solve with lumped mass.
-TEST(AutoRegions, ElementFrequenciesBoundTheSystem) {
+TEST(RegionProposal, ElementFrequenciesBoundTheSystem) {
   const Problem bar = test::stiffEndBarProblem(test::testSettings(ForceModelType::linear, 0.0, 0.0, MassType::lumped));
   const Eigen::MatrixXd K = Eigen::MatrixXd(bar.stiffnessMatrix());
   const Eigen::MatrixXd M = Eigen::MatrixXd(bar.massMatrix());
@@ -52,7 +52,7 @@ double referenceElementFrequency(const ElementPositions& x, const Material& mate
 // eigenvalue, the closed form loses up to about eps * sqrt(g_max / g_min) (the square roots of
 // G's eigenvalues), 1e-12 at the flattest tets here, so 1e-9 leaves room and still catches
 // any error in the formula (a wrong term moves omega by percents).
-TEST(AutoRegions, ClosedFormElementFrequencyEqualsTheElementEigenproblem) {
+TEST(RegionProposal, ClosedFormElementFrequencyEqualsTheElementEigenproblem) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::uniform_real_distribution<double> poisson(-0.9, 0.49);
@@ -89,8 +89,8 @@ TEST(AutoRegions, ClosedFormElementFrequencyEqualsTheElementEigenproblem) {
 
 // On every shipped mesh the closed form gives the 12x12 eigen-solve's frequencies (relative
 // 1e-9, as above) and the same decision: the same elements above the default relative
-// target (3x the median), so suggestRegions proposes what it proposed before.
-TEST(AutoRegions, ClosedFormDecidesAsTheElementEigenproblemOnShippedMeshes) {
+// target (3x the median), so proposeRegions proposes what it proposed before.
+TEST(RegionProposal, ClosedFormDecidesAsTheElementEigenproblemOnShippedMeshes) {
   for (const char* name : {"antenna/antenna", "antenna/antenna-wide", "ball/ball", "beam/beam", "dinosaur/dinosaur",
                            "dragon/dragon", "drop/drop", "flower/flower", "snail/snail"}) {
     const TetMesh mesh = readMesh(std::string(ASYNCFEM_MODELS_DIR) + "/" + name + ".veg");
@@ -115,7 +115,7 @@ TEST(AutoRegions, ClosedFormDecidesAsTheElementEigenproblemOnShippedMeshes) {
   }
 }
 
-TEST(AutoRegions, StiffTipBecomesOneFastRegionMeetingTheTarget) {
+TEST(RegionProposal, StiffTipBecomesOneFastRegionMeetingTheTarget) {
   const test::TestSystem ts = test::makeTestSystem(0, 0);
   const Eigen::VectorXd omega = elementMaxFrequencies(ts.mesh);
   // Choose hL so the soft part meets the target and the stiff tip does not.
@@ -125,11 +125,11 @@ TEST(AutoRegions, StiffTipBecomesOneFastRegionMeetingTheTarget) {
     bucket = std::max(bucket, omega[e]);
   }
   ASSERT_GT(stiffMax, 2 * softMax);
-  AutoRegionOptions options;
+  RegionProposalOptions options;
   options.targetOmegaH = 1.0;
   options.largeTimestep = 0.9 / softMax;
   options.growLayers = 0;
-  const AutoRegionProposal proposal = suggestRegions(ts.mesh, ts.system.freeDofs, options);
+  const RegionProposal proposal = proposeRegions(ts.mesh, ts.system.freeDofs, options);
   ASSERT_EQ(proposal.regions.size(), 1u);
   const ProposedRegion& r = proposal.regions[0];
   EXPECT_GE(r.region.ratio, 2);
@@ -142,42 +142,42 @@ TEST(AutoRegions, StiffTipBecomesOneFastRegionMeetingTheTarget) {
   async.step();
 }
 
-TEST(AutoRegions, GrowingAddsRingsAndKeepsOneRegion) {
+TEST(RegionProposal, GrowingAddsRingsAndKeepsOneRegion) {
   const test::TestSystem ts = test::makeTestSystem(0, 0);
-  AutoRegionOptions options;
+  RegionProposalOptions options;
   options.targetOmegaH = 1.0;
   const Eigen::VectorXd omega = elementMaxFrequencies(ts.mesh);
   options.largeTimestep = 1.5 / omega.minCoeff();
   options.growLayers = 0;
   options.costCheck = false;  // this target marks most of the bar: about geometry, not cost
-  const auto none = suggestRegions(ts.mesh, ts.system.freeDofs, options);
+  const auto none = proposeRegions(ts.mesh, ts.system.freeDofs, options);
   options.growLayers = 1;
-  const auto grown = suggestRegions(ts.mesh, ts.system.freeDofs, options);
+  const auto grown = proposeRegions(ts.mesh, ts.system.freeDofs, options);
   ASSERT_FALSE(none.regions.empty());
   ASSERT_FALSE(grown.regions.empty());
   EXPECT_GE(grown.regions[0].region.vertices.size(), none.regions[0].region.vertices.size());
 }
 
-TEST(AutoRegions, NothingProposedWhenEverythingMeetsTheTarget) {
+TEST(RegionProposal, NothingProposedWhenEverythingMeetsTheTarget) {
   const test::TestSystem ts = test::makeTestSystem(0, 0);
-  AutoRegionOptions options;
+  RegionProposalOptions options;
   options.largeTimestep = 0.5 / elementMaxFrequencies(ts.mesh).maxCoeff();
   options.targetOmegaH = 1.0;
-  EXPECT_TRUE(suggestRegions(ts.mesh, ts.system.freeDofs, options).regions.empty());
+  EXPECT_TRUE(proposeRegions(ts.mesh, ts.system.freeDofs, options).regions.empty());
   options.largeTimestep = -1;
-  EXPECT_THROW(suggestRegions(ts.mesh, ts.system.freeDofs, options), ValidationError);
+  EXPECT_THROW(proposeRegions(ts.mesh, ts.system.freeDofs, options), ValidationError);
 }
 
 // Relative mode (the default): the stiff, light tip is about an order of magnitude
 // "faster" than the median element, so it alone becomes a region, whatever hL is.
-TEST(AutoRegions, RelativeModeFindsTheStiffPartAtAnyTimestep) {
+TEST(RegionProposal, RelativeModeFindsTheStiffPartAtAnyTimestep) {
   const test::TestSystem ts = test::makeTestSystem(0, 0);
   double targetPerTimestep = -1;  // the relative target is proportional to hL
   for (double hL : {1e-4, 1e-2, 1.0}) {
-    AutoRegionOptions options;
+    RegionProposalOptions options;
     options.largeTimestep = hL;
     options.growLayers = 0;
-    const AutoRegionProposal proposal = suggestRegions(ts.mesh, ts.system.freeDofs, options);
+    const RegionProposal proposal = proposeRegions(ts.mesh, ts.system.freeDofs, options);
     ASSERT_EQ(proposal.regions.size(), 1u) << "hL " << hL;
     for (int v : proposal.regions[0].region.vertices) EXPECT_GE(ts.mesh.restPosition(v).x(), 0.75 - 1e-12);
     EXPECT_GE(proposal.regions[0].region.ratio, 2);
@@ -190,20 +190,20 @@ TEST(AutoRegions, RelativeModeFindsTheStiffPartAtAnyTimestep) {
 // stiff, light tip is proposed by the frequency criterion, but every visible mode is a
 // bending mode of the whole beam with at most a quarter of its modal mass in the tip, so
 // the region is withdrawn and the scene runs single-rate at hL.
-TEST(AutoRegions, ModalCheckWithdrawsTheTipOfTheDefaultBeam) {
+TEST(RegionProposal, ModalCheckWithdrawsTheTipOfTheDefaultBeam) {
   const Problem beam = test::defaultBeamProblem();
   const TetMesh& mesh = beam.mesh();
   const FreeDofs& freeDofs = beam.freeDofs();
   const VibrationMatrices matrices = vibrationMatrices(mesh, MassType::consistent);
-  AutoRegionOptions options;
+  RegionProposalOptions options;
   options.largeTimestep = 1.0 / 120.0;
-  const AutoRegionProposal unchecked = suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
+  const RegionProposal unchecked = proposeRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
   ASSERT_EQ(unchecked.regions.size(), 1u);  // modalCheck is off by default
   EXPECT_FALSE(unchecked.modalReport.has_value());
 
   options.modalCheck = true;
   options.frameRate = 30.0;
-  const AutoRegionProposal checked = suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
+  const RegionProposal checked = proposeRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
   EXPECT_TRUE(checked.regions.empty());
   ASSERT_EQ(checked.withdrawnRegions.size(), 1u);
   EXPECT_EQ(checked.withdrawnRegions[0].region.vertices, unchecked.regions[0].region.vertices);
@@ -213,11 +213,11 @@ TEST(AutoRegions, ModalCheckWithdrawsTheTipOfTheDefaultBeam) {
   // The proposal (no region) is still a valid partition.
   EXPECT_FALSE(RegionPartition(mesh, freeDofs, checked.asyncRegions()).touching());
   // The run summary's line says what was decided and why, in both cases.
-  const std::string withdrawn = autoRegionSummary(checked);
+  const std::string withdrawn = regionProposalSummary(checked);
   EXPECT_NE(withdrawn.find("no fast region kept, single-rate at hL: the modal check withdrew 1 region(s): no mode"),
             std::string::npos)
       << withdrawn;
-  const std::string kept = autoRegionSummary(unchecked);
+  const std::string kept = regionProposalSummary(unchecked);
   EXPECT_NE(kept.find("1 region(s) kept: auto1 ("), std::string::npos) << kept;
 }
 
@@ -225,7 +225,7 @@ TEST(AutoRegions, ModalCheckWithdrawsTheTipOfTheDefaultBeam) {
 // and damped at hL gets omega hS <= options.modeOmegaSubstep, and the ratio is the smallest
 // that does so (one less leaves the fastest of them above it), the mode named in the
 // proposal and in the reason it prints.
-void expectRatioFromKeptModes(const AutoRegionProposal& proposal, const AutoRegionOptions& options,
+void expectRatioFromKeptModes(const RegionProposal& proposal, const RegionProposalOptions& options,
                               const std::string& table) {
   const ProposedRegion& region = proposal.regions[0];
   double fastestKept = 0.0;
@@ -241,21 +241,21 @@ void expectRatioFromKeptModes(const AutoRegionProposal& proposal, const AutoRegi
   EXPECT_EQ(proposal.modalReport->modes[static_cast<std::size_t>(region.modeForRatio)].omegaLargeStep, fastestKept);
   const std::string reason = ratioReason(proposal, region);
   EXPECT_NE(reason.find("for mode " + std::to_string(region.modeForRatio + 1) + " ("), std::string::npos) << reason;
-  EXPECT_NE(autoRegionSummary(proposal).find(reason), std::string::npos) << autoRegionSummary(proposal);
+  EXPECT_NE(regionProposalSummary(proposal).find(reason), std::string::npos) << regionProposalSummary(proposal);
 }
 
 // The rod's wave speed is 4.5x the block's, so the frequency criterion marks it (plus one
 // ring of block vertices); its bending pair lies below the Nyquist frequency and lives in
 // it, so the modal check keeps the region.
-TEST(AutoRegions, ModalCheckKeepsARegionWhoseModesLiveInIt) {
+TEST(RegionProposal, ModalCheckKeepsARegionWhoseModesLiveInIt) {
   const TetMesh mesh = test::antennaOnBlock();
   const FreeDofs freeDofs = test::clampedBelow(mesh, 1e-12);
   const VibrationMatrices matrices = vibrationMatrices(mesh, MassType::consistent);
-  AutoRegionOptions options = test::antennaModalOptions();
+  RegionProposalOptions options = test::antennaModalOptions();
   // On this small mesh (|L| = 147 DOFs) the cost model finds m = 2 async dearer than two
   // single-rate steps; this test is about the modal check alone.
   options.costCheck = false;
-  const AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
+  const RegionProposal proposal = proposeRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
   ASSERT_TRUE(proposal.modalReport.has_value()) << proposal.cost.decision;
   std::ostringstream table;
   printRegionModeReport(table, *proposal.modalReport);
@@ -273,15 +273,15 @@ TEST(AutoRegions, ModalCheckKeepsARegionWhoseModesLiveInIt) {
   const ProposedRegion& region = proposal.regions[0];
   EXPECT_EQ(proposal.modalReport->verdict, ModalVerdict::asyncKeepsModes) << table.str();
   expectRatioFromKeptModes(proposal, options, table.str());
-  AutoRegionOptions elementsOnly = options;
+  RegionProposalOptions elementsOnly = options;
   elementsOnly.modalCheck = false;
-  const AutoRegionProposal byElements = suggestRegions(mesh, freeDofs, elementsOnly);
+  const RegionProposal byElements = proposeRegions(mesh, freeDofs, elementsOnly);
   ASSERT_EQ(byElements.regions.size(), 1u);
   EXPECT_LT(byElements.regions[0].region.ratio, region.region.ratio);
   EXPECT_EQ(region.ratioFromElements, byElements.regions[0].region.ratio);
 
   options.frameRate = -1.0;
-  EXPECT_THROW(suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass), ValidationError);
+  EXPECT_THROW(proposeRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass), ValidationError);
 }
 
 // The shipped antenna (models/antenna/antenna.json: hL = 1/60, 60 frames/s, bottom fixed,
@@ -290,15 +290,15 @@ TEST(AutoRegions, ModalCheckKeepsARegionWhoseModesLiveInIt) {
 // region, keeps the rod's bending pair (omega hL 0.93 and 1.17), and takes its ratio from
 // them: 24 (omega hS 0.049), where the element criterion alone gives 2 and resolving them
 // to the check's 0.1 only 12.
-TEST(AutoRegions, AntennaProposalTakesItsRatioFromTheModesItKeeps) {
+TEST(RegionProposal, AntennaProposalTakesItsRatioFromTheModesItKeeps) {
   const TetMesh mesh = readMesh(std::string(ASYNCFEM_MODELS_DIR) + "/antenna/antenna.veg");
   const FreeDofs freeDofs = FreeDofs::fromFixedVertices(mesh.numVertices(), mesh.vertexSet("bottom"));
   const VibrationMatrices matrices = vibrationMatrices(mesh, MassType::consistent);
-  AutoRegionOptions options;
+  RegionProposalOptions options;
   options.largeTimestep = 1.0 / 60.0;
   options.modalCheck = true;
   options.frameRate = 60.0;
-  const AutoRegionProposal proposal = suggestRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
+  const RegionProposal proposal = proposeRegions(mesh, freeDofs, options, matrices.stiffness, matrices.mass);
   ASSERT_TRUE(proposal.modalReport.has_value()) << proposal.cost.decision;
   std::ostringstream table;
   printRegionModeReport(table, *proposal.modalReport);
@@ -352,18 +352,18 @@ Bridge jitteredBridge() {
 // would need, or nothing is kept (single-rate). The estimate is a model, not a
 // measurement: the test checks the decision against the model's own numbers and that the
 // cap holds.
-TEST(AutoRegions, OneMaterialBridgeProposesOnlyWhatPays) {
+TEST(RegionProposal, OneMaterialBridgeProposesOnlyWhatPays) {
   const Bridge bridge = jitteredBridge();
-  AutoRegionOptions options;
+  RegionProposalOptions options;
   options.largeTimestep = 1e-3;
-  AutoRegionOptions unchecked = options;
+  RegionProposalOptions unchecked = options;
   unchecked.costCheck = false;
   unchecked.maxRegions = 1000;
-  const AutoRegionProposal raw = suggestRegions(bridge.mesh, bridge.freeDofs, unchecked);
+  const RegionProposal raw = proposeRegions(bridge.mesh, bridge.freeDofs, unchecked);
   ASSERT_GT(raw.regions.size(), 1u) << "the jitter must make the frequency criterion mark something";
   EXPECT_FALSE(raw.cost.evaluated);
 
-  const AutoRegionProposal proposal = suggestRegions(bridge.mesh, bridge.freeDofs, options);
+  const RegionProposal proposal = proposeRegions(bridge.mesh, bridge.freeDofs, options);
   EXPECT_LE(proposal.regions.size() + proposal.costWithdrawnRegions.size(), 4u);
   EXPECT_EQ(proposal.regions.size() + proposal.costWithdrawnRegions.size() + proposal.cappedRegions.size(),
             raw.regions.size());
@@ -380,7 +380,7 @@ TEST(AutoRegions, OneMaterialBridgeProposesOnlyWhatPays) {
   }
   // Every region of the raw proposal at once (14 on the held-out bridge) costs more than
   // single-rate at the smallest step they need: the model says so too.
-  const AutoRegionCost all = estimateAsyncCost(bridge.mesh, bridge.freeDofs, raw.asyncRegions());
+  const RegionProposalCost all = estimateAsyncCost(bridge.mesh, bridge.freeDofs, raw.asyncRegions());
   EXPECT_EQ(
       all.singleRateSubsteps,
       std::max_element(raw.regions.begin(), raw.regions.end(), [](const ProposedRegion& a, const ProposedRegion& b) {
@@ -390,22 +390,22 @@ TEST(AutoRegions, OneMaterialBridgeProposesOnlyWhatPays) {
 
 // The favourable case: a small stiff part needing a large ratio. Async is estimated far
 // cheaper than single-rate at its step, and a margin of zero withdraws the region.
-TEST(AutoRegions, CostModelKeepsASmallFastRegionAndHonoursTheMargin) {
+TEST(RegionProposal, CostModelKeepsASmallFastRegionAndHonoursTheMargin) {
   const test::TestSystem ts = test::makeTestSystem(0, 0);
   std::vector<int> tip;
   for (int v = 0; v < ts.mesh.numVertices(); ++v)
     if (ts.mesh.restPosition(v).x() > 0.875 - 1e-12) tip.push_back(v);
   const std::vector<AsyncRegion> regions{{"tip", tip, 16}};
-  const AutoRegionCost cost = estimateAsyncCost(ts.mesh, ts.system.freeDofs, regions);
+  const RegionProposalCost cost = estimateAsyncCost(ts.mesh, ts.system.freeDofs, regions);
   EXPECT_EQ(cost.singleRateSubsteps, 16);
   EXPECT_TRUE(cost.asyncCheaper) << cost.decision;
   // Half the free DOFs or fewer run at 16x: well under the cost of 16 full steps.
   EXPECT_LT(cost.ratio(), 0.75) << cost.decision;
   EXPECT_GT(cost.asyncSetupFlops, 0.0);
-  const AutoRegionCost nonlinear = estimateAsyncCost(ts.mesh, ts.system.freeDofs, regions, true);
+  const RegionProposalCost nonlinear = estimateAsyncCost(ts.mesh, ts.system.freeDofs, regions, true);
   EXPECT_GT(nonlinear.asyncFlops, cost.asyncFlops);
   EXPECT_GT(nonlinear.singleRateFlops, cost.singleRateFlops);
-  const AutoRegionCost strict = estimateAsyncCost(ts.mesh, ts.system.freeDofs, regions, false, 0.0);
+  const RegionProposalCost strict = estimateAsyncCost(ts.mesh, ts.system.freeDofs, regions, false, 0.0);
   EXPECT_FALSE(strict.asyncCheaper);
   EXPECT_NE(strict.decision.find("withdrawn"), std::string::npos) << strict.decision;
 }

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The cost model of automatic regions (AutoRegionCost, estimateAsyncCost): flops of an
+// The cost model of proposed regions (RegionProposalCost, estimateAsyncCost): flops of an
 // asynchronous large step against single-rate, from CHOLMOD's symbolic analyses.
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <cstdio>
 #include <memory>
@@ -60,9 +60,9 @@ FactorCost analyseBlock(const std::vector<std::pair<int, int>>& vertexPairs, int
 
 }  // namespace
 
-AutoRegionCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs, const std::vector<AsyncRegion>& regions,
-                                 bool nonlinear, double costMargin) {
-  AutoRegionCost cost;
+RegionProposalCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDofs,
+                                     const std::vector<AsyncRegion>& regions, bool nonlinear, double costMargin) {
+  RegionProposalCost cost;
   cost.evaluated = true;
   const RegionPartition partition(mesh, freeDofs, regions);
   const int nv = mesh.numVertices();

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Run-time regions: AdaptiveRegionPolicy's decisions and AsyncBackwardEuler's
+// Run-time regions: RunTimeRegionPolicy's decisions and AsyncBackwardEuler's
 // re-partitions (fresh and cached set-ups), against integrators set up by hand.
 #include <gtest/gtest.h>
 
-#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
 #include <asyncfem/asyncIntegrator/registration.hpp>
+#include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -25,22 +25,22 @@ void expectSameState(const Integrator& a, const Integrator& b) {
   EXPECT_EQ((a.velocity() - b.velocity()).cwiseAbs().maxCoeff(), 0.0);
 }
 
-AdaptiveRegionOptions scheduleOf(std::vector<ScheduledRegion> windows) {
-  AdaptiveRegionOptions options;
+RunTimeRegionOptions scheduleOf(std::vector<ScheduledRegion> windows) {
+  RunTimeRegionOptions options;
   options.schedule = std::move(windows);
   return options;
 }
 
 // A window open over the whole run is a fixed region: the adaptive run equals the fixed
 // one bit for bit (the same set-up, then the same steps).
-TEST(AdaptiveRegions, AnAlwaysOpenWindowEqualsTheFixedRegion) {
+TEST(RunTimeRegions, AnAlwaysOpenWindowEqualsTheFixedRegion) {
   const test::TestSystem ts = test::makeTestSystem(0.3, 2e-3);
   const std::vector<int> tip = test::verticesBeyond(ts.mesh, 0.75);
   AsyncBackwardEuler fixed(ts.mesh, ts.system, kLargeStep, {{"tip", tip, 4}});
   AsyncBackwardEuler adaptive(ts.mesh, ts.system, kLargeStep, {});
   fixed.setState(ts.u0, ts.v0);
   adaptive.setState(ts.u0, ts.v0);
-  adaptive.setAdaptiveRegions(scheduleOf({{"tip", 0.0, 1.0, tip, 4}}));
+  adaptive.setRunTimeRegions(scheduleOf({{"tip", 0.0, 1.0, tip, 4}}));
   ASSERT_EQ(adaptive.partition().numRegions(), 1);
   for (int k = 0; k < 5; ++k) {
     fixed.step();
@@ -55,7 +55,7 @@ TEST(AdaptiveRegions, AnAlwaysOpenWindowEqualsTheFixedRegion) {
   bool listed = false;
   for (const std::string& line : report.lines) listed = listed || line.find("initial regions") != std::string::npos;
   EXPECT_TRUE(listed);
-  EXPECT_NE(report.resumeCaveat.find("adaptive regions"), std::string::npos) << report.resumeCaveat;
+  EXPECT_NE(report.resumeCaveat.find("run-time regions"), std::string::npos) << report.resumeCaveat;
   EXPECT_TRUE(fixed.report().resumeCaveat.empty()) << fixed.report().resumeCaveat;
   EXPECT_EQ(adaptive.repartitions()[0].fastVertices, static_cast<int>(tip.size()));
 }
@@ -63,7 +63,7 @@ TEST(AdaptiveRegions, AnAlwaysOpenWindowEqualsTheFixedRegion) {
 // A window [2 hL, 4 hL) opens and closes exactly at those large-step boundaries, and the
 // run equals one whose partitions are set by hand at the same steps; the second opening of
 // the same window takes the cached set-up, with the same result as a fresh one.
-TEST(AdaptiveRegions, WindowsSwitchAtTheirBoundariesAndTheCacheChangesNothing) {
+TEST(RunTimeRegions, WindowsSwitchAtTheirBoundariesAndTheCacheChangesNothing) {
   const test::TestSystem ts = test::makeTestSystem(0.0, 1e-3);
   const std::vector<int> tip = test::verticesBeyond(ts.mesh, 0.75);
   const std::vector<AsyncRegion> fast{{"tip", tip, 4}};
@@ -72,7 +72,7 @@ TEST(AdaptiveRegions, WindowsSwitchAtTheirBoundariesAndTheCacheChangesNothing) {
   adaptive.setState(ts.u0, ts.v0);
   byHand.setState(ts.u0, ts.v0);
   // Boundaries half a step away from the step times, so rounding cannot move them.
-  adaptive.setAdaptiveRegions(scheduleOf(
+  adaptive.setRunTimeRegions(scheduleOf(
       {{"tip", 1.5 * kLargeStep, 3.5 * kLargeStep, tip, 4}, {"tip", 5.5 * kLargeStep, 7.5 * kLargeStep, tip, 4}}));
   const std::vector<int> switchAt{2, 4, 6, 8};
   for (int k = 0; k < 9; ++k) {
@@ -100,15 +100,15 @@ TEST(AdaptiveRegions, WindowsSwitchAtTheirBoundariesAndTheCacheChangesNothing) {
 
 // With room for one set-up, the empty partition (what every contact returns to) is the one
 // kept: after A and then B, going back to no region takes the cached set-up.
-TEST(AdaptiveRegions, TheEmptyPartitionStaysCached) {
+TEST(RunTimeRegions, TheEmptyPartitionStaysCached) {
   const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
-  AdaptiveRegionOptions options =
+  RunTimeRegionOptions options =
       scheduleOf({{"a", 1.5 * kLargeStep, 2.5 * kLargeStep, test::verticesBeyond(ts.mesh, 0.75), 4},
                   {"b", 2.5 * kLargeStep, 3.5 * kLargeStep, test::verticesBeyond(ts.mesh, 0.5), 2}});
   options.cacheSize = 1;
   AsyncBackwardEuler adaptive(ts.mesh, ts.system, kLargeStep, {});
   adaptive.setState(ts.u0, ts.v0);
-  adaptive.setAdaptiveRegions(options);
+  adaptive.setRunTimeRegions(options);
   for (int k = 0; k < 5; ++k) adaptive.step();
   const std::vector<RepartitionRecord>& records = adaptive.repartitions();
   ASSERT_EQ(records.size(), 3U);
@@ -121,19 +121,19 @@ TEST(AdaptiveRegions, TheEmptyPartitionStaysCached) {
 // The contact policy through a stand-in obstacle: the vertices with x above a threshold
 // that the test moves. The region appears at once, grown by rings, stays while what is
 // needed stays inside it, and goes only after the dwell.
-TEST(AdaptiveRegions, ContactRegionGrowsAtOnceAndShrinksAfterTheDwell) {
+TEST(RunTimeRegions, ContactRegionGrowsAtOnceAndShrinksAfterTheDwell) {
   const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
   double threshold = 2.0;  // nothing near
   const ObstacleProximity proximity = [&](const Eigen::VectorXd&, double, std::vector<int>& out) {
     out = test::verticesBeyond(ts.mesh, threshold);
   };
-  AdaptiveRegionOptions options;
+  RunTimeRegionOptions options;
   options.contact = true;
   options.contactRatio = 6;
   options.contactRings = 1;
   options.contactLookahead = 0.0;
   options.minDwell = 3;
-  AdaptiveRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
+  RunTimeRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(ts.system.numDofs());
   std::vector<AsyncRegion> current;
   std::string reason;
@@ -148,9 +148,9 @@ TEST(AdaptiveRegions, ContactRegionGrowsAtOnceAndShrinksAfterTheDwell) {
   // 1/8 cubes; with a slack of 2, one ring more again.
   EXPECT_EQ((*next)[0].vertices, test::verticesBeyond(ts.mesh, 0.75));
   {
-    AdaptiveRegionOptions wider = options;
+    RunTimeRegionOptions wider = options;
     wider.contactSlack = 2;
-    AdaptiveRegionPolicy widerPolicy(ts.mesh, ts.system.freeDofs, wider);
+    RunTimeRegionPolicy widerPolicy(ts.mesh, ts.system.freeDofs, wider);
     std::string widerReason;
     const auto widerNext = widerPolicy.decide(0.0, kLargeStep, zero, zero, proximity, {}, 1, widerReason);
     ASSERT_TRUE(widerNext);
@@ -176,7 +176,7 @@ TEST(AdaptiveRegions, ContactRegionGrowsAtOnceAndShrinksAfterTheDwell) {
 // A cached set-up stands in for the policy's proposal when it covers what is needed, also
 // beside a schedule, as long as it gives the windows' vertices exactly the ratio they have
 // now: the window's region while it is open, nothing extra once it has closed.
-TEST(AdaptiveRegions, CachedSetUpsStandInBesideASchedule) {
+TEST(RunTimeRegions, CachedSetUpsStandInBesideASchedule) {
   const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
   const std::vector<int> root = [&] {
     std::vector<int> out;
@@ -184,7 +184,7 @@ TEST(AdaptiveRegions, CachedSetUpsStandInBesideASchedule) {
       if (ts.mesh.restPosition(v).x() > 0.2 && ts.mesh.restPosition(v).x() < 0.3) out.push_back(v);
     return out;
   }();
-  AdaptiveRegionOptions options = scheduleOf({{"window", 0.0, 1.0, root, 4}});
+  RunTimeRegionOptions options = scheduleOf({{"window", 0.0, 1.0, root, 4}});
   options.contact = true;
   options.contactRatio = 6;
   options.contactRings = 0;
@@ -192,7 +192,7 @@ TEST(AdaptiveRegions, CachedSetUpsStandInBesideASchedule) {
   const ObstacleProximity proximity = [&](const Eigen::VectorXd&, double, std::vector<int>& out) {
     out = test::verticesBeyond(ts.mesh, 0.9);
   };
-  AdaptiveRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
+  RunTimeRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(ts.system.numDofs());
   const std::vector<AsyncRegion> proposal{{"window", root, 4}, {"contact", test::verticesBeyond(ts.mesh, 0.9), 6}};
   const std::vector<AsyncRegion> larger{{"window", root, 4}, {"contact", test::verticesBeyond(ts.mesh, 0.7), 6}};
@@ -210,7 +210,7 @@ TEST(AdaptiveRegions, CachedSetUpsStandInBesideASchedule) {
 
 // Regions that touch (an element with vertices in both) are merged at the larger ratio,
 // and vertices without a free DOF are left out (the clamped face x = 0 here).
-TEST(AdaptiveRegions, TouchingWindowsMergeAndFixedVerticesAreLeftOut) {
+TEST(RunTimeRegions, TouchingWindowsMergeAndFixedVerticesAreLeftOut) {
   const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
   std::vector<int> clampedEnd, nextLayer;
   for (int v = 0; v < ts.mesh.numVertices(); ++v) {
@@ -218,8 +218,8 @@ TEST(AdaptiveRegions, TouchingWindowsMergeAndFixedVerticesAreLeftOut) {
     if (x < 1e-9) clampedEnd.push_back(v);
     if (std::abs(x - 0.125) < 1e-9) nextLayer.push_back(v);
   }
-  AdaptiveRegionPolicy policy(ts.mesh, ts.system.freeDofs,
-                              scheduleOf({{"a", 0.0, 1.0, clampedEnd, 2}, {"b", 0.0, 1.0, nextLayer, 5}}));
+  RunTimeRegionPolicy policy(ts.mesh, ts.system.freeDofs,
+                             scheduleOf({{"a", 0.0, 1.0, clampedEnd, 2}, {"b", 0.0, 1.0, nextLayer, 5}}));
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(ts.system.numDofs());
   const std::vector<AsyncRegion> wanted = policy.wanted(0.0, kLargeStep, zero, zero, nullptr);
   ASSERT_EQ(wanted.size(), 1U);
@@ -230,39 +230,39 @@ TEST(AdaptiveRegions, TouchingWindowsMergeAndFixedVerticesAreLeftOut) {
   EXPECT_FALSE(RegionPartition(ts.mesh, ts.system.freeDofs, wanted).touching());
 }
 
-TEST(AdaptiveRegions, BadOptionsAreErrors) {
+TEST(RunTimeRegions, BadOptionsAreErrors) {
   const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
-  const auto expectError = [&](const AdaptiveRegionOptions& options, const std::string& part) {
+  const auto expectError = [&](const RunTimeRegionOptions& options, const std::string& part) {
     try {
-      AdaptiveRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
+      RunTimeRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
       FAIL() << "expected a ValidationError mentioning " << part;
     } catch (const ValidationError& e) {
       EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
     }
   };
-  AdaptiveRegionOptions options = scheduleOf({{"w", 1.0, 1.0, {0}, 2}});
+  RunTimeRegionOptions options = scheduleOf({{"w", 1.0, 1.0, {0}, 2}});
   expectError(options, "schedule[0]: end must be after start");
   options = scheduleOf({{"w", 0.0, 1.0, {ts.mesh.numVertices()}, 2}});
   expectError(options, "out of range");
-  options = AdaptiveRegionOptions{};
+  options = RunTimeRegionOptions{};
   options.shrinkFactor = 0.5;
   expectError(options, "shrink");
-  options = AdaptiveRegionOptions{};
+  options = RunTimeRegionOptions{};
   options.indicator = true;
   options.indicatorRatio = 1;
   expectError(options, "indicator tolerance must be > 0, ratio >= 2");
   // The contact policy needs obstacles.
   AsyncBackwardEuler async(ts.mesh, ts.system, kLargeStep, {});
-  AdaptiveRegionOptions contact;
+  RunTimeRegionOptions contact;
   contact.contact = true;
-  EXPECT_THROW(async.setAdaptiveRegions(contact), ValidationError);
+  EXPECT_THROW(async.setRunTimeRegions(contact), ValidationError);
 }
 
 // The indicator (Eq. R1): a velocity history with a constant acceleration has no second
 // difference, so no region; a kick at the x = 1 face gives those vertices
 // e = |kick| / 2 against tolerance times the RMS speed, a power-of-two ratio from it
 // (capped), and the face grown by one ring of hysteresis as the region.
-TEST(AdaptiveRegions, IndicatorMarksWhereTheLargeStepErrs) {
+TEST(RunTimeRegions, IndicatorMarksWhereTheLargeStepErrs) {
   const test::TestSystem ts = test::makeTestSystem(0.0, 0.0);
   const int n = ts.mesh.numVertices();
   const std::vector<int> face = test::verticesBeyond(ts.mesh, 0.99);
@@ -285,12 +285,12 @@ TEST(AdaptiveRegions, IndicatorMarksWhereTheLargeStepErrs) {
   // (kick, largest ratio): the wanted ratio grows with the kick but saturates near 14 (the
   // kicked face dominates the RMS speed), so the cap is reached with a cap of 8.
   for (const auto& [kick, cap] : std::vector<std::pair<double, int>>{{0.6, 16}, {3.0, 16}, {50.0, 16}, {50.0, 8}}) {
-    AdaptiveRegionOptions options;
+    RunTimeRegionOptions options;
     options.indicator = true;
     options.indicatorTolerance = 0.1;
     options.indicatorRatio = cap;
     options.indicatorRings = 0;
-    AdaptiveRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
+    RunTimeRegionPolicy policy(ts.mesh, ts.system.freeDofs, options);
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(3 * n);
     std::string reason;
     const std::vector<AsyncRegion> none;
@@ -330,13 +330,13 @@ TEST(AdaptiveRegions, IndicatorMarksWhereTheLargeStepErrs) {
 // A run with the indicator: a random start state (large velocity second differences) makes
 // the policy set up a region once three large-step velocities are known (step 2), and the
 // partition it chose is a valid one the run continues with.
-TEST(AdaptiveRegions, IndicatorRunsInTheIntegrator) {
+TEST(RunTimeRegions, IndicatorRunsInTheIntegrator) {
   const test::TestSystem ts = test::makeTestSystem(0.0, 1e-3);
   AsyncBackwardEuler async(ts.mesh, ts.system, kLargeStep, {});
   async.setState(ts.u0, ts.v0);
-  AdaptiveRegionOptions options;
+  RunTimeRegionOptions options;
   options.indicator = true;
-  async.setAdaptiveRegions(options);
+  async.setRunTimeRegions(options);
   for (int k = 0; k < 6; ++k) async.step();
   ASSERT_FALSE(async.repartitions().empty());
   EXPECT_EQ(async.repartitions()[0].step, 2);
@@ -366,7 +366,7 @@ std::string parseError(const IntegratorContext& context, const nlohmann::json& o
 }
 
 // The scene's "regions": {"adaptive": ...}: read, written back, and its errors name the key.
-TEST(AdaptiveRegions, SceneKeys) {
+TEST(RunTimeRegions, SceneKeys) {
   const nlohmann::json options = nlohmann::json::parse(R"({"regions": {"adaptive": {
       "schedule": [{"name": "tip", "ratio": 4, "start": 0.1, "end": 0.2, "boxes": [{"min": [0.74, -1, -1], "max": [2, 2, 2]}]}],
       "minDwell": 5, "shrink": 3, "cache": 2}}})");

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <asyncfem/asyncIntegrator/adaptiveRegions.hpp>
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
+#include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
@@ -74,21 +74,21 @@ double elementSizeFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, co
   return edge > 0.0 ? elementMaxFrequency(unitRegularTet(), material) / edge : std::numeric_limits<double>::infinity();
 }
 
-const char* toString(AutoRegionPath path) {
+const char* toString(RegionProposalPath path) {
   switch (path) {
-    case AutoRegionPath::elementCriterion:
+    case RegionProposalPath::elementCriterion:
       return "element criterion";
-    case AutoRegionPath::precheck:
+    case RegionProposalPath::precheck:
       return "pre-check";
-    case AutoRegionPath::costCheck:
+    case RegionProposalPath::costCheck:
       return "cost check";
-    case AutoRegionPath::modalCheck:
+    case RegionProposalPath::modalCheck:
       return "modal check";
   }
   return "?";
 }
 
-std::vector<AsyncRegion> AutoRegionProposal::asyncRegions() const {
+std::vector<AsyncRegion> RegionProposal::asyncRegions() const {
   std::vector<AsyncRegion> out;
   out.reserve(regions.size());
   for (const ProposedRegion& r : regions) out.push_back(r.region);
@@ -97,21 +97,21 @@ std::vector<AsyncRegion> AutoRegionProposal::asyncRegions() const {
 
 namespace {
 
-void validate(const AutoRegionOptions& options) {
+void validate(const RegionProposalOptions& options) {
   if (!(options.largeTimestep > 0.0) || !std::isfinite(options.largeTimestep)) {
-    throw ValidationError("automatic regions: the large timestep must be positive");
+    throw ValidationError("proposed regions: the large timestep must be positive");
   }
   if (!(options.targetOmegaH > 0.0) && !(options.relativeThreshold > 1.0)) {
-    throw ValidationError("automatic regions: give an omega*h target > 0 or a relative threshold > 1");
+    throw ValidationError("proposed regions: give an omega*h target > 0 or a relative threshold > 1");
   }
   if (options.growLayers < 0 || options.maxRatio < 1) {
-    throw ValidationError("automatic regions: growLayers must be >= 0 and maxRatio >= 1");
+    throw ValidationError("proposed regions: growLayers must be >= 0 and maxRatio >= 1");
   }
 }
 
 /// The omega hL above which an element is fast: the given target, or the relative
 /// threshold times the median element's omega hL.
-double targetOmegaH(const Eigen::VectorXd& omega, const AutoRegionOptions& options) {
+double targetOmegaH(const Eigen::VectorXd& omega, const RegionProposalOptions& options) {
   if (options.targetOmegaH > 0.0) return options.targetOmegaH;
   std::vector<double> sorted(omega.data(), omega.data() + omega.size());
   std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
@@ -193,7 +193,7 @@ std::vector<int> fastComponents(const TetMesh& mesh, const VertexElementAdjacenc
 /// touching it is integrated at least partly at its substep), element count and ratio;
 /// L's largest frequency into the proposal.
 void collectRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const Eigen::VectorXd& omega,
-                    const std::vector<int>& component, int numComponents, int maxRatio, AutoRegionProposal& proposal) {
+                    const std::vector<int>& component, int numComponents, int maxRatio, RegionProposal& proposal) {
   std::vector<ProposedRegion> regions(static_cast<std::size_t>(numComponents));
   for (int e = 0; e < mesh.numElements(); ++e) {
     int owner = -1;
@@ -229,7 +229,7 @@ void collectRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const Eigen::
 
 /// Keeps the maxRegions regions that need the largest ratios (then the largest ones):
 /// every region costs its own factor, Z and interface block.
-void capRegions(int maxRegions, AutoRegionProposal& proposal) {
+void capRegions(int maxRegions, RegionProposal& proposal) {
   if (static_cast<int>(proposal.regions.size()) <= std::max(maxRegions, 0)) return;
   std::stable_sort(proposal.regions.begin(), proposal.regions.end(),
                    [](const ProposedRegion& a, const ProposedRegion& b) {
@@ -246,10 +246,10 @@ void capRegions(int maxRegions, AutoRegionProposal& proposal) {
 
 /// The cost check (options.costCheck): withdraws the regions unless async is estimated
 /// cheaper than single-rate at the step their ratios stand for.
-void costCheck(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
-               AutoRegionProposal& proposal) {
+void costCheck(const TetMesh& mesh, const FreeDofs& freeDofs, const RegionProposalOptions& options,
+               RegionProposal& proposal) {
   if (!options.costCheck || proposal.regions.empty()) return;
-  proposal.decidedBy = AutoRegionPath::costCheck;
+  proposal.decidedBy = RegionProposalPath::costCheck;
   proposal.cost = estimateAsyncCost(mesh, freeDofs, proposal.asyncRegions(), options.nonlinear, options.costMargin);
   if (!proposal.cost.asyncCheaper) {
     proposal.costWithdrawnRegions = std::move(proposal.regions);
@@ -263,14 +263,14 @@ double median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
-/// The pre-check (AutoRegionOptions::precheck): whether any element is fast by its material
+/// The pre-check (RegionProposalOptions::precheck): whether any element is fast by its material
 /// and size alone (elementSizeFrequency() above the target the element criterion uses: the
 /// relative threshold times their median, or the absolute target). When none is, the
 /// elements the criterion marked are fast by their shape only (flat, slim or cut elements,
 /// whose fastest modes are the element's own), and the regions are withdrawn.
-void precheckRegions(const TetMesh& mesh, const Eigen::VectorXd& omega, const AutoRegionOptions& options,
-                     AutoRegionProposal& proposal) {
-  AutoRegionPrecheck& check = proposal.precheck;
+void precheckRegions(const TetMesh& mesh, const Eigen::VectorXd& omega, const RegionProposalOptions& options,
+                     RegionProposal& proposal) {
+  RegionProposalPrecheck& check = proposal.precheck;
   check.evaluated = true;
   const int numElements = mesh.numElements();
   std::vector<double> speed(mesh.materials().size());
@@ -304,19 +304,19 @@ void precheckRegions(const TetMesh& mesh, const Eigen::VectorXd& omega, const Au
   if (check.shapeOnly) {
     proposal.precheckWithdrawnRegions = std::move(proposal.regions);
     proposal.regions.clear();
-    proposal.decidedBy = AutoRegionPath::precheck;
+    proposal.decidedBy = RegionProposalPath::precheck;
   }
 }
 
 /// The element criterion, the cap, the pre-check when asked (with the modal check) and the
 /// cost check.
-AutoRegionProposal propose(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
-                           bool precheck) {
+RegionProposal propose(const TetMesh& mesh, const FreeDofs& freeDofs, const RegionProposalOptions& options,
+                       bool precheck) {
   validate(options);
   Stopwatch total;
   total.start();
   const Eigen::VectorXd omega = elementMaxFrequencies(mesh);
-  AutoRegionProposal proposal;
+  RegionProposal proposal;
   proposal.frequencySeconds = total.stop();
   total.start();
   proposal.largeTimestep = options.largeTimestep;
@@ -331,7 +331,7 @@ AutoRegionProposal propose(const TetMesh& mesh, const FreeDofs& freeDofs, const 
   capRegions(options.maxRegions, proposal);
   if (precheck && !proposal.regions.empty()) {
     precheckRegions(mesh, omega, options, proposal);
-    if (proposal.decidedBy == AutoRegionPath::precheck) {
+    if (proposal.decidedBy == RegionProposalPath::precheck) {
       total.stop();
       proposal.decisionSeconds = total.totalSeconds();
       return proposal;
@@ -351,7 +351,7 @@ AutoRegionProposal propose(const TetMesh& mesh, const FreeDofs& freeDofs, const 
 
 }  // namespace
 
-AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options) {
+RegionProposal proposeRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const RegionProposalOptions& options) {
   return propose(mesh, freeDofs, options, false);
 }
 
@@ -368,7 +368,7 @@ namespace {
 /// capped at options.maxRatio, when that needs more than the element criterion's ratio
 /// (kept in ratioFromElements; modeForRatio names the fastest such mode). Returns whether
 /// a ratio changed.
-bool ratiosFromModes(const AutoRegionOptions& options, AutoRegionProposal& proposal) {
+bool ratiosFromModes(const RegionProposalOptions& options, RegionProposal& proposal) {
   bool raised = false;
   const std::vector<ModeInRegions>& modes = proposal.modalReport->modes;
   for (std::size_t k = 0; k < modes.size(); ++k) {
@@ -410,9 +410,9 @@ int nextModalCount(const Eigen::VectorXd& frequencies, double nyquist) {
 /// nextModalCount() while the highest is still below the Nyquist frequency (visible modes beyond the
 /// computed ones could live in S), up to maxModalCount; one factorization of K - sigma M
 /// for every count (LowestModesSolver), Ritz values to options.modalTolerance.
-ModalResult modesUpToNyquist(const FreeDofs& freeDofs, const AutoRegionOptions& options,
+ModalResult modesUpToNyquist(const FreeDofs& freeDofs, const RegionProposalOptions& options,
                              const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
-                             AutoRegionProposal& proposal) {
+                             RegionProposal& proposal) {
   Stopwatch watch;
   const double nyquist = modalCriteria::nyquistPerFrameRate * options.frameRate;
   const int largestCount = std::min(options.maxModalCount, freeDofs.numFree() - 1);
@@ -437,27 +437,27 @@ ModalResult modesUpToNyquist(const FreeDofs& freeDofs, const AutoRegionOptions& 
 /// The modal check of the element criterion's regions (options.modalCheck): ratios from
 /// the modes they keep (then priced again by the cost check), withdrawn when no visible
 /// mode lives in them.
-void validateModalCheck(const AutoRegionOptions& options) {
+void validateModalCheck(const RegionProposalOptions& options) {
   if (!(options.frameRate > 0.0) || !std::isfinite(options.frameRate)) {
-    throw ValidationError("automatic regions: the frame rate of the modal check must be positive");
+    throw ValidationError("proposed regions: the frame rate of the modal check must be positive");
   }
   if (options.modalCount < 1 || options.maxModalCount < options.modalCount) {
-    throw ValidationError("automatic regions: need 1 <= modalCount <= maxModalCount for the modal check");
+    throw ValidationError("proposed regions: need 1 <= modalCount <= maxModalCount for the modal check");
   }
   if (!(options.modeOmegaSubstep > 0.0) || !std::isfinite(options.modeOmegaSubstep)) {
-    throw ValidationError("automatic regions: modeOmegaSubstep must be positive");
+    throw ValidationError("proposed regions: modeOmegaSubstep must be positive");
   }
   if (!(options.modalTolerance > 0.0) || !std::isfinite(options.modalTolerance)) {
-    throw ValidationError("automatic regions: modalTolerance must be positive");
+    throw ValidationError("proposed regions: modalTolerance must be positive");
   }
 }
 
-void checkModes(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
+void checkModes(const TetMesh& mesh, const FreeDofs& freeDofs, const RegionProposalOptions& options,
                 const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass,
-                AutoRegionProposal& proposal) {
+                RegionProposal& proposal) {
   if (proposal.regions.empty()) return;
   const ModalResult modes = modesUpToNyquist(freeDofs, options, stiffness, mass, proposal);
-  proposal.decidedBy = AutoRegionPath::modalCheck;
+  proposal.decidedBy = RegionProposalPath::modalCheck;
   const auto report = [&] {
     return analyseRegionModes(modes, mass, modalRegions(proposal.asyncRegions()), options.largeTimestep,
                               options.frameRate);
@@ -467,7 +467,7 @@ void checkModes(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionO
     proposal.modalReport = report();
     costCheck(mesh, freeDofs, options, proposal);
   }
-  proposal.decidedBy = AutoRegionPath::modalCheck;  // also when its ratios sent the regions to the cost check again
+  proposal.decidedBy = RegionProposalPath::modalCheck;  // also when its ratios sent the regions to the cost check again
   if (proposal.modalReport->verdict == ModalVerdict::noVisibleModeInFast) {
     proposal.withdrawnRegions = std::move(proposal.regions);
     proposal.regions.clear();
@@ -475,12 +475,11 @@ void checkModes(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionO
 }
 }  // namespace
 
-AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
-                                  const Eigen::SparseMatrix<double>& stiffness,
-                                  const Eigen::SparseMatrix<double>& mass) {
+RegionProposal proposeRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const RegionProposalOptions& options,
+                              const Eigen::SparseMatrix<double>& stiffness, const Eigen::SparseMatrix<double>& mass) {
   Stopwatch total;
   total.start();
-  AutoRegionProposal proposal = propose(mesh, freeDofs, options, options.modalCheck && options.precheck);
+  RegionProposal proposal = propose(mesh, freeDofs, options, options.modalCheck && options.precheck);
   if (options.modalCheck) {
     validateModalCheck(options);
     checkModes(mesh, freeDofs, options, stiffness, mass, proposal);
@@ -490,11 +489,11 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   return proposal;
 }
 
-AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const AutoRegionOptions& options,
-                                  MassType massType) {
+RegionProposal proposeRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const RegionProposalOptions& options,
+                              MassType massType) {
   Stopwatch total;
   total.start();
-  AutoRegionProposal proposal = propose(mesh, freeDofs, options, options.modalCheck && options.precheck);
+  RegionProposal proposal = propose(mesh, freeDofs, options, options.modalCheck && options.precheck);
   if (options.modalCheck) {
     validateModalCheck(options);
     if (!proposal.regions.empty()) {
@@ -508,7 +507,7 @@ AutoRegionProposal suggestRegions(const TetMesh& mesh, const FreeDofs& freeDofs,
   return proposal;
 }
 
-std::string ratioReason(const AutoRegionProposal& proposal, const ProposedRegion& region) {
+std::string ratioReason(const RegionProposal& proposal, const ProposedRegion& region) {
   char text[300];
   const int m = region.region.ratio;
   if (region.modeForRatio >= 0 && proposal.modalReport) {
@@ -526,7 +525,7 @@ std::string ratioReason(const AutoRegionProposal& proposal, const ProposedRegion
 }
 
 namespace {
-std::string autoRegionDecision(const AutoRegionProposal& proposal) {
+std::string regionProposalDecision(const RegionProposal& proposal) {
   const std::string prefix = "\"auto\": ";
   if (!proposal.regions.empty()) {
     std::string line = prefix + std::to_string(proposal.regions.size()) + " region(s) kept:";
@@ -537,7 +536,7 @@ std::string autoRegionDecision(const AutoRegionProposal& proposal) {
     return line;
   }
   if (!proposal.precheckWithdrawnRegions.empty()) {
-    const AutoRegionPrecheck& c = proposal.precheck;
+    const RegionProposalPrecheck& c = proposal.precheck;
     char line[600];
     std::snprintf(line, sizeof line,
                   "no fast region kept, single-rate at hL: the pre-check found no light or stiff part: wave speeds "
@@ -566,7 +565,7 @@ std::string autoRegionDecision(const AutoRegionProposal& proposal) {
 }
 }  // namespace
 
-std::string autoRegionSummary(const AutoRegionProposal& proposal) {
+std::string regionProposalSummary(const RegionProposal& proposal) {
   char decided[200];
   if (proposal.modalFactorizations > 0) {
     std::snprintf(decided, sizeof decided,
@@ -577,7 +576,7 @@ std::string autoRegionSummary(const AutoRegionProposal& proposal) {
     std::snprintf(decided, sizeof decided, " (decided in %.3g ms by the %s)", 1e3 * proposal.decisionSeconds,
                   toString(proposal.decidedBy));
   }
-  return autoRegionDecision(proposal) + decided;
+  return regionProposalDecision(proposal) + decided;
 }
 
 }  // namespace asyncfem

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Meshes the automatic-region tests propose regions on.
+// Meshes the proposed-region tests propose regions on.
 #pragma once
 
 #include <Eigen/Core>
-#include <asyncfem/asyncIntegrator/autoRegions.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
 #include <asyncfem/volumetricMesh/generators.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
@@ -59,8 +59,8 @@ inline FreeDofs clampedBelow(const TetMesh& mesh, double z) {
 }
 
 /// The modal check on the antenna on a block: hL = 1/60 s, 30 frames/s.
-inline AutoRegionOptions antennaModalOptions() {
-  AutoRegionOptions options;
+inline RegionProposalOptions antennaModalOptions() {
+  RegionProposalOptions options;
   options.largeTimestep = 1.0 / 60.0;
   options.modalCheck = true;
   options.frameRate = 30.0;
