@@ -3,7 +3,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/loadsPolicy.hpp>
-#include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>

@@ -246,4 +246,17 @@ std::vector<RegionSummary> summarizeRegions(const RegionPartition& partition) {
   return summaries;
 }
 
+void growByRings(const TetMesh& mesh, std::vector<char>& marked, int rings) {
+  for (int ring = 0; ring < rings; ++ring) {
+    std::vector<char> grown = marked;
+    for (int e = 0; e < mesh.numElements(); ++e) {
+      bool any = false;
+      for (int a = 0; a < 4; ++a) any = any || marked[static_cast<std::size_t>(mesh.elements()(a, e))];
+      if (any)
+        for (int a = 0; a < 4; ++a) grown[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
+    }
+    marked.swap(grown);
+  }
+}
+
 }  // namespace asyncfem

@@ -135,6 +135,10 @@ class RegionPartition {
 /// itself when no two regions touch at one ratio. What AsyncBackwardEuler solves.
 RegionPartition mergeTouchingAtOneRatio(const TetMesh& mesh, const FreeDofs& freeDofs, RegionPartition partition);
 
+/// Marks every vertex that shares an element with a marked one (marked: one entry per
+/// vertex), `rings` times: how the region policies grow a vertex set.
+void growByRings(const TetMesh& mesh, std::vector<char>& marked, int rings);
+
 /// One RegionSummary per fast region of partition (name, vertices, interface DOFs, m).
 std::vector<RegionSummary> summarizeRegions(const RegionPartition& partition);
 

@@ -161,7 +161,4 @@ class RunTimeRegionPolicy {
 /// set-up time they cost, then one line each (the first and last ten when there are more).
 void appendRepartitionLines(const std::vector<RepartitionRecord>& records, std::vector<std::string>& lines);
 
-/// Marks every vertex that shares an element with a marked one, `rings` times.
-void growByRings(const TetMesh& mesh, std::vector<char>& marked, int rings);
-
 }  // namespace asyncfem
