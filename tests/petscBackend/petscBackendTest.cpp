@@ -30,6 +30,7 @@
 #include <utility>
 #include <vector>
 
+#include "../hexElements/hexBar.hpp"
 #include "cantilever.hpp"
 
 namespace asyncfem::test {
@@ -486,6 +487,23 @@ TEST(PetscBackendFailure, BadSettingsAreRejected) {
   EXPECT_THROW(PetscSimulation(mesh, settings), ValidationError);
   EXPECT_THROW(parsePetscSolverKind("lu"), ValidationError);
   EXPECT_EQ(parsePetscSolverKind("cg-hypre"), PetscSolverKind::cgHypre);
+}
+
+// A hexahedral mesh is refused by name on every rank, with the conversion, before any
+// element loop reads it as tetrahedra.
+TEST(PetscBackendFailure, HexahedralMeshesAreRefusedWithTheConversion) {
+  const TetMesh hexahedra = test::hexBar(1);
+  PetscSimulationSettings settings;  // valid but for the mesh: a timestep, one fixed vertex
+  settings.timestep = kTimestep;
+  settings.fixedVertices = {0};
+  try {
+    PetscSimulation simulation(hexahedra, settings);
+    ADD_FAILURE() << "a hexahedral mesh was accepted";
+  } catch (const ValidationError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("the PETSc backend"), std::string::npos) << message;
+    EXPECT_NE(message.find("--hex-to-tets"), std::string::npos) << message;
+  }
 }
 
 // Every force model of the single-process libraries on the PETSc backend: the same
