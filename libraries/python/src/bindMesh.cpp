@@ -104,7 +104,15 @@ void bindMesh(py::module_& module) {
           "(n, 3) read-only view of the rest positions (no copy)")
       .def_property_readonly(
           "elements", [](py::object self) { return transposedView(self.cast<const TetMesh&>().elements(), self); },
-          "(m, 4) read-only int32 view of the connectivity (no copy)")
+          "(m, 4) read-only int32 view of the connectivity (no copy); a hexahedral mesh raises "
+          "ValidationError (see hexahedra)")
+      .def_property_readonly(
+          "element_kind", [](const TetMesh& mesh) { return mesh.isHexahedral() ? "hexahedron" : "tetrahedron"; },
+          "\"tetrahedron\" or \"hexahedron\" (Vega CUBIC and Gmsh hexahedra): one kind per mesh")
+      .def_property_readonly(
+          "hexahedra", [](py::object self) { return transposedView(self.cast<const TetMesh&>().hexahedra(), self); },
+          "(m, 8) read-only int32 view of a hexahedral mesh's connectivity (no copy; vertex order of Vega's "
+          "CUBIC elements); a tetrahedral mesh raises ValidationError")
       .def(
           "rest_position",
           [](const TetMesh& mesh, int v) {
