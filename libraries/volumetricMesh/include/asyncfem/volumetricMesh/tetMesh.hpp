@@ -135,7 +135,8 @@ class TetMesh {
   Eigen::Vector3d restPosition(int vertex) const { return restPositions_.col(vertex); }
   /// Tetrahedra, 4 x numElements (throws on a hexahedral mesh, see requireTetrahedra).
   const Eigen::Matrix4Xi& elements() const {
-    requireTetrahedra("this operation");
+    requireTetrahedra(
+        "TetMesh::elements() (the tetrahedral connectivity; hexahedra() and connectivity() serve both kinds)");
     return elements_;
   }
   Eigen::Vector4i element(int e) const { return elements().col(e); }
