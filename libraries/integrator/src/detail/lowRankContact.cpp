@@ -63,14 +63,12 @@ const Eigen::MatrixXd& LowRankContactSolver::columnsOf(int vertex, FreeSystem& f
   return columns_.emplace(vertex, std::move(solved)).first->second;
 }
 
-void LowRankContactSolver::solve(FreeSystem& free, const FreeDofs& dofs, const VertexJacobian& contact,
-                                 double stiffnessWeight, double dampingWeight, const Eigen::VectorXd& rhs,
-                                 Eigen::VectorXd& x, IntegratorStats& stats) {
-  const std::vector<int>& fullToFree = dofs.fullToFree();
-  // U: per block, sqrt(lambda) q for the positive eigenpairs of the block the step matrix
-  // would take (contactStepBlock, as addVertexBlocks adds it); per coupling, one column
-  // sqrt(h^2 k + h c) g, g = w_i N at its vertices. Column j has the entries
-  // [start_[j], start_[j + 1]): vertex entryVertex_[e], 3-vector u_.col(e).
+// U: per block, sqrt(lambda) q for the positive eigenpairs of the block the step matrix
+// would take (contactStepBlock, as addVertexBlocks adds it); per coupling, one column
+// sqrt(h^2 k + h c) g, g = w_i N at its vertices. Column j has the entries
+// [start_[j], start_[j + 1]): vertex entryVertex_[e], 3-vector u_.col(e).
+void LowRankContactSolver::buildColumns(const FreeDofs& dofs, const VertexJacobian& contact, double stiffnessWeight,
+                                        double dampingWeight) {
   u_.resize(3, static_cast<Eigen::Index>((3 * contact.vertices.size()) + (4 * contact.couplings.size())));
   entryVertex_.clear();
   start_.assign(1, 0);
@@ -98,6 +96,13 @@ void LowRankContactSolver::solve(FreeSystem& free, const FreeDofs& dofs, const V
     }
     if (static_cast<int>(entryVertex_.size()) > start_.back()) start_.push_back(static_cast<int>(entryVertex_.size()));
   }
+}
+
+void LowRankContactSolver::solve(FreeSystem& free, const FreeDofs& dofs, const VertexJacobian& contact,
+                                 double stiffnessWeight, double dampingWeight, const Eigen::VectorXd& rhs,
+                                 Eigen::VectorXd& x, IntegratorStats& stats) {
+  const std::vector<int>& fullToFree = dofs.fullToFree();
+  buildColumns(dofs, contact, stiffnessWeight, dampingWeight);
   const auto rank = static_cast<Eigen::Index>(start_.size() - 1);
   free.solve(rhs, base_, stats);
   if (rank == 0) {

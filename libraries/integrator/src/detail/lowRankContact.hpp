@@ -42,6 +42,8 @@ class LowRankContactSolver {
   std::size_t cachedVertices() const { return columns_.size(); }
 
  private:
+  /// The update's columns U (u_, entryVertex_, start_) for this contact Jacobian.
+  void buildColumns(const FreeDofs& dofs, const VertexJacobian& contact, double stiffnessWeight, double dampingWeight);
   /// A_0^{-1} E_v on the free DOFs (n x 3; zero columns for fixed DOFs), computed once.
   const Eigen::MatrixXd& columnsOf(int vertex, FreeSystem& free, const FreeDofs& dofs, IntegratorStats& stats);
 
