@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """libraries/volumetricMesh from Python: construction, views, sets, materials, readers,
 writers, generators and queries."""
+import os
+
 import numpy as np
 import pytest
 
@@ -127,3 +129,21 @@ def test_queries(beam_mesh):
     assert qualities["aspect_ratio"].min() >= 1.0 - 1e-12
     assert af.element_quality(beam_mesh, 0).aspect_ratio == qualities["aspect_ratio"][0]
     assert len(af.unused_vertices(beam_mesh)) == 0
+
+
+def test_hexahedral_mesh_from_arrays():
+    """(m, 8) rows make a hexahedral mesh in Vega's CUBIC order; it equals the same cubes read from .veg."""
+    read = af.read_mesh(os.path.join(os.path.dirname(__file__), "..", "data", "volumetricMesh", "cubes.veg"))
+    mesh = af.TetMesh(read.rest_positions, read.hexahedra, read.materials, read.element_materials)
+    assert mesh.element_kind == "hexahedron" and mesh.num_elements == read.num_elements == 4
+    np.testing.assert_array_equal(mesh.hexahedra, read.hexahedra)  # exact: the same ids, no reordering
+    cube_volume = 0.5**3  # cubes.veg: four cubes of side 0.5
+    density = sum(read.materials[m].density for m in read.element_materials)
+    assert af.total_mass(mesh) == af.total_mass(read) == pytest.approx(density * cube_volume, rel=1e-14)
+    # One unit cube: the volume is 1 (the rows keep their order, so a reversed cube would give -1).
+    corners = np.array([[x, y, z] for z in (0.0, 1.0) for y in (0.0, 1.0) for x in (0.0, 1.0)])
+    cube = af.TetMesh(corners, np.array([[0, 1, 3, 2, 4, 5, 7, 6]]))
+    assert cube.element_kind == "hexahedron"
+    assert af.total_mass(cube) == pytest.approx(af.Material().density, rel=1e-14)
+    with pytest.raises(ValueError, match=r"\(m, 4\) \(tetrahedra\) or \(m, 8\) \(hexahedra\), got 6"):
+        af.TetMesh(corners, np.array([[0, 1, 3, 2, 4, 5]]))

@@ -19,7 +19,16 @@ using Release = py::call_guard<py::gil_scoped_release>;
 TetMesh makeMesh(const py::handle& positions, const py::handle& elements, std::vector<Material> materials,
                  const py::handle& elementMaterials) {
   const auto points = matrixArgument(positions, "positions", -1, 3);
-  const auto tets = indexMatrixArgument(elements, "elements", -1, 4);
+  // (m, 8) rows are hexahedra in Vega's CUBIC order; anything else must be (m, 4) tetrahedra.
+  const py::array given = py::module_::import("numpy").attr("asarray")(elements);
+  const bool hexahedral = given.ndim() == 2 && given.shape(1) == 8;
+  if (given.ndim() == 2 && given.shape(1) != 4 && !hexahedral) {
+    throw py::value_error(
+        "elements: expected an integer array of shape (m, 4) (tetrahedra) or (m, 8) (hexahedra), "
+        "got " +
+        std::to_string(given.shape(1)) + " vertices per row");
+  }
+  const auto tets = indexMatrixArgument(elements, "elements", -1, hexahedral ? 8 : 4);
   std::vector<int> materialIndices;
   if (elementMaterials.is_none()) {
     materialIndices.assign(static_cast<std::size_t>(tets.shape(0)), 0);
@@ -32,6 +41,10 @@ TetMesh makeMesh(const py::handle& positions, const py::handle& elements, std::v
   }
   // (n, 3) C order is the 3 x n column-major layout TetMesh stores.
   Eigen::Matrix3Xd rest = Eigen::Map<const Eigen::Matrix3Xd>(points.data(), 3, points.shape(0));
+  if (hexahedral) {
+    HexElements connectivity = Eigen::Map<const HexElements>(tets.data(), 8, tets.shape(0));
+    return {std::move(rest), std::move(connectivity), std::move(materials), std::move(materialIndices)};
+  }
   Eigen::Matrix4Xi connectivity = Eigen::Map<const Eigen::Matrix4Xi>(tets.data(), 4, tets.shape(0));
   return {std::move(rest), std::move(connectivity), std::move(materials), std::move(materialIndices)};
 }
@@ -89,11 +102,15 @@ void bindMesh(py::module_& module) {
                ", poisson_ratio=" + py::repr(py::float_(m.poissonRatio)).cast<std::string>() + ")";
       });
 
-  py::class_<TetMesh>(module, "TetMesh",
-                      "Linear tetrahedral mesh with a material per element and named vertex and element sets.")
+  py::class_<TetMesh>(
+      module, "TetMesh",
+      "Volumetric mesh of linear tetrahedra or trilinear hexahedra (one kind per mesh), with a material "
+      "per element and named vertex and element sets.")
       .def(py::init(&makeMesh), py::arg("positions"), py::arg("elements"),
            py::arg("materials") = std::vector<Material>{Material{}}, py::arg("element_materials") = py::none(),
-           "positions: (n, 3) float64 rest positions; elements: (m, 4) integer vertex ids; materials: list of "
+           "positions: (n, 3) float64 rest positions; elements: (m, 4) integer vertex ids of tetrahedra, or (m, 8) of "
+           "hexahedra in Vega's CUBIC order (bottom face counter-clockwise seen from above, then the top face); "
+           "materials: list of "
            "Material; element_materials: m indices into materials (default: all 0).")
       .def_property_readonly("num_vertices", &TetMesh::numVertices)
       .def_property_readonly("num_elements", &TetMesh::numElements)
