@@ -31,20 +31,26 @@ HexStvkElement hexStvk(const HexElementPositions& restPositions, const HexElemen
     const Eigen::Matrix3d first = f * second;
     for (int a = 0; a < 8; ++a) out.force.segment<3>(3 * a) += volume * first * gradients.col(a);
     if (!withTangent) continue;
-    // Column 3 b + j: dP for dF = e_j grad_b^T, then its action on every grad_a.
+    // dP for dF = e_j g_b^T acting on g_a, with h = F g: block (a, b) of the tangent is
+    // (g_a . S g_b) I + lambda h_a h_b^T + mu (g_a . g_b) F F^T + mu h_b h_a^T.
+    const Eigen::Matrix<double, 3, 8> deformedGradients = f * gradients;
+    const Eigen::Matrix<double, 3, 8> stressed = second * gradients;
+    const Eigen::Matrix3d stretch = mu * f * f.transpose();
     for (int b = 0; b < 8; ++b) {
-      for (int j = 0; j < 3; ++j) {
-        const Eigen::Matrix3d dF = Eigen::Vector3d::Unit(j) * gradients.col(b).transpose();
-        const Eigen::Matrix3d dGreen = 0.5 * (f.transpose() * dF + dF.transpose() * f);
-        const Eigen::Matrix3d dSecond = lambda * dGreen.trace() * Eigen::Matrix3d::Identity() + 2.0 * mu * dGreen;
-        const Eigen::Matrix3d dFirst = dF * second + f * dSecond;
-        for (int a = 0; a < 8; ++a) {
-          out.tangent.block<3, 1>(3 * a, (3 * b) + j) += volume * dFirst * gradients.col(a);
-        }
+      for (int a = b; a < 8; ++a) {
+        const Eigen::Vector3d ha = deformedGradients.col(a), hb = deformedGradients.col(b);
+        Eigen::Matrix3d block = (lambda * ha * hb.transpose()) + (mu * hb * ha.transpose()) +
+                                (gradients.col(a).dot(gradients.col(b)) * stretch);
+        block.diagonal().array() += gradients.col(a).dot(stressed.col(b));
+        out.tangent.block<3, 3>(3 * a, 3 * b) += volume * block;
       }
     }
   }
-  if (withTangent) out.tangent = 0.5 * (out.tangent + out.tangent.transpose());
+  if (withTangent) {  // the blocks above the diagonal are the transposes of those below
+    for (int b = 0; b < 8; ++b)
+      for (int a = b + 1; a < 8; ++a)
+        out.tangent.block<3, 3>(3 * b, 3 * a) = out.tangent.block<3, 3>(3 * a, 3 * b).transpose();
+  }
   return out;
 }
 
