@@ -123,11 +123,13 @@ void printCantilever(const std::vector<Level>& rows) {
   const double fine = rows.back().hex.tip, coarser = rows[rows.size() - 2].hex.tip;
   const double reference = fine + ((fine - coarser) / 3.0);  // Richardson, error ~ h^2
   std::printf("\n## Cantilever under its own weight: tip deflection\n\n");
-  std::printf("Euler-Bernoulli %.6e, Timoshenko %.6e, reference (Richardson of the two finest hexahedral levels) "
-              "%.6e = %.4f x Euler-Bernoulli\n\n",
-              bending, timoshenko, reference, reference / bending);
-  std::printf("| cubes | free DOFs | hex tip / E-B | tets tip / E-B | hex error | tets error | hex s | tets s | "
-              "tets s / hex s |\n|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "Euler-Bernoulli %.6e, Timoshenko %.6e, reference (Richardson of the two finest hexahedral levels) "
+      "%.6e = %.4f x Euler-Bernoulli\n\n",
+      bending, timoshenko, reference, reference / bending);
+  std::printf(
+      "| cubes | free DOFs | hex tip / E-B | tets tip / E-B | hex error | tets error | hex s | tets s | "
+      "tets s / hex s |\n|---|---|---|---|---|---|---|---|---|\n");
   for (const Level& row : rows) {
     std::printf("| %d x %d x %d | %d | %.4f | %.4f | %.2e | %.2e | %.4f | %.4f | %.2f |\n", 10 * row.k, row.k, row.k,
                 row.dofs, row.hex.tip / bending, row.tet.tip / bending, std::abs(row.hex.tip - reference) / reference,
@@ -168,8 +170,9 @@ void printKernels(int cells, int repeats) {
                    std::make_unique<CorotationalLinearFEM>(tets)}};
   std::printf("\n## forcesAndTangent(): %d cubes (%d tetrahedra), %d vertices, %d thread(s)\n\n", hexes.numElements(),
               tets.numElements(), hexes.numVertices(), omp_get_max_threads());
-  std::printf("| model | hex us / cube | tets us / tet | tets us / cube (6 tets) | hex us / vertex | "
-              "tets us / vertex | hex / tets per cube |\n|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| model | hex us / cube | tets us / tet | tets us / cube (6 tets) | hex us / vertex | "
+      "tets us / vertex | hex / tets per cube |\n|---|---|---|---|---|---|---|\n");
   for (Pair& pair : pairs) {
     const double hex = kernelSeconds(*pair.hex, u, repeats), tet = kernelSeconds(*pair.tet, u, repeats);
     const double cubes = hexes.numElements(), vertices = hexes.numVertices();
@@ -182,8 +185,9 @@ void printKernels(int cells, int repeats) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Hexahedra against the tetrahedra of the same cubes: cantilever convergence, run time against "
-               "error at equal DOFs, element-kernel throughput (Markdown tables)."};
+  CLI::App app{
+      "Hexahedra against the tetrahedra of the same cubes: cantilever convergence, run time against "
+      "error at equal DOFs, element-kernel throughput (Markdown tables)."};
   int levels = 4, kernelCells = 8, repeats = 5, threads = 1;
   app.add_option("--levels", levels, "cantilever levels k = 1, 2, 4, ... (10 k x k x k cubes)")
       ->check(CLI::Range(2, 6));

@@ -15,7 +15,11 @@ namespace asyncfem {
 /// and the energy, the sum of the elements', from a per-element kernel (element()). The
 /// stiffness pattern is fixed at construction (every 3 x 3 block of every element, also
 /// where a value is zero), so integrators may keep a symbolic factorization. The element
-/// loop is serial. Throws ValidationError on a tetrahedral mesh.
+/// loop runs the colours of a greedy vertex-sharing colouring in order and the elements of
+/// one colour on OpenMP threads (from 2048 elements on), so element() must be safe to call
+/// concurrently; every entry is summed in the same order on any number of threads. An
+/// element() that throws stops the evaluation with the lowest-numbered failing element's
+/// error. Throws ValidationError on a tetrahedral mesh.
 class HexForceModel : public ForceModel {
  public:
   int numDofs() const override { return numDofs_; }
@@ -39,6 +43,9 @@ class HexForceModel : public ForceModel {
   /// (when not null, into the pattern) and returns the energy.
   double evaluate(const Eigen::VectorXd& displacement, Eigen::VectorXd* forces,
                   Eigen::SparseMatrix<double>* stiffness) const;
+  /// Adds element e's forces and tangent into forces and stiffness (either may be null).
+  void scatter(Eigen::Index e, const HexElementEnergy& result, Eigen::VectorXd* forces,
+               Eigen::SparseMatrix<double>* stiffness) const;
   void checkDisplacement(const Eigen::VectorXd& displacement, const char* what) const;
 
   std::string name_;
@@ -50,6 +57,10 @@ class HexForceModel : public ForceModel {
   /// entry (3 a + i, 3 b + j) is at slot + j * columnLength_[vertex b] + i.
   std::vector<Eigen::Matrix<int, 8, 8>> blockSlots_;
   std::vector<int> columnLength_;  ///< per vertex: entries of each of its three columns
+  /// Elements grouped by colour (elements of one colour share no vertex): colour c holds
+  /// coloredElements_[colorOffsets_[c] .. colorOffsets_[c + 1]).
+  std::vector<int> coloredElements_;
+  std::vector<int> colorOffsets_;
 };
 
 }  // namespace asyncfem
