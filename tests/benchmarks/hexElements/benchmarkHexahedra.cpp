@@ -14,7 +14,10 @@
 //    kinematics differ from the 3D solid's by about 1%.
 // 2. The same static solves as run time against error at equal DOFs (the hexahedra and
 //    their tetrahedra share the vertices): assembly + CHOLMOD factorization + solve.
-// 3. forcesAndTangent() per element, per cube and per vertex of StVK and corotational FEM
+// 3. StVK's energy of one cube by 2 x 2 x 2 Gauss (hexStvk) against 3 x 3 x 3, which is exact
+//    for the degree-4 polynomial a trilinear field gives (and so equal to what Vega's
+//    closed-form cube coefficients compute), under a random strain of growing size.
+// 4. forcesAndTangent() per element, per cube and per vertex of StVK and corotational FEM
 //    on a 4 c x c x c box of cubes at a random 1% strain, hexahedra against the tetrahedra
 //    of the same cubes.
 #include <omp.h>
@@ -25,11 +28,13 @@
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/hexElements/hexAssembly.hpp>
 #include <asyncfem/hexElements/hexCorotationalForceModel.hpp>
+#include <asyncfem/hexElements/hexStvk.hpp>
 #include <asyncfem/hexElements/hexStvkForceModel.hpp>
 #include <asyncfem/hyperelasticFEM/stvkFEM.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <asyncfem/stiffnessMatrix/assembler.hpp>
 #include <asyncfem/stiffnessMatrix/dofs.hpp>
+#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <asyncfem/volumetricMesh/hexToTets.hpp>
 #include <cmath>
 #include <cstdio>
@@ -138,6 +143,44 @@ void printCantilever(const std::vector<Level>& rows) {
   }
 }
 
+/// StVK's energy of one hexahedron by 3 x 3 x 3 Gauss-Legendre, exact for its integrand.
+double exactStvkEnergy(const HexElementPositions& rest, const HexElementPositions& deformed, double lambda, double mu) {
+  const double points[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, weights[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+  double energy = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) {
+        double volume = 0.0;
+        const Eigen::Matrix<double, 3, 8> gradients =
+            hexShapeGradients(rest, Eigen::Vector3d(points[i], points[j], points[k]), &volume);
+        const Eigen::Matrix3d f = deformed * gradients.transpose();
+        const Eigen::Matrix3d green = 0.5 * (f.transpose() * f - Eigen::Matrix3d::Identity());
+        energy += weights[i] * weights[j] * weights[k] * volume *
+                  ((0.5 * lambda * green.trace() * green.trace()) + (mu * green.squaredNorm()));
+      }
+  return energy;
+}
+
+void printQuadrature() {
+  const TetMesh cube = test::hexBox(Eigen::Vector3i::Ones(), Eigen::Vector3d::Ones(), kSteelish);
+  HexElementPositions rest;
+  for (int a = 0; a < 8; ++a) rest.col(a) = cube.restPosition(cube.hexahedron(0)[a]);
+  const Eigen::Vector2d lame = lameParameters(kSteelish.youngsModulus, kSteelish.poissonRatio);
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  HexElementPositions direction;
+  for (int a = 0; a < 8; ++a) direction.col(a) = Eigen::Vector3d(unit(random), unit(random), unit(random));
+  std::printf("\n## StVK energy of one cube: 2 x 2 x 2 Gauss against exact (3 x 3 x 3) integration\n\n");
+  std::printf(
+      "| vertex displacement / side | energy 2x2x2 | energy exact | relative difference |\n|---|---|---|---|\n");
+  for (const double size : {0.001, 0.01, 0.1, 0.3}) {
+    const HexElementPositions deformed = rest + (size * direction);
+    const double gauss = hexStvk(rest, deformed, kSteelish.youngsModulus, kSteelish.poissonRatio, false).energy;
+    const double exact = exactStvkEnergy(rest, deformed, lame[0], lame[1]);
+    std::printf("| %g | %.6e | %.6e | %.2e |\n", size, gauss, exact, (gauss - exact) / exact);
+  }
+}
+
 /// Best-of-repeats seconds of forcesAndTangent() at a displacement flipped between calls.
 double kernelSeconds(ForceModel& model, const Eigen::VectorXd& displacement, int repeats) {
   Eigen::VectorXd forces, u = displacement;
@@ -199,6 +242,7 @@ int main(int argc, char** argv) {
   std::printf("benchmarkHexahedra on %s, load %s, %d thread(s)\n", bench::cpuModel().c_str(),
               bench::loadAverage().c_str(), threads);
   printCantilever(measureCantilever(levels));
+  printQuadrature();
   printKernels(kernelCells, repeats);
   return 0;
 }
