@@ -11,6 +11,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/forceModel/linearForceModel.hpp>
+#include <asyncfem/hexElements/hexAssembly.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
 #include <asyncfem/integrator/integratorOptions.hpp>
 #include <asyncfem/integrator/trapezoidal.hpp>
@@ -489,23 +490,6 @@ TEST(PetscBackendFailure, BadSettingsAreRejected) {
   EXPECT_EQ(parsePetscSolverKind("cg-hypre"), PetscSolverKind::cgHypre);
 }
 
-// A hexahedral mesh is refused by name on every rank, with the conversion, before any
-// element loop reads it as tetrahedra.
-TEST(PetscBackendFailure, HexahedralMeshesAreRefusedWithTheConversion) {
-  const TetMesh hexahedra = test::hexBar(1);
-  PetscSimulationSettings settings;  // valid but for the mesh: a timestep, one fixed vertex
-  settings.timestep = kTimestep;
-  settings.fixedVertices = {0};
-  try {
-    PetscSimulation simulation(hexahedra, settings);
-    ADD_FAILURE() << "a hexahedral mesh was accepted";
-  } catch (const ValidationError& error) {
-    const std::string message = error.what();
-    EXPECT_NE(message.find("the PETSc backend"), std::string::npos) << message;
-    EXPECT_NE(message.find("--hex-to-tets"), std::string::npos) << message;
-  }
-}
-
 // Every force model of the single-process libraries on the PETSc backend: the same
 // Problem stepped by the integrator library's BackwardEuler or Trapezoidal (CHOLMOD,
 // exact solves) and by the backend with MUMPS, whose element loops run the same force
@@ -629,6 +613,69 @@ TEST_P(PetscForceModels, TrajectoryMatchesTheLocalRun) {
 
 INSTANTIATE_TEST_SUITE_P(EveryModel, PetscForceModels, ::testing::Range(0, 4),
                          [](const ::testing::TestParamInfo<int>& info) { return modelCase(info.param).name; });
+
+/// Condition number of M + h^2 K at rest on the free DOFs of a hexahedral mesh (dense).
+double hexSystemConditionNumber(const TetMesh& mesh, const std::vector<int>& fixed) {
+  const FreeDofs dofs = FreeDofs::fromFixedVertices(mesh.numVertices(), fixed);
+  const Eigen::SparseMatrix<double> full =
+      hexMassMatrix(mesh, MassType::consistent) + (kTimestep * kTimestep) * hexLinearStiffnessMatrix(mesh);
+  const SubmatrixExtractor free(full, dofs.freeToFull(), dofs.freeToFull());
+  const Eigen::VectorXd eigenvalues =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Eigen::MatrixXd(free.extract(full))).eigenvalues();
+  return eigenvalues.maxCoeff() / eigenvalues.minCoeff();
+}
+
+// Hexahedral meshes on the backend: linear, corotational and StVK FEM on a bar of 8 x 2 x 2
+// cubes, each against the single-process run of the same Problem (backward Euler, CHOLMOD,
+// the linearized step), with MUMPS on every rank count. The rank-local element loops run
+// the hexahedral kernels (hexElements), the matrices the 24 x 24 element matrices.
+TEST(PetscBackend, HexahedralMeshesMatchTheLocalRun) {
+  auto mesh = std::make_shared<const TetMesh>(test::hexBar(2));
+  std::vector<int> fixed;
+  for (int v = 0; v < mesh->numVertices(); ++v)
+    if (mesh->restPosition(v).x() == 0.0) fixed.push_back(v);
+  // Direct solves on both sides: rounding only, 10 kappa 1e-15 as comparisonTolerance.
+  const double tolerance = 10.0 * hexSystemConditionNumber(*mesh, fixed) * 1e-15;
+  ASSERT_LT(tolerance, 1e-6);
+  std::vector<Eigen::VectorXd> linear;
+  for (const ForceModelType type : {ForceModelType::linear, ForceModelType::corotational, ForceModelType::stvk}) {
+    const std::string name = toString(type);
+    const ModelCase c{name.c_str(), modelPhysics(type), IntegratorOptions{}, "backward-euler"};
+    const Problem problem(mesh, fixed, c.physics);
+    const PetscTrajectory petsc = petscModelTrajectory(problem, c);
+    EXPECT_EQ(petsc.stats.steps, kModelSteps);
+    if (worldRank() != 0) continue;
+    const std::vector<Eigen::VectorXd> reference = localModelTrajectory(problem, c);
+    ASSERT_GT(reference.back().lpNorm<Eigen::Infinity>(), 1e-3);  // it moved
+    EXPECT_LE(trajectoryDifference(petsc.displacements, reference), tolerance)
+        << toString(type) << " on " << worldSize() << " ranks";
+    if (type == ForceModelType::linear) {
+      linear = reference;
+    } else {  // the nonlinear models differ from the linear one: the comparison has teeth
+      EXPECT_GT(trajectoryDifference(linear, reference), 10.0 * tolerance) << toString(type);
+    }
+  }
+}
+
+// An inverted hexahedron (two corners of the top face swapped) is named by the rank that
+// assembles it, on every rank.
+TEST(PetscBackendFailure, InvertedHexahedronIsNamedOnEveryRank) {
+  const TetMesh good = test::hexBar(2);
+  HexElements hexahedra = good.hexahedra();
+  const int bad = good.numElements() - 1;
+  std::swap(hexahedra(4, bad), hexahedra(6, bad));
+  const TetMesh mesh(good.restPositions(), hexahedra, good.materials(), good.elementMaterials());
+  PetscSimulationSettings settings;
+  settings.timestep = kTimestep;
+  settings.fixedVertices = {0};
+  try {
+    PetscSimulation simulation(mesh, settings);
+    ADD_FAILURE() << "no exception on rank " << worldRank();
+  } catch (const ValidationError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("hexahedron " + std::to_string(bad) + " has det J"), std::string::npos) << message;
+  }
+}
 
 // A hyperelastic element that fails on one rank (neo-Hookean log J of an element
 // flattened by the initial state, inversion handling off) stops every rank with the

@@ -18,16 +18,19 @@ std::vector<int> partitionElements(const TetMesh& mesh, int numParts) {
   idx_t elementCount = numElements;
   idx_t vertexCount = mesh.numVertices();
   std::vector<idx_t> elementStart(static_cast<std::size_t>(numElements) + 1);
-  std::vector<idx_t> elementVertices(static_cast<std::size_t>(numElements) * 4);
+  const int corners = mesh.verticesPerElement();
+  std::vector<idx_t> elementVertices(static_cast<std::size_t>(numElements) * static_cast<std::size_t>(corners));
   for (int e = 0; e < numElements; ++e) {
-    elementStart[static_cast<std::size_t>(e)] = 4 * e;
-    for (int a = 0; a < 4; ++a)
-      elementVertices[(4 * static_cast<std::size_t>(e)) + static_cast<std::size_t>(a)] = mesh.elements()(a, e);
+    elementStart[static_cast<std::size_t>(e)] = corners * e;
+    for (int a = 0; a < corners; ++a)
+      elementVertices[(static_cast<std::size_t>(corners) * static_cast<std::size_t>(e)) + static_cast<std::size_t>(a)] =
+          mesh.elementVertex(e, a);
   }
-  elementStart.back() = 4 * numElements;
-  // Elements are neighbours in the dual graph when they share a face (three vertices),
-  // so the cut counts interface faces, which is what the assembly communicates over.
-  idx_t commonVertices = 3;
+  elementStart.back() = corners * numElements;
+  // Elements are neighbours in the dual graph when they share a face (three vertices of a
+  // tetrahedron, four of a hexahedron), so the cut counts interface faces, which is what
+  // the assembly communicates over.
+  idx_t commonVertices = mesh.isHexahedral() ? 4 : 3;
   idx_t partCount = numParts;
   idx_t cut = 0;
   std::vector<idx_t> elementParts(static_cast<std::size_t>(numElements));

@@ -63,7 +63,6 @@ namespace {
 /// Throws ValidationError on every rank for settings the backend cannot run with.
 void validateSettings(MPI_Comm comm, const TetMesh& mesh, const PetscSimulationSettings& settings) {
   collectively(comm, [&] {
-    mesh.requireTetrahedra("the PETSc backend (PetscSimulation)");
     if (!(settings.timestep > 0.0) || !std::isfinite(settings.timestep)) {
       throw ValidationError("PETSc backend: the timestep must be finite and > 0 (got " +
                             std::to_string(settings.timestep) + ")");

@@ -39,7 +39,7 @@ std::vector<bool> fixedMask(const std::vector<int>& fixedVertices, int numVertic
 std::vector<int> assignOwners(const TetMesh& mesh, const std::vector<bool>& fixed, const std::vector<int>& elementPart,
                               DistributedLayout& layout, VertexElements& adjacency) {
   const int numVertices = mesh.numVertices();
-  const Eigen::Matrix4Xi& elements = mesh.elements();
+  const int corners = mesh.verticesPerElement();
   std::vector<int> owner(static_cast<std::size_t>(numVertices), INT_MAX);
   adjacency.start.assign(static_cast<std::size_t>(numVertices) + 1, 0);
   layout.elementsPerRank.assign(static_cast<std::size_t>(layout.numRanks), 0);
@@ -47,8 +47,8 @@ std::vector<int> assignOwners(const TetMesh& mesh, const std::vector<bool>& fixe
     const int part = elementPart[static_cast<std::size_t>(e)];
     ++layout.elementsPerRank[static_cast<std::size_t>(part)];
     if (part == layout.rank) layout.localElements.push_back(e);
-    for (int a = 0; a < 4; ++a) {
-      const auto v = static_cast<std::size_t>(elements(a, e));
+    for (int a = 0; a < corners; ++a) {
+      const auto v = static_cast<std::size_t>(mesh.elementVertex(e, a));
       owner[v] = std::min(owner[v], part);
       ++adjacency.start[v + 1];
     }
@@ -64,8 +64,8 @@ std::vector<int> assignOwners(const TetMesh& mesh, const std::vector<bool>& fixe
   adjacency.elements.resize(static_cast<std::size_t>(adjacency.start.back()));
   std::vector<int> fill(adjacency.start.begin(), adjacency.start.end() - 1);
   for (int e = 0; e < mesh.numElements(); ++e) {
-    for (int a = 0; a < 4; ++a) {
-      adjacency.elements[static_cast<std::size_t>(fill[static_cast<std::size_t>(elements(a, e))]++)] = e;
+    for (int a = 0; a < corners; ++a) {
+      adjacency.elements[static_cast<std::size_t>(fill[static_cast<std::size_t>(mesh.elementVertex(e, a))]++)] = e;
     }
   }
   return owner;
@@ -102,11 +102,12 @@ bool isOwned(const DistributedLayout& layout, PetscInt block) {
 // Ghosts (free vertices of local elements owned by another rank) and each local
 // element's global and local DOFs.
 void numberElementDofs(const TetMesh& mesh, DistributedLayout& layout) {
-  const Eigen::Matrix4Xi& elements = mesh.elements();
+  const int corners = mesh.verticesPerElement();
+  layout.dofsPerElement = 3 * corners;
   std::vector<PetscInt> ghostBlocks;
   for (int e : layout.localElements) {
-    for (int a = 0; a < 4; ++a) {
-      const PetscInt block = layout.vertexBlock[static_cast<std::size_t>(elements(a, e))];
+    for (int a = 0; a < corners; ++a) {
+      const PetscInt block = layout.vertexBlock[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       if (block >= 0 && !isOwned(layout, block)) ghostBlocks.push_back(block);
     }
   }
@@ -124,8 +125,10 @@ void numberElementDofs(const TetMesh& mesh, DistributedLayout& layout) {
   layout.elementLocalDofs.resize(layout.localElements.size());
   for (std::size_t k = 0; k < layout.localElements.size(); ++k) {
     const int e = layout.localElements[k];
-    for (int a = 0; a < 4; ++a) {
-      const PetscInt block = layout.vertexBlock[static_cast<std::size_t>(elements(a, e))];
+    layout.elementDofs[k].fill(-1);
+    layout.elementLocalDofs[k].fill(-1);
+    for (int a = 0; a < corners; ++a) {
+      const PetscInt block = layout.vertexBlock[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       const PetscInt local = block >= 0 ? localBlock(block) : -1;
       for (int c = 0; c < 3; ++c) {
         const auto slot = static_cast<std::size_t>((3 * a) + c);
@@ -139,7 +142,7 @@ void numberElementDofs(const TetMesh& mesh, DistributedLayout& layout) {
 // Exact preallocation: the blocks of row vertex v are the free vertices of all elements
 // around v, whatever rank assembles them.
 void countMatrixBlocks(const TetMesh& mesh, const VertexElements& adjacency, DistributedLayout& layout) {
-  const Eigen::Matrix4Xi& elements = mesh.elements();
+  const int corners = mesh.verticesPerElement();
   layout.diagonalBlocks.assign(at(layout.ownedBlocks), 0);
   layout.offDiagonalBlocks.assign(at(layout.ownedBlocks), 0);
   std::vector<int> stamp(static_cast<std::size_t>(mesh.numVertices()), -1);
@@ -157,7 +160,7 @@ void countMatrixBlocks(const TetMesh& mesh, const VertexElements& adjacency, Dis
     countColumn(v);  // the diagonal block is always stored
     for (int k = adjacency.start[vi]; k < adjacency.start[vi + 1]; ++k) {
       const int e = adjacency.elements[static_cast<std::size_t>(k)];
-      for (int a = 0; a < 4; ++a) countColumn(elements(a, e));
+      for (int a = 0; a < corners; ++a) countColumn(mesh.elementVertex(e, a));
     }
   }
 }

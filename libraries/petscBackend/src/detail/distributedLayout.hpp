@@ -31,10 +31,13 @@ struct DistributedLayout {
   /// Global DOFs of free vertices of local elements owned elsewhere (three per vertex,
   /// ascending): the ghost entries of the displacement.
   std::vector<PetscInt> ghostDofs;
-  /// Per local element, its 12 global DOFs (-1 for fixed ones) and their indices in
-  /// the ghosted displacement's local form (owned first, then ghosts; -1 for fixed).
-  std::vector<std::array<PetscInt, 12>> elementDofs;
-  std::vector<std::array<PetscInt, 12>> elementLocalDofs;
+  /// DOFs of one element: 12 for a tetrahedron, 24 for a hexahedron.
+  int dofsPerElement = 12;
+  /// Per local element, its global DOFs (-1 for fixed ones) and their indices in the
+  /// ghosted displacement's local form (owned first, then ghosts; -1 for fixed); the first
+  /// dofsPerElement entries are used.
+  std::vector<std::array<PetscInt, 24>> elementDofs;
+  std::vector<std::array<PetscInt, 24>> elementLocalDofs;
   /// Per owned block row: the number of non-zero 3x3 blocks in the columns this rank
   /// owns and in the others (exact preallocation of the system matrices).
   std::vector<PetscInt> diagonalBlocks;

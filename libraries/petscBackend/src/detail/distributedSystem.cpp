@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/hexElements/hexElementMatrices.hpp>
 #include <asyncfem/petscBackend/partition.hpp>
+#include <asyncfem/volumetricMesh/hexahedron.hpp>
 #include <climits>
 #include <cmath>
 #include <sstream>
@@ -15,7 +17,7 @@ namespace asyncfem::detail {
 
 namespace {
 
-using RowMajorElementMatrix = Eigen::Matrix<double, 12, 12, Eigen::RowMajor>;
+using RowMajorElementMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 /// Rest data of element e; ValidationError for a degenerate element, with the same
 /// criterion as the single-process assembly (|V| <= 1e-14 L^3, L the longest edge).
@@ -40,12 +42,45 @@ ElementData elementData(const TetMesh& mesh, int e) {
   return data;
 }
 
-ElementMatrix elementMass(const ElementData& data, MassType massType) {
+/// Rest data of hexahedron e: its volume (the sum of det J over the Gauss points) and
+/// density; ValidationError naming the element and the Gauss point where det J <= 0.
+ElementData hexElementData(const TetMesh& mesh, int e, HexElementPositions& rest) {
+  rest = mesh.hexahedronRestPositions(e);
+  ElementData data;
+  for (int g = 0; g < 8; ++g) {
+    double jacobian = 0.0;
+    hexShapeGradients(rest, hexahedron::gaussPoint(g), &jacobian);
+    if (!(jacobian > 0.0)) {
+      std::ostringstream message;
+      message << "PETSc backend: hexahedron " << e << " has det J = " << jacobian << " at Gauss point " << g
+              << " (inverted or degenerate)";
+      throw ValidationError(message.str());
+    }
+    data.volume += jacobian;  // Gauss weight 1
+  }
+  data.density = mesh.elementMaterial(e).density;
+  return data;
+}
+
+}  // namespace
+
+Eigen::MatrixXd DistributedSystem::elementMass(std::size_t k, MassType massType) const {
+  const ElementData& data = elements[k];
+  if (!hexRest.empty()) {
+    return massType == MassType::lumped ? hexLumpedMass(hexRest[k], data.density)
+                                        : hexConsistentMass(hexRest[k], data.density);
+  }
   return massType == MassType::lumped ? lumpedElementMass(data.volume, data.density)
                                       : consistentElementMass(data.volume, data.density);
 }
 
-}  // namespace
+Eigen::MatrixXd DistributedSystem::elementStiffness(const TetMesh& mesh, std::size_t k) const {
+  const Material& material = mesh.elementMaterial(layout.localElements[k]);
+  if (!hexRest.empty()) return hexLinearStiffness(hexRest[k], material.youngsModulus, material.poissonRatio);
+  return linearElementStiffness(elements[k].rest, material.youngsModulus, material.poissonRatio);
+}
+
+namespace {}  // namespace
 
 DistributedSystem::DistributedSystem(MPI_Comm communicator, const TetMesh& mesh,
                                      const PetscSimulationSettings& settings)
@@ -71,7 +106,13 @@ void DistributedSystem::partition(const TetMesh& mesh, const std::vector<int>& f
     layout = buildDistributedLayout(mesh, fixedVertices, parts, rank, numRanks);
     if (layout.numBlocks == 0) throw ValidationError("PETSc backend: every vertex is fixed, nothing to simulate");
     elements.reserve(layout.localElements.size());
-    for (int e : layout.localElements) elements.push_back(elementData(mesh, e));
+    if (mesh.isHexahedral()) {
+      hexRest.resize(layout.localElements.size());
+      for (std::size_t k = 0; k < layout.localElements.size(); ++k)
+        elements.push_back(hexElementData(mesh, layout.localElements[k], hexRest[k]));
+    } else {
+      for (int e : layout.localElements) elements.push_back(elementData(mesh, e));
+    }
   });
 }
 
@@ -96,18 +137,18 @@ void DistributedSystem::createMatrix(MatHandle& matrix) const {
   checkPetsc(MatSetOption(matrix.get(), MAT_SUBSET_OFF_PROC_ENTRIES, PETSC_TRUE), "MatSetOption");
 }
 
-/// Zeroes matrix (keeping its pattern) and adds every local element's 12x12 matrix.
+/// Zeroes matrix (keeping its pattern) and adds every local element's matrix (12 x 12 or
+/// 24 x 24).
 template <class ElementFunction>
 void DistributedSystem::assembleMatrix(Mat matrix, const ElementFunction& elementMatrix) {
   checkPetsc(MatZeroEntries(matrix), "MatZeroEntries");
   collectively(comm, [&] {
-    ElementMatrix local;
     RowMajorElementMatrix rowMajor;
+    const PetscInt count = layout.dofsPerElement;
     for (std::size_t k = 0; k < elements.size(); ++k) {
-      elementMatrix(k, local);
-      rowMajor = local;
+      rowMajor = elementMatrix(k);
       const PetscInt* dofs = layout.elementDofs[k].data();
-      checkPetsc(MatSetValues(matrix, 12, dofs, 12, dofs, rowMajor.data(), ADD_VALUES), "MatSetValues");
+      checkPetsc(MatSetValues(matrix, count, dofs, count, dofs, rowMajor.data(), ADD_VALUES), "MatSetValues");
     }
   });
   checkPetsc(MatAssemblyBegin(matrix, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
@@ -119,16 +160,12 @@ void DistributedSystem::assembleMatrix(Mat matrix, const ElementFunction& elemen
 void DistributedSystem::assembleMassAndStiffness(const TetMesh& mesh, const PetscSimulationSettings& settings) {
   createMatrix(mass);
   createMatrix(stiffness);
-  assembleMatrix(mass.get(),
-                 [&](std::size_t k, ElementMatrix& out) { out = elementMass(elements[k], settings.massType); });
+  assembleMatrix(mass.get(), [&](std::size_t k) { return elementMass(k, settings.massType); });
   if (nonlinear) {
     checkPetsc(MatZeroEntries(stiffness.get()), "MatZeroEntries");
     assembleNonlinear(displacement.get(), stiffness.get());
   } else {
-    assembleMatrix(stiffness.get(), [&](std::size_t k, ElementMatrix& out) {
-      const Material& material = mesh.elementMaterial(layout.localElements[k]);
-      out = linearElementStiffness(elements[k].rest, material.youngsModulus, material.poissonRatio);
-    });
+    assembleMatrix(stiffness.get(), [&](std::size_t k) { return elementStiffness(mesh, k); });
   }
   checkPetsc(MatDuplicate(mass.get(), MAT_COPY_VALUES, system.out()), "MatDuplicate");
   checkPetsc(MatSetOption(system.get(), MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
@@ -163,11 +200,12 @@ void DistributedSystem::createVectors() {
 void DistributedSystem::assembleStaticForce(const PetscSimulationSettings& settings) {
   if (!settings.gravity.isZero(0.0)) {
     collectively(comm, [&] {
-      ElementVector stackedGravity;
-      for (int a = 0; a < 4; ++a) stackedGravity.segment<3>(3 * a) = settings.gravity;
+      Eigen::VectorXd stackedGravity(layout.dofsPerElement);
+      for (int a = 0; 3 * a < layout.dofsPerElement; ++a) stackedGravity.segment<3>(3 * a) = settings.gravity;
       for (std::size_t k = 0; k < elements.size(); ++k) {
-        const ElementVector force = elementMass(elements[k], settings.massType) * stackedGravity;
-        checkPetsc(VecSetValues(staticForce.get(), 12, layout.elementDofs[k].data(), force.data(), ADD_VALUES),
+        const Eigen::VectorXd force = elementMass(k, settings.massType) * stackedGravity;
+        checkPetsc(VecSetValues(staticForce.get(), layout.dofsPerElement, layout.elementDofs[k].data(), force.data(),
+                                ADD_VALUES),
                    "VecSetValues");
       }
     });

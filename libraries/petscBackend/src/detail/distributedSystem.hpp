@@ -6,6 +6,7 @@
 #include <petscvec.h>
 
 #include <Eigen/Core>
+#include <asyncfem/hexElements/hexElementMatrices.hpp>
 #include <asyncfem/petscBackend/petscSimulation.hpp>
 #include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
@@ -19,7 +20,9 @@
 
 namespace asyncfem::detail {
 
-/// What a local element's mass and linear stiffness need (rest shape, material).
+/// What a local element's mass and linear stiffness need (rest shape, material); a
+/// hexahedron's rest shape is in DistributedSystem::hexRest and only volume and density
+/// are set here.
 struct ElementData {
   ElementPositions rest;
   Eigen::Matrix<double, 3, 4> gradients;  ///< shape-function gradients, rest configuration
@@ -59,6 +62,10 @@ struct DistributedSystem {
   Eigen::VectorXd gather(Vec vector) const;
   /// Copies the owned entries of a full (3n, original numbering) vector into vector.
   void scatterOwned(const Eigen::VectorXd& full, Vec vector) const;
+  /// Local element k's mass (lumped or consistent) and linear stiffness, 12 x 12 for a
+  /// tetrahedron and 24 x 24 for a hexahedron.
+  Eigen::MatrixXd elementMass(std::size_t k, MassType massType) const;
+  Eigen::MatrixXd elementStiffness(const TetMesh& mesh, std::size_t k) const;
   /// The lowest vertex with a non-finite u or v over all ranks, or -1.
   int lowestNonFiniteVertex() const;
 
@@ -67,6 +74,7 @@ struct DistributedSystem {
   bool nonlinear = false;
   DistributedLayout layout;
   std::vector<ElementData> elements;            ///< per local element
+  std::vector<HexElementPositions> hexRest;     ///< per local element of a hexahedral mesh (empty otherwise)
   std::unique_ptr<LocalForceModel> forceModel;  ///< nonlinear models only
 
   /// iterateStiffness: K at a Newton iterate (nonlinear models with Newton iterations).

@@ -12,12 +12,12 @@ LocalForceModel::LocalForceModel(const TetMesh& mesh, const DistributedLayout& l
   std::vector<int> meshVertex;
   const TetMesh part = subMesh(mesh, meshElement_, meshVertex);
   // Each element's DOF indices name its vertices' indices; the sub-mesh vertex of corner
-  // a of local element k is part.elements()(a, k).
+  // a of local element k is part.elementVertex(k, a).
   localFormDof_.assign(static_cast<std::size_t>(part.numDofs()), -1);
   globalDof_.assign(static_cast<std::size_t>(part.numDofs()), -1);
   for (std::size_t k = 0; k < meshElement_.size(); ++k) {
-    for (int i = 0; i < 12; ++i) {
-      const auto dof = static_cast<std::size_t>((3 * part.elements()(i / 3, static_cast<Eigen::Index>(k))) + (i % 3));
+    for (int i = 0; i < layout.dofsPerElement; ++i) {
+      const auto dof = static_cast<std::size_t>((3 * part.elementVertex(static_cast<int>(k), i / 3)) + (i % 3));
       localFormDof_[dof] = layout.elementLocalDofs[k][static_cast<std::size_t>(i)];
       globalDof_[dof] = layout.elementDofs[k][static_cast<std::size_t>(i)];
     }

@@ -4,16 +4,38 @@
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
+#include <asyncfem/hexElements/hexCorotationalForceModel.hpp>
+#include <asyncfem/hexElements/hexStvkForceModel.hpp>
 #include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <regex>
 #include <string>
 
 namespace asyncfem::detail {
 
+namespace {
+
+/// The hexahedral mesh's model: StVK or corotational FEM (the exact tangent is the
+/// derivative of R K v, as in Problem); the others are refused naming the conversion.
+std::unique_ptr<ForceModel> makeHexSubMeshModel(const TetMesh& mesh, PetscForceModelKind kind, TangentKind tangent) {
+  switch (kind) {
+    case PetscForceModelKind::corotational:
+      return std::make_unique<HexCorotationalForceModel>(mesh, tangent == TangentKind::simple);
+    case PetscForceModelKind::stvk:
+      return std::make_unique<HexStvkForceModel>(mesh);
+    default:
+      break;
+  }
+  mesh.requireTetrahedra("the PETSc backend's " + toString(kind) + " model");
+  throw Error("PETSc backend: the linear model has no local force model");
+}
+
+}  // namespace
+
 TetMesh subMesh(const TetMesh& mesh, const std::vector<int>& elements, std::vector<int>& meshVertex) {
   meshVertex.clear();
+  const int corners = mesh.verticesPerElement();
   for (int e : elements) {
-    for (int a = 0; a < 4; ++a) meshVertex.push_back(mesh.elements()(a, e));
+    for (int a = 0; a < corners; ++a) meshVertex.push_back(mesh.elementVertex(e, a));
   }
   std::sort(meshVertex.begin(), meshVertex.end());
   meshVertex.erase(std::unique(meshVertex.begin(), meshVertex.end()), meshVertex.end());
@@ -23,21 +45,24 @@ TetMesh subMesh(const TetMesh& mesh, const std::vector<int>& elements, std::vect
     subVertex[static_cast<std::size_t>(meshVertex[i])] = static_cast<int>(i);
     positions.col(static_cast<Eigen::Index>(i)) = mesh.restPositions().col(meshVertex[i]);
   }
-  Eigen::Matrix4Xi connectivity(4, static_cast<Eigen::Index>(elements.size()));
+  Eigen::MatrixXi connectivity(corners, static_cast<Eigen::Index>(elements.size()));
   std::vector<int> materials;
   materials.reserve(elements.size());
   for (std::size_t k = 0; k < elements.size(); ++k) {
-    for (int a = 0; a < 4; ++a) {
+    for (int a = 0; a < corners; ++a) {
       connectivity(a, static_cast<Eigen::Index>(k)) =
-          subVertex[static_cast<std::size_t>(mesh.elements()(a, elements[k]))];
+          subVertex[static_cast<std::size_t>(mesh.elementVertex(elements[k], a))];
     }
     materials.push_back(mesh.elementMaterialIndex(elements[k]));
   }
-  return TetMesh(std::move(positions), std::move(connectivity), mesh.materials(), std::move(materials));
+  if (mesh.isHexahedral())
+    return TetMesh(std::move(positions), HexElements(connectivity), mesh.materials(), std::move(materials));
+  return TetMesh(std::move(positions), Eigen::Matrix4Xi(connectivity), mesh.materials(), std::move(materials));
 }
 
 std::unique_ptr<ForceModel> makeSubMeshModel(const TetMesh& mesh, PetscForceModelKind kind, TangentKind tangent,
                                              const HyperelasticOptions& hyperelastic) {
+  if (mesh.isHexahedral()) return makeHexSubMeshModel(mesh, kind, tangent);
   switch (kind) {
     case PetscForceModelKind::corotational:
       return std::make_unique<CorotationalLinearFEM>(mesh, tangent);
