@@ -142,6 +142,37 @@ void expectTwoSurfaceCandidatesComplete(const Body& first, const Body& second, d
   }
 }
 
+// Tiny boxes spread over a large domain: a grid of about 2^60 cells, past the radix sort's
+// key range, and few pairs among many boxes, past the counting sort's index range; both
+// fall back to comparison sorts, which must give the same pairs in the same order.
+TEST(BroadPhase, SparseScenesTakeTheComparisonSortsAndMatchBruteForce) {
+  std::mt19937 generator(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const int count = 6000;
+  BoxSet boxes;
+  boxes.min.resize(3, count);
+  boxes.max.resize(3, count);
+  for (int b = 0; b < count; ++b) {
+    const Eigen::Vector3d low = b % 60 == 59 ? Eigen::Vector3d(boxes.min.col(b - 1).array() + 5e-8)
+                                             : Eigen::Vector3d(unit(generator), unit(generator), unit(generator));
+    boxes.min.col(b) = low;
+    boxes.max.col(b) = low.array() + 1e-7;
+  }
+  const auto expected = overlappingBoxes(boxes, BroadPhaseMethod::BruteForce);
+  ASSERT_GE(expected.size(), 100u);                           // every 60th box overlaps its predecessor
+  ASSERT_LT(8 * expected.size() + 4096, std::size_t{count});  // the counting sort's range is exceeded
+  for (const BroadPhaseMethod method : kFastMethods)
+    EXPECT_EQ(overlappingBoxes(boxes, method), expected) << static_cast<int>(method);
+  BoxSet first, second;
+  first.min = boxes.min.leftCols(count / 2);
+  first.max = boxes.max.leftCols(count / 2);
+  second.min = boxes.min.rightCols(count / 2);
+  second.max = boxes.max.rightCols(count / 2);
+  const auto expectedPairs = overlappingBoxes(first, second, BroadPhaseMethod::BruteForce);
+  for (const BroadPhaseMethod method : kFastMethods)
+    EXPECT_EQ(overlappingBoxes(first, second, method), expectedPairs) << static_cast<int>(method);
+}
+
 TEST(BroadPhase, BodyAgainstObstacleFindsEveryPairWithinDhat) {
   // A perturbed box resting 0.01 above a wavy triangulated floor (the static obstacle).
   const Body body = perturbedBox(4, {0.0, 0.01, 0.0}, 1.0, 0.02, 3);

@@ -43,8 +43,31 @@ BoxPairs bruteForceSelfPairs(const BoxSet& boxes) {
   return pairs;
 }
 
+/// The pairs in ascending (first, second) order: two stable counting sorts, by second and
+/// then by first, when the index ranges are within a small multiple of the pair count (a
+/// broad phase's usual case, linear where std::sort is n log n); std::sort otherwise.
 BoxPairs sorted(BoxPairs pairs) {
-  std::sort(pairs.begin(), pairs.end());
+  int firstCount = 0, secondCount = 0;
+  for (const auto& [i, j] : pairs) {
+    firstCount = std::max(firstCount, i + 1);
+    secondCount = std::max(secondCount, j + 1);
+  }
+  const std::size_t budget = (8 * pairs.size()) + 4096;
+  if (static_cast<std::size_t>(firstCount) > budget || static_cast<std::size_t>(secondCount) > budget) {
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+  }
+  BoxPairs buffer(pairs.size());
+  std::vector<std::size_t> start;
+  const auto countingSort = [&](int count, auto digit) {
+    start.assign(static_cast<std::size_t>(count) + 1, 0);
+    for (const auto& pair : pairs) ++start[static_cast<std::size_t>(digit(pair)) + 1];
+    for (std::size_t d = 0; d < static_cast<std::size_t>(count); ++d) start[d + 1] += start[d];
+    for (const auto& pair : pairs) buffer[start[static_cast<std::size_t>(digit(pair))]++] = pair;
+    pairs.swap(buffer);
+  };
+  countingSort(secondCount, [](const std::pair<int, int>& pair) { return pair.second; });
+  countingSort(firstCount, [](const std::pair<int, int>& pair) { return pair.first; });
   return pairs;
 }
 

@@ -9,19 +9,22 @@ namespace asyncfem::detail {
 namespace {
 
 /// A uniform grid over the boxes' common bounding box. Cell (i, j, k) covers
-/// origin + cellSize * [(i, j, k), (i + 1, j + 1, k + 1)); its key packs i, j, k into 21 bits
-/// each.
+/// origin + cellSize * [(i, j, k), (i + 1, j + 1, k + 1)) (the last cell of an axis also
+/// holds its upper bound); its key is i + n_x (j + n_y k), below cellCount().
 struct Grid {
   Eigen::Array3d origin;
   double cellSize = 1.0;
+  Eigen::Array3i cells = Eigen::Array3i::Ones();  ///< cells per axis
 
   Eigen::Array3i cell(const Eigen::Array3d& point) const {
-    return ((point - origin) / cellSize).floor().cast<int>().max(0);
+    return ((point - origin) / cellSize).floor().cast<int>().max(0).min(cells - 1);
   }
-  static std::uint64_t key(const Eigen::Array3i& cell) {
-    return static_cast<std::uint64_t>(cell.x()) | (static_cast<std::uint64_t>(cell.y()) << 21) |
-           (static_cast<std::uint64_t>(cell.z()) << 42);
+  std::uint64_t key(const Eigen::Array3i& cell) const {
+    return static_cast<std::uint64_t>(cell.x()) +
+           (static_cast<std::uint64_t>(cells.x()) *
+            (static_cast<std::uint64_t>(cell.y()) + (static_cast<std::uint64_t>(cells.y()) * cell.z())));
   }
+  std::uint64_t cellCount() const { return static_cast<std::uint64_t>(cells.cast<std::int64_t>().prod()); }
 };
 
 constexpr int kMaxCellsPerAxis = 1 << 20;
@@ -39,6 +42,7 @@ Grid makeGrid(const BoxSet& first, const BoxSet& second) {
   const double extent = (high - low).maxCoeff();
   grid.cellSize = std::max(meanSide, extent / (kMaxCellsPerAxis - 1));
   if (!(grid.cellSize > 0.0)) grid.cellSize = 1.0;  // every box is the same point
+  grid.cells = ((high - low) / grid.cellSize).floor().cast<int>().max(0).min(kMaxCellsPerAxis - 1) + 1;
   return grid;
 }
 
@@ -59,14 +63,41 @@ struct GridEntries {
   std::vector<CellEntry> entries;
   std::vector<int> largeBoxes;
   std::vector<char> isLarge;
+  Eigen::Matrix3Xi lowCells;  ///< per box, the cell of its low corner
 };
+
+/// Sorts entries made in ascending box order by key, stably, so that they end sorted by
+/// (key, box): least-significant-digit radix sort, 11 bits a pass, over the bits the
+/// grid's keys use (a pass fewer than a comparison sort's log n for every grid this
+/// library builds below 2^33 cells; above, std::sort).
+void sortEntries(std::vector<CellEntry>& entries, std::uint64_t cellCount) {
+  constexpr int kDigitBits = 11;
+  constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
+  int bits = 1;
+  while (bits < 64 && (std::uint64_t{1} << bits) < cellCount) ++bits;
+  if (bits > 3 * kDigitBits) {
+    std::sort(entries.begin(), entries.end());
+    return;
+  }
+  std::vector<CellEntry> buffer(entries.size());
+  std::vector<std::size_t> start(kBuckets + 1);
+  for (int shift = 0; shift < bits; shift += kDigitBits) {
+    std::fill(start.begin(), start.end(), 0);
+    for (const CellEntry& entry : entries) ++start[((entry.key >> shift) & (kBuckets - 1)) + 1];
+    for (std::size_t d = 0; d < kBuckets; ++d) start[d + 1] += start[d];
+    for (const CellEntry& entry : entries) buffer[start[(entry.key >> shift) & (kBuckets - 1)]++] = entry;
+    entries.swap(buffer);
+  }
+}
 
 GridEntries cellEntries(const BoxSet& boxes, const Grid& grid) {
   GridEntries result;
   result.entries.reserve(4 * static_cast<std::size_t>(boxes.size()));
   result.isLarge.assign(static_cast<std::size_t>(boxes.size()), 0);
+  result.lowCells.resize(3, boxes.size());
   for (int b = 0; b < boxes.size(); ++b) {
     const Eigen::Array3i low = grid.cell(boxes.min.col(b).array());
+    result.lowCells.col(b) = low.matrix();
     const Eigen::Array3i high = grid.cell(boxes.max.col(b).array());
     if ((high - low + 1).cast<long long>().prod() > kLargeBoxCells) {
       result.largeBoxes.push_back(b);
@@ -75,16 +106,18 @@ GridEntries cellEntries(const BoxSet& boxes, const Grid& grid) {
     }
     for (int k = low.z(); k <= high.z(); ++k)
       for (int j = low.y(); j <= high.y(); ++j)
-        for (int i = low.x(); i <= high.x(); ++i) result.entries.push_back({Grid::key({i, j, k}), b});
+        for (int i = low.x(); i <= high.x(); ++i) result.entries.push_back({grid.key({i, j, k}), b});
   }
-  std::sort(result.entries.begin(), result.entries.end());
+  sortEntries(result.entries, grid.cellCount());
   return result;
 }
 
 /// Whether `key` is the cell of the low corner of the boxes' intersection: the one cell of
 /// all those both boxes touch that reports the pair, so that no pair is reported twice.
-bool reportingCell(std::uint64_t key, const BoxSet& first, int i, const BoxSet& second, int j, const Grid& grid) {
-  return Grid::key(grid.cell(first.min.col(i).array().max(second.min.col(j).array()))) == key;
+/// Cells are monotone per axis, so that cell is the larger of the two low corners' cells.
+bool reportingCell(std::uint64_t key, const GridEntries& first, int i, const GridEntries& second, int j,
+                   const Grid& grid) {
+  return grid.key(first.lowCells.col(i).array().max(second.lowCells.col(j).array())) == key;
 }
 
 std::size_t rangeEnd(const std::vector<CellEntry>& entries, std::size_t begin) {
@@ -126,7 +159,7 @@ BoxPairs spatialHashPairs(const BoxSet& first, const BoxSet& second) {
         const int i = firstEntries[p].box;
         for (std::size_t q = b; q < bEnd; ++q) {
           const int j = secondEntries[q].box;
-          if (boxesOverlap(first, i, second, j) && reportingCell(key, first, i, second, j, grid))
+          if (boxesOverlap(first, i, second, j) && reportingCell(key, firstGrid, i, secondGrid, j, grid))
             pairs.emplace_back(i, j);
         }
       }
@@ -159,7 +192,8 @@ BoxPairs spatialHashSelfPairs(const BoxSet& boxes) {
       const int i = entries[p].box;
       for (std::size_t q = p + 1; q < end; ++q) {
         const int j = entries[q].box;
-        if (boxesOverlap(boxes, i, boxes, j) && reportingCell(key, boxes, i, boxes, j, grid)) pairs.emplace_back(i, j);
+        if (boxesOverlap(boxes, i, boxes, j) && reportingCell(key, gridEntries, i, gridEntries, j, grid))
+          pairs.emplace_back(i, j);
       }
     }
     begin = end;
