@@ -428,7 +428,8 @@ int main(int argc, char** argv) {
                  "Closed triangle surface (any format assimp reads: OBJ, STL, PLY, OFF, ...)");
   app.add_option("--model", options.model, "Built-in example model: dinosaur, flower, dragon, drop, ball");
   app.add_option("-o,--output", options.output, "Output mesh (.veg, or .vtu for ParaView)")->required();
-  app.add_option("--spacing", options.spacing, "BCC lattice spacing (length units of the input)")
+  app.add_option("--spacing", options.spacing,
+                 "BCC lattice spacing, or with --cubes the cube edge (length units of the input)")
       ->check(asyncfem::cli::positive());
   app.add_option("--cells", options.cells, "Lattice cells across the longest side of the bounding box (default 30)")
       ->check(asyncfem::cli::inRange(1, 2000));
