@@ -63,6 +63,16 @@ class FrameRendererTest : public ::testing::Test {
     return result;
   }
 
+  /// scene.json: backward Euler on meshFile with its vertex set "xmin" fixed, six frames.
+  void writeScene(const std::string& meshFile) const {
+    std::ofstream(folder_ / "scene.json") << R"({
+      "mesh": {"file": ")" << meshFile << R"("},
+      "fixed": {"sets": ["xmin"]},
+      "integrator": {"name": "backward-euler", "timestep": 0.01},
+      "frames": {"rate": 10, "count": 6}
+    })";
+  }
+
   fs::path folder_;
   TetMesh mesh_;
 };
@@ -242,16 +252,45 @@ TEST_F(FrameRendererTest, VertexCountMismatchIsAClearError) {
 }
 
 TEST_F(FrameRendererTest, SceneGivesTheMesh) {
-  std::ofstream(folder_ / "scene.json") << R"({
-    "mesh": {"file": "bar.veg"},
-    "fixed": {"sets": ["xmin"]},
-    "integrator": {"name": "backward-euler", "timestep": 0.01},
-    "frames": {"rate": 10, "count": 6}
-  })";
+  writeScene("bar.veg");
   const RunResult r =
       run("run.afsim --scene scene.json --frames 0 --width 48 --height 32 -q -o out --warp rotation-strain");
   EXPECT_EQ(r.exitCode, 0) << r.err;
   EXPECT_TRUE(fs::exists(folder_ / "out" / "frame_00000.png"));
+}
+
+TEST_F(FrameRendererTest, HexahedralSceneDrawsAnEmbeddedRenderMesh) {
+  // A bar of 8 x 2 x 2 CUBIC elements, bent over five frames, with a render mesh (a
+  // tetrahedron of four points, one 0.1 beyond the bar's end) embedded in its hexahedra.
+  TetMesh cubes = renderTesting::renderTestCubeBar();
+  std::vector<int> xmin;
+  for (int v = 0; v < cubes.numVertices(); ++v)
+    if (cubes.restPosition(v).x() == 0.0) xmin.push_back(v);
+  cubes.setVertexSet("xmin", xmin);
+  writeVeg(folder_ / "cubes.veg", cubes);
+  SimulationFileHeader header;
+  header.numVertices = cubes.numVertices();
+  header.frameInterval = 0.1;
+  {
+    SimulationWriter writer(folder_ / "cubes.afsim", header);
+    for (int k = 0; k < 6; ++k) writer.appendFrame(0.1 * k, k / 5.0 * renderTesting::bentBar(cubes));
+  }
+  SurfaceMesh shape;
+  shape.vertices.resize(3, 4);
+  shape.vertices << 0.2, 1.7, 1.0, 1.0, 0.1, 0.1, 0.35, 0.1, 0.1, 0.1, 0.1, 0.35;
+  shape.triangles = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {0, 2, 3}};
+  writeObj(folder_ / "shape.obj", shape);
+  writeScene("cubes.veg");
+  const RunResult r =
+      run("cubes.afsim --scene scene.json --render-mesh shape.obj --frames 0:6:5 --width 64 --height 48 "
+          "--camera-position 0.8,0.2,5 --camera-target 0.8,0.2,0.2 -o out");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("shape.obj, 4 vertices, 4 triangles (1 outside the mesh, up to 0.10 away)"), std::string::npos)
+      << r.out;
+  // The bent frame draws the surface lower down than the rest frame: the images differ.
+  const Image rest = readPng(folder_ / "out" / "frame_00000.png");
+  const Image bent = readPng(folder_ / "out" / "frame_00005.png");
+  EXPECT_NE(rest.pixels, bent.pixels);
 }
 
 // --ground puts the floor at the scene's contact.ground: two heights give two images, and a

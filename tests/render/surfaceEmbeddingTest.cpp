@@ -98,6 +98,40 @@ TEST(SurfaceEmbedding, EmbeddedMeshFollowsAnAffineMotion) {
   }
 }
 
+TEST(SurfaceEmbedding, HexahedraReproduceAnAffineMotionInsideAndOutside) {
+  // Trilinear shape functions reproduce affine fields: with the rest map inverted exactly
+  // (Newton, hexahedron::referenceCoordinates) every embedded point follows x -> (I + A) x + b,
+  // including the outside vertex, which extrapolates its nearest hexahedron. Tolerance: Newton
+  // stops below 1e-13 in reference units (about 1e-14 in length for cubes of 0.2), then
+  // rounding in sums of eight terms.
+  for (const double wobble : {0.0, 0.03}) {
+    const TetMesh mesh = renderTestCubeBar(wobble);
+    const SurfaceMesh shape = octahedronWithOutlier();
+    const SurfaceEmbedding surface = SurfaceEmbedding::embed(mesh, shape);
+    ASSERT_EQ(surface.tetVertices().rows(), 8);
+    EXPECT_EQ(surface.numOutsideVertices(), 1);
+    EXPECT_NEAR(surface.maxOutsideDistance(), 0.45, 1e-12);  // the bar's end face x = 1.6 is flat
+    for (int k = 0; k < 6; ++k) {
+      // Inside: the eight weights are convex and give back the point.
+      EXPECT_GE(surface.weights().col(k).minCoeff(), -1e-12) << "vertex " << k;
+      EXPECT_NEAR(surface.weights().col(k).sum(), 1.0, 1e-14);
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
+      for (int a = 0; a < 8; ++a) p += surface.weights()(a, k) * mesh.restPosition(surface.tetVertices()(a, k));
+      EXPECT_LE((p - shape.vertices.col(k)).norm(), 1e-13) << "vertex " << k;
+    }
+    Eigen::Matrix3d a;
+    a << 0.1, -0.3, 0.2, 0.05, 0.0, -0.1, 0.3, 0.2, -0.05;
+    const Eigen::Vector3d b(0.4, -1.25, 3.0);
+    Eigen::VectorXd u(mesh.numDofs());
+    for (int v = 0; v < mesh.numVertices(); ++v) u.segment<3>(3 * v) = a * mesh.restPosition(v) + b;
+    const Eigen::Matrix3Xd x = surface.positions(u);
+    for (int k = 0; k < 7; ++k) {
+      const Eigen::Vector3d expected = shape.vertices.col(k) + a * shape.vertices.col(k) + b;
+      EXPECT_LE((x.col(k) - expected).norm(), 1e-12) << "wobble " << wobble << ", vertex " << k;
+    }
+  }
+}
+
 TEST(SurfaceEmbedding, ReadsOtherFormatsAndWeldsSeams) {
   const auto folder = freshFolder("formats");
   // ASCII STL stores every triangle's corners separately: welding joins them.

@@ -185,6 +185,59 @@ TEST(TetMesherUtility, GradedSurfaceMeshKeepsTheSurfaceWithFewerElements) {
   EXPECT_LT(readVeg(gradedVeg).numElements(), readVeg(uniformVeg).numElements());
 }
 
+TEST(TetMesherUtility, CubesFromASurfaceOrAModelWithTheVolumeError) {
+  // The 48 x 24 UV sphere at spacing 0.1: 4224 cubes (the count voxelize gives for this grid,
+  // Voxelize.SphereVolumeErrorShrinksUnderRefinement), written as CUBIC elements and read back.
+  const auto obj = scratch("cubeSphere.obj");
+  std::ofstream(obj) << test::toObj(test::uvSphere(Eigen::Vector3d::Zero(), 1.0, 48, 24));
+  const auto veg = scratch("cubeSphere.veg");
+  const RunResult sphere = run(obj.string() + " --cubes --spacing 0.1 -o " + veg.string());
+  ASSERT_EQ(sphere.status, 0) << sphere.output;
+  EXPECT_NE(sphere.output.find("4224 cubes, 5233 vertices"), std::string::npos) << sphere.output;
+  EXPECT_NE(sphere.output.find("volume: cubes 4.224, surface 4.15897, error +1.56%"), std::string::npos)
+      << sphere.output;
+  const TetMesh mesh = readVeg(veg);
+  EXPECT_TRUE(mesh.isHexahedral());
+  EXPECT_EQ(mesh.numElements(), 4224);
+
+  const RunResult model = run("--model drop --cubes -o " + scratch("cubeDrop.vtu").string());
+  ASSERT_EQ(model.status, 0) << model.output;
+  EXPECT_NE(model.output.find("set stiffPart: "), std::string::npos) << model.output;
+}
+
+TEST(TetMesherUtility, CubesRefuseOpenOrMisorientedSurfacesAndBadSpacings) {
+  const auto expectError = [](const std::string& arguments, const std::string& message) {
+    const RunResult result = run(arguments);
+    EXPECT_EQ(result.status, 1) << arguments << ": " << result.output;
+    EXPECT_NE(result.output.find(message), std::string::npos) << arguments << ": " << result.output;
+  };
+  TriangleSurface open = test::splitCube(Eigen::Vector3d::Zero(), 1.0);
+  open.triangles.conservativeResize(3, open.numTriangles() - 1);
+  open.triangleParts.pop_back();
+  const auto openObj = scratch("cubesOpen.obj");
+  std::ofstream(openObj) << test::toObj(open);
+  const std::string veg = " -o " + scratch("cubes.veg").string();
+  expectError(openObj.string() + " --cubes --spacing 0.1" + veg, "3 open boundary edges");
+  // One triangle reversed: its three edges are traversed the same way as by their neighbours.
+  TriangleSurface flipped = test::splitCube(Eigen::Vector3d::Zero(), 1.0);
+  flipped.triangles.col(0).tail<2>().reverseInPlace();
+  const auto flippedObj = scratch("cubesFlipped.obj");
+  std::ofstream(flippedObj) << test::toObj(flipped);
+  expectError(flippedObj.string() + " --cubes --spacing 0.1" + veg,
+              "0 open boundary edges, 0 non-manifold edges, 3 inconsistently oriented edges");
+  const auto cubeObj = scratch("cubesClosed.obj");
+  std::ofstream(cubeObj) << test::toObj(test::splitCube(Eigen::Vector3d::Zero(), 1.0));
+  // One cell of edge 10 from the corner (0, 0, 0): its centre (5, 5, 5) is outside.
+  expectError(cubeObj.string() + " --cubes --spacing 10" + veg, "no cube centre at spacing 10 lies inside");
+  expectError(cubeObj.string() + " --cubes --spacing 0.1 --max-cubes 500" + veg,
+              "1000 cubes, more than the cap of 500; a spacing of about 0.125992 or larger fits");
+  expectError(cubeObj.string() + " --cubes --spacing 0.1 --grade 2" + veg, "--grade applies to tetrahedra");
+  const RunResult fine = run(cubeObj.string() + " --cubes --spacing 0.1" + veg);
+  EXPECT_EQ(fine.status, 0) << fine.output;
+  EXPECT_NE(fine.output.find("1000 cubes, 1331 vertices"), std::string::npos) << fine.output;
+  EXPECT_NE(fine.output.find("error +0.00%"), std::string::npos) << fine.output;
+}
+
 TEST(TetMesherUtility, BadOptionsAreErrors) {
   EXPECT_EQ(run("--model nosuch -o " + scratch("x.veg").string()).status, 1);
   EXPECT_NE(run("--model nosuch -o " + scratch("x.veg").string()).output.find("known: dinosaur"), std::string::npos);

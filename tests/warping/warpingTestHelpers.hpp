@@ -5,10 +5,13 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <asyncfem/volumetricMesh/generators.hpp>
+#include <asyncfem/volumetricMesh/hexahedron.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <cmath>
 #include <set>
 #include <utility>
+
+#include "../hexElements/hexBar.hpp"
 
 namespace asyncfem::testing {
 
@@ -20,6 +23,21 @@ inline TetMesh warpingTestBox() {
   spec.size = Eigen::Vector3d(2.0, 1.0, 1.0);
   spec.cells = Eigen::Vector3i(4, 2, 2);
   return makeBoxMesh(spec);
+}
+
+/// test::hexBar(2) (8 x 2 x 2 cubes of 0.125 over [0, 1] x [0, 0.25]^2) with its interior
+/// vertices moved by up to wobble along a smooth non-affine field (general hexahedra for
+/// wobble > 0).
+inline TetMesh warpingTestHexBar(double wobble) {
+  const TetMesh bar = test::hexBar(2);
+  Eigen::Matrix3Xd x = bar.restPositions();
+  for (int v = 0; v < bar.numVertices(); ++v) {
+    const Eigen::Vector3d p = x.col(v);
+    if (p.x() > 0.0 && p.x() < 1.0 && p.y() > 0.0 && p.y() < 0.25 && p.z() > 0.0 && p.z() < 0.25) {
+      x.col(v) += wobble * Eigen::Vector3d(std::sin(13.0 * p.x()), std::cos(11.0 * p.x()), std::sin(17.0 * p.x()));
+    }
+  }
+  return {std::move(x), bar.hexahedra(), bar.materials(), bar.elementMaterials()};
 }
 
 /// Stacked 3n vector of field(X) over the rest positions.
@@ -51,18 +69,24 @@ inline Eigen::VectorXd rigidRotation(const TetMesh& mesh, double theta, const Ei
   });
 }
 
-/// Largest relative change of an element edge's length, max |l - L| / L, for positions
+/// Largest relative change of an element edge's length (tetrahedra or hexahedra), max |l - L| / L, for positions
 /// rest + displacement.
 inline double maxEdgeLengthError(const TetMesh& mesh, const Eigen::VectorXd& displacement) {
   std::set<std::pair<int, int>> edges;
+  auto addEdge = [&](int e, int a, int b) {
+    const int i = mesh.elementVertex(e, a);
+    const int j = mesh.elementVertex(e, b);
+    edges.emplace(std::min(i, j), std::max(i, j));
+  };
   for (int e = 0; e < mesh.numElements(); ++e) {
-    for (int a = 0; a < 4; ++a) {
-      for (int b = a + 1; b < 4; ++b) {
-        const int i = mesh.elements()(a, e);
-        const int j = mesh.elements()(b, e);
-        edges.emplace(std::min(i, j), std::max(i, j));
-      }
+    if (mesh.isHexahedral()) {
+      // The twelve edges, each on two of the faces.
+      for (const auto& f : hexahedron::kFaces)
+        for (std::size_t c = 0; c < 4; ++c) addEdge(e, f[c], f[(c + 1) % 4]);
+      continue;
     }
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) addEdge(e, a, b);
   }
   double worst = 0.0;
   for (const auto& [i, j] : edges) {

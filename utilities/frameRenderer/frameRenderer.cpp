@@ -617,7 +617,7 @@ void printSummary(const CommandLine& options, const Shared& shared, std::size_t 
   out << "  surface     " << shared.surfaceName << ", " << shared.surface.numSurfaceVertices() << " vertices, "
       << shared.surface.triangles().size() << " triangles";
   if (shared.surface.numOutsideVertices() > 0) {
-    out << " (" << shared.surface.numOutsideVertices() << " outside the tet mesh, up to "
+    out << " (" << shared.surface.numOutsideVertices() << " outside the mesh, up to "
         << shared.surface.maxOutsideDistance() << " away)";
   }
   out << "\n  problem     " << (options.mesh ? "mesh file, no scene" : "mesh and fixed vertices of the scene") << ": "

@@ -6,6 +6,10 @@
 //             [--part-sets] [--material SET:rho,E,nu]... [--default-material rho,E,nu]
 //             [--repair] [--weld-tolerance T] [--quiet]
 //   tetMesher --model dinosaur|flower|dragon|drop|ball --output OUT.veg [--spacing H] [--set ...]
+//   tetMesher SURFACE|--model NAME --cubes --output OUT.veg [--spacing H | --cells N] [--max-cubes N]
+//
+// With --cubes the solid becomes trilinear hexahedra instead: the cubes of a regular grid whose
+// centres are inside (voxelize.hpp), written as Vega CUBIC elements (or VTK hexahedra).
 //
 // The report goes to stdout; errors print "tetMesher: <message>" on stderr and exit 1
 // (2 for unusable command-line options). docs/tet-mesher.md describes everything.
@@ -20,6 +24,7 @@
 #include <asyncfem/tetMesher/meshChecks.hpp>
 #include <asyncfem/tetMesher/signedDistance.hpp>
 #include <asyncfem/tetMesher/triangleSurface.hpp>
+#include <asyncfem/tetMesher/voxelize.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <asyncfem/volumetricMesh/writers.hpp>
 #include <cmath>
@@ -128,6 +133,8 @@ struct Options {
   double maxHole = 0.2;
   double weldTolerance = -1.0;
   bool quiet = false;
+  bool cubes = false;
+  long long maxCubes = asyncfem::VoxelOptions{}.maxCubes;
 };
 
 void printQuality(const TetMesh& mesh, const asyncfem::StuffingReport& stuffing, double spacing) {
@@ -286,6 +293,13 @@ void checkAndReportSurfaceMesh(const TetMesh& mesh, const asyncfem::SignedDistan
       asyncfem::inputTriangleIndex(distance.surface(), deviation.surfaceToMeshTriangle));
 }
 
+/// --part-sets, --material-sets, --group-sets.
+void addRequestedLabelSets(TetMesh& mesh, const asyncfem::SignedDistance& distance, const Options& options) {
+  if (options.partSets) asyncfem::addSurfaceLabelSets(mesh, distance, asyncfem::SurfaceLabel::Part);
+  if (options.materialSets) asyncfem::addSurfaceLabelSets(mesh, distance, asyncfem::SurfaceLabel::Material);
+  if (options.groupSets) asyncfem::addSurfaceLabelSets(mesh, distance, asyncfem::SurfaceLabel::Group);
+}
+
 /// A surface file at the given spacing (from --cells, default 30, when <= 0).
 TetMesh meshSurface(const Options& options, const asyncfem::MesherOptions& mesherOptions, double& spacing,
                     asyncfem::StuffingReport& stuffing) {
@@ -296,9 +310,57 @@ TetMesh meshSurface(const Options& options, const asyncfem::MesherOptions& meshe
   const Eigen::AlignedBox3d bounds(inputBounds.min().array() - spacing, inputBounds.max().array() + spacing);
   TetMesh mesh = asyncfem::stuffIsosurface(distance.function(), bounds, spacing, mesherOptions, &stuffing);
   checkAndReportSurfaceMesh(mesh, distance, prepared, spacing, options);
-  if (options.partSets) asyncfem::addSurfaceLabelSets(mesh, distance, asyncfem::SurfaceLabel::Part);
-  if (options.materialSets) asyncfem::addSurfaceLabelSets(mesh, distance, asyncfem::SurfaceLabel::Material);
-  if (options.groupSets) asyncfem::addSurfaceLabelSets(mesh, distance, asyncfem::SurfaceLabel::Group);
+  addRequestedLabelSets(mesh, distance, options);
+  return mesh;
+}
+
+void printCubes(const asyncfem::VoxelReport& report, double spacing) {
+  std::printf("cubes: spacing %.6g, grid %d x %d x %d (%lld cells), %d cubes, %d vertices, %.3f s\n", spacing,
+              report.gridCells.x(), report.gridCells.y(), report.gridCells.z(), report.gridCellCount, report.cubes,
+              report.vertices, report.seconds);
+}
+
+/// --cubes: the surface or the model as cubes whose centres are inside, with its volume error.
+TetMesh meshCubes(const Options& options, const asyncfem::MesherOptions& mesherOptions, double& spacing) {
+  if (options.grade > 0) throw ValidationError("--grade applies to tetrahedra; --cubes makes a uniform grid");
+  asyncfem::VoxelOptions voxelOptions;
+  voxelOptions.material = mesherOptions.material;
+  voxelOptions.maxCubes = options.maxCubes;
+  asyncfem::VoxelReport report;
+  if (!options.model.empty()) {
+    const asyncfem::ExampleModel model = asyncfem::exampleModelFromName(options.model);
+    if (options.cells > 0) throw ValidationError("--cells applies to surfaces; give --spacing for a model");
+    if (spacing <= 0.0) spacing = asyncfem::exampleModelShape(model).spacing;
+    TetMesh mesh = asyncfem::makeExampleModelCubes(model, spacing, &report);
+    if (!options.quiet) {
+      printCubes(report, spacing);
+      std::printf("volume: cubes %.6g (an implicit model has no reference volume to compare with)\n",
+                  report.cubeVolume);
+    }
+    return mesh;
+  }
+  PreparedSurface prepared = prepareSurface(options);
+  if (spacing <= 0.0) spacing = prepared.inputBounds.sizes().maxCoeff() / (options.cells > 0 ? options.cells : 30);
+  const asyncfem::SignedDistance distance(std::move(prepared.surface), prepared.mode);
+  TetMesh mesh = asyncfem::voxelize(distance.function(), prepared.inputBounds, spacing, voxelOptions, &report);
+  if (prepared.mode == asyncfem::SignMode::Pseudonormal) {
+    asyncfem::requireNoSelfOverlap(mesh, distance, options.input);
+  } else {
+    // Cube faces lie within sqrt(3) / 2 spacings of the solid's surface; farther ones span holes.
+    asyncfem::requireRepairableHoles(mesh, distance, spacing, options.maxHole, options.input);
+  }
+  addRequestedLabelSets(mesh, distance, options);
+  if (options.quiet) return mesh;
+  printCubes(report, spacing);
+  if (prepared.mode == asyncfem::SignMode::Pseudonormal && prepared.enclosed > 0.0) {
+    std::printf("volume: cubes %.6g, surface %.6g, error %+.2f%%\n", report.cubeVolume, prepared.enclosed,
+                100.0 * asyncfem::relativeVolumeError(report.cubeVolume, prepared.enclosed));
+  } else {
+    std::printf(
+        "volume: cubes %.6g (the open surface encloses no definite volume; its divergence-theorem value is "
+        "%.6g)\n",
+        report.cubeVolume, prepared.enclosed);
+  }
   return mesh;
 }
 
@@ -333,10 +395,13 @@ int run(const Options& options) {
   }
   asyncfem::StuffingReport stuffing;
   double spacing = options.spacing;
-  TetMesh mesh = options.model.empty() ? meshSurface(options, mesherOptions, spacing, stuffing)
-                                       : meshModel(options, spacing, stuffing);
+  TetMesh mesh = options.cubes           ? meshCubes(options, mesherOptions, spacing)
+                 : options.model.empty() ? meshSurface(options, mesherOptions, spacing, stuffing)
+                                         : meshModel(options, spacing, stuffing);
   addRequestedSets(mesh, options);
-  if (!options.quiet) {
+  if (options.cubes) {
+    if (!options.quiet) printSets(mesh);
+  } else if (!options.quiet) {
     printQuality(mesh, stuffing, spacing);
     printSets(mesh);
   }
@@ -355,13 +420,16 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   asyncfem::preferPassiveThreadWaiting(argv);
-  CLI::App app{"Tetrahedral meshes by isosurface stuffing from closed surfaces or built-in example models"};
+  CLI::App app{
+      "Tetrahedral meshes by isosurface stuffing (or cube meshes with --cubes) from closed surfaces or built-in "
+      "example models"};
   Options options;
   app.add_option("surface", options.input,
                  "Closed triangle surface (any format assimp reads: OBJ, STL, PLY, OFF, ...)");
   app.add_option("--model", options.model, "Built-in example model: dinosaur, flower, dragon, drop, ball");
   app.add_option("-o,--output", options.output, "Output mesh (.veg, or .vtu for ParaView)")->required();
-  app.add_option("--spacing", options.spacing, "BCC lattice spacing (length units of the input)")
+  app.add_option("--spacing", options.spacing,
+                 "BCC lattice spacing, or with --cubes the cube edge (length units of the input)")
       ->check(asyncfem::cli::positive());
   app.add_option("--cells", options.cells, "Lattice cells across the longest side of the bounding box (default 30)")
       ->check(asyncfem::cli::inRange(1, 2000));
@@ -396,6 +464,11 @@ int main(int argc, char** argv) {
       ->check(asyncfem::cli::positive());
   app.add_option("--weld-tolerance", options.weldTolerance,
                  "Merge surface vertices closer than this (default 1e-7 x bounding-box diagonal)");
+  app.add_flag("--cubes", options.cubes,
+               "Cubes instead of tetrahedra: the cells of a grid at --spacing whose centres are inside, written "
+               "as hexahedra (Vega CUBIC)");
+  app.add_option("--max-cubes", options.maxCubes, "With --cubes: the most cubes allowed (default 2000000)")
+      ->check(asyncfem::cli::inRange(1, 100000000));
   app.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
   if (const std::optional<int> status = asyncfem::cli::parse(app, argc, argv, "tetMesher")) return *status;
   return asyncfem::cli::run("tetMesher", [&] {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/render/surfaceEmbedding.hpp>
+#include <asyncfem/volumetricMesh/hexahedron.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <cmath>
 #include <limits>
@@ -62,28 +63,50 @@ class ElementGrid {
     visited_.assign(static_cast<std::size_t>(mesh.numElements()), -1);
   }
 
-  /// Barycentric coordinates of p in element e (sum 1).
-  Eigen::Vector4d barycentric(int e, const Eigen::Vector3d& p) const {
+  /// The weights of p in element e (sum 1): barycentric coordinates in a tetrahedron, the
+  /// eight trilinear shape functions at p's reference coordinates in a hexahedron.
+  Eigen::VectorXd weights(int e, const Eigen::Vector3d& p) const {
+    if (mesh_.isHexahedral()) {
+      return hexahedron::shapeFunctions(hexahedron::referenceCoordinates(mesh_.hexahedronRestPositions(e), p));
+    }
     const Eigen::Vector3d l = inverses_[static_cast<std::size_t>(e)] * (p - mesh_.restPosition(mesh_.elements()(0, e)));
-    return {1.0 - l.sum(), l.x(), l.y(), l.z()};
+    return Eigen::Vector4d(1.0 - l.sum(), l.x(), l.y(), l.z());
   }
 
-  /// Euclidean distance from p to element e (0 inside).
+  /// Non-negative exactly when p is in element e, larger deeper inside: the smallest
+  /// barycentric coordinate, or 1 - max |xi_i| of the reference coordinates of a hexahedron.
+  double insideScore(int e, const Eigen::Vector3d& p) const {
+    if (mesh_.isHexahedral()) {
+      return 1.0 - hexahedron::referenceCoordinates(mesh_.hexahedronRestPositions(e), p).lpNorm<Eigen::Infinity>();
+    }
+    return weights(e, p).minCoeff();
+  }
+
+  /// Euclidean distance from p to element e (0 inside): to the nearest of its boundary
+  /// triangles (a hexahedron's quadrilateral a b c d as a b c and a c d, exact for planar faces).
   double distance(int e, const Eigen::Vector3d& p) const {
-    if (barycentric(e, p).minCoeff() >= 0.0) {
+    if (insideScore(e, p) >= 0.0) {
       return 0.0;
     }
-    const Eigen::Matrix<double, 3, 4> x = mesh_.elementRestPositions(e);
     double best = std::numeric_limits<double>::infinity();
-    constexpr int faces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-    for (const auto& f : faces) {
-      best = std::min(best, (p - closestPointOnTriangle(p, x.col(f[0]), x.col(f[1]), x.col(f[2]))).norm());
+    auto triangle = [&](int a, int b, int c) {
+      const Eigen::Vector3d q = closestPointOnTriangle(p, vertex(e, a), vertex(e, b), vertex(e, c));
+      best = std::min(best, (p - q).norm());
+    };
+    if (mesh_.isHexahedral()) {
+      for (const auto& f : hexahedron::kFaces) {
+        triangle(f[0], f[1], f[2]);
+        triangle(f[0], f[2], f[3]);
+      }
+      return best;
     }
+    constexpr int faces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+    for (const auto& f : faces) triangle(f[0], f[1], f[2]);
     return best;
   }
 
-  /// The element containing p (largest smallest barycentric coordinate among the
-  /// candidates, ties to the lower id) or else the nearest one; its distance in *dist.
+  /// The element containing p (largest insideScore among the candidates, ties to the lower
+  /// id) or else the nearest one; its distance in *dist.
   int locate(const Eigen::Vector3d& p, int stamp, double* dist) {
     const Eigen::Vector3i center = cellOf(p);
     const int containing = containingElement(center, p);
@@ -95,20 +118,28 @@ class ElementGrid {
   }
 
  private:
-  /// Element boxes and inverse edge matrices, and lower_; returns the upper corner of all boxes.
+  Eigen::Vector3d vertex(int e, int a) const { return mesh_.restPosition(mesh_.elementVertex(e, a)); }
+
+  /// Element boxes, the tetrahedra's inverse edge matrices, and lower_; returns the upper
+  /// corner of all boxes.
   Eigen::Vector3d measureElements() {
     const int numElements = mesh_.numElements();
     lower_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     Eigen::Vector3d upper = -lower_;
     boxes_.resize(static_cast<std::size_t>(numElements));
-    inverses_.resize(static_cast<std::size_t>(numElements));
+    if (!mesh_.isHexahedral()) inverses_.resize(static_cast<std::size_t>(numElements));
     for (int e = 0; e < numElements; ++e) {
-      const Eigen::Matrix<double, 3, 4> x = mesh_.elementRestPositions(e);
-      boxes_[static_cast<std::size_t>(e)] = {x.rowwise().minCoeff(), x.rowwise().maxCoeff()};
-      lower_ = lower_.cwiseMin(boxes_[static_cast<std::size_t>(e)].min);
-      upper = upper.cwiseMax(boxes_[static_cast<std::size_t>(e)].max);
+      BoundingBox& box = boxes_[static_cast<std::size_t>(e)];
+      box = {vertex(e, 0), vertex(e, 0)};
+      for (int a = 1; a < mesh_.verticesPerElement(); ++a) {
+        box.min = box.min.cwiseMin(vertex(e, a));
+        box.max = box.max.cwiseMax(vertex(e, a));
+      }
+      lower_ = lower_.cwiseMin(box.min);
+      upper = upper.cwiseMax(box.max);
+      if (mesh_.isHexahedral()) continue;
       Eigen::Matrix3d edges;
-      edges << x.col(1) - x.col(0), x.col(2) - x.col(0), x.col(3) - x.col(0);
+      edges << vertex(e, 1) - vertex(e, 0), vertex(e, 2) - vertex(e, 0), vertex(e, 3) - vertex(e, 0);
       inverses_[static_cast<std::size_t>(e)] = edges.inverse();
     }
     return upper;
@@ -156,15 +187,15 @@ class ElementGrid {
     }
   }
 
-  /// The element of center's cell that contains p (largest smallest barycentric
-  /// coordinate, ties to the lower id), or -1.
+  /// The element of center's cell that contains p (largest insideScore, ties to the lower
+  /// id), or -1.
   int containingElement(const Eigen::Vector3i& center, const Eigen::Vector3d& p) const {
     int best = -1;
     double bestScore = -std::numeric_limits<double>::infinity();
     for (std::size_t s = offsets_[cellIndex(center)]; s < static_cast<std::size_t>(offsets_[cellIndex(center) + 1]);
          ++s) {
       const int e = cellElements_[s];
-      const double score = barycentric(e, p).minCoeff();
+      const double score = insideScore(e, p);
       if (score > bestScore || (score == bestScore && e < best)) {
         bestScore = score;
         best = e;
@@ -319,21 +350,21 @@ SurfaceEmbedding SurfaceEmbedding::boundary(const TetMesh& mesh) {
 
 SurfaceEmbedding SurfaceEmbedding::embed(const TetMesh& mesh, SurfaceMesh surface) {
   if (mesh.numElements() == 0) {
-    throw ValidationError("cannot embed a surface in a tet mesh without elements");
+    throw ValidationError("cannot embed a surface in a volumetric mesh without elements");
   }
   const auto m = surface.vertices.cols();
   checkTriangles(surface);
   SurfaceEmbedding embedding;
   embedding.numTetVertices_ = mesh.numVertices();
-  embedding.tetVertices_.resize(4, m);
-  embedding.weights_.resize(4, m);
+  embedding.tetVertices_.resize(mesh.verticesPerElement(), m);
+  embedding.weights_.resize(mesh.verticesPerElement(), m);
   ElementGrid grid(mesh);
   for (Eigen::Index k = 0; k < m; ++k) {
     const Eigen::Vector3d p = surface.vertices.col(k);
     double distance = 0.0;
     const int e = grid.locate(p, static_cast<int>(k), &distance);
-    embedding.tetVertices_.col(k) = mesh.element(e);
-    embedding.weights_.col(k) = grid.barycentric(e, p);
+    embedding.tetVertices_.col(k) = mesh.connectivity().col(e);
+    embedding.weights_.col(k) = grid.weights(e, p);
     if (distance > 0.0) {
       ++embedding.numOutside_;
       embedding.maxOutsideDistance_ = std::max(embedding.maxOutsideDistance_, distance);
@@ -351,7 +382,7 @@ Eigen::Matrix3Xd SurfaceEmbedding::positions(const Eigen::Ref<const Eigen::Vecto
   Eigen::Matrix3Xd x = surface_.vertices;
   for (Eigen::Index k = 0; k < x.cols(); ++k) {
     Eigen::Vector3d u = weights_(0, k) * displacement.segment<3>(3 * static_cast<Eigen::Index>(tetVertices_(0, k)));
-    for (int a = 1; a < 4; ++a) {
+    for (Eigen::Index a = 1; a < tetVertices_.rows(); ++a) {
       u += weights_(a, k) * displacement.segment<3>(3 * static_cast<Eigen::Index>(tetVertices_(a, k)));
     }
     x.col(k) += u;
@@ -367,7 +398,7 @@ Eigen::Matrix3Xf SurfaceEmbedding::interpolate(const Eigen::Matrix3Xf& perTetVer
   Eigen::Matrix3Xf out(3, surface_.vertices.cols());
   for (Eigen::Index k = 0; k < out.cols(); ++k) {
     Eigen::Vector3f value = Eigen::Vector3f::Zero();
-    for (int a = 0; a < 4; ++a) {
+    for (Eigen::Index a = 0; a < tetVertices_.rows(); ++a) {
       value += static_cast<float>(weights_(a, k)) * perTetVertex.col(tetVertices_(a, k));
     }
     out.col(k) = value.cwiseMax(0.0F).cwiseMin(1.0F);

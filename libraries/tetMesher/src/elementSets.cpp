@@ -11,15 +11,21 @@ namespace asyncfem {
 
 Eigen::Matrix3Xd elementCentroids(const TetMesh& mesh) {
   Eigen::Matrix3Xd centroids(3, mesh.numElements());
-  for (int e = 0; e < mesh.numElements(); ++e) centroids.col(e) = mesh.elementRestPositions(e).rowwise().mean();
+  const int n = mesh.verticesPerElement();
+  for (int e = 0; e < mesh.numElements(); ++e) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int a = 0; a < n; ++a) sum += mesh.restPosition(mesh.elementVertex(e, a));
+    centroids.col(e) = sum / n;
+  }
   return centroids;
 }
 
 void setElementAndVertexSet(TetMesh& mesh, const std::string& name, std::vector<int> elements) {
   std::vector<int> vertices;
-  vertices.reserve(4 * elements.size());
+  const int n = mesh.verticesPerElement();
+  vertices.reserve(static_cast<std::size_t>(n) * elements.size());
   for (int e : elements)
-    for (int a = 0; a < 4; ++a) vertices.push_back(mesh.elements()(a, e));
+    for (int a = 0; a < n; ++a) vertices.push_back(mesh.elementVertex(e, a));
   mesh.setElementSet(name, std::move(elements));
   mesh.setVertexSet(name, std::move(vertices));
 }

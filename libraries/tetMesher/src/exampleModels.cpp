@@ -233,4 +233,15 @@ TetMesh makeExampleModel(ExampleModel model, double spacing, StuffingReport* rep
   return mesh;
 }
 
+TetMesh makeExampleModelCubes(ExampleModel model, double spacing, VoxelReport* report) {
+  const ImplicitModel shape = exampleModelShape(model);
+  VoxelOptions options;
+  options.material = defaultMaterial(model);
+  TetMesh mesh = voxelize(implicitUnionOfParts(shape.parts, shape.blend), shape.bounds,
+                          spacing > 0.0 ? spacing : shape.spacing, options, report);
+  addImplicitPartSets(mesh, shape.parts);
+  assignFastParts(mesh, model);
+  return mesh;
+}
+
 }  // namespace asyncfem

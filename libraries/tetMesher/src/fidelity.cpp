@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/tetMesher/elementSets.hpp>
 #include <asyncfem/tetMesher/fidelity.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
 #include <cmath>
@@ -119,8 +120,9 @@ void requireNoSelfOverlap(const TetMesh& mesh, const SignedDistance& distance, c
   const int n = mesh.numElements();
   if (n == 0) return;
   const int stride = std::max(1, n / std::max(1, maxSamples));
+  const Eigen::Matrix3Xd centroids = elementCentroids(mesh);
   for (int e = 0; e < n; e += stride) {
-    const Eigen::Vector3d x = mesh.elementRestPositions(e).rowwise().mean();
+    const Eigen::Vector3d x = centroids.col(e);
     const double w = distance.windingNumber(x);
     if (w > 1.5 || w < -0.5) {
       int triangle = -1;

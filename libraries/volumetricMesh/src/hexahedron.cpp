@@ -44,6 +44,18 @@ Eigen::Matrix3d jacobian(const Eigen::Matrix<double, 3, 8>& x, const Eigen::Vect
   return x * shapeFunctionDerivatives(xi);
 }
 
+Eigen::Vector3d referenceCoordinates(const Eigen::Matrix<double, 3, 8>& x, const Eigen::Vector3d& p, int iterations) {
+  Eigen::Vector3d xi = Eigen::Vector3d::Zero();
+  for (int i = 0; i < iterations; ++i) {
+    const Eigen::Vector3d residual = x * shapeFunctions(xi) - p;
+    const Eigen::Vector3d step = jacobian(x, xi).partialPivLu().solve(residual);
+    if (!step.allFinite()) break;  // a flat element: keep the last iterate
+    xi -= step;
+    if (step.lpNorm<Eigen::Infinity>() < 1e-13) break;
+  }
+  return xi;
+}
+
 Eigen::Vector3d gaussPoint(int g) {
   const double p = 1.0 / std::sqrt(3.0);
   const auto& c = kCorners[static_cast<std::size_t>(g)];

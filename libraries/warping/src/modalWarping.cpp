@@ -11,27 +11,25 @@
 namespace asyncfem {
 
 ModalWarping::ModalWarping(const TetMesh& mesh) : numVertices_(mesh.numVertices()) {
-  std::vector<Eigen::Matrix<double, 3, 4>> gradients;
-  Eigen::VectorXd volumes;
-  detail::elementShapeGradients(mesh, gradients, volumes);
-
+  const detail::ElementGeometry geometry = detail::elementGeometry(mesh);
+  const int k = geometry.verticesPerElement;
   Eigen::VectorXd vertexVolume = Eigen::VectorXd::Zero(numVertices_);
   for (int e = 0; e < mesh.numElements(); ++e) {
-    for (int a = 0; a < 4; ++a) {
-      vertexVolume[mesh.elements()(a, e)] += volumes[e];
+    for (int a = 0; a < k; ++a) {
+      vertexVolume[geometry.elements(a, e)] += geometry.volumes[e];
     }
   }
-  // Row block of vertex i: sum over its elements e of (V_e / sum V) (1/2) [grad N_a]x,
-  // placed in the column block of the element's vertex a.
+  // Row block of vertex i: sum over its elements e of (V_e / sum V) (1/2) [grad N_a]x (at the
+  // element's centre), placed in the column block of the element's vertex a.
   std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(mesh.numElements()) * 4 * 4 * 6);
+  triplets.reserve(static_cast<std::size_t>(mesh.numElements()) * k * k * 6);
   for (int e = 0; e < mesh.numElements(); ++e) {
-    const Eigen::Matrix<double, 3, 4>& g = gradients[static_cast<std::size_t>(e)];
-    for (int p = 0; p < 4; ++p) {
-      const int row = 3 * mesh.elements()(p, e);
-      const double weight = 0.5 * volumes[e] / vertexVolume[mesh.elements()(p, e)];
-      for (int a = 0; a < 4; ++a) {
-        const int column = 3 * mesh.elements()(a, e);
+    const auto g = geometry.centreGradients.middleCols(static_cast<Eigen::Index>(k) * e, k);
+    for (int p = 0; p < k; ++p) {
+      const int row = 3 * geometry.elements(p, e);
+      const double weight = 0.5 * geometry.volumes[e] / vertexVolume[geometry.elements(p, e)];
+      for (int a = 0; a < k; ++a) {
+        const int column = 3 * geometry.elements(a, e);
         const Eigen::Vector3d w = weight * g.col(a);
         // [w]x = [[0, -wz, wy], [wz, 0, -wx], [-wy, wx, 0]]
         triplets.emplace_back(row + 0, column + 1, -w.z());

@@ -52,17 +52,47 @@ std::vector<bool> fixedMask(const std::vector<int>& fixedVertices, int numVertic
   return fixed;
 }
 
+/// For elements of K vertices: (F_e - I) int_e grad N_a with F_e = exp([omega_e]x) (I + S_e)
+/// from the centre gradient, into columns K e + a of out.
+template <int K>
+void targetRightHandSides(const Eigen::Map<const Eigen::Matrix3Xd>& u, const Eigen::MatrixXi& elements,
+                          const Eigen::Matrix3Xd& centreGradients, const Eigen::Matrix3Xd& integratedGradients,
+                          Eigen::Matrix<double, 3, Eigen::Dynamic>& out) {
+  const int numElements = static_cast<int>(elements.cols());
+  // Threads only pay off beyond a few thousand elements (a parallel region costs about
+  // as much as 1000 elements here, and far more when the cores are oversubscribed).
+#pragma omp parallel for schedule(static) if (numElements >= kParallelThreshold)
+  for (int e = 0; e < numElements; ++e) {
+    Eigen::Matrix<double, 3, K> vertexDisplacements;
+    for (int a = 0; a < K; ++a) {
+      vertexDisplacements.col(a) = u.col(elements(a, e));
+    }
+    const Eigen::Matrix3d gradient = vertexDisplacements * centreGradients.middleCols<K>(K * e).transpose();
+    const Eigen::Matrix3d skew = 0.5 * (gradient - gradient.transpose());
+    const Eigen::Matrix3d strain = 0.5 * (gradient + gradient.transpose());
+    const Eigen::Matrix3d rotation = detail::rotationFromVector(detail::axial(skew));
+    // R (I + S) - I = (R - I) + R S, written so that u = 0 gives exactly zero.
+    const Eigen::Matrix3d target = (rotation - Eigen::Matrix3d::Identity()) + rotation * strain;
+    out.middleCols<K>(K * e) = target * integratedGradients.middleCols<K>(K * e);
+  }
+}
+
 }  // namespace
 
 RotationStrainWarping::RotationStrainWarping(const TetMesh& mesh, const std::vector<int>& fixedVertices,
                                              SolverKind solverKind)
-    : numVertices_(mesh.numVertices()), numElements_(mesh.numElements()), elements_(mesh.elements()) {
-  detail::elementShapeGradients(mesh, shapeGradients_, volumes_);
+    : numVertices_(mesh.numVertices()),
+      numElements_(mesh.numElements()),
+      verticesPerElement_(mesh.verticesPerElement()),
+      elements_(mesh.connectivity()) {
+  const detail::ElementGeometry geometry = detail::elementGeometry(mesh);
+  centreGradients_ = geometry.centreGradients;
+  integratedGradients_ = geometry.integratedGradients;
   const auto n = static_cast<std::size_t>(numVertices_);
   const std::vector<bool> fixed = fixedMask(fixedVertices, numVertices_);
   std::vector<bool> used(n, false);
   for (int e = 0; e < numElements_; ++e) {
-    for (int a = 0; a < 4; ++a) {
+    for (int a = 0; a < verticesPerElement_; ++a) {
       used[static_cast<std::size_t>(elements_(a, e))] = true;
     }
   }
@@ -70,9 +100,9 @@ RotationStrainWarping::RotationStrainWarping(const TetMesh& mesh, const std::vec
   std::vector<int> unknownIndex(n, -1);
   std::vector<int> constrainedIndex(n, -1);
   numberVertices(used, fixed, unknownIndex, constrainedIndex);
-  factorLaplacian(unknownIndex, constrainedIndex, solverKind);
+  factorLaplacian(mesh, geometry, unknownIndex, constrainedIndex, solverKind);
   buildGatherMap(mesh);
-  elementRightHandSides_.resize(3, 4 * static_cast<Eigen::Index>(numElements_));
+  elementRightHandSides_.resize(3, static_cast<Eigen::Index>(verticesPerElement_) * numElements_);
 }
 
 /// Connected components of the used vertices (through shared elements), numbered by
@@ -82,7 +112,7 @@ void RotationStrainWarping::findComponents(const std::vector<bool>& used, const 
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   for (int e = 0; e < numElements_; ++e) {
-    for (int a = 1; a < 4; ++a) {
+    for (int a = 1; a < verticesPerElement_; ++a) {
       unite(parent, elements_(0, e), elements_(a, e));
     }
   }
@@ -133,22 +163,23 @@ void RotationStrainWarping::numberVertices(const std::vector<bool>& used, const 
   }
 }
 
-/// L_ab = sum_e V_e grad N_a . grad N_b, split into the unknown-unknown block (factored)
+/// L_ab = sum_e int_e grad N_a . grad N_b, split into the unknown-unknown block (factored)
 /// and the unknown-constrained block (moves the constrained values to the right side).
-void RotationStrainWarping::factorLaplacian(const std::vector<int>& unknownIndex,
+void RotationStrainWarping::factorLaplacian(const TetMesh& mesh, const detail::ElementGeometry& geometry,
+                                            const std::vector<int>& unknownIndex,
                                             const std::vector<int>& constrainedIndex, SolverKind solverKind) {
+  const int k = verticesPerElement_;
   std::vector<Eigen::Triplet<double>> unknownTriplets;
   std::vector<Eigen::Triplet<double>> couplingTriplets;
-  unknownTriplets.reserve(static_cast<std::size_t>(numElements_) * 16);
+  unknownTriplets.reserve(static_cast<std::size_t>(numElements_) * k * k);
   for (int e = 0; e < numElements_; ++e) {
-    const Eigen::Matrix<double, 3, 4>& g = shapeGradients_[static_cast<std::size_t>(e)];
-    const Eigen::Matrix4d local = volumes_[e] * (g.transpose() * g);
-    for (int a = 0; a < 4; ++a) {
+    const Eigen::MatrixXd local = detail::elementLaplacian(mesh, geometry, e);
+    for (int a = 0; a < k; ++a) {
       const int row = unknownIndex[static_cast<std::size_t>(elements_(a, e))];
       if (row < 0) {
         continue;
       }
-      for (int b = 0; b < 4; ++b) {
+      for (int b = 0; b < k; ++b) {
         const auto vb = static_cast<std::size_t>(elements_(b, e));
         if (unknownIndex[vb] >= 0) {
           unknownTriplets.emplace_back(row, unknownIndex[vb], local(a, b));
@@ -185,7 +216,7 @@ void RotationStrainWarping::buildGatherMap(const TetMesh& mesh) {
       while (elements_(local, e) != v) {
         ++local;
       }
-      adjacencySlots_[static_cast<std::size_t>(k)] = (4 * e) + local;
+      adjacencySlots_[static_cast<std::size_t>(k)] = (verticesPerElement_ * e) + local;
     }
   }
 }
@@ -217,25 +248,13 @@ Eigen::VectorXd RotationStrainWarping::warp(const Eigen::Ref<const Eigen::Vector
   return warped;
 }
 
-/// F_e = exp([omega_e]x) (I + S_e) of every element; its contribution V_e (F_e - I) grad N_a
+/// F_e = exp([omega_e]x) (I + S_e) of every element; its contribution (F_e - I) int_e grad N_a
 /// to the right-hand side goes to elementRightHandSides_.
 void RotationStrainWarping::elementPass(const Eigen::Map<const Eigen::Matrix3Xd>& u) {
-  // Threads only pay off beyond a few thousand elements (a parallel region costs about
-  // as much as 1000 elements here, and far more when the cores are oversubscribed).
-#pragma omp parallel for schedule(static) if (numElements_ >= kParallelThreshold)
-  for (int e = 0; e < numElements_; ++e) {
-    Eigen::Matrix<double, 3, 4> vertexDisplacements;
-    for (int a = 0; a < 4; ++a) {
-      vertexDisplacements.col(a) = u.col(elements_(a, e));
-    }
-    const Eigen::Matrix<double, 3, 4>& g = shapeGradients_[static_cast<std::size_t>(e)];
-    const Eigen::Matrix3d gradient = detail::displacementGradient(vertexDisplacements, g);
-    const Eigen::Matrix3d skew = 0.5 * (gradient - gradient.transpose());
-    const Eigen::Matrix3d strain = 0.5 * (gradient + gradient.transpose());
-    const Eigen::Matrix3d rotation = detail::rotationFromVector(detail::axial(skew));
-    // R (I + S) - I = (R - I) + R S, written so that u = 0 gives exactly zero.
-    const Eigen::Matrix3d target = (rotation - Eigen::Matrix3d::Identity()) + rotation * strain;
-    elementRightHandSides_.block<3, 4>(0, 4 * static_cast<Eigen::Index>(e)) = volumes_[e] * (target * g);
+  if (verticesPerElement_ == 8) {
+    targetRightHandSides<8>(u, elements_, centreGradients_, integratedGradients_, elementRightHandSides_);
+  } else {
+    targetRightHandSides<4>(u, elements_, centreGradients_, integratedGradients_, elementRightHandSides_);
   }
 }
 

@@ -9,18 +9,22 @@
 
 namespace asyncfem {
 
-/// A triangle surface that follows a tet mesh's displacement: either the tet mesh's own
+/// A triangle surface that follows a volumetric mesh's displacement: either the mesh's own
 /// boundary, or a separate render mesh embedded in it.
 ///
-/// Every surface vertex p stores four tet-mesh vertices v_a and weights w_a (computed once
-/// by the factory functions). The deformed position for a stacked 3n displacement u is
+/// Every surface vertex p stores k mesh vertices v_a and weights w_a (computed once by the
+/// factory functions; k = 4, or 8 for a render mesh embedded in hexahedra). The deformed
+/// position for a stacked 3n displacement u is
 ///     x(p) = p + sum_a w_a u(v_a),
-/// and per-tet-vertex attributes (colours) interpolate the same way. For the boundary
+/// and per-mesh-vertex attributes (colours) interpolate the same way. For the boundary
 /// surface the weights are (1, 0, 0, 0) on the vertex itself, so x = X + u exactly. For
 /// an embedded mesh the w_a are the barycentric coordinates of p in the tetrahedron that
 /// contains it or, for a vertex outside the tet mesh, in the nearest tetrahedron (then
 /// some w_a are negative: the nearest element's affine field is extrapolated, which keeps
-/// the surface attached under any affine motion, in particular rigid ones).
+/// the surface attached under any affine motion, in particular rigid ones). In a hexahedral
+/// mesh they are the eight trilinear shape functions at p's reference coordinates in the
+/// containing (or nearest) hexahedron, found by Newton's method
+/// (hexahedron::referenceCoordinates); trilinear interpolation reproduces affine motions too.
 class SurfaceEmbedding {
  public:
   SurfaceEmbedding() = default;
@@ -28,7 +32,7 @@ class SurfaceEmbedding {
   /// The boundary triangles of mesh (boundaryTriangles(), outward oriented) over the
   /// vertices they use.
   static SurfaceEmbedding boundary(const TetMesh& mesh);
-  /// surface embedded in mesh (same coordinates). Point location uses a uniform grid over
+  /// surface embedded in mesh (same coordinates; tetrahedra or hexahedra). Point location uses a uniform grid over
   /// the element bounding boxes: O((elements + surface vertices) * local density).
   /// Throws asyncfem::ValidationError if mesh has no element or a surface triangle names
   /// a vertex out of range.
@@ -45,14 +49,15 @@ class SurfaceEmbedding {
   /// The rest surface (positions at u = 0) and its triangles.
   const SurfaceMesh& restSurface() const { return surface_; }
   const std::vector<std::array<int, 3>>& triangles() const { return surface_.triangles; }
-  /// Surface vertices outside every tetrahedron (extrapolated from the nearest one).
+  /// Surface vertices outside every element (extrapolated from the nearest one).
   int numOutsideVertices() const { return numOutside_; }
-  /// Largest distance from an outside vertex to its tetrahedron (0 if none), length units.
+  /// Largest distance from an outside vertex to its element (0 if none), length units.
   double maxOutsideDistance() const { return maxOutsideDistance_; }
 
-  /// Tet vertex ids (4 x m) and weights (4 x m) of the surface vertices.
-  const Eigen::Matrix4Xi& tetVertices() const { return tetVertices_; }
-  const Eigen::Matrix4Xd& weights() const { return weights_; }
+  /// Mesh vertex ids (k x m, k = 4, or 8 when embedded in hexahedra) and weights (k x m) of
+  /// the surface vertices.
+  const Eigen::MatrixXi& tetVertices() const { return tetVertices_; }
+  const Eigen::MatrixXd& weights() const { return weights_; }
 
   /// Deformed surface positions (3 x m) for a stacked displacement of the tet mesh (3n;
   /// asyncfem::Error otherwise).
@@ -64,8 +69,8 @@ class SurfaceEmbedding {
  private:
   SurfaceMesh surface_;
   int numTetVertices_ = 0;
-  Eigen::Matrix4Xi tetVertices_;
-  Eigen::Matrix4Xd weights_;
+  Eigen::MatrixXi tetVertices_;
+  Eigen::MatrixXd weights_;
   int numOutside_ = 0;
   double maxOutsideDistance_ = 0.0;
 };

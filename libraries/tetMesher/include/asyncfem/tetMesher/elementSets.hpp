@@ -10,7 +10,8 @@
 
 namespace asyncfem {
 
-/// Rest-position centroid of every element, 3 x numElements.
+/// Rest-position centroid (vertex mean) of every element, tetrahedron or hexahedron, 3 x
+/// numElements. The functions below serve both kinds of mesh.
 Eigen::Matrix3Xd elementCentroids(const TetMesh& mesh);
 
 /// Sets the element set `name` to the given elements and the vertex set `name` to their

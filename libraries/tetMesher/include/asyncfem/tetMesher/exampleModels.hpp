@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <asyncfem/tetMesher/implicit.hpp>
 #include <asyncfem/tetMesher/isosurfaceStuffing.hpp>
+#include <asyncfem/tetMesher/voxelize.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
 #include <string>
 #include <vector>
@@ -45,5 +46,11 @@ ImplicitModel exampleModelShape(ExampleModel model);
 /// MesherOptions (0: the uniform lattice of the shipped meshes).
 TetMesh makeExampleModel(ExampleModel model, double spacing = 0.0, StuffingReport* report = nullptr,
                          int gradingLevels = 0);
+
+/// The model as cubes (voxelize of its implicit solid at the given spacing, <= 0: the shipped
+/// spacing), with the same part sets, extra sets and materials as makeExampleModel. Unlike
+/// makeExampleModel it does not require one connected piece (cubes touching along an edge only
+/// are a valid mesh).
+TetMesh makeExampleModelCubes(ExampleModel model, double spacing = 0.0, VoxelReport* report = nullptr);
 
 }  // namespace asyncfem

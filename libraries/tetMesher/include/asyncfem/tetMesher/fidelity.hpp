@@ -41,7 +41,7 @@ double requireRepairableHoles(const TetMesh& mesh, const SignedDistance& distanc
                               const std::string& source);
 
 /// Throws a ValidationError when a closed surface overlaps itself: the generalized winding
-/// number at some element centroid (checked at up to maxSamples of them, evenly spread)
+/// number at some element centroid (tetrahedra or hexahedra; checked at up to maxSamples of them, evenly spread)
 /// exceeds 1.5, i.e. the point is inside two shells; names the place and the nearest
 /// triangle, and points to the winding-number mode (which meshes the union).
 void requireNoSelfOverlap(const TetMesh& mesh, const SignedDistance& distance, const std::string& source,

@@ -34,6 +34,14 @@ Eigen::Matrix<double, 8, 3> shapeFunctionDerivatives(const Eigen::Vector3d& xi);
 /// Jacobian dx/dxi (3 x 3) at xi of the element with vertex positions x (3 x 8).
 Eigen::Matrix3d jacobian(const Eigen::Matrix<double, 3, 8>& x, const Eigen::Vector3d& xi);
 
+/// The reference coordinates xi with x(xi) = p, the inverse of the trilinear map, by Newton's
+/// method from the centre xi = 0: at most `iterations` steps, fewer once a step moves xi by less
+/// than 1e-13. Exact after one step for a parallelepiped (an affine map). Points outside the
+/// element get coordinates outside [-1, 1]^3 (the map extended); for a strongly distorted element
+/// and a point far outside, the last iterate is returned.
+Eigen::Vector3d referenceCoordinates(const Eigen::Matrix<double, 3, 8>& x, const Eigen::Vector3d& p,
+                                     int iterations = 20);
+
 /// The 2 x 2 x 2 Gauss points (+-1/sqrt 3 on each axis, weight 1 each), point g at the
 /// signs of corner g. Exact for the volume (det J has degree <= 2 in each coordinate) and
 /// for the linear stiffness and consistent mass of a parallelepiped.

@@ -12,8 +12,9 @@ namespace asyncfem {
 ///
 /// Per vertex i the local rotation vector (radians) is half the curl of the linear
 /// displacement, w_i = (1/2) curl u (X_i). With linear tetrahedra the curl is constant per
-/// element, (1/2) curl u |_e = (1/2) sum_a grad N_a x u_a, and the vertex value is the
-/// volume-weighted mean over the elements around the vertex:
+/// element, (1/2) curl u |_e = (1/2) sum_a grad N_a x u_a; with trilinear hexahedra the same
+/// sum over the eight vertices takes the gradients at the element's centre (exact for affine
+/// fields). The vertex value is the volume-weighted mean over the elements around the vertex:
 ///     w_i = sum_{e ∋ i} V_e (1/2) sum_a grad N_a x u_a  /  sum_{e ∋ i} V_e,
 /// a fixed sparse linear map w = C u (3n x 3n) built by the constructor.
 ///

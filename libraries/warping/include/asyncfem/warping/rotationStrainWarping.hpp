@@ -11,10 +11,15 @@
 
 namespace asyncfem {
 
+namespace detail {
+struct ElementGeometry;
+}  // namespace detail
+
 /// Rotation-strain coordinate warping (Huang, Tong, Wei & Bao 2011; used to display the
 /// linear FEM results of Zhao, Li & Barbič 2016).
 ///
-/// Per element e (linear tetrahedron, constant gradient) the displacement gradient
+/// Per element e (linear tetrahedron, constant gradient; or trilinear hexahedron, gradient at
+/// its centre) the displacement gradient
 ///     G_e = sum_a u_a (grad N_a)^T                           (3x3, dimensionless)
 /// is split into its skew and symmetric parts,
 ///     W_e = (G_e - G_e^T) / 2 = [omega_e]x,   S_e = (G_e + G_e^T) / 2,
@@ -26,7 +31,10 @@ namespace asyncfem {
 ///     minimise  sum_e V_e || grad w |_e - (F_e - I) ||_F^2   over the warped displacement w,
 /// whose normal equations are L w = b, one right-hand side per coordinate, with the
 /// scalar volume Laplacian L_ab = sum_e V_e grad N_a . grad N_b (n x n, units of length)
-/// and b_a = sum_e V_e (F_e - I) grad N_a. The constraints:
+/// and b_a = sum_e V_e (F_e - I) grad N_a. On hexahedra the gradient of w varies over the
+/// element and both are integrals over it, L_ab = sum_e int_e grad N_a . grad N_b and
+/// b_a = sum_e (F_e - I) int_e grad N_a (2 x 2 x 2 Gauss points; one point would leave
+/// hourglass modes in L). The constraints:
 /// - fixed vertices (constructor argument) keep the displacement given to warp() (zero in
 ///   a simulation's output);
 /// - a connected component of the mesh without fixed vertices is translation-free: its
@@ -73,7 +81,8 @@ class RotationStrainWarping final : public Warping {
   void findComponents(const std::vector<bool>& used, const std::vector<bool>& fixed);
   void numberVertices(const std::vector<bool>& used, const std::vector<bool>& fixed, std::vector<int>& unknownIndex,
                       std::vector<int>& constrainedIndex);
-  void factorLaplacian(const std::vector<int>& unknownIndex, const std::vector<int>& constrainedIndex,
+  void factorLaplacian(const TetMesh& mesh, const detail::ElementGeometry& geometry,
+                       const std::vector<int>& unknownIndex, const std::vector<int>& constrainedIndex,
                        SolverKind solverKind);
   void buildGatherMap(const TetMesh& mesh);
   /// Stages of warp() for the displacement u (3 x n).
@@ -83,11 +92,14 @@ class RotationStrainWarping final : public Warping {
 
   int numVertices_ = 0;
   int numElements_ = 0;
-  Eigen::Matrix4Xi elements_;
-  std::vector<Eigen::Matrix<double, 3, 4>> shapeGradients_;  // column a = grad N_a (1 / length)
-  Eigen::VectorXd volumes_;                                  // |V_e|
+  int verticesPerElement_ = 4;  // k: 4 (tetrahedra) or 8 (hexahedra)
+  Eigen::MatrixXi elements_;    // k x numElements
+  // Columns k e + a: grad N_a at element e's centre (1 / length), and its integral over the
+  // element (length^2; V_e grad N_a for a tetrahedron).
+  Eigen::Matrix3Xd centreGradients_;
+  Eigen::Matrix3Xd integratedGradients_;
   // Gather map for b: the elements around vertex v are adjacencyOffsets_[v] ..
-  // adjacencyOffsets_[v+1] in adjacencySlots_, each stored as 4 e + local index.
+  // adjacencyOffsets_[v+1] in adjacencySlots_, each stored as k e + local index.
   std::vector<int> adjacencyOffsets_;
   std::vector<int> adjacencySlots_;
 
@@ -101,7 +113,7 @@ class RotationStrainWarping final : public Warping {
   std::unique_ptr<SparseSolver> solver_;                     // factor of L(unknown, unknown)
 
   // Per-frame scratch, kept to avoid allocations.
-  Eigen::Matrix<double, 3, Eigen::Dynamic> elementRightHandSides_;  // 3 x 4 numElements
+  Eigen::Matrix<double, 3, Eigen::Dynamic> elementRightHandSides_;  // 3 x k numElements
   Eigen::MatrixXd rightHandSide_;                                   // numUnknowns x 3
   Eigen::MatrixXd solution_;
 };
