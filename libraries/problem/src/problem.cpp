@@ -5,7 +5,7 @@
 #include <asyncfem/forceModel/linearForceModel.hpp>
 #include <asyncfem/hexElements/hexAssembly.hpp>
 #include <asyncfem/hexElements/hexCorotationalForceModel.hpp>
-#include <asyncfem/hexElements/hexStvkForceModel.hpp>
+#include <asyncfem/hexElements/hexHyperelasticForceModel.hpp>
 #include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <asyncfem/problem/problem.hpp>
 #include <asyncfem/volumetricMesh/queries.hpp>
@@ -61,19 +61,12 @@ Problem::Problem(std::shared_ptr<const TetMesh> mesh, std::vector<int> fixedVert
 }
 
 void Problem::requireHexahedralModel() const {
-  const ForceModelType model = settings_.forceModel;
-  if (!runsOnHexahedra(model)) {
-    mesh_->requireTetrahedra("the " + toString(model) +
-                             " force model (hexahedral meshes run linear, corotational and stvk)");
-  }
   const HyperelasticOptions& options = settings_.hyperelastic;
-  if (model == ForceModelType::stvk &&
-      (options.inversionHandlingEnabled() || options.enableCompressionResistance || options.enforceSPD ||
-       options.stvkFormulation != StVKFormulation::greenStrain)) {
+  if (settings_.forceModel == ForceModelType::stvk && options.stvkFormulation == StVKFormulation::greenStrain &&
+      (options.inversionHandlingEnabled() || options.enableCompressionResistance || options.enforceSPD)) {
     throw ValidationError(
-        "problem: StVK on hexahedra is the Green-strain form without inversion handling: it takes no inversion "
-        "threshold, compression resistance, enforceSPD or principal-stretch formulation (convert the mesh into "
-        "tetrahedra for those: meshInfo MESH --hex-to-tets --write OUT.veg)");
+        "problem: StVK on hexahedra in the Green-strain form (HexStvkForceModel) has no inversion threshold, "
+        "compression resistance or enforceSPD: choose the principal-stretch formulation for them");
   }
 }
 
@@ -151,10 +144,6 @@ std::string toString(ForceModelType type) {
   return std::string(findEnumName(kForceModelNames, type).value_or("unknown"));
 }
 
-bool runsOnHexahedra(ForceModelType type) {
-  return type == ForceModelType::linear || type == ForceModelType::corotational || type == ForceModelType::stvk;
-}
-
 std::shared_ptr<ForceModel> Problem::makeForceModel() const {
   switch (settings_.forceModel) {
     case ForceModelType::linear:
@@ -165,14 +154,12 @@ std::shared_ptr<ForceModel> Problem::makeForceModel() const {
       }
       return std::make_shared<CorotationalLinearFEM>(*mesh_, assembler(), settings_.tangent);
     case ForceModelType::stvk:
-      if (mesh_->isHexahedral()) return std::make_shared<HexStvkForceModel>(*mesh_);
-      return makeHyperelasticForceModel(*mesh_, HyperelasticMaterialKind::stvk, settings_.hyperelastic, assembler());
     case ForceModelType::neoHookean:
-      return makeHyperelasticForceModel(*mesh_, HyperelasticMaterialKind::neoHookean, settings_.hyperelastic,
-                                        assembler());
-    case ForceModelType::mooneyRivlin:
-      return makeHyperelasticForceModel(*mesh_, HyperelasticMaterialKind::mooneyRivlin, settings_.hyperelastic,
-                                        assembler());
+    case ForceModelType::mooneyRivlin: {
+      const HyperelasticMaterialKind kind = *hyperelasticMaterial(settings_.forceModel);
+      if (mesh_->isHexahedral()) return makeHexHyperelasticForceModel(*mesh_, kind, settings_.hyperelastic);
+      return makeHyperelasticForceModel(*mesh_, kind, settings_.hyperelastic, assembler());
+    }
   }
   throw ValidationError("problem: unknown force model type");
 }

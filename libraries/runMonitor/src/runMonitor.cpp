@@ -78,6 +78,12 @@ RunMonitor::RunMonitor(const Problem& problem, Settings settings) : mesh_(&probl
   const ProblemSettings& physics = problem.settings();
   if (isHyperelastic(physics.forceModel) && !physics.hyperelastic.inversionHandlingEnabled()) {
     inversionCheckModel_ = toString(physics.forceModel);
+    inversionAdvice_ =
+        physics.forceModel == ForceModelType::stvk &&
+                physics.hyperelastic.stvkFormulation == StVKFormulation::greenStrain
+            ? "set forceModel.stvkFormulation to \"principal-stretches\" and forceModel.inversionThreshold (e.g. 0.5) "
+              "or reduce the step or the load"
+            : "set forceModel.inversionThreshold (e.g. 0.1) or reduce the step or the load";
     restJacobians_.reserve(static_cast<std::size_t>(mesh_->numElements()) * (mesh_->isHexahedral() ? 8 : 1));
     for (int e = 0; e < mesh_->numElements(); ++e) {
       const ElementJacobians rest = elementJacobians(*mesh_, e, nullptr);
@@ -223,15 +229,11 @@ void RunMonitor::checkInversion(const Integrator& integrator, long long frame, l
     if (j > 0.0) continue;
     const int vertex = mesh_->elementVertex(e, 0);
     NumericalErrorLocation location = locate(integrator, frame, step, stepEnd, vertex);
-    throw NumericalError(
-        where + ": element " + std::to_string(e) + " (first vertex: " + describeVertex(integrator, vertex) +
-            ") inverted (J = det F = " + formatNumber(j) + ") under the " + inversionCheckModel_ +
-            " model, which has no inversion handling; " +
-            (mesh_->isHexahedral() ? std::string("reduce the step or the load, or convert the mesh into tetrahedra "
-                                                 "(meshInfo MESH --hex-to-tets) and set forceModel.inversionThreshold")
-                                   : std::string("set forceModel.inversionThreshold (e.g. 0.1) or reduce the step or "
-                                                 "the load")),
-        location);
+    throw NumericalError(where + ": element " + std::to_string(e) +
+                             " (first vertex: " + describeVertex(integrator, vertex) +
+                             ") inverted (J = det F = " + formatNumber(j) + ") under the " + inversionCheckModel_ +
+                             " model, which has no inversion handling; " + inversionAdvice_,
+                         location);
   }
 }
 

@@ -301,10 +301,6 @@ std::shared_ptr<const Problem> buildProblem(const Scene& scene, std::vector<std:
   std::vector<int> fixed = collectFixedVertices(scene, *mesh);
   std::vector<VertexLoad> loads = collectLoads(scene, *mesh, requireFrameTiming(scene).timestep);
   const ProblemSettings settings = problemSettings(scene);
-  if (mesh->isHexahedral() && !runsOnHexahedra(settings.forceModel)) {  // Problem refuses it too, without the key
-    mesh->requireTetrahedra(scene.sourceName + ": forceModel.type: \"" + toString(settings.forceModel) +
-                            "\" (hexahedral meshes run \"linear\", \"corotational\" and \"stvk\")");
-  }
   std::shared_ptr<const PenaltyContact> contact = buildSceneContact(scene, *mesh);
   return std::make_shared<const Problem>(mesh, std::move(fixed), settings, std::move(loads), std::move(contact));
 }

@@ -23,8 +23,6 @@ enum class ForceModelType { linear, corotational, stvk, neoHookean, mooneyRivlin
 
 /// "linear", "corotational", "stvk", "neo-hookean", "mooney-rivlin".
 std::string toString(ForceModelType type);
-/// Whether the model has hexahedral elements (library hexElements): linear, corotational and stvk.
-bool runsOnHexahedra(ForceModelType type);
 
 /// The physics of a problem beyond its mesh, boundary and loads.
 struct ProblemSettings {
@@ -50,11 +48,13 @@ struct ProblemSettings {
 /// The time-dependent operator of M a + D v + f_int(u) = f_ext(t, u, v): integrators get
 /// it as a DynamicSystem (dynamicSystem()), whose external force evaluates loads().
 ///
-/// Hexahedral meshes (Vega's CUBIC .veg, Gmsh hexahedra) run linear FEM, StVK (its
-/// Green-strain form, HexStvkForceModel) and corotational FEM (HexCorotationalForceModel;
-/// settings.tangent picks its tangent), with K and M of library hexElements (trilinear
-/// elements, 2 x 2 x 2 Gauss points); the other models and assembler() refuse them with a
-/// ValidationError naming the conversion.
+/// Hexahedral meshes (Vega's CUBIC .veg, Gmsh hexahedra) run every force model with K and M
+/// of library hexElements (trilinear elements, 2 x 2 x 2 Gauss points): linear FEM,
+/// corotational FEM (HexCorotationalForceModel; settings.tangent picks its tangent), StVK in
+/// its Green-strain form (HexStvkForceModel) and the hyperelastic materials through
+/// principal stretches with settings.hyperelastic (HexHyperelasticForceModel:
+/// makeHexHyperelasticForceModel); assembler() refuses them with a ValidationError naming
+/// the conversion.
 ///
 /// Vertices that no element uses (a stray surface in a Gmsh or TetGen file) carry no
 /// mass and no stiffness, so as free DOFs they would make every system matrix singular:
@@ -102,8 +102,8 @@ class Problem {
   std::vector<std::string> skipped() const;
 
  private:
-  /// The hexahedral mesh's model: linear, or StVK in its Green-strain form; throws
-  /// ValidationError otherwise, naming the conversion into tetrahedra.
+  /// Refuses, on a hexahedral mesh, the Green-strain StVK with an inversion option it would
+  /// not read (ValidationError), before any model is built.
   void requireHexahedralModel() const;
 
   std::shared_ptr<const TetMesh> mesh_;

@@ -91,6 +91,9 @@ class RunMonitor {
   long long energyEvaluations_ = 0;
   /// The force model's name when the inversion check runs, empty otherwise.
   std::string inversionCheckModel_;
+  /// What the inversion check's message advises (the options that give the model inversion
+  /// handling), when it runs.
+  std::string inversionAdvice_;
   /// Each element's Jacobian determinants at rest, one per tetrahedron (its edge matrix
   /// (x1 - x0, x2 - x0, x3 - x0)), eight per hexahedron (its corners'), element after element.
   std::vector<double> restJacobians_;
