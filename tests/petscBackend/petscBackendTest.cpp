@@ -625,9 +625,9 @@ double hexSystemConditionNumber(const TetMesh& mesh, const std::vector<int>& fix
   return eigenvalues.maxCoeff() / eigenvalues.minCoeff();
 }
 
-// Hexahedral meshes on the backend: linear, corotational and StVK FEM on a bar of 8 x 2 x 2
-// cubes, each against the single-process run of the same Problem (backward Euler, CHOLMOD,
-// the linearized step), with MUMPS on every rank count. The rank-local element loops run
+// Hexahedral meshes on the backend: every force model on a bar of 8 x 2 x 2 cubes, each
+// against the single-process run of the same Problem (backward Euler, CHOLMOD, the
+// linearized step), with MUMPS on every rank count. The rank-local element loops run
 // the hexahedral kernels (hexElements), the matrices the 24 x 24 element matrices.
 TEST(PetscBackend, HexahedralMeshesMatchTheLocalRun) {
   auto mesh = std::make_shared<const TetMesh>(test::hexBar(2));
@@ -638,9 +638,12 @@ TEST(PetscBackend, HexahedralMeshesMatchTheLocalRun) {
   const double tolerance = 10.0 * hexSystemConditionNumber(*mesh, fixed) * 1e-15;
   ASSERT_LT(tolerance, 1e-6);
   std::vector<Eigen::VectorXd> linear;
-  for (const ForceModelType type : {ForceModelType::linear, ForceModelType::corotational, ForceModelType::stvk}) {
+  for (const ForceModelType type : {ForceModelType::linear, ForceModelType::corotational, ForceModelType::stvk,
+                                    ForceModelType::neoHookean, ForceModelType::mooneyRivlin}) {
     const std::string name = toString(type);
-    const ModelCase c{name.c_str(), modelPhysics(type), IntegratorOptions{}, "backward-euler"};
+    ModelCase c{name.c_str(), modelPhysics(type), IntegratorOptions{}, "backward-euler"};
+    if (type == ForceModelType::mooneyRivlin)
+      c.physics.hyperelastic.mooneyRivlin = MooneyRivlinParameters{5e4, 1.2e5, 1.6e6};
     const Problem problem(mesh, fixed, c.physics);
     const PetscTrajectory petsc = petscModelTrajectory(problem, c);
     EXPECT_EQ(petsc.stats.steps, kModelSteps);

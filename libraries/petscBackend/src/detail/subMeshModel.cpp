@@ -5,7 +5,7 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/hexElements/hexCorotationalForceModel.hpp>
-#include <asyncfem/hexElements/hexStvkForceModel.hpp>
+#include <asyncfem/hexElements/hexHyperelasticForceModel.hpp>
 #include <asyncfem/hyperelasticFEM/factory.hpp>
 #include <regex>
 #include <string>
@@ -14,18 +14,22 @@ namespace asyncfem::detail {
 
 namespace {
 
-/// The hexahedral mesh's model: StVK or corotational FEM (the exact tangent is the
-/// derivative of R K v, as in Problem); the others are refused naming the conversion.
-std::unique_ptr<ForceModel> makeHexSubMeshModel(const TetMesh& mesh, PetscForceModelKind kind, TangentKind tangent) {
+/// The hexahedral mesh's model, as Problem builds it: corotational FEM (the exact tangent
+/// is the derivative of R K v) or a hyperelastic material (makeHexHyperelasticForceModel).
+std::unique_ptr<ForceModel> makeHexSubMeshModel(const TetMesh& mesh, PetscForceModelKind kind, TangentKind tangent,
+                                                const HyperelasticOptions& hyperelastic) {
   switch (kind) {
     case PetscForceModelKind::corotational:
       return std::make_unique<HexCorotationalForceModel>(mesh, tangent == TangentKind::simple);
     case PetscForceModelKind::stvk:
-      return std::make_unique<HexStvkForceModel>(mesh);
-    default:
+      return makeHexHyperelasticForceModel(mesh, HyperelasticMaterialKind::stvk, hyperelastic);
+    case PetscForceModelKind::neoHookean:
+      return makeHexHyperelasticForceModel(mesh, HyperelasticMaterialKind::neoHookean, hyperelastic);
+    case PetscForceModelKind::mooneyRivlin:
+      return makeHexHyperelasticForceModel(mesh, HyperelasticMaterialKind::mooneyRivlin, hyperelastic);
+    case PetscForceModelKind::linear:
       break;
   }
-  mesh.requireTetrahedra("the PETSc backend's " + toString(kind) + " model");
   throw Error("PETSc backend: the linear model has no local force model");
 }
 
@@ -62,7 +66,7 @@ TetMesh subMesh(const TetMesh& mesh, const std::vector<int>& elements, std::vect
 
 std::unique_ptr<ForceModel> makeSubMeshModel(const TetMesh& mesh, PetscForceModelKind kind, TangentKind tangent,
                                              const HyperelasticOptions& hyperelastic) {
-  if (mesh.isHexahedral()) return makeHexSubMeshModel(mesh, kind, tangent);
+  if (mesh.isHexahedral()) return makeHexSubMeshModel(mesh, kind, tangent, hyperelastic);
   switch (kind) {
     case PetscForceModelKind::corotational:
       return std::make_unique<CorotationalLinearFEM>(mesh, tangent);
