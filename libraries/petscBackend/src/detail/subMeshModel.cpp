@@ -14,23 +14,19 @@ namespace asyncfem::detail {
 
 namespace {
 
-/// The hexahedral mesh's model, as Problem builds it: corotational FEM (the exact tangent
-/// is the derivative of R K v) or a hyperelastic material (makeHexHyperelasticForceModel).
-std::unique_ptr<ForceModel> makeHexSubMeshModel(const TetMesh& mesh, PetscForceModelKind kind, TangentKind tangent,
-                                                const HyperelasticOptions& hyperelastic) {
+/// The hyperelastic material of a backend model kind (the others have none).
+HyperelasticMaterialKind hyperelasticMaterial(PetscForceModelKind kind) {
   switch (kind) {
-    case PetscForceModelKind::corotational:
-      return std::make_unique<HexCorotationalForceModel>(mesh, tangent == TangentKind::simple);
     case PetscForceModelKind::stvk:
-      return makeHexHyperelasticForceModel(mesh, HyperelasticMaterialKind::stvk, hyperelastic);
+      return HyperelasticMaterialKind::stvk;
     case PetscForceModelKind::neoHookean:
-      return makeHexHyperelasticForceModel(mesh, HyperelasticMaterialKind::neoHookean, hyperelastic);
+      return HyperelasticMaterialKind::neoHookean;
     case PetscForceModelKind::mooneyRivlin:
-      return makeHexHyperelasticForceModel(mesh, HyperelasticMaterialKind::mooneyRivlin, hyperelastic);
-    case PetscForceModelKind::linear:
+      return HyperelasticMaterialKind::mooneyRivlin;
+    default:
       break;
   }
-  throw Error("PETSc backend: the linear model has no local force model");
+  throw Error("PETSc backend: the " + toString(kind) + " model is not hyperelastic");
 }
 
 }  // namespace
@@ -64,22 +60,18 @@ TetMesh subMesh(const TetMesh& mesh, const std::vector<int>& elements, std::vect
   return TetMesh(std::move(positions), Eigen::Matrix4Xi(connectivity), mesh.materials(), std::move(materials));
 }
 
+// As Problem builds them: on hexahedra the hexahedral kernels (corotational FEM's exact
+// tangent the derivative of R K v, makeHexHyperelasticForceModel for the materials).
 std::unique_ptr<ForceModel> makeSubMeshModel(const TetMesh& mesh, PetscForceModelKind kind, TangentKind tangent,
                                              const HyperelasticOptions& hyperelastic) {
-  if (mesh.isHexahedral()) return makeHexSubMeshModel(mesh, kind, tangent, hyperelastic);
-  switch (kind) {
-    case PetscForceModelKind::corotational:
-      return std::make_unique<CorotationalLinearFEM>(mesh, tangent);
-    case PetscForceModelKind::stvk:
-      return makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::stvk, hyperelastic);
-    case PetscForceModelKind::neoHookean:
-      return makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::neoHookean, hyperelastic);
-    case PetscForceModelKind::mooneyRivlin:
-      return makeHyperelasticForceModel(mesh, HyperelasticMaterialKind::mooneyRivlin, hyperelastic);
-    case PetscForceModelKind::linear:
-      break;
+  if (kind == PetscForceModelKind::linear) throw Error("PETSc backend: the linear model has no local force model");
+  if (kind == PetscForceModelKind::corotational) {
+    if (mesh.isHexahedral()) return std::make_unique<HexCorotationalForceModel>(mesh, tangent == TangentKind::simple);
+    return std::make_unique<CorotationalLinearFEM>(mesh, tangent);
   }
-  throw Error("PETSc backend: the linear model has no local force model");
+  const HyperelasticMaterialKind material = hyperelasticMaterial(kind);
+  return mesh.isHexahedral() ? makeHexHyperelasticForceModel(mesh, material, hyperelastic)
+                             : makeHyperelasticForceModel(mesh, material, hyperelastic);
 }
 
 void inMeshNumbering(const std::vector<int>& meshElement, const std::function<void()>& work) {
