@@ -126,7 +126,7 @@ std::vector<char> fastVertices(const TetMesh& mesh, const Eigen::VectorXd& omega
   std::vector<char> fast(static_cast<std::size_t>(mesh.numVertices()), 0);
   for (int e = 0; e < mesh.numElements(); ++e) {
     if (omega[e] * hL > target)
-      for (int a = 0; a < 4; ++a) fast[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
+      for (int a = 0; a < mesh.verticesPerElement(); ++a) fast[static_cast<std::size_t>(mesh.elementVertex(e, a))] = 1;
   }
   growByRings(mesh, fast, growLayers);
   return fast;
@@ -139,8 +139,8 @@ bool enclosed(const TetMesh& mesh, const VertexElementAdjacency& adjacency, cons
   if (begin == end) return false;
   for (int k = begin; k < end; ++k) {
     const int e = adjacency.elements[static_cast<std::size_t>(k)];
-    for (int a = 0; a < 4; ++a) {
-      const int w = mesh.elements()(a, e);
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int w = mesh.elementVertex(e, a);
       if (w != v && !fast[static_cast<std::size_t>(w)]) return false;
     }
   }
@@ -175,8 +175,8 @@ std::vector<int> fastComponents(const TetMesh& mesh, const VertexElementAdjacenc
       for (int k = adjacency.offsets[static_cast<std::size_t>(v)];
            k < adjacency.offsets[static_cast<std::size_t>(v) + 1]; ++k) {
         const int e = adjacency.elements[static_cast<std::size_t>(k)];
-        for (int a = 0; a < 4; ++a) {
-          const int w = mesh.elements()(a, e);
+        for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+          const int w = mesh.elementVertex(e, a);
           if (fast[static_cast<std::size_t>(w)] && component[static_cast<std::size_t>(w)] < 0) {
             component[static_cast<std::size_t>(w)] = numComponents;
             queue.push_back(w);
@@ -198,8 +198,8 @@ void collectRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const Eigen::
   for (int e = 0; e < mesh.numElements(); ++e) {
     int owner = -1;
     bool allFast = true;
-    for (int a = 0; a < 4; ++a) {
-      const int c = component[static_cast<std::size_t>(mesh.elements()(a, e))];
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int c = component[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       if (c >= 0) owner = c;
       allFast = allFast && c >= 0;
     }
