@@ -2,16 +2,18 @@
 // The asynchronous integrator on a hexahedral mesh (docs/asynchronous-integrator.md,
 // "Hexahedral meshes"): the two-level step against its per-substep definition, the nested
 // step against Eq. N3, the energy theorem, the element tangents of the hexahedral force
-// models, nonlinear models at small amplitude, the comparators at m = 1 and run-time
-// regions.
+// models, nonlinear models at small amplitude, the comparators at m = 1, run-time regions
+// and the element frequencies of the region proposal.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/loadsPolicy.hpp>
+#include <asyncfem/asyncIntegrator/regionProposal.hpp>
 #include <asyncfem/asyncIntegrator/runTimeRegions.hpp>
 #include <asyncfem/asyncIntegrator/schroeder2011.hpp>
 #include <asyncfem/asyncIntegrator/uncoupledMultirate.hpp>
+#include <asyncfem/hexElements/hexAssembly.hpp>
 #include <asyncfem/integrator/backwardEuler.hpp>
 #include <cmath>
 #include <cstdio>
@@ -282,6 +284,44 @@ TEST(HexahedralAsync, NonlinearModelsAreLinearAtSmallAmplitude) {
     std::printf("hexahedra, %s async vs linear async: %.2e at amplitude 0.01, %.2e at 1\n", toString(type).c_str(),
                 small, large);
   }
+}
+
+// Region proposal on hexahedra: every element's highest frequency (24 x 24, lumped mass)
+// bounds the assembled bar's highest frequency (lumped mass, clamped) from above, as the
+// element eigenvalue inequality says, within round-off (1e-10 relative), and not by far
+// (the bound is within 2x here). The proposal marks the stiff end (16x the soft wave speed),
+// and its modal check runs on the hexahedral K and M.
+TEST(HexahedralAsync, ElementFrequenciesBoundTheMeshAndMarkTheStiffEnd) {
+  const std::shared_ptr<const TetMesh> mesh = stiffEndHexBar();
+  const Eigen::VectorXd omega = elementMaxFrequencies(*mesh);
+  const FreeDofs freeDofs = FreeDofs::fromFixedVertices(mesh->numVertices(), test::verticesOnPlanes(*mesh, {0.0}));
+  const std::vector<int>& free = freeDofs.freeToFull();
+  const Eigen::MatrixXd k(hexLinearStiffnessMatrix(*mesh)), m(hexMassMatrix(*mesh, MassType::lumped));
+  Eigen::VectorXd massRoot(static_cast<Eigen::Index>(free.size()));
+  for (std::size_t a = 0; a < free.size(); ++a) massRoot[static_cast<Eigen::Index>(a)] = std::sqrt(m(free[a], free[a]));
+  Eigen::MatrixXd scaled(massRoot.size(), massRoot.size());
+  for (std::size_t a = 0; a < free.size(); ++a)
+    for (std::size_t b = 0; b < free.size(); ++b)
+      scaled(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
+          k(free[a], free[b]) / (massRoot[static_cast<Eigen::Index>(a)] * massRoot[static_cast<Eigen::Index>(b)]);
+  const double highest = std::sqrt(
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scaled, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff());
+  EXPECT_LE(highest, omega.maxCoeff() * (1.0 + 1e-10));
+  EXPECT_GE(highest, 0.5 * omega.maxCoeff());
+  RegionProposalOptions options;
+  options.largeTimestep = 1e-2;
+  const RegionProposal proposal = proposeRegions(*mesh, freeDofs, options);
+  ASSERT_EQ(proposal.regions.size(), 1U);
+  for (const int v : test::verticesBeyond(*mesh, 0.75 + 1e-9))
+    EXPECT_TRUE(
+        std::binary_search(proposal.regions[0].region.vertices.begin(), proposal.regions[0].region.vertices.end(), v))
+        << "vertex " << v;
+  // The modal check assembles the hexahedral K and M (vibrationMatrices) and decides.
+  options.modalCheck = true;
+  const RegionProposal checked = proposeRegions(*mesh, freeDofs, options, MassType::lumped);
+  EXPECT_EQ(checked.decidedBy, RegionProposalPath::modalCheck) << regionProposalSummary(checked);
+  std::printf("hexahedra: highest frequency of the bar %.4g rad/s, largest element frequency %.4g rad/s; %s\n", highest,
+              omega.maxCoeff(), regionProposalSummary(checked).c_str());
 }
 
 }  // namespace

@@ -15,6 +15,8 @@
 #include <numeric>
 #include <string>
 
+#include "detail/hexahedronFrequency.hpp"
+
 namespace asyncfem {
 
 double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, const Material& material) {
@@ -43,8 +45,12 @@ double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, con
 }
 
 Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh) {
-  mesh.requireTetrahedra("elementMaxFrequencies");  // before the parallel loop, which must not throw
   Eigen::VectorXd omega(mesh.numElements());
+  if (mesh.isHexahedral()) {  // serial: a misshapen hexahedron throws, naming it
+    for (int e = 0; e < mesh.numElements(); ++e)
+      omega[e] = hexahedronMaxFrequency(mesh.hexahedronRestPositions(e), mesh.elementMaterial(e));
+    return omega;
+  }
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < mesh.numElements(); ++e) {
     omega[e] = elementMaxFrequency(mesh.elementRestPositions(e), mesh.elementMaterial(e));
@@ -274,13 +280,18 @@ void precheckRegions(const TetMesh& mesh, const Eigen::VectorXd& omega, const Re
   check.evaluated = true;
   const int numElements = mesh.numElements();
   std::vector<double> speed(mesh.materials().size());
-  for (std::size_t k = 0; k < speed.size(); ++k) speed[k] = elementMaxFrequency(unitRegularTet(), mesh.materials()[k]);
+  for (std::size_t k = 0; k < speed.size(); ++k) {
+    const Material& material = mesh.materials()[k];
+    speed[k] = mesh.isHexahedral() ? hexahedronMaxFrequency(detail::unitCube(), material)
+                                   : elementMaxFrequency(unitRegularTet(), material);
+  }
   std::vector<double> sizeFrequency(static_cast<std::size_t>(numElements));
   double minSpeed = std::numeric_limits<double>::infinity(), maxSpeed = 0.0;
   double minEdge = std::numeric_limits<double>::infinity(), maxEdge = 0.0;
   for (int e = 0; e < numElements; ++e) {
     const double c = speed[static_cast<std::size_t>(mesh.elementMaterialIndex(e))];
-    const double edge = rmsEdgeLength(mesh.elementRestPositions(e));
+    const double edge = mesh.isHexahedral() ? detail::rmsEdgeLength(mesh.hexahedronRestPositions(e))
+                                            : rmsEdgeLength(mesh.elementRestPositions(e));
     sizeFrequency[static_cast<std::size_t>(e)] = c / edge;
     minSpeed = std::min(minSpeed, c);
     maxSpeed = std::max(maxSpeed, c);
