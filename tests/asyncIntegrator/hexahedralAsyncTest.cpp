@@ -2,8 +2,8 @@
 // The asynchronous integrator on a hexahedral mesh (docs/asynchronous-integrator.md,
 // "Hexahedral meshes"): the two-level step against its per-substep definition, the nested
 // step against Eq. N3, the energy theorem, the element tangents of the hexahedral force
-// models, nonlinear models at small amplitude, the comparators at m = 1, run-time regions
-// and the element frequencies of the region proposal.
+// models, nonlinear models at small amplitude, the comparators at m = 1, run-time regions,
+// the loads policy and the element frequencies of the region proposal.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -256,6 +256,42 @@ TEST(HexahedralAsync, RunTimeRegionsAndVertexMasses) {
   EXPECT_GT(indicated.repartitions()[0].fastVertices, 0);
   EXPECT_TRUE(indicated.displacement().allFinite());
   EXPECT_NEAR(lumpedVertexMasses(ts.mesh).sum(), 0.25 * 0.25 * (0.75 * 1000.0 + 0.25 * 200.0), 1e-12);
+}
+
+// The loads policy on hexahedra: a pull on the x = 1 face from 2.5 hL to 5.5 hL makes the
+// part "tip" (x >= 0.75) fast from step 2, the step the pull starts in, and releases it
+// after the pull, once its motion relative to its neighbourhood (weighed by the hexahedra's
+// lumped vertex masses) has decayed; without given parts the part is the loaded face grown
+// by one ring of hexahedra (the 18 vertices at x >= 0.875).
+TEST(HexahedralAsync, LoadsPolicyMakesThePulledPartFast) {
+  const std::shared_ptr<const TetMesh> mesh = stiffEndHexBar();
+  const std::vector<int> face = test::verticesOnPlanes(*mesh, {1.0});
+  const double hL = 5e-3;
+  const test::TestBody body(Problem(mesh, test::verticesOnPlanes(*mesh, {0.0}),
+                                    test::testSettings(ForceModelType::linear, 60.0, 0.0),
+                                    {VertexLoad{face, Eigen::Vector3d(0.0, -0.5, 0.2), 2.5 * hL, 5.5 * hL}}));
+  const std::vector<int> tip = test::verticesBeyond(body.mesh, 0.75);
+  RunTimeRegionOptions parts;
+  parts.loads = true;
+  parts.loadsParts = {{"tip", tip, 4}};
+  parts.minDwell = 4;
+  RunTimeRegionOptions grown;
+  grown.loads = true;
+  grown.loadsRatio = 4;
+  grown.loadsRings = 1;
+  AsyncBackwardEuler adaptive(body.mesh, body.system, hL, {}), fromFace(body.mesh, body.system, hL, {});
+  adaptive.setRunTimeRegions(parts);
+  fromFace.setRunTimeRegions(grown);
+  for (int k = 0; k < 60; ++k) adaptive.step();
+  for (int k = 0; k < 4; ++k) fromFace.step();
+  const std::vector<RepartitionRecord>& records = adaptive.repartitions();
+  ASSERT_EQ(records.size(), 2U) << (records.empty() ? "" : records[0].reason);
+  EXPECT_EQ(records[0].step, 2);
+  EXPECT_EQ(records[0].fastVertices, static_cast<int>(tip.size()));
+  EXPECT_GT(records[1].step, 5 + parts.minDwell);
+  EXPECT_EQ(records[1].regions, 0);
+  ASSERT_FALSE(fromFace.repartitions().empty());
+  EXPECT_EQ(fromFace.repartitions()[0].fastVertices, 18);
 }
 
 /// Relative difference of the states after 5 large steps of the async integrator (tip
