@@ -4,8 +4,10 @@
 
 #include <Eigen/Dense>
 #include <asyncfem/asyncIntegrator/asyncBackwardEuler.hpp>
+#include <asyncfem/hexElements/hexElementMatrices.hpp>
 #include <asyncfem/integrator/registry.hpp>
 #include <asyncfem/problem/problem.hpp>
+#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>
 #include <memory>
 #include <utility>
@@ -73,6 +75,25 @@ inline DenseFreeMatrices denseFreeMatrices(const DynamicSystem& system) {
     }
   out.D = system.rayleighMass * out.M + system.rayleighStiffness * out.K;
   return out;
+}
+
+/// The linear FEM stiffness of element e of either kind: 12 x 12 (tetrahedron) or 24 x 24
+/// (hexahedron).
+inline Eigen::MatrixXd elementLinearStiffness(const TetMesh& mesh, int e) {
+  const Material& material = mesh.elementMaterial(e);
+  if (mesh.isHexahedral()) {
+    return hexLinearStiffness(mesh.hexahedronRestPositions(e), material.youngsModulus, material.poissonRatio);
+  }
+  return linearElementStiffness(mesh.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
+}
+
+/// The consistent mass of element e of either kind.
+inline Eigen::MatrixXd elementConsistentMass(const TetMesh& mesh, int e) {
+  const double density = mesh.elementMaterial(e).density;
+  if (mesh.isHexahedral()) return hexConsistentMass(mesh.hexahedronRestPositions(e), density);
+  double volume = 0.0;
+  shapeFunctionGradients(mesh.elementRestPositions(e), &volume);
+  return consistentElementMass(std::abs(volume), density);
 }
 
 /// Dense single-rate backward Euler on the free DOFs (design note, paper Eq. 5), the

@@ -21,7 +21,7 @@ namespace asyncfem::test {
 /// and velocities, no block formulas): the residual is affine in the unknowns
 /// (v^{S_i}_1..v^{S_i}_{m_i} for every region, then v^L_m), so its dense Jacobian is built
 /// column by column and the system solved by LU. Linear forces; K_I of each region is summed
-/// here from the mesh's element stiffness matrices. The external force is evaluated at each
+/// here from the mesh's element stiffness matrices (tetrahedra or hexahedra). The external force is evaluated at each
 /// equation's own state (a fast region's substep r at its state after substep r, L at the end
 /// of the step: implicit contact's definition); where it depends on the state (penalty
 /// contact, piecewise affine) the residual is no longer affine and the step takes Newton
@@ -54,19 +54,17 @@ class DefinitionStep {
     for (int e = 0; e < mesh.numElements(); ++e) {
       int fast = -1;
       bool large = false;
-      for (int a = 0; a < 4; ++a) {
-        const int region = vertexRegion[static_cast<std::size_t>(mesh.element(e)[a])];
+      for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+        const int region = vertexRegion[static_cast<std::size_t>(mesh.elementVertex(e, a))];
         if (region >= 0) fast = region;
         large = large || region < 0;
       }
       if (fast < 0 || !large) continue;
-      const Material& material = mesh.elementMaterial(e);
-      const ElementMatrix ke =
-          linearElementStiffness(mesh.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
-      for (int p = 0; p < 12; ++p)
-        for (int q = 0; q < 12; ++q) {
-          const int a = freeIndex[static_cast<std::size_t>(3 * mesh.element(e)[p / 3] + p % 3)];
-          const int b = freeIndex[static_cast<std::size_t>(3 * mesh.element(e)[q / 3] + q % 3)];
+      const Eigen::MatrixXd ke = elementLinearStiffness(mesh, e);
+      for (int p = 0; p < ke.rows(); ++p)
+        for (int q = 0; q < ke.cols(); ++q) {
+          const int a = freeIndex[static_cast<std::size_t>(3 * mesh.elementVertex(e, p / 3) + p % 3)];
+          const int b = freeIndex[static_cast<std::size_t>(3 * mesh.elementVertex(e, q / 3) + q % 3)];
           if (a >= 0 && b >= 0) interfaceK_[static_cast<std::size_t>(fast)](a, b) += ke(p, q);
         }
     }

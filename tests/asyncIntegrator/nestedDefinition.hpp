@@ -56,25 +56,21 @@ inline double nestedDefinitionResidual(const TestSystem& ts, const AsyncBackward
         Eigen::VectorXd::Zero(counts.vertexCounts()[static_cast<std::size_t>(i / 3)]);
   double scale = 0.0;
   for (int e = 0; e < mesh.numElements(); ++e) {
-    const Material& material = mesh.elementMaterial(e);
-    double volume = 0.0;
-    shapeFunctionGradients(mesh.elementRestPositions(e), &volume);
-    const ElementMatrix ke =
-        linearElementStiffness(mesh.elementRestPositions(e), material.youngsModulus, material.poissonRatio);
-    const ElementMatrix de =
-        system.rayleighMass * consistentElementMass(std::abs(volume), material.density) + system.rayleighStiffness * ke;
+    const Eigen::MatrixXd ke = elementLinearStiffness(mesh, e);
+    const Eigen::MatrixXd de = system.rayleighMass * elementConsistentMass(mesh, e) + system.rayleighStiffness * ke;
+    const auto size = static_cast<int>(ke.rows());
     const int count = counts.elementCounts()[static_cast<std::size_t>(e)];
     for (int q = 1; q <= count; ++q) {
       const long long tq = q * (units / count);
-      Eigen::Matrix<double, 12, 1> ue, ve;
-      for (int a = 0; a < 12; ++a) {
-        const int i = 3 * mesh.element(e)[a / 3] + a % 3;
+      Eigen::VectorXd ue(size), ve(size);
+      for (int a = 0; a < size; ++a) {
+        const int i = 3 * mesh.elementVertex(e, a / 3) + a % 3;
         ue[a] = displacement(i, tq);
         ve[a] = velocity(i, tq);
       }
-      const Eigen::Matrix<double, 12, 1> force = -(hL / count) * (ke * ue + de * ve);
-      for (int a = 0; a < 12; ++a) {
-        const int i = 3 * mesh.element(e)[a / 3] + a % 3;
+      const Eigen::VectorXd force = -(hL / count) * (ke * ue + de * ve);
+      for (int a = 0; a < size; ++a) {
+        const int i = 3 * mesh.elementVertex(e, a / 3) + a % 3;
         if (fullToFree[static_cast<std::size_t>(i)] < 0) continue;
         impulse[static_cast<std::size_t>(i)][stepOf(i, tq).first - 1] += force[a];
         scale = std::max(scale, std::abs(force[a]));

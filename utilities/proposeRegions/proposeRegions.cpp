@@ -238,8 +238,9 @@ void printJson(const RegionProposal& proposal, double largeTimestep, const std::
 
 void printTable(const RegionProposal& proposal, const TetMesh& mesh, const RegionProposalOptions& options) {
   const double largeTimestep = options.largeTimestep;
-  std::printf("mesh: %d vertices, %d tets; hL = %g; target omega*h = %.3g%s\n", mesh.numVertices(), mesh.numElements(),
-              largeTimestep, proposal.targetOmegaH, options.targetOmegaH > 0 ? "" : " (relative mode)");
+  std::printf("mesh: %d vertices, %d %s; hL = %g; target omega*h = %.3g%s\n", mesh.numVertices(), mesh.numElements(),
+              mesh.isHexahedral() ? "hexahedra" : "tets", largeTimestep, proposal.targetOmegaH,
+              options.targetOmegaH > 0 ? "" : " (relative mode)");
   std::printf("L: max omega*hL = %.3g over the elements left in L\n", proposal.largeRegionMaxFrequency * largeTimestep);
   if (proposal.regions.empty() && proposal.withdrawnRegions.empty() && proposal.precheckWithdrawnRegions.empty()) {
     std::printf("no fast region needed: every element meets the target at hL\n");

@@ -4,22 +4,21 @@
 #include <algorithm>
 #include <asyncfem/asyncIntegrator/loadsPolicy.hpp>
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <numeric>
 #include <string>
 
+#include "detail/meshElements.hpp"
+
 namespace asyncfem {
 
 Eigen::VectorXd lumpedVertexMasses(const TetMesh& mesh) {
   Eigen::VectorXd mass = Eigen::VectorXd::Zero(mesh.numVertices());
   for (int e = 0; e < mesh.numElements(); ++e) {
-    double volume = 0.0;
-    shapeFunctionGradients(mesh.elementRestPositions(e), &volume);
-    const double share = mesh.elementMaterial(e).density * std::abs(volume) / 4.0;
-    for (int a = 0; a < 4; ++a) mass[mesh.elements()(a, e)] += share;
+    const Eigen::VectorXd share = detail::vertexMassesOf(mesh, e);
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) mass[mesh.elementVertex(e, a)] += share[a];
   }
   return mass;
 }
@@ -150,8 +149,8 @@ std::vector<std::vector<int>> components(const TetMesh& mesh, const std::vector<
   };
   for (int e = 0; e < mesh.numElements(); ++e) {
     int first = -1;
-    for (int a = 0; a < 4; ++a) {
-      const int vertex = mesh.elements()(a, e);
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int vertex = mesh.elementVertex(e, a);
       if (!marked[static_cast<std::size_t>(vertex)]) continue;
       if (first < 0) {
         first = vertex;

@@ -97,14 +97,14 @@ void RegionPartition::countSteps(const TetMesh& mesh) {
     if (vertexRegion_[v] >= 0) vertexCounts_[v] = regions_[static_cast<std::size_t>(vertexRegion_[v])].ratio;
   elementCounts_.assign(static_cast<std::size_t>(mesh.numElements()), 1);
   for (int e = 0; e < mesh.numElements(); ++e) {
-    int fastest = mesh.elements()(0, e), firstFast = -1;
-    for (int a = 1; a < 4; ++a) {
-      const int v = mesh.elements()(a, e);
+    int fastest = mesh.elementVertex(e, 0), firstFast = -1;
+    for (int a = 1; a < mesh.verticesPerElement(); ++a) {
+      const int v = mesh.elementVertex(e, a);
       if (vertexCounts_[static_cast<std::size_t>(v)] > vertexCounts_[static_cast<std::size_t>(fastest)]) fastest = v;
     }
     const int count = vertexCounts_[static_cast<std::size_t>(fastest)];
-    for (int a = 0; a < 4; ++a) {
-      const int v = mesh.elements()(a, e);
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int v = mesh.elementVertex(e, a);
       const int region = vertexRegion_[static_cast<std::size_t>(v)];
       if (count % vertexCounts_[static_cast<std::size_t>(v)] != 0) {
         throw ValidationError(
@@ -178,8 +178,8 @@ std::vector<std::vector<char>> RegionPartition::classifyElements(const TetMesh& 
   for (int e = 0; e < mesh.numElements(); ++e) {
     bool hasLarge = false;
     std::vector<int> fast;
-    for (int a = 0; a < 4; ++a) {
-      const int region = vertexRegion_[static_cast<std::size_t>(mesh.elements()(a, e))];
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int region = vertexRegion_[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       if (region < 0) {
         hasLarge = true;
       } else if (std::find(fast.begin(), fast.end(), region) == fast.end()) {
@@ -190,8 +190,8 @@ std::vector<std::vector<char>> RegionPartition::classifyElements(const TetMesh& 
     interfaceElements_.push_back(e);
     if (!hasLarge) continue;
     for (const int region : fast)
-      for (int a = 0; a < 4; ++a) {
-        const int v = mesh.elements()(a, e);
+      for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+        const int v = mesh.elementVertex(e, a);
         if (vertexRegion_[static_cast<std::size_t>(v)] >= 0) continue;
         for (int c = 0; c < 3; ++c)
           touchesRegion[static_cast<std::size_t>(region)][static_cast<std::size_t>(3 * v + c)] = 1;
@@ -251,9 +251,11 @@ void growByRings(const TetMesh& mesh, std::vector<char>& marked, int rings) {
     std::vector<char> grown = marked;
     for (int e = 0; e < mesh.numElements(); ++e) {
       bool any = false;
-      for (int a = 0; a < 4; ++a) any = any || marked[static_cast<std::size_t>(mesh.elements()(a, e))];
+      for (int a = 0; a < mesh.verticesPerElement(); ++a)
+        any = any || marked[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       if (any)
-        for (int a = 0; a < 4; ++a) grown[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
+        for (int a = 0; a < mesh.verticesPerElement(); ++a)
+          grown[static_cast<std::size_t>(mesh.elementVertex(e, a))] = 1;
     }
     marked.swap(grown);
   }

@@ -15,6 +15,8 @@
 #include <numeric>
 #include <string>
 
+#include "detail/hexahedronFrequency.hpp"
+
 namespace asyncfem {
 
 double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, const Material& material) {
@@ -43,8 +45,12 @@ double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, con
 }
 
 Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh) {
-  mesh.requireTetrahedra("elementMaxFrequencies");  // before the parallel loop, which must not throw
   Eigen::VectorXd omega(mesh.numElements());
+  if (mesh.isHexahedral()) {  // serial: a misshapen hexahedron throws, naming it
+    for (int e = 0; e < mesh.numElements(); ++e)
+      omega[e] = hexahedronMaxFrequency(mesh.hexahedronRestPositions(e), mesh.elementMaterial(e));
+    return omega;
+  }
 #pragma omp parallel for schedule(static)
   for (int e = 0; e < mesh.numElements(); ++e) {
     omega[e] = elementMaxFrequency(mesh.elementRestPositions(e), mesh.elementMaterial(e));
@@ -126,7 +132,7 @@ std::vector<char> fastVertices(const TetMesh& mesh, const Eigen::VectorXd& omega
   std::vector<char> fast(static_cast<std::size_t>(mesh.numVertices()), 0);
   for (int e = 0; e < mesh.numElements(); ++e) {
     if (omega[e] * hL > target)
-      for (int a = 0; a < 4; ++a) fast[static_cast<std::size_t>(mesh.elements()(a, e))] = 1;
+      for (int a = 0; a < mesh.verticesPerElement(); ++a) fast[static_cast<std::size_t>(mesh.elementVertex(e, a))] = 1;
   }
   growByRings(mesh, fast, growLayers);
   return fast;
@@ -139,8 +145,8 @@ bool enclosed(const TetMesh& mesh, const VertexElementAdjacency& adjacency, cons
   if (begin == end) return false;
   for (int k = begin; k < end; ++k) {
     const int e = adjacency.elements[static_cast<std::size_t>(k)];
-    for (int a = 0; a < 4; ++a) {
-      const int w = mesh.elements()(a, e);
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int w = mesh.elementVertex(e, a);
       if (w != v && !fast[static_cast<std::size_t>(w)]) return false;
     }
   }
@@ -175,8 +181,8 @@ std::vector<int> fastComponents(const TetMesh& mesh, const VertexElementAdjacenc
       for (int k = adjacency.offsets[static_cast<std::size_t>(v)];
            k < adjacency.offsets[static_cast<std::size_t>(v) + 1]; ++k) {
         const int e = adjacency.elements[static_cast<std::size_t>(k)];
-        for (int a = 0; a < 4; ++a) {
-          const int w = mesh.elements()(a, e);
+        for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+          const int w = mesh.elementVertex(e, a);
           if (fast[static_cast<std::size_t>(w)] && component[static_cast<std::size_t>(w)] < 0) {
             component[static_cast<std::size_t>(w)] = numComponents;
             queue.push_back(w);
@@ -198,8 +204,8 @@ void collectRegions(const TetMesh& mesh, const FreeDofs& freeDofs, const Eigen::
   for (int e = 0; e < mesh.numElements(); ++e) {
     int owner = -1;
     bool allFast = true;
-    for (int a = 0; a < 4; ++a) {
-      const int c = component[static_cast<std::size_t>(mesh.elements()(a, e))];
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int c = component[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       if (c >= 0) owner = c;
       allFast = allFast && c >= 0;
     }
@@ -274,13 +280,18 @@ void precheckRegions(const TetMesh& mesh, const Eigen::VectorXd& omega, const Re
   check.evaluated = true;
   const int numElements = mesh.numElements();
   std::vector<double> speed(mesh.materials().size());
-  for (std::size_t k = 0; k < speed.size(); ++k) speed[k] = elementMaxFrequency(unitRegularTet(), mesh.materials()[k]);
+  for (std::size_t k = 0; k < speed.size(); ++k) {
+    const Material& material = mesh.materials()[k];
+    speed[k] = mesh.isHexahedral() ? hexahedronMaxFrequency(detail::unitCube(), material)
+                                   : elementMaxFrequency(unitRegularTet(), material);
+  }
   std::vector<double> sizeFrequency(static_cast<std::size_t>(numElements));
   double minSpeed = std::numeric_limits<double>::infinity(), maxSpeed = 0.0;
   double minEdge = std::numeric_limits<double>::infinity(), maxEdge = 0.0;
   for (int e = 0; e < numElements; ++e) {
     const double c = speed[static_cast<std::size_t>(mesh.elementMaterialIndex(e))];
-    const double edge = rmsEdgeLength(mesh.elementRestPositions(e));
+    const double edge = mesh.isHexahedral() ? detail::rmsEdgeLength(mesh.hexahedronRestPositions(e))
+                                            : rmsEdgeLength(mesh.elementRestPositions(e));
     sizeFrequency[static_cast<std::size_t>(e)] = c / edge;
     minSpeed = std::min(minSpeed, c);
     maxSpeed = std::max(maxSpeed, c);

@@ -67,12 +67,13 @@ RegionProposalCost estimateAsyncCost(const TetMesh& mesh, const FreeDofs& freeDo
   const RegionPartition partition(mesh, freeDofs, regions);
   const int nv = mesh.numVertices();
   std::vector<std::pair<int, int>> pairs;
-  pairs.reserve(static_cast<std::size_t>(6 * mesh.numElements() + nv));
+  pairs.reserve(static_cast<std::size_t>(
+      (mesh.verticesPerElement() * (mesh.verticesPerElement() - 1) / 2 * mesh.numElements()) + nv));
   for (int v = 0; v < nv; ++v) pairs.emplace_back(v, v);
   for (int e = 0; e < mesh.numElements(); ++e)
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) {
-        const int x = mesh.elements()(a, e), y = mesh.elements()(b, e);
+    for (int a = 0; a < mesh.verticesPerElement(); ++a)
+      for (int b = a + 1; b < mesh.verticesPerElement(); ++b) {
+        const int x = mesh.elementVertex(e, a), y = mesh.elementVertex(e, b);
         pairs.emplace_back(std::min(x, y), std::max(x, y));
       }
   std::sort(pairs.begin(), pairs.end());

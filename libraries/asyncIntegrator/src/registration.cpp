@@ -385,7 +385,6 @@ AsyncSettings parseAsyncSettings(const IntegratorContext& context, const nlohman
   const std::string& sourceName = context.sourceName;
   if (!context.mesh) throw ValidationError(sourceName + ": " + context.optionsPath + ": async needs the mesh");
   const TetMesh& mesh = *context.mesh;
-  mesh.requireTetrahedra(sourceName + ": each multirate integrator (async, schroeder2011, multirate-uncoupled)");
   JsonObjectReader reader(options, context.optionsPath, sourceName);
   AsyncSettings out;
   out.solver = parseSolverOptions(reader, context.hasContact);

@@ -50,8 +50,8 @@ std::vector<AsyncRegion> mergeTouching(const TetMesh& mesh, const std::vector<As
     }
   for (int e = 0; e < mesh.numElements(); ++e) {
     int first = -1;
-    for (int a = 0; a < 4; ++a) {
-      const int o = owner[static_cast<std::size_t>(mesh.elements()(a, e))];
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int o = owner[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       if (o < 0) continue;
       if (first < 0) {
         first = o;
@@ -96,12 +96,12 @@ std::vector<AsyncRegion> nestTouching(const TetMesh& mesh, const std::vector<Asy
     }
   for (int e = 0; e < mesh.numElements(); ++e) {
     int fastest = 1;
-    for (int a = 0; a < 4; ++a) {
-      const int o = owner[static_cast<std::size_t>(mesh.elements()(a, e))];
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int o = owner[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       if (o >= 0) fastest = std::max(fastest, regions[static_cast<std::size_t>(o)].ratio);
     }
-    for (int a = 0; a < 4; ++a) {
-      const int o = owner[static_cast<std::size_t>(mesh.elements()(a, e))];
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int o = owner[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       if (o >= 0 && fastest % regions[static_cast<std::size_t>(o)].ratio != 0) return mergeTouching(mesh, regions);
     }
   }
@@ -123,8 +123,8 @@ std::vector<AsyncRegion> indicatorComponents(const TetMesh& mesh, const std::vec
   std::iota(parent.begin(), parent.end(), 0);
   for (int e = 0; e < mesh.numElements(); ++e) {
     int first = -1;
-    for (int a = 0; a < 4; ++a) {
-      const int vertex = mesh.elements()(a, e);
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int vertex = mesh.elementVertex(e, a);
       if (ratio[static_cast<std::size_t>(vertex)] == 0) continue;
       if (first < 0) {
         first = vertex;
@@ -258,10 +258,11 @@ std::vector<int> RunTimeRegionPolicy::indicatorRatios(int extraRings) const {
     std::vector<int> grown = ratio;
     for (int e = 0; e < mesh_->numElements(); ++e) {
       int largest = 0;
-      for (int a = 0; a < 4; ++a) largest = std::max(largest, ratio[static_cast<std::size_t>(mesh_->elements()(a, e))]);
+      for (int a = 0; a < mesh_->verticesPerElement(); ++a)
+        largest = std::max(largest, ratio[static_cast<std::size_t>(mesh_->elementVertex(e, a))]);
       if (largest == 0) continue;
-      for (int a = 0; a < 4; ++a) {
-        int& r = grown[static_cast<std::size_t>(mesh_->elements()(a, e))];
+      for (int a = 0; a < mesh_->verticesPerElement(); ++a) {
+        int& r = grown[static_cast<std::size_t>(mesh_->elementVertex(e, a))];
         r = std::max(r, largest);
       }
     }

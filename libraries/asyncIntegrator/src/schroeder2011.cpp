@@ -5,7 +5,6 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
 #include <algorithm>
-#include <array>
 #include <asyncfem/asyncIntegrator/schroeder2011.hpp>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
@@ -19,6 +18,7 @@
 
 #include "detail/elementTangents.hpp"
 #include "detail/fastRegion.hpp"
+#include "detail/meshElements.hpp"
 #include "detail/multirateSupport.hpp"
 #include "detail/sparseBlocks.hpp"
 
@@ -32,11 +32,11 @@ using detail::updateBlock;
 
 constexpr const char* kName = "schroeder2011";
 
-/// An element with vertices in S_i and in L: where its 12 DOFs sit among the region's
-/// interface DOFs I_i (-1 for S DOFs and fixed DOFs).
+/// An element with vertices in S_i and in L: where its 12 (tetrahedron) or 24 (hexahedron)
+/// DOFs sit among the region's interface DOFs I_i (-1 for S DOFs and fixed DOFs).
 struct InterfaceElement {
   int element = 0;
-  std::array<int, 12> interfaceIndex{};
+  std::vector<int> interfaceIndex;
 };
 
 /// (S7): the largest h with h^2 omega^2 <= 4 + 2 h c, c = alpha + beta omega^2, the
@@ -213,16 +213,15 @@ void Schroeder2011::collectInterfaceElements() {
     for (std::size_t k = 0; k < iface.size(); ++k) index[static_cast<std::size_t>(iface[k])] = static_cast<int>(k);
   }
   for (const int e : partition_.interfaceElements()) {
-    const Eigen::Vector4i vertices = mesh.element(e);
     int fast = -1;
-    for (int a = 0; a < 4; ++a) fast = std::max(fast, partition_.vertexRegion()[static_cast<std::size_t>(vertices[a])]);
+    for (int a = 0; a < mesh.verticesPerElement(); ++a)
+      fast = std::max(fast, partition_.vertexRegion()[static_cast<std::size_t>(mesh.elementVertex(e, a))]);
     if (fast < 0) continue;
     InterfaceElement element;
     element.element = e;
-    for (int a = 0; a < 4; ++a)
-      for (int c = 0; c < 3; ++c)
-        element.interfaceIndex[static_cast<std::size_t>((3 * a) + c)] =
-            interfaceIndex[static_cast<std::size_t>(fast)][static_cast<std::size_t>((3 * vertices[a]) + c)];
+    for (int p = 0; p < detail::elementDofs(mesh); ++p)
+      element.interfaceIndex.push_back(
+          interfaceIndex[static_cast<std::size_t>(fast)][static_cast<std::size_t>(detail::elementDof(mesh, e, p))]);
     d.interfaceElements[static_cast<std::size_t>(fast)].push_back(element);
   }
 }
@@ -242,14 +241,13 @@ void Schroeder2011::checkInterfaceStiffness() const {
     for (std::size_t k = 0; k < s.size(); ++k) sIndex[static_cast<std::size_t>(s[k])] = static_cast<int>(k);
     std::vector<Eigen::Triplet<double>> triplets;
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(mesh.numDofs());
-    Eigen::Matrix<double, 12, 12> tangent;
+    Eigen::MatrixXd tangent;
     for (const InterfaceElement& element : d.interfaceElements[static_cast<std::size_t>(i)]) {
       interfaceTangent(zero, element.element, tangent);
-      const Eigen::Vector4i vertices = mesh.element(element.element);
-      for (int p = 0; p < 12; ++p) {
-        const int row = sIndex[static_cast<std::size_t>((3 * vertices[p / 3]) + (p % 3))];
+      for (int p = 0; p < tangent.rows(); ++p) {
+        const int row = sIndex[static_cast<std::size_t>(detail::elementDof(mesh, element.element, p))];
         if (row < 0) continue;
-        for (int q = 0; q < 12; ++q) {
+        for (int q = 0; q < tangent.cols(); ++q) {
           const int column = element.interfaceIndex[static_cast<std::size_t>(q)];
           if (column >= 0) triplets.emplace_back(row, column, tangent(p, q));
         }
@@ -271,8 +269,7 @@ void Schroeder2011::checkInterfaceStiffness() const {
   }
 }
 
-void Schroeder2011::interfaceTangent(const Eigen::VectorXd& u, int element,
-                                     Eigen::Matrix<double, 12, 12>& tangent) const {
+void Schroeder2011::interfaceTangent(const Eigen::VectorXd& u, int element, Eigen::MatrixXd& tangent) const {
   impl_->tangents->tangent(u, element, tangent);
 }
 
@@ -379,13 +376,13 @@ void Schroeder2011::rebuild() {
     const std::vector<int>& iface = partition_.interfaceDofs(i);
     std::vector<Eigen::Triplet<double>> local;
     const double correction = (hS - hL) * (hL + beta);
-    Eigen::Matrix<double, 12, 12> tangent;
+    Eigen::MatrixXd tangent;
     for (const InterfaceElement& element : d.interfaceElements[static_cast<std::size_t>(i)]) {
       interfaceTangent(u0, element.element, tangent);
-      for (int p = 0; p < 12; ++p) {
+      for (int p = 0; p < tangent.rows(); ++p) {
         const int row = element.interfaceIndex[static_cast<std::size_t>(p)];
         if (row < 0) continue;
-        for (int q = 0; q < 12; ++q) {
+        for (int q = 0; q < tangent.cols(); ++q) {
           const int column = element.interfaceIndex[static_cast<std::size_t>(q)];
           if (column < 0) continue;
           local.emplace_back(row, column, tangent(p, q));

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/hexElements/hexAssembly.hpp>
 #include <asyncfem/modalAnalysis/lowestModes.hpp>
 #include <cmath>
 #include <memory>
@@ -131,6 +132,7 @@ Eigen::MatrixXd massNormalizedModes(const Eigen::MatrixXd& freeModes, const Eige
 }  // namespace
 
 VibrationMatrices vibrationMatrices(const TetMesh& mesh, MassType massType) {
+  if (mesh.isHexahedral()) return {hexLinearStiffnessMatrix(mesh), hexMassMatrix(mesh, massType)};
   const MatrixAssembler assembler(mesh);
   VibrationMatrices matrices;
   matrices.stiffness = linearStiffnessMatrix(mesh, assembler);

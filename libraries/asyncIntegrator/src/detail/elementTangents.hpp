@@ -11,10 +11,10 @@
 
 namespace asyncfem::detail {
 
-/// The tangent K_e (12 x 12, N/m) of element e: the force model's elementTangent() where it
-/// gives one, otherwise (a linear model built from a matrix) the mesh's linear FEM element
-/// stiffness, constant. Whoever uses the fallback must check that the model's K is that
-/// stiffness (the callers do, on the columns they need).
+/// The tangent K_e (N/m; 12 x 12 on tetrahedra, 24 x 24 on hexahedra) of element e: the
+/// force model's elementTangentOfAnyKind() where it gives one, otherwise (a linear model
+/// built from a matrix) the mesh's linear FEM element stiffness (meshElements.hpp), constant. Whoever uses the fallback
+/// must check that the model's K is that stiffness (the callers do, on the columns they need).
 class ElementTangents {
  public:
   /// Probes model on element 0 at rest. Throws asyncfem::ValidationError "<who>: ..." for a
@@ -25,9 +25,9 @@ class ElementTangents {
   /// Whether the force model gives per-element tangents (else the linear fallback).
   bool perElement() const { return perElement_; }
   /// K_e at displacement u (3n).
-  void tangent(const Eigen::VectorXd& u, int e, Eigen::Matrix<double, 12, 12>& out) const;
+  void tangent(const Eigen::VectorXd& u, int e, Eigen::MatrixXd& out) const;
   /// The mesh's linear FEM stiffness of element e.
-  Eigen::Matrix<double, 12, 12> linear(int e) const;
+  Eigen::MatrixXd linear(int e) const;
 
  private:
   const TetMesh& mesh_;

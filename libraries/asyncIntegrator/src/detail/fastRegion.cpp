@@ -333,11 +333,12 @@ void FastRegion::assembleInterfaceStiffness(const ForceModel& forceModel, const 
   const auto q = static_cast<Eigen::Index>(Mis.rows());
   interfaceStiffness.setZero(q, q);
   for (InterfaceElement& element : interfaceElements) {
-    if (perElement) forceModel.elementTangent(u, element.element, element.tangent);
-    for (int b = 0; b < 12; ++b) {
+    if (perElement) forceModel.elementTangentOfAnyKind(u, element.element, element.tangent);
+    const auto size = static_cast<int>(element.interfaceIndex.size());
+    for (int b = 0; b < size; ++b) {
       const int column = element.interfaceIndex[static_cast<std::size_t>(b)];
       if (column < 0) continue;
-      for (int a = 0; a < 12; ++a) {
+      for (int a = 0; a < size; ++a) {
         const int row = element.interfaceIndex[static_cast<std::size_t>(a)];
         if (row >= 0) interfaceStiffness(row, column) += element.tangent(a, b);
       }

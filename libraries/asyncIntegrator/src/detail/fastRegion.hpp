@@ -26,8 +26,8 @@ namespace asyncfem::detail {
 /// among the region's interface DOFs I_i (-1 for S DOFs and fixed DOFs), and its tangent.
 struct InterfaceElement {
   int element = 0;
-  std::array<int, 12> interfaceIndex{};
-  Eigen::Matrix<double, 12, 12> tangent;
+  std::vector<int> interfaceIndex;  ///< per element-local DOF (12 on tetrahedra, 24 on hexahedra)
+  Eigen::MatrixXd tangent;
 };
 
 /// The time-step-independent description of a region: its DOFs and its interface.

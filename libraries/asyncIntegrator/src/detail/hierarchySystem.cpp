@@ -6,11 +6,11 @@
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/core/stopwatch.hpp>
-#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <set>
 #include <string>
 #include <tuple>
 
+#include "detail/meshElements.hpp"
 #include "detail/sparseBlocks.hpp"
 #include "detail/structuredHierarchySolve.hpp"
 
@@ -19,12 +19,11 @@ namespace asyncfem::detail {
 namespace {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
-using ElementBlock = Eigen::Matrix<double, 12, 12>;
-
-void appendElement(const Eigen::Vector4i& vertices, const ElementBlock& block, Triplets& out) {
-  for (int b = 0; b < 12; ++b)
-    for (int a = 0; a < 12; ++a)
-      out.emplace_back(3 * vertices[a / 3] + a % 3, 3 * vertices[b / 3] + b % 3, block(a, b));
+/// Element e's block (elementDofs() square) at its vertices' DOFs.
+void appendElement(const TetMesh& mesh, int e, const Eigen::MatrixXd& block, Triplets& out) {
+  const int size = elementDofs(mesh);
+  for (int b = 0; b < size; ++b)
+    for (int a = 0; a < size; ++a) out.emplace_back(elementDof(mesh, e, a), elementDof(mesh, e, b), block(a, b));
 }
 
 SparseMatrix fromTriplets(int size, const Triplets& triplets) {
@@ -95,7 +94,7 @@ HierarchySystem::~HierarchySystem() = default;
 void HierarchySystem::checkLinearStiffness() {
   Triplets triplets;
   for (int e = 0; e < mesh_.numElements(); ++e) {
-    appendElement(mesh_.element(e), tangents_.linear(e), triplets);
+    appendElement(mesh_, e, tangents_.linear(e), triplets);
   }
   SparseMatrix model = system_.forceModel->createStiffnessMatrix();
   system_.forceModel->tangentStiffness(Eigen::VectorXd::Zero(mesh_.numDofs()), model);
@@ -108,12 +107,8 @@ void HierarchySystem::checkLinearStiffness() {
   }
 }
 
-ElementBlock HierarchySystem::elementMass(int e) const {
-  double volume = 0.0;
-  shapeFunctionGradients(mesh_.elementRestPositions(e), &volume);
-  const double density = mesh_.elementMaterial(e).density;
-  return elementMass_ == ElementMass::lumped ? lumpedElementMass(std::abs(volume), density)
-                                             : consistentElementMass(std::abs(volume), density);
+Eigen::MatrixXd HierarchySystem::elementMass(int e) const {
+  return massOf(mesh_, e, elementMass_ == ElementMass::lumped);
 }
 
 // Mass-proportional damping is an element force (Eq. N2), so each element's mass is needed:
@@ -123,7 +118,7 @@ void HierarchySystem::chooseElementMass() {
   for (ElementMass kind : {ElementMass::consistent, ElementMass::lumped}) {
     elementMass_ = kind;
     Triplets triplets;
-    for (int e = 0; e < mesh_.numElements(); ++e) appendElement(mesh_.element(e), elementMass(e), triplets);
+    for (int e = 0; e < mesh_.numElements(); ++e) appendElement(mesh_, e, elementMass(e), triplets);
     if (relativeDifference(system_.mass, fromTriplets(mesh_.numDofs(), triplets)) <= kSameMatrix) return;
   }
   elementMass_ = ElementMass::none;
@@ -134,13 +129,13 @@ void HierarchySystem::chooseElementMass() {
 
 void HierarchySystem::groupElements(const Eigen::VectorXd& u) {
   std::map<int, Triplets> stiffness, mass;
-  ElementBlock tangent;
+  Eigen::MatrixXd tangent;
   const bool needMass = elementMass_ != ElementMass::none && massByCount_.empty();
   for (int e = 0; e < mesh_.numElements(); ++e) {
     const int count = elementCounts_[static_cast<std::size_t>(e)];
     tangents_.tangent(u, e, tangent);
-    appendElement(mesh_.element(e), tangent, stiffness[count]);
-    if (needMass) appendElement(mesh_.element(e), elementMass(e), mass[count]);
+    appendElement(mesh_, e, tangent, stiffness[count]);
+    if (needMass) appendElement(mesh_, e, elementMass(e), mass[count]);
   }
   stiffnessByCount_.clear();
   for (const auto& [count, triplets] : stiffness) stiffnessByCount_[count] = fromTriplets(mesh_.numDofs(), triplets);

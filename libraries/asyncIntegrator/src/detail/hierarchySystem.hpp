@@ -104,7 +104,7 @@ class HierarchySystem {
   /// Eq. N2) or D_g (velocity term), credited to the rows of the steps they fall in.
   void addElementRows(int count, const SparseMatrix& matrix, bool displacementTerm,
                       std::vector<Eigen::Triplet<double>>& out) const;
-  Eigen::Matrix<double, 12, 12> elementMass(int e) const;
+  Eigen::MatrixXd elementMass(int e) const;
   /// The elimination order (Eq. N8): unknowns by the time their step ends, then by an AMD
   /// order of the free DOFs' graph, v before w; and the row scaling of the position rows.
   void chooseOrder();

@@ -3,10 +3,10 @@
 
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
-#include <asyncfem/stiffnessMatrix/elementMatrices.hpp>
 #include <string>
 
 #include "detail/elementTangents.hpp"
+#include "detail/meshElements.hpp"
 #include "detail/sparseBlocks.hpp"
 
 namespace asyncfem::detail {
@@ -36,17 +36,17 @@ void checkLinearModelMatchesMesh(const TetMesh& mesh, const RegionPartition& par
   // Sparse 3n x |columns| blocks, so the check costs O(interface elements), not O(n |I|).
   std::vector<Eigen::Triplet<double>> meshEntries, modelEntries;
   const ElementTangents tangents(mesh, *system.forceModel, "async integrator");
+  const int size = elementDofs(mesh);
   for (int e = 0; e < mesh.numElements(); ++e) {
-    const Eigen::Vector4i vertices = mesh.element(e);
     bool touches = false;
-    for (int a = 0; a < 4 && !touches; ++a)
-      for (int c = 0; c < 3; ++c) touches = touches || columnOf[static_cast<std::size_t>(3 * vertices[a] + c)] >= 0;
+    for (int q = 0; q < size && !touches; ++q)
+      touches = columnOf[static_cast<std::size_t>(elementDof(mesh, e, q))] >= 0;
     if (!touches) continue;
-    const ElementMatrix ke = tangents.linear(e);
-    for (int q = 0; q < 12; ++q) {
-      const int column = columnOf[static_cast<std::size_t>(3 * vertices[q / 3] + q % 3)];
+    const Eigen::MatrixXd ke = tangents.linear(e);
+    for (int q = 0; q < size; ++q) {
+      const int column = columnOf[static_cast<std::size_t>(elementDof(mesh, e, q))];
       if (column < 0) continue;
-      for (int p = 0; p < 12; ++p) meshEntries.emplace_back(3 * vertices[p / 3] + p % 3, column, ke(p, q));
+      for (int p = 0; p < size; ++p) meshEntries.emplace_back(elementDof(mesh, e, p), column, ke(p, q));
     }
   }
   for (std::size_t k = 0; k < columns.size(); ++k)
@@ -83,22 +83,22 @@ bool findInterfaceElements(const TetMesh& mesh, const RegionPartition& partition
   const ElementTangents tangents(mesh, *system.forceModel, "async integrator (stable coupling)",
                                  "use the coupling \"paper\"");
   const bool perElement = tangents.perElement();
+  const int size = elementDofs(mesh);
   for (int e = 0; e < mesh.numElements(); ++e) {
-    const Eigen::Vector4i vertices = mesh.element(e);
     int fast = -1;
     bool touchesLarge = false;
-    for (int a = 0; a < 4; ++a) {
-      const int region = vertexRegion[static_cast<std::size_t>(vertices[a])];
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      const int region = vertexRegion[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       if (region >= 0) fast = region;
       if (region < 0) touchesLarge = true;
     }
     if (fast < 0 || !touchesLarge) continue;
     InterfaceElement element;
     element.element = e;
-    for (int a = 0; a < 4; ++a)
-      for (int c = 0; c < 3; ++c)
-        element.interfaceIndex[static_cast<std::size_t>(3 * a + c)] =
-            interfaceIndex[static_cast<std::size_t>(fast)][static_cast<std::size_t>(3 * vertices[a] + c)];
+    element.interfaceIndex.resize(static_cast<std::size_t>(size));
+    for (int p = 0; p < size; ++p)
+      element.interfaceIndex[static_cast<std::size_t>(p)] =
+          interfaceIndex[static_cast<std::size_t>(fast)][static_cast<std::size_t>(elementDof(mesh, e, p))];
     if (!perElement) element.tangent = tangents.linear(e);
     regions[static_cast<std::size_t>(fast)].interfaceElements.push_back(element);
   }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <asyncfem/asyncIntegrator/detail/vertexRotations.hpp>
 #include <asyncfem/corotationalLinearFEM/polarDecomposition.hpp>
 #include <cmath>
@@ -11,10 +12,13 @@ namespace {
 /// Below this fraction of its rest value, an element's |det D| counts as flat.
 constexpr double kFlatElement = 1e-8;
 
-/// The element's edge matrix at displacement (null: at rest).
+/// The element's edge matrix at displacement (null: at rest): the edges from vertex 0 to
+/// vertices 1, 2, 3 of a tetrahedron, to its three neighbours 1, 3, 4 on a hexahedron.
 Eigen::Matrix3d edgeMatrix(const TetMesh& mesh, const Eigen::VectorXd* displacement, int element) {
+  static constexpr std::array<int, 4> kTetCorners{0, 1, 2, 3}, kHexCorners{0, 1, 3, 4};
+  const std::array<int, 4>& corners = mesh.isHexahedral() ? kHexCorners : kTetCorners;
   const auto corner = [&](int c) -> Eigen::Vector3d {
-    const int v = mesh.elements()(c, element);
+    const int v = mesh.elementVertex(element, corners[static_cast<std::size_t>(c)]);
     const Eigen::Vector3d rest = mesh.restPosition(v);
     return displacement ? Eigen::Vector3d(rest + displacement->segment<3>(3 * static_cast<Eigen::Index>(v))) : rest;
   };
@@ -47,7 +51,8 @@ void VertexRotations::update(const TetMesh& mesh, const Eigen::VectorXd& displac
     const Eigen::Matrix3d& inverse = referenceInverse_[static_cast<std::size_t>(e)];
     if (inverse.isZero(0.0)) continue;
     const Eigen::Matrix3d gradient = edgeMatrix(mesh, &displacement, e) * inverse;
-    for (int c = 0; c < 4; ++c) meanGradient_[static_cast<std::size_t>(mesh.elements()(c, e))] += gradient;
+    for (int c = 0; c < mesh.verticesPerElement(); ++c)
+      meanGradient_[static_cast<std::size_t>(mesh.elementVertex(e, c))] += gradient;
   }
   largestAngle_ = 0.0;
   for (std::size_t v = 0; v < rotations_.size(); ++v) {

@@ -19,10 +19,17 @@ namespace asyncfem {
 /// 2 mu diag(g) + lambda sqrt(g) sqrt(g)^T (Lame constants lambda, mu): two 3x3 eigenvalue
 /// problems instead of the 12x12 one (docs/asynchronous-integrator.md, "Proposed regions").
 double elementMaxFrequency(const Eigen::Matrix<double, 3, 4>& restPositions, const Material& material);
+/// The highest natural frequency of one trilinear hexahedron (vertices in hexahedron.hpp's order):
+/// the largest eigenvalue of K_e v = lambda M_e v with hexLinearStiffness and hexLumpedMass
+/// (rho int N_a dV on every DOF of vertex a), from the 24 x 24 symmetric eigenproblem of
+/// M_e^{-1/2} K_e M_e^{-1/2}. Throws asyncfem::ValidationError as hexLinearStiffness for a
+/// rest shape with det J <= 0 at a Gauss point.
+double hexahedronMaxFrequency(const Eigen::Matrix<double, 3, 8>& restPositions, const Material& material);
 
-/// elementMaxFrequency() of every element. By the element eigenvalue inequality,
-/// max_e omega_e bounds the assembled system's highest frequency from above, so it is a
-/// safe measure of how small a timestep an element wants.
+/// elementMaxFrequency() or hexahedronMaxFrequency() of every element. By the element
+/// eigenvalue inequality, max_e omega_e bounds the assembled system's highest frequency
+/// (lumped mass) from above, so it is a safe measure of how small a timestep an element
+/// wants.
 Eigen::VectorXd elementMaxFrequencies(const TetMesh& mesh);
 
 struct RegionProposalOptions {

@@ -123,7 +123,7 @@ class Schroeder2011 final : public PartitionedIntegrator {
   void checkSubsteps(double largeTimestep) const;
   /// An interface element's tangent at u: the model's element tangent, or the mesh's
   /// linear FEM element stiffness for a linear model without one.
-  void interfaceTangent(const Eigen::VectorXd& u, int element, Eigen::Matrix<double, 12, 12>& tangent) const;
+  void interfaceTangent(const Eigen::VectorXd& u, int element, Eigen::MatrixXd& tangent) const;
   void substeps(int region, double t0, Eigen::VectorXd& boundaryImpulse);
   Eigen::VectorXd coupledRightHandSide(double t1, const Eigen::VectorXd& boundaryImpulse);
   Schroeder2011Options options_;

@@ -52,6 +52,17 @@ class ForceModel {
     (void)tangent;
     return false;
   }
+  /// elementTangent() for meshes of either element kind: 12 x 12 on tetrahedra, 24 x 24 on
+  /// hexahedra (the DOFs of the element's vertices in connectivity order), with the same
+  /// meaning and return value. The default forwards to elementTangent(); models on
+  /// hexahedral meshes override it.
+  virtual bool elementTangentOfAnyKind(const Eigen::VectorXd& displacement, int element,
+                                       Eigen::MatrixXd& tangent) const {
+    Eigen::Matrix<double, 12, 12> fixed;
+    if (!elementTangent(displacement, element, fixed)) return false;
+    tangent = fixed;
+    return true;
+  }
 };
 
 }  // namespace asyncfem

@@ -29,6 +29,18 @@ class HexForceModel : public ForceModel {
   void forcesAndTangent(const Eigen::VectorXd& displacement, Eigen::VectorXd& forces,
                         Eigen::SparseMatrix<double>& stiffness) override;
   double elasticEnergy(const Eigen::VectorXd& displacement) override;
+  /// The 24 x 24 tangent of hexahedron e alone at displacement, as element() gives it (the
+  /// same entries the assembled tangent sums). Always available.
+  bool elementTangentOfAnyKind(const Eigen::VectorXd& displacement, int e, Eigen::MatrixXd& tangent) const override {
+    HexElementPositions rest, deformed;
+    for (int a = 0; a < 8; ++a) {
+      const int v = hexahedra_(a, e);
+      rest.col(a) = restPositions_.col(v);
+      deformed.col(a) = rest.col(a) + displacement.segment<3>(3 * static_cast<Eigen::Index>(v));
+    }
+    tangent = element(e, rest, deformed, true).tangent;
+    return true;
+  }
 
  protected:
   /// name: the model's class name, for messages.

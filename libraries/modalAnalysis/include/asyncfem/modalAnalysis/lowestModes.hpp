@@ -16,8 +16,9 @@ struct VibrationMatrices {
   Eigen::SparseMatrix<double> stiffness;  ///< linear FEM K (3n x 3n)
   Eigen::SparseMatrix<double> mass;       ///< M of the requested type (3n x 3n)
 };
-/// K and M of the mesh with its materials, on one assembler's pattern. For a corotational
-/// scene, K is its tangent at the rest shape (corotational FEM linearises to linear FEM there).
+/// K and M of the mesh with its materials, on one assembler's pattern (hexahedra: hexElements'
+/// assembly). For a corotational scene, K is its tangent at the rest shape (corotational FEM
+/// linearises to linear FEM there).
 VibrationMatrices vibrationMatrices(const TetMesh& mesh, MassType massType);
 
 /// Settings of lowestModes().

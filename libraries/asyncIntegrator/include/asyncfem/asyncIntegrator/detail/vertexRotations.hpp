@@ -12,7 +12,8 @@ namespace asyncfem::detail {
 
 /// For every vertex, the rotation R_v of the polar decomposition of the mean deformation
 /// gradient of its elements, measured from a reference state (not from rest): F_e = D_e
-/// D_e,ref^{-1} with D the element's edge matrix. A corotational or hyperelastic tangent
+/// D_e,ref^{-1} with D the element's edge matrix (on a hexahedron its three edges at vertex
+/// 0, exact for an affine motion such as a turn). A corotational or hyperelastic tangent
 /// that has only turned with the body since the reference satisfies K ~ R K_ref R^T, with R
 /// the block diagonal of the R_v, and so does the Schur system of the large step; rotate()
 /// applies R or R^T to a vector on a list of DOFs.
