@@ -44,7 +44,8 @@ TetMesh placedObjectMesh(const Scene& scene, std::size_t i, std::vector<std::str
   }
   Eigen::Matrix3Xd placed = mesh.restPositions();
   for (Eigen::Index v = 0; v < placed.cols(); ++v) placed.col(v) = object.placement.apply(placed.col(v));
-  TetMesh result(placed, mesh.elements(), mesh.materials(), mesh.elementMaterials());
+  TetMesh result = mesh.isHexahedral() ? TetMesh(placed, mesh.hexahedra(), mesh.materials(), mesh.elementMaterials())
+                                       : TetMesh(placed, mesh.elements(), mesh.materials(), mesh.elementMaterials());
   for (const auto& [name, members] : mesh.elementSets()) result.setElementSet(name, members);
   for (const auto& [name, members] : mesh.vertexSets()) result.setVertexSet(name, members);
   return result;
@@ -102,8 +103,19 @@ TetMesh buildObjectsMesh(const Scene& scene, std::vector<std::string>* warnings)
     vertices += parts.back().numVertices();
     elements += parts.back().numElements();
   }
+  // One mesh holds one element kind: every object tetrahedra, or every object hexahedra.
+  for (std::size_t i = 1; i < parts.size(); ++i) {
+    if (parts[i].elementKind() != parts.front().elementKind()) {
+      throwSceneError(scene, objectKey(i) + ".mesh",
+                      describeObject(scene, i) + " has " + elementKindPlural(parts[i].elementKind()) + " and " +
+                          describeObject(scene, 0) + " " + elementKindPlural(parts.front().elementKind()) +
+                          ": the objects of a scene share one element kind (meshInfo MESH --hex-to-tets --write "
+                          "OUT.veg converts hexahedra)");
+    }
+  }
+  const int corners = parts.empty() ? 4 : parts.front().verticesPerElement();
   Eigen::Matrix3Xd positions(3, vertices);
-  Eigen::Matrix4Xi connectivity(4, elements);
+  Eigen::MatrixXi connectivity(corners, elements);
   std::vector<Material> materials;
   std::vector<int> elementMaterials;
   int firstElement = 0;
@@ -111,7 +123,7 @@ TetMesh buildObjectsMesh(const Scene& scene, std::vector<std::string>* warnings)
     const TetMesh& part = parts[i];
     const std::string& name = scene.objects[i].name;
     positions.middleCols(firstVertex[i], part.numVertices()) = part.restPositions();
-    connectivity.middleCols(firstElement, part.numElements()) = part.elements().array() + firstVertex[i];
+    connectivity.middleCols(firstElement, part.numElements()) = part.connectivity().array() + firstVertex[i];
     const int firstMaterial = static_cast<int>(materials.size());
     for (Material material : part.materials()) {
       material.name = name + "/" + material.name;
@@ -120,7 +132,8 @@ TetMesh buildObjectsMesh(const Scene& scene, std::vector<std::string>* warnings)
     for (const int m : part.elementMaterials()) elementMaterials.push_back(firstMaterial + m);
     firstElement += part.numElements();
   }
-  TetMesh mesh(positions, connectivity, materials, elementMaterials);
+  TetMesh mesh = corners == 8 ? TetMesh(positions, HexElements(connectivity), materials, elementMaterials)
+                              : TetMesh(positions, Eigen::Matrix4Xi(connectivity), materials, elementMaterials);
   firstElement = 0;
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const TetMesh& part = parts[i];
