@@ -25,6 +25,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <asyncfem/core/stopwatch.hpp>
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/corotationalLinearFEM/corotationalLinearFEM.hpp>
 #include <asyncfem/hexElements/hexAssembly.hpp>
 #include <asyncfem/hexElements/hexCorotationalForceModel.hpp>
@@ -228,6 +229,7 @@ void printKernels(int cells, int repeats) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  preferPassiveThreadWaiting(argv);
   CLI::App app{
       "Hexahedra against the tetrahedra of the same cubes: cantilever convergence, run time against "
       "error at equal DOFs, element-kernel throughput (Markdown tables)."};
