@@ -6,6 +6,8 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <string>
 
 namespace asyncfem {
 
@@ -23,6 +25,20 @@ inline void preferPassiveThreadWaiting(char** argv) {
   ::setenv("OMP_WAIT_POLICY", "passive", 1);
   ::execv("/proc/self/exe", argv);
   // execv only returns on failure (no /proc): carry on with the default policy.
+}
+
+/// Whether fewer than `wanted` cores are free now besides the calling thread: the tasks
+/// the kernel counts as running or ready to run (/proc/loadavg's fourth field, "R/T",
+/// which counts the caller) against the online cores. An instant's reading, for choosing a
+/// thread count just before a large computation; false where /proc/loadavg is not there.
+inline bool coresAreBusy(int wanted) {
+  std::ifstream in("/proc/loadavg");
+  std::string one, five, fifteen, tasks;
+  if (!(in >> one >> five >> fifteen >> tasks)) return false;
+  const long running = std::strtol(tasks.c_str(), nullptr, 10);
+  const long cores = ::sysconf(_SC_NPROCESSORS_ONLN);
+  if (running < 1 || cores < 1) return false;
+  return cores - (running - 1) < wanted;
 }
 
 /// While alive, the BLAS runs each of its calls on at most `threads` threads of its own, then
@@ -48,6 +64,8 @@ class ScopedBlasThreads {
     hold(true);
   }
   ~ScopedBlasThreads() { hold(false); }
+  /// The BLAS's thread count before this guard (0 where the BLAS is not OpenBLAS).
+  int previousCount() const { return previous_; }
   ScopedBlasThreads(const ScopedBlasThreads&) = delete;
   ScopedBlasThreads& operator=(const ScopedBlasThreads&) = delete;
 
