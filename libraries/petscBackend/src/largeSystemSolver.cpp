@@ -395,8 +395,8 @@ VertexOwners assignVertexOwners(const TetMesh& mesh, const std::vector<int>& ele
   const int numVertices = mesh.numVertices();
   result.owner.assign(static_cast<std::size_t>(numVertices), ranks);
   for (int e = 0; e < mesh.numElements(); ++e) {
-    for (const int v : mesh.element(e)) {
-      int& o = result.owner[static_cast<std::size_t>(v)];
+    for (int a = 0; a < mesh.verticesPerElement(); ++a) {
+      int& o = result.owner[static_cast<std::size_t>(mesh.elementVertex(e, a))];
       o = std::min(o, elementParts[static_cast<std::size_t>(e)]);
     }
   }

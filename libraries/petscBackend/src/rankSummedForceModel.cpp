@@ -57,6 +57,10 @@ class RankSummedForceModel final : public ForceModel {
                       Eigen::Matrix<double, 12, 12>& tangent) const override {
     return whole_->elementTangent(displacement, element, tangent);
   }
+  bool elementTangentOfAnyKind(const Eigen::VectorXd& displacement, int element,
+                               Eigen::MatrixXd& tangent) const override {
+    return whole_->elementTangentOfAnyKind(displacement, element, tangent);
+  }
 
   // This rank's elements through the sub-mesh model, scattered into the whole mesh's
   // vector and pattern, then summed over the ranks.
