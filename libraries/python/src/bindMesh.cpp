@@ -82,9 +82,10 @@ std::vector<VtuArray> vtuArrays(const py::dict& arrays, int count, const char* w
   return result;
 }
 
-}  // namespace
+void bindMaterialsAndSets(py::class_<TetMesh>& mesh);
 
-void bindMesh(py::module_& module) {
+/// Material and TetMesh.
+void bindMeshClasses(py::module_& module) {
   py::class_<Material>(module, "Material", "Isotropic linear-elastic material (SI units by convention).")
       .def(py::init([](std::string name, double density, double youngsModulus, double poissonRatio) {
              return Material{std::move(name), density, youngsModulus, poissonRatio};
@@ -102,11 +103,11 @@ void bindMesh(py::module_& module) {
                ", poisson_ratio=" + py::repr(py::float_(m.poissonRatio)).cast<std::string>() + ")";
       });
 
-  py::class_<TetMesh>(
+  py::class_<TetMesh> mesh(
       module, "TetMesh",
       "Volumetric mesh of linear tetrahedra or trilinear hexahedra (one kind per mesh), with a material "
-      "per element and named vertex and element sets.")
-      .def(py::init(&makeMesh), py::arg("positions"), py::arg("elements"),
+      "per element and named vertex and element sets.");
+  mesh.def(py::init(&makeMesh), py::arg("positions"), py::arg("elements"),
            py::arg("materials") = std::vector<Material>{Material{}}, py::arg("element_materials") = py::none(),
            "positions: (n, 3) float64 rest positions; elements: (m, 4) integer vertex ids of tetrahedra, or (m, 8) of "
            "hexahedra in Vega's CUBIC order (bottom face counter-clockwise seen from above, then the top face); "
@@ -150,8 +151,13 @@ void bindMesh(py::module_& module) {
             checkElement(mesh, e);
             return Eigen::Matrix<double, 3, 4>(mesh.elementRestPositions(e));
           },
-          py::arg("element"), "3 x 4: the rest positions of the element's vertices as columns")
-      .def_property_readonly("materials", &TetMesh::materials)
+          py::arg("element"), "3 x 4: the rest positions of the element's vertices as columns");
+  bindMaterialsAndSets(mesh);
+}
+
+/// TetMesh's materials, vertex and element sets.
+void bindMaterialsAndSets(py::class_<TetMesh>& mesh) {
+  mesh.def_property_readonly("materials", &TetMesh::materials)
       .def_property_readonly("element_materials", [](const TetMesh& mesh) { return intArray(mesh.elementMaterials()); })
       .def(
           "element_material",
@@ -201,6 +207,12 @@ void bindMesh(py::module_& module) {
       });
 
   // Readers.
+}
+
+void bindMeshWriters(py::module_& module);
+
+/// Readers, writers and their options and reports.
+void bindMeshFiles(py::module_& module) {
   py::class_<MeshReadOptions>(
       module, "MeshReadOptions",
       "Options of the mesh readers: default material, reorientation of inverted elements, degenerate volume tolerance")
@@ -243,6 +255,11 @@ void bindMesh(py::module_& module) {
   addReader("read_veg", &readVeg, "Reads a Vega .veg file.");
   addReader("read_tetgen", &readTetGen, "Reads a TetGen .node/.ele pair.");
   addReader("read_gmsh", &readGmsh, "Reads a Gmsh .msh (ASCII 2.2 or 4.1) file.");
+  bindMeshWriters(module);
+}
+
+/// .bou reading, .veg and .vtu writing, .vtu series.
+void bindMeshWriters(py::module_& module) {
   module.def(
       "read_bou",
       [](const std::filesystem::path& path, int numVertices) { return intArray(readBou(path, numVertices)); },
@@ -300,6 +317,10 @@ void bindMesh(py::module_& module) {
                   "the file name of frame k (frame_NNNNN.vtu)");
 
   // Generators.
+}
+
+/// The mesh generators and their settings.
+void bindMeshGenerators(py::module_& module) {
   py::class_<BoxRegion>(module, "BoxRegion", "A box of a generated mesh whose elements get their own material and set")
       .def(py::init([](std::string name, const Eigen::Vector3d& min, const Eigen::Vector3d& max, Material material) {
              return BoxRegion{std::move(name), min, max, std::move(material)};
@@ -377,6 +398,10 @@ void bindMesh(py::module_& module) {
              "the snail mesh (models/snail): a heavy shell with light eye tentacles");
 
   // Queries.
+}
+
+/// Queries of a mesh: volumes, masses, boundary, bounding box, quality.
+void bindMeshQueries(py::module_& module) {
   module.def(
       "signed_element_volume",
       [](const TetMesh& mesh, int e) {
@@ -453,6 +478,15 @@ void bindMesh(py::module_& module) {
   module.def(
       "unused_vertices", [](const TetMesh& mesh) { return intArray(unusedVertices(mesh)); }, py::arg("mesh"),
       "ids of the vertices no element uses");
+}
+
+}  // namespace
+
+void bindMesh(py::module_& module) {
+  bindMeshClasses(module);
+  bindMeshFiles(module);
+  bindMeshGenerators(module);
+  bindMeshQueries(module);
 }
 
 }  // namespace asyncfem::python
