@@ -98,4 +98,19 @@ Eigen::Matrix<double, 24, 24> hexLumpedMass(const HexElementPositions& restPosit
   return m;
 }
 
+HexGaussPoints hexGaussPoints(const HexElementPositions& restPositions) {
+  HexGaussPoints points;
+  for (int g = 0; g < 8; ++g) {
+    double volume = 0.0;
+    points.gradients[static_cast<std::size_t>(g)] =
+        hexShapeGradients(restPositions, hexahedron::gaussPoint(g), &volume);
+    if (!(volume > 0.0)) {
+      throw ValidationError("det J = " + std::to_string(volume) + " at Gauss point " + std::to_string(g) +
+                            " of the rest shape: the hexahedron is inverted or degenerate");
+    }
+    points.volumes[static_cast<std::size_t>(g)] = volume;
+  }
+  return points;
+}
+
 }  // namespace asyncfem

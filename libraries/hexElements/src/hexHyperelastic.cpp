@@ -24,21 +24,6 @@ void addGaussPointTangent(const Eigen::Matrix<double, 9, 9>& stressDerivative,
 
 }  // namespace
 
-HexGaussPoints hexGaussPoints(const HexElementPositions& restPositions) {
-  HexGaussPoints points;
-  for (int g = 0; g < 8; ++g) {
-    double volume = 0.0;
-    points.gradients[static_cast<std::size_t>(g)] =
-        hexShapeGradients(restPositions, hexahedron::gaussPoint(g), &volume);
-    if (!(volume > 0.0)) {
-      throw ValidationError("det J = " + std::to_string(volume) + " at Gauss point " + std::to_string(g) +
-                            " of the rest shape: the hexahedron is inverted or degenerate");
-    }
-    points.volumes[static_cast<std::size_t>(g)] = volume;
-  }
-  return points;
-}
-
 HexElementEnergy hexIsotropicHyperelastic(const HexGaussPoints& rest, const HexElementPositions& deformedPositions,
                                           const IsotropicMaterialPoint& material, bool withTangent) {
   HexElementEnergy out;

@@ -10,19 +10,20 @@ namespace asyncfem {
 
 HexStvkElement hexStvk(const HexElementPositions& restPositions, const HexElementPositions& deformedPositions,
                        double youngsModulus, double poissonRatio, bool withTangent) {
-  const Eigen::Vector2d lame = lameParameters(youngsModulus, poissonRatio);
+  return hexStvk(hexGaussPoints(restPositions), deformedPositions, lameParameters(youngsModulus, poissonRatio),
+                 withTangent);
+}
+
+HexStvkElement hexStvk(const HexGaussPoints& rest, const HexElementPositions& deformedPositions,
+                       const Eigen::Vector2d& lame, bool withTangent) {
   const double lambda = lame[0];
   const double mu = lame[1];
   HexStvkElement out;
   out.force.setZero();
   if (withTangent) out.tangent.setZero();
-  for (int g = 0; g < 8; ++g) {
-    double volume = 0.0;  // det J of the rest shape: the Gauss weight (1) times the volume ratio
-    const Eigen::Matrix<double, 3, 8> gradients = hexShapeGradients(restPositions, hexahedron::gaussPoint(g), &volume);
-    if (!(volume > 0.0)) {
-      throw ValidationError("hexStvk: det J = " + std::to_string(volume) + " at Gauss point " + std::to_string(g) +
-                            " of the rest shape: the hexahedron is inverted or degenerate");
-    }
+  for (std::size_t g = 0; g < 8; ++g) {
+    const double volume = rest.volumes[g];  // det J of the rest shape: the Gauss weight (1) times the volume ratio
+    const Eigen::Matrix<double, 3, 8>& gradients = rest.gradients[g];
     const Eigen::Matrix3d f = deformedPositions * gradients.transpose();
     const Eigen::Matrix3d green = 0.5 * (f.transpose() * f - Eigen::Matrix3d::Identity());
     const double trace = green.trace();

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 
 namespace asyncfem {
 
@@ -46,5 +47,17 @@ Eigen::Matrix<double, 24, 24> hexConsistentMass(const HexElementPositions& restP
 /// Row-sum lumped mass: rho int N_a dV on each diagonal entry of vertex a (rho V / 8 for
 /// a parallelepiped), zero elsewhere.
 Eigen::Matrix<double, 24, 24> hexLumpedMass(const HexElementPositions& restPositions, double density);
+
+/// The rest shape of a hexahedron at its 2 x 2 x 2 Gauss points (hexahedron::gaussPoint,
+/// weights 1): shape-function gradients dN/dX (3 x 8 per point) and det J (volume per
+/// reference volume, the point's weight in the integrals).
+struct HexGaussPoints {
+  std::array<Eigen::Matrix<double, 3, 8>, 8> gradients;
+  std::array<double, 8> volumes{};
+};
+
+/// Throws ValidationError when det J <= 0 at a Gauss point of restPositions (inverted or
+/// degenerate rest shape), as hexLinearStiffness.
+HexGaussPoints hexGaussPoints(const HexElementPositions& restPositions);
 
 }  // namespace asyncfem

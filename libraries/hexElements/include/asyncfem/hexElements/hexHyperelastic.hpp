@@ -8,18 +8,6 @@
 
 namespace asyncfem {
 
-/// The rest shape of a hexahedron at its 2 x 2 x 2 Gauss points (hexahedron::gaussPoint,
-/// weights 1): shape-function gradients dN/dX (3 x 8 per point) and det J (volume per
-/// reference volume, the point's weight in the integrals).
-struct HexGaussPoints {
-  std::array<Eigen::Matrix<double, 3, 8>, 8> gradients;
-  std::array<double, 8> volumes{};
-};
-
-/// Throws ValidationError when det J <= 0 at a Gauss point of restPositions (inverted or
-/// degenerate rest shape), as hexLinearStiffness.
-HexGaussPoints hexGaussPoints(const HexElementPositions& restPositions);
-
 /// An isotropic hyperelastic material (IsotropicMaterialPoint: StVK, neo-Hookean or
 /// Mooney-Rivlin, with its inversion handling) on the trilinear hexahedron, by 2 x 2 x 2
 /// Gauss integration of the deformation gradient F_g = x dN/dX at each point:

@@ -19,5 +19,9 @@ using HexStvkElement = HexElementEnergy;
 /// det J <= 0 at a Gauss point. withTangent = false leaves tangent unset.
 HexStvkElement hexStvk(const HexElementPositions& restPositions, const HexElementPositions& deformedPositions,
                        double youngsModulus, double poissonRatio, bool withTangent = true);
+/// The same from the rest shape's Gauss-point data (hexGaussPoints, computed once per
+/// element by HexStvkForceModel) and the Lame parameters (lambda, mu).
+HexStvkElement hexStvk(const HexGaussPoints& rest, const HexElementPositions& deformedPositions,
+                       const Eigen::Vector2d& lame, bool withTangent = true);
 
 }  // namespace asyncfem

@@ -14,7 +14,8 @@ namespace asyncfem {
 ///
 /// No inversion handling (StVK's energy softens under strong compression, as Vega's
 /// StVKForceModel). Throws ValidationError on a tetrahedral mesh and, naming the element,
-/// for a rest shape with det J <= 0 at a Gauss point.
+/// for a rest shape with det J <= 0 at a Gauss point. Keeps each element's rest Gauss-point
+/// data (hexGaussPoints, 1.6 kB per element), so that an evaluation does not recompute them.
 class HexStvkForceModel : public HexForceModel {
  public:
   explicit HexStvkForceModel(const TetMesh& mesh);
@@ -25,7 +26,8 @@ class HexStvkForceModel : public HexForceModel {
                            bool withTangent) const override;
 
  private:
-  std::vector<Eigen::Vector2d> youngAndPoisson_;  ///< per element
+  std::vector<Eigen::Vector2d> lame_;        ///< per element: (lambda, mu)
+  std::vector<HexGaussPoints> gaussPoints_;  ///< per element: the rest shape at the Gauss points
 };
 
 }  // namespace asyncfem
