@@ -5,7 +5,6 @@
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/hexElements/hexElementMatrices.hpp>
 #include <asyncfem/petscBackend/partition.hpp>
-#include <asyncfem/volumetricMesh/hexahedron.hpp>
 #include <climits>
 #include <cmath>
 #include <sstream>
@@ -46,18 +45,14 @@ ElementData elementData(const TetMesh& mesh, int e) {
 /// density; ValidationError naming the element and the Gauss point where det J <= 0.
 ElementData hexElementData(const TetMesh& mesh, int e, HexElementPositions& rest) {
   rest = mesh.hexahedronRestPositions(e);
-  ElementData data;
-  for (int g = 0; g < 8; ++g) {
-    double jacobian = 0.0;
-    hexShapeGradients(rest, hexahedron::gaussPoint(g), &jacobian);
-    if (!(jacobian > 0.0)) {
-      std::ostringstream message;
-      message << "PETSc backend: hexahedron " << e << " has det J = " << jacobian << " at Gauss point " << g
-              << " (inverted or degenerate)";
-      throw ValidationError(message.str());
-    }
-    data.volume += jacobian;  // Gauss weight 1
+  HexGaussPoints points;
+  try {
+    points = hexGaussPoints(rest);
+  } catch (const ValidationError& error) {
+    throw ValidationError("PETSc backend: hexahedron " + std::to_string(e) + " has " + error.what());
   }
+  ElementData data;
+  for (const double volume : points.volumes) data.volume += volume;  // Gauss weights 1
   data.density = mesh.elementMaterial(e).density;
   return data;
 }
