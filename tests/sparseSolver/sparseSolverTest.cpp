@@ -10,11 +10,13 @@
 #include <vector>
 
 #include "../common/gaussianMatrix.hpp"
+#include "gridLaplacian.hpp"
 
 namespace asyncfem {
 namespace {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
+using test::gridLaplacian;
 
 // Relative residual tolerance. A backward-stable factorization gives
 // ||A x - b|| / ||b|| <= g * cond(A) * eps with a modest growth factor g. The test
@@ -22,30 +24,6 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 // [shift, 12 + shift]) or cond_inf(A) <= 79 (the unsymmetric ones, strictly diagonally
 // dominant with margin 0.2), so cond * eps <= 3e-14; 1e-10 leaves room for g up to 3000.
 constexpr double kResidualTolerance = 1e-10;
-
-/// 3D grid Laplacian (7-point stencil, Dirichlet boundary) plus shift * I: SPD, n = k^3,
-/// eigenvalues in (shift, 12 + shift).
-SparseMatrix gridLaplacian(int k, double shift) {
-  const int n = k * k * k;
-  std::vector<Eigen::Triplet<double>> triplets;
-  auto id = [k](int i, int j, int l) { return i + k * (j + k * l); };
-  for (int l = 0; l < k; ++l)
-    for (int j = 0; j < k; ++j)
-      for (int i = 0; i < k; ++i) {
-        const int row = id(i, j, l);
-        triplets.emplace_back(row, row, 6.0 + shift);
-        if (i > 0) triplets.emplace_back(row, id(i - 1, j, l), -1.0);
-        if (i + 1 < k) triplets.emplace_back(row, id(i + 1, j, l), -1.0);
-        if (j > 0) triplets.emplace_back(row, id(i, j - 1, l), -1.0);
-        if (j + 1 < k) triplets.emplace_back(row, id(i, j + 1, l), -1.0);
-        if (l > 0) triplets.emplace_back(row, id(i, j, l - 1), -1.0);
-        if (l + 1 < k) triplets.emplace_back(row, id(i, j, l + 1), -1.0);
-      }
-  SparseMatrix a(n, n);
-  a.setFromTriplets(triplets.begin(), triplets.end());
-  a.makeCompressed();
-  return a;
-}
 
 /// Structurally symmetric, numerically unsymmetric: the Laplacian with shift 2 (diagonal
 /// 8) and each off-diagonal -1 perturbed by U(-0.3, 0.3), so every row is strictly

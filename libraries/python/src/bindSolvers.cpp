@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // libraries/sparseSolver: CHOLMOD, UMFPACK and Eigen factorizations behind one interface.
 
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/sparseSolver/sparseSolver.hpp>
 #include <bindings.hpp>
 
@@ -45,6 +46,10 @@ void bindSolvers(py::module_& module) {
       .value("eigen_ldlt", SolverKind::eigenLDLT)
       .value("eigen_lu", SolverKind::eigenLU)
       .value("dense", SolverKind::dense);
+  module.def(
+      "blas_threads", [] { return ScopedBlasThreads::currentCount(); },
+      "OpenBLAS's thread count as the solvers' guard reads it (the factorizations hold it to one thread, so that "
+      "results do not depend on it); 0 where the process has no OpenBLAS");
   module.def("parse_solver_kind", &parseSolverKind, py::arg("name"),
              "'cholmod', 'umfpack', 'eigen-ldlt', 'eigen-lu', 'dense' -> SolverKind");
   module.def(

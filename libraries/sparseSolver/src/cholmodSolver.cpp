@@ -118,12 +118,12 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     // on the beam scene's corotational async step (2 cores): 17.0 ms to 13.9 ms.
     const int dynamic = omp_get_dynamic();
     omp_set_dynamic(1);
-    // CHOLMOD's BLAS calls (dpotrf among them, whose values depend on the thread count) on
-    // one thread, as SupernodalCholesky's dpotrf: the factor then does not depend on the
-    // machine's load, and beside other work OpenBLAS's threads no longer wait on each other
-    // (a 45k-DOF factorization: 30 s instead of 0.7 s beside two busy processes on 2 cores;
-    // idle, two threads gained 1.3x).
-    const ScopedBlasThreads blas(1);
+    // CHOLMOD's BLAS calls (dpotrf and dgemm among them, whose values depend on the thread
+    // count) on factorBlasThreads(), 1 unless the user sets more: the factor then does not
+    // depend on the machine's load, and beside other work OpenBLAS's threads do not wait on
+    // each other (a 45k-DOF factorization: 30 s instead of 0.7 s beside two busy processes
+    // on 2 cores; idle, two threads gained 1.3x).
+    const ScopedBlasThreads blas(factorBlasThreads());
     const int ok = cholmod_factorize(&view, factor_, common_.get());
     omp_set_dynamic(dynamic);
     if (!ok || common_->status < CHOLMOD_OK) {
@@ -172,12 +172,10 @@ class CholmodSolver final : public SolverBase, public SupernodalFactorSource {
     b.x = const_cast<double*>(bData);
     b.xtype = CHOLMOD_REAL;
     b.dtype = CHOLMOD_DOUBLE;
-    // One call for all k columns; solve2 keeps X and its workspace between calls.
-    // The BLAS's own threads only where the cores are free: beside other work they wait on
-    // each other (as in SupernodalCholesky::factor); the substitutions' values do not depend
-    // on their count.
-    ScopedBlasThreads blas(1);
-    blas.hold(coresAreBusy(blas.previousCount()));
+    // One call for all k columns; solve2 keeps X and its workspace between calls. The
+    // BLAS on factorBlasThreads(), as in the factorization: dgemm's and dgemv's bits depend
+    // on the thread count.
+    const ScopedBlasThreads blas(factorBlasThreads());
     if (!cholmod_solve2(CHOLMOD_A, factor_, &b, nullptr, &x_, nullptr, &y_, &e_, common_.get()) ||
         common_->status < CHOLMOD_OK) {
       throw NumericalError("cholmod: solve failed (CHOLMOD status " + std::to_string(common_->status) + ")");

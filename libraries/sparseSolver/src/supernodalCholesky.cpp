@@ -81,14 +81,12 @@ bool SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& a, double* va
   // Small supernodes on one BLAS thread: a call that wakes the BLAS's own threads pays a
   // futex wake-up and leaves them spinning (sched_yield) for a while on cores the caller's
   // OpenMP threads want (bridge-sized corotational step at two threads, kThreadedBlasWork).
+  // Large ones on factorBlasThreads() (1 unless the user sets more): a count that followed
+  // the machine's load would change the factor's last bits with it, and beside other work
+  // OpenBLAS's threads wait on each other (a 27k-DOF factorization took 6.6 s instead of
+  // 0.37 s beside a two-job build on 2 cores).
   ScopedBlasThreads blas(1);
-  // Large supernodes too when other work holds the cores: OpenBLAS's threads then wait on
-  // each other behind it (a 27k-DOF factorization took 6.6 s instead of 0.37 s on one
-  // thread beside a two-job build on 2 cores; idle, two threads gain 1.3x). dtrsm and dsyrk
-  // give the same bits on any thread count, dpotrf does not (sparseSolverTests,
-  // BlasResults.*), so dpotrf always runs on one thread and the factor does not depend on
-  // the machine's load.
-  const bool busy = coresAreBusy(blas.previousCount());
+  const int large = factorBlasThreads();
   std::fill(values, values + valueCount, 0.0);
   const double* entries = a.valuePtr();
   for (std::size_t k = 0; k < target_.size(); ++k) {
@@ -101,12 +99,11 @@ bool SupernodalCholesky::factor(const Eigen::SparseMatrix<double>& a, double* va
     const int rows = f.pi[s + 1] - f.pi[s];
     const int below = rows - columns;
     double* block = values + f.px[s];
-    blas.hold(true);
+    blas.allow(static_cast<double>(rows) * rows * columns < kThreadedBlasWork ? 1 : large);
     int info = 0;
     dpotrf_("L", &columns, block, &rows, &info);  // L11 L11^T of the diagonal block, in place
     if (info != 0) return false;
     if (below == 0) continue;
-    blas.hold(busy || static_cast<double>(rows) * rows * columns < kThreadedBlasWork);
     // L21 = A21 L11^-T, then the ancestors lose L21 L21^T (lower triangle into update_).
     dtrsm_("R", "L", "T", "N", &below, &columns, &one, block, &rows, block + columns, &rows);
     dsyrk_("L", "N", &below, &columns, &one, block + columns, &rows, &zero, update_.get(), &below);

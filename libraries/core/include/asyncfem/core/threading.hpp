@@ -2,11 +2,13 @@
 #pragma once
 
 #include <dlfcn.h>
+#include <link.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <asyncfem/core/error.hpp>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <string>
 
 namespace asyncfem {
@@ -27,18 +29,26 @@ inline void preferPassiveThreadWaiting(char** argv) {
   // execv only returns on failure (no /proc): carry on with the default policy.
 }
 
-/// Whether fewer than `wanted` cores are free now besides the calling thread: the tasks
-/// the kernel counts as running or ready to run (/proc/loadavg's fourth field, "R/T",
-/// which counts the caller) against the online cores. An instant's reading, for choosing a
-/// thread count just before a large computation; false where /proc/loadavg is not there.
-inline bool coresAreBusy(int wanted) {
-  std::ifstream in("/proc/loadavg");
-  std::string one, five, fifteen, tasks;
-  if (!(in >> one >> five >> fifteen >> tasks)) return false;
-  const long running = std::strtol(tasks.c_str(), nullptr, 10);
-  const long cores = ::sysconf(_SC_NPROCESSORS_ONLN);
-  if (running < 1 || cores < 1) return false;
-  return cores - (running - 1) < wanted;
+/// The thread count the sparse factorizations and solves give the BLAS: the environment
+/// variable ASYNCFEM_BLAS_THREADS (a positive integer), 1 where it is unset. A setting, not a
+/// reading of the machine, for two reasons. The last bits of a factor depend on the BLAS's
+/// thread count (OpenBLAS's dpotrf and dgemm split their sums between threads: 7e-15 and
+/// 1.4e-14 apart on 2 cores, sparseSolverTests BlasResults.*), so a count that followed the
+/// load would make a run's trajectory, and a resumed run, depend on what else the machine
+/// was doing. And beside other work OpenBLAS's threads wait on each other (a 45k-DOF
+/// factorization took 30 s instead of 0.7 s beside two busy processes on 2 cores). One
+/// thread costs an idle machine's largest factorizations up to 1.3x on 2 cores; a user who
+/// owns the cores can give more (and gets trajectories that depend on that number only).
+/// Throws asyncfem::Error naming the variable for a value that is not a positive integer.
+inline int factorBlasThreads() {
+  const char* text = std::getenv("ASYNCFEM_BLAS_THREADS");
+  if (text == nullptr || text[0] == '\0') return 1;
+  char* end = nullptr;
+  const long value = std::strtol(text, &end, 10);
+  if (*end != '\0' || value < 1 || value > 4096) {
+    throw Error(std::string("ASYNCFEM_BLAS_THREADS: expected a positive integer (at most 4096), got \"") + text + "\"");
+  }
+  return static_cast<int>(value);
 }
 
 /// While alive, the BLAS runs each of its calls on at most `threads` threads of its own, then
@@ -66,9 +76,24 @@ class ScopedBlasThreads {
   ~ScopedBlasThreads() { hold(false); }
   /// The BLAS's thread count before this guard (0 where the BLAS is not OpenBLAS).
   int previousCount() const { return previous_; }
+  /// The BLAS's thread count now, as a guard finds it: 0 where the process has no OpenBLAS
+  /// or the guard cannot reach it (then guards change nothing).
+  static int currentCount() {
+    int (*get)() = nullptr;
+    symbol("openblas_get_num_threads", get);
+    return get != nullptr ? get() : 0;
+  }
   ScopedBlasThreads(const ScopedBlasThreads&) = delete;
   ScopedBlasThreads& operator=(const ScopedBlasThreads&) = delete;
 
+  /// The BLAS runs on min(threads, previous count) threads (at least 1) until the next
+  /// allow() or hold(); the destructor gives the previous count back.
+  void allow(int threads) {
+    if (set_ == nullptr) return;
+    const int count = std::max(1, std::min(threads, previous_));
+    set_(count);
+    held_ = count < previous_;
+  }
   /// true: the BLAS runs on at most the constructor's count (as after construction);
   /// false: on its previous count again, until the next hold(true). For a sequence of calls
   /// of which only the largest gain from the BLAS's threads (a supernodal factorization).
@@ -83,9 +108,33 @@ class ScopedBlasThreads {
   // pointer, which ISO C++ does not convert to a function pointer directly).
   template <class Function>
   static void symbol(const char* name, Function& function) {
-    void* address = ::dlsym(RTLD_DEFAULT, name);
+    void* address = loadedSymbol(name);
     function = nullptr;
     if (address != nullptr) std::memcpy(&function, &address, sizeof(function));
+  }
+  // The global scope first (a program linked with the BLAS); then every loaded object by
+  // name, since a library loaded into a local scope is not in the global one: the Python
+  // module and its BLAS, loaded with RTLD_LOCAL, where a global lookup found no OpenBLAS and
+  // the guard did nothing, so that a run from Python factored on another thread count than
+  // the same run of offlineSimulator and their results differed in the last bits.
+  static void* loadedSymbol(const char* name) {
+    if (void* address = ::dlsym(RTLD_DEFAULT, name)) return address;
+    struct Search {
+      const char* name;
+      void* address;
+    } search{name, nullptr};
+    ::dl_iterate_phdr(
+        [](dl_phdr_info* info, std::size_t, void* data) -> int {
+          auto* s = static_cast<Search*>(data);
+          if (info->dlpi_name == nullptr || info->dlpi_name[0] == '\0') return 0;
+          void* handle = ::dlopen(info->dlpi_name, RTLD_LAZY | RTLD_NOLOAD);  // no new load, a reference
+          if (handle == nullptr) return 0;
+          s->address = ::dlsym(handle, s->name);
+          ::dlclose(handle);  // the object stays: it was loaded before this reference
+          return s->address != nullptr ? 1 : 0;
+        },
+        &search);
+    return search.address;
   }
 
   void (*set_)(int) = nullptr;
