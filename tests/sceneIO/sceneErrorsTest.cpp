@@ -186,7 +186,7 @@ const ErrorCase cases[] = {
      "scene.json: output.velocities: expected true or false"},
     {"OutputRegionsNotBool", R"({"output": {"regions": "yes"}})", "scene.json: output.regions: expected true or false"},
     {"OutputRegionsMisspelt", R"({"output": {"region": true}})",
-     "scene.json: output.region: unknown key (known here: file, vtu, velocities, sync, regions)"},
+     "scene.json: output.region: unknown key (known here: file, vtu, velocities, contactForces, sync, regions)"},
     {"OutputRegionsSingleRate", R"({"output": {"regions": true}})",
      "scene.json: output.regions: records the fast regions of a multirate integrator, but \"backward-euler\" is "
      "single-rate (use \"async\" with regions, or leave output.regions out)",

@@ -322,7 +322,7 @@ TEST_F(SimulationFileTest, AbsurdHeaderFailsFast) {
   EXPECT_NE(errorOf(path).find("record size"), std::string::npos);
 
   bytes = good;
-  patchHeader(bytes, 40, 6, 8, true);  // unknown flags
+  patchHeader(bytes, 40, 8, 8, true);  // unknown flags (bit 3; bits 0 to 2 are known)
   writeBytes(path, bytes);
   EXPECT_NE(errorOf(path).find("unknown flags"), std::string::npos);
 
@@ -542,6 +542,16 @@ TEST_F(SimulationFileTest, ReaderRefusesARecordSizeThatIgnoresTheFlag) {
       << errorOf(path);
 }
 
+// The error continuing path's first frame under header gives ("" when it continues).
+std::string continueRefusal(const fs::path& path, const SimulationFileHeader& header) {
+  try {
+    SimulationWriter::continueFile(path, header, 1, {});
+  } catch (const asyncfem::Error& error) {
+    return error.what();
+  }
+  return "";
+}
+
 TEST_F(SimulationFileTest, ContinuingKeepsTheRecordSizeAndRefusesAnotherFlag) {
   const fs::path path = file("continue.afsim");
   writeThreeFrames(path);
@@ -556,17 +566,64 @@ TEST_F(SimulationFileTest, ContinuingKeepsTheRecordSizeAndRefusesAnotherFlag) {
   EXPECT_EQ(reader.readFrame(2).regionRatios[3], 8);  // ratiosOf(5, 8): vertex 8 % 5 fast
   SimulationFileHeader without = ratioHeader(5, false);
   without.hasRegionRatios = false;
-  try {
-    SimulationWriter::continueFile(path, without, 1, {});
-    ADD_FAILURE() << "a run without region ratios continued a file with them";
-  } catch (const asyncfem::Error& error) {
-    EXPECT_NE(std::string(error.what())
-                  .find("continue.afsim: cannot continue it: its header differs from this run's: its records carry "
-                        "region ratios (header flag bit 1) but this run's do not (output.regions)"),
-              std::string::npos)
-        << error.what();
-  }
+  const std::string refusal = continueRefusal(path, without);
+  EXPECT_NE(refusal.find("continue.afsim: cannot continue it: its header differs from this run's: its records carry "
+                         "region ratios (header flag bit 1) but this run's do not (output.regions)"),
+            std::string::npos)
+      << refusal;
   EXPECT_EQ(SimulationReader(path).numFrames(), 3);  // untouched
+}
+
+// Records with contact forces (header flag bit 2): 3n doubles after the velocities and
+// before the region ratios, each array stored bit for bit.
+TEST_F(SimulationFileTest, ContactForcesRoundTripBetweenTheVelocitiesAndTheRatios) {
+  const fs::path path = file("forces.afsim");
+  const int n = 5;
+  SimulationFileHeader header = ratioHeader(n, true);
+  header.hasContactForces = true;
+  {
+    SimulationWriter writer(path, header);
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::VectorXd u = valuesOf(n, k), v = valuesOf(n, k + 7), f = -valuesOf(n, k + 3);
+      const std::vector<int> ratios = ratiosOf(n, k);
+      writer.appendFrame(0.1 * (k + 1), u, asyncfem::FrameArrays{&v, &f, &ratios});
+    }
+    // Arrays that the header does not announce, or that it does and are missing, are refused.
+    const Eigen::VectorXd u = valuesOf(n, 2), v = valuesOf(n, 9);
+    const std::vector<int> ratios = ratiosOf(n, 2);
+    EXPECT_THROW(writer.appendFrame(0.3, u, v, ratios), asyncfem::Error);
+    const Eigen::VectorXd shortForce = Eigen::VectorXd::Zero(3 * n - 1);
+    EXPECT_THROW(writer.appendFrame(0.3, u, asyncfem::FrameArrays{&v, &shortForce, &ratios}), asyncfem::Error);
+    Eigen::VectorXd notFinite = valuesOf(n, 2);
+    notFinite[4] = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THROW(writer.appendFrame(0.3, u, asyncfem::FrameArrays{&v, &notFinite, &ratios}), asyncfem::Error);
+    EXPECT_EQ(writer.numFrames(), 2);
+  }
+  // 16 + 3 arrays of 24n + the ratios (10 bytes padded to 16) + 8.
+  EXPECT_EQ(header.recordBytes(), 16 + 72 * n + 16 + 8);
+  EXPECT_EQ(static_cast<std::int64_t>(fs::file_size(path)), 64 + 2 * header.recordBytes());
+  EXPECT_EQ(readBytes(path)[40], 7);  // flags: velocities, ratios, contact forces
+  SimulationReader reader(path);
+  EXPECT_TRUE(reader.header().hasContactForces);
+  for (int k = 0; k < 2; ++k) {
+    const asyncfem::SimulationFrame frame = reader.readFrame(k);
+    EXPECT_EQ(frame.displacement, valuesOf(n, k));
+    EXPECT_EQ(frame.velocity, valuesOf(n, k + 7));
+    EXPECT_EQ(frame.contactForce, -valuesOf(n, k + 3));
+    EXPECT_EQ(frame.regionRatios[static_cast<std::size_t>(k)], 8);
+  }
+  // A run that would not store them cannot continue the file: the flag is named.
+  SimulationFileHeader without = header;
+  without.hasContactForces = false;
+  const std::string refusal = continueRefusal(path, without);
+  EXPECT_NE(refusal.find("its records carry contact forces (header flag bit 2) but this run's do not "
+                         "(output.contactForces)"),
+            std::string::npos)
+      << refusal;
+  // A file without the flag reads no forces.
+  const fs::path plain = file("plain-forces.afsim");
+  { SimulationWriter(plain, ratioHeader(n, false)).appendFrame(0.1, valuesOf(n, 0), ratiosOf(n, 0)); }
+  EXPECT_TRUE(SimulationReader(plain).readFrame(0).contactForce.size() == 0);
 }
 
 }  // namespace

@@ -277,6 +277,38 @@ TEST_F(OfflineSimulatorTest, VelocitiesOnlyWhenRequested) {
   EXPECT_EQ(reader.readFrame(0).velocity.size(), 48);
 }
 
+// output.contactForces: each record and each .vtu carries every vertex's contact force
+// (the ground 1 mm above the box's bottom face pushes it up from the first step); a run
+// stopped and resumed writes the same bytes, and a resume without the key is refused by it.
+TEST_F(OfflineSimulatorTest, ContactForcesGoIntoTheRecordsAndTheVtuFrames) {
+  auto json = smallScene();
+  json["contact"] = {{"ground", {{"height", 0.001}}}, {"stiffness", 1e4}};
+  json["output"]["contactForces"] = true;
+  json["output"]["vtu"] = {{"folder", "vtu"}, {"encoding", "ascii"}};
+  const fs::path scene = writeScene(json);
+  const RunResult r = run(quoted(scene) + " --quiet");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  asyncfem::SimulationReader reader(folder_ / "out/run.afsim");
+  EXPECT_TRUE(reader.header().hasContactForces);
+  const asyncfem::SimulationFrame frame = reader.readFrame(0);
+  ASSERT_EQ(frame.contactForce.size(), 48);
+  double up = 0.0;
+  for (int v = 0; v < 16; ++v) up += frame.contactForce[(3 * v) + 1];
+  EXPECT_GT(up, 0.0);  // the ground pushes up
+  EXPECT_NE(readText(folder_ / "vtu/frame_00000.vtu").find("Name=\"contactForce\" NumberOfComponents=\"3\""),
+            std::string::npos);
+  // Stopped after 3 frames and resumed: the same bytes as the uninterrupted run.
+  const fs::path output = folder_ / "out/run.afsim";
+  ASSERT_EQ(run(quoted(scene) + " --quiet --frames 3").exitCode, 0);
+  ASSERT_EQ(run(quoted(scene) + " --quiet --resume").exitCode, 0);
+  expectSameAsUninterrupted(scene, 6, output);
+  // The same file continued without the forces: refused, naming the key.
+  json["output"]["contactForces"] = false;
+  const RunResult refused = run(quoted(writeScene(json)) + " --quiet --resume");
+  EXPECT_NE(refused.exitCode, 0);
+  EXPECT_NE(refused.err.find("output.contactForces"), std::string::npos) << refused.err;
+}
+
 TEST_F(OfflineSimulatorTest, ProgressFlagDrawsTheBar) {
   const RunResult r = run(quoted(writeScene(smallScene())) + " --progress");
   ASSERT_EQ(r.exitCode, 0) << r.err;

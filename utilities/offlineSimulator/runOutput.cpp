@@ -61,7 +61,8 @@ asyncfem::SimulationFileHeader outputHeader(const CommandLine& options, const as
   // The scene, so that frameRenderer and afsimTool find the mesh by themselves.
   header.scenePath = fs::weakly_canonical(fs::absolute(options.scene)).string();
   header.sceneFingerprint = asyncfem::problemFingerprint(*simulation.problem);
-  asyncfem::describeRegionOutput(scene, simulation, header);  // output.regions: the fast regions of each frame
+  asyncfem::describeRegionOutput(scene, simulation, header);        // output.regions: the fast regions of each frame
+  asyncfem::describeContactForceOutput(scene, simulation, header);  // output.contactForces
   return header;
 }
 
@@ -114,7 +115,12 @@ void writeFrame(RunOutput& output, const asyncfem::Scene& scene, const asyncfem:
     output.checkpoint(simulation, done, scene.output.sync, record);
   }
   if (output.vtuSeries && frame % scene.output.vtuEvery == 0) {
-    output.vtuSeries->writeFrame(frame, integrator.time(), *simulation.mesh, integrator.displacement());
+    std::vector<asyncfem::VtuArray> pointArrays;
+    if (scene.output.contactForces) {
+      const Eigen::VectorXd forces = asyncfem::contactForces(simulation);
+      pointArrays.push_back({"contactForce", 3, std::vector<double>(forces.data(), forces.data() + forces.size())});
+    }
+    output.vtuSeries->writeFrame(frame, integrator.time(), *simulation.mesh, integrator.displacement(), pointArrays);
   }
 }
 

@@ -27,6 +27,10 @@ void bindOutput(py::module_& module) {
           "has_region_ratios", [](const SimulationFileHeader& header) { return header.hasRegionRatios; },
           "True when each record also carries every vertex's step ratio (header flag bit 1; offlineSimulator's "
           "output.regions)")
+      .def_property_readonly(
+          "has_contact_forces", [](const SimulationFileHeader& header) { return header.hasContactForces; },
+          "True when each record also carries every vertex's contact force (header flag bit 2; offlineSimulator's "
+          "output.contactForces)")
       .def_property_readonly("record_bytes", &SimulationFileHeader::recordBytes);
 
   py::class_<SimulationFrame>(module, "SimulationFrame",
@@ -35,6 +39,9 @@ void bindOutput(py::module_& module) {
       .def_readonly("time", &SimulationFrame::time)
       .def_readonly("displacement", &SimulationFrame::displacement)
       .def_readonly("velocity", &SimulationFrame::velocity)
+      .def_readonly("contact_force", &SimulationFrame::contactForce,
+                    "every vertex's contact force (3n, N) at the frame's state; empty when the file records none "
+                    "(offlineSimulator's output.contactForces)")
       .def_property_readonly(
           "region_ratios",
           [](const SimulationFrame& frame) {

@@ -351,6 +351,10 @@ std::vector<std::string> runDifferences(const SimulationCheckpoint& checkpoint, 
     differences.push_back(std::string("output.velocities (") + (stored.hasVelocities ? "true" : "false") + " there, " +
                           (header.hasVelocities ? "true" : "false") + " here)");
   }
+  if (stored.hasContactForces != header.hasContactForces) {
+    differences.push_back(std::string("output.contactForces (") + (stored.hasContactForces ? "true" : "false") +
+                          " there, " + (header.hasContactForces ? "true" : "false") + " here)");
+  }
   if (fingerprintDiffers && differences.empty()) {
     differences.emplace_back(
         "the scene file or the mesh it builds (a key other than frames.count and output, or the mesh file's vertices, "

@@ -369,6 +369,7 @@ void parseOutput(JsonObjectReader& top, Scene& scene) {
     vtuReader.finish();
   }
   scene.output.velocities = reader.boolean("velocities", false);
+  scene.output.contactForces = reader.boolean("contactForces", false);
   scene.output.sync = reader.boolean("sync", false);
   if (reader.has("regions")) scene.output.regions = reader.boolean("regions", false);
   reader.finish();

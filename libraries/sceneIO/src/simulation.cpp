@@ -461,23 +461,40 @@ void describeRegionOutput(const Scene& scene, const Simulation& simulation, Simu
   header.hasRegionRatios = recordsRegionRatios(scene);
 }
 
+void describeContactForceOutput(const Scene& scene, const Simulation& simulation, SimulationFileHeader& header) {
+  if (scene.output.contactForces && !simulation.contact) {
+    throw ValidationError(scene.sourceName +
+                          ": output.contactForces: the scene has no contact (no ground, plane, "
+                          "sphere, obstacle or contact between bodies) whose forces could be stored");
+  }
+  header.hasContactForces = scene.output.contactForces;
+}
+
+Eigen::VectorXd contactForces(const Simulation& simulation) {
+  const Integrator& integrator = *simulation.integrator;
+  Eigen::VectorXd forces = Eigen::VectorXd::Zero(integrator.displacement().size());
+  if (simulation.contact) {
+    simulation.contact->addForces(integrator.time(), integrator.displacement(), integrator.velocity(), forces);
+  }
+  return forces;
+}
+
 void appendSimulationFrame(SimulationWriter& writer, const Simulation& simulation) {
   const Integrator& integrator = *simulation.integrator;
   const SimulationFileHeader& header = writer.header();
-  if (!header.hasRegionRatios) {
-    if (header.hasVelocities) {
-      writer.appendFrame(integrator.time(), integrator.displacement(), integrator.velocity());
-    } else {
-      writer.appendFrame(integrator.time(), integrator.displacement());
-    }
-    return;
+  FrameArrays arrays;
+  std::vector<int> ratios;
+  Eigen::VectorXd forces;
+  if (header.hasVelocities) arrays.velocity = &integrator.velocity();
+  if (header.hasContactForces) {
+    forces = contactForces(simulation);
+    arrays.contactForce = &forces;
   }
-  const std::vector<int> ratios = vertexStepRatios(integrator, static_cast<int>(header.numVertices));
-  if (header.hasVelocities) {
-    writer.appendFrame(integrator.time(), integrator.displacement(), integrator.velocity(), ratios);
-  } else {
-    writer.appendFrame(integrator.time(), integrator.displacement(), ratios);
+  if (header.hasRegionRatios) {
+    ratios = vertexStepRatios(integrator, static_cast<int>(header.numVertices));
+    arrays.regionRatios = &ratios;
   }
+  writer.appendFrame(integrator.time(), integrator.displacement(), arrays);
 }
 
 void advanceFrame(Simulation& simulation, int frame) {

@@ -97,6 +97,7 @@ void readHeaderFields(const std::string& name, const unsigned char* bytes, Simul
   }
   header.hasVelocities = (flags & detail::flagVelocities) != 0;
   header.hasRegionRatios = (flags & detail::flagRegionRatios) != 0;
+  header.hasContactForces = (flags & detail::flagContactForces) != 0;
   const std::uint64_t recordBytes = detail::getU64(bytes + detail::offsetRecordBytes);
   if (recordBytes != static_cast<std::uint64_t>(header.recordBytes())) {
     throw ParseError(name, 0,
@@ -217,18 +218,14 @@ void SimulationReader::readFrame(std::int64_t k, SimulationFrame& out) {
   out.time = detail::getF64(in + 8);
   const auto size = static_cast<Eigen::Index>(3 * header_.numVertices);
   std::size_t position = detail::recordPrefixBytes;
-  out.displacement.resize(size);
-  for (Eigen::Index i = 0; i < size; ++i, position += 8) {
-    out.displacement[i] = detail::getF64(in + position);
-  }
-  if (header_.hasVelocities) {
-    out.velocity.resize(size);
-    for (Eigen::Index i = 0; i < size; ++i, position += 8) {
-      out.velocity[i] = detail::getF64(in + position);
-    }
-  } else {
-    out.velocity.resize(0);
-  }
+  // The 3n doubles of one array where the record carries it, in the record's order.
+  const auto readArray = [&](bool present, Eigen::VectorXd& array) {
+    array.resize(present ? size : 0);
+    for (Eigen::Index i = 0; i < array.size(); ++i, position += 8) array[i] = detail::getF64(in + position);
+  };
+  readArray(true, out.displacement);
+  readArray(header_.hasVelocities, out.velocity);
+  readArray(header_.hasContactForces, out.contactForce);
   if (header_.hasRegionRatios) {
     readRatios(path_.string(), k, in + position, header_.numVertices, out.regionRatios);
   } else {

@@ -29,7 +29,7 @@ std::int64_t SimulationFileHeader::headerBytes() const {
 }
 
 std::int64_t SimulationFileHeader::recordBytes() const {
-  const std::int64_t arrays = hasVelocities ? 2 : 1;
+  const std::int64_t arrays = 1 + (hasVelocities ? 1 : 0) + (hasContactForces ? 1 : 0);
   return static_cast<std::int64_t>(detail::recordPrefixBytes + detail::recordSuffixBytes) +
          (arrays * 3 * numVertices * static_cast<std::int64_t>(sizeof(double))) +
          (hasRegionRatios ? detail::regionRatioBytes(numVertices) : 0);
@@ -133,11 +133,15 @@ void checkSameFlags(const std::string& name, const unsigned char* stored, const 
     if ((there & flag) == (here & flag)) return;
     throw Error(name + ": cannot continue it: its header differs from this run's: its records " +
                 ((there & flag) != 0 ? "carry " : "do not carry ") + what + " (header flag bit " +
-                (flag == detail::flagVelocities ? "0" : "1") + ") but this run's " +
-                ((here & flag) != 0 ? "do" : "do not") + " (" + key + "); run without --resume to start over");
+                (flag == detail::flagVelocities     ? "0"
+                 : flag == detail::flagRegionRatios ? "1"
+                                                    : "2") +
+                ") but this run's " + ((here & flag) != 0 ? "do" : "do not") + " (" + key +
+                "); run without --resume to start over");
   };
   differs(detail::flagRegionRatios, "region ratios", "output.regions");
   differs(detail::flagVelocities, "velocities", "output.velocities");
+  differs(detail::flagContactForces, "contact forces", "output.contactForces");
 }
 
 }  // namespace
@@ -295,7 +299,7 @@ void SimulationWriter::close() {
   }
 }
 
-void SimulationWriter::checkArraysGiven(bool velocity, bool ratios) const {
+void SimulationWriter::checkArraysGiven(bool velocity, bool ratios, bool contactForce) const {
   const std::string where = path_.string() + ": frame " + std::to_string(numFrames_) + ": ";
   if (header_.hasVelocities != velocity) {
     throw Error(where + (velocity ? "velocities given, but the file was created without them"
@@ -304,6 +308,10 @@ void SimulationWriter::checkArraysGiven(bool velocity, bool ratios) const {
   if (header_.hasRegionRatios != ratios) {
     throw Error(where + (ratios ? "region ratios given, but the file was created without them"
                                 : "the file stores region ratios, but none were given"));
+  }
+  if (header_.hasContactForces != contactForce) {
+    throw Error(where + (contactForce ? "contact forces given, but the file was created without them"
+                                      : "the file stores contact forces, but none were given"));
   }
 }
 
@@ -330,8 +338,19 @@ void SimulationWriter::appendFrame(double time, const Eigen::Ref<const Eigen::Ve
   appendRecord(time, displacement, &velocity, &ratios);
 }
 
+void SimulationWriter::appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
+                                   const FrameArrays& arrays) {
+  checkArraysGiven(arrays.velocity != nullptr, arrays.regionRatios != nullptr, arrays.contactForce != nullptr);
+  std::optional<Eigen::Ref<const Eigen::VectorXd>> velocity, contactForce;
+  if (arrays.velocity != nullptr) velocity.emplace(*arrays.velocity);
+  if (arrays.contactForce != nullptr) contactForce.emplace(*arrays.contactForce);
+  appendRecord(time, displacement, velocity ? &*velocity : nullptr, arrays.regionRatios,
+               contactForce ? &*contactForce : nullptr);
+}
+
 void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
-                                    const Eigen::Ref<const Eigen::VectorXd>* velocity, const std::vector<int>* ratios) {
+                                    const Eigen::Ref<const Eigen::VectorXd>* velocity, const std::vector<int>* ratios,
+                                    const Eigen::Ref<const Eigen::VectorXd>* contactForce) {
   const std::string where = path_.string() + ": frame " + std::to_string(numFrames_);
   if (!file_) {
     throw Error(where + ": the file is closed");
@@ -339,12 +358,14 @@ void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::V
   stopBeforeFrameIfAsked(numFrames_);
   checkFileIntact(where);
   const Eigen::Index size = 3 * header_.numVertices;
-  if (displacement.size() != size || (velocity != nullptr && velocity->size() != size)) {
+  if (displacement.size() != size || (velocity != nullptr && velocity->size() != size) ||
+      (contactForce != nullptr && contactForce->size() != size)) {
     throw Error(where + ": expected vectors of size " + std::to_string(size) + ", got " +
                 std::to_string(displacement.size()));
   }
   // A reader must be able to trust every frame it finds, so nothing non-finite is stored.
-  if (!std::isfinite(time) || !displacement.allFinite() || (velocity != nullptr && !velocity->allFinite())) {
+  if (!std::isfinite(time) || !displacement.allFinite() || (velocity != nullptr && !velocity->allFinite()) ||
+      (contactForce != nullptr && !contactForce->allFinite())) {
     throw Error(where + ": refusing to store non-finite values");
   }
   if (ratios != nullptr) checkRatios(where, *ratios, header_.numVertices);
@@ -359,6 +380,11 @@ void SimulationWriter::appendRecord(double time, const Eigen::Ref<const Eigen::V
   if (velocity != nullptr) {
     for (Eigen::Index i = 0; i < size; ++i, offset += 8) {
       detail::putF64(out + offset, (*velocity)[i]);
+    }
+  }
+  if (contactForce != nullptr) {
+    for (Eigen::Index i = 0; i < size; ++i, offset += 8) {
+      detail::putF64(out + offset, (*contactForce)[i]);
     }
   }
   if (ratios != nullptr) {

@@ -354,9 +354,9 @@ std::string VtuSeriesWriter::frameFileName(std::int64_t frame) {
 }
 
 void VtuSeriesWriter::writeFrame(std::int64_t frame, double time, const TetMesh& mesh,
-                                 const Eigen::VectorXd& displacement) {
+                                 const Eigen::VectorXd& displacement, const std::vector<VtuArray>& pointArrays) {
   const std::string name = frameFileName(frame);
-  writeVtu(folder_ / name, mesh, displacement, {}, {}, encoding_);
+  writeVtu(folder_ / name, mesh, displacement, pointArrays, {}, encoding_);
   entries_.push_back({time, name});
   writeCollection();
 }

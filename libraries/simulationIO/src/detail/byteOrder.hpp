@@ -51,11 +51,13 @@ inline double getF64(const unsigned char* in) { return std::bit_cast<double>(get
 inline constexpr char simulationMagic[8] = {'A', 'F', 'E', 'M', 'S', 'I', 'M', '\0'};
 inline constexpr std::uint64_t flagVelocities = 1;
 inline constexpr std::uint64_t flagRegionRatios = 2;
-inline constexpr std::uint64_t knownFlags = flagVelocities | flagRegionRatios;
+inline constexpr std::uint64_t flagContactForces = 4;
+inline constexpr std::uint64_t knownFlags = flagVelocities | flagRegionRatios | flagContactForces;
 
 /// The flags a header's fields give.
 inline std::uint64_t headerFlags(const SimulationFileHeader& header) {
-  return (header.hasVelocities ? flagVelocities : 0) | (header.hasRegionRatios ? flagRegionRatios : 0);
+  return (header.hasVelocities ? flagVelocities : 0) | (header.hasRegionRatios ? flagRegionRatios : 0) |
+         (header.hasContactForces ? flagContactForces : 0);
 }
 /// Bytes of the region ratios of n vertices in a record: n u16, padded to a multiple of 8.
 inline std::int64_t regionRatioBytes(std::int64_t numVertices) { return (2 * numVertices + 7) / 8 * 8; }

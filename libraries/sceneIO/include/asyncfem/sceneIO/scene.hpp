@@ -195,7 +195,10 @@ struct Scene {
     std::filesystem::path vtuFolder;  ///< empty: no .vtu files
     int vtuEvery = 1;                 ///< write a .vtu every this many frames
     bool velocities = false;          ///< also store velocities in the .afsim file
-    bool sync = false;                ///< fsync after every frame
+    /// output.contactForces: also store every vertex's contact force in the .afsim file
+    /// (and the .vtu files), evaluated at each frame's state (contactForces())
+    bool contactForces = false;
+    bool sync = false;  ///< fsync after every frame
     /// output.regions: each .afsim record also carries every vertex's step ratio (the fast
     /// regions in use at that frame); unset: on exactly for run-time regions
     /// (recordsRegionRatios()).

@@ -116,8 +116,21 @@ void requireMultirateForRegionOutput(const Scene& scene, const Integrator& integ
 /// after requireMultirateForRegionOutput().
 void describeRegionOutput(const Scene& scene, const Simulation& simulation, SimulationFileHeader& header);
 
+/// Sets header.hasContactForces from output.contactForces. Throws
+/// asyncfem::ValidationError "<scene>: output.contactForces: ..." when the scene asks for
+/// them but has no contact (no ground, plane, sphere, obstacle or body-body contact).
+void describeContactForceOutput(const Scene& scene, const Simulation& simulation, SimulationFileHeader& header);
+
+/// The force the scene's contact model exerts on every vertex (3n, N) at the simulation's
+/// current time and state (displacement and velocity): the penalty springs, their damping
+/// and friction, against obstacles and between surfaces (PenaltyContact::addForces). Zero
+/// without contact. Backward Euler with implicit contact applies exactly this force in the
+/// step that ended at this state; an explicit step applied the force of its start state.
+Eigen::VectorXd contactForces(const Simulation& simulation);
+
 /// Appends the simulation's current state (time, displacement) as the next frame of
-/// writer, with the velocities and the region ratios (vertexStepRatios) its header asks for.
+/// writer, with the velocities, contact forces (contactForces()) and region ratios
+/// (vertexStepRatios) its header asks for.
 void appendSimulationFrame(SimulationWriter& writer, const Simulation& simulation);
 
 /// Advances the simulation by one frame (stepsPerFrame steps) under its RunMonitor, the

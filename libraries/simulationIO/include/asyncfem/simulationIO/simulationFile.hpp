@@ -23,7 +23,7 @@ namespace asyncfem {
 ///         24     8  frame interval (f64, time between frames)
 ///         32     8  integrator timestep (f64, informational; 0 if unknown)
 ///         40     8  flags (u64): bit 0 = records carry velocities, bit 1 = records carry
-///                   region ratios; other bits 0
+///                   region ratios, bit 2 = records carry contact forces; other bits 0
 ///         48     8  record size in bytes (u64, derived from n and flags; checked)
 ///         56     4  reserved (0)
 ///         60     4  CRC-32 of bytes 0..59
@@ -44,6 +44,9 @@ struct SimulationFileHeader {
   /// Flag bit 1: each record also carries every vertex's step ratio to the large step (u16;
   /// 1 in the large-step region L, m_i in fast region S_i), for runs whose regions move.
   bool hasRegionRatios = false;
+  /// Flag bit 2: each record also carries the contact force on every vertex (3n doubles,
+  /// after the velocities), for runs that export them (scene key output.contactForces).
+  bool hasContactForces = false;
   /// The scene the run came from (version 2; empty: none recorded, version 1), and the
   /// fingerprint of the mesh and fixed vertices it built, so that a reader can find the
   /// mesh by itself and tell when the scene has changed since.
@@ -54,7 +57,8 @@ struct SimulationFileHeader {
   std::int64_t headerBytes() const;
 
   /// Bytes of one frame record: index (8) + time (8) + 3n doubles of displacement
-  /// (+ 3n of velocity) (+ n u16 region ratios, zero-padded to a multiple of 8 bytes) +
+  /// (+ 3n of velocity) (+ 3n of contact force) (+ n u16 region ratios, zero-padded to a
+  /// multiple of 8 bytes) +
   /// CRC-32 (4) + 4 reserved bytes.
   std::int64_t recordBytes() const;
 };
@@ -79,7 +83,16 @@ struct SimulationFrame {
   double time = 0.0;
   Eigen::VectorXd displacement;
   Eigen::VectorXd velocity;
+  Eigen::VectorXd contactForce;  ///< 3n when the file carries contact forces, else empty
   std::vector<std::uint16_t> regionRatios;
+};
+
+/// The arrays of a frame record besides its displacement, each given exactly when the
+/// header says the records carry it (null otherwise).
+struct FrameArrays {
+  const Eigen::VectorXd* velocity = nullptr;       ///< 3n
+  const Eigen::VectorXd* contactForce = nullptr;   ///< 3n
+  const std::vector<int>* regionRatios = nullptr;  ///< n
 };
 
 /// Writes a simulation output file. The constructor creates (or truncates) the file and
@@ -131,6 +144,9 @@ class SimulationWriter {
   void appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement, const std::vector<int>& ratios);
   void appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
                    const Eigen::Ref<const Eigen::VectorXd>& velocity, const std::vector<int>& ratios);
+  /// Any combination of arrays, as the header says (the only overload for a file with
+  /// contact forces).
+  void appendFrame(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement, const FrameArrays& arrays);
 
   /// Frames appended so far.
   std::int64_t numFrames() const { return numFrames_; }
@@ -153,9 +169,10 @@ class SimulationWriter {
                    std::int64_t keepFrames, ContinueTag);
   /// Throws naming the frame when the arrays given (velocity, ratios) are not the ones the
   /// header says the records carry.
-  void checkArraysGiven(bool velocity, bool ratios) const;
+  void checkArraysGiven(bool velocity, bool ratios, bool contactForce = false) const;
   void appendRecord(double time, const Eigen::Ref<const Eigen::VectorXd>& displacement,
-                    const Eigen::Ref<const Eigen::VectorXd>* velocity, const std::vector<int>* ratios);
+                    const Eigen::Ref<const Eigen::VectorXd>* velocity, const std::vector<int>* ratios,
+                    const Eigen::Ref<const Eigen::VectorXd>* contactForce = nullptr);
   /// Bytes of the header and the complete frames written so far.
   std::int64_t completeBytes() const;
   /// Throws (and closes the file) when something else deleted, replaced or truncated the

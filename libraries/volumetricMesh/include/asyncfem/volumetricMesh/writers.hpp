@@ -77,9 +77,10 @@ class VtuSeriesWriter {
   /// "frame_00042.vtu" for frame 42.
   static std::string frameFileName(std::int64_t frame);
 
-  /// Writes frame's .vtu (rest positions + displacement, see writeVtu) and the .pvd with
-  /// it appended at time.
-  void writeFrame(std::int64_t frame, double time, const TetMesh& mesh, const Eigen::VectorXd& displacement);
+  /// Writes frame's .vtu (rest positions + displacement and the given point arrays, see
+  /// writeVtu) and the .pvd with it appended at time.
+  void writeFrame(std::int64_t frame, double time, const TetMesh& mesh, const Eigen::VectorXd& displacement,
+                  const std::vector<VtuArray>& pointArrays = {});
   /// Lists an already written frame file in the collection (a resumed run's earlier
   /// frames) without writing it; the .pvd is rewritten at the next writeFrame or
   /// writeCollection.
