@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <asyncfem/benchmarkTools/modalReference.hpp>
 #include <asyncfem/core/error.hpp>
+#include <asyncfem/modalAnalysis/generalizedEigen.hpp>
 #include <cmath>
 #include <limits>
 #include <string>
-
-#include "detail/generalizedEigen.hpp"
 
 namespace asyncfem {
 
@@ -71,14 +70,14 @@ ModalReference::ModalReference(const Eigen::SparseMatrix<double>& mass, const Ei
   freeMass_ = extractor.extract(mass);
   Eigen::MatrixXd denseMass = Eigen::MatrixXd(freeMass_);
   Eigen::MatrixXd denseStiffness = Eigen::MatrixXd(SubmatrixExtractor(stiffness, free, free).extract(stiffness));
-  if (!detail::solveGeneralizedEigen(denseStiffness, denseMass, eigenvalues_)) {
+  if (!solveGeneralizedEigen(denseStiffness, denseMass, eigenvalues_)) {
     throw NumericalError("modal reference: generalized eigendecomposition of the " + std::to_string(n) +
                          " free DOFs failed (is the mass matrix positive definite on them?)");
   }
   modes_ = std::move(denseStiffness);
 }
 
-std::string ModalReference::backend() { return detail::generalizedEigenBackend(); }
+std::string ModalReference::backend() { return generalizedEigenBackend(); }
 
 namespace {
 

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <algorithm>
+#include <asyncfem/core/threading.hpp>
+#include <asyncfem/modalAnalysis/generalizedEigen.hpp>
 #include <vector>
-
-#include "detail/generalizedEigen.hpp"
 
 extern "C" {
 // LAPACK (Fortran calling convention): generalized symmetric-definite eigenproblem,
@@ -11,7 +11,7 @@ void dsygvd_(const int* itype, const char* jobz, const char* uplo, const int* n,
              const int* ldb, double* w, double* work, const int* lwork, int* iwork, const int* liwork, int* info);
 }
 
-namespace asyncfem::detail {
+namespace asyncfem {
 
 bool solveGeneralizedEigen(Eigen::MatrixXd& stiffness, Eigen::MatrixXd& mass, Eigen::VectorXd& eigenvalues) {
   const int n = static_cast<int>(stiffness.rows());
@@ -20,6 +20,9 @@ bool solveGeneralizedEigen(Eigen::MatrixXd& stiffness, Eigen::MatrixXd& mass, Ei
   const int itype = 1;  // A x = lambda B x
   const char jobz = 'V', uplo = 'L';
   int info = 0;
+  // One BLAS thread: the blocked reductions sum in an order that depends on the thread
+  // count, and a region's modes must not depend on the machine's load.
+  const ScopedBlasThreads blas(1);
   // Workspace query first.
   int lwork = -1, liwork = -1, iworkSize = 0;
   double workSize = 0.0;
@@ -37,4 +40,4 @@ bool solveGeneralizedEigen(Eigen::MatrixXd& stiffness, Eigen::MatrixXd& mass, Ei
 
 std::string generalizedEigenBackend() { return "LAPACK dsygvd"; }
 
-}  // namespace asyncfem::detail
+}  // namespace asyncfem

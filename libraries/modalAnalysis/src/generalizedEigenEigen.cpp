@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <Eigen/Dense>
+#include <asyncfem/modalAnalysis/generalizedEigen.hpp>
 
-#include "detail/generalizedEigen.hpp"
-
-namespace asyncfem::detail {
+namespace asyncfem {
 
 bool solveGeneralizedEigen(Eigen::MatrixXd& stiffness, Eigen::MatrixXd& mass, Eigen::VectorXd& eigenvalues) {
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(stiffness, mass,
@@ -16,4 +15,4 @@ bool solveGeneralizedEigen(Eigen::MatrixXd& stiffness, Eigen::MatrixXd& mass, Ei
 
 std::string generalizedEigenBackend() { return "Eigen GeneralizedSelfAdjointEigenSolver"; }
 
-}  // namespace asyncfem::detail
+}  // namespace asyncfem
