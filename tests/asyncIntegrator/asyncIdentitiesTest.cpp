@@ -102,7 +102,8 @@ TEST(AsyncIdentities, AllFastEqualsSmallSteps) {
 
 // Identity 4: the structured solve equals the naive full-system solve, for several m,
 // |S|, damping values, one and three regions, every Schur mode that is exact, both
-// recovery modes, and A^S factored sparse (every region) or dense (every region).
+// recovery modes, A^S factored sparse (every region) or dense (every region), and Z by
+// substitution or from the regions' modes (with either recovery).
 TEST(AsyncIdentities, StructuredEqualsNaive) {
   for (const AsyncCoupling coupling : kCouplings)
     for (const Damping& damping : kDampings) {
@@ -132,6 +133,13 @@ TEST(AsyncIdentities, StructuredEqualsNaive) {
           sparseRegions.denseRegionDofs = 0;
           AsyncOptions denseRegions = defaults;  // dense A^S and G for every region
           denseRegions.regionSolver = SolverKind::dense;
+          AsyncOptions substituted = defaults;  // Z by m |I| substitutions in every region
+          substituted.zSolve = ZSolve::substitution;
+          AsyncOptions modes = defaults;  // Z from every region's modes, dense Z_m and sum_r Z_r
+          modes.zSolve = ZSolve::modes;
+          modes.recovery = RecoveryMode::denseZ;
+          AsyncOptions modesSubstituted = modes;  // ... recovered by a second substitution
+          modesSubstituted.recovery = RecoveryMode::substitution;
           auto naive = makeAsync(ts, 2e-3, regions, naiveOptions);
           std::vector<std::unique_ptr<AsyncBackwardEuler>> structured;
           structured.push_back(makeAsync(ts, 2e-3, regions, defaults));
@@ -139,6 +147,9 @@ TEST(AsyncIdentities, StructuredEqualsNaive) {
           structured.push_back(makeAsync(ts, 2e-3, regions, lowRankDense));
           structured.push_back(makeAsync(ts, 2e-3, regions, sparseRegions));
           structured.push_back(makeAsync(ts, 2e-3, regions, denseRegions));
+          structured.push_back(makeAsync(ts, 2e-3, regions, substituted));
+          structured.push_back(makeAsync(ts, 2e-3, regions, modes));
+          structured.push_back(makeAsync(ts, 2e-3, regions, modesSubstituted));
           for (int k = 0; k < 3; ++k) {
             naive->step();
             for (auto& s : structured) s->step();

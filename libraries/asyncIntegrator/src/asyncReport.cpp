@@ -96,10 +96,12 @@ RunReport AsyncBackwardEuler::report() const {
 void detail::TwoLevelStepSolver::reportLines(std::vector<std::string>& lines) const {
   const AsyncRunStats& r = runStats_;
   char line[256];
+  char modal[64] = "";
+  if (r.zModalRegions > 0) std::snprintf(modal, sizeof(modal), ", %d region(s) from their modes", r.zModalRegions);
   std::snprintf(line, sizeof(line),
-                "async set-up %.3f s (Z %.3f s over %lld right-hand sides on %d threads, H^LL* %.3f s); |S| %d, "
+                "async set-up %.3f s (Z %.3f s over %lld right-hand sides on %d threads%s, H^LL* %.3f s); |S| %d, "
                 "|I| %d, |L| %d DOFs",
-                r.setupSeconds, r.setupZSeconds, r.zColumns, r.zThreads, r.setupSchurSeconds, r.fastDofs,
+                r.setupSeconds, r.setupZSeconds, r.zColumns, r.zThreads, modal, r.setupSchurSeconds, r.fastDofs,
                 r.interfaceDofs, r.largeDofs);
   lines.emplace_back(line);
   lines.push_back(steadyStepLine(r));

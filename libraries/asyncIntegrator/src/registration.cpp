@@ -175,6 +175,8 @@ const ChoiceTable<SolverKind> kRegionSolvers{{"cholmod", SolverKind::cholmod},
                                              {"eigen-ldlt", SolverKind::eigenLDLT},
                                              {"eigen-lu", SolverKind::eigenLU},
                                              {"dense", SolverKind::dense}};
+const ChoiceTable<ZSolve> kZSolves{
+    {"automatic", ZSolve::automatic}, {"substitution", ZSolve::substitution}, {"modes", ZSolve::modes}};
 const ChoiceTable<NestedSolve> kNestedSolves{
     {"automatic", NestedSolve::automatic}, {"structured", NestedSolve::structured}, {"lu", NestedSolve::lu}};
 
@@ -185,6 +187,7 @@ const std::vector<SolverKey>& solverKeys() {
       choiceKey("schur", place(&AsyncOptions::schur), kSchurModes),
       choiceKey("method", place(&AsyncOptions::method), kSolveMethods),
       choiceKey("recovery", place(&AsyncOptions::recovery), kRecoveryModes),
+      choiceKey("zSolve", place(&AsyncOptions::zSolve), kZSolves),
       choiceKey("regionSolver", place(&AsyncOptions::regionSolver), kRegionSolvers),
       integerKey("denseRegionDofs", place(&AsyncOptions::denseRegionDofs), 0, 4096),
       choiceKey("nestedSolve", place(&AsyncOptions::nestedSolve), kNestedSolves),
@@ -338,7 +341,7 @@ void rejectAsyncOnlyKeys(const IntegratorContext& context, const nlohmann::json&
     JsonObjectReader::failAt(context.sourceName, path,
                              "expected an object, got " + JsonObjectReader::describe(options));
   }
-  for (const char* key : {"coupling", "schur", "method", "recovery", "substepStatePrediction"}) {
+  for (const char* key : {"coupling", "schur", "method", "recovery", "zSolve", "substepStatePrediction"}) {
     if (options.contains(key)) {
       JsonObjectReader::failAt(context.sourceName, path + "." + key, "used by \"async\" only, not by \"" + name + "\"");
     }

@@ -79,6 +79,7 @@ void checkHierarchyOptions(const AsyncOptions& options, const std::string& why) 
   if (options.processes.regionDistribution.sum) refuse("regionDistribution", "regions owned by one process");
   if (options.schur != defaults.schur) refuse("schur", "a Schur mode");
   if (options.recovery != defaults.recovery) refuse("recovery", "a recovery mode");
+  if (options.zSolve != defaults.zSolve) refuse("zSolve", "a choice of how Z is computed");
   if (options.regionSolver != defaults.regionSolver) refuse("regionSolver", "a region solver");
   if (options.denseRegionDofs != defaults.denseRegionDofs) refuse("denseRegionDofs", "dense region factors");
 }

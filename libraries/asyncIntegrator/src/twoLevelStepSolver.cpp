@@ -181,6 +181,7 @@ void TwoLevelStepSolver::fullSchurRebuild() {
   stats_.factorizations += run.helperFactorizations;
   runStats_.zThreads = run.threads;
   runStats_.zColumns = run.columns;
+  runStats_.zModalRegions = run.modalRegions;
   const double zSeconds = factor.stop();
   schurReport_.zColumnSeconds += zSeconds;
   stats_.factorizationSeconds += zSeconds;

@@ -17,6 +17,9 @@
 //   benchmarkAsync --study setup --scenes A.json B.json ...
 //                                   per scene: set-up and re-partition cost, exact against
 //                                   AsyncOptions::KeptFactors::quickSetUp, in single-rate steps at hL
+//   benchmarkAsync --study modes --scenes A.json B.json ... [--corotational]
+//                                   per scene: set-up with Z by substitution and from the
+//                                   regions' modes (AsyncOptions::zSolve) against single-rate's
 //   benchmarkAsync --study steady --only async|single --scenes A.json --steps N
 //                                   one configuration only, for callgrind: the steady steps
 //                                   are the only ones collected (run under
@@ -526,6 +529,13 @@ Scene steadyScene(const std::string& spec, bool corotational) {
   return scene;
 }
 
+/// The asynchronous integrator a scene built (ValidationError naming spec for another one).
+AsyncBackwardEuler& asyncOf(Simulation& simulation, const std::string& spec) {
+  auto* async = dynamic_cast<AsyncBackwardEuler*>(simulation.integrator.get());
+  if (async == nullptr) throw ValidationError(spec + ": the scene's integrator is not async");
+  return *async;
+}
+
 /// Large steps per block when the corotational steady study times async and single-rate
 /// at hS in turn.
 constexpr int kInterleavedSteps = 10;
@@ -555,8 +565,7 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
   for (const std::string& spec : scenes) {
     const Scene scene = steadyScene(spec, corotational);
     Simulation simulation = buildSimulation(scene);
-    auto* async = dynamic_cast<AsyncBackwardEuler*>(simulation.integrator.get());
-    if (async == nullptr) throw ValidationError(spec + ": the scene's integrator is not async");
+    auto* async = &asyncOf(simulation, spec);
     std::unique_ptr<AsyncBackwardEuler> rebuilt;
     if (rebuildSchur || laggedIterations > 0 || unturned) {
       // The same scene with AsyncOptions::KeptFactors::laggedSchur off (Z and H^{LL*} every large step),
@@ -728,6 +737,70 @@ void steadyStudy(const std::vector<std::string>& scenes, int steps, bool corotat
   std::printf("\n");
 }
 
+/// Z by substitution against Z from the regions' modes (AsyncOptions::zSolve): per scene,
+/// the set-up (and its Z part) of each, constructed in turn `repeats` times (medians), and
+/// single-rate backward Euler's set-up (construction and first step: its factorization) at
+/// hL in the same run; then both integrators take `steps` steps from the scene's start and
+/// the largest relative difference of their displacements is printed (round-off).
+void zModesStudy(const std::vector<std::string>& scenes, int repeats, int steps, bool corotational) {
+  std::printf(
+      "### Z by substitution and from the regions' modes (%s forces, medians of %d set-ups each)\n\n"
+      "| scene | vertices | S DOFs | interface DOFs | m | single-rate set-up ms | substitution: set-up ms (Z) "
+      "| modes: set-up ms (Z) | Z: substitution / modes | automatic: Z ms (regions from modes) | set-up / "
+      "single-rate: substitution, modes, automatic | difference after %d steps |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+      corotational ? "corotational" : "linear", repeats, steps);
+  for (const std::string& spec : scenes) {
+    const Scene scene = steadyScene(spec, corotational);
+    Simulation simulation = buildSimulation(scene);
+    const AsyncBackwardEuler* sceneAsync = &asyncOf(simulation, spec);
+    std::vector<AsyncRegion> regions;
+    int ratio = 1;
+    for (int i = 0; i < sceneAsync->partition().numRegions(); ++i) {
+      regions.push_back(sceneAsync->partition().region(i));
+      ratio = std::max(ratio, sceneAsync->partition().ratio(i));
+    }
+    const DynamicSystem system = sceneAsync->system();
+    const double hL = sceneAsync->timestep();
+    std::array<std::vector<double>, 3> setUp, zPart;
+    std::vector<double> single;
+    std::array<std::unique_ptr<AsyncBackwardEuler>, 3> kept;
+    const ZSolve kinds[3] = {ZSolve::substitution, ZSolve::modes, ZSolve::automatic};
+    for (int repeat = 0; repeat < repeats; ++repeat) {
+      for (int kind = 0; kind < 3; ++kind) {
+        AsyncOptions options = sceneAsync->options();
+        options.zSolve = kinds[kind];
+        auto async = std::make_unique<AsyncBackwardEuler>(*simulation.mesh, system, hL, regions, options);
+        setUp[kind].push_back(async->runStats().setupSeconds);
+        zPart[kind].push_back(async->runStats().setupZSeconds);
+        kept[kind] = std::move(async);
+      }
+      Stopwatch construction;
+      auto singleRate = makeIntegrator("backward-euler", system, hL);
+      singleRate->step();
+      single.push_back(construction.stop());
+    }
+    const int automatic = kept[2]->runStats().zModalRegions;
+    for (int k = 0; k < steps; ++k)
+      for (auto& async : kept) async->step();
+    const Eigen::VectorXd& a = kept[0]->displacement();
+    const double difference = (kept[1]->displacement() - a).norm() / std::max(a.norm(), 1e-300);
+    std::array<double, 3> s{}, z{};
+    for (int kind = 0; kind < 3; ++kind) {
+      s[kind] = median(setUp[kind]);
+      z[kind] = median(zPart[kind]);
+    }
+    const double base = median(single);
+    std::printf(
+        "| %s | %d | %d | %d | %d | %.1f | %.1f (%.1f) | %.1f (%.1f) | %.1f | %.1f (%d of %zu) | %.1f, %.1f, %.1f | "
+        "%.1e |\n",
+        scene.sourceName.c_str(), simulation.mesh->numVertices(), kept[0]->runStats().fastDofs,
+        kept[0]->runStats().interfaceDofs, ratio, 1e3 * base, 1e3 * s[0], 1e3 * z[0], 1e3 * s[1], 1e3 * z[1],
+        z[0] / z[1], 1e3 * z[2], automatic, regions.size(), s[0] / base, s[1] / base, s[2] / base, difference);
+  }
+  std::printf("\n");
+}
+
 struct SetUpRow {
   std::string name;
   int vertices = 0, fastVertices = 0, interfaceDofs = 0, ratio = 1, movedVertices = 0;
@@ -862,8 +935,9 @@ int main(int argc, char** argv) {
   std::string only;
   bool corotational = false, collectFirst = false, rebuildSchur = false, unturned = false;
   int laggedIterations = 0;
-  app.add_option("--study", study, "growth | ratio | schur | corotational | contact | steady | setup | all")
-      ->check(CLI::IsMember({"growth", "ratio", "schur", "corotational", "contact", "steady", "setup", "all"}));
+  app.add_option("--study", study, "growth | ratio | schur | corotational | contact | steady | setup | modes | all")
+      ->check(
+          CLI::IsMember({"growth", "ratio", "schur", "corotational", "contact", "steady", "setup", "modes", "all"}));
   app.add_option("--scenes", scenes, "steady and setup studies: scene files, or dragon:SPACING:SET:M:HL");
   app.add_option("--only", only, "steady study: time one configuration only (for callgrind)")
       ->check(CLI::IsMember({"async", "single", "single-hs"}));
@@ -898,6 +972,7 @@ int main(int argc, char** argv) {
     if (study == "steady")
       steadyStudy(scenes, steps, corotational, only, collectFirst, rebuildSchur, laggedIterations, unturned);
     if (study == "setup") setUpStudy(scenes, steps);
+    if (study == "modes") zModesStudy(scenes, 3, steps, corotational);
   } catch (const asyncfem::Error& e) {
     std::fprintf(stderr, "benchmarkAsync: %s\n", e.what());
     return 1;

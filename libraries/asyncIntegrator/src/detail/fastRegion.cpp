@@ -3,13 +3,42 @@
 #include "detail/fastRegion.hpp"
 
 #include <algorithm>
+#include <asyncfem/core/threading.hpp>
 #include <asyncfem/integrator/stepFormula.hpp>
+#include <asyncfem/modalAnalysis/generalizedEigen.hpp>
 
 #include "detail/multirateSupport.hpp"
 #include "detail/parallelTasks.hpp"
 #include "detail/sparseBlocks.hpp"
 
+extern "C" {
+// BLAS (Fortran calling convention): C = alpha op(A) op(B) + beta C.
+void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k, const double* alpha,
+            const double* a, const int* lda, const double* b, const int* ldb, const double* beta, double* c,
+            const int* ldc);
+}
+
 namespace asyncfem::detail {
+
+namespace {
+
+/// out = a b through the BLAS's dgemm, on factorBlasThreads() (dgemm's bits depend on the
+/// thread count): several times Eigen's speed on the dense products of the modal Z, since
+/// the BLAS picks the machine's vector instructions at run time.
+void denseProduct(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& out) {
+  out.resize(a.rows(), b.cols());
+  const int m = static_cast<int>(a.rows()), n = static_cast<int>(b.cols()), k = static_cast<int>(a.cols());
+  if (m == 0 || n == 0) return;
+  if (k == 0) {
+    out.setZero();
+    return;
+  }
+  const double one = 1.0, zero = 0.0;
+  const ScopedBlasThreads blas(factorBlasThreads());
+  dgemm_("N", "N", &m, &n, &k, &one, a.data(), &m, b.data(), &k, &zero, out.data(), &m);
+}
+
+}  // namespace
 
 FastRegion::FastRegion(const SparseMatrix& mass, const SparseMatrix& stiffnessPattern, const RegionLayout& layout,
                        SolverKind solverKind, int denseDofs)
@@ -40,6 +69,7 @@ void FastRegion::updateBlocks(const SparseMatrix& stiffness, double largeStep, d
                               AsyncCoupling couplingKind) {
   const double hS = largeStep / ratio;
   smallStep = hS;
+  alpha_ = damped ? alpha : 0.0;
   beta_ = damped ? beta : 0.0;
   // A^S and G are rebuilt from K below: contact blocks in them go with their old values.
   contactSaved_.clear();
@@ -56,6 +86,8 @@ void FastRegion::updateBlocks(const SparseMatrix& stiffness, double largeStep, d
   // A^S = M^{SS} + hS D^{SS} + hS^2 K^{SS}: backward Euler's matrix at hS (Eq. A1).
   const stepFormula::MatrixWeights weights = stepFormula::backwardEuler::systemMatrix(hS, alpha, beta);
   combineInto(weights.mass, Mss, weights.stiffness, Kss, systemMatrix);
+  massWeight_ = weights.mass;
+  stiffnessWeight_ = weights.stiffness;
   combineInto(0.0, Mss, hS * hS, Kss, G);
   refreshTranspose();
   if (dense.factor) Gdense = G;
@@ -329,6 +361,83 @@ void FastRegion::correctionColumns(SparseSolver& columnSolver, bool damped, Eige
   correction.middleCols(first, width) = w.columns;
 }
 
+bool FastRegion::correctionFromModes(bool damped) {
+  if (!contactPositions.empty()) return false;
+  const auto sizeS = static_cast<Eigen::Index>(Mss.rows());
+  Eigen::MatrixXd modes = Kss.toDense();  // Phi once solved
+  if ((modes - modes.transpose()).cwiseAbs().maxCoeff() > 1e-13 * modes.cwiseAbs().maxCoeff()) return false;
+  Eigen::MatrixXd mass = Mss.toDense();
+  Eigen::VectorXd lambda;
+  if (!solveGeneralizedEigen(modes, mass, lambda)) return false;
+  // In modal coordinates A^S, M^{SS} and G are diagonal: a = massWeight + stiffnessWeight
+  // lambda, 1 and hS^2 lambda. B_r = bM_r M^{SI} + bK_r K^{SI} + bD_r (alpha M^{SI} + beta
+  // K^{SI}), so Phi^T Z_r = cM_r Phi^T M^{SI} + cK_r Phi^T K^{SI} with per-mode scalars from
+  // a cM_r = (bM_r + alpha bD_r) + cM_{r-1} - hS^2 lambda sum_{i<r} cM_i (cK_r likewise).
+  // weights(k, j): mode k's sum over r of (eM, eK, eD)[j / 2] times (cM, cK)[j % 2]; then the
+  // last substep's and the plain sums (dense recovery).
+  const CouplingCoefficients& k = coupling;
+  Eigen::MatrixXd weights = Eigen::MatrixXd::Zero(sizeS, 10);
+  for (Eigen::Index mode = 0; mode < sizeS; ++mode) {
+    const double a = massWeight_ + stiffnessWeight_ * lambda[mode];
+    const double g = smallStep * smallStep * lambda[mode];
+    double c[2] = {0.0, 0.0}, running[2] = {0.0, 0.0};
+    for (int r = 1; r <= ratio; ++r) {
+      const double input[2] = {k.bM[r - 1] + (damped ? alpha_ * k.bD[r - 1] : 0.0),
+                               k.bK[r - 1] + (damped ? beta_ * k.bD[r - 1] : 0.0)};
+      for (int j = 0; j < 2; ++j) {
+        c[j] = (input[j] + c[j] - g * running[j]) / a;
+        running[j] += c[j];
+        weights(mode, j) += k.eM[r - 1] * c[j];
+        weights(mode, 2 + j) += k.eK[r - 1] * c[j];
+        if (damped) weights(mode, 4 + j) += k.eD[r - 1] * c[j];
+      }
+    }
+    for (int j = 0; j < 2; ++j) {
+      weights(mode, 6 + j) = c[j];
+      weights(mode, 8 + j) = running[j];
+    }
+  }
+  const auto q = static_cast<Eigen::Index>(Msi.cols());
+  const Eigen::MatrixXd projectedM = modes.transpose() * Msi, projectedK = modes.transpose() * Ksi;  // |S| x q
+  // C_i = [M^{IS} Phi, K^{IS} Phi, D^{IS} Phi] [W_M; W_K; W_D], W_X = Phi^T (sum_r e^X_r Z_r)
+  // (column pair 2x of weights), and with dense recovery [Z_m, sum_r Z_r] = Phi [Phi^T Z_m,
+  // Phi^T sum_r Z_r] (pairs 3 and 4): one product each, through the BLAS (dgemm).
+  const int blocks = damped ? 3 : 2;
+  Eigen::MatrixXd projectedInterface(q, blocks * sizeS), combined(blocks * sizeS, q);
+  const SparseMatrix* interfaceRows[3] = {&Mis, &Kis, &Dis};
+  for (int x = 0; x < blocks; ++x) {
+    projectedInterface.middleCols(x * sizeS, sizeS).noalias() = *interfaceRows[x] * modes;
+    combined.middleRows(x * sizeS, sizeS) =
+        weights.col(2 * x).asDiagonal() * projectedM + weights.col((2 * x) + 1).asDiagonal() * projectedK;
+  }
+  denseProduct(projectedInterface, combined, correction);
+  if (dense.recovery) {
+    Eigen::MatrixXd ends(sizeS, 2 * q), both;
+    for (int x = 0; x < 2; ++x) {
+      ends.middleCols(x * q, q) =
+          weights.col(6 + (2 * x)).asDiagonal() * projectedM + weights.col(7 + (2 * x)).asDiagonal() * projectedK;
+    }
+    denseProduct(modes, ends, both);
+    zLast = both.leftCols(q);
+    zSum = both.rightCols(q);
+  }
+  return true;
+}
+
+double FastRegion::substitutionPrice() const {
+  const double sizeS = static_cast<double>(Mss.rows());
+  const double perColumn = solver->stats().solveFlopsPerRhs + (4.0 * static_cast<double>(Kss.nonZeros())) +
+                           (12.0 * sizeS);  // the solve, the product with G, the running sums
+  return static_cast<double>(ratio) * static_cast<double>(Msi.cols()) * perColumn;
+}
+
+double FastRegion::modalPrice() const {
+  const double sizeS = static_cast<double>(Mss.rows()), q = static_cast<double>(Msi.cols());
+  // dsygvd with vectors about 9 n^3; the three products of C_i 2 q^2 n each; Z_m and
+  // sum_r Z_r (dense recovery) 2 n^2 q each.
+  return (9.0 * sizeS * sizeS * sizeS) + (6.0 * q * q * sizeS) + (dense.recovery ? 4.0 * sizeS * sizeS * q : 0.0);
+}
+
 void FastRegion::assembleInterfaceStiffness(const ForceModel& forceModel, const Eigen::VectorXd& u, bool perElement) {
   const auto q = static_cast<Eigen::Index>(Mis.rows());
   interfaceStiffness.setZero(q, q);
@@ -368,6 +477,19 @@ bool chooseDenseZ(const FastRegion& region, RecoveryMode mode) {
           2.0 * static_cast<double>(sizeS) * static_cast<double>(q) <= kMaxDenseZEntries);
 }
 
+/// A dense flop of the modal path (BLAS 3, LAPACK) against a flop of the substitutions
+/// (sparse solves with a small factor and sparse products, of a few columns at a time):
+/// what one costs in time against the other, measured in the set-ups of
+/// docs/benchmarks.md ("Z from the region's modes").
+constexpr double kDenseFlopAdvantage = 4.0;
+
+/// Whether region takes Z from its modes (ZSolve), before trying.
+bool wantsModes(const FastRegion& region, ZSolve mode) {
+  if (mode == ZSolve::substitution || region.hasContactBlocks() || (region.dense.recovery && region.dense.trackReach))
+    return false;
+  return mode == ZSolve::modes || region.modalPrice() < kDenseFlopAdvantage * region.substitutionPrice();
+}
+
 struct ColumnTask {
   int region = 0;
   int block = 0;  // 0: the region's own solver, j > 0: helperSolvers[j - 1]
@@ -381,6 +503,10 @@ CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOp
   std::vector<ColumnTask> tasks;
   std::vector<std::pair<int, int>> helpers;  // (region, helper) factorizations to run
   CorrectionRun run;
+  // Regions whose modes are cheaper than their substitutions first (one task each; the
+  // eigensolver runs on one BLAS thread).
+  std::vector<int> modal;
+  std::vector<char> fromModes(regions.size(), 0);
   for (std::size_t i = 0; i < regions.size(); ++i) {
     FastRegion& rb = regions[i];
     const Eigen::Index q = rb.Msi.cols();
@@ -390,7 +516,17 @@ CorrectionRun computeCorrections(std::vector<FastRegion>& regions, const AsyncOp
     rb.zLast.resize(rb.dense.recovery ? sizeS : 0, rb.dense.recovery ? q : 0);
     rb.zSum.resize(rb.dense.recovery ? sizeS : 0, rb.dense.recovery ? q : 0);
     if (!rb.owned) rb.correction.setZero();  // the owner's C_i arrives by the sum over processes
-    if (q == 0 || !rb.owned) continue;
+    if (q > 0 && rb.owned && wantsModes(rb, options.zSolve)) modal.push_back(static_cast<int>(i));
+  }
+  parallelTasks(static_cast<int>(modal.size()), threads, [&](int t) {
+    const auto i = static_cast<std::size_t>(modal[static_cast<std::size_t>(t)]);
+    fromModes[i] = regions[i].correctionFromModes(damped) ? 1 : 0;
+  });
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    FastRegion& rb = regions[i];
+    const Eigen::Index q = rb.Msi.cols();
+    if (fromModes[i]) ++run.modalRegions;
+    if (q == 0 || !rb.owned || fromModes[i]) continue;
     run.columns += static_cast<long long>(rb.ratio) * q;
     const int blocks =
         static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(threads, q / kMinZColumnsPerThread)));

@@ -84,6 +84,18 @@ class FastRegion {
   /// (dense recovery).
   /// block: which of the concurrent column blocks (its own scratch, kept between rebuilds).
   void correctionColumns(SparseSolver& solver, bool damped, Eigen::Index first, Eigen::Index width, int block);
+  /// C_i (and Z_m, sum_r Z_r with dense recovery) from the region's modes instead of m |I_i|
+  /// substitutions: with K^{SS} Phi = M^{SS} Phi Lambda (Phi^T M^{SS} Phi = I, one dense
+  /// generalized eigendecomposition), A^S, M^{SS} and G are diagonal in Phi, so each mode's
+  /// substeps follow a scalar recurrence, and Z = Phi (W_M Phi^T M^{SI} + W_K Phi^T K^{SI})
+  /// with per-mode weights W (docs/asynchronous-integrator.md, "Z from the region's modes").
+  /// Returns false, changing nothing, where that does not hold or fails: contact blocks in
+  /// A^S, K^{SS} not symmetric to 1e-13, the eigensolver's failure.
+  bool correctionFromModes(bool damped);
+  /// The price, in flops, of Z by substitution (m |I| solves with A^S and products with G)
+  /// and from the modes (the eigendecomposition, about 9 |S|^3, and the dense products).
+  double substitutionPrice() const;
+  double modalPrice() const;
   /// K_I^{II}: the interface elements' tangent on I x I (dense), with each element's
   /// tangent from the force model at u when perElement (else the cached linear ones).
   void assembleInterfaceStiffness(const ForceModel& forceModel, const Eigen::VectorXd& u, bool perElement);
@@ -172,7 +184,9 @@ class FastRegion {
   void addShortcutCorrection(const double* t, double* out) const;
 
   int denseDofs_ = 0;
-  double beta_ = 0.0;
+  double alpha_ = 0.0, beta_ = 0.0;
+  // A^S = massWeight_ M^{SS} + stiffnessWeight_ K^{SS} (without contact blocks).
+  double massWeight_ = 1.0, stiffnessWeight_ = 0.0;
   KeptEntries contactSaved_;  // A^S and G entries the contact blocks changed, and their values before
   bool denseDecided_ = false;
   TransposePattern gtPattern_;  // G's pattern and where GT's entries come from
@@ -191,7 +205,8 @@ class FastRegion {
 /// What one computation of Z over every region did.
 struct CorrectionRun {
   int threads = 1;        ///< most A^S factor copies one region used
-  long long columns = 0;  ///< right-hand sides: sum_i m_i |I_i|
+  long long columns = 0;  ///< right-hand sides: sum_i m_i |I_i| over the regions substituted
+  int modalRegions = 0;   ///< regions whose C_i came from their modes (FastRegion::correctionFromModes)
   long long helperFactorizations = 0;
 };
 

@@ -65,6 +65,19 @@ enum class RecoveryMode {
   denseZ,
 };
 
+/// How a set-up (or a nonlinear rebuild) computes each region's Z = (H^{SS})^{-1} H^{SI} and its
+/// Schur correction C_i (docs/asynchronous-integrator.md, "Z from the region's modes").
+enum class ZSolve {
+  /// Per region, from the modes where their price in flops (about 9 |S_i|^3) is below a
+  /// quarter of the substitutions' (m_i |I_i| solves), else by substitution; regions with
+  /// contact blocks by substitution.
+  automatic,
+  substitution,  ///< m_i |I_i| forward substitutions with A^S (solves in column blocks)
+  /// One dense generalized eigendecomposition of (K^{SS}, M^{SS}) per region; a region where
+  /// it does not apply (contact blocks, a non-symmetric tangent) is substituted.
+  modes,
+};
+
 /// How a fast region and L exchange forces inside a large step (docs/asynchronous-integrator.md,
 /// section "Method", Eqs. A4-A12).
 enum class AsyncCoupling {
@@ -89,6 +102,7 @@ struct AsyncOptions {
   SchurMode schur = SchurMode::lowRank;
   AsyncSolveMethod method = AsyncSolveMethod::structured;
   RecoveryMode recovery = RecoveryMode::automatic;
+  ZSolve zSolve = ZSolve::automatic;
   /// The hierarchy solve's strategy (only where that solve runs).
   NestedSolve nestedSolve = NestedSolve::automatic;
   SolverKind regionSolver = SolverKind::cholmod;  ///< factors A^{S_i} (SPD)
@@ -229,6 +243,7 @@ struct AsyncRunStats {
   int largeDofs = 0;                              ///< |L|
   int zThreads = 1;                               ///< threads (A^S factor copies) the last Z computation used
   long long zColumns = 0;                         ///< right-hand sides of one Z computation: sum_i m_i |I_i|
+  int zModalRegions = 0;                          ///< regions of the last Z computation taken from their modes
   long long laggedSteps = 0;                      ///< steps solved with the lagged H^{LL*} (AsyncOptions::laggedSchur)
   long long schurIterations = 0;                  ///< iterative refinement iterations over those steps
   long long laggedRefreshes = 0;                  ///< rebuilds that turned the kept C_i instead of computing Z
