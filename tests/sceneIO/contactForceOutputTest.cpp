@@ -68,9 +68,11 @@ TEST(ContactForceOutput, TheForcesAreWhatChangesTheMomentum) {
 
 // At rest on the ground the contact forces carry the weight: after 0.8 s their sum is m g
 // upwards and nothing sideways (measured 0.9995 m g; tolerance 1%, above what the decaying
-// motion leaves). Implicit contact: with explicit contact the damping c h / m on the
-// cube's light corner vertices is above 2, they chatter with a period of two steps, and
-// the sum sampled at frames settles at 1.17 m g (which these stored forces showed).
+// motion leaves). Implicit contact: with explicit contact the bottom vertices keep a
+// contact force that alternates from step to step (a period-two-step oscillation, its
+// damping term clamping the force on alternate steps), and frames eight steps apart sample
+// one phase of it: their sum sat at 1.17 m g (at nine steps per frame it alternates
+// 1.009, 0.992 m g from frame to frame), which these stored forces showed.
 TEST(ContactForceOutput, AtRestTheGroundCarriesTheWeight) {
   Simulation simulation = buildSimulation(parseScene(cubeOnTheGround(true), "", "s.json"));
   for (int step = 0; step < 192; ++step) simulation.integrator->step();
@@ -89,6 +91,34 @@ TEST(ContactForceOutput, AtRestTheGroundCarriesTheWeight) {
     touching += force > 0.0 ? 1 : 0;
   }
   EXPECT_EQ(touching, 9);
+}
+
+// Explicit contact damping c, or friction's viscosity eta in its viscous regime, beyond
+// c h / m = 2 on the median boundary vertex (lumped mass 1/4 kg here) flips the vertices'
+// velocity every step: the scene is warned, naming the key, the ratio and the limit. At
+// c h / m = 1/3 (damping 20) or with implicit contact there is no such warning.
+TEST(ContactForceOutput, ExplicitDampingAndFrictionBeyondTheLimitAreWarned) {
+  json scene = cubeOnTheGround(false);
+  scene["contact"]["damping"] = 300;  // c h / m = 300 x (1/240) / (1/4) = 5
+  const Simulation warned = buildSimulation(parseScene(scene, "", "s.json"));
+  ASSERT_EQ(warned.warnings.size(), 1u);
+  const std::string& warning = warned.warnings.front();
+  EXPECT_NE(warning.find("s.json: contact.damping: 300 on a boundary vertex of median lumped mass 0.25"),
+            std::string::npos)
+      << warning;
+  EXPECT_NE(warning.find("c h / m = 5"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("below 120"), std::string::npos) << warning;
+  EXPECT_TRUE(buildSimulation(parseScene(cubeOnTheGround(false), "", "s.json")).warnings.empty());
+  scene["contact"]["implicit"] = true;
+  EXPECT_TRUE(buildSimulation(parseScene(scene, "", "s.json")).warnings.empty());
+  json friction = cubeOnTheGround(false);
+  friction["contact"]["friction"] = 0.5;  // the default viscosity 1e3: eta h / m = 16.7
+  const Simulation rubbing = buildSimulation(parseScene(friction, "", "s.json"));
+  ASSERT_EQ(rubbing.warnings.size(), 1u);
+  EXPECT_NE(rubbing.warnings.front().find("s.json: contact.frictionViscosity: 1000"), std::string::npos)
+      << rubbing.warnings.front();
+  friction["contact"]["frictionViscosity"] = 100;  // 1.67
+  EXPECT_TRUE(buildSimulation(parseScene(friction, "", "s.json")).warnings.empty());
 }
 
 // The forces go into the records bit for bit, frame by frame; the header says so.
