@@ -209,6 +209,50 @@ TEST_F(AfsimToolTest, VtuWritesTheChosenFramesAndACollection) {
   EXPECT_NE(text.find("Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\""), std::string::npos);
 }
 
+// intersections on two unit boxes 0.5 apart above the ground (16 vertices): at rest
+// nothing intersects; with the second box moved 1 along -x the two overlap; with both
+// moved 0.1 down they sink 0.1 below the ground without intersecting each other.
+TEST_F(AfsimToolTest, IntersectionsCountTrianglePairsAndTheContactDepthPerFrame) {
+  std::ofstream(folder_ / "boxes.json") << R"({
+    "objects": [
+      {"name": "a", "mesh": {"generator": "box", "size": [1, 1, 1], "cells": [1, 1, 1]}},
+      {"name": "b", "mesh": {"generator": "box", "size": [1, 1, 1], "cells": [1, 1, 1]}, "translation": [1.5, 0, 0]}
+    ],
+    "contact": {"ground": {"height": 0}},
+    "integrator": {"name": "backward-euler", "timestep": 0.05},
+    "frames": {"rate": 20, "count": 3}
+  })";
+  asyncfem::SimulationFileHeader header;
+  header.numVertices = 16;
+  header.frameInterval = 0.05;
+  {
+    asyncfem::SimulationWriter writer(folder_ / "boxes.afsim", header);
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(48);
+    writer.appendFrame(0.05, u);
+    for (int v = 8; v < 16; ++v) u[3 * v] = -1.0;
+    writer.appendFrame(0.1, u);
+    u.setZero();
+    for (int v = 0; v < 16; ++v) u[(3 * v) + 1] = -0.1;
+    writer.appendFrame(0.15, u);
+  }
+  const RunResult r = run("intersections boxes.afsim --scene boxes.json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const std::vector<std::string> lines = split(r.out, '\n');
+  ASSERT_GE(lines.size(), 4U) << r.out;
+  EXPECT_EQ(lines[0], "frame,time,bodyPairs,obstaclePairs,contactDepth");
+  EXPECT_EQ(lines[1], "0,0.05,0,0,0");
+  const std::vector<std::string> overlapping = split(lines[2], ',');
+  ASSERT_EQ(overlapping.size(), 5U);
+  EXPECT_GT(std::stoi(overlapping[2]), 0) << lines[2];
+  EXPECT_EQ(lines[3], "2,0.15,0,0,0.1");
+  EXPECT_NE(r.err.find("intersections: 1 of 3 frames have intersecting triangles"), std::string::npos) << r.err;
+  // A file that records no scene needs one.
+  const RunResult noScene = run("intersections boxes.afsim");
+  EXPECT_EQ(noScene.exitCode, 1);
+  EXPECT_NE(noScene.err.find("boxes.afsim records no scene: give it with --scene SCENE.json"), std::string::npos)
+      << noScene.err;
+}
+
 TEST_F(AfsimToolTest, ErrorsNameWhatIsWrong) {
   const std::vector<std::pair<std::string, std::string>> cases{
       {"csv run.afsim --vertices 3,12", "vertex 12 is out of range: run.afsim has 12 vertices (ids 0 to 11)"},

@@ -4,14 +4,17 @@
 //   afsimTool info SIM.afsim
 //   afsimTool csv SIM.afsim --vertices 12,40 [--frames 0:100] [--mesh MESH | --scene SCENE.json] [-o FILE.csv]
 //   afsimTool vtu SIM.afsim (--mesh MESH | --scene SCENE.json) [--frames 10,20] [-o DIR] [--encoding binary|ascii]
+//   afsimTool intersections SIM.afsim [--scene SCENE.json] [--frames 0:100]
 //
 // info prints the header, the frame times, the fast vertices of the first and last frame
 // when the records carry region ratios, whether every record's checksum matches (else
 // the first bad frame, exit status 1) and the run's checkpoint when one lies next to the
 // file. csv writes one row per frame: index, time and the chosen vertices' displacement
 // (and rest + displacement positions with a mesh). vtu writes DIR/frame_NNNNN.vtu per
-// chosen frame and DIR/frames.pvd. Errors print "afsimTool: <message>" on stderr and exit
-// with status 1. Described in docs/simulation-output.md, section "Getting results out".
+// chosen frame and DIR/frames.pvd. intersections checks every chosen frame's surfaces exactly
+// (intersections.hpp): intersecting triangle pairs between and within the bodies and against
+// mesh obstacles, and the deepest penetration of the analytic obstacles. Errors print "afsimTool: <message>" on stderr
+// and exit with status 1. Described in docs/simulation-output.md, section "Getting results out".
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
@@ -31,6 +34,8 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "intersections.hpp"
 
 namespace {
 
@@ -291,6 +296,13 @@ int run(int argc, char** argv) {
   vtuCommand->add_option("--encoding", options.encoding, "binary (raw appended, default) or ascii")
       ->check(CLI::IsMember({"binary", "ascii"}));
 
+  CLI::App* intersectionsCommand = app.add_subcommand(
+      "intersections", "Per frame: intersecting surface triangle pairs and the deepest obstacle penetration (CSV)");
+  intersectionsCommand->add_option("simulation", options.simulation, "The .afsim file")->required();
+  intersectionsCommand->add_option("--scene", options.scene,
+                                   "The scene that produced the file (default: the recorded one)");
+  intersectionsCommand->add_option("--frames", options.frames, "Frames, start:stop:step or a comma list (default all)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -298,6 +310,8 @@ int run(int argc, char** argv) {
   }
   if (infoCommand->parsed()) return info(options);
   if (csvCommand->parsed()) return csv(options);
+  if (intersectionsCommand->parsed())
+    return afsimtool::intersections(options.simulation, options.scene, options.frames);
   return vtu(options);
 }
 

@@ -164,10 +164,14 @@ double PenaltyContact::energy(double time, const Eigen::VectorXd& displacement) 
 }
 
 double PenaltyContact::maxPenetration(const Eigen::VectorXd& displacement) const {
+  return maxPenetration(0.0, displacement);
+}
+
+double PenaltyContact::maxPenetration(double time, const Eigen::VectorXd& displacement) const {
   double worst = 0.0;
   forEachContact(displacement, nullptr,
                  [&](int, double depth, const Eigen::Vector3d&, double) { worst = std::max(worst, depth); });
-  return surfaces_ ? std::max(worst, surfaces_->maxDepth(0.0, displacement)) : worst;
+  return surfaces_ ? std::max(worst, surfaces_->maxDepth(time, displacement)) : worst;
 }
 
 std::vector<int> PenaltyContact::verticesWithin(const Eigen::VectorXd& displacement, double margin) const {

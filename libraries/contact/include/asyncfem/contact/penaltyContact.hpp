@@ -96,7 +96,10 @@ class PenaltyContact {
   /// their obstacles: the normal spring's force is minus its gradient, so with it the
   /// contact forces do no net work (damping, the clamp and friction only dissipate).
   double energy(const Eigen::VectorXd& displacement) const;
-  /// Largest penetration depth over all vertices and obstacles at u (0 if none).
+  /// Largest penetration depth over all vertices and obstacles at u (0 if none): below the
+  /// planes and spheres, and into the surfaces' contact layer (SurfaceContact::maxDepth,
+  /// moving obstacles where they are at t; the overload without a time at t = 0).
+  double maxPenetration(double time, const Eigen::VectorXd& displacement) const;
   double maxPenetration(const Eigen::VectorXd& displacement) const;
   /// Number of vertices in contact at u.
   int activeContacts(const Eigen::VectorXd& displacement) const;
