@@ -35,6 +35,7 @@ std::vector<ShippedCase> shippedCases() {
           {"beam/beam-single-rate.json", M::corotational},
           {"beam/beam.json", M::neoHookean},
           {"bowl/bowl.json", M::corotational},
+          {"collision/curl.json", M::neoHookean},
           {"collision/headOn.json", M::stvk},
           {"collision/stack.json", M::stvk},
           {"dinosaur/dinosaur.json", M::stvk},
