@@ -23,6 +23,27 @@ def test_run_scene_writes_what_it_returns(tmp_path):
     assert frames[1].reshape(-1, 3)[:, 1].min() < 0  # pulled down
 
 
+def test_run_scene_stores_what_the_scene_output_asks_for(tmp_path):
+    """A scene with output.velocities and output.contactForces: the records carry both, and
+    a cube released above the ground ends up pushed up by it."""
+    scene = tmp_path / "cube.json"
+    scene.write_text(
+        '{"objects": [{"name": "cube", "translation": [0, 0.002, 0], "mesh": {"generator": "box",'
+        ' "size": [0.2, 0.2, 0.2], "cells": [2, 2, 2]}}], "gravity": [0, -9.81, 0],'
+        ' "contact": {"ground": {"height": 0}, "stiffness": 2e3, "damping": 20, "implicit": true},'
+        ' "output": {"velocities": true, "contactForces": true},'
+        ' "integrator": {"name": "backward-euler", "timestep": 0.004166666666666667},'
+        ' "frames": {"rate": 30, "count": 4}}')
+    output = tmp_path / "cube.afsim"
+    frames = af.run_scene(scene, output=output)
+    reader = af.SimulationReader(output)
+    assert reader.header.has_velocities and reader.header.has_contact_forces
+    last = reader.read_frame(3)
+    np.testing.assert_array_equal(last.displacement, frames[3])
+    assert last.velocity.size == frames.shape[1]
+    assert last.contact_force.reshape(-1, 3)[:, 1].sum() > 0  # the ground pushes up
+
+
 def test_run_scene_errors(tmp_path):
     with pytest.raises(ValueError, match="frames"):
         af.run_scene(SCENE, frames=0)

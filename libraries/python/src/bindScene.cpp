@@ -221,13 +221,17 @@ void bindScene(py::module_& module) {
           header.numVertices = simulation.mesh->numVertices();
           header.frameInterval = simulation.timing.frameInterval;
           header.timestep = simulation.timing.timestep;
+          // The records the scene's output asks for, as offlineSimulator writes them.
+          header.hasVelocities = scene.output.velocities;
+          describeRegionOutput(scene, simulation, header);
+          describeContactForceOutput(scene, simulation, header);
           writer = std::make_unique<SimulationWriter>(*output, header);
         }
         displacements.resize(simulation.mesh->numDofs(), simulation.timing.frameCount);
         for (int frame = 0; frame < simulation.timing.frameCount; ++frame) {
           advanceFrame(simulation, frame);
           displacements.col(frame) = simulation.integrator->displacement();
-          if (writer) writer->appendFrame(simulation.integrator->time(), simulation.integrator->displacement());
+          if (writer) appendSimulationFrame(*writer, simulation);
         }
         py::gil_scoped_acquire gil;
         return py::array_t<double>(py::cast(Eigen::MatrixXd(displacements.transpose())));
@@ -235,7 +239,8 @@ void bindScene(py::module_& module) {
       py::arg("path"), py::arg("output") = py::none(), py::arg("frames") = py::none(),
       py::arg("integrator") = py::none(),
       "Runs a scene file as offlineSimulator does (without checkpoints): returns the (frames, 3n) "
-      "displacements after each frame and writes them to output (.afsim) if given. integrator replaces "
+      "displacements after each frame and writes them to output (.afsim) if given, with the velocities, contact "
+      "forces and region ratios the scene's output asks for. integrator replaces "
       "the scene's (its options that the new one does not read are dropped).");
 }
 
