@@ -66,6 +66,25 @@ def test_async_with_ratio_one_is_backward_euler(beam):
     np.testing.assert_allclose(one.displacement, reference.displacement, rtol=0, atol=1e-9 * scale)
 
 
+def test_z_from_the_regions_modes(beam):
+    """AsyncOptions.z_solve: Z from the tip's modes gives the steps Z by substitution gives, to
+    round-off (1e-10 of the motion; the two paths round differently)."""
+    system, _, _ = linear_system(beam, fixed_set="root", external_force=downward_pull(beam, "tip"))
+    tip = af.region_vertices(beam, element_sets=["tip"])
+    runs = {}
+    for z_solve in (af.ZSolve.substitution, af.ZSolve.modes):
+        options = af.AsyncOptions()
+        options.z_solve = z_solve
+        assert options.z_solve == z_solve
+        integrator = af.AsyncBackwardEuler(beam, system, 0.01, [af.AsyncRegion("tip", tip, 16)], options)
+        integrator.step(4)
+        assert integrator.z_modal_regions == (1 if z_solve == af.ZSolve.modes else 0)
+        runs[z_solve] = integrator.displacement
+    scale = np.abs(runs[af.ZSolve.substitution]).max()
+    assert scale > 0
+    np.testing.assert_allclose(runs[af.ZSolve.modes], runs[af.ZSolve.substitution], rtol=0, atol=1e-10 * scale)
+
+
 def test_proposed_regions(beam):
     """The stiff, light tip of the generated beam is proposed as a fast region (its element
     frequencies are about sqrt(50e6/200 / (1e6/1000)) = 16 times the body's)."""

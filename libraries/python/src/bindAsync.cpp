@@ -127,6 +127,12 @@ void bindAsyncOptions(py::module_& module) {
       .value("automatic", RecoveryMode::automatic)
       .value("substitution", RecoveryMode::substitution)
       .value("dense_z", RecoveryMode::denseZ);
+  py::enum_<ZSolve>(module, "ZSolve",
+                    "How a set-up computes each region's Z and Schur correction: automatic (by flop price), "
+                    "substitution (m |I| solves) or modes (one dense eigendecomposition of the region)")
+      .value("automatic", ZSolve::automatic)
+      .value("substitution", ZSolve::substitution)
+      .value("modes", ZSolve::modes);
   py::enum_<AsyncCoupling>(module, "AsyncCoupling",
                            "stable (energy never grows, the default) or paper (the publication's coupling)")
       .value("stable", AsyncCoupling::stable)
@@ -152,6 +158,8 @@ void bindAsyncOptions(py::module_& module) {
       .def_readwrite("schur", &AsyncOptions::schur)
       .def_readwrite("method", &AsyncOptions::method)
       .def_readwrite("recovery", &AsyncOptions::recovery)
+      .def_readwrite("z_solve", &AsyncOptions::zSolve,
+                     "ZSolve: Z by substitution or from the regions' modes (scene key zSolve)")
       .def_readwrite("nested_solve", &AsyncOptions::nestedSolve,
                      "how the hierarchy solve solves (regions that touch or nest, or method hierarchy)")
       .def_readwrite("region_solver", &AsyncOptions::regionSolver)
@@ -247,6 +255,9 @@ void bindAsyncIntegrator(py::module_& module) {
       .def_property_readonly("schur_asymmetry", &AsyncBackwardEuler::schurAsymmetry)
       .def_property_readonly("z_column_seconds", &AsyncBackwardEuler::zColumnSeconds)
       .def_property_readonly("schur_mode_used", &AsyncBackwardEuler::schurModeUsed)
+      .def_property_readonly(
+          "z_modal_regions", [](const AsyncBackwardEuler& a) { return a.runStats().zModalRegions; },
+          "regions whose Z came from their modes in the last set-up or rebuild (AsyncOptions.z_solve)")
       .def("solve_floor_seconds", &AsyncBackwardEuler::solveFloorSeconds, py::arg("repeats") = 5,
            py::call_guard<py::gil_scoped_release>(),
            "seconds of the solves one large step cannot avoid (median of repeats), the floor a step is compared with")
