@@ -107,17 +107,20 @@ RunOutput openOutput(const CommandLine& options, const asyncfem::Scene& scene, a
 void writeFrame(RunOutput& output, const asyncfem::Scene& scene, const asyncfem::Simulation& simulation, int frame,
                 RunRecord& record) {
   const asyncfem::Integrator& integrator = *simulation.integrator;
-  asyncfem::appendSimulationFrame(*output.writer, simulation);
+  const bool vtuFrame = output.vtuSeries && frame % scene.output.vtuEvery == 0;
+  // The contact forces once, for the record and the .vtu.
+  Eigen::VectorXd forces;
+  if (scene.output.contactForces) forces = asyncfem::contactForces(simulation);
+  asyncfem::appendSimulationFrame(*output.writer, simulation, scene.output.contactForces ? &forces : nullptr);
   const int done = frame + 1;
   const double sinceLast =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - output.lastCheckpoint).count();
   if (record.schedule.due(done, sinceLast) || done == simulation.timing.frameCount || stopSignal() != 0) {
     output.checkpoint(simulation, done, scene.output.sync, record);
   }
-  if (output.vtuSeries && frame % scene.output.vtuEvery == 0) {
+  if (vtuFrame) {
     std::vector<asyncfem::VtuArray> pointArrays;
     if (scene.output.contactForces) {
-      const Eigen::VectorXd forces = asyncfem::contactForces(simulation);
       pointArrays.push_back({"contactForce", 3, std::vector<double>(forces.data(), forces.data() + forces.size())});
     }
     output.vtuSeries->writeFrame(frame, integrator.time(), *simulation.mesh, integrator.displacement(), pointArrays);

@@ -508,17 +508,16 @@ Eigen::VectorXd contactForces(const Simulation& simulation) {
   return forces;
 }
 
-void appendSimulationFrame(SimulationWriter& writer, const Simulation& simulation) {
+void appendSimulationFrame(SimulationWriter& writer, const Simulation& simulation,
+                           const Eigen::VectorXd* contactForce) {
   const Integrator& integrator = *simulation.integrator;
   const SimulationFileHeader& header = writer.header();
   FrameArrays arrays;
   std::vector<int> ratios;
   Eigen::VectorXd forces;
   if (header.hasVelocities) arrays.velocity = &integrator.velocity();
-  if (header.hasContactForces) {
-    forces = contactForces(simulation);
-    arrays.contactForce = &forces;
-  }
+  if (header.hasContactForces && contactForce == nullptr) forces = contactForces(simulation);
+  if (header.hasContactForces) arrays.contactForce = contactForce != nullptr ? contactForce : &forces;
   if (header.hasRegionRatios) {
     ratios = vertexStepRatios(integrator, static_cast<int>(header.numVertices));
     arrays.regionRatios = &ratios;

@@ -71,6 +71,7 @@ class ScopedBlasThreads {
       return;
     }
     previous_ = get();
+    current_ = previous_;
     hold(true);
   }
   ~ScopedBlasThreads() { hold(false); }
@@ -89,19 +90,14 @@ class ScopedBlasThreads {
   /// The BLAS runs on min(threads, previous count) threads (at least 1) until the next
   /// allow() or hold(); the destructor gives the previous count back.
   void allow(int threads) {
-    if (set_ == nullptr) return;
     const int count = std::max(1, std::min(threads, previous_));
+    if (set_ == nullptr || count == current_) return;  // nothing to change
     set_(count);
-    held_ = count < previous_;
+    current_ = count;
   }
   /// true: the BLAS runs on at most the constructor's count (as after construction);
-  /// false: on its previous count again, until the next hold(true). For a sequence of calls
-  /// of which only the largest gain from the BLAS's threads (a supernodal factorization).
-  void hold(bool held) {
-    if (set_ == nullptr || previous_ <= threads_ || held == held_) return;  // nothing to change
-    set_(held ? threads_ : previous_);
-    held_ = held;
-  }
+  /// false: on its previous count again, until the next hold(true).
+  void hold(bool held) { allow(held ? threads_ : previous_); }
 
  private:
   // A function of the process's libraries by name, or null (copied from dlsym's object
@@ -140,7 +136,7 @@ class ScopedBlasThreads {
   void (*set_)(int) = nullptr;
   int threads_ = 1;
   int previous_ = 0;
-  bool held_ = false;
+  int current_ = 0;  // the count this guard last set (previous_ until it sets one)
 };
 
 }  // namespace asyncfem

@@ -130,8 +130,10 @@ Eigen::VectorXd contactForces(const Simulation& simulation);
 
 /// Appends the simulation's current state (time, displacement) as the next frame of
 /// writer, with the velocities, contact forces (contactForces()) and region ratios
-/// (vertexStepRatios) its header asks for.
-void appendSimulationFrame(SimulationWriter& writer, const Simulation& simulation);
+/// (vertexStepRatios) its header asks for. contactForce: contactForces(simulation) where the
+/// caller has it already (null: evaluated here when the header asks for it).
+void appendSimulationFrame(SimulationWriter& writer, const Simulation& simulation,
+                           const Eigen::VectorXd* contactForce = nullptr);
 
 /// Advances the simulation by one frame (stepsPerFrame steps) under its RunMonitor, the
 /// frame's start being a restart point of the integrator (Integrator::restartPoint(), which
