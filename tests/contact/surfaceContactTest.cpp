@@ -40,6 +40,15 @@ SurfaceContact bodies(double gap, double thickness, double damping = 0.0, double
   return SurfaceContact(twoTets(gap), kTwoObjects, {}, options, 1000.0, damping, friction, 10.0);
 }
 
+// Velocities in [-1, 1] for the two tets' eight vertices.
+Eigen::VectorXd randomVelocities(unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> noise(-1.0, 1.0);
+  Eigen::VectorXd v(24);
+  for (Eigen::Index i = 0; i < v.size(); ++i) v[i] = noise(random);
+  return v;
+}
+
 TEST(SurfaceContact, VertexUnderAFacePushesApartWithStiffnessTimesDepth) {
   // Vertex 3 at height 0, B's bottom face at 0.05: gap 0.05 in a layer of 0.1.
   const SurfaceContact contact = bodies(0.05, 0.1);
@@ -151,10 +160,7 @@ TEST(SurfaceContact, CoupledJacobianIsTheForceDerivativeWithItsOffDiagonalBlocks
 
 TEST(SurfaceContact, ForcesBetweenBodiesSumToZeroWithDampingAndFriction) {
   const SurfaceContact contact = bodies(0.02, 0.3, 50.0, 0.4);
-  std::mt19937 random(11);
-  std::uniform_real_distribution<double> noise(-1.0, 1.0);
-  Eigen::VectorXd v(24);
-  for (Eigen::Index i = 0; i < v.size(); ++i) v[i] = noise(random);
+  const Eigen::VectorXd v = randomVelocities(11);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(24);
   contact.addForces(0.0, Eigen::VectorXd::Zero(24), v, f);
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
@@ -213,6 +219,49 @@ TEST(SurfaceContact, AVertexBehindAClosedObstacleFaceIsPushedOut) {
   f.setZero();
   open.addForces(0.0, Eigen::VectorXd::Zero(12), Eigen::VectorXd::Zero(12), f);
   EXPECT_NEAR(f[1], -1000 * (0.05 - 0.02), 1e-9);
+}
+
+TEST(SurfaceContact, TheRanksSplitTheForceAndItsCouplingsIntoWholePairs) {
+  // B lowered into A's top so that several pairs are active (vertex-face, edge-edge), with
+  // damping and friction; the ranks put the tets' vertices in three groups, so that pairs
+  // join vertices of different ranks. Summed over the ranks present, the forces are addForces' (each pair's force
+  // computed alike, added in another order: round-off of a few terms), and each rank's forces sum to zero (whole pairs,
+  // every vertex of them, whatever its rank).
+  const SurfaceContact contact = bodies(0.02, 0.3, 50.0, 0.4);
+  const Eigen::VectorXd v = randomVelocities(5);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(24);
+  for (int vertex = 4; vertex < 8; ++vertex) u[3 * vertex + 1] = -0.1;  // B lowered into A's top
+  ASSERT_GE(contact.pairs(0.0, u).size(), 3U);
+  Eigen::VectorXd whole = Eigen::VectorXd::Zero(24);
+  contact.addForces(0.0, u, v, whole);
+  const std::vector<int> rank{1, 0, 2, 0, 0, 1, 0, 0};
+  Eigen::VectorXd summed = Eigen::VectorXd::Zero(24);
+  std::size_t couplings = 0;
+  int ranksWithForce = 0;
+  for (int owner = 0; owner <= 2; ++owner) {
+    Eigen::VectorXd part = Eigen::VectorXd::Zero(24);
+    contact.addForcesOfRank(0.0, u, v, rank, owner, part);
+    EXPECT_LE(part.reshaped(3, 8).rowwise().sum().norm(), 1e-13 * (1.0 + part.norm())) << "rank " << owner;
+    if (part.norm() > 0.0) ++ranksWithForce;
+    summed += part;
+    VertexJacobian jacobian;
+    contact.addCoupledJacobianOfRank(0.0, u, v, rank, owner, jacobian);
+    for (const VertexCoupling& coupling : jacobian.couplings) {
+      int highest = -1;
+      for (const int vertex : coupling.vertices)
+        if (vertex >= 0) highest = std::max(highest, rank[static_cast<std::size_t>(vertex)]);
+      EXPECT_EQ(highest, owner);
+    }
+    couplings += jacobian.couplings.size();
+  }
+  ASSERT_GT(whole.norm(), 0.0);
+  EXPECT_GE(ranksWithForce, 2);  // the split is not trivial
+  EXPECT_LE((summed - whole).cwiseAbs().maxCoeff(), 1e-13 * whole.cwiseAbs().maxCoeff());
+  VertexJacobian all;
+  contact.addCoupledJacobian(0.0, u, v, all);
+  EXPECT_EQ(couplings, all.couplings.size());
+  Eigen::VectorXd part = Eigen::VectorXd::Zero(24);
+  EXPECT_THROW(contact.addForcesOfRank(0.0, u, v, {0, 1}, 0, part), ValidationError);
 }
 
 TEST(SurfaceContact, ReusedCandidateListsGiveTheSameForces) {

@@ -156,6 +156,8 @@ DynamicSystem homogeneousLinearSystem(const DynamicSystem& system) {
   out.externalForce = nullptr;
   out.externalForceJacobian = nullptr;
   out.externalForceAt = nullptr;
+  out.externalForceOfRank = nullptr;
+  out.externalForceJacobianOfRank = nullptr;
   out.externalForceJacobianAt = nullptr;
   out.stateDependentOnlyInContact = false;
   if (!system.forceModel->isLinear()) {

@@ -77,6 +77,19 @@ double PenaltyContact::energy(const Eigen::VectorXd& displacement) const { retur
 
 void PenaltyContact::addForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                                Eigen::VectorXd& forces, const std::vector<int>* vertices) const {
+  addPrimitiveForces(displacement, velocity, forces, vertices);
+  if (surfaces_) surfaces_->addForces(time, displacement, velocity, forces, vertices);
+}
+
+void PenaltyContact::addForcesOfRank(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                     const std::vector<int>& vertices, const std::vector<int>& rank, int owner,
+                                     Eigen::VectorXd& forces) const {
+  addPrimitiveForces(displacement, velocity, forces, &vertices);
+  if (surfaces_) surfaces_->addForcesOfRank(time, displacement, velocity, rank, owner, forces);
+}
+
+void PenaltyContact::addPrimitiveForces(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                        Eigen::VectorXd& forces, const std::vector<int>* vertices) const {
   const PenaltyContactParameters& p = parameters_;
   forEachContact(displacement, vertices, [&](int v, double depth, const Eigen::Vector3d& normal, double) {
     const Eigen::Vector3d vel = velocity.segment<3>(3 * v);
@@ -93,7 +106,6 @@ void PenaltyContact::addForces(double time, const Eigen::VectorXd& displacement,
     }
     forces.segment<3>(3 * v) += f;
   });
-  if (surfaces_) surfaces_->addForces(time, displacement, velocity, forces, vertices);
 }
 
 PenaltyContactJacobian PenaltyContact::jacobian(double time, const Eigen::VectorXd& displacement,
@@ -101,6 +113,14 @@ PenaltyContactJacobian PenaltyContact::jacobian(double time, const Eigen::Vector
                                                 const std::vector<int>* vertices) const {
   PenaltyContactJacobian out = primitiveJacobian(displacement, velocity, vertices);
   if (surfaces_) surfaces_->addJacobian(time, displacement, velocity, out, vertices);
+  return out;
+}
+
+PenaltyContactJacobian PenaltyContact::jacobianOfRank(double time, const Eigen::VectorXd& displacement,
+                                                      const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
+                                                      const std::vector<int>& rank, int owner) const {
+  PenaltyContactJacobian out = primitiveJacobian(displacement, velocity, &vertices);
+  if (surfaces_) surfaces_->addCoupledJacobianOfRank(time, displacement, velocity, rank, owner, out);
   return out;
 }
 

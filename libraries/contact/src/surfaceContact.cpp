@@ -5,6 +5,8 @@
 #include <asyncfem/core/error.hpp>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <string>
 
 namespace asyncfem {
@@ -264,12 +266,13 @@ std::shared_ptr<const SurfaceContact::Candidates> SurfaceContact::candidatesFor(
 }
 
 void SurfaceContact::narrowPhase(const Candidates& candidates, const Points& points, double distance,
-                                 std::vector<SurfacePair>& out) const {
+                                 std::vector<SurfacePair>& out, const CandidateFilter* keep) const {
   const double limit = distance * distance;
   // Below this the gradient's direction is lost in round-off (q / d is 0 / 0).
   const double smallest = 1e-12 * options_.thickness;
   for (std::size_t k = 0; k < candidates.pointTriangle.size(); ++k) {
     const std::array<int, 4>& ids = candidates.pointTriangle[k];
+    if (keep != nullptr && !(*keep)(ids)) continue;
     const Eigen::Vector3d p = points(ids[0]), a = points(ids[1]), b = points(ids[2]), c = points(ids[3]);
     const double q = pointTriangleDistanceSquared(p, a, b, c);
     if (!(q < limit) || !(q > smallest * smallest)) continue;
@@ -280,6 +283,7 @@ void SurfaceContact::narrowPhase(const Candidates& candidates, const Points& poi
     if (countsOnce(pair, candidates.pointTriangleIndex[k], q, points)) out.push_back(pair);
   }
   for (const std::array<int, 4>& ids : candidates.edgeEdge) {
+    if (keep != nullptr && !(*keep)(ids)) continue;
     const Eigen::Vector3d a0 = points(ids[0]), a1 = points(ids[1]), b0 = points(ids[2]), b1 = points(ids[3]);
     const double q = edgeEdgeDistanceSquared(a0, a1, b0, b1);
     if (!(q < limit) || !(q > smallest * smallest)) continue;
@@ -293,14 +297,14 @@ void SurfaceContact::narrowPhase(const Candidates& candidates, const Points& poi
   }
 }
 
-std::vector<SurfacePair> SurfaceContact::activePairs(double time, const Eigen::VectorXd& displacement,
-                                                     Points* points) const {
+std::vector<SurfacePair> SurfaceContact::activePairs(double time, const Eigen::VectorXd& displacement, Points* points,
+                                                     const CandidateFilter* keep) const {
   const Clock::time_point start = Clock::now();
   Points local = pointsAt(time, displacement);
   Points& at = points != nullptr ? (*points = std::move(local)) : local;
   const std::shared_ptr<const Candidates> candidates = candidatesFor(at);
   std::vector<SurfacePair> pairs;
-  narrowPhase(*candidates, at, options_.thickness, pairs);
+  narrowPhase(*candidates, at, options_.thickness, pairs, keep);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   std::lock_guard<std::mutex> lock(mutex_);
   stats_.detectionSeconds += seconds;
@@ -332,17 +336,30 @@ class VertexFilter {
 
 }  // namespace
 
-void SurfaceContact::addForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                               Eigen::VectorXd& forces, const std::vector<int>* vertices) const {
+SurfaceContact::CandidateFilter SurfaceContact::ownedBy(const std::vector<int>& rank, int owner) const {
+  const int n = static_cast<int>(rest_.cols());
+  if (rank.size() != static_cast<std::size_t>(n))
+    throw ValidationError("surface contact: " + std::to_string(rank.size()) + " vertex ranks for " + std::to_string(n) +
+                          " vertices");
+  return [&rank, owner, n](const std::array<int, 4>& points) {
+    int highest = std::numeric_limits<int>::min();
+    for (const int id : points)
+      if (id < n) highest = std::max(highest, rank[static_cast<std::size_t>(id)]);
+    return highest == owner;
+  };
+}
+
+template <class Wanted>
+void SurfaceContact::addPairForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                   Eigen::VectorXd& forces, const CandidateFilter* keep, Wanted&& wanted) const {
   Points points;
-  const std::vector<SurfacePair> found = activePairs(time, displacement, &points);
+  const std::vector<SurfacePair> found = activePairs(time, displacement, &points, keep);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ++stats_.evaluations;
     stats_.activePairs += static_cast<long long>(found.size());
     stats_.largestActive = std::max(stats_.largestActive, static_cast<long long>(found.size()));
   }
-  const VertexFilter wanted(vertices, static_cast<int>(rest_.cols()));
   for (const SurfacePair& pair : found) {
     Eigen::Vector3d relative = Eigen::Vector3d::Zero();
     for (int i = 0; i < 4; ++i)
@@ -363,6 +380,19 @@ void SurfaceContact::addForces(double time, const Eigen::VectorXd& displacement,
         forces.segment<3>(3 * static_cast<Eigen::Index>(id)) += pair.weights[static_cast<std::size_t>(i)] * f;
     }
   }
+}
+
+void SurfaceContact::addForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                               Eigen::VectorXd& forces, const std::vector<int>* vertices) const {
+  const VertexFilter wanted(vertices, static_cast<int>(rest_.cols()));
+  addPairForces(time, displacement, velocity, forces, nullptr, wanted);
+}
+
+void SurfaceContact::addForcesOfRank(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                     const std::vector<int>& rank, int owner, Eigen::VectorXd& forces) const {
+  const int n = static_cast<int>(rest_.cols());
+  const CandidateFilter keep = ownedBy(rank, owner);
+  addPairForces(time, displacement, velocity, forces, &keep, [n](int id) { return id < n; });
 }
 
 void SurfaceContact::addJacobian(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
@@ -393,10 +423,10 @@ void SurfaceContact::addJacobian(double time, const Eigen::VectorXd& displacemen
   }
 }
 
-void SurfaceContact::addCoupledJacobian(double time, const Eigen::VectorXd& displacement,
-                                        const Eigen::VectorXd& velocity, VertexJacobian& jacobian) const {
+void SurfaceContact::addPairCouplings(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                      VertexJacobian& jacobian, const CandidateFilter* keep) const {
   Points points;
-  const std::vector<SurfacePair> found = activePairs(time, displacement, &points);
+  const std::vector<SurfacePair> found = activePairs(time, displacement, &points, keep);
   const int n = static_cast<int>(rest_.cols());
   for (const SurfacePair& pair : found) {
     Eigen::Vector3d relative = Eigen::Vector3d::Zero();
@@ -416,6 +446,18 @@ void SurfaceContact::addCoupledJacobian(double time, const Eigen::VectorXd& disp
     coupling.damping = damping_;
     jacobian.couplings.push_back(coupling);
   }
+}
+
+void SurfaceContact::addCoupledJacobian(double time, const Eigen::VectorXd& displacement,
+                                        const Eigen::VectorXd& velocity, VertexJacobian& jacobian) const {
+  addPairCouplings(time, displacement, velocity, jacobian, nullptr);
+}
+
+void SurfaceContact::addCoupledJacobianOfRank(double time, const Eigen::VectorXd& displacement,
+                                              const Eigen::VectorXd& velocity, const std::vector<int>& rank, int owner,
+                                              VertexJacobian& jacobian) const {
+  const CandidateFilter keep = ownedBy(rank, owner);
+  addPairCouplings(time, displacement, velocity, jacobian, &keep);
 }
 
 double SurfaceContact::energy(double time, const Eigen::VectorXd& displacement) const {

@@ -35,6 +35,18 @@ void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen:
 
 void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                   const std::vector<int>& vertices, Eigen::VectorXd& forces) const {
+  addVertexLoads(time, vertices, forces);
+  if (contact_) contact_->addForces(time, displacement, velocity, forces, &vertices);
+}
+
+void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                  const std::vector<int>& vertices, const std::vector<int>& rank, int owner,
+                  Eigen::VectorXd& forces) const {
+  addVertexLoads(time, vertices, forces);
+  if (contact_) contact_->addForcesOfRank(time, displacement, velocity, vertices, rank, owner, forces);
+}
+
+void Loads::addVertexLoads(double time, const std::vector<int>& vertices, Eigen::VectorXd& forces) const {
   if (constant_.size() > 0)
     for (const int v : vertices) forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += constant_.segment<3>(3 * v);
   for (const VertexLoad& load : windows_) {
@@ -47,7 +59,6 @@ void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen:
       if (*at == v) forces.segment<3>(3 * static_cast<Eigen::Index>(v)) += load.perVertex;
     }
   }
-  if (contact_) contact_->addForces(time, displacement, velocity, forces, &vertices);
 }
 
 std::vector<double> Loads::breakpoints() const {

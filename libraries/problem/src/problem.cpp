@@ -183,6 +183,13 @@ DynamicSystem Problem::dynamicSystem() const {
                                         Eigen::VectorXd& forces) {
       external->addTo(time, displacement, velocity, vertices, forces);
     };
+    if (contact_ && contact_->surfaces()) {
+      system.externalForceOfRank = [external](double time, const Eigen::VectorXd& displacement,
+                                              const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
+                                              const std::vector<int>& rank, int owner, Eigen::VectorXd& forces) {
+        external->addTo(time, displacement, velocity, vertices, rank, owner, forces);
+      };
+    }
     // Gravity is constant and contact depends on the state only; the windows open and
     // close at their bounds. A bound within a millionth of the interval of it counts as
     // inside, so that the snapping of bounds to step times never makes the answer wrong.
@@ -213,6 +220,12 @@ DynamicSystem Problem::dynamicSystem() const {
             jacobian = contact->jacobian(time, displacement, velocity, &vertices);
           };
       if (contact_->surfaces()) {
+        system.externalForceJacobianOfRank = [contact = contact_](
+                                                 double time, const Eigen::VectorXd& displacement,
+                                                 const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
+                                                 const std::vector<int>& rank, int owner, VertexJacobian& jacobian) {
+          jacobian = contact->jacobianOfRank(time, displacement, velocity, vertices, rank, owner);
+        };
         system.externalForceCoupledJacobian = [contact = contact_](double time, const Eigen::VectorXd& displacement,
                                                                    const Eigen::VectorXd& velocity,
                                                                    VertexJacobian& jacobian) {

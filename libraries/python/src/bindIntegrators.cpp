@@ -113,6 +113,8 @@ void bindIntegrators(py::module_& module) {
             // as constant over a large step (what a Problem's loads allowed).
             s.system.externalForceChanges = nullptr;
             s.system.externalForceAt = nullptr;
+            s.system.externalForceOfRank = nullptr;
+            s.system.externalForceJacobianOfRank = nullptr;
             s.system.stateDependentOnlyInContact = false;
             s.externalForce = callable;
           },

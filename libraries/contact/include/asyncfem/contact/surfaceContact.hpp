@@ -9,6 +9,7 @@
 #include <asyncfem/contact/meshObstacle.hpp>
 #include <asyncfem/core/vertexJacobian.hpp>
 #include <asyncfem/volumetricMesh/tetMesh.hpp>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -84,6 +85,14 @@ class SurfaceContact {
   /// given).
   void addForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                  Eigen::VectorXd& forces, const std::vector<int>* vertices = nullptr) const;
+  /// The forces of the pairs whose highest rank among their mesh vertices is owner
+  /// (rank: one integer per mesh vertex), added to every mesh vertex of those pairs: the
+  /// same values as addForces, so that adding every rank present gives addForces' sum. A
+  /// multirate integrator gives each pair to the finest rate among its vertices this way
+  /// (asyncIntegrator, "Contact between regions"). Throws ValidationError for a rank
+  /// list of the wrong size.
+  void addForcesOfRank(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                       const std::vector<int>& rank, int owner, Eigen::VectorXd& forces) const;
   /// Appends per-vertex blocks for an implicit step: for each pair with F > 0 and each of
   /// its mesh vertices i, stiffness k |w_i| S N N^T and damping c |w_i| S N N^T with
   /// S = sum of |w_j| over the pair's mesh vertices. These block-diagonal terms bound the
@@ -100,6 +109,9 @@ class SurfaceContact {
   /// (DynamicSystem::externalForceCoupledJacobian).
   void addCoupledJacobian(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                           VertexJacobian& jacobian) const;
+  /// addCoupledJacobian's couplings of the pairs of rank owner (as addForcesOfRank).
+  void addCoupledJacobianOfRank(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                const std::vector<int>& rank, int owner, VertexJacobian& jacobian) const;
   /// The potential sum k/2 (dhat - s)^2 over the pairs at time t and displacement u.
   double energy(double time, const Eigen::VectorXd& displacement) const;
   /// The largest dhat - s over the pairs (0 if none).
@@ -122,6 +134,9 @@ class SurfaceContact {
 
  private:
   struct Candidates;
+  /// Which candidate pairs (their four point ids) a query looks at; null: all.
+  using CandidateFilter = std::function<bool(const std::array<int, 4>&)>;
+
   /// Where the points are: mesh vertices (rest + u) and obstacle vertices at t.
   struct Points {
     Eigen::Matrix3Xd body;
@@ -136,9 +151,20 @@ class SurfaceContact {
   std::shared_ptr<const Candidates> detect(const Points& points, double distance) const;
   std::shared_ptr<const Candidates> candidatesFor(const Points& points) const;
   /// The pairs of candidates closer than distance.
-  void narrowPhase(const Candidates& candidates, const Points& points, double distance,
-                   std::vector<SurfacePair>& out) const;
-  std::vector<SurfacePair> activePairs(double time, const Eigen::VectorXd& displacement, Points* points) const;
+  void narrowPhase(const Candidates& candidates, const Points& points, double distance, std::vector<SurfacePair>& out,
+                   const CandidateFilter* keep = nullptr) const;
+  /// Whether a pair's highest mesh-vertex rank is owner (rank: one per mesh vertex, checked).
+  CandidateFilter ownedBy(const std::vector<int>& rank, int owner) const;
+  /// addCoupledJacobian's couplings of the active pairs among the candidates keep takes.
+  void addPairCouplings(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                        VertexJacobian& jacobian, const CandidateFilter* keep) const;
+  /// The forces of the active pairs among the candidates keep takes, added at the points
+  /// wanted(id) takes.
+  template <class Wanted>
+  void addPairForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                     Eigen::VectorXd& forces, const CandidateFilter* keep, Wanted&& wanted) const;
+  std::vector<SurfacePair> activePairs(double time, const Eigen::VectorXd& displacement, Points* points,
+                                       const CandidateFilter* keep = nullptr) const;
   /// Whether a vertex-triangle pair is its contact's one pair: when its closest point is an
   /// edge or corner of the triangle (to round-off), no other triangle through that feature is
   /// closer, it is the first of equally close ones, and two points count once.

@@ -40,6 +40,24 @@ using ExternalForceAtFunction =
     std::function<void(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                        const std::vector<int>& vertices, Eigen::VectorXd& forces)>;
 
+/// The terms of the external force that belong to one rank: given a rank per mesh vertex
+/// (rank, size n), a term belongs to the highest rank among the mesh vertices it acts on. Adds
+/// to forces the terms of rank owner: the per-vertex ones (loads, obstacle contact) at the
+/// listed vertices (ascending; the caller lists those of that rank), and every term that
+/// joins several mesh vertices (a surface contact pair between bodies or within one) on all
+/// of its vertices, whatever their ranks. Summed over the ranks present (each with its
+/// vertices), it is externalForce. What lets a multirate integrator evaluate a pair at the
+/// states of its finest vertex and give its slower vertices the matching impulse.
+using ExternalForceOfRankFunction = std::function<void(
+    double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
+    const std::vector<int>& rank, int owner, Eigen::VectorXd& forces)>;
+
+/// The derivatives of the terms externalForceOfRank takes for owner: the per-vertex terms'
+/// as per-vertex blocks, those that join vertices as VertexJacobian::couplings.
+using ExternalForceJacobianOfRankFunction = std::function<void(
+    double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
+    const std::vector<int>& rank, int owner, VertexJacobian& jacobian)>;
+
 /// externalForceJacobian at some vertices only: the entries of the listed vertices
 /// (ascending), in the order externalForceJacobian gives them.
 using ExternalForceJacobianAtFunction =
@@ -87,6 +105,15 @@ struct DynamicSystem {
   /// externalForceJacobian must reset or replace these too.
   ExternalForceAtFunction externalForceAt;
   ExternalForceJacobianAtFunction externalForceJacobianAt;
+  /// Optional: set where the external force has terms that join several mesh vertices
+  /// (surface contact). The asynchronous integrator then evaluates each such term at the
+  /// states of the finest rate among its vertices (docs/asynchronous-integrator.md,
+  /// "Contact between regions"); without it every vertex's force is taken at its own
+  /// rate's states, which is exact only for per-vertex terms. Whoever replaces externalForce
+  /// must reset or replace this too.
+  ExternalForceOfRankFunction externalForceOfRank;
+  /// With externalForceOfRank and externalForceJacobian: the derivatives of its terms.
+  ExternalForceJacobianOfRankFunction externalForceJacobianOfRank;
   /// Where the external force's obstacles are (penalty contact); empty without obstacles.
   ObstacleProximity obstacleProximity;
   /// true when externalForce depends on the state (u, v) only at vertices in contact with

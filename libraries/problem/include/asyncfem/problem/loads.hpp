@@ -43,6 +43,11 @@ class Loads {
   /// as addTo, added in the same order; the other entries are left as they are.
   void addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
              const std::vector<int>& vertices, Eigen::VectorXd& forces) const;
+  /// The terms of f_ext(t, u, v) of rank owner (PenaltyContact::addForcesOfRank): the
+  /// per-vertex loads and obstacle forces at the listed vertices (ascending) and the surface
+  /// contact pairs whose highest vertex rank is owner, on all their vertices.
+  void addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+             const std::vector<int>& vertices, const std::vector<int>& rank, int owner, Eigen::VectorXd& forces) const;
   /// Times at which the force changes (window bounds), sorted, unique, finite.
   std::vector<double> breakpoints() const;
   /// From this time on no load changes: the last finite window bound (0 when there is
@@ -61,6 +66,9 @@ class Loads {
   const std::shared_ptr<const PenaltyContact>& contact() const { return contact_; }
 
  private:
+  /// The constant part and the open windows at the listed vertices.
+  void addVertexLoads(double time, const std::vector<int>& vertices, Eigen::VectorXd& forces) const;
+
   Eigen::VectorXd constant_;
   std::vector<VertexLoad> windows_;
   std::shared_ptr<const PenaltyContact> contact_;
