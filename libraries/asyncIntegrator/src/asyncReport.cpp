@@ -34,7 +34,11 @@ void appendContactLines(const AsyncRunStats& r, int contactIterations, std::vect
   if (r.contactSteps == 0) return;
   lines.push_back(detail::contactLine(
       r, "", "iterations", contactIterations,
-      "A^S refactored " + std::to_string(r.contactRegionFactorizations) + " times for its contact blocks"));
+      "A^S refactored " + std::to_string(r.contactRegionFactorizations) + " times for its contact blocks" +
+          (r.contactPairBlocksDropped > 0 ? "; " + std::to_string(r.contactPairBlocksDropped) +
+                                                " steps stalled with the fast regions' surface-pair blocks and went on "
+                                                "without them"
+                                          : std::string())));
   char line[256];
   if (r.contactFreeSteps == 0 && r.contactScreenedSteps == 0) return;
   std::snprintf(line, sizeof(line),

@@ -36,8 +36,9 @@ void TwoLevelStepSolver::solveWithImplicitContact(double t0, double t1) {
     Impl& d;
     ~Restore() { d.contact.removeBlocks(d.largeSystem); }
   } restore{d};
-  const detail::ContactStep step{&system_, &partition_,       &displacement_,        &velocity_, t0, t1,
-                                 hL,       &d.regionVertices, certifiesContactFree()};
+  detail::ContactStep step{&system_, &partition_,       &displacement_,        &velocity_, t0, t1,
+                           hL,       &d.regionVertices, certifiesContactFree()};
+  if (system_.externalForceOfRank) step.ranked = &d.ranked;
   if (d.contact.start(step, d.rhsL, *d.externalL, d.regions, d.largeSystem)) ++runStats_.contactScreenedSteps;
   refactorContactRegions();
   // Rent or buy, as for the lagged factor: once the iterations that stale corrections cost
@@ -65,7 +66,9 @@ void TwoLevelStepSolver::solveWithImplicitContact(double t0, double t1) {
       for (int i = 0; i < partition_.numRegions(); ++i)
         if (!d.regions[static_cast<std::size_t>(i)].substituted) substituteRegion(i);
     }
+    const bool hadPairBlocks = !d.contact.droppedPairBlocks();
     const double residual = d.contact.update(d.regions, d.Y, d.largeSystem, d.rhsL);
+    if (hadPairBlocks && d.contact.droppedPairBlocks()) ++runStats_.contactPairBlocksDropped;
     refactorContactRegions();
     ++runStats_.contactIterations;
     if (!std::isfinite(residual)) {

@@ -78,6 +78,7 @@ void TwoLevelStepSolver::setUp() {
     runStats_.fastDofs += static_cast<int>(partition_.regionDofs(i).size());
     runStats_.interfaceDofs += static_cast<int>(partition_.interfaceDofs(i).size());
   }
+  if (system_.externalForceOfRank) d.ranked.setPartition(partition_, system_.freeDofs, d.regionVertices);
   if (distributed()) assignRegionOwners();
   if (d.model.linear && !d.build.stiffnessKnown) {
     // K is constant: evaluated for the first partition, kept for the next ones (whose steps
@@ -317,6 +318,10 @@ void TwoLevelStepSolver::gatherExternalForces(double t0, double t1) {
   const bool predict = options_.contact.substepStatePrediction || implicit;
   const bool constantInStep =
       hasExternal && !predict && system_.externalForceChanges && !system_.externalForceChanges(t0, t1);
+  if (hasExternal && predict && system_.externalForceOfRank) {
+    gatherRankedForces(t0, t1, implicit);
+    return;
+  }
   for (int i = 0; i < partition_.numRegions(); ++i) {
     FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
     const std::vector<int>& s = partition_.regionDofs(i);
@@ -358,6 +363,32 @@ void TwoLevelStepSolver::gatherExternalForces(double t0, double t1) {
   } else {
     d.externalL = hasExternal ? &d.forceAt(system_, t1, u0, u0, v0) : nullptr;
   }
+}
+
+// gatherExternalForces where the system splits its force by rank (surface contact): at
+// region i's substep r the whole body at its predicted state u_0 + r hS_i v_0, each term at
+// the states of its rank (detail::RankedForces); L's own terms at the predicted end state
+// (implicit contact) or at u_0.
+void TwoLevelStepSolver::gatherRankedForces(double t0, double t1, bool implicit) {
+  Impl& d = *impl_;
+  const Eigen::VectorXd& u0 = displacement_;
+  const Eigen::VectorXd& v0 = velocity_;
+  d.ranked.clear();
+  for (int i = 0; i < partition_.numRegions(); ++i) {
+    const FastRegion& rb = d.regions[static_cast<std::size_t>(i)];
+    for (int r = 1; r <= rb.ratio; ++r) {
+      d.predicted = u0 + (r * rb.smallStep) * v0;
+      d.ranked.addRegion(system_, i, r, substepTime(t0, t1, r, rb.ratio, rb.smallStep), d.predicted, v0);
+    }
+  }
+  if (implicit) d.predicted = u0 + timestep() * v0;
+  d.ranked.addLarge(system_, t1, implicit ? d.predicted : u0, v0);
+  for (int i = 0; i < partition_.numRegions(); ++i)
+    d.regions[static_cast<std::size_t>(i)].external = d.ranked.region[static_cast<std::size_t>(i)];
+  d.rankedL.setZero(u0.size());
+  const std::vector<int>& large = partition_.largeDofs();
+  for (std::size_t k = 0; k < large.size(); ++k) d.rankedL[large[k]] = d.ranked.large[static_cast<Eigen::Index>(k)];
+  d.externalL = &d.rankedL;
 }
 
 // Solve counts and flops, totalled over the solvers (Z columns included).

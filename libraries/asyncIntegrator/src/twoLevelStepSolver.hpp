@@ -97,6 +97,10 @@ struct TwoLevelState {
   // predicted substep: where the system has externalForceAt, substeps evaluate only them.
   std::vector<std::vector<int>> regionVertices;
   Eigen::VectorXd regionForce;
+  // Where the system has externalForceOfRank (surface contact): the force terms split by
+  // rank, and L's external force built from them (full size, L's entries).
+  detail::RankedForces ranked;
+  Eigen::VectorXd rankedL;
   // Implicit contact (DynamicSystem::externalForceJacobian): the contact iteration, and
   // whether a region's A^S holds contact blocks that Z and H^{LL*} were not built with.
   detail::ContactIteration contact;
@@ -188,6 +192,8 @@ class TwoLevelStepSolver final : public StepSolver {
   void refactorLargeSystem();
   void evaluateStartOfStep();
   void gatherExternalForces(double t0, double t1);
+  /// gatherExternalForces at the predicted states with the force split by rank.
+  void gatherRankedForces(double t0, double t1, bool implicit);
   void countSolves();
   // One step's right-hand sides, solve and recovery (structuredStep.cpp).
   void largeRightHandSide();

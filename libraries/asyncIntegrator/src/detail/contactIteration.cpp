@@ -99,6 +99,17 @@ void ContactIteration::visitStates(const std::vector<FastRegion>& regions, Visit
     sums_ = trialX_[i].rowwise().sum();
     setSubstep(i, regions[i].ratio, sums_);
   }
+  const bool whole = step_.ranked != nullptr;
+  if (whole) {
+    prefix_.resize(regions.size());
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+      prefix_[i].setZero(trialX_[i].rows(), trialX_[i].cols() + 1);
+      for (Eigen::Index c = 0; c < trialX_[i].cols(); ++c)
+        prefix_[i].col(c + 1) = prefix_[i].col(c) + trialX_[i].col(c);
+    }
+  }
+  const Eigen::VectorXd endU = whole ? u_ : Eigen::VectorXd();
+  const Eigen::VectorXd endV = whole ? v_ : Eigen::VectorXd();
   visit(step_.t1, -1, 0);
   for (std::size_t i = 0; i < regions.size(); ++i) {
     const FastRegion& rb = regions[i];
@@ -107,11 +118,44 @@ void ContactIteration::visitStates(const std::vector<FastRegion>& regions, Visit
     for (int r = 1; r < m; ++r) {
       running_ += trialX_[i].col(r - 1);
       setSubstep(i, r, running_);
+      if (whole) setOthersAt(regions, i, r);
       visit(substepTime(step_.t0, step_.t1, r, m, rb.smallStep), static_cast<int>(i), r);
     }
     // Back to the end state: the next region's substeps see this one at its end.
+    if (whole) {
+      u_ = endU;
+      v_ = endV;
+      continue;
+    }
     sums_ = trialX_[i].rowwise().sum();
     setSubstep(i, m, sums_);
+  }
+}
+
+void ContactIteration::setOthersAt(const std::vector<FastRegion>& regions, std::size_t i, int r) {
+  const Eigen::VectorXd& u0 = *step_.u0;
+  const Eigen::VectorXd& v0 = *step_.v0;
+  const RegionPartition& partition = *step_.partition;
+  const double tau = r * regions[i].smallStep;  // from t0
+  const std::vector<int>& large = partition.largeDofs();
+  for (std::size_t k = 0; k < large.size(); ++k) {
+    const int dof = large[k];
+    u_[dof] = u0[dof] + tau * v_[dof];  // v_ holds v^L, constant over the step
+  }
+  const int m = regions[i].ratio;
+  for (std::size_t j = 0; j < regions.size(); ++j) {
+    if (j == i) continue;
+    const FastRegion& other = regions[j];
+    // Its substep c with (c - 1) hS_j < tau <= c hS_j, and the time into it.
+    const int c = ((r * other.ratio) + m - 1) / m;
+    const double into = tau - ((c - 1) * other.smallStep);
+    const std::vector<int>& s = partition.regionDofs(static_cast<int>(j));
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      const auto row = static_cast<Eigen::Index>(k);
+      const double velocity = v0[s[k]] + trialX_[j](row, c - 1);
+      v_[s[k]] = velocity;
+      u_[s[k]] = u0[s[k]] + (other.smallStep * (((c - 1) * v0[s[k]]) + prefix_[j](row, c - 1))) + (into * velocity);
+    }
   }
 }
 
@@ -119,6 +163,21 @@ void ContactIteration::forcesAt(const std::vector<FastRegion>& regions) {
   const RegionPartition& partition = *step_.partition;
   const std::vector<int>& large = partition.largeDofs();
   const DynamicSystem& system = *step_.system;
+  if (RankedForces* ranked = step_.ranked) {
+    ranked->clear();
+    visitStates(regions, [&](double time, int region, int r) {
+      if (region >= 0) {
+        ranked->addRegion(system, region, r, time, u_, v_);
+        return;
+      }
+      ranked->addLarge(system, time, u_, v_);
+      for (std::size_t i = 0; i < regions.size(); ++i)
+        ranked->addRegion(system, static_cast<int>(i), regions[i].ratio, time, u_, v_);
+    });
+    trialForceL_ = step_.hL * ranked->large;
+    for (std::size_t i = 0; i < regions.size(); ++i) trialForceS_[i] = regions[i].smallStep * ranked->region[i];
+    return;
+  }
   if (f_.size() != u_.size()) f_.setZero(u_.size());
   visitStates(regions, [&](double time, int region, int r) {
     // At a region's substep only its own DOFs are read: with externalForceAt only its
@@ -159,18 +218,57 @@ void ContactIteration::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegi
   std::vector<std::vector<Eigen::Matrix3d>> blocksS(count), stiffnessS(count);
   blockSlot_.assign(vertexRegion_.size(), 0);
   touches_.assign(vertexRegion_.size(), 0);
-  // L's vertices at the end state; a region's at the end state, or else at the first of
-  // its substeps where it touches.
-  const auto takeBlocks = [&](double time, int only, int /*r*/) {
-    if (only >= 0 && system.externalForceJacobianAt) {
-      system.externalForceJacobianAt(time, u_, v_, (*step_.regionVertices)[static_cast<std::size_t>(only)], jacobian_);
-    } else {
-      system.externalForceJacobian(time, u_, v_, jacobian_);
+  const RankedForces* ranked = system.externalForceJacobianOfRank ? step_.ranked : nullptr;
+
+  largeSlot_.assign(vertexRegion_.size(), 0);
+  // The blocks of jacobian_'s vertices: L's at the end state (owner -1), a region's at the
+  // end state or else at the first of its substeps where it touches. With ranked terms
+  // (owner >= 0: region owner's terms at its substep r), the couplings of surface pairs
+  // enter as their per-vertex bounds: an L vertex takes r hS^2 K + hS C, the derivative of
+  // its share hS f(r) by its velocity increment (its position there moves by r hS per unit
+  // of it); the owner's vertices take theirs as any contact block, until the iteration
+  // stalls with them (update drops them for the rest of the step). A^S is one matrix for
+  // every substep, so a block taken where a light vertex strikes mid-step acts at every
+  // substep. Measured (docs/collision.md, the antenna striking a block at m = 30): always
+  // with them the iteration stalled at a relative residual of 0.1-0.2 and the runs blew up;
+  // never with them 3-5 of 60 steps ended unconverged (at most 0.1), but two soft boxes
+  // colliding head-on (tests/sceneIO/asyncSurfaceContactTest.cpp) stopped at 0.13 where the
+  // blocks reach 2e-4; dropping them where the iteration stalls keeps both.
+  const auto take = [&](int owner, int r) {
+    if (ranked && !jacobian_.couplings.empty()) {
+      couplings_.clear();
+      couplings_.couplings = jacobian_.couplings;
+      bounded_ = boundCouplings(couplings_);
+      for (std::size_t k = 0; k < bounded_.vertices.size() && owner >= 0 && regionPairBlocks_; ++k) {
+        if (vertexRegion_[static_cast<std::size_t>(bounded_.vertices[k])] != owner) continue;
+        jacobian_.vertices.push_back(bounded_.vertices[k]);
+        jacobian_.stiffness.push_back(bounded_.stiffness[k]);
+        jacobian_.damping.push_back(bounded_.damping[k]);
+      }
+      const double h = owner < 0 ? step_.hL : regions[static_cast<std::size_t>(owner)].smallStep;
+      const double stiffnessWeight = owner < 0 ? h * h : r * h * h;
+      for (std::size_t k = 0; k < bounded_.vertices.size(); ++k) {
+        const int vertex = bounded_.vertices[k];
+        if (vertexRegion_[static_cast<std::size_t>(vertex)] >= 0) continue;
+        const Eigen::Matrix3d block = contactStepBlock(system.freeDofs, bounded_, k, stiffnessWeight, h);
+        if (block.isZero(0.0)) continue;
+        int& slot = largeSlot_[static_cast<std::size_t>(vertex)];
+        if (slot == 0) {
+          std::array<int, 3> position{};
+          for (int c = 0; c < 3; ++c)
+            position[static_cast<std::size_t>(c)] = largePosition_[static_cast<std::size_t>((3 * vertex) + c)];
+          inMatrix_.positions.push_back(position);
+          inMatrix_.values.push_back(block);
+          slot = static_cast<int>(inMatrix_.positions.size());
+        } else {
+          inMatrix_.values[static_cast<std::size_t>(slot - 1)] += block;
+        }
+      }
     }
     for (std::size_t k = 0; k < jacobian_.vertices.size(); ++k) {
       const int vertex = jacobian_.vertices[k];
       const int region = vertexRegion_[static_cast<std::size_t>(vertex)];
-      if (only >= 0 && region != only) continue;
+      if (owner >= 0 && region != owner) continue;
       const std::vector<int>& positionOf = region < 0 ? largePosition_ : regionPosition_;
       std::array<int, 3> position{};
       for (int c = 0; c < 3; ++c)
@@ -197,6 +295,24 @@ void ContactIteration::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegi
       blocksS[i].push_back(block);
       stiffnessS[i].push_back(contactStepBlock(system.freeDofs, jacobian_, k, h * h, 0.0));
     }
+  };
+  const auto takeBlocks = [&](double time, int only, int r) {
+    if (ranked) {
+      ranked->jacobian(system, only, time, u_, v_, jacobian_);
+      take(only, r);
+      if (only >= 0) return;
+      for (std::size_t i = 0; i < count; ++i) {  // each region's terms at its last substep
+        ranked->jacobian(system, static_cast<int>(i), time, u_, v_, jacobian_);
+        take(static_cast<int>(i), regions[i].ratio);
+      }
+      return;
+    }
+    if (only >= 0 && system.externalForceJacobianAt) {
+      system.externalForceJacobianAt(time, u_, v_, (*step_.regionVertices)[static_cast<std::size_t>(only)], jacobian_);
+    } else {
+      system.externalForceJacobian(time, u_, v_, jacobian_);
+    }
+    take(only, r);
   };
   if (!statesClear) visitStates(regions, takeBlocks);
   // A region's block weighted by the share of its substeps where the vertex touches (the
@@ -270,6 +386,8 @@ bool ContactIteration::start(const ContactStep& step, const Eigen::VectorXd& rhs
   mixStates_.clear();
   mixOperators_.clear();
   mixSteps_.clear();
+  regionPairBlocks_ = true;
+  droppedPairBlocks_ = false;
   // The blocks at the predicted states; g = h f_ext there + J 0 is what the rhs holds.
   trialY_ = acceptedY_;
   trialX_ = acceptedX_;
@@ -444,6 +562,16 @@ double ContactIteration::update(std::vector<FastRegion>& regions, Eigen::VectorX
     if (!std::isfinite(residual)) return std::nan("");  // reported at worstVertex_
     if (merit < meritNorm_ || halvings == kMaxHalvings) break;
     theta *= 0.5;
+  }
+  // A stalled iteration (the solve's own step had to be cut to an eighth or less) drops the
+  // fast regions' pair blocks for the rest of the step, and the solves mixed so far (made
+  // with them). See addBlocks.
+  if (!accepted && theta <= 0.125 && regionPairBlocks_ && step_.ranked != nullptr) {
+    regionPairBlocks_ = false;
+    droppedPairBlocks_ = true;
+    mixStates_.clear();
+    mixOperators_.clear();
+    mixSteps_.clear();
   }
   // Accept z (the caller's state becomes it), take the contact blocks there and set the
   // next solve's force terms: g = G(z) + J z (Eq. C3).

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "detail/fastRegion.hpp"
+#include "detail/rankedForces.hpp"
 #include "detail/sparseBlocks.hpp"
 
 namespace asyncfem::detail {
@@ -53,6 +54,10 @@ struct ContactStep {
   /// Whether start() may skip the predicted states where none can touch (Eq. C7; with
   /// AsyncOptions::Contact::certifyContactFree).
   bool screenPredicted = false;
+  /// Set where the system has externalForceOfRank: the force terms are split by rank
+  /// (RankedForces), and at a region's substep every vertex is where it is at that time (L
+  /// on its constant-velocity path, the other regions on their backward Euler paths).
+  RankedForces* ranked = nullptr;
 };
 
 /// The contact iteration of one large step: Newton's method on the step equations with the
@@ -99,6 +104,9 @@ class ContactIteration {
   /// Whether the last factor of H^{LL*} solves the current large system exactly.
   bool factorIsExact() const { return factored_ == inMatrix_; }
   bool blocksInMatrix() const { return !inMatrix_.empty(); }
+  /// Whether this step's iteration stalled with the fast regions' blocks of surface pairs
+  /// and went on without them (addBlocks).
+  bool droppedPairBlocks() const { return droppedPairBlocks_; }
   /// The vertex with the largest residual after the last update (for error messages), -1 if none.
   int worstVertex() const { return worstVertex_; }
 
@@ -110,9 +118,14 @@ class ContactIteration {
  private:
   /// Calls visit(time, region, r) at every state of the increments trialY_ and trialX_
   /// held in u_ and v_: first the end state (region -1, every region at its last substep),
-  /// then each region's substeps r < m (the others at their end). u_, v_ end at the end state.
+  /// then each region's substeps r < m (the others at their end; with step_.ranked where
+  /// they are at that substep's time: setOthersAt). u_, v_ end at the end state.
   template <class Visit>
   void visitStates(const std::vector<FastRegion>& regions, Visit&& visit);
+  /// At region i's substep r, L and every other region where they are at its time: L at
+  /// u_0 + r hS_i v^L, region j on its backward Euler path (prefix_: the running sums of
+  /// its increments).
+  void setOthersAt(const std::vector<FastRegion>& regions, std::size_t i, int r);
   /// G(z), the force terms h f_ext at the states of trialY_ and trialX_, into trialForceL_
   /// and trialForceS_.
   void forcesAt(const std::vector<FastRegion>& regions);
@@ -151,9 +164,10 @@ class ContactIteration {
   // A trial state and its force terms.
   Eigen::VectorXd trialY_, trialForceL_;
   std::vector<Eigen::MatrixXd> trialX_, trialForceS_;
-  Eigen::VectorXd u_, v_, f_;       // full-size state and force
-  std::vector<int> nearObstacles_;  // predictedStatesClear's proximity query
-  Eigen::VectorXd running_, sums_;  // a region's sums of its substeps' increments
+  Eigen::VectorXd u_, v_, f_;            // full-size state and force
+  std::vector<int> nearObstacles_;       // predictedStatesClear's proximity query
+  Eigen::VectorXd running_, sums_;       // a region's sums of its substeps' increments
+  std::vector<Eigen::MatrixXd> prefix_;  // per region, column c: the sum of its first c increments
   // The solves Anderson mixing combines: each one's state, A_0 z - base there and its step
   // from the state it started at, flattened (L's, then each region's column-major), oldest first.
   std::vector<Eigen::VectorXd> mixStates_, mixOperators_, mixSteps_;
@@ -162,6 +176,12 @@ class ContactIteration {
   // Per vertex in this addBlocks: 1 + the index of its block in its region's list (0:
   // none yet), and at how many of its region's substeps it touches.
   std::vector<int> blockSlot_, touches_;
+  // Per vertex of L: 1 + the index of its ranked terms' block in inMatrix_ (0: none yet).
+  std::vector<int> largeSlot_;
+  VertexJacobian couplings_, bounded_;
+  // Whether a region's vertices take the per-vertex bounds of their surface pairs (until the
+  // iteration stalls with them), and whether this step dropped them.
+  bool regionPairBlocks_ = true, droppedPairBlocks_ = false;  // a ranked Jacobian's couplings, and as per-vertex bounds
 };
 
 }  // namespace asyncfem::detail

@@ -260,6 +260,7 @@ struct AsyncRunStats {
   long long contactStepSystemFactorizations = 0;  ///< hierarchy solve: the step system's LU with contact blocks
   long long contactFreeSteps = 0;                 ///< of contactSteps, certified free of contact (Eq. C6)
   long long contactScreenedSteps = 0;             ///< of contactSteps, predicted states clear of obstacles (Eq. C7)
+  long long contactPairBlocksDropped = 0;         ///< of contactSteps, went on without the regions' surface-pair blocks
   /// Mean seconds of a steady-state large step (stepSeconds / steps), and with rebuilds.
   double meanStepSeconds() const { return steps > 0 ? stepSeconds / static_cast<double>(steps) : 0.0; }
   double meanStepWithRebuildSeconds() const {
