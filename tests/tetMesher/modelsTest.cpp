@@ -190,6 +190,7 @@ TEST(ExampleModels, ScenesRunWithTheAsyncIntegrator) {
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << command;
     EXPECT_TRUE(std::filesystem::exists(output));
     std::filesystem::remove(output);
+    std::filesystem::remove(output.string() + ".checkpoint");  // the simulator's checkpoint beside it
   }
 }
 
