@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <Eigen/LU>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <asyncfem/core/error.hpp>
