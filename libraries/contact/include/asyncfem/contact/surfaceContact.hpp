@@ -67,8 +67,9 @@ struct SurfacePair {
 ///
 /// Candidates come from the collision library's broad phase at distance 2 dhat and are
 /// reused while no surface or obstacle vertex has moved more than dhat / 2 since (a pair
-/// closer than dhat is then still among them): forces do not depend on whether a list was
-/// reused. Thread-safe (the list is shared under a mutex).
+/// closer than dhat is then still among them); the last 32 lists are kept (fewer for large
+/// meshes: at most 32 MB of their points), for callers that visit several states in turn. Forces do not depend on
+/// whether a list was reused. Thread-safe (the lists are shared under a mutex).
 class SurfaceContact {
  public:
   /// mesh: the bodies (rest positions, boundary); objectOfVertex: each vertex's object
@@ -183,7 +184,9 @@ class SurfaceContact {
   double stiffness_, damping_, friction_, frictionViscosity_;
 
   mutable std::mutex mutex_;
-  mutable std::shared_ptr<const Candidates> cached_;
+  static constexpr std::size_t kKeptLists = 32;
+  static constexpr std::size_t kKeptPointValues = 4000000;
+  mutable std::vector<std::shared_ptr<const Candidates>> cached_;  // most recently used first
   mutable SurfaceContactStats stats_;
 };
 
