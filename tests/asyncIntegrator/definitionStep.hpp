@@ -26,7 +26,11 @@ namespace asyncfem::test {
 /// of the step: implicit contact's definition); where it depends on the state (penalty
 /// contact, piecewise affine) the residual is no longer affine and the step takes Newton
 /// iterations with a difference Jacobian (exact within one contact set) until the update is
-/// round-off.
+/// round-off. Where the system splits its force by rank (DynamicSystem::externalForceOfRank:
+/// surface contact; one region here, rank 1, L rank 0), the pairs that join the region are
+/// taken at its substeps, their force on L's vertices as hS times their sum over the
+/// substeps, and L's own terms at the end of the step (docs/asynchronous-integrator.md,
+/// "Contact between regions").
 class DefinitionStep {
  public:
   DefinitionStep(const TetMesh& mesh, const DynamicSystem& system, std::vector<AsyncRegion> regions)
@@ -46,6 +50,17 @@ class DefinitionStep {
       const int region = vertexRegion[static_cast<std::size_t>(free[a] / 3)];
       regionOfFree_[static_cast<std::size_t>(a)] = region;
       (region < 0 ? large_ : fast_[region]).push_back(a);
+    }
+    // Ranks for a system that splits its force (one region: its vertices rank 1, the rest 0),
+    // and each rank's vertices with a free DOF.
+    vertexRank_.assign(static_cast<std::size_t>(mesh.numVertices()), 0);
+    rankVertices_.assign(2, {});
+    for (int v = 0; v < mesh.numVertices(); ++v) {
+      const int rank = vertexRegion[static_cast<std::size_t>(v)] >= 0 ? 1 : 0;
+      vertexRank_[static_cast<std::size_t>(v)] = rank;
+      bool free = false;
+      for (int c = 0; c < 3; ++c) free = free || !system.freeDofs.isFixed((3 * v) + c);
+      if (free) rankVertices_[static_cast<std::size_t>(rank)].push_back(v);
     }
     // K_I of region i: the elements with a vertex in S_i and a vertex in no fast region.
     std::vector<int> freeIndex(static_cast<std::size_t>(n), -1);
@@ -99,14 +114,18 @@ class DefinitionStep {
   }
 
  private:
-  // f_ext at time and the free state (u, v).
-  Eigen::VectorXd externalForce(double time, const Eigen::VectorXd& u, const Eigen::VectorXd& v) const {
+  // f_ext at time and the free state (u, v): all of it (rank -1), or the terms of one rank.
+  Eigen::VectorXd externalForce(double time, const Eigen::VectorXd& u, const Eigen::VectorXd& v, int rank = -1) const {
     Eigen::VectorXd f = Eigen::VectorXd::Zero(mesh_.numDofs());
-    if (system_.externalForce) {
+    if (rank >= 0) {
+      system_.externalForceOfRank(time, system_.freeDofs.expand(u), system_.freeDofs.expand(v),
+                                  rankVertices_[static_cast<std::size_t>(rank)], vertexRank_, rank, f);
+    } else if (system_.externalForce) {
       system_.externalForce(time, system_.freeDofs.expand(u), system_.freeDofs.expand(v), f);
     }
     return system_.freeDofs.restrict(f);
   }
+  bool ranked() const { return static_cast<bool>(system_.externalForceOfRank); }
 
   // Residual of every equation for the unknowns z; the end state on request.
   Eigen::VectorXd residual(const Eigen::VectorXd& z, double hL, double t, const Eigen::VectorXd& u0,
@@ -121,6 +140,7 @@ class DefinitionStep {
     // L's equation, accumulated over the regions' substeps.
     Eigen::VectorXd lagged =
         Eigen::VectorXd::Zero(nf);  // hS sum_r [K_I (u^L_r - u^L_0) + K^{LS} (u^S_r - u^S_0) + D^{LS} v^S_r]
+    Eigen::VectorXd pairsOnLarge = Eigen::VectorXd::Zero(nf);  // hS sum_r f_pairs(r), ranked only
     Eigen::MatrixXd nonInterfaceK = K_;
     for (const Eigen::MatrixXd& ki : interfaceK_) nonInterfaceK -= ki;
     Eigen::Index offset = 0;
@@ -139,7 +159,9 @@ class DefinitionStep {
           vr[s[k]] = z[offset + static_cast<Eigen::Index>(k)];
           ur[s[k]] = uPrev[s[k]] + hS * vr[s[k]];
         }
-        const Eigen::VectorXd force = externalForce(t + r * hS, ur, vr) - K_ * u0 - K_ * (ur - u0) - D_ * vr;
+        const Eigen::VectorXd external = externalForce(t + r * hS, ur, vr, ranked() ? 1 : -1);
+        if (ranked()) pairsOnLarge += hS * external;  // L's rows: the region's pairs' share
+        const Eigen::VectorXd force = external - K_ * u0 - K_ * (ur - u0) - D_ * vr;
         const Eigen::VectorXd momentum = M_ * (vr - vPrev);
         for (std::size_t k = 0; k < s.size(); ++k)
           out[offset + static_cast<Eigen::Index>(k)] = momentum[s[k]] - hS * force[s[k]];
@@ -164,8 +186,10 @@ class DefinitionStep {
       onlyL[dof] = uFinal[dof] - u0[dof];
       vL[dof] = vFinal[dof];
     }
+    const Eigen::VectorXd endForce =
+        ranked() ? Eigen::VectorXd(externalForce(t + hL, uFinal, vFinal, 0)) : externalForce(t + hL, uFinal, vFinal);
     const Eigen::VectorXd impulse =
-        hL * (externalForce(t + hL, uFinal, vFinal) - K_ * u0) - hL * (nonInterfaceK * onlyL) - lagged - hL * (D_ * vL);
+        hL * (endForce - K_ * u0) + pairsOnLarge - hL * (nonInterfaceK * onlyL) - lagged - hL * (D_ * vL);
     const Eigen::VectorXd momentum = M_ * (vFinal - v0);
     for (std::size_t k = 0; k < large_.size(); ++k)
       out[largeOffset + static_cast<Eigen::Index>(k)] = momentum[large_[k]] - impulse[large_[k]];
@@ -182,6 +206,8 @@ class DefinitionStep {
   std::vector<int> large_;
   std::map<int, std::vector<int>> fast_;
   std::vector<Eigen::MatrixXd> interfaceK_;
+  std::vector<int> vertexRank_;
+  std::vector<std::vector<int>> rankVertices_;
 };
 
 }  // namespace asyncfem::test
