@@ -119,7 +119,7 @@ class DefinitionStep {
     Eigen::VectorXd f = Eigen::VectorXd::Zero(mesh_.numDofs());
     if (rank >= 0) {
       system_.externalForceOfRank(time, system_.freeDofs.expand(u), system_.freeDofs.expand(v),
-                                  rankVertices_[static_cast<std::size_t>(rank)], vertexRank_, rank, f);
+                                  rankVertices_[static_cast<std::size_t>(rank)], vertexRank_, rank, f, nullptr);
     } else if (system_.externalForce) {
       system_.externalForce(time, system_.freeDofs.expand(u), system_.freeDofs.expand(v), f);
     }

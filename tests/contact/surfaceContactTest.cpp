@@ -240,12 +240,11 @@ TEST(SurfaceContact, TheRanksSplitTheForceAndItsCouplingsIntoWholePairs) {
   int ranksWithForce = 0;
   for (int owner = 0; owner <= 2; ++owner) {
     Eigen::VectorXd part = Eigen::VectorXd::Zero(24);
-    contact.addForcesOfRank(0.0, u, v, rank, owner, part);
+    VertexJacobian jacobian;
+    contact.addForcesOfRank(0.0, u, v, rank, owner, part, &jacobian);
     EXPECT_LE(part.reshaped(3, 8).rowwise().sum().norm(), 1e-13 * (1.0 + part.norm())) << "rank " << owner;
     if (part.norm() > 0.0) ++ranksWithForce;
     summed += part;
-    VertexJacobian jacobian;
-    contact.addCoupledJacobianOfRank(0.0, u, v, rank, owner, jacobian);
     for (const VertexCoupling& coupling : jacobian.couplings) {
       int highest = -1;
       for (const int vertex : coupling.vertices)

@@ -112,7 +112,6 @@ TEST(AsyncSurfaceContact, TheStepSolvesItsPerSubstepDefinition) {
   // split): the definition tells the two apart.
   DynamicSystem unsplit = simulation.integrator->system();
   unsplit.externalForceOfRank = nullptr;
-  unsplit.externalForceJacobianOfRank = nullptr;
   AsyncOptions options;
   options.contact.tolerance = 1e-13;
   options.contact.iterations = 300;

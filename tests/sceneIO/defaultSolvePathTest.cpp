@@ -38,6 +38,7 @@ std::vector<ShippedCase> shippedCases() {
           {"collision/curl.json", M::neoHookean},
           {"collision/headOn.json", M::stvk},
           {"collision/stack.json", M::stvk},
+          {"collision/strike.json", M::corotational},
           {"dinosaur/dinosaur.json", M::stvk},
           {"dragon/dragon.json", M::corotational},
           {"dragon/figure9.json", M::stvk},

@@ -157,7 +157,6 @@ DynamicSystem homogeneousLinearSystem(const DynamicSystem& system) {
   out.externalForceJacobian = nullptr;
   out.externalForceAt = nullptr;
   out.externalForceOfRank = nullptr;
-  out.externalForceJacobianOfRank = nullptr;
   out.externalForceJacobianAt = nullptr;
   out.stateDependentOnlyInContact = false;
   if (!system.forceModel->isLinear()) {

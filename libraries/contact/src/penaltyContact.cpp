@@ -83,9 +83,10 @@ void PenaltyContact::addForces(double time, const Eigen::VectorXd& displacement,
 
 void PenaltyContact::addForcesOfRank(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                                      const std::vector<int>& vertices, const std::vector<int>& rank, int owner,
-                                     Eigen::VectorXd& forces) const {
+                                     Eigen::VectorXd& forces, PenaltyContactJacobian* jacobian) const {
   addPrimitiveForces(displacement, velocity, forces, &vertices);
-  if (surfaces_) surfaces_->addForcesOfRank(time, displacement, velocity, rank, owner, forces);
+  if (jacobian != nullptr) *jacobian = primitiveJacobian(displacement, velocity, &vertices);
+  if (surfaces_) surfaces_->addForcesOfRank(time, displacement, velocity, rank, owner, forces, jacobian);
 }
 
 void PenaltyContact::addPrimitiveForces(const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
@@ -113,14 +114,6 @@ PenaltyContactJacobian PenaltyContact::jacobian(double time, const Eigen::Vector
                                                 const std::vector<int>* vertices) const {
   PenaltyContactJacobian out = primitiveJacobian(displacement, velocity, vertices);
   if (surfaces_) surfaces_->addJacobian(time, displacement, velocity, out, vertices);
-  return out;
-}
-
-PenaltyContactJacobian PenaltyContact::jacobianOfRank(double time, const Eigen::VectorXd& displacement,
-                                                      const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
-                                                      const std::vector<int>& rank, int owner) const {
-  PenaltyContactJacobian out = primitiveJacobian(displacement, velocity, &vertices);
-  if (surfaces_) surfaces_->addCoupledJacobianOfRank(time, displacement, velocity, rank, owner, out);
   return out;
 }
 

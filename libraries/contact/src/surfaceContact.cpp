@@ -365,7 +365,8 @@ SurfaceContact::CandidateFilter SurfaceContact::ownedBy(const std::vector<int>& 
 
 template <class Wanted>
 void SurfaceContact::addPairForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                                   Eigen::VectorXd& forces, const CandidateFilter* keep, Wanted&& wanted) const {
+                                   Eigen::VectorXd& forces, const CandidateFilter* keep, Wanted&& wanted,
+                                   VertexJacobian* couplings) const {
   Points points;
   const std::vector<SurfacePair> found = activePairs(time, displacement, &points, keep);
   {
@@ -382,6 +383,7 @@ void SurfaceContact::addPairForces(double time, const Eigen::VectorXd& displacem
     const double normalSpeed = pair.normal.dot(relative);
     const double normalForce = (stiffness_ * (options_.thickness - pair.gap)) - (damping_ * normalSpeed);
     if (!(normalForce > 0.0)) continue;  // the clamp: contact pushes, never pulls
+    if (couplings != nullptr) couplings->couplings.push_back(couplingOf(pair));
     Eigen::Vector3d f = normalForce * pair.normal;
     if (friction_ > 0.0) {
       const Eigen::Vector3d tangential = relative - normalSpeed * pair.normal;
@@ -399,14 +401,29 @@ void SurfaceContact::addPairForces(double time, const Eigen::VectorXd& displacem
 void SurfaceContact::addForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                                Eigen::VectorXd& forces, const std::vector<int>* vertices) const {
   const VertexFilter wanted(vertices, static_cast<int>(rest_.cols()));
-  addPairForces(time, displacement, velocity, forces, nullptr, wanted);
+  addPairForces(time, displacement, velocity, forces, nullptr, wanted, nullptr);
 }
 
 void SurfaceContact::addForcesOfRank(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                                     const std::vector<int>& rank, int owner, Eigen::VectorXd& forces) const {
+                                     const std::vector<int>& rank, int owner, Eigen::VectorXd& forces,
+                                     VertexJacobian* couplings) const {
   const int n = static_cast<int>(rest_.cols());
   const CandidateFilter keep = ownedBy(rank, owner);
-  addPairForces(time, displacement, velocity, forces, &keep, [n](int id) { return id < n; });
+  addPairForces(
+      time, displacement, velocity, forces, &keep, [n](int id) { return id < n; }, couplings);
+}
+
+VertexCoupling SurfaceContact::couplingOf(const SurfacePair& pair) const {
+  const int n = static_cast<int>(rest_.cols());
+  VertexCoupling coupling;
+  for (std::size_t i = 0; i < 4; ++i) {
+    coupling.vertices[i] = pair.points[i] < n ? pair.points[i] : -1;  // an obstacle point is no DOF
+    coupling.weights[i] = pair.weights[i];
+  }
+  coupling.direction = pair.normal;
+  coupling.stiffness = stiffness_;
+  coupling.damping = damping_;
+  return coupling;
 }
 
 void SurfaceContact::addJacobian(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
@@ -437,11 +454,10 @@ void SurfaceContact::addJacobian(double time, const Eigen::VectorXd& displacemen
   }
 }
 
-void SurfaceContact::addPairCouplings(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                                      VertexJacobian& jacobian, const CandidateFilter* keep) const {
+void SurfaceContact::addCoupledJacobian(double time, const Eigen::VectorXd& displacement,
+                                        const Eigen::VectorXd& velocity, VertexJacobian& jacobian) const {
   Points points;
-  const std::vector<SurfacePair> found = activePairs(time, displacement, &points, keep);
-  const int n = static_cast<int>(rest_.cols());
+  const std::vector<SurfacePair> found = activePairs(time, displacement, &points);
   for (const SurfacePair& pair : found) {
     Eigen::Vector3d relative = Eigen::Vector3d::Zero();
     for (int i = 0; i < 4; ++i) {
@@ -450,28 +466,8 @@ void SurfaceContact::addPairCouplings(double time, const Eigen::VectorXd& displa
     }
     const double normalForce = (stiffness_ * (options_.thickness - pair.gap)) - (damping_ * pair.normal.dot(relative));
     if (!(normalForce > 0.0)) continue;  // clamped: no force, no derivative
-    VertexCoupling coupling;
-    for (std::size_t i = 0; i < 4; ++i) {
-      coupling.vertices[i] = pair.points[i] < n ? pair.points[i] : -1;  // an obstacle point is no DOF
-      coupling.weights[i] = pair.weights[i];
-    }
-    coupling.direction = pair.normal;
-    coupling.stiffness = stiffness_;
-    coupling.damping = damping_;
-    jacobian.couplings.push_back(coupling);
+    jacobian.couplings.push_back(couplingOf(pair));
   }
-}
-
-void SurfaceContact::addCoupledJacobian(double time, const Eigen::VectorXd& displacement,
-                                        const Eigen::VectorXd& velocity, VertexJacobian& jacobian) const {
-  addPairCouplings(time, displacement, velocity, jacobian, nullptr);
-}
-
-void SurfaceContact::addCoupledJacobianOfRank(double time, const Eigen::VectorXd& displacement,
-                                              const Eigen::VectorXd& velocity, const std::vector<int>& rank, int owner,
-                                              VertexJacobian& jacobian) const {
-  const CandidateFilter keep = ownedBy(rank, owner);
-  addPairCouplings(time, displacement, velocity, jacobian, &keep);
 }
 
 double SurfaceContact::energy(double time, const Eigen::VectorXd& displacement) const {

@@ -40,10 +40,11 @@ void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen:
 }
 
 void Loads::addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                  const std::vector<int>& vertices, const std::vector<int>& rank, int owner,
-                  Eigen::VectorXd& forces) const {
+                  const std::vector<int>& vertices, const std::vector<int>& rank, int owner, Eigen::VectorXd& forces,
+                  VertexJacobian* jacobian) const {
   addVertexLoads(time, vertices, forces);
-  if (contact_) contact_->addForcesOfRank(time, displacement, velocity, vertices, rank, owner, forces);
+  if (jacobian != nullptr) jacobian->clear();
+  if (contact_) contact_->addForcesOfRank(time, displacement, velocity, vertices, rank, owner, forces, jacobian);
 }
 
 void Loads::addVertexLoads(double time, const std::vector<int>& vertices, Eigen::VectorXd& forces) const {

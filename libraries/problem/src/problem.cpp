@@ -184,10 +184,13 @@ DynamicSystem Problem::dynamicSystem() const {
       external->addTo(time, displacement, velocity, vertices, forces);
     };
     if (contact_ && contact_->surfaces()) {
-      system.externalForceOfRank = [external](double time, const Eigen::VectorXd& displacement,
-                                              const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
-                                              const std::vector<int>& rank, int owner, Eigen::VectorXd& forces) {
-        external->addTo(time, displacement, velocity, vertices, rank, owner, forces);
+      system.externalForceOfRank = [external, implicit = settings_.implicitContact](
+                                       double time, const Eigen::VectorXd& displacement,
+                                       const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
+                                       const std::vector<int>& rank, int owner, Eigen::VectorXd& forces,
+                                       VertexJacobian* jacobian) {
+        if (jacobian != nullptr && !implicit) jacobian->clear();  // explicit contact: no derivatives
+        external->addTo(time, displacement, velocity, vertices, rank, owner, forces, implicit ? jacobian : nullptr);
       };
     }
     // Gravity is constant and contact depends on the state only; the windows open and
@@ -220,12 +223,6 @@ DynamicSystem Problem::dynamicSystem() const {
             jacobian = contact->jacobian(time, displacement, velocity, &vertices);
           };
       if (contact_->surfaces()) {
-        system.externalForceJacobianOfRank = [contact = contact_](
-                                                 double time, const Eigen::VectorXd& displacement,
-                                                 const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
-                                                 const std::vector<int>& rank, int owner, VertexJacobian& jacobian) {
-          jacobian = contact->jacobianOfRank(time, displacement, velocity, vertices, rank, owner);
-        };
         system.externalForceCoupledJacobian = [contact = contact_](double time, const Eigen::VectorXd& displacement,
                                                                    const Eigen::VectorXd& velocity,
                                                                    VertexJacobian& jacobian) {

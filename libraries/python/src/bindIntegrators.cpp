@@ -114,7 +114,6 @@ void bindIntegrators(py::module_& module) {
             s.system.externalForceChanges = nullptr;
             s.system.externalForceAt = nullptr;
             s.system.externalForceOfRank = nullptr;
-            s.system.externalForceJacobianOfRank = nullptr;
             s.system.stateDependentOnlyInContact = false;
             s.externalForce = callable;
           },

@@ -165,15 +165,25 @@ void ContactIteration::forcesAt(const std::vector<FastRegion>& regions) {
   const DynamicSystem& system = *step_.system;
   if (RankedForces* ranked = step_.ranked) {
     ranked->clear();
+    // The derivatives come from the same evaluations, kept per visit for addBlocks (in the
+    // order it visits), which takes them where this state is accepted.
+    const bool derivatives = static_cast<bool>(system.externalForceJacobian);
+    std::size_t visit = 0;
+    const auto next = [&]() -> VertexJacobian* {
+      if (!derivatives) return nullptr;
+      if (visitJacobians_.size() <= visit) visitJacobians_.resize(visit + 1);
+      return &visitJacobians_[visit++];
+    };
     visitStates(regions, [&](double time, int region, int r) {
       if (region >= 0) {
-        ranked->addRegion(system, region, r, time, u_, v_);
+        ranked->addRegion(system, region, r, time, u_, v_, next());
         return;
       }
-      ranked->addLarge(system, time, u_, v_);
+      ranked->addLarge(system, time, u_, v_, next());
       for (std::size_t i = 0; i < regions.size(); ++i)
-        ranked->addRegion(system, static_cast<int>(i), regions[i].ratio, time, u_, v_);
+        ranked->addRegion(system, static_cast<int>(i), regions[i].ratio, time, u_, v_, next());
     });
+    keptJacobians_ = derivatives;
     trialForceL_ = step_.hL * ranked->large;
     for (std::size_t i = 0; i < regions.size(); ++i) trialForceS_[i] = regions[i].smallStep * ranked->region[i];
     return;
@@ -218,7 +228,18 @@ void ContactIteration::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegi
   std::vector<std::vector<Eigen::Matrix3d>> blocksS(count), stiffnessS(count);
   blockSlot_.assign(vertexRegion_.size(), 0);
   touches_.assign(vertexRegion_.size(), 0);
-  const RankedForces* ranked = system.externalForceJacobianOfRank ? step_.ranked : nullptr;
+  const RankedForces* ranked = system.externalForceJacobian ? step_.ranked : nullptr;
+  // The derivatives forcesAt kept at these very states (the last trial, now accepted).
+  const bool kept = keptJacobians_ && !statesClear;
+  keptJacobians_ = false;
+  std::size_t visit = 0;
+  const auto derivativesAt = [&](int owner, double time) {
+    if (kept) {
+      jacobian_ = visitJacobians_[visit++];
+    } else {
+      ranked->jacobian(system, owner, time, u_, v_, jacobian_);
+    }
+  };
 
   largeSlot_.assign(vertexRegion_.size(), 0);
   // The blocks of jacobian_'s vertices: L's at the end state (owner -1), a region's at the
@@ -298,11 +319,11 @@ void ContactIteration::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegi
   };
   const auto takeBlocks = [&](double time, int only, int r) {
     if (ranked) {
-      ranked->jacobian(system, only, time, u_, v_, jacobian_);
+      derivativesAt(only, time);
       take(only, r);
       if (only >= 0) return;
       for (std::size_t i = 0; i < count; ++i) {  // each region's terms at its last substep
-        ranked->jacobian(system, static_cast<int>(i), time, u_, v_, jacobian_);
+        derivativesAt(static_cast<int>(i), time);
         take(static_cast<int>(i), regions[i].ratio);
       }
       return;
@@ -388,6 +409,7 @@ bool ContactIteration::start(const ContactStep& step, const Eigen::VectorXd& rhs
   mixSteps_.clear();
   regionPairBlocks_ = true;
   droppedPairBlocks_ = false;
+  keptJacobians_ = false;
   // The blocks at the predicted states; g = h f_ext there + J 0 is what the rhs holds.
   trialY_ = acceptedY_;
   trialX_ = acceptedX_;

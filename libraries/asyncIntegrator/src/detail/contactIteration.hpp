@@ -179,6 +179,10 @@ class ContactIteration {
   // Per vertex of L: 1 + the index of its ranked terms' block in inMatrix_ (0: none yet).
   std::vector<int> largeSlot_;
   VertexJacobian couplings_, bounded_;
+  // forcesAt's derivatives at each state it visited (ranked terms, implicit contact), and
+  // whether they are those of the state addBlocks is about to visit.
+  std::vector<VertexJacobian> visitJacobians_;
+  bool keptJacobians_ = false;
   // Whether a region's vertices take the per-vertex bounds of their surface pairs (until the
   // iteration stalls with them), and whether this step dropped them.
   bool regionPairBlocks_ = true, droppedPairBlocks_ = false;  // a ranked Jacobian's couplings, and as per-vertex bounds

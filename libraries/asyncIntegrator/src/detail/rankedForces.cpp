@@ -41,18 +41,18 @@ void RankedForces::clear() {
 }
 
 void RankedForces::addLarge(const DynamicSystem& system, double time, const Eigen::VectorXd& u,
-                            const Eigen::VectorXd& v) {
+                            const Eigen::VectorXd& v, VertexJacobian* jacobian) {
   force_.setZero(u.size());
-  system.externalForceOfRank(time, u, v, largeVertices_, rank_, 0, force_);
+  system.externalForceOfRank(time, u, v, largeVertices_, rank_, 0, force_, jacobian);
   const std::vector<int>& dofs = partition_->largeDofs();
   for (std::size_t k = 0; k < dofs.size(); ++k) large[static_cast<Eigen::Index>(k)] += force_[dofs[k]];
 }
 
 void RankedForces::addRegion(const DynamicSystem& system, int i, int r, double time, const Eigen::VectorXd& u,
-                             const Eigen::VectorXd& v) {
+                             const Eigen::VectorXd& v, VertexJacobian* jacobian) {
   const auto at = static_cast<std::size_t>(i);
   force_.setZero(u.size());
-  system.externalForceOfRank(time, u, v, (*regionVertices_)[at], rank_, regionRank_[at], force_);
+  system.externalForceOfRank(time, u, v, (*regionVertices_)[at], rank_, regionRank_[at], force_, jacobian);
   const int m = partition_->ratio(i);
   // L: hL (share) = hS_i f, share = f / m.
   const std::vector<int>& largeDofs = partition_->largeDofs();
@@ -75,12 +75,13 @@ void RankedForces::addRegion(const DynamicSystem& system, int i, int r, double t
 
 void RankedForces::jacobian(const DynamicSystem& system, int i, double time, const Eigen::VectorXd& u,
                             const Eigen::VectorXd& v, VertexJacobian& jacobian) const {
+  scratch_.setZero(u.size());
   if (i < 0) {
-    system.externalForceJacobianOfRank(time, u, v, largeVertices_, rank_, 0, jacobian);
+    system.externalForceOfRank(time, u, v, largeVertices_, rank_, 0, scratch_, &jacobian);
     return;
   }
   const auto at = static_cast<std::size_t>(i);
-  system.externalForceJacobianOfRank(time, u, v, (*regionVertices_)[at], rank_, regionRank_[at], jacobian);
+  system.externalForceOfRank(time, u, v, (*regionVertices_)[at], rank_, regionRank_[at], scratch_, &jacobian);
 }
 
 }  // namespace asyncfem::detail

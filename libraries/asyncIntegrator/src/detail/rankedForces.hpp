@@ -29,15 +29,15 @@ class RankedForces {
                     const std::vector<std::vector<int>>& regionVertices);
   /// Sets every force to zero for a step: L's (|L|) and each region's (|S_i| x m_i).
   void clear();
-  /// L's own terms (rank 0) at (time, u, v), into large.
-  void addLarge(const DynamicSystem& system, double time, const Eigen::VectorXd& u, const Eigen::VectorXd& v);
+  /// L's own terms (rank 0) at (time, u, v), into large; their derivatives into jacobian
+  /// where not null (DynamicSystem::externalForceOfRank).
+  void addLarge(const DynamicSystem& system, double time, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                VertexJacobian* jacobian = nullptr);
   /// Region i's terms at its substep r (1..m_i) at (time, u, v): the whole state, L and the
-  /// other regions where they are at that time.
+  /// other regions where they are at that time; their derivatives into jacobian where not null.
   void addRegion(const DynamicSystem& system, int i, int r, double time, const Eigen::VectorXd& u,
-                 const Eigen::VectorXd& v);
-
-  /// Region i's terms' derivatives at (time, u, v) (DynamicSystem::externalForceJacobianOfRank;
-  /// i = -1: L's own terms), into jacobian.
+                 const Eigen::VectorXd& v, VertexJacobian* jacobian = nullptr);
+  /// Region i's terms' derivatives alone at (time, u, v) (i = -1: L's own terms).
   void jacobian(const DynamicSystem& system, int i, double time, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
                 VertexJacobian& jacobian) const;
 
@@ -51,6 +51,7 @@ class RankedForces {
   const std::vector<std::vector<int>>* regionVertices_ = nullptr;
   std::vector<int> rank_, regionRank_, largeVertices_;
   Eigen::VectorXd force_;
+  mutable Eigen::VectorXd scratch_;  // jacobian()'s forces, not kept
 };
 
 }  // namespace asyncfem::detail

@@ -65,20 +65,16 @@ class PenaltyContact {
   /// put them then; the overloads without a time evaluate at t = 0.
   void addForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                  Eigen::VectorXd& forces, const std::vector<int>* vertices = nullptr) const;
+  PenaltyContactJacobian jacobian(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
+                                  const std::vector<int>* vertices = nullptr) const;
   /// The planes' and spheres' forces at the listed vertices (ascending) and the surface
   /// pairs of rank owner (SurfaceContact::addForcesOfRank) on all their vertices: the
   /// terms a multirate integrator evaluates at the states of the rate with that rank.
+  /// jacobian, where not null: their derivatives from the same evaluation, jacobian()'s
+  /// blocks of the planes and spheres at the listed vertices and the pairs as couplings.
   void addForcesOfRank(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                        const std::vector<int>& vertices, const std::vector<int>& rank, int owner,
-                       Eigen::VectorXd& forces) const;
-  PenaltyContactJacobian jacobian(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                                  const std::vector<int>* vertices = nullptr) const;
-  /// The derivatives of the terms addForcesOfRank takes: jacobian()'s blocks of the planes
-  /// and spheres at the listed vertices, and the surface pairs of rank owner as couplings
-  /// (SurfaceContact::addCoupledJacobianOfRank).
-  PenaltyContactJacobian jacobianOfRank(double time, const Eigen::VectorXd& displacement,
-                                        const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
-                                        const std::vector<int>& rank, int owner) const;
+                       Eigen::VectorXd& forces, PenaltyContactJacobian* jacobian = nullptr) const;
   /// jacobian() with the surface contact's pairs as couplings (SurfaceContact::addCoupledJacobian)
   /// instead of per-vertex bounds; the planes' and spheres' blocks as jacobian() gives them.
   PenaltyContactJacobian coupledJacobian(double time, const Eigen::VectorXd& displacement,

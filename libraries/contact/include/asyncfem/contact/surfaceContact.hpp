@@ -90,10 +90,12 @@ class SurfaceContact {
   /// (rank: one integer per mesh vertex), added to every mesh vertex of those pairs: the
   /// same values as addForces, so that adding every rank present gives addForces' sum. A
   /// multirate integrator gives each pair to the finest rate among its vertices this way
-  /// (asyncIntegrator, "Contact between regions"). Throws ValidationError for a rank
-  /// list of the wrong size.
+  /// (asyncIntegrator, "Contact between regions"). couplings, where not null: each of those
+  /// pairs with F > 0 appended as addCoupledJacobian gives it (the same evaluation).
+  /// Throws ValidationError for a rank list of the wrong size.
   void addForcesOfRank(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                       const std::vector<int>& rank, int owner, Eigen::VectorXd& forces) const;
+                       const std::vector<int>& rank, int owner, Eigen::VectorXd& forces,
+                       VertexJacobian* couplings = nullptr) const;
   /// Appends per-vertex blocks for an implicit step: for each pair with F > 0 and each of
   /// its mesh vertices i, stiffness k |w_i| S N N^T and damping c |w_i| S N N^T with
   /// S = sum of |w_j| over the pair's mesh vertices. These block-diagonal terms bound the
@@ -110,9 +112,6 @@ class SurfaceContact {
   /// (DynamicSystem::externalForceCoupledJacobian).
   void addCoupledJacobian(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
                           VertexJacobian& jacobian) const;
-  /// addCoupledJacobian's couplings of the pairs of rank owner (as addForcesOfRank).
-  void addCoupledJacobianOfRank(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                                const std::vector<int>& rank, int owner, VertexJacobian& jacobian) const;
   /// The potential sum k/2 (dhat - s)^2 over the pairs at time t and displacement u.
   double energy(double time, const Eigen::VectorXd& displacement) const;
   /// The largest dhat - s over the pairs (0 if none).
@@ -156,14 +155,14 @@ class SurfaceContact {
                    const CandidateFilter* keep = nullptr) const;
   /// Whether a pair's highest mesh-vertex rank is owner (rank: one per mesh vertex, checked).
   CandidateFilter ownedBy(const std::vector<int>& rank, int owner) const;
-  /// addCoupledJacobian's couplings of the active pairs among the candidates keep takes.
-  void addPairCouplings(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                        VertexJacobian& jacobian, const CandidateFilter* keep) const;
   /// The forces of the active pairs among the candidates keep takes, added at the points
   /// wanted(id) takes.
   template <class Wanted>
   void addPairForces(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-                     Eigen::VectorXd& forces, const CandidateFilter* keep, Wanted&& wanted) const;
+                     Eigen::VectorXd& forces, const CandidateFilter* keep, Wanted&& wanted,
+                     VertexJacobian* couplings) const;
+  /// A pair as a VertexCoupling (its mesh vertices, weights, normal, k and c).
+  VertexCoupling couplingOf(const SurfacePair& pair) const;
   std::vector<SurfacePair> activePairs(double time, const Eigen::VectorXd& displacement, Points* points,
                                        const CandidateFilter* keep = nullptr) const;
   /// Whether a vertex-triangle pair is its contact's one pair: when its closest point is an

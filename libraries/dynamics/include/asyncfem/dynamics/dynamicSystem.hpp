@@ -48,15 +48,12 @@ using ExternalForceAtFunction =
 /// of its vertices, whatever their ranks. Summed over the ranks present (each with its
 /// vertices), it is externalForce. What lets a multirate integrator evaluate a pair at the
 /// states of its finest vertex and give its slower vertices the matching impulse.
+/// jacobian, where not null and the system has externalForceJacobian: the derivatives of
+/// those terms from the same evaluation (cleared first): the per-vertex terms' as per-vertex
+/// blocks, those that join vertices as VertexJacobian::couplings.
 using ExternalForceOfRankFunction = std::function<void(
     double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
-    const std::vector<int>& rank, int owner, Eigen::VectorXd& forces)>;
-
-/// The derivatives of the terms externalForceOfRank takes for owner: the per-vertex terms'
-/// as per-vertex blocks, those that join vertices as VertexJacobian::couplings.
-using ExternalForceJacobianOfRankFunction = std::function<void(
-    double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity, const std::vector<int>& vertices,
-    const std::vector<int>& rank, int owner, VertexJacobian& jacobian)>;
+    const std::vector<int>& rank, int owner, Eigen::VectorXd& forces, VertexJacobian* jacobian)>;
 
 /// externalForceJacobian at some vertices only: the entries of the listed vertices
 /// (ascending), in the order externalForceJacobian gives them.
@@ -112,8 +109,6 @@ struct DynamicSystem {
   /// rate's states, which is exact only for per-vertex terms. Whoever replaces externalForce
   /// must reset or replace this too.
   ExternalForceOfRankFunction externalForceOfRank;
-  /// With externalForceOfRank and externalForceJacobian: the derivatives of its terms.
-  ExternalForceJacobianOfRankFunction externalForceJacobianOfRank;
   /// Where the external force's obstacles are (penalty contact); empty without obstacles.
   ObstacleProximity obstacleProximity;
   /// true when externalForce depends on the state (u, v) only at vertices in contact with

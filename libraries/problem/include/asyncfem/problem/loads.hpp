@@ -45,9 +45,12 @@ class Loads {
              const std::vector<int>& vertices, Eigen::VectorXd& forces) const;
   /// The terms of f_ext(t, u, v) of rank owner (PenaltyContact::addForcesOfRank): the
   /// per-vertex loads and obstacle forces at the listed vertices (ascending) and the surface
-  /// contact pairs whose highest vertex rank is owner, on all their vertices.
+  /// contact pairs whose highest vertex rank is owner, on all their vertices; jacobian, where
+  /// not null, the contact's derivatives from the same evaluation (cleared first; the loads
+  /// have none).
   void addTo(double time, const Eigen::VectorXd& displacement, const Eigen::VectorXd& velocity,
-             const std::vector<int>& vertices, const std::vector<int>& rank, int owner, Eigen::VectorXd& forces) const;
+             const std::vector<int>& vertices, const std::vector<int>& rank, int owner, Eigen::VectorXd& forces,
+             VertexJacobian* jacobian = nullptr) const;
   /// Times at which the force changes (window bounds), sorted, unique, finite.
   std::vector<double> breakpoints() const;
   /// From this time on no load changes: the last finite window bound (0 when there is
