@@ -133,5 +133,20 @@ TEST(AsyncSurfaceContact, TheStepSolvesItsPerSubstepDefinition) {
   EXPECT_GT(worstPerVertex, 1e-4);
 }
 
+TEST(AsyncSurfaceContact, TheHierarchySolveRefusesSurfaceContactByName) {
+  // Its steps take each vertex's force at its own rate, which does not balance a pair's
+  // impulses between rates: refused at the set-up, naming the regions, not run unsound.
+  json scene = asyncHeadOn("left");
+  scene["integrator"]["options"]["method"] = "hierarchy";
+  try {
+    buildSimulation(parseScene(scene, "", "headOn.json"));
+    FAIL() << "the hierarchy solve took surface contact";
+  } catch (const std::exception& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("regions"), std::string::npos) << message;
+    EXPECT_NE(message.find("surface contact"), std::string::npos) << message;
+  }
+}
+
 }  // namespace
 }  // namespace asyncfem

@@ -102,6 +102,14 @@ AsyncStepSolver chooseStepSolver(const AsyncOptions& options, const RegionPartit
                              "nest (\"hierarchy\" with \"nestedSolve\": \"lu\" is the reference there)");
     }
     requireHierarchyComposes(options, why);
+    if (system.externalForceOfRank) {
+      // Its steps take each vertex's external force at the vertex's own rate: exact for
+      // per-vertex loads, not for a surface pair between rates (its impulses would not
+      // balance: docs/asynchronous-integrator.md, "Contact between regions").
+      throw AsyncOptionError("regions",
+                             "surface contact (contact.surfaces) is not available with the hierarchy solve (" + why +
+                                 "): keep the fast regions apart, or make them one region");
+    }
     return AsyncStepSolver::hierarchy;
   }
   if (options.nestedSolve != NestedSolve::automatic) {

@@ -46,8 +46,9 @@ class AsyncOptionError : public ValidationError {
 /// AsyncOptionError naming the refused option and why. Regions that touch or nest (and
 /// AsyncSolveMethod::hierarchy) take the hierarchy solve, which refuses the paper's coupling,
 /// the quick set-up, substep contact prediction, an external solver of L's system, region
-/// distribution, and any non-default setting of the two-level solve (schur, recovery,
-/// regionSolver, denseRegionDofs); the two-level solvers refuse a nestedSolve other than
+/// distribution, any non-default setting of the two-level solve (schur, recovery,
+/// regionSolver, denseRegionDofs) and a system with surface contact (externalForceOfRank,
+/// named as "regions"); the two-level solvers refuse a nestedSolve other than
 /// automatic. An external large-system solver and region distribution need the stable
 /// coupling and the structured method.
 AsyncStepSolver chooseStepSolver(const AsyncOptions& options, const RegionPartition& partition,
