@@ -220,6 +220,85 @@ void ContactIteration::forcesAt(const std::vector<FastRegion>& regions) {
   });
 }
 
+// A ranked evaluation's pair couplings as per-vertex bounds (see addBlocks): L's vertices'
+// blocks into inMatrix_ (r hS^2 K + hS C for a pair of region owner's rank at its substep r,
+// hL^2 K + hL C for L's own), the owner's vertices' appended to jacobian_ while the
+// iteration takes them.
+void ContactIteration::takePairBounds(int owner, int r, const std::vector<FastRegion>& regions) {
+  const DynamicSystem& system = *step_.system;
+  couplings_.clear();
+  couplings_.couplings = jacobian_.couplings;
+  bounded_ = boundCouplings(couplings_);
+  for (std::size_t k = 0; k < bounded_.vertices.size() && owner >= 0 && regionPairBlocks_; ++k) {
+    if (vertexRegion_[static_cast<std::size_t>(bounded_.vertices[k])] != owner) continue;
+    jacobian_.vertices.push_back(bounded_.vertices[k]);
+    jacobian_.stiffness.push_back(bounded_.stiffness[k]);
+    jacobian_.damping.push_back(bounded_.damping[k]);
+  }
+  const double h = owner < 0 ? step_.hL : regions[static_cast<std::size_t>(owner)].smallStep;
+  const double stiffnessWeight = owner < 0 ? h * h : r * h * h;
+  for (std::size_t k = 0; k < bounded_.vertices.size(); ++k) {
+    const int vertex = bounded_.vertices[k];
+    if (vertexRegion_[static_cast<std::size_t>(vertex)] >= 0) continue;
+    const Eigen::Matrix3d block = contactStepBlock(system.freeDofs, bounded_, k, stiffnessWeight, h);
+    if (block.isZero(0.0)) continue;
+    int& slot = largeSlot_[static_cast<std::size_t>(vertex)];
+    if (slot == 0) {
+      std::array<int, 3> position{};
+      for (int c = 0; c < 3; ++c)
+        position[static_cast<std::size_t>(c)] = largePosition_[static_cast<std::size_t>((3 * vertex) + c)];
+      inMatrix_.positions.push_back(position);
+      inMatrix_.values.push_back(block);
+      slot = static_cast<int>(inMatrix_.positions.size());
+    } else {
+      inMatrix_.values[static_cast<std::size_t>(slot - 1)] += block;
+    }
+  }
+}
+
+// addBlocks' blocks into the matrices: a region's weighted by the share of its substeps
+// where the vertex touches, into its A^S (changedRegions_), L's into the large system.
+void ContactIteration::installBlocks(SparseMatrix& largeSystem, std::vector<FastRegion>& regions,
+                                     const std::vector<std::vector<std::array<int, 3>>>& positionsS,
+                                     std::vector<std::vector<Eigen::Matrix3d>>& blocksS,
+                                     std::vector<std::vector<Eigen::Matrix3d>>& stiffnessS) {
+  const std::size_t count = regions.size();
+  // A region's block weighted by the share of its substeps where the vertex touches (the
+  // substeps' mean linearization; exact where it touches at all of them).
+  for (std::size_t v = 0; v < blockSlot_.size(); ++v) {
+    if (blockSlot_[v] == 0) continue;
+    const auto i = static_cast<std::size_t>(vertexRegion_[v]);
+    const double share = static_cast<double>(touches_[v]) / regions[i].ratio;
+    const auto slot = static_cast<std::size_t>(blockSlot_[v] - 1);
+    blocksS[i][slot] *= share;
+    stiffnessS[i][slot] *= share;
+  }
+  changedRegions_.clear();
+  for (std::size_t i = 0; i < count; ++i)
+    if (regions[i].setContactBlocks(positionsS[i], blocksS[i], stiffnessS[i]))
+      changedRegions_.push_back(static_cast<int>(i));
+  // Each touched entry's value is kept and restored exactly by removeBlocks (adding and
+  // subtracting would leave round-off in Â^L, and a resumed run would then differ).
+  for (std::size_t k = 0; k < inMatrix_.positions.size(); ++k) {
+    forBlockEntries(inMatrix_.positions[k], [&](int r, int c, int row, int column) {
+      addKeepingEntry(largeSystem, row, column, inMatrix_.values[k](r, c), saved_, "L's system");
+    });
+  }
+}
+
+// The blocks of jacobian_'s vertices: L's at the end state (owner -1), a region's at the
+// end state or else at the first of its substeps where it touches. With ranked terms
+// (owner >= 0: region owner's terms at its substep r), the couplings of surface pairs
+// enter as their per-vertex bounds: an L vertex takes r hS^2 K + hS C, the derivative of
+// its share hS f(r) by its velocity increment (its position there moves by r hS per unit
+// of it); the owner's vertices take theirs as any contact block, until the iteration
+// stalls with them (update drops them for the rest of the step). A^S is one matrix for
+// every substep, so a block taken where a light vertex strikes mid-step acts at every
+// substep. Measured (docs/collision.md, the antenna striking a block at m = 30): always
+// with them the iteration stalled at a relative residual of 0.1-0.2 and the runs blew up;
+// never with them 3-5 of 60 steps ended unconverged (at most 0.1), but two soft boxes
+// colliding head-on (tests/sceneIO/asyncSurfaceContactTest.cpp) stopped at 0.13 where the
+// blocks reach 2e-4; dropping them where the iteration stalls keeps both.
 void ContactIteration::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegion>& regions, bool statesClear) {
   removeBlocks(largeSystem);
   const DynamicSystem& system = *step_.system;
@@ -242,50 +321,8 @@ void ContactIteration::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegi
   };
 
   largeSlot_.assign(vertexRegion_.size(), 0);
-  // The blocks of jacobian_'s vertices: L's at the end state (owner -1), a region's at the
-  // end state or else at the first of its substeps where it touches. With ranked terms
-  // (owner >= 0: region owner's terms at its substep r), the couplings of surface pairs
-  // enter as their per-vertex bounds: an L vertex takes r hS^2 K + hS C, the derivative of
-  // its share hS f(r) by its velocity increment (its position there moves by r hS per unit
-  // of it); the owner's vertices take theirs as any contact block, until the iteration
-  // stalls with them (update drops them for the rest of the step). A^S is one matrix for
-  // every substep, so a block taken where a light vertex strikes mid-step acts at every
-  // substep. Measured (docs/collision.md, the antenna striking a block at m = 30): always
-  // with them the iteration stalled at a relative residual of 0.1-0.2 and the runs blew up;
-  // never with them 3-5 of 60 steps ended unconverged (at most 0.1), but two soft boxes
-  // colliding head-on (tests/sceneIO/asyncSurfaceContactTest.cpp) stopped at 0.13 where the
-  // blocks reach 2e-4; dropping them where the iteration stalls keeps both.
   const auto take = [&](int owner, int r) {
-    if (ranked && !jacobian_.couplings.empty()) {
-      couplings_.clear();
-      couplings_.couplings = jacobian_.couplings;
-      bounded_ = boundCouplings(couplings_);
-      for (std::size_t k = 0; k < bounded_.vertices.size() && owner >= 0 && regionPairBlocks_; ++k) {
-        if (vertexRegion_[static_cast<std::size_t>(bounded_.vertices[k])] != owner) continue;
-        jacobian_.vertices.push_back(bounded_.vertices[k]);
-        jacobian_.stiffness.push_back(bounded_.stiffness[k]);
-        jacobian_.damping.push_back(bounded_.damping[k]);
-      }
-      const double h = owner < 0 ? step_.hL : regions[static_cast<std::size_t>(owner)].smallStep;
-      const double stiffnessWeight = owner < 0 ? h * h : r * h * h;
-      for (std::size_t k = 0; k < bounded_.vertices.size(); ++k) {
-        const int vertex = bounded_.vertices[k];
-        if (vertexRegion_[static_cast<std::size_t>(vertex)] >= 0) continue;
-        const Eigen::Matrix3d block = contactStepBlock(system.freeDofs, bounded_, k, stiffnessWeight, h);
-        if (block.isZero(0.0)) continue;
-        int& slot = largeSlot_[static_cast<std::size_t>(vertex)];
-        if (slot == 0) {
-          std::array<int, 3> position{};
-          for (int c = 0; c < 3; ++c)
-            position[static_cast<std::size_t>(c)] = largePosition_[static_cast<std::size_t>((3 * vertex) + c)];
-          inMatrix_.positions.push_back(position);
-          inMatrix_.values.push_back(block);
-          slot = static_cast<int>(inMatrix_.positions.size());
-        } else {
-          inMatrix_.values[static_cast<std::size_t>(slot - 1)] += block;
-        }
-      }
-    }
+    if (ranked && !jacobian_.couplings.empty()) takePairBounds(owner, r, regions);
     for (std::size_t k = 0; k < jacobian_.vertices.size(); ++k) {
       const int vertex = jacobian_.vertices[k];
       const int region = vertexRegion_[static_cast<std::size_t>(vertex)];
@@ -336,27 +373,7 @@ void ContactIteration::addBlocks(SparseMatrix& largeSystem, std::vector<FastRegi
     take(only, r);
   };
   if (!statesClear) visitStates(regions, takeBlocks);
-  // A region's block weighted by the share of its substeps where the vertex touches (the
-  // substeps' mean linearization; exact where it touches at all of them).
-  for (std::size_t v = 0; v < blockSlot_.size(); ++v) {
-    if (blockSlot_[v] == 0) continue;
-    const auto i = static_cast<std::size_t>(vertexRegion_[v]);
-    const double share = static_cast<double>(touches_[v]) / regions[i].ratio;
-    const auto slot = static_cast<std::size_t>(blockSlot_[v] - 1);
-    blocksS[i][slot] *= share;
-    stiffnessS[i][slot] *= share;
-  }
-  changedRegions_.clear();
-  for (std::size_t i = 0; i < count; ++i)
-    if (regions[i].setContactBlocks(positionsS[i], blocksS[i], stiffnessS[i]))
-      changedRegions_.push_back(static_cast<int>(i));
-  // Each touched entry's value is kept and restored exactly by removeBlocks (adding and
-  // subtracting would leave round-off in Â^L, and a resumed run would then differ).
-  for (std::size_t k = 0; k < inMatrix_.positions.size(); ++k) {
-    forBlockEntries(inMatrix_.positions[k], [&](int r, int c, int row, int column) {
-      addKeepingEntry(largeSystem, row, column, inMatrix_.values[k](r, c), saved_, "L's system");
-    });
-  }
+  installBlocks(largeSystem, regions, positionsS, blocksS, stiffnessS);
 }
 
 void ContactIteration::removeBlocks(SparseMatrix& /*largeSystem*/) {

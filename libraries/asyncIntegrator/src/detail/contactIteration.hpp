@@ -132,6 +132,14 @@ class ContactIteration {
   /// The contact blocks at the states of trialY_ and trialX_, in place of the ones before;
   /// none where statesClear (no state visited can touch: predictedStatesClear).
   void addBlocks(Eigen::SparseMatrix<double>& largeSystem, std::vector<FastRegion>& regions, bool statesClear = false);
+  /// addBlocks' blocks into the matrices (the regions' weighted by their touching share).
+  void installBlocks(Eigen::SparseMatrix<double>& largeSystem, std::vector<FastRegion>& regions,
+                     const std::vector<std::vector<std::array<int, 3>>>& positionsS,
+                     std::vector<std::vector<Eigen::Matrix3d>>& blocksS,
+                     std::vector<std::vector<Eigen::Matrix3d>>& stiffnessS);
+  /// A ranked evaluation's pair couplings (in jacobian_) as per-vertex bounds: L's blocks
+  /// into inMatrix_, the owner region's appended to jacobian_ (see addBlocks).
+  void takePairBounds(int owner, int r, const std::vector<FastRegion>& regions);
   /// Whether no predicted state (the increments zero) comes within reach of an obstacle, so
   /// that every contact block there is zero (Eq. C7).
   bool predictedStatesClear();
