@@ -3,7 +3,6 @@
 // docs/asynchronous-integrator.md, section "Implicit contact".
 #include "detail/contactIteration.hpp"
 
-#include <Eigen/QR>
 #include <asyncfem/core/error.hpp>
 #include <asyncfem/integrator/contactBlock.hpp>
 #include <cmath>
@@ -21,33 +20,6 @@ int firstNonFinite(const Eigen::MatrixXd& values, const std::vector<int>& dofs) 
     for (Eigen::Index r = 0; r < values.rows(); ++r)
       if (!std::isfinite(values(r, c))) return dofs[static_cast<std::size_t>(r)] / 3;
   return -1;
-}
-
-/// L's vector, then each region's matrix column by column, as one vector.
-template <class Region>
-void pack(const Eigen::VectorXd& large, std::size_t count, Region&& region, Eigen::VectorXd& out) {
-  Eigen::Index size = large.size();
-  for (std::size_t i = 0; i < count; ++i) size += region(i).size();
-  out.resize(size);
-  out.head(large.size()) = large;
-  Eigen::Index at = large.size();
-  for (std::size_t i = 0; i < count; ++i) {
-    const Eigen::MatrixXd& values = region(i);
-    out.segment(at, values.size()) = values.reshaped();
-    at += values.size();
-  }
-}
-
-/// The inverse of pack (the matrices keep their shapes).
-template <class Region>
-void unpack(const Eigen::VectorXd& in, Eigen::VectorXd& large, std::size_t count, Region&& region) {
-  large = in.head(large.size());
-  Eigen::Index at = large.size();
-  for (std::size_t i = 0; i < count; ++i) {
-    Eigen::MatrixXd& values = region(i);
-    values.reshaped() = in.segment(at, values.size());
-    at += values.size();
-  }
 }
 
 }  // namespace
@@ -108,8 +80,10 @@ void ContactIteration::visitStates(const std::vector<FastRegion>& regions, Visit
         prefix_[i].col(c + 1) = prefix_[i].col(c) + trialX_[i].col(c);
     }
   }
-  const Eigen::VectorXd endU = whole ? u_ : Eigen::VectorXd();
-  const Eigen::VectorXd endV = whole ? v_ : Eigen::VectorXd();
+  if (whole) {
+    endU_ = u_;
+    endV_ = v_;
+  }
   visit(step_.t1, -1, 0);
   for (std::size_t i = 0; i < regions.size(); ++i) {
     const FastRegion& rb = regions[i];
@@ -123,8 +97,8 @@ void ContactIteration::visitStates(const std::vector<FastRegion>& regions, Visit
     }
     // Back to the end state: the next region's substeps see this one at its end.
     if (whole) {
-      u_ = endU;
-      v_ = endV;
+      u_ = endU_;
+      v_ = endV_;
       continue;
     }
     sums_ = trialX_[i].rowwise().sum();
@@ -421,9 +395,7 @@ bool ContactIteration::start(const ContactStep& step, const Eigen::VectorXd& rhs
     scale_ = std::max({scale_, rb.rhs.lpNorm<Eigen::Infinity>(), forceS_[i].lpNorm<Eigen::Infinity>()});
   }
   meritNorm_ = std::sqrt(squares);
-  mixStates_.clear();
-  mixOperators_.clear();
-  mixSteps_.clear();
+  forgetMixing();
   regionPairBlocks_ = true;
   droppedPairBlocks_ = false;
   keptJacobians_ = false;
@@ -522,56 +494,6 @@ double ContactIteration::tryState(const std::vector<FastRegion>& regions, const 
   return trialResidual(regions, theta, merit);
 }
 
-// Eq. (C5): with d_j = z_solve,j - z_j the step of solve j from the state it started at,
-// gamma minimizes |d_k - sum_j gamma_j (d_{j+1} - d_j)|_2 and the combination is
-// z_solve,k - sum_j gamma_j (z_solve,j+1 - z_solve,j) (A_0 z - base alike: it is affine).
-bool ContactIteration::mix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
-  const std::size_t count = regions.size();
-  const auto solvedX = [&](std::size_t i) -> Eigen::MatrixXd& { return regions[i].x; };
-  const auto solvedS = [&](std::size_t i) -> Eigen::MatrixXd& { return solvedOperatorS_[i]; };
-  if (mixSteps_.size() > static_cast<std::size_t>(kMixingDepth)) {
-    mixStates_.erase(mixStates_.begin());
-    mixOperators_.erase(mixOperators_.begin());
-    mixSteps_.erase(mixSteps_.begin());
-  }
-  mixStates_.emplace_back();
-  mixOperators_.emplace_back();
-  pack(Y, count, solvedX, mixStates_.back());
-  pack(solvedOperatorL_, count, solvedS, mixOperators_.back());
-  pack(
-      acceptedY_, count, [&](std::size_t i) -> const Eigen::MatrixXd& { return acceptedX_[i]; }, packed_);
-  mixSteps_.push_back(mixStates_.back() - packed_);
-  const std::size_t n = mixSteps_.size();
-  if (n < 2) return false;
-  Eigen::MatrixXd differences(mixSteps_.back().size(), static_cast<Eigen::Index>(n - 1));
-  for (std::size_t j = 0; j + 1 < n; ++j)
-    differences.col(static_cast<Eigen::Index>(j)) = mixSteps_[j + 1] - mixSteps_[j];
-  const Eigen::VectorXd gamma = differences.colPivHouseholderQr().solve(mixSteps_.back());
-  if (!gamma.allFinite()) return false;
-  packed_ = mixStates_.back();
-  Eigen::VectorXd mixedOperator = mixOperators_.back();
-  for (std::size_t j = 0; j + 1 < n; ++j) {
-    const double g = gamma[static_cast<Eigen::Index>(j)];
-    packed_ -= g * (mixStates_[j + 1] - mixStates_[j]);
-    mixedOperator -= g * (mixOperators_[j + 1] - mixOperators_[j]);
-  }
-  unpack(packed_, Y, count, solvedX);
-  unpack(mixedOperator, solvedOperatorL_, count, solvedS);
-  return true;
-}
-
-// Back to the last solve's own state; the older solves are dropped (their combination did
-// not lower the residual).
-void ContactIteration::unmix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions) {
-  const std::size_t count = regions.size();
-  unpack(mixStates_.back(), Y, count, [&](std::size_t i) -> Eigen::MatrixXd& { return regions[i].x; });
-  unpack(mixOperators_.back(), solvedOperatorL_, count,
-         [&](std::size_t i) -> Eigen::MatrixXd& { return solvedOperatorS_[i]; });
-  mixStates_.erase(mixStates_.begin(), mixStates_.end() - 1);
-  mixOperators_.erase(mixOperators_.begin(), mixOperators_.end() - 1);
-  mixSteps_.erase(mixSteps_.begin(), mixSteps_.end() - 1);
-}
-
 double ContactIteration::update(std::vector<FastRegion>& regions, Eigen::VectorXd& Y, SparseMatrix& largeSystem,
                                 Eigen::VectorXd& rhsL) {
   // A_0 z - base at the solve's z (Eq. C4): the force terms it used less the contact
@@ -608,9 +530,7 @@ double ContactIteration::update(std::vector<FastRegion>& regions, Eigen::VectorX
   if (!accepted && theta <= 0.125 && regionPairBlocks_ && step_.ranked != nullptr) {
     regionPairBlocks_ = false;
     droppedPairBlocks_ = true;
-    mixStates_.clear();
-    mixOperators_.clear();
-    mixSteps_.clear();
+    forgetMixing();
   }
   // Accept z (the caller's state becomes it), take the contact blocks there and set the
   // next solve's force terms: g = G(z) + J z (Eq. C3).

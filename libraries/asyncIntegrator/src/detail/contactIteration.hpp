@@ -151,6 +151,8 @@ class ContactIteration {
   /// Records the solve (its state Y, x and A_0 z - base there) and, with earlier solves
   /// kept, replaces it by their Anderson combination (Eq. C5). Returns whether it did.
   bool mix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions);
+  /// Drops the solves recorded for mixing (contactMixing.cpp).
+  void forgetMixing();
   /// The state (and A_0 z - base) of the last solve recorded, back in Y, x and the solved operators.
   void unmix(Eigen::VectorXd& Y, std::vector<FastRegion>& regions);
   /// The residual at theta from the accepted state toward Y, x (trialY_, trialX_ set);
@@ -175,6 +177,7 @@ class ContactIteration {
   Eigen::VectorXd u_, v_, f_;            // full-size state and force
   std::vector<int> nearObstacles_;       // predictedStatesClear's proximity query
   Eigen::VectorXd running_, sums_;       // a region's sums of its substeps' increments
+  Eigen::VectorXd endU_, endV_;          // the end state, while the substeps move every vertex
   std::vector<Eigen::MatrixXd> prefix_;  // per region, column c: the sum of its first c increments
   // The solves Anderson mixing combines: each one's state, A_0 z - base there and its step
   // from the state it started at, flattened (L's, then each region's column-major), oldest first.

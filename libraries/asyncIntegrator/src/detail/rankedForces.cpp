@@ -43,7 +43,7 @@ void RankedForces::clear() {
 void RankedForces::addLarge(const DynamicSystem& system, double time, const Eigen::VectorXd& u,
                             const Eigen::VectorXd& v, VertexJacobian* jacobian) {
   force_.setZero(u.size());
-  system.externalForceOfRank(time, u, v, largeVertices_, rank_, 0, force_, jacobian);
+  evaluate(system, -1, time, u, v, force_, jacobian);
   const std::vector<int>& dofs = partition_->largeDofs();
   for (std::size_t k = 0; k < dofs.size(); ++k) large[static_cast<Eigen::Index>(k)] += force_[dofs[k]];
 }
@@ -52,7 +52,7 @@ void RankedForces::addRegion(const DynamicSystem& system, int i, int r, double t
                              const Eigen::VectorXd& v, VertexJacobian* jacobian) {
   const auto at = static_cast<std::size_t>(i);
   force_.setZero(u.size());
-  system.externalForceOfRank(time, u, v, (*regionVertices_)[at], rank_, regionRank_[at], force_, jacobian);
+  evaluate(system, i, time, u, v, force_, jacobian);
   const int m = partition_->ratio(i);
   // L: hL (share) = hS_i f, share = f / m.
   const std::vector<int>& largeDofs = partition_->largeDofs();
@@ -76,12 +76,17 @@ void RankedForces::addRegion(const DynamicSystem& system, int i, int r, double t
 void RankedForces::jacobian(const DynamicSystem& system, int i, double time, const Eigen::VectorXd& u,
                             const Eigen::VectorXd& v, VertexJacobian& jacobian) const {
   scratch_.setZero(u.size());
+  evaluate(system, i, time, u, v, scratch_, &jacobian);
+}
+
+void RankedForces::evaluate(const DynamicSystem& system, int i, double time, const Eigen::VectorXd& u,
+                            const Eigen::VectorXd& v, Eigen::VectorXd& forces, VertexJacobian* jacobian) const {
   if (i < 0) {
-    system.externalForceOfRank(time, u, v, largeVertices_, rank_, 0, scratch_, &jacobian);
+    system.externalForceOfRank(time, u, v, largeVertices_, rank_, 0, forces, jacobian);
     return;
   }
   const auto at = static_cast<std::size_t>(i);
-  system.externalForceOfRank(time, u, v, (*regionVertices_)[at], rank_, regionRank_[at], scratch_, &jacobian);
+  system.externalForceOfRank(time, u, v, (*regionVertices_)[at], rank_, regionRank_[at], forces, jacobian);
 }
 
 }  // namespace asyncfem::detail

@@ -47,6 +47,10 @@ class RankedForces {
   std::vector<Eigen::MatrixXd> region;
 
  private:
+  /// Region i's terms (i = -1: L's own) at (time, u, v), added to forces.
+  void evaluate(const DynamicSystem& system, int i, double time, const Eigen::VectorXd& u, const Eigen::VectorXd& v,
+                Eigen::VectorXd& forces, VertexJacobian* jacobian) const;
+
   const RegionPartition* partition_ = nullptr;
   const std::vector<std::vector<int>>* regionVertices_ = nullptr;
   std::vector<int> rank_, regionRank_, largeVertices_;
